@@ -1,0 +1,24 @@
+# physgs: does a dynamic 3DGS reconstruction of a wind-driven tree recover physics?
+# Profiles: --config profile=quick|default|paper (default: config/trees.yaml's `profile`).
+from snakemake.utils import min_version, validate
+
+import physgs.config
+
+min_version("9.0")
+
+
+configfile: "config/trees.yaml"
+
+
+validate(config, "workflow/schemas/config.schema.yaml")
+CFG = physgs.config.resolve(config, config.get("profile"))
+validate(CFG, "workflow/schemas/config.schema.yaml")
+TREES = CFG["trees"]
+
+
+include: "workflow/rules/testbed.smk"
+
+
+rule all:
+    input:
+        rules.testbed.input,
