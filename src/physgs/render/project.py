@@ -1,0 +1,143 @@
+"""EWA projection of 3D Gaussians to the image plane (vectorised torch, differentiable by autograd).
+
+Follows 3DGS / gsplat: world -> camera (OpenCV: z forward, y down), 3D covariance
+R_q S S^T R_q^T, perspective Jacobian (with gsplat's clamp of x/z, y/z to 1.3x the field of view so
+Gaussians far off to the side do not blow up), +0.3 px^2 dilation of the 2D covariance, conic = its
+inverse. Culled Gaussians (behind the near plane, degenerate) get a mask and finite zero outputs,
+never NaN: every division uses a clamped denominator, so gradients stay finite too.
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+import torch
+
+from physgs.camera import Camera
+
+EPS2D = 0.3  # px^2 added to the 2D covariance (anti-aliasing dilation, as 3DGS)
+ALPHA_MIN = 1.0 / 255.0  # a Gaussian's alpha below this at a pixel is skipped
+ALPHA_MAX = 0.99  # alpha is clamped to this (keeps 1 - alpha away from zero)
+T_MIN = 1e-4  # compositing stops before transmittance would fall below this
+TILE = 16  # tile side in pixels
+
+
+@dataclass(frozen=True)
+class Projected:
+    """Per-Gaussian image-plane quantities (N Gaussians).
+
+    means2d [N, 2] pixels (x right, y down; pixel centres at integer + 0.5);
+    conics [N, 3] (a, b, c) of the inverse 2D covariance [[a, b], [b, c]] in 1/px^2;
+    depths [N] camera z (world units); cov2d [N, 3] (xx, xy, yy) px^2, detached, for binning;
+    valid [N] bool: in front of the near plane with a positive-definite 2D covariance.
+    Invalid entries hold finite zeros.
+    """
+
+    means2d: torch.Tensor
+    conics: torch.Tensor
+    depths: torch.Tensor
+    cov2d: torch.Tensor
+    valid: torch.Tensor
+
+
+def quat_to_rotmat(quats: torch.Tensor) -> torch.Tensor:
+    """quats [N, 4] (w, x, y, z), any nonzero norm -> rotation matrices [N, 3, 3]."""
+    q = quats / quats.norm(dim=-1, keepdim=True).clamp_min(1e-12)
+    w, x, y, z = q.unbind(-1)
+    return torch.stack(
+        [
+            1 - 2 * (y * y + z * z), 2 * (x * y - w * z), 2 * (x * z + w * y),
+            2 * (x * y + w * z), 1 - 2 * (x * x + z * z), 2 * (y * z - w * x),
+            2 * (x * z - w * y), 2 * (y * z + w * x), 1 - 2 * (x * x + y * y),
+        ],
+        dim=-1,
+    ).reshape(q.shape[:-1] + (3, 3))
+
+
+def camera_tensors(camera: Camera, like: torch.Tensor) -> tuple[torch.Tensor, torch.Tensor]:
+    """Camera (R [3, 3], t [3]) as tensors with the dtype and device of ``like``."""
+    R = torch.as_tensor(np.asarray(camera.R), dtype=like.dtype, device=like.device)
+    t = torch.as_tensor(np.asarray(camera.t), dtype=like.dtype, device=like.device)
+    return R, t
+
+
+def project_gaussians(means: torch.Tensor, quats: torch.Tensor, scales: torch.Tensor,
+                      camera: Camera, eps2d: float = EPS2D) -> Projected:
+    """Project Gaussians (means [N, 3] world units, quats [N, 4] wxyz, scales [N, 3] world units).
+
+    Returns a :class:`Projected`; differentiable w.r.t. means, quats and scales.
+    """
+    R, t = camera_tensors(camera, means)
+    xyz = means @ R.T + t  # [N, 3] camera coordinates
+    x, y, z = xyz.unbind(-1)
+    in_front = z > camera.near
+    # Clamp before dividing so culled Gaussians (z <= near) never produce inf/NaN, even in grads.
+    zs = torch.where(in_front, z, torch.ones_like(z))
+
+    Rq = quat_to_rotmat(quats)  # [N, 3, 3]
+    M = R @ (Rq * scales[:, None, :])  # [N, 3, 3] camera-frame square root of the covariance
+
+    fx, fy, cx, cy = camera.fx, camera.fy, camera.cx, camera.cy
+    W, H = camera.width, camera.height
+    # gsplat's field-of-view clamp of the Jacobian's evaluation point.
+    lim_x_pos = (W - cx) / fx + 0.3 * W / fx
+    lim_x_neg = cx / fx + 0.3 * W / fx
+    lim_y_pos = (H - cy) / fy + 0.3 * H / fy
+    lim_y_neg = cy / fy + 0.3 * H / fy
+    tx = zs * torch.clamp(x / zs, -lim_x_neg, lim_x_pos)
+    ty = zs * torch.clamp(y / zs, -lim_y_neg, lim_y_pos)
+    zero = torch.zeros_like(zs)
+    J = torch.stack(
+        [fx / zs, zero, -fx * tx / (zs * zs), zero, fy / zs, -fy * ty / (zs * zs)], dim=-1
+    ).reshape(-1, 2, 3)  # [N, 2, 3]
+    JM = J @ M  # [N, 2, 3]
+    cov = JM @ JM.transpose(1, 2)  # [N, 2, 2]
+    a = cov[:, 0, 0] + eps2d
+    b = cov[:, 0, 1]
+    c = cov[:, 1, 1] + eps2d
+    det = a * c - b * b
+    valid = in_front & (det > 0) & torch.isfinite(det)
+    dets = torch.where(valid, det, torch.ones_like(det))
+    conics = torch.stack([c / dets, -b / dets, a / dets], dim=-1)
+    means2d = torch.stack([fx * x / zs + cx, fy * y / zs + cy], dim=-1)
+    v = valid[:, None]
+    conics = torch.where(v, conics, torch.zeros_like(conics))
+    means2d = torch.where(v, means2d, torch.zeros_like(means2d))
+    depths = torch.where(valid, z, torch.zeros_like(z))
+    cov2d = torch.stack([a, b, c], dim=-1).detach()
+    cov2d = torch.where(v, cov2d, torch.zeros_like(cov2d))
+    return Projected(means2d, conics, depths, cov2d, valid)
+
+
+def pixel_bounds(means2d: np.ndarray, cov2d: np.ndarray, opacities: np.ndarray, valid: np.ndarray,
+                 width: int, height: int) -> np.ndarray:
+    """Conservative pixel boxes outside which a Gaussian's alpha is below ALPHA_MIN.
+
+    alpha >= 1/255 needs d^T conic d <= 2 ln(255 o); that ellipse's bounding box has half-widths
+    sqrt(2 ln(255 o) cov_xx), sqrt(2 ln(255 o) cov_yy). Inputs are numpy: means2d [N, 2] px,
+    cov2d [N, 3] px^2, opacities [N], valid [N]. Returns int64 [N, 4] (x0, x1, y0, y1) inclusive
+    pixel index ranges clipped to the image; x0 > x1 marks a Gaussian that touches no pixel.
+    """
+    n = means2d.shape[0]
+    out = np.empty((n, 4), dtype=np.int64)
+    out[:, 0], out[:, 1], out[:, 2], out[:, 3] = 1, 0, 1, 0
+    o = opacities.astype(np.float64)
+    keep = valid & (o * 255.0 > 1.0) & np.isfinite(means2d).all(1)
+    if not keep.any():
+        return out
+    thr = 2.0 * np.log(255.0 * o[keep])
+    m = means2d[keep].astype(np.float64)
+    cv = cov2d[keep].astype(np.float64)
+    rx = np.sqrt(thr * np.maximum(cv[:, 0], 0.0))
+    ry = np.sqrt(thr * np.maximum(cv[:, 2], 0.0))
+    # pixel j has centre j + 0.5; one pixel of slack on each side absorbs rounding.
+    x0 = np.floor(np.clip(m[:, 0] - rx - 0.5, -2.0, width + 2.0)) - 1
+    x1 = np.ceil(np.clip(m[:, 0] + rx - 0.5, -2.0, width + 2.0)) + 1
+    y0 = np.floor(np.clip(m[:, 1] - ry - 0.5, -2.0, height + 2.0)) - 1
+    y1 = np.ceil(np.clip(m[:, 1] + ry - 0.5, -2.0, height + 2.0)) + 1
+    box = np.stack([np.maximum(x0, 0), np.minimum(x1, width - 1),
+                    np.maximum(y0, 0), np.minimum(y1, height - 1)], axis=1).astype(np.int64)
+    bad = ~np.isfinite(rx) | ~np.isfinite(ry)  # NaN extents cannot be bounded: cover the image
+    box[bad] = [0, width - 1, 0, height - 1]
+    out[keep] = box
+    return out
