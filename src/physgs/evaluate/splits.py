@@ -1,0 +1,131 @@
+"""Evaluation splits (SPEC section 4): view, time, transfer, plus per-frame curves.
+
+The evaluation never sees a model class: it calls a render callback
+``render_fn(frame_idx, condition, camera) -> (rgb [H, W, 3] float in [0, 1], alpha [H, W])``
+where ``frame_idx`` is the 0-based recorded frame (t = frame_idx / fps seconds) and
+``condition`` indexes ``observed.conditions`` (0 = training wind).
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass, fields
+from typing import Callable
+
+import numpy as np
+
+from physgs.evaluate.atomic import save_npz
+from physgs.evaluate.metrics import centroid_error, psnr, to_float_image
+
+RenderFn = Callable[[int, int, object], tuple[np.ndarray, np.ndarray]]
+
+
+@dataclass(frozen=True)
+class EvalResult:
+    """Per-frame scores of one model on one tree. PSNR in dB, centroid errors in pixels.
+
+    camera_psnr [C, F]: training camera, every condition, all F = n_train + n_tail frames.
+    centroid_err [C, F]: canopy-centroid error at the training camera, same frames.
+    view_psnr [A, M]: held-out azimuths x held-out frames (training wind, inside the window).
+    """
+
+    camera_psnr: np.ndarray  # [C, F]
+    centroid_err: np.ndarray  # [C, F]
+    view_psnr: np.ndarray  # [A, M]
+    conditions: np.ndarray  # [C] mean-speed multipliers, 0 = training wind
+    heldout_azimuths_deg: np.ndarray  # [A]
+    heldout_frame_idx: np.ndarray  # [M]
+    n_train: int
+    n_tail: int
+
+    # --- derived per-frame splits -------------------------------------------------------
+    @property
+    def temporal_psnr(self) -> np.ndarray:
+        """[F] per-frame PSNR at the training camera and wind (fig_temporal)."""
+        return self.camera_psnr[0]
+
+    @property
+    def time_psnr(self) -> np.ndarray:
+        """[n_tail] the time split: tail frames, training camera and wind."""
+        return self.camera_psnr[0, self.n_train:]
+
+    @property
+    def train_timestamps_psnr(self) -> np.ndarray:
+        """[C, n_train] training camera, frames 1-300 of each condition (0 = in-sample fit)."""
+        return self.camera_psnr[:, : self.n_train]
+
+    @property
+    def beyond_window_psnr(self) -> np.ndarray:
+        """[C, n_tail] training camera, frames 301-350 of each condition."""
+        return self.camera_psnr[:, self.n_train:]
+
+    # --- split means (what the tables show) ---------------------------------------------
+    def summary(self) -> dict[str, float]:
+        """Mean PSNR per split (dB): view, time, and train/beyond for every condition c as
+        ``train_c{c}`` / ``beyond_c{c}``; mean centroid errors as ``centroid_c{c}`` (px)."""
+        out = {"view": float(self.view_psnr.mean()), "time": float(self.time_psnr.mean())}
+        for c in range(len(self.conditions)):
+            out[f"train_c{c}"] = float(self.train_timestamps_psnr[c].mean())
+            out[f"beyond_c{c}"] = float(self.beyond_window_psnr[c].mean())
+            out[f"centroid_c{c}"] = float(self.centroid_err[c].mean())
+        return out
+
+    def save(self, path) -> None:
+        """Write as .npz atomically."""
+        save_npz(path, **{f.name: np.asarray(getattr(self, f.name)) for f in fields(self)})
+
+
+def load_eval(path) -> EvalResult:
+    """Read an EvalResult written by ``EvalResult.save``."""
+    try:
+        with np.load(path) as z:
+            d = {k: z[k] for k in z.files}
+    except (OSError, ValueError) as e:
+        raise ValueError(f"cannot read evaluation file {path}: {e}; delete it and re-run its rule") from e
+    missing = {f.name for f in fields(EvalResult)} - set(d)
+    if missing:
+        raise ValueError(f"evaluation file {path} lacks {sorted(missing)}; re-run its rule")
+    d["n_train"], d["n_tail"] = int(d["n_train"]), int(d["n_tail"])
+    return EvalResult(**d)
+
+
+def _render(render_fn: RenderFn, frame: int, cond: int, camera, shape: tuple[int, int]):
+    rgb, alpha = render_fn(int(frame), int(cond), camera)
+    rgb, alpha = np.asarray(rgb), np.asarray(alpha, dtype=np.float64)
+    if rgb.shape != (*shape, 3) or alpha.shape != shape:
+        raise ValueError(f"render_fn returned rgb {rgb.shape}, alpha {alpha.shape} for frame {frame}, "
+                         f"condition {cond}; expected {(*shape, 3)} and {shape} (the camera's size)")
+    return to_float_image(rgb), alpha
+
+
+def evaluate(render_fn: RenderFn, observed, *, progress: Callable[[str], None] | None = None) -> EvalResult:
+    """Score a model through its render callback on every split of SPEC section 4.
+
+    observed: a ``physgs.testbed.dataset.Observed``. Renders C x F frames at the training camera
+    and A x M held-out views (training condition). Returns per-frame PSNR (dB) and centroid
+    errors (px); means per split come from ``EvalResult.summary()``.
+    """
+    frames = observed.frames  # [C, F, H, W, 3] uint8
+    C, F, H, W, _ = frames.shape
+    if F != observed.n_train + observed.n_tail:
+        raise ValueError(f"observed has {F} frames but n_train + n_tail = "
+                         f"{observed.n_train + observed.n_tail}; the dataset is inconsistent")
+    cam_psnr = np.empty((C, F))
+    cen = np.empty((C, F))
+    for c in range(C):
+        if progress:
+            progress(f"training camera, condition {c}")
+        for j in range(F):
+            rgb, alpha = _render(render_fn, j, c, observed.train_camera, (H, W))
+            cam_psnr[c, j] = psnr(rgb, frames[c, j])
+            cen[c, j] = centroid_error(alpha, observed.masks[c, j])
+    A, M = len(observed.heldout_cameras), len(observed.heldout_frame_idx)
+    view = np.empty((A, M))
+    for a, cam in enumerate(observed.heldout_cameras):
+        if progress:
+            progress(f"held-out azimuth {observed.heldout_azimuths_deg[a]} deg")
+        for m, j in enumerate(observed.heldout_frame_idx):
+            rgb, _ = _render(render_fn, j, 0, cam, observed.heldout_frames.shape[2:4])
+            view[a, m] = psnr(rgb, observed.heldout_frames[a, m])
+    return EvalResult(cam_psnr, cen, view, np.asarray(observed.conditions, dtype=np.float64),
+                      np.asarray(observed.heldout_azimuths_deg, dtype=np.float64),
+                      np.asarray(observed.heldout_frame_idx, dtype=np.int64),
+                      int(observed.n_train), int(observed.n_tail))

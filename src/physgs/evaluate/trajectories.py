@@ -1,0 +1,81 @@
+"""Branch-tip trajectories in pixels at the training camera, through the window and the tail."""
+from __future__ import annotations
+
+from dataclasses import dataclass, fields
+from typing import Callable
+
+import numpy as np
+
+from physgs.evaluate.atomic import save_npz
+
+MeansFn = Callable[[int, int], np.ndarray]  # (frame_idx, condition) -> Gaussian means [N, 3]
+
+
+@dataclass(frozen=True)
+class Trajectories:
+    """Tip paths projected by the training camera, pixels (x right, y down).
+
+    gt_px, pred_px: [P, F, 2] for the tip vertices ``tips`` [P] over recorded frames 0..F-1 of
+    ``condition``; frames < n_train lie in the training window, the rest in the tail.
+    """
+
+    gt_px: np.ndarray  # [P, F, 2]
+    pred_px: np.ndarray  # [P, F, 2]
+    tips: np.ndarray  # [P] vertex (= Gaussian) indices
+    condition: int
+    n_train: int
+
+    def error_px(self) -> np.ndarray:
+        """[P, F] pixel distance between predicted and ground-truth tips."""
+        return np.linalg.norm(self.pred_px - self.gt_px, axis=-1)
+
+    def save(self, path) -> None:
+        save_npz(path, **{f.name: np.asarray(getattr(self, f.name)) for f in fields(self)})
+
+
+def load_trajectories(path) -> Trajectories:
+    with np.load(path) as z:
+        d = {k: z[k] for k in z.files}
+    d["condition"], d["n_train"] = int(d["condition"]), int(d["n_train"])
+    return Trajectories(**d)
+
+
+def gt_tip_positions(truth, tips: np.ndarray, condition: int, lead_in_frames: int, n_frames: int,
+                     pose_fn: Callable | None = None) -> np.ndarray:
+    """Ground-truth world positions [P, F, 3] of vertices ``tips`` at recorded frames 0..F-1.
+
+    Recorded frame j uses bone angles ``truth.theta[condition, lead_in_frames + j]`` (rad) posed
+    by forward kinematics ``pose_fn(truth, theta_b [B]) -> [N, 3]`` (default
+    ``physgs.testbed.kinematics.pose_vertices``).
+    """
+    if pose_fn is None:
+        # imported here so the metric code loads without the testbed package
+        from physgs.testbed.kinematics import pose_vertices as pose_fn
+    theta = np.asarray(truth.theta)[condition]  # [L+F, B]
+    if lead_in_frames + n_frames > theta.shape[0]:
+        raise ValueError(f"truth has {theta.shape[0]} samples, fewer than lead-in {lead_in_frames} "
+                         f"+ {n_frames} frames; dataset and truth files disagree")
+    out = np.empty((len(tips), n_frames, 3))
+    for j in range(n_frames):
+        out[:, j] = np.asarray(pose_fn(truth, theta[lead_in_frames + j]))[tips]
+    return out
+
+
+def tip_trajectories(means_fn: MeansFn, truth, observed, *, condition: int = 0,
+                     tips: np.ndarray | None = None, pose_fn: Callable | None = None) -> Trajectories:
+    """Ground-truth and predicted branch-tip paths in pixels at the training camera.
+
+    means_fn(frame_idx, condition) -> [N, 3] numpy Gaussian means of the model (one Gaussian per
+    mesh vertex, so vertex index = Gaussian index). tips: vertex indices [P] (default
+    ``truth.tip_vertices``). Covers all F = n_train + n_tail recorded frames.
+    """
+    tips = np.asarray(truth.tip_vertices if tips is None else tips, dtype=np.int64)
+    F = int(observed.n_train + observed.n_tail)
+    cam = observed.train_camera
+    gt = gt_tip_positions(truth, tips, condition, int(observed.lead_in_frames), F, pose_fn)
+    pred = np.stack([np.asarray(means_fn(j, condition))[tips] for j in range(F)], axis=1)  # [P, F, 3]
+    P = len(tips)
+    gt_px, _ = cam.project(gt.reshape(-1, 3))
+    pred_px, _ = cam.project(pred.reshape(-1, 3).astype(np.float64))
+    return Trajectories(gt_px.reshape(P, F, 2), pred_px.reshape(P, F, 2), tips, int(condition),
+                        int(observed.n_train))

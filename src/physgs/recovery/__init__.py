@@ -1,0 +1,11 @@
+"""Parameter recovery against ground truth and null controls (SPEC section 4).
+
+Modules: ``matcher`` (part-to-bone matching by trajectory correlation), ``null`` (untrained
+null control, nearest-bone gap), ``damping`` (zeta_hat, gamma_hat), ``record`` (scoring one
+model, JSON storage).
+"""
+from physgs.recovery.damping import DampingResult, damping_summary
+from physgs.recovery.matcher import MatchResult, loglog_r2, match_parts, pearson_matrix, training_window
+
+__all__ = ["MatchResult", "match_parts", "pearson_matrix", "loglog_r2", "training_window",
+           "DampingResult", "damping_summary"]

@@ -1,0 +1,65 @@
+"""Score one trained model's recovery against the truth file, and store results as JSON."""
+from __future__ import annotations
+
+import json
+from dataclasses import dataclass
+
+import numpy as np
+
+from physgs.evaluate.atomic import write_json
+from physgs.recovery.damping import DampingResult, damping_summary
+from physgs.recovery.matcher import MatchResult, match_parts, training_window
+from physgs.recovery.null import NullResult
+
+
+@dataclass(frozen=True)
+class RecoveryRecord:
+    """Frequency match and damping summary of one (tree, config) model."""
+
+    match: MatchResult
+    damping: DampingResult
+
+
+def bone_window(truth, lead_in_frames: int, n_train: int) -> np.ndarray:
+    """[B, n_train] ground-truth bone angles (rad) over the training window at the training wind."""
+    theta = np.asarray(truth.theta)[0]  # [L+F, B]
+    return training_window(theta.T, lead_in_frames, n_train)
+
+
+def score_recovery(part_theta: np.ndarray, omega_hat: np.ndarray, zeta_hat: np.ndarray, truth,
+                   lead_in_frames: int, n_train: int) -> RecoveryRecord:
+    """Match parts to bones and summarise damping.
+
+    part_theta [K, L+F]: the model's part angles (rad) under the training wind, lead-in first
+    (``model.part_theta(wind)``); omega_hat [K] rad/s, zeta_hat [K]; truth: a ``Truth``.
+    Damping is summarised over all parts (the paper's median zeta_hat is over all parts).
+    """
+    part = training_window(part_theta, lead_in_frames, n_train)
+    m = match_parts(part, bone_window(truth, lead_in_frames, n_train), omega_hat, truth.omega)
+    zeta_true = float(np.median(truth.zeta))
+    return RecoveryRecord(m, damping_summary(omega_hat, zeta_hat, zeta_true))
+
+
+def save_recovery(path, rec: RecoveryRecord) -> None:
+    write_json(path, {"match": rec.match.to_dict(), "damping": rec.damping.to_dict()})
+
+
+def load_recovery(path) -> RecoveryRecord:
+    d = _read(path)
+    return RecoveryRecord(MatchResult.from_dict(d["match"]), DampingResult.from_dict(d["damping"]))
+
+
+def save_null(path, res: NullResult) -> None:
+    write_json(path, res.to_dict())
+
+
+def load_null(path) -> NullResult:
+    return NullResult.from_dict(_read(path))
+
+
+def _read(path) -> dict:
+    try:
+        with open(path) as fh:
+            return json.load(fh)
+    except (OSError, json.JSONDecodeError) as e:
+        raise ValueError(f"cannot read recovery file {path}: {e}; delete it and re-run its rule") from e
