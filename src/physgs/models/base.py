@@ -1,0 +1,135 @@
+"""What every model shares: the context read off the observed dataset, and the canonical set."""
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+import torch
+from torch import nn
+
+from physgs.models.gaussians import CanonicalGaussians, GaussianState
+
+
+@dataclass(frozen=True)
+class ModelContext:
+    """The observed-dataset facts a model is built from (never ground-truth physics).
+
+    canonical_xyz [N, 3] world units (mesh vertices at recorded frame 1); fps frames/s;
+    n_train training frames; lead_in_frames L (wind column L = recorded frame 1);
+    wind_mean, wind_std m/s of the training condition's observed wind (lead-in included);
+    wind_force_std m^2/s^2, std of v^2 - mean(v)^2 of that wind (scales the oscillator gain);
+    view_dir [3] unit viewing direction of the training camera (world).
+    """
+
+    canonical_xyz: np.ndarray
+    fps: int
+    n_train: int
+    lead_in_frames: int
+    wind_mean: float
+    wind_std: float
+    wind_force_std: float
+    view_dir: np.ndarray
+
+    def to_dict(self) -> dict:
+        """Checkpoint-safe form (tensors and Python scalars only)."""
+        return {
+            "canonical_xyz": torch.tensor(np.asarray(self.canonical_xyz, dtype=np.float32)),
+            "fps": int(self.fps), "n_train": int(self.n_train),
+            "lead_in_frames": int(self.lead_in_frames), "wind_mean": float(self.wind_mean),
+            "wind_std": float(self.wind_std), "wind_force_std": float(self.wind_force_std),
+            "view_dir": torch.tensor(np.asarray(self.view_dir, dtype=np.float64)),
+        }
+
+    @staticmethod
+    def from_dict(d: dict) -> "ModelContext":
+        return ModelContext(
+            np.asarray(d["canonical_xyz"], dtype=np.float32), int(d["fps"]), int(d["n_train"]),
+            int(d["lead_in_frames"]), float(d["wind_mean"]), float(d["wind_std"]),
+            float(d["wind_force_std"]), np.asarray(d["view_dir"], dtype=np.float64),
+        )
+
+
+def context_from_observed(obs) -> ModelContext:
+    """ModelContext from a ``physgs.testbed.dataset.Observed`` (training condition = index 0)."""
+    w = np.asarray(obs.wind[0], dtype=np.float64)  # [L+F] m/s
+    std = float(w.std())
+    if not np.isfinite(w).all() or std <= 0:
+        raise ValueError(
+            "the training condition's observed wind is constant or not finite; a wind-driven "
+            "model needs varying wind: regenerate the testbed dataset"
+        )
+    fwd = np.asarray(obs.train_camera.R, dtype=np.float64)[2]  # camera +z in world
+    return ModelContext(
+        canonical_xyz=np.asarray(obs.canonical_xyz, dtype=np.float32), fps=int(obs.fps),
+        n_train=int(obs.n_train), lead_in_frames=int(obs.lead_in_frames), wind_mean=float(w.mean()),
+        wind_std=std, wind_force_std=float((w**2 - w.mean() ** 2).std()), view_dir=fwd,
+    )
+
+
+class BaseModel(nn.Module):
+    """A canonical Gaussian set plus a deformation; subclasses implement ``deform``.
+
+    ``gaussians_at(frame_idx, wind)`` gives the Gaussians at recorded frame ``frame_idx``
+    (0-based; t_norm = frame_idx / (n_train - 1)) under the condition whose observed wind
+    [L+F] (m/s, lead-in included) is passed.
+    """
+
+    name = "base"
+
+    def __init__(self, ctx: ModelContext, canonical_cfg: dict):
+        super().__init__()
+        self.ctx = ctx
+        self.fps = ctx.fps
+        self.n_train = ctx.n_train
+        self.lead_in = ctx.lead_in_frames
+        self.canonical = CanonicalGaussians(ctx.canonical_xyz, **canonical_cfg)
+        xyz = np.asarray(ctx.canonical_xyz, dtype=np.float64)
+        lo, hi = xyz.min(0), xyz.max(0)
+        # Scene size in world units: scales position learning rates like 3DGS's spatial_lr_scale.
+        self.extent = float(0.5 * np.linalg.norm(hi - lo))
+
+    def t_norm(self, frame_idx: int) -> float:
+        """Normalised time: 0 at recorded frame 0, 1 at the last training frame."""
+        return frame_idx / (self.n_train - 1)
+
+    def _check(self, frame_idx: int, wind: torch.Tensor) -> None:
+        if wind.ndim != 1:
+            raise ValueError(f"{self.name}: wind must be one condition's series [L+F], got shape "
+                             f"{tuple(wind.shape)}")
+        if not 0 <= frame_idx < wind.shape[0] - self.lead_in:
+            raise ValueError(
+                f"{self.name}: frame {frame_idx} outside the recording (0 .. "
+                f"{wind.shape[0] - self.lead_in - 1} for a wind series of {wind.shape[0]} "
+                f"columns with lead-in {self.lead_in})"
+            )
+
+    def canonical_state(self) -> GaussianState:
+        """The undeformed canonical Gaussians (used by the shared static warm-up)."""
+        return self.canonical.state()
+
+    def gaussians_at(self, frame_idx: int, wind: torch.Tensor) -> GaussianState:
+        """Gaussians at recorded frame ``frame_idx`` under the observed wind [L+F] (m/s)."""
+        wind = torch.as_tensor(wind, dtype=torch.float32)
+        self._check(int(frame_idx), wind)
+        return self.deform(int(frame_idx), wind)
+
+    def deform(self, frame_idx: int, wind: torch.Tensor) -> GaussianState:
+        raise NotImplementedError
+
+    def param_groups(self, lr: dict) -> list[dict]:
+        """Adam parameter groups; the canonical set uses the same rates in every model.
+
+        lr: config train.lr (means and pivot rates are multiplied by the scene extent).
+        """
+        c = self.canonical
+        groups = [
+            {"name": "means", "params": [c.means], "lr": lr["means"] * self.extent},
+            {"name": "quats", "params": [c.quats], "lr": lr["quats"]},
+            {"name": "scales", "params": [c.log_scales], "lr": lr["scales"]},
+            {"name": "opacities", "params": [c.opacity_logits], "lr": lr["opacities"]},
+            {"name": "colors", "params": [c.color_logits], "lr": lr["colors"]},
+        ]
+        return groups + self.deformation_param_groups(lr)
+
+    def deformation_param_groups(self, lr: dict) -> list[dict]:
+        return []

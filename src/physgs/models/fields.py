@@ -1,0 +1,111 @@
+"""Learned deformation fields: Deformation MLP and Deformable-3DGS, each with or without wind.
+
+Input per Gaussian: Fourier features of its canonical position (normalised to about [-1, 1] by
+the canonical bounding box, detached as in Deformable-3DGS) and of t_norm, plus, for the + wind
+variants, the standardised 48-value wind history (shared by all Gaussians of a frame).
+Output heads start at zero, so at initialisation every field returns the canonical pose.
+"""
+from __future__ import annotations
+
+import numpy as np
+import torch
+from torch import nn
+
+from physgs.models.base import BaseModel, ModelContext
+from physgs.models.encoding import fourier, fourier_dim
+from physgs.models.gaussians import GaussianState
+from physgs.models.windwindow import wind_window, window_step
+
+HEAD_DIMS = {"dx": 3, "dq": 4, "ds": 3}
+
+
+class DeformationField(nn.Module):
+    """ReLU MLP with an optional input skip and zero-initialised linear heads.
+
+    depth hidden layers of ``width``; if ``skip`` is set the network input is concatenated to
+    the activations after hidden layer ``skip`` (0-based), as in Deformable-3DGS.
+    """
+
+    def __init__(self, in_dim: int, depth: int, width: int, skip: int | None,
+                 heads: tuple[str, ...]):
+        super().__init__()
+        if skip is not None and not 0 <= skip < depth - 1:
+            raise ValueError(f"skip layer {skip} must lie in [0, depth - 1) = [0, {depth - 1})")
+        self.skip = skip
+        layers = []
+        for i in range(depth):
+            d_in = in_dim if i == 0 else width + (in_dim if skip is not None and i == skip + 1
+                                                  else 0)
+            layers.append(nn.Linear(d_in, width))
+        self.layers = nn.ModuleList(layers)
+        self.heads = nn.ModuleDict({h: nn.Linear(width, HEAD_DIMS[h]) for h in heads})
+        for h in self.heads.values():
+            nn.init.zeros_(h.weight)
+            nn.init.zeros_(h.bias)
+
+    def forward(self, x: torch.Tensor) -> dict[str, torch.Tensor]:  # x [N, in_dim]
+        h = x
+        for i, layer in enumerate(self.layers):
+            h = torch.relu(layer(h))
+            if self.skip is not None and i == self.skip:
+                h = torch.cat([x, h], dim=-1)
+        return {name: head(h) for name, head in self.heads.items()}
+
+
+class FieldModel(BaseModel):
+    """Canonical Gaussians deformed by a learned field of (position, time[, wind history]).
+
+    arch "mlp": position offset only; arch "d3dgs": position, rotation (added to the quaternion)
+    and scale (added to the log-scale) offsets.
+    """
+
+    def __init__(self, ctx: ModelContext, canonical_cfg: dict, *, arch: str, pos_bands: int,
+                 time_bands: int, depth: int, width: int, skip: int | None, wind: bool,
+                 window_seconds: float, window_values: int, name: str):
+        super().__init__(ctx, canonical_cfg)
+        if arch not in ("mlp", "d3dgs"):
+            raise ValueError(f"unknown field architecture {arch!r}; use 'mlp' or 'd3dgs'")
+        self.name = name
+        self.arch = arch
+        self.pos_bands, self.time_bands = pos_bands, time_bands
+        self.use_wind = wind
+        self.window_values = window_values
+        self.window_step = window_step(window_seconds, window_values, ctx.fps)
+        xyz = np.asarray(ctx.canonical_xyz, dtype=np.float64)
+        lo, hi = xyz.min(0), xyz.max(0)
+        self.register_buffer("xyz_center", torch.tensor(0.5 * (lo + hi), dtype=torch.float32))
+        half = np.maximum(0.5 * (hi - lo).max(), 1e-6)
+        self.register_buffer("xyz_half", torch.tensor(half, dtype=torch.float32))
+        # Frozen training-condition statistics: weaker winds stay weaker after standardising.
+        self.register_buffer("wind_mean", torch.tensor(ctx.wind_mean, dtype=torch.float32))
+        self.register_buffer("wind_std", torch.tensor(ctx.wind_std, dtype=torch.float32))
+        in_dim = fourier_dim(3, pos_bands) + fourier_dim(1, time_bands) + (
+            window_values if wind else 0)
+        heads = ("dx",) if arch == "mlp" else ("dx", "dq", "ds")
+        self.field = DeformationField(in_dim, depth, width, skip, heads)
+
+    def features(self, frame_idx: int, wind: torch.Tensor) -> torch.Tensor:
+        """Field input [N, in_dim] at recorded frame ``frame_idx``."""
+        xn = (self.canonical.means.detach() - self.xyz_center) / self.xyz_half  # [N, 3]
+        n = xn.shape[0]
+        t = torch.tensor([self.t_norm(frame_idx)], dtype=xn.dtype)
+        parts = [fourier(xn, self.pos_bands), fourier(t, self.time_bands).expand(n, -1)]
+        if self.use_wind:
+            w = wind_window(wind, frame_idx, self.lead_in, self.wind_mean, self.wind_std,
+                            self.window_values, self.window_step)  # [48]
+            parts.append(w.to(xn.dtype).expand(n, -1))
+        return torch.cat(parts, dim=-1)
+
+    def deform(self, frame_idx: int, wind: torch.Tensor) -> GaussianState:
+        c = self.canonical
+        out = self.field(self.features(frame_idx, wind))
+        means = c.means + out["dx"]
+        quats, log_s = c.quats, c.log_scales
+        if "dq" in out:
+            quats = quats + out["dq"]
+            log_s = log_s + out["ds"]
+        return GaussianState(means, quats, torch.exp(log_s), torch.sigmoid(c.opacity_logits),
+                             torch.sigmoid(c.color_logits))
+
+    def deformation_param_groups(self, lr: dict) -> list[dict]:
+        return [{"name": "deform", "params": list(self.field.parameters()), "lr": lr["deform"]}]

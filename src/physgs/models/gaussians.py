@@ -1,0 +1,149 @@
+"""The canonical Gaussian set every model deforms, its per-frame state, and rotation helpers.
+
+Quaternions are (w, x, y, z) and act on column vectors; they need not be unit (the rasterizer
+normalises), but the helpers here that build rotations return unit quaternions.
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+import scipy.spatial
+import torch
+from torch import nn
+
+
+@dataclass(frozen=True)
+class GaussianState:
+    """Gaussians ready for ``physgs.render.rasterization``.
+
+    means [N, 3] world units; quats [N, 4] (w, x, y, z); scales [N, 3] world units (> 0);
+    opacities [N] in (0, 1); colors [N, 3] in (0, 1).
+    """
+
+    means: torch.Tensor
+    quats: torch.Tensor
+    scales: torch.Tensor
+    opacities: torch.Tensor
+    colors: torch.Tensor
+
+
+def quat_multiply(a: torch.Tensor, b: torch.Tensor) -> torch.Tensor:
+    """Hamilton product a * b of quaternions [..., 4] (w, x, y, z); rotation b first, then a."""
+    aw, ax, ay, az = a.unbind(-1)
+    bw, bx, by, bz = b.unbind(-1)
+    return torch.stack([
+        aw * bw - ax * bx - ay * by - az * bz,
+        aw * bx + ax * bw + ay * bz - az * by,
+        aw * by - ax * bz + ay * bw + az * bx,
+        aw * bz + ax * by - ay * bx + az * bw,
+    ], dim=-1)
+
+
+def quat_to_rotmat(q: torch.Tensor) -> torch.Tensor:
+    """Rotation matrices [..., 3, 3] from quaternions [..., 4] (normalised here)."""
+    q = q / q.norm(dim=-1, keepdim=True)
+    w, x, y, z = q.unbind(-1)
+    return torch.stack([
+        1 - 2 * (y * y + z * z), 2 * (x * y - w * z), 2 * (x * z + w * y),
+        2 * (x * y + w * z), 1 - 2 * (x * x + z * z), 2 * (y * z - w * x),
+        2 * (x * z - w * y), 2 * (y * z + w * x), 1 - 2 * (x * x + y * y),
+    ], dim=-1).reshape(q.shape[:-1] + (3, 3))
+
+
+def axis_angle_quat(axis: torch.Tensor, angle: torch.Tensor) -> torch.Tensor:
+    """Unit quaternions [..., 4] for rotations by ``angle`` [...] rad about unit ``axis`` [..., 3]."""
+    half = 0.5 * angle
+    return torch.cat([torch.cos(half)[..., None], torch.sin(half)[..., None] * axis], dim=-1)
+
+
+def rodrigues_minus_identity(axis: torch.Tensor, angle: torch.Tensor) -> torch.Tensor:
+    """R - I [..., 3, 3] for rotations by ``angle`` [...] rad about unit ``axis`` [..., 3].
+
+    Kept apart from I so that a zero angle gives exactly zero (and small angles lose no digits).
+    """
+    x, y, z = axis.unbind(-1)
+    zero = torch.zeros_like(x)
+    Kx = torch.stack([zero, -z, y, z, zero, -x, -y, x, zero], -1).reshape(axis.shape[:-1] + (3, 3))
+    s = torch.sin(angle)[..., None, None]
+    c = torch.cos(angle)[..., None, None]
+    return s * Kx + (1 - c) * (Kx @ Kx)
+
+
+def rodrigues(axis: torch.Tensor, angle: torch.Tensor) -> torch.Tensor:
+    """Rotation matrices [..., 3, 3] by ``angle`` [...] rad about unit ``axis`` [..., 3]."""
+    return torch.eye(3, dtype=axis.dtype, device=axis.device) + rodrigues_minus_identity(axis, angle)
+
+
+def rotate_about_pivot(means: torch.Tensor, quats: torch.Tensor, axis: torch.Tensor,
+                       angle: torch.Tensor, pivot: torch.Tensor) -> tuple[torch.Tensor, torch.Tensor]:
+    """Rigidly rotate Gaussians: positions about ``pivot`` and orientations alike.
+
+    means [N, 3]; quats [N, 4]; axis [N, 3] unit; angle [N] rad; pivot [N, 3] (per Gaussian,
+    e.g. gathered from its part). Returns (means [N, 3], quats [N, 4]). Rotating the orientation
+    too keeps an elongated Gaussian aligned with the branch it sits on.
+    """
+    RmI = rodrigues_minus_identity(axis, angle)  # [N, 3, 3]
+    # x' = p + R (x - p) = x + (R - I)(x - p): exactly x at angle 0.
+    new_means = means + (RmI @ (means - pivot)[..., None])[..., 0]
+    new_quats = quat_multiply(axis_angle_quat(axis, angle), quats)
+    return new_means, new_quats
+
+
+def nearest_neighbour_scale(xyz: np.ndarray, k: int = 3) -> np.ndarray:
+    """Isotropic scale [N] (world units): mean distance to the k nearest other points.
+
+    Coincident points (distance 0) get the smallest positive spacing in the set, so every
+    Gaussian has a drawable size.
+    """
+    xyz = np.asarray(xyz, dtype=np.float64)
+    if xyz.ndim != 2 or xyz.shape[1] != 3 or xyz.shape[0] < 2:
+        raise ValueError(f"canonical positions must be [N >= 2, 3]; got shape {xyz.shape}")
+    if not np.isfinite(xyz).all():
+        raise ValueError("canonical positions contain NaN or inf; regenerate the testbed dataset")
+    k = min(k, xyz.shape[0] - 1)
+    d, _ = scipy.spatial.cKDTree(xyz).query(xyz, k=k + 1)
+    s = d[:, 1:].mean(axis=1)
+    if not (s > 0).any():
+        raise ValueError("all canonical positions coincide; the mesh is degenerate")
+    return np.where(s > 0, s, s[s > 0].min())
+
+
+def _logit(p: float) -> float:
+    return float(np.log(p / (1 - p)))
+
+
+class CanonicalGaussians(nn.Module):
+    """Trainable canonical set: one Gaussian per mesh vertex (positions only from the mesh).
+
+    Init: means = xyz [N, 3]; identity rotation; isotropic scale = scale_factor x mean
+    distance to the ``knn`` nearest vertices; opacity ``opacity``; grey colour ``color``.
+    Parameters are stored unactivated (log-scale, opacity and colour logits).
+    """
+
+    def __init__(self, xyz: np.ndarray, *, opacity: float = 0.1, color: float = 0.5,
+                 knn: int = 3, scale_factor: float = 1.0):
+        super().__init__()
+        if not (0 < opacity < 1 and 0 < color < 1):
+            raise ValueError(f"canonical opacity and color must lie in (0, 1); got {opacity}, "
+                             f"{color} (config models.canonical)")
+        xyz = np.asarray(xyz, dtype=np.float64)
+        s = nearest_neighbour_scale(xyz, knn) * scale_factor  # [N]
+        n = xyz.shape[0]
+        self.means = nn.Parameter(torch.tensor(xyz, dtype=torch.float32))
+        q = torch.zeros(n, 4)
+        q[:, 0] = 1.0
+        self.quats = nn.Parameter(q)
+        self.log_scales = nn.Parameter(torch.tensor(np.log(s), dtype=torch.float32)[:, None]
+                                       .repeat(1, 3))
+        self.opacity_logits = nn.Parameter(torch.full((n,), _logit(opacity)))
+        self.color_logits = nn.Parameter(torch.full((n, 3), _logit(color)))
+
+    @property
+    def n(self) -> int:
+        return self.means.shape[0]
+
+    def state(self) -> GaussianState:
+        """Activated canonical Gaussians."""
+        return GaussianState(self.means, self.quats, torch.exp(self.log_scales),
+                             torch.sigmoid(self.opacity_logits), torch.sigmoid(self.color_logits))

@@ -1,0 +1,133 @@
+"""Ours: the physically parameterised deformation prior.
+
+K rigid parts (k-means on canonical positions). Part p swings by theta_p(t), the response of a
+damped oscillator (omega_p, zeta_p) driven by gain_p * (v(t)^2 - vbar^2) of the observed wind,
+integrated by RK4 from rest at the first wind sample (start of the lead-in), so the recorded
+window is at steady state. Each part rotates rigidly by theta_p about its swing axis through its
+pivot; positions and orientations rotate together.
+
+Parameterisation (all bounded or normalised so one Adam rate suits every tree):
+- omega = exp(log lo + (log hi - log lo) * sigmoid(raw)), rad/s, inside [omega_lo, omega_hi];
+- zeta = zeta_lo + (zeta_hi - zeta_lo) * sigmoid(raw);
+- gain = raw * omega_init^2 / std(v^2 - vbar^2) of the training wind, so raw is roughly the
+  quasi-static swing in radians; starts at 0, so the model starts at the canonical pose;
+- swing axis = raw / |raw|; the wind direction is not an input, so it starts along the
+  horizontal part of the training camera's viewing direction (a swing in the image plane, the
+  motion the camera sees best) and is learned;
+- pivot (world units), initialised at the part's member nearest the base of the tree.
+"""
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import torch
+from torch import nn
+
+from physgs.models.base import BaseModel, ModelContext
+from physgs.models.gaussians import GaussianState, rotate_about_pivot
+from physgs.models.oscillator import STABILITY_GUARD, integrate, required_substeps
+from physgs.models.parts import kmeans_parts
+
+
+def _logit(p: float) -> float:
+    return math.log(p / (1.0 - p))
+
+
+class OscillatorPrior(BaseModel):
+    """Per-part wind-driven oscillators with rigid rotation (see module docstring)."""
+
+    name = "ours"
+
+    def __init__(self, ctx: ModelContext, canonical_cfg: dict, *, K: int, omega_hz: list,
+                 zeta: list, omega_init_hz: float, zeta_init: float, substeps: int,
+                 rk4_guard: float = STABILITY_GUARD, kmeans_n_init: int = 4, seed: int = 0,
+                 labels: np.ndarray | None = None):
+        super().__init__(ctx, canonical_cfg)
+        lo, hi = (2 * math.pi * float(f) for f in omega_hz)
+        zlo, zhi = (float(z) for z in zeta)
+        w0 = 2 * math.pi * float(omega_init_hz)
+        if not (0 < lo < w0 < hi):
+            raise ValueError(f"models.ours needs 0 < omega_hz[0] < omega_init_hz < omega_hz[1]; "
+                             f"got {omega_hz}, {omega_init_hz}")
+        if not (0 < zlo < zeta_init < zhi):
+            raise ValueError(f"models.ours needs 0 < zeta[0] < zeta_init < zeta[1]; got {zeta}, "
+                             f"{zeta_init}")
+        self.omega_lo, self.omega_hi, self.zeta_lo, self.zeta_hi = lo, hi, zlo, zhi
+        self.dt = 1.0 / ctx.fps
+        self.guard = float(rk4_guard)
+        # Enough substeps that every omega the bounds allow passes the guard.
+        self.substeps = max(int(substeps), required_substeps(hi, self.dt, self.guard))
+        xyz = np.asarray(ctx.canonical_xyz, dtype=np.float64)
+        if labels is None:
+            labels = kmeans_parts(xyz, K, seed, kmeans_n_init)
+        labels = np.asarray(labels, dtype=np.int64)
+        if labels.shape != (xyz.shape[0],) or labels.min() < 0 or labels.max() >= K:
+            raise ValueError(f"part labels must be [N] in [0, K={K}); got shape {labels.shape}")
+        self.K = K
+        self.register_buffer("part_labels", torch.tensor(labels))
+        self.omega_raw = nn.Parameter(torch.full(
+            (K,), _logit((math.log(w0) - math.log(lo)) / (math.log(hi) - math.log(lo)))))
+        self.zeta_raw = nn.Parameter(torch.full((K,), _logit((zeta_init - zlo) / (zhi - zlo))))
+        self.gain_raw = nn.Parameter(torch.zeros(K))
+        self.register_buffer("gain_scale", torch.tensor(w0**2 / ctx.wind_force_std))
+        axis = np.asarray(ctx.view_dir, dtype=np.float64).copy()
+        axis[2] = 0.0
+        if np.linalg.norm(axis) < 1e-6:  # camera looking straight down: any horizontal axis
+            axis = np.array([1.0, 0.0, 0.0])
+        axis /= np.linalg.norm(axis)
+        self.axis_raw = nn.Parameter(torch.tensor(axis, dtype=torch.float32).repeat(K, 1))
+        base = np.array([*xyz[:, :2].mean(0), xyz[:, 2].min()])
+        pivots = np.empty((K, 3))
+        for p in range(K):
+            members = xyz[labels == p]
+            pivots[p] = members[np.argmin(np.linalg.norm(members - base, axis=1))]
+        self.pivot = nn.Parameter(torch.tensor(pivots, dtype=torch.float32))
+
+    @property
+    def omega(self) -> torch.Tensor:
+        """[K] natural frequencies, rad/s."""
+        lo, hi = math.log(self.omega_lo), math.log(self.omega_hi)
+        return torch.exp(lo + (hi - lo) * torch.sigmoid(self.omega_raw))
+
+    @property
+    def zeta(self) -> torch.Tensor:
+        """[K] damping ratios (dimensionless)."""
+        return self.zeta_lo + (self.zeta_hi - self.zeta_lo) * torch.sigmoid(self.zeta_raw)
+
+    @property
+    def gain(self) -> torch.Tensor:
+        """[K] force gains, rad / m^2 (angular acceleration per unit of v^2 - vbar^2)."""
+        return self.gain_raw * self.gain_scale
+
+    @property
+    def axis(self) -> torch.Tensor:
+        """[K, 3] unit swing axes (world)."""
+        return self.axis_raw / self.axis_raw.norm(dim=-1, keepdim=True)
+
+    def part_theta(self, wind: torch.Tensor) -> torch.Tensor:
+        """Swing angles theta [K, L+F] (rad) under one condition's observed wind [L+F] (m/s).
+
+        vbar is the mean of that condition's observed wind.
+        """
+        wind = torch.as_tensor(wind, dtype=torch.float64)
+        if wind.ndim != 1:
+            raise ValueError(f"part_theta: wind must be [L+F], got shape {tuple(wind.shape)}")
+        return integrate(self.omega, self.zeta, self.gain, wind, float(wind.mean()), self.dt,
+                         self.substeps, guard=self.guard)
+
+    def deform(self, frame_idx: int, wind: torch.Tensor) -> GaussianState:
+        theta = self.part_theta(wind)[:, self.lead_in + frame_idx]  # [K]
+        lab = self.part_labels
+        c = self.canonical
+        means, quats = rotate_about_pivot(c.means, c.quats, self.axis[lab], theta[lab],
+                                          self.pivot[lab])
+        return GaussianState(means, quats, torch.exp(c.log_scales),
+                             torch.sigmoid(c.opacity_logits), torch.sigmoid(c.color_logits))
+
+    def deformation_param_groups(self, lr: dict) -> list[dict]:
+        return [
+            {"name": "physics", "params": [self.omega_raw, self.zeta_raw, self.gain_raw,
+                                           self.axis_raw], "lr": lr["physics"]},
+            {"name": "pivot", "params": [self.pivot], "lr": lr["pivot"] * self.extent},
+        ]

@@ -1,0 +1,16 @@
+"""Static pose: the canonical set alone, the floor every model must clear."""
+from __future__ import annotations
+
+import torch
+
+from physgs.models.base import BaseModel
+from physgs.models.gaussians import GaussianState
+
+
+class StaticModel(BaseModel):
+    """No deformation: every frame shows the canonical Gaussians."""
+
+    name = "static"
+
+    def deform(self, frame_idx: int, wind: torch.Tensor) -> GaussianState:
+        return self.canonical.state()

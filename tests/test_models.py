@@ -1,0 +1,158 @@
+"""Model components: rotations, canonical pose at init, wind window, parts, ours, checkpoints."""
+import math
+
+import numpy as np
+import pytest
+import torch
+from scipy.spatial.transform import Rotation
+
+import physgs.config
+from physgs.models import MODEL_NAMES, ModelContext, build_model, load_checkpoint, save_checkpoint
+from physgs.models.encoding import fourier
+from physgs.models.gaussians import quat_to_rotmat, rotate_about_pivot
+from physgs.models.oscillator import integrate
+from physgs.models.parts import kmeans_parts
+from physgs.models.windwindow import wind_window, window_columns, window_step
+
+LEAD_IN = 160
+FPS = 24
+
+
+def _ctx(n=200, seed=0):
+    rng = np.random.default_rng(seed)
+    xyz = rng.normal(size=(n, 3)) * [0.5, 0.5, 1.0] + [0.0, 0.0, 2.0]
+    w = 6.0 + 1.5 * rng.standard_normal(LEAD_IN + 350)
+    return ModelContext(xyz.astype(np.float32), FPS, 300, LEAD_IN, float(w.mean()), float(w.std()),
+                        float((w**2 - w.mean() ** 2).std()), np.array([0.0, 1.0, 0.0])), w
+
+
+def _cfg():
+    return physgs.config.load("config/trees.yaml", "quick")["models"]
+
+
+def _cov(q, s):
+    R = quat_to_rotmat(q)
+    return R @ torch.diag_embed(s**2) @ R.transpose(-1, -2)
+
+
+def test_rotating_an_elongated_gaussian_keeps_it_on_its_axis():
+    # A needle along the branch direction d, centred 1 unit from the pivot along d.
+    d = torch.tensor([[0.6, 0.0, 0.8]], dtype=torch.float64)
+    pivot = torch.tensor([[0.1, -0.2, 0.3]], dtype=torch.float64)
+    q0 = torch.tensor(Rotation.align_vectors([d[0].numpy()], [[1.0, 0, 0]])[0].as_quat(
+        scalar_first=True))[None]
+    scales = torch.tensor([[1.0, 0.05, 0.05]], dtype=torch.float64)
+    axis = torch.tensor([[0.0, 1.0, 0.0]], dtype=torch.float64)
+    angle = torch.tensor([0.7], dtype=torch.float64)
+    means, quats = rotate_about_pivot(pivot + d, q0, axis, angle, pivot)
+    R = torch.tensor(Rotation.from_rotvec(0.7 * axis[0].numpy()).as_matrix())  # scipy oracle
+    d_rot = R @ d[0]
+    assert torch.allclose(means[0], pivot[0] + d_rot, atol=1e-12)
+    # Long axis of the new covariance is the rotated branch direction (position and orientation
+    # moved together), and the covariance is R Sigma R^T.
+    cov = _cov(quats, scales)[0]
+    assert torch.allclose(cov, R @ _cov(q0, scales)[0] @ R.T, atol=1e-12)
+    evals, evecs = torch.linalg.eigh(cov)
+    assert abs(abs(float(evecs[:, -1] @ d_rot)) - 1) < 1e-10
+
+
+def test_fourier_features_match_explicit_formula():
+    x = torch.tensor([[0.3, -0.5, 0.9]])
+    f = fourier(x, 2)
+    expected = [0.3, -0.5, 0.9]
+    for k in range(2):
+        a = [(2**k) * math.pi * v for v in (0.3, -0.5, 0.9)]
+        expected += [math.sin(v) for v in a] + [math.cos(v) for v in a]
+    assert torch.allclose(f[0], torch.tensor(expected), atol=1e-6)
+
+
+@pytest.mark.parametrize("name", MODEL_NAMES)
+def test_every_model_starts_exactly_at_the_canonical_pose(name):
+    ctx, w = _ctx()
+    model = build_model(name, ctx, _cfg(), seed=0)
+    c = model.canonical_state()
+    for j in (0, 150, 349):
+        g = model.gaussians_at(j, torch.tensor(w))
+        for a, b in ((g.means, c.means), (g.scales, c.scales), (g.opacities, c.opacities),
+                     (g.colors, c.colors)):
+            assert torch.equal(a, b)
+        # Identity rotation composed with a zero-angle swing stays exactly identity.
+        assert torch.equal(g.quats, c.quats)
+
+
+def test_wind_window_ends_at_t_steps_three_frames_and_reads_the_lead_in():
+    step = window_step(6.0, 48, 24)
+    assert step == 3
+    cols = window_columns(0, LEAD_IN, 48, step)
+    assert cols[-1] == LEAD_IN and np.all(np.diff(cols) == 3) and cols.size == 48
+    assert cols[0] == LEAD_IN - 141 and cols[0] >= 0  # frame 1 reads 141 frames into the lead-in
+    wind = torch.arange(LEAD_IN + 350, dtype=torch.float32)  # value = column index
+    w = wind_window(wind, 10, LEAD_IN, 2.0, 4.0, 48, step)
+    assert torch.equal(w * 4.0 + 2.0, torch.tensor(window_columns(10, LEAD_IN, 48, 3),
+                                                   dtype=torch.float32))
+    with pytest.raises(ValueError, match="lead-in"):
+        window_columns(0, 100, 48, step)
+    with pytest.raises(ValueError, match="subsample evenly"):
+        window_step(6.0, 50, 24)
+
+
+def test_wind_models_see_the_wind_and_use_frozen_training_statistics():
+    ctx, w = _ctx()
+    model = build_model("mlp_wind", ctx, _cfg())
+    f_train = model.features(5, torch.tensor(w, dtype=torch.float32))
+    f_weak = model.features(5, torch.tensor(0.71 * w, dtype=torch.float32))
+    win = f_train[0, -48:]
+    assert abs(float(win.mean())) < 1.0  # standardised
+    # Scaling the wind shifts the standardised history (not re-standardised per condition).
+    expected = (0.71 * w[window_columns(5, LEAD_IN, 48, 3)] - ctx.wind_mean) / ctx.wind_std
+    assert np.allclose(f_weak[0, -48:].numpy(), expected, atol=1e-5)
+
+
+def test_kmeans_parts_deterministic_and_checked():
+    ctx, _ = _ctx(300)
+    a = kmeans_parts(ctx.canonical_xyz, 12, seed=3)
+    b = kmeans_parts(ctx.canonical_xyz, 12, seed=3)
+    assert np.array_equal(a, b) and set(a) == set(range(12))
+    with pytest.raises(ValueError, match="exceeds"):
+        kmeans_parts(ctx.canonical_xyz[:10], 11, seed=0)
+
+
+def test_ours_bounds_guard_and_theta():
+    ctx, w = _ctx()
+    cfg = _cfg()
+    model = build_model("ours", ctx, cfg, config="joint96")
+    assert model.K == 96 and model.part_labels.shape == (200,)
+    lo, hi = (2 * math.pi * f for f in cfg["ours"]["omega_hz"])
+    assert hi * model.dt / model.substeps <= cfg["ours"]["rk4_guard"]
+    with torch.no_grad():
+        model.omega_raw.fill_(50.0)  # saturates at the upper bound: still integrable
+        model.zeta_raw.fill_(-50.0)
+        model.gain_raw.fill_(0.05)
+    assert torch.all(model.omega <= hi + 1e-4) and torch.all(model.zeta >= cfg["ours"]["zeta"][0])
+    theta = model.part_theta(torch.tensor(w))
+    assert theta.shape == (96, w.size) and torch.isfinite(theta).all()
+    # vbar is that condition's mean wind; same numbers as a direct solver call.
+    direct = integrate(model.omega, model.zeta, model.gain, w, float(w.mean()), 1 / FPS,
+                       model.substeps)
+    assert torch.allclose(theta, direct)
+
+
+def test_checkpoint_roundtrip(tmp_path):
+    ctx, w = _ctx()
+    for name in ("ours", "d3dgs_wind"):
+        model = build_model(name, ctx, _cfg())
+        with torch.no_grad():
+            for p in model.parameters():
+                p.add_(0.01 * torch.randn_like(p))
+        path = tmp_path / f"{name}.pt"
+        save_checkpoint(path, model, name=name, config="single", seed=0, models_cfg=_cfg(),
+                        train_cfg={}, stats={"iterations": 1})
+        back = load_checkpoint(path)
+        a = model.gaussians_at(200, torch.tensor(w))
+        b = back.gaussians_at(200, torch.tensor(w))
+        assert torch.equal(a.means, b.means) and torch.equal(a.quats, b.quats)
+    (tmp_path / "bad.pt").write_bytes(b"not a checkpoint")
+    with pytest.raises(ValueError, match="corrupt"):
+        load_checkpoint(tmp_path / "bad.pt")
+    with pytest.raises(FileNotFoundError, match="snakemake"):
+        load_checkpoint(tmp_path / "missing.pt")
