@@ -1,0 +1,227 @@
+"""Figures (SPEC section 4): fig_temporal, fig_teaser, fig_results, fig_damping.
+
+Each ``fig_*`` takes collected results as arrays and a list of output paths; the suffix of a
+path picks its format (.pdf, .png), each written atomically. Matplotlib's Agg backend is used
+so nothing needs a display.
+"""
+from __future__ import annotations
+
+from pathlib import Path
+from typing import Mapping, Sequence
+
+import matplotlib
+
+matplotlib.use("Agg")
+import matplotlib.pyplot as plt  # noqa: E402
+import numpy as np  # noqa: E402
+from matplotlib.ticker import LogLocator, NullFormatter, ScalarFormatter  # noqa: E402
+
+from physgs.evaluate.atomic import atomic_path  # noqa: E402
+from physgs.report.tables import MODEL_NAMES, MODELS, condition_label  # noqa: E402
+
+COLORS = {"static": "0.55", "mlp": "tab:orange", "mlp_wind": "tab:red", "d3dgs": "tab:purple",
+          "d3dgs_wind": "tab:brown", "ours": "tab:blue", "gt": "k"}
+GOOD, BAD = "#1a9850", "#f46d43"  # green where ours is best, orange where a baseline beats it
+WINDOW, TAIL = "0.6", "tab:blue"
+
+
+def save_figure(fig, outputs: Sequence[str | Path], dpi: int = 200) -> None:
+    """Save ``fig`` to every path in ``outputs`` (format from the suffix), atomically; closes it."""
+    try:
+        for out in outputs:
+            suffix = Path(out).suffix.lstrip(".")
+            if suffix not in ("pdf", "png"):
+                raise ValueError(f"figure output {out!r}: suffix must be .pdf or .png")
+            with atomic_path(out) as tmp:
+                fig.savefig(tmp, format=suffix, dpi=dpi, bbox_inches="tight")
+    finally:
+        plt.close(fig)
+
+
+def best_baseline(summaries: Mapping[str, Mapping[str, float]], key: str = "time",
+                  exclude: Sequence[str] = ("static", "ours")) -> str:
+    """The learned baseline with the highest ``summary[key]`` (dB) among summaries[model]."""
+    cands = {m: s[key] for m, s in summaries.items() if m not in exclude}
+    if not cands:
+        raise ValueError("best_baseline: no baseline among the given models")
+    return max(cands, key=cands.get)
+
+
+def representative_frame(psnr_ours: np.ndarray, psnr_base: np.ndarray) -> int:
+    """Index of the frame whose ours-minus-baseline PSNR gap is closest to the split's mean gap."""
+    gap = np.asarray(psnr_ours, float) - np.asarray(psnr_base, float)
+    return int(np.argmin(np.abs(gap - gap.mean())))
+
+
+# --------------------------------------------------------------------------------------------
+def fig_temporal(curves: Mapping[tuple[str, str], np.ndarray], trees: Sequence[str], n_train: int,
+                 outputs: Sequence[str | Path], models: Sequence[str] = MODELS) -> None:
+    """Per-frame PSNR (dB) at the training camera and wind, one panel per tree.
+
+    curves[(tree, model)]: [F] PSNR over recorded frames 1..F; the window boundary (after frame
+    n_train) is marked and the tail shaded.
+    """
+    fig, axes = plt.subplots(1, len(trees), figsize=(4.2 * len(trees), 3.2), squeeze=False, sharey=False)
+    for ax, t in zip(axes[0], trees):
+        for m in models:
+            if (t, m) not in curves:
+                raise KeyError(f"fig_temporal: no per-frame PSNR for ({t}, {m})")
+            y = np.asarray(curves[(t, m)])
+            x = np.arange(1, len(y) + 1)
+            ax.plot(x, y, color=COLORS.get(m), lw=1.6 if m == "ours" else 1.0,
+                    ls="--" if m == "static" else "-", label=MODEL_NAMES.get(m, m))
+        ax.axvline(n_train + 0.5, color="k", lw=0.8, ls=":")
+        ax.axvspan(n_train + 0.5, len(y) + 0.5, color="0.92", zorder=0)
+        ax.set_title(t.capitalize())
+        ax.set_xlabel("frame")
+        ax.set_xlim(1, len(y))
+    axes[0, 0].set_ylabel("PSNR (dB)")
+    axes[0, -1].legend(fontsize=7, loc="lower left")
+    fig.tight_layout()
+    save_figure(fig, outputs)
+
+
+# --------------------------------------------------------------------------------------------
+def fig_teaser(trajectories: Mapping[str, object], centroid_err: Mapping[str, np.ndarray],
+               conditions: Sequence[float], outputs: Sequence[str | Path], *, tip: int | None = None,
+               unseen: int = -1, title: str = "") -> None:
+    """Branch-tip paths through the window (grey) and tail (blue), and canopy-centroid error.
+
+    trajectories[model]: ``Trajectories`` at the training wind (e.g. ours and the best
+    baseline; the ground truth is taken from the first). centroid_err[model]: [C, F] pixels.
+    tip: which tip to draw (default: the one the ground truth moves most). unseen: index of
+    the unseen condition shown in the last panel.
+    """
+    models = list(trajectories)
+    first = trajectories[models[0]]
+    n_train = first.n_train
+    if tip is None:
+        tip = int(np.argmax(np.ptp(first.gt_px, axis=1).sum(-1)))
+    panels = [("Ground truth", first.gt_px[tip])] + [(MODEL_NAMES.get(m, m), trajectories[m].pred_px[tip])
+                                                     for m in models]
+    fig = plt.figure(figsize=(3.0 * len(panels), 5.6))
+    gs = fig.add_gridspec(2, 2 * len(panels))
+    gt = first.gt_px[tip]
+    pad = 0.15 * max(np.ptp(gt[:, 0]), np.ptp(gt[:, 1]), 1.0)
+    lims = [gt[:, 0].min() - pad, gt[:, 0].max() + pad, gt[:, 1].max() + pad, gt[:, 1].min() - pad]
+    for i, (name, p) in enumerate(panels):
+        ax = fig.add_subplot(gs[0, 2 * i: 2 * i + 2])
+        if i:
+            ax.plot(gt[:, 0], gt[:, 1], color="k", lw=0.5, ls=":", label="ground truth")
+        ax.plot(p[:n_train, 0], p[:n_train, 1], color=WINDOW, lw=0.9, label="training window")
+        ax.plot(p[n_train - 1:, 0], p[n_train - 1:, 1], color=TAIL, lw=1.4, label="tail")
+        ax.set_xlim(lims[0], lims[1])
+        ax.set_ylim(lims[2], lims[3])  # image y points down
+        ax.set_aspect("equal", adjustable="box")
+        ax.set_title(name, fontsize=9)
+        ax.set_xlabel("x (px)")
+        if i == 0:
+            ax.set_ylabel("y (px)")
+        if i == len(panels) - 1:
+            ax.legend(fontsize=6)
+    unseen = unseen % len(conditions)
+    half = len(panels)
+    for j, (c, lab) in enumerate([(0, "training wind"), (unseen, f"unseen wind {condition_label(conditions[unseen], tex=False)}")]):
+        ax = fig.add_subplot(gs[1, j * half:(j + 1) * half])
+        for m in models:
+            e = np.asarray(centroid_err[m])[c]
+            ax.plot(np.arange(1, len(e) + 1), e, color=COLORS.get(m), lw=1.0,
+                    label=f"{MODEL_NAMES.get(m, m)} (mean {e.mean():.1f} px)")
+        ax.axvline(n_train + 0.5, color="k", lw=0.8, ls=":")
+        ax.set_title(f"canopy-centroid error, {lab}", fontsize=9)
+        ax.set_xlabel("frame")
+        ax.set_ylabel("px")
+        ax.legend(fontsize=7)
+    if title:
+        fig.suptitle(title)
+    fig.tight_layout()
+    save_figure(fig, outputs)
+
+
+# --------------------------------------------------------------------------------------------
+def fig_results(rows: Sequence[str], columns: Sequence[str],
+                images: Mapping[tuple[str, str], tuple[np.ndarray, float | None]],
+                outputs: Sequence[str | Path], ours: str = "ours") -> None:
+    """Qualitative grid: one row per (tree, split) label, one column per model (or 'gt').
+
+    images[(row, column)] = (rgb [H, W, 3] in [0, 1] or uint8, PSNR in dB or None for the
+    ground truth). PSNR is printed on each panel, green on ours where it is best in its row
+    and orange on a baseline that beats ours.
+    """
+    fig, axes = plt.subplots(len(rows), len(columns), figsize=(1.7 * len(columns), 1.8 * len(rows)),
+                             squeeze=False)
+    for i, r in enumerate(rows):
+        scores = {c: images[(r, c)][1] for c in columns if images[(r, c)][1] is not None}
+        ours_score = scores.get(ours)
+        for j, c in enumerate(columns):
+            if (r, c) not in images:
+                raise KeyError(f"fig_results: no image for row {r!r}, column {c!r}")
+            img, score = images[(r, c)]
+            ax = axes[i, j]
+            ax.imshow(np.asarray(img), interpolation="nearest")
+            ax.set_xticks([])
+            ax.set_yticks([])
+            if score is not None:
+                color = "k"
+                if ours_score is not None:
+                    if c == ours and ours_score >= max(scores.values()):
+                        color = GOOD
+                    elif c != ours and score > ours_score:
+                        color = BAD
+                ax.text(0.03, 0.03, f"{score:.2f}", transform=ax.transAxes, fontsize=7, color=color,
+                        bbox=dict(facecolor="white", alpha=0.75, lw=0, pad=1))
+            if i == 0:
+                ax.set_title("Ground truth" if c == "gt" else MODEL_NAMES.get(c, c), fontsize=7)
+            if j == 0:
+                ax.set_ylabel(r, fontsize=7)
+    fig.tight_layout(pad=0.3)
+    save_figure(fig, outputs)
+
+
+# --------------------------------------------------------------------------------------------
+def fig_damping(damping: Mapping[tuple[str, str], object], trees: Sequence[str], configs: Sequence[str],
+                zeta_true: float, outputs: Sequence[str | Path]) -> None:
+    """Left: zeta_hat per part for each tree and config against the true ratio (line).
+    Right: decay rate gamma_hat = zeta_hat * omega_hat (1/s) against omega_hat (rad/s), log-log,
+    with the ground-truth line gamma = zeta_true * omega.
+
+    damping[(tree, config)]: ``DampingResult``.
+    """
+    fig, (a0, a1) = plt.subplots(1, 2, figsize=(10, 3.8))
+    tree_colors = dict(zip(trees, ["tab:green", "tab:blue", "tab:red", "tab:purple"]))
+    markers = dict(zip(configs, ["o", "s", "^", "D"]))
+    pos, labels, allw = 0, [], []
+    for t in trees:
+        for c in configs:
+            if (t, c) not in damping:
+                raise KeyError(f"fig_damping: no damping result for ({t}, {c})")
+            d = damping[(t, c)]
+            jitter = np.random.default_rng(pos).uniform(-0.15, 0.15, len(d.zeta))  # display only
+            a0.scatter(pos + jitter, d.zeta, s=6, color=tree_colors[t], alpha=0.5)
+            a0.plot([pos - 0.3, pos + 0.3], [d.median_zeta] * 2, color="k", lw=1.5)
+            labels.append(f"{t} {c}")
+            pos += 1
+            a1.scatter(d.omega, d.gamma, s=8, color=tree_colors[t], marker=markers[c], alpha=0.6,
+                       label=f"{t}, {c} (median $\\hat\\zeta$ {d.median_zeta:.3f})")
+            allw.append(d.omega)
+    a0.axhline(zeta_true, color="k", ls="--", lw=0.8, label=f"truth $\\zeta$ = {zeta_true}")
+    a0.set_xticks(range(pos))
+    a0.set_xticklabels(labels, fontsize=7, rotation=40, ha="right")
+    a0.set_ylabel(r"$\hat\zeta_p$")
+    a0.set_title("damping ratio per part (bar: median)", fontsize=9)
+    a0.legend(fontsize=7)
+    w = np.concatenate(allw)
+    grid = np.geomspace(w.min() * 0.9, w.max() * 1.1, 50)
+    a1.plot(grid, zeta_true * grid, "k--", lw=1, label=r"truth $\gamma = \zeta\omega$")
+    a1.set_xscale("log")
+    a1.set_yscale("log")
+    for axis in (a1.xaxis, a1.yaxis):  # plain numbers: 10^x labels collide on a short log axis
+        axis.set_major_locator(LogLocator(base=10, subs=(1.0, 2.0, 5.0)))
+        axis.set_major_formatter(ScalarFormatter())
+        axis.set_minor_formatter(NullFormatter())
+    a1.set_xlabel(r"$\hat\omega_p$ (rad/s)")
+    a1.set_ylabel(r"$\hat\gamma_p = \hat\zeta_p\hat\omega_p$ (1/s)")
+    a1.set_title("decay rate against natural frequency", fontsize=9)
+    a1.legend(fontsize=6, loc="upper left", bbox_to_anchor=(1.01, 1.0))
+    fig.tight_layout()
+    save_figure(fig, outputs)
