@@ -1,0 +1,39 @@
+"""Callbacks that let the evaluation score any model through the shared interfaces only
+(``model.gaussians_at`` and ``physgs.render.rasterization``), never a model class."""
+from __future__ import annotations
+
+import numpy as np
+import torch
+
+
+def model_render_fn(model, observed, *, backend: str = "auto"):
+    """render_fn(frame_idx, condition, camera) -> (rgb [H, W, 3] in [0, 1], alpha [H, W]) numpy.
+
+    model: any module with ``gaussians_at(frame_idx, wind [L+F])``; observed: ``Observed``
+    (its wind per condition and background colour). Runs without autograd.
+    """
+    from physgs.render import rasterization
+
+    winds = [torch.as_tensor(w, dtype=torch.float32) for w in observed.wind]  # C x [L+F] m/s
+    bg = torch.as_tensor(np.asarray(observed.background), dtype=torch.float32)
+
+    def render_fn(frame_idx: int, condition: int, camera):
+        with torch.no_grad():
+            g = model.gaussians_at(int(frame_idx), winds[condition])
+            out = rasterization(g.means, g.quats, g.scales, g.opacities, g.colors, camera, bg,
+                                backend=backend, return_depth=False)
+        return (out.rgb.clamp(0, 1).cpu().numpy().astype(np.float64),
+                out.alpha.cpu().numpy().astype(np.float64))
+
+    return render_fn
+
+
+def model_means_fn(model, observed):
+    """means_fn(frame_idx, condition) -> Gaussian means [N, 3] numpy (world units)."""
+    winds = [torch.as_tensor(w, dtype=torch.float32) for w in observed.wind]
+
+    def means_fn(frame_idx: int, condition: int) -> np.ndarray:
+        with torch.no_grad():
+            return model.gaussians_at(int(frame_idx), winds[condition]).means.cpu().numpy()
+
+    return means_fn
