@@ -17,6 +17,7 @@ TREES = CFG["trees"]
 
 
 include: "workflow/rules/testbed.smk"
+include: "workflow/rules/train.smk"
 
 
 rule all:

@@ -1,0 +1,45 @@
+# Training: one job per (tree, model, configuration). The only input is the observed dataset;
+# the ground-truth physics file (truth.npz) is never an input of a training rule.
+import physgs.models.registry as _models
+
+TRAIN_JOBS = _models.training_jobs()  # 5 baselines x single + ours x (single, joint32, joint96)
+
+
+def _train_input(wildcards):
+    if wildcards.config not in _models.configs_for(wildcards.model):
+        raise ValueError(
+            f"model '{wildcards.model}' is not trained in configuration '{wildcards.config}'; "
+            f"valid: {_models.configs_for(wildcards.model)} (joint configurations are ours only)"
+        )
+    return f"results/testbed/{wildcards.tree}/observed.npz"
+
+
+rule train:
+    input:
+        observed=_train_input,
+    output:
+        ckpt="results/models/{tree}/{model}_{config}.pt",
+        loss="results/models/{tree}/{model}_{config}.loss.csv",
+    wildcard_constraints:
+        tree="|".join(CFG["trees"]),
+        model="|".join(_models.MODEL_NAMES),
+        config="|".join(_models.CONFIG_NAMES),
+    params:
+        cfg=CFG,
+    log:
+        "logs/train/{tree}/{model}_{config}.log",
+    benchmark:
+        "results/benchmarks/train/{tree}/{model}_{config}.tsv"
+    threads: 2
+    resources:
+        mem_mb=4000,
+        # minutes; generous (about 1 s per iteration) so a cluster never kills a default job
+        runtime=10 + CFG["train"]["iterations"] // 60,
+    script:
+        "../scripts/train.py"
+
+
+rule train_all:
+    input:
+        expand("results/models/{tree}/{job}.pt", tree=TREES,
+               job=[f"{m}_{c}" for m, c in TRAIN_JOBS]),

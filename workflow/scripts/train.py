@@ -1,0 +1,19 @@
+"""Snakemake script of rule `train`: fit one model on one tree's observed dataset."""
+import contextlib
+
+import torch
+
+from physgs.testbed.dataset import load_observed
+from physgs.train import run_training
+
+torch.set_num_threads(snakemake.threads)  # noqa: F821 (injected by Snakemake)
+with open(snakemake.log[0], "w") as log, contextlib.redirect_stderr(log):  # noqa: F821
+    res = run_training(
+        load_observed(snakemake.input.observed),  # noqa: F821
+        snakemake.params.cfg,  # noqa: F821
+        model=snakemake.wildcards.model,  # noqa: F821
+        config=snakemake.wildcards.config,  # noqa: F821
+        checkpoint_path=snakemake.output.ckpt,  # noqa: F821
+        loss_path=snakemake.output.loss,  # noqa: F821
+    )
+    print(f"done: {res.stats}", file=log)
