@@ -1,0 +1,352 @@
+"""The testbed dataset: build one tree end to end, save it, and load it back with validation.
+
+Per tree two files: ``observed.npz`` (what models may read) and ``truth.npz`` (ground truth, never
+an input of a training rule). Time: recorded frame j (0-based) is at t = j / fps seconds; the
+stored wind and theta have L lead-in columns first, so column L + j is recorded frame j.
+"""
+from __future__ import annotations
+
+import os
+import zipfile
+import zlib
+from dataclasses import dataclass
+from pathlib import Path
+
+import numpy as np
+from tqdm import tqdm
+
+from physgs.camera import Camera
+from physgs.testbed import kinematics, physics, raycast, scene, weberpenn, wind as windmod
+from physgs.testbed.mesh import TreeMesh, build_mesh
+
+FORMAT_VERSION = 1
+REBUILD = "rebuild it with `snakemake --cores 2 testbed` (delete the bad file first)"
+
+
+class DatasetError(RuntimeError):
+    """A missing, corrupt or inconsistent dataset file; the message names the file and the fix."""
+
+
+# --------------------------------------------------------------------------------------------
+# Containers
+
+
+@dataclass(frozen=True)
+class Observed:
+    """What a model may read. Shapes: C conditions, L lead-in frames, F = n_train + n_tail
+    recorded frames, A held-out azimuths, M held-out frames, N vertices, H x W pixels.
+
+    wind [C, L+F] float32 m/s (column L = recorded frame 0); vbar [C] m/s the condition's nominal
+    mean speed (the drag forcing is v^2 - vbar^2); frames [C, F, H, W, 3] uint8; masks [C, F, H, W]
+    bool; heldout_frames [A, M, H, W, 3]; heldout_masks [A, M, H, W]; canonical_xyz [N, 3] float32
+    (m), vertex positions at recorded frame 0 of the training condition.
+    """
+
+    fps: int
+    n_train: int
+    n_tail: int
+    lead_in_frames: int
+    conditions: np.ndarray
+    vbar: np.ndarray
+    wind: np.ndarray
+    frames: np.ndarray
+    masks: np.ndarray
+    train_camera: Camera
+    heldout_azimuths_deg: np.ndarray
+    heldout_cameras: list
+    heldout_frame_idx: np.ndarray
+    heldout_frames: np.ndarray
+    heldout_masks: np.ndarray
+    background: np.ndarray
+    canonical_xyz: np.ndarray
+
+
+@dataclass(frozen=True)
+class Truth:
+    """Ground truth (never read by training). omega [B] rad/s, zeta [B], gain [B] (rad/s^2 per
+    m^2/s^2), theta [C, L+F, B] rad (same columns as wind), bone_head / bone_tail [B, 3] m (rest),
+    bone_parent [B] (-1 root), bone_level [B], bone_radius / bone_length [B] m, swing_axis [3],
+    vertex_bone [N], rest_vertices [N, 3] m, faces [M, 3], vertex_colors [N, 3], tip_vertices [P],
+    omega_clamped [B] bool, omega_c (calibration constant c in omega = c r / L^2), g0, fps,
+    lead_in_frames, vbar [C] m/s."""
+
+    omega: np.ndarray
+    zeta: np.ndarray
+    gain: np.ndarray
+    theta: np.ndarray
+    bone_head: np.ndarray
+    bone_tail: np.ndarray
+    bone_parent: np.ndarray
+    bone_level: np.ndarray
+    bone_radius: np.ndarray
+    bone_length: np.ndarray
+    swing_axis: np.ndarray
+    vertex_bone: np.ndarray
+    rest_vertices: np.ndarray
+    faces: np.ndarray
+    vertex_colors: np.ndarray
+    tip_vertices: np.ndarray
+    omega_clamped: np.ndarray
+    omega_c: float
+    g0: float
+    fps: int
+    lead_in_frames: int
+    vbar: np.ndarray
+
+
+# --------------------------------------------------------------------------------------------
+# Simulation (no rendering)
+
+
+def _seed(seed: int, *parts) -> np.random.SeedSequence:
+    return np.random.SeedSequence([int(seed)] + [zlib.crc32(str(p).encode()) for p in parts])
+
+
+@dataclass(frozen=True)
+class TreeSim:
+    skeleton: weberpenn.Skeleton
+    mesh: TreeMesh
+    truth: Truth
+    wind: np.ndarray  # [C, L+F] float32 m/s
+    conditions: np.ndarray  # [C]
+
+
+def simulate_tree(tb: dict, preset: dict, *, seed: int, tree: str) -> TreeSim:
+    """Geometry, physics and wind for one tree (everything but the frames).
+
+    tb: the resolved ``testbed`` config section; preset: ``presets.<tree>``.
+    """
+    skel = weberpenn.generate(preset, seed=seed, name=tree)
+    leaves = preset.get("leaves") or {}
+    mesh = build_mesh(skel, target_vertices=int(tb["vertices"][tree]),
+                      leaf_fraction=float(leaves.get("fraction", 0.0)),
+                      leaf_scale=float(leaves.get("scale", 0.1)), seed_seq=_seed(seed, tree, "mesh"))
+    omega, c, clamped = physics.calibrate_omega(skel.radius, skel.length, tb["band_hz"])
+    B = skel.n_bones
+    zeta = np.full(B, float(tb["zeta"]))
+    fps, F = int(tb["fps"]), int(tb["n_train"]) + int(tb["n_tail"])
+    L = physics.lead_in_frames(omega.min(), float(tb["zeta"]), float(tb["lead_in_tau"]), fps)
+
+    w = tb["wind"]
+    wf = windmod.make_wind(v0=w["v0"], turbulence_intensity=w["turbulence_intensity"],
+                           f_lo_hz=w["f_lo_hz"], f_hi_hz=w["f_hi_hz"], seed_seq=_seed(seed, "wind"))
+    if (L + F) / fps >= 60.0:
+        raise windmod.WindError(f"record of {(L + F) / fps:.1f} s exceeds the 60 s wind period; "
+                                "lower testbed.lead_in_tau or n_train/n_tail")
+    t = np.arange(-L, F) / fps
+    v = wf.speed(t)
+    if v.min() <= 0:
+        raise windmod.WindError(f"wind speed reaches {v.min():.2f} m/s <= 0; lower "
+                                "testbed.wind.turbulence_intensity in config/trees.yaml")
+    cond = np.asarray(tb["conditions"], dtype=np.float64)
+    wind32 = (cond[:, None] * v[None, :]).astype(np.float32)  # [C, L+F]
+    vbar = cond * float(w["v0"])
+    u = physics.drag_forcing(wind32.astype(np.float64), vbar)  # [C, T], the wind models observe
+    unit = physics.simulate(omega, zeta, u[:, :, None] * omega[None, None, :] ** 2, 1.0 / fps)
+    # "RMS swing" = RMS over bones and training frames of each bone's world angle (its own theta
+    # plus its ancestors'), what a viewer sees; per-bone theta is smaller on deep chains.
+    world = kinematics.cumulative_angle(skel.parent, unit[0, L:L + int(tb["n_train"])])
+    rms = np.sqrt(np.mean(world ** 2))
+    g0 = np.deg2rad(float(tb["rms_swing_deg"])) / rms
+    theta = g0 * unit  # linear system: scaling the gain scales the response
+
+    axis = kinematics.swing_axis(float(w["direction_deg"]))
+    arm_levels = int(preset["armature_levels"])
+    tip_cands = np.array([mesh.stem_tip_vertex[i] for i, s in enumerate(skel.stems)
+                          if s.level == arm_levels - 1])
+    az = np.arctan2(mesh.vertices[tip_cands, 1], mesh.vertices[tip_cands, 0])
+    order = tip_cands[np.argsort(az)]
+    P = min(6, len(order))
+    tips = order[np.linspace(0, len(order) - 1, P).round().astype(int)] if P else order
+
+    truth = Truth(omega=omega, zeta=zeta, gain=g0 * omega ** 2, theta=theta,
+                  bone_head=skel.head, bone_tail=skel.tail, bone_parent=skel.parent,
+                  bone_level=skel.level, bone_radius=skel.radius, bone_length=skel.length,
+                  swing_axis=axis, vertex_bone=mesh.vertex_bone, rest_vertices=mesh.vertices,
+                  faces=mesh.faces, vertex_colors=mesh.vertex_colors, tip_vertices=tips,
+                  omega_clamped=clamped, omega_c=c, g0=float(g0), fps=fps, lead_in_frames=L, vbar=vbar)
+    return TreeSim(skel, mesh, truth, wind32, cond)
+
+
+# --------------------------------------------------------------------------------------------
+# Rendering
+
+
+def _motion_bounds(truth: Truth, L: int, chunk: int = 32):
+    """Bounds of every posed vertex over all recorded frames and conditions."""
+    lo, hi = np.full(3, np.inf), np.full(3, -np.inf)
+    th = truth.theta[:, L:].reshape(-1, truth.theta.shape[-1])
+    for i in range(0, len(th), chunk):
+        V = kinematics.pose_vertices(truth, th[i:i + chunk])
+        lo = np.minimum(lo, V.min(axis=(0, 1)))
+        hi = np.maximum(hi, V.max(axis=(0, 1)))
+    c = 0.5 * (lo + hi)
+    rh = 0.0
+    for i in range(0, len(th), chunk):
+        V = kinematics.pose_vertices(truth, th[i:i + chunk])
+        rh = max(rh, float(np.linalg.norm(V[..., :2] - c[:2], axis=-1).max()))
+    return lo, hi, rh
+
+
+def build_dataset(tb: dict, preset: dict, *, seed: int, tree: str, progress: bool = True):
+    """Simulate and render one tree. Returns (observed arrays dict, truth arrays dict)."""
+    sim = simulate_tree(tb, preset, seed=seed, tree=tree)
+    tr = sim.truth
+    L, fps = tr.lead_in_frames, tr.fps
+    n_train, n_tail = int(tb["n_train"]), int(tb["n_tail"])
+    F = n_train + n_tail
+    lo, hi, rh = _motion_bounds(tr, L)
+    az = np.asarray(tb["heldout_azimuths_deg"], dtype=np.float64)
+    cams = scene.frame_cameras(lo, hi, rh, [0.0, *az], fov_deg=float(tb["fov_deg"]),
+                               resolution=int(tb["resolution"]))
+    train_cam, held_cams = cams[0], cams[1:]
+    ss, bg = int(tb["supersample"]), np.asarray(tb["background"], dtype=np.float64)
+    face_colors = tr.vertex_colors[tr.faces].mean(axis=1)
+    held_idx = np.arange(0, n_train, int(tb["heldout_every"]))
+    C, A, M, R = len(sim.conditions), len(held_cams), len(held_idx), int(tb["resolution"])
+
+    frames = np.empty((C, F, R, R, 3), np.uint8)
+    masks = np.empty((C, F, R, R), bool)
+    hframes = np.empty((A, M, R, R, 3), np.uint8)
+    hmasks = np.empty((A, M, R, R), bool)
+    bar = tqdm(total=C * F + A * M, desc=f"render {tree}", disable=not progress, mininterval=2.0)
+    rays = raycast.RayBundle(train_cam, ss)
+    for c in range(C):
+        for j in range(F):
+            V = kinematics.pose_vertices(tr, tr.theta[c, L + j])
+            rgb, alpha = raycast.render_mesh(V, tr.faces, face_colors, rays, bg)
+            frames[c, j], masks[c, j] = raycast.to_uint8(rgb), alpha >= 0.5
+            bar.update()
+    for a, cam in enumerate(held_cams):
+        rays = raycast.RayBundle(cam, ss)
+        for m, j in enumerate(held_idx):
+            V = kinematics.pose_vertices(tr, tr.theta[0, L + j])
+            rgb, alpha = raycast.render_mesh(V, tr.faces, face_colors, rays, bg)
+            hframes[a, m], hmasks[a, m] = raycast.to_uint8(rgb), alpha >= 0.5
+            bar.update()
+    bar.close()
+
+    canonical = kinematics.pose_vertices(tr, tr.theta[0, L]).astype(np.float32)
+    observed = dict(format_version=FORMAT_VERSION, fps=fps, n_train=n_train, n_tail=n_tail,
+                    lead_in_frames=L, conditions=sim.conditions, vbar=tr.vbar, wind=sim.wind,
+                    frames=frames, masks=masks, heldout_azimuths_deg=az, heldout_frame_idx=held_idx,
+                    heldout_frames=hframes, heldout_masks=hmasks, background=bg,
+                    canonical_xyz=canonical,
+                    **{f"train_camera_{k}": v for k, v in train_cam.to_dict().items()},
+                    **{f"heldout_camera_{k}": np.stack([cm.to_dict()[k] for cm in held_cams])
+                       for k in ("viewmat", "intrinsics", "size", "near")})
+    truth = {k: getattr(tr, k) for k in Truth.__dataclass_fields__}
+    truth["format_version"] = FORMAT_VERSION
+    return observed, truth
+
+
+# --------------------------------------------------------------------------------------------
+# Save / load
+
+
+def save_npz_atomic(arrays: dict, path: Path | str) -> Path:
+    """Write arrays to ``path`` via a temporary file in the same folder, then rename."""
+    path = Path(path)
+    path.parent.mkdir(parents=True, exist_ok=True)
+    tmp = path.with_name(path.name + ".part")
+    try:
+        with open(tmp, "wb") as f:
+            np.savez_compressed(f, **arrays)
+        os.replace(tmp, path)
+    finally:
+        if tmp.exists():
+            tmp.unlink()
+    return path
+
+
+def save_dataset(observed: dict, truth: dict, observed_path, truth_path) -> None:
+    """Write both files; neither appears unless both were written completely."""
+    parts = []
+    try:
+        for arrays, p in ((observed, Path(observed_path)), (truth, Path(truth_path))):
+            p.parent.mkdir(parents=True, exist_ok=True)
+            tmp = p.with_name(p.name + ".part")
+            parts.append((tmp, p))
+            with open(tmp, "wb") as f:
+                np.savez_compressed(f, **arrays)
+        for tmp, p in parts:
+            os.replace(tmp, p)
+    finally:
+        for tmp, _ in parts:
+            if tmp.exists():
+                tmp.unlink()
+
+
+def _open(path: Path | str, required: tuple[str, ...]) -> dict:
+    path = Path(path)
+    if not path.is_file():
+        raise DatasetError(f"dataset file {path} does not exist; build it with "
+                           "`snakemake --cores 2 testbed` (or the matching results/testbed target)")
+    try:
+        with np.load(path, allow_pickle=False) as z:
+            missing = [k for k in required if k not in z.files]
+            if missing:
+                raise DatasetError(f"dataset file {path} lacks {missing}: it is from another "
+                                   f"version or incomplete; {REBUILD}")
+            d = {k: z[k] for k in z.files}
+    except DatasetError:
+        raise
+    except (zipfile.BadZipFile, ValueError, OSError, EOFError, KeyError) as e:
+        raise DatasetError(f"dataset file {path} is corrupt ({type(e).__name__}: {e}); {REBUILD}") from None
+    if int(d.get("format_version", -1)) != FORMAT_VERSION:
+        raise DatasetError(f"dataset file {path} has format_version {d.get('format_version')}, "
+                           f"expected {FORMAT_VERSION}; {REBUILD}")
+    return d
+
+
+def _check(path, ok: bool, what: str):
+    if not ok:
+        raise DatasetError(f"dataset file {path} is inconsistent: {what}; {REBUILD}")
+
+
+OBSERVED_KEYS = ("fps", "n_train", "n_tail", "lead_in_frames", "conditions", "vbar", "wind", "frames",
+                 "masks", "train_camera_viewmat", "train_camera_intrinsics", "train_camera_size",
+                 "train_camera_near", "heldout_azimuths_deg", "heldout_camera_viewmat",
+                 "heldout_camera_intrinsics", "heldout_camera_size", "heldout_camera_near",
+                 "heldout_frame_idx", "heldout_frames", "heldout_masks", "background", "canonical_xyz")
+
+
+def load_observed(path: Path | str) -> Observed:
+    """Load and validate ``observed.npz`` (raises DatasetError naming the file and the fix)."""
+    d = _open(path, OBSERVED_KEYS)
+    C, F = len(d["conditions"]), int(d["n_train"]) + int(d["n_tail"])
+    L = int(d["lead_in_frames"])
+    _check(path, d["wind"].shape == (C, L + F), f"wind shape {d['wind'].shape} != ({C}, {L + F})")
+    _check(path, d["frames"].shape[:2] == (C, F) and d["frames"].dtype == np.uint8,
+           f"frames shape {d['frames'].shape} / dtype {d['frames'].dtype}")
+    _check(path, d["masks"].shape == d["frames"].shape[:4], "masks do not match frames")
+    A = len(d["heldout_azimuths_deg"])
+    _check(path, d["heldout_camera_viewmat"].shape == (A, 4, 4), "held-out cameras do not match azimuths")
+    _check(path, d["heldout_frames"].shape[:2] == (A, len(d["heldout_frame_idx"])),
+           "held-out frames do not match azimuths x frame indices")
+    _check(path, d["canonical_xyz"].ndim == 2 and d["canonical_xyz"].shape[1] == 3, "canonical_xyz not [N, 3]")
+    _check(path, bool(np.isfinite(d["wind"]).all() and np.isfinite(d["canonical_xyz"]).all()),
+           "non-finite wind or canonical_xyz")
+    cam = Camera.from_dict({k: d[f"train_camera_{k}"] for k in ("viewmat", "intrinsics", "size", "near")})
+    held = [Camera.from_dict({k: d[f"heldout_camera_{k}"][a] for k in ("viewmat", "intrinsics", "size", "near")})
+            for a in range(A)]
+    return Observed(fps=int(d["fps"]), n_train=int(d["n_train"]), n_tail=int(d["n_tail"]),
+                    lead_in_frames=L, conditions=d["conditions"], vbar=d["vbar"], wind=d["wind"],
+                    frames=d["frames"], masks=d["masks"], train_camera=cam,
+                    heldout_azimuths_deg=d["heldout_azimuths_deg"], heldout_cameras=held,
+                    heldout_frame_idx=d["heldout_frame_idx"], heldout_frames=d["heldout_frames"],
+                    heldout_masks=d["heldout_masks"], background=d["background"],
+                    canonical_xyz=d["canonical_xyz"])
+
+
+def load_truth(path: Path | str) -> Truth:
+    """Load and validate ``truth.npz`` (raises DatasetError naming the file and the fix)."""
+    keys = tuple(Truth.__dataclass_fields__)
+    d = _open(path, keys)
+    B = len(d["omega"])
+    _check(path, d["theta"].ndim == 3 and d["theta"].shape[2] == B, f"theta shape {d['theta'].shape}")
+    _check(path, d["bone_head"].shape == (B, 3) and len(d["bone_parent"]) == B, "bone arrays disagree")
+    _check(path, len(d["vertex_bone"]) == len(d["rest_vertices"]), "vertex_bone does not match rest_vertices")
+    _check(path, bool((d["vertex_bone"] >= 0).all() and (d["vertex_bone"] < B).all()), "vertex_bone out of range")
+    scalars = {"omega_c": float, "g0": float, "fps": int, "lead_in_frames": int}
+    return Truth(**{k: scalars[k](d[k]) if k in scalars else d[k] for k in keys})
