@@ -12,6 +12,7 @@ import numpy as np
 import torch
 
 from physgs.camera import Camera
+from physgs.render.fast import rasterize_fast
 from physgs.render.project import project_gaussians
 from physgs.render.reference import composite_reference
 
@@ -29,6 +30,14 @@ class RenderOutput:
     depth: torch.Tensor | None
 
 
+def _all(torch_pred, np_pred, x: torch.Tensor) -> bool:
+    # numpy on the CPU: a single small torch op can cost milliseconds of OpenMP barrier on a
+    # busy 2-core machine.
+    if x.device.type == "cpu":
+        return bool(np_pred(x.detach().numpy()).all())
+    return bool(torch_pred(x.detach()).all())
+
+
 def _check_inputs(means, quats, scales, opacities, colors, camera, background):
     n = means.shape[0] if means.ndim == 2 else -1
     shapes = {"means": (means, (n, 3)), "quats": (quats, (n, 4)), "scales": (scales, (n, 3)),
@@ -42,15 +51,15 @@ def _check_inputs(means, quats, scales, opacities, colors, camera, background):
         if x.dtype != means.dtype or x.device != means.device:
             raise ValueError(f"rasterization: {name} is {x.dtype} on {x.device} but means is "
                              f"{means.dtype} on {means.device}; cast all inputs alike")
-        if not torch.isfinite(x).all():
+        if not _all(torch.isfinite, np.isfinite, x):
             raise ValueError(f"rasterization: {name} contains NaN or inf; fix the upstream model "
                              "(e.g. a diverged training step)")
     if means.dtype not in (torch.float32, torch.float64):
         raise ValueError(f"rasterization: dtype {means.dtype} unsupported; use float32 or float64")
-    if (scales < 0).any():
+    if not _all(lambda v: v >= 0, lambda v: v >= 0, scales):
         raise ValueError("rasterization: scales must be >= 0 (already activated, e.g. exp of the "
                          "log-scale parameter)")
-    if ((opacities < 0) | (opacities > 1)).any():
+    if not _all(lambda v: (v >= 0) & (v <= 1), lambda v: (v >= 0) & (v <= 1), opacities):
         raise ValueError("rasterization: opacities must lie in [0, 1] (already activated, e.g. "
                          "sigmoid of the logit parameter)")
     if not isinstance(camera, Camera):
@@ -103,15 +112,14 @@ def rasterization(means: torch.Tensor, quats: torch.Tensor, scales: torch.Tensor
         rgb, alpha, depth = rasterize_gsplat(means, quats, scales, opacities, colors, camera,
                                              background, return_depth)
         return RenderOutput(rgb, alpha, depth)
-    proj = project_gaussians(means, quats, scales, camera)
-    args = (proj.means2d, proj.conics, opacities, colors, proj.depths, proj.valid, proj.cov2d,
-            background, camera.width, camera.height, return_depth)
     if backend == "fast":
-        from physgs.render.fast import composite_fast
-
-        rgb, alpha, depth = composite_fast(*args)
-    else:
-        rgb, alpha, depth = composite_reference(*args)
+        rgb, alpha, depth = rasterize_fast(means, quats, scales, opacities, colors, camera,
+                                           background, return_depth)
+        return RenderOutput(rgb, alpha, depth)
+    proj = project_gaussians(means, quats, scales, camera)
+    rgb, alpha, depth = composite_reference(proj.means2d, proj.conics, opacities, colors,
+                                            proj.depths, proj.valid, proj.cov2d, background,
+                                            camera.width, camera.height, return_depth)
     return RenderOutput(rgb, alpha, depth)
 
 

@@ -1,2 +1,109 @@
-"""Fast CPU compositing (numba kernels). Temporary: routes to the reference until the kernels land."""
-from physgs.render.reference import composite_reference as composite_fast  # noqa: F401
+"""Fast CPU rasterizer: fused numba projection + tile compositing behind one
+torch.autograd.Function with an explicit backward (kernels in :mod:`physgs.render.kernels`).
+
+Everything between the input tensors and the output images runs in numba or vectorised numpy:
+no Python loop over Gaussians and no small torch ops (whose OpenMP barriers cost more than the
+arithmetic on a busy 2-core machine).
+"""
+from __future__ import annotations
+
+import numpy as np
+import torch
+
+from physgs.camera import Camera
+from physgs.render import kernels
+from physgs.render.project import EPS2D, TILE, pixel_bounds
+
+
+def _np(x: torch.Tensor) -> np.ndarray:
+    # float64 whatever the input dtype: the kernels compute in float64 and compile only once.
+    return np.ascontiguousarray(x.detach().cpu().numpy(), dtype=np.float64)
+
+
+def camera_arrays(camera: Camera):
+    """(Rc [3, 3], tc [3], intr [4], lims [4]) float64 for the kernels; lims are gsplat's
+    tangent clamps (x-, x+, y-, y+) of the projection Jacobian."""
+    fx, fy, cx, cy, W, H = camera.fx, camera.fy, camera.cx, camera.cy, camera.width, camera.height
+    lims = np.array([cx / fx + 0.3 * W / fx, (W - cx) / fx + 0.3 * W / fx,
+                     cy / fy + 0.3 * H / fy, (H - cy) / fy + 0.3 * H / fy])
+    return (np.ascontiguousarray(camera.R, dtype=np.float64),
+            np.ascontiguousarray(camera.t, dtype=np.float64), np.array([fx, fy, cx, cy]), lims)
+
+
+class _FastRasterize(torch.autograd.Function):
+    @staticmethod
+    def forward(ctx, means, quats, scales, opacities, colors, background, camera):
+        m, q, s, o, col, bg = (_np(x) for x in (means, quats, scales, opacities, colors,
+                                               background))
+        n, D = col.shape
+        W, H = camera.width, camera.height
+        cam = camera_arrays(camera)
+        m2 = np.empty((n, 2))
+        con = np.empty((n, 3))
+        dep = np.empty(n)
+        cov = np.empty((n, 3))
+        valid = np.empty(n, np.bool_)
+        kernels.project_forward(m, q, s, *cam, camera.near, EPS2D, m2, con, dep, cov, valid)
+        boxes = pixel_bounds(m2, cov, o, valid, W, H)
+        touches = boxes[:, 0] <= boxes[:, 1]
+        order = np.argsort(np.where(touches, dep, np.inf), kind="stable")[: int(touches.sum())]
+        tiles_x = (W + TILE - 1) // TILE
+        tiles_y = (H + TILE - 1) // TILE
+        tile_start, pair_gid = kernels.bin_tiles(boxes, order.astype(np.int64), TILE, tiles_x,
+                                                 tiles_y)
+        rgb = np.empty((H, W, D))
+        alpha = np.empty((H, W))
+        depth = np.empty((H, W))
+        acc_c = np.empty((H, W, D))
+        acc_d = np.empty((H, W))
+        t_final = np.empty((H, W))
+        n_contrib = np.empty((H, W), np.int64)
+        comp = (m2, con, o, col, dep, bg, boxes, tile_start, pair_gid, TILE, tiles_x, W, H)
+        kernels.forward(*comp, rgb, alpha, depth, acc_c, acc_d, t_final, n_contrib)
+        ctx.saved = (m, q, s, cam, camera.near, valid, comp, acc_c, acc_d, t_final)
+        ctx.device, ctx.dtype = means.device, means.dtype
+        return tuple(torch.from_numpy(x).to(means.device, means.dtype)
+                     for x in (rgb, alpha, depth))
+
+    @staticmethod
+    def backward(ctx, g_rgb, g_alpha, g_depth):
+        m, q, s, cam, near, valid, comp, acc_c, acc_d, t_final = ctx.saved
+        H, W = t_final.shape
+        D = comp[3].shape[1]
+        n = m.shape[0]
+
+        def up(g, shape):  # upstream gradient as float64 numpy; None means zero
+            if g is None:
+                return np.zeros(shape)
+            return np.ascontiguousarray(g.detach().cpu().numpy(), dtype=np.float64)
+
+        g_rgb = up(g_rgb, (H, W, D))
+        g_alpha = up(g_alpha, (H, W))
+        g_depth = up(g_depth, (H, W))
+        pair_gid = comp[8]
+        pair_grad = np.zeros((pair_gid.shape[0], kernels.N_GRAD + D))
+        kernels.backward(*comp, acc_c, acc_d, t_final, g_rgb, g_alpha, g_depth, pair_grad)
+        G = kernels.reduce_pairs(pair_gid, pair_grad, n)  # [N, 7 + D]
+        v_means = np.empty((n, 3))
+        v_quats = np.empty((n, 4))
+        v_scales = np.empty((n, 3))
+        kernels.project_backward(m, q, s, *cam, near, EPS2D, valid,
+                                 np.ascontiguousarray(G[:, 0:2]), np.ascontiguousarray(G[:, 2:5]),
+                                 np.ascontiguousarray(G[:, 6]), v_means, v_quats, v_scales)
+        g_bg = np.einsum("hwd,hw->d", g_rgb, t_final)
+        out = (v_means, v_quats, v_scales, G[:, 5], G[:, kernels.N_GRAD:], g_bg)
+        return tuple(torch.from_numpy(np.ascontiguousarray(x)).to(ctx.device, ctx.dtype)
+                     for x in out) + (None,)
+
+
+def rasterize_fast(means: torch.Tensor, quats: torch.Tensor, scales: torch.Tensor,
+                   opacities: torch.Tensor, colors: torch.Tensor, camera: Camera,
+                   background: torch.Tensor, return_depth: bool = True):
+    """Fast CPU backend of :func:`physgs.render.rasterization` (same shapes and units).
+
+    Returns (rgb [H, W, D], alpha [H, W], depth [H, W] or None). Tensors on another device are
+    copied to the CPU and back. Arithmetic is float64 inside the kernels for any input dtype.
+    """
+    rgb, alpha, depth = _FastRasterize.apply(means, quats, scales, opacities, colors, background,
+                                             camera)
+    return rgb, alpha, (depth if return_depth else None)

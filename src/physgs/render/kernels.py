@@ -1,0 +1,417 @@
+"""Numba kernels of the fast CPU rasterizer: tile binning, forward compositing, explicit backward.
+
+Work layout: 16x16 tiles run in parallel (prange); inside a tile the Gaussians are visited front
+to back ("Gaussian-major") and each one updates only the pixels of its conservative pixel box, so
+the work is the summed footprint rather than pixels x candidates. Per pixel this is exactly the
+3DGS recurrence (skip alpha < 1/255, stop before transmittance falls below 1e-4), because pixels
+outside a box have alpha < 1/255 anyway. Arithmetic is float64 inside the kernels whatever the
+input dtype; per-pixel float64 totals from the forward pass feed the backward pass, which needs
+no reverse traversal: the light behind Gaussian i is (total - prefix up to i).
+
+Determinism: every tile writes only its own pixels and its own rows of the per-(tile, Gaussian)
+gradient buffer; a sequential loop then sums those rows per Gaussian in a fixed order. No atomics.
+"""
+from __future__ import annotations
+
+import math
+
+import numba as nb
+import numpy as np
+
+ALPHA_MIN = 1.0 / 255.0
+ALPHA_MAX = 0.99
+T_MIN = 1e-4
+N_GRAD = 7  # per-pair gradient columns before colours: mx, my, conic a, b, c, opacity, depth
+
+
+@nb.njit(cache=True)
+def bin_tiles(boxes, order, tile, tiles_x, tiles_y):  # pragma: no cover - compiled
+    """Tile lists of depth-sorted Gaussians.
+
+    boxes [N, 4] int64 (x0, x1, y0, y1) inclusive pixel ranges; order [M] Gaussian ids sorted
+    front to back, only ones whose box is non-empty. Returns (tile_start [T + 1], pair_gid [P]):
+    tile t holds pair_gid[tile_start[t]:tile_start[t + 1]], in depth order.
+    """
+    n_tiles = tiles_x * tiles_y
+    start = np.zeros(n_tiles + 1, np.int64)
+    for k in range(order.shape[0]):
+        g = order[k]
+        for ty in range(boxes[g, 2] // tile, boxes[g, 3] // tile + 1):
+            for tx in range(boxes[g, 0] // tile, boxes[g, 1] // tile + 1):
+                start[ty * tiles_x + tx + 1] += 1
+    for t in range(n_tiles):
+        start[t + 1] += start[t]
+    cursor = start[:-1].copy()
+    pair_gid = np.empty(start[n_tiles], np.int64)
+    for k in range(order.shape[0]):
+        g = order[k]
+        for ty in range(boxes[g, 2] // tile, boxes[g, 3] // tile + 1):
+            for tx in range(boxes[g, 0] // tile, boxes[g, 1] // tile + 1):
+                t = ty * tiles_x + tx
+                pair_gid[cursor[t]] = g
+                cursor[t] += 1
+    return start, pair_gid
+
+
+@nb.njit(parallel=True, cache=True)
+def forward(means2d, conics, opac, colors, depths, bg, boxes, tile_start, pair_gid, tile,
+            tiles_x, width, height, out_rgb, out_alpha, out_depth, acc_c, acc_d, t_final,
+            n_contrib):  # pragma: no cover - compiled
+    """Composite front to back. Inputs: means2d [N, 2] px, conics [N, 3], opac [N],
+    colors [N, D], depths [N], bg [D], boxes [N, 4], tile lists from bin_tiles.
+    Writes out_rgb [H, W, D], out_alpha [H, W], out_depth [H, W] (input dtype) and float64 totals
+    for the backward: acc_c [H, W, D] = sum c a T, acc_d [H, W] = sum z a T, t_final [H, W];
+    n_contrib [H, W] counts composited Gaussians."""
+    D = colors.shape[1]
+    n_tiles = tile_start.shape[0] - 1
+    for t in nb.prange(n_tiles):
+        ty0 = (t // tiles_x) * tile
+        tx0 = (t % tiles_x) * tile
+        th = min(tile, height - ty0)
+        tw = min(tile, width - tx0)
+        npix = th * tw
+        T = np.ones(npix)
+        done = np.zeros(npix, np.bool_)
+        cacc = np.zeros((npix, D))
+        dacc = np.zeros(npix)
+        cnt = np.zeros(npix, np.int64)
+        n_done = 0
+        for k in range(tile_start[t], tile_start[t + 1]):
+            if n_done == npix:
+                break
+            g = pair_gid[k]
+            mx = means2d[g, 0]
+            my = means2d[g, 1]
+            ca = conics[g, 0]
+            cb = conics[g, 1]
+            cc = conics[g, 2]
+            o = opac[g]
+            y0 = max(boxes[g, 2], ty0)
+            y1 = min(boxes[g, 3], ty0 + th - 1)
+            x0 = max(boxes[g, 0], tx0)
+            x1 = min(boxes[g, 1], tx0 + tw - 1)
+            for py in range(y0, y1 + 1):
+                dy = py + 0.5 - my
+                for px in range(x0, x1 + 1):
+                    p = (py - ty0) * tw + (px - tx0)
+                    if done[p]:
+                        continue
+                    dx = px + 0.5 - mx
+                    sigma = ca * dx * dx + 2.0 * cb * dx * dy + cc * dy * dy
+                    a = min(ALPHA_MAX, o * math.exp(-0.5 * sigma))
+                    if a < ALPHA_MIN:
+                        continue
+                    nt = T[p] * (1.0 - a)
+                    if nt < T_MIN:
+                        done[p] = True
+                        n_done += 1
+                        continue
+                    w = a * T[p]
+                    for c in range(D):
+                        cacc[p, c] += w * colors[g, c]
+                    dacc[p] += w * depths[g]
+                    cnt[p] += 1
+                    T[p] = nt
+        for ly in range(th):
+            for lx in range(tw):
+                p = ly * tw + lx
+                py = ty0 + ly
+                px = tx0 + lx
+                for c in range(D):
+                    acc_c[py, px, c] = cacc[p, c]
+                    out_rgb[py, px, c] = cacc[p, c] + T[p] * bg[c]
+                acc_d[py, px] = dacc[p]
+                out_depth[py, px] = dacc[p]
+                t_final[py, px] = T[p]
+                out_alpha[py, px] = 1.0 - T[p]
+                n_contrib[py, px] = cnt[p]
+
+
+@nb.njit(parallel=True, cache=True)
+def backward(means2d, conics, opac, colors, depths, bg, boxes, tile_start, pair_gid, tile,
+             tiles_x, width, height, acc_c, acc_d, t_final, g_rgb, g_alpha, g_depth,
+             pair_grad):  # pragma: no cover - compiled
+    """Explicit backward of :func:`forward`. g_rgb [H, W, D], g_alpha [H, W], g_depth [H, W] are
+    upstream gradients (float64). Writes pair_grad [P, 7 + D] per (tile, Gaussian) pair:
+    d/d(mx, my, conic a, b, c, opacity, depth, colours). Front-to-back pass: the light behind
+    Gaussian i is total - prefix_i, so no per-pixel list is stored."""
+    D = colors.shape[1]
+    n_tiles = tile_start.shape[0] - 1
+    for t in nb.prange(n_tiles):
+        ty0 = (t // tiles_x) * tile
+        tx0 = (t % tiles_x) * tile
+        th = min(tile, height - ty0)
+        tw = min(tile, width - tx0)
+        npix = th * tw
+        T = np.ones(npix)
+        done = np.zeros(npix, np.bool_)
+        pc = np.zeros((npix, D))  # prefix sum c a T, Gaussian i included
+        pd = np.zeros(npix)
+        gacc = np.zeros(N_GRAD + D)
+        n_done = 0
+        for k in range(tile_start[t], tile_start[t + 1]):
+            if n_done == npix:
+                break
+            g = pair_gid[k]
+            mx = means2d[g, 0]
+            my = means2d[g, 1]
+            ca = conics[g, 0]
+            cb = conics[g, 1]
+            cc = conics[g, 2]
+            o = opac[g]
+            z = depths[g]
+            gacc[:] = 0.0
+            y0 = max(boxes[g, 2], ty0)
+            y1 = min(boxes[g, 3], ty0 + th - 1)
+            x0 = max(boxes[g, 0], tx0)
+            x1 = min(boxes[g, 1], tx0 + tw - 1)
+            for py in range(y0, y1 + 1):
+                dy = py + 0.5 - my
+                for px in range(x0, x1 + 1):
+                    p = (py - ty0) * tw + (px - tx0)
+                    if done[p]:
+                        continue
+                    dx = px + 0.5 - mx
+                    sigma = ca * dx * dx + 2.0 * cb * dx * dy + cc * dy * dy
+                    G = math.exp(-0.5 * sigma)
+                    raw = o * G
+                    a = min(ALPHA_MAX, raw)
+                    if a < ALPHA_MIN:
+                        continue
+                    Tp = T[p]
+                    nt = Tp * (1.0 - a)
+                    if nt < T_MIN:
+                        done[p] = True
+                        n_done += 1
+                        continue
+                    w = a * Tp
+                    inv = 1.0 / (1.0 - a)
+                    tf = t_final[py, px]
+                    dlda = g_alpha[py, px] * tf * inv
+                    for c in range(D):
+                        gc = g_rgb[py, px, c]
+                        pc[p, c] += w * colors[g, c]
+                        behind = acc_c[py, px, c] - pc[p, c] + tf * bg[c]
+                        dlda += gc * (colors[g, c] * Tp - behind * inv)
+                        gacc[N_GRAD + c] += gc * w
+                    gd = g_depth[py, px]
+                    pd[p] += w * z
+                    dlda += gd * (z * Tp - (acc_d[py, px] - pd[p]) * inv)
+                    gacc[6] += gd * w
+                    T[p] = nt
+                    if raw <= ALPHA_MAX:  # the clamp passes no gradient above 0.99
+                        gacc[5] += dlda * G
+                        ds = -0.5 * a * dlda  # dL/dsigma
+                        gacc[2] += ds * dx * dx
+                        gacc[3] += ds * 2.0 * dx * dy
+                        gacc[4] += ds * dy * dy
+                        gacc[0] -= ds * 2.0 * (ca * dx + cb * dy)
+                        gacc[1] -= ds * 2.0 * (cb * dx + cc * dy)
+            for j in range(N_GRAD + D):
+                pair_grad[k, j] = gacc[j]
+
+
+@nb.njit(cache=True)
+def reduce_pairs(pair_gid, pair_grad, n):  # pragma: no cover - compiled
+    """Sum pair_grad [P, C] into per-Gaussian rows [n, C] in pair order (deterministic)."""
+    out = np.zeros((n, pair_grad.shape[1]))
+    for k in range(pair_gid.shape[0]):
+        g = pair_gid[k]
+        for j in range(pair_grad.shape[1]):
+            out[g, j] += pair_grad[k, j]
+    return out
+
+
+@nb.njit(cache=True, inline="always")
+def _quat_rotmat(qw, qx, qy, qz):  # pragma: no cover - compiled
+    """Unit quaternion (w, x, y, z) -> row-major 3x3 rotation as a [3, 3] array."""
+    Rq = np.empty((3, 3))
+    Rq[0, 0] = 1 - 2 * (qy * qy + qz * qz)
+    Rq[0, 1] = 2 * (qx * qy - qw * qz)
+    Rq[0, 2] = 2 * (qx * qz + qw * qy)
+    Rq[1, 0] = 2 * (qx * qy + qw * qz)
+    Rq[1, 1] = 1 - 2 * (qx * qx + qz * qz)
+    Rq[1, 2] = 2 * (qy * qz - qw * qx)
+    Rq[2, 0] = 2 * (qx * qz - qw * qy)
+    Rq[2, 1] = 2 * (qy * qz + qw * qx)
+    Rq[2, 2] = 1 - 2 * (qx * qx + qy * qy)
+    return Rq
+
+
+@nb.njit(parallel=True, cache=True)
+def project_forward(means, quats, scales, Rc, tc, intr, lims, near, eps2d, means2d, conics,
+                    depths, cov2d, valid):  # pragma: no cover - compiled
+    """Fused EWA projection, same maths as :func:`physgs.render.project.project_gaussians`.
+
+    means [N, 3], quats [N, 4] wxyz, scales [N, 3] world units; Rc [3, 3], tc [3] world->camera;
+    intr (fx, fy, cx, cy) px; lims (x-, x+, y-, y+) tangent clamps; near world units.
+    Writes means2d [N, 2] px, conics [N, 3], depths [N], cov2d [N, 3] px^2, valid [N];
+    culled Gaussians get zeros.
+    """
+    fx, fy, cx, cy = intr[0], intr[1], intr[2], intr[3]
+    for i in nb.prange(means.shape[0]):
+        x = Rc[0, 0] * means[i, 0] + Rc[0, 1] * means[i, 1] + Rc[0, 2] * means[i, 2] + tc[0]
+        y = Rc[1, 0] * means[i, 0] + Rc[1, 1] * means[i, 1] + Rc[1, 2] * means[i, 2] + tc[1]
+        z = Rc[2, 0] * means[i, 0] + Rc[2, 1] * means[i, 1] + Rc[2, 2] * means[i, 2] + tc[2]
+        ok = z > near
+        a = 0.0
+        b = 0.0
+        c = 0.0
+        det = 0.0
+        if ok:
+            qn = math.sqrt(quats[i, 0] ** 2 + quats[i, 1] ** 2 + quats[i, 2] ** 2
+                           + quats[i, 3] ** 2)
+            qn = max(qn, 1e-12)
+            Rq = _quat_rotmat(quats[i, 0] / qn, quats[i, 1] / qn, quats[i, 2] / qn,
+                              quats[i, 3] / qn)
+            M = Rc @ Rq  # scaled columns below
+            for col in range(3):
+                for row in range(3):
+                    M[row, col] *= scales[i, col]
+            tx = z * min(max(x / z, -lims[0]), lims[1])
+            ty = z * min(max(y / z, -lims[2]), lims[3])
+            # JM = J @ M, J = [[fx/z, 0, -fx tx/z^2], [0, fy/z, -fy ty/z^2]]
+            j00 = fx / z
+            j02 = -fx * tx / (z * z)
+            j11 = fy / z
+            j12 = -fy * ty / (z * z)
+            a = 0.0
+            b = 0.0
+            c = 0.0
+            for col in range(3):
+                r0 = j00 * M[0, col] + j02 * M[2, col]
+                r1 = j11 * M[1, col] + j12 * M[2, col]
+                a += r0 * r0
+                b += r0 * r1
+                c += r1 * r1
+            a += eps2d
+            c += eps2d
+            det = a * c - b * b
+            ok = det > 0 and math.isfinite(det)
+        valid[i] = ok
+        if ok:
+            means2d[i, 0] = fx * x / z + cx
+            means2d[i, 1] = fy * y / z + cy
+            conics[i, 0] = c / det
+            conics[i, 1] = -b / det
+            conics[i, 2] = a / det
+            depths[i] = z
+            cov2d[i, 0] = a
+            cov2d[i, 1] = b
+            cov2d[i, 2] = c
+        else:
+            means2d[i, 0] = 0.0
+            means2d[i, 1] = 0.0
+            depths[i] = 0.0
+            for j in range(3):
+                conics[i, j] = 0.0
+                cov2d[i, j] = 0.0
+
+
+@nb.njit(parallel=True, cache=True)
+def project_backward(means, quats, scales, Rc, tc, intr, lims, near, eps2d, valid, v_means2d,
+                     v_conics, v_depths, v_means, v_quats, v_scales):  # pragma: no cover
+    """Explicit backward of :func:`project_forward`: upstream v_means2d [N, 2], v_conics [N, 3],
+    v_depths [N] -> v_means [N, 3], v_quats [N, 4], v_scales [N, 3] (written; zero if culled).
+    Each Gaussian is independent, so the parallel loop is race-free and deterministic."""
+    fx, fy, cx, cy = intr[0], intr[1], intr[2], intr[3]
+    for i in nb.prange(means.shape[0]):
+        for j in range(3):
+            v_means[i, j] = 0.0
+            v_scales[i, j] = 0.0
+        for j in range(4):
+            v_quats[i, j] = 0.0
+        if not valid[i]:
+            continue
+        x = Rc[0, 0] * means[i, 0] + Rc[0, 1] * means[i, 1] + Rc[0, 2] * means[i, 2] + tc[0]
+        y = Rc[1, 0] * means[i, 0] + Rc[1, 1] * means[i, 1] + Rc[1, 2] * means[i, 2] + tc[1]
+        z = Rc[2, 0] * means[i, 0] + Rc[2, 1] * means[i, 1] + Rc[2, 2] * means[i, 2] + tc[2]
+        qraw = np.empty(4)
+        for j in range(4):
+            qraw[j] = quats[i, j]
+        qn = max(math.sqrt(qraw[0] ** 2 + qraw[1] ** 2 + qraw[2] ** 2 + qraw[3] ** 2), 1e-12)
+        qw, qx, qy, qz = qraw[0] / qn, qraw[1] / qn, qraw[2] / qn, qraw[3] / qn
+        Rq = _quat_rotmat(qw, qx, qy, qz)
+        RR = Rc @ Rq
+        M = RR.copy()
+        for col in range(3):
+            for row in range(3):
+                M[row, col] *= scales[i, col]
+        ux = x / z
+        uy = y / z
+        cl_x = ux < -lims[0] or ux > lims[1]
+        cl_y = uy < -lims[2] or uy > lims[3]
+        tx = z * min(max(ux, -lims[0]), lims[1])
+        ty = z * min(max(uy, -lims[2]), lims[3])
+        J = np.zeros((2, 3))
+        J[0, 0] = fx / z
+        J[0, 2] = -fx * tx / (z * z)
+        J[1, 1] = fy / z
+        J[1, 2] = -fy * ty / (z * z)
+        Sc = M @ M.T  # camera-frame 3D covariance
+        cov = J @ Sc @ J.T
+        a = cov[0, 0] + eps2d
+        b = cov[0, 1]
+        c = cov[1, 1] + eps2d
+        det = a * c - b * b
+        Con = np.empty((2, 2))
+        Con[0, 0] = c / det
+        Con[0, 1] = -b / det
+        Con[1, 0] = -b / det
+        Con[1, 1] = a / det
+        # conic = inverse(cov): dL/dcov = -Con G Con, G the symmetric split of dL/dconic.
+        G = np.empty((2, 2))
+        G[0, 0] = v_conics[i, 0]
+        G[0, 1] = 0.5 * v_conics[i, 1]
+        G[1, 0] = 0.5 * v_conics[i, 1]
+        G[1, 1] = v_conics[i, 2]
+        Vcov = -(Con @ G @ Con)  # symmetric [2, 2]
+        # cov = J Sc J^T
+        VSc = J.T @ Vcov @ J  # [3, 3]
+        VJ = 2.0 * (Vcov @ J @ Sc)  # [2, 3]
+        # Sc = M M^T, M = RR diag(s), RR = Rc Rq
+        VM = 2.0 * (VSc @ M)  # [3, 3]
+        VRR = np.empty((3, 3))
+        for col in range(3):
+            for row in range(3):
+                VRR[row, col] = VM[row, col] * scales[i, col]
+            v_scales[i, col] = (VM[0, col] * RR[0, col] + VM[1, col] * RR[1, col]
+                                + VM[2, col] * RR[2, col])
+        VRq = Rc.T @ VRR
+        # rotation matrix -> unit quaternion
+        gw = 2 * (-qz * VRq[0, 1] + qy * VRq[0, 2] + qz * VRq[1, 0] - qx * VRq[1, 2]
+                  - qy * VRq[2, 0] + qx * VRq[2, 1])
+        gx = 2 * (qy * VRq[0, 1] + qz * VRq[0, 2] + qy * VRq[1, 0] - 2 * qx * VRq[1, 1]
+                  - qw * VRq[1, 2] + qz * VRq[2, 0] + qw * VRq[2, 1] - 2 * qx * VRq[2, 2])
+        gy = 2 * (-2 * qy * VRq[0, 0] + qx * VRq[0, 1] + qw * VRq[0, 2] + qx * VRq[1, 0]
+                  + qz * VRq[1, 2] - qw * VRq[2, 0] + qz * VRq[2, 1] - 2 * qy * VRq[2, 2])
+        gz = 2 * (-2 * qz * VRq[0, 0] - qw * VRq[0, 1] + qx * VRq[0, 2] + qw * VRq[1, 0]
+                  - 2 * qz * VRq[1, 1] + qy * VRq[1, 2] + qx * VRq[2, 0] + qy * VRq[2, 1])
+        # normalisation q / |q|
+        dot = qw * gw + qx * gx + qy * gy + qz * gz
+        v_quats[i, 0] = (gw - qw * dot) / qn
+        v_quats[i, 1] = (gx - qx * dot) / qn
+        v_quats[i, 2] = (gy - qy * dot) / qn
+        v_quats[i, 3] = (gz - qz * dot) / qn
+        # J entries -> camera position (x, y, z) through z, tx, ty
+        v_tx = VJ[0, 2] * (-fx / (z * z))
+        v_ty = VJ[1, 2] * (-fy / (z * z))
+        vz = (VJ[0, 0] * (-fx / (z * z)) + VJ[1, 1] * (-fy / (z * z))
+              + VJ[0, 2] * (2 * fx * tx / (z * z * z)) + VJ[1, 2] * (2 * fy * ty / (z * z * z)))
+        vx = 0.0
+        vy = 0.0
+        if cl_x:
+            vz += v_tx * tx / z  # tx = z * lim
+        else:
+            vx += v_tx
+        if cl_y:
+            vz += v_ty * ty / z
+        else:
+            vy += v_ty
+        # means2d and depth
+        vx += v_means2d[i, 0] * fx / z
+        vy += v_means2d[i, 1] * fy / z
+        vz += -v_means2d[i, 0] * fx * x / (z * z) - v_means2d[i, 1] * fy * y / (z * z)
+        vz += v_depths[i]
+        for j in range(3):
+            v_means[i, j] = Rc[0, j] * vx + Rc[1, j] * vy + Rc[2, j] * vz
