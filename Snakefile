@@ -18,8 +18,12 @@ TREES = CFG["trees"]
 
 include: "workflow/rules/testbed.smk"
 include: "workflow/rules/train.smk"
+include: "workflow/rules/evaluate.smk"
+include: "workflow/rules/recovery.smk"
+include: "workflow/rules/report.smk"
 
 
 rule all:
     input:
         rules.testbed.input,
+        rules.report.input,

@@ -1,0 +1,72 @@
+"""Evaluate one trained checkpoint end to end: splits, tip trajectories and qualitative panels.
+
+This is what the Snakemake rule `evaluate` calls; it only joins the pieces of
+``physgs.evaluate`` (scores through the render callback, never through a model class).
+"""
+from __future__ import annotations
+
+import numpy as np
+
+from physgs.evaluate.adapter import model_means_fn, model_render_fn
+from physgs.evaluate.atomic import save_npz
+from physgs.evaluate.metrics import psnr
+from physgs.evaluate.splits import evaluate
+from physgs.evaluate.trajectories import tip_trajectories
+
+
+def panel_choice(observed) -> dict[str, tuple[int, int, int]]:
+    """The qualitative panels of fig_results: split -> (frame_idx, condition, camera index).
+
+    camera index -1 is the training camera, otherwise a held-out azimuth. Fixed choices so every
+    model shows the same frame: the middle of the tail (unseen time), the held-out azimuth
+    nearest +30 degrees in the middle of the window (unseen view), and the weakest unseen wind in
+    the middle of the tail (unseen wind, where replay cannot help).
+    """
+    mid_tail = int(observed.n_train + observed.n_tail // 2)
+    az = np.asarray(observed.heldout_azimuths_deg, dtype=np.float64)
+    a = int(np.argmin(np.abs(az - 30.0)))
+    m = len(observed.heldout_frame_idx) // 2
+    return {
+        "time": (mid_tail, 0, -1),
+        "view": (int(observed.heldout_frame_idx[m]), 0, a),
+        "wind": (mid_tail, len(observed.conditions) - 1, -1),
+    }
+
+
+def render_panels(render_fn, observed) -> dict[str, np.ndarray]:
+    """Renders and ground truth of the fig_results panels; arrays keyed '<split>_pred/_gt/_psnr'."""
+    out = {}
+    for split, (j, c, a) in panel_choice(observed).items():
+        if a < 0:
+            cam, gt = observed.train_camera, observed.frames[c, j]
+        else:
+            m = int(np.flatnonzero(np.asarray(observed.heldout_frame_idx) == j)[0])
+            cam, gt = observed.heldout_cameras[a], observed.heldout_frames[a, m]
+        rgb, _ = render_fn(j, c, cam)
+        out[f"{split}_pred"] = (np.clip(rgb, 0, 1) * 255 + 0.5).astype(np.uint8)
+        out[f"{split}_gt"] = np.asarray(gt)
+        out[f"{split}_psnr"] = np.asarray(float(psnr(rgb, gt)))
+    return out
+
+
+def evaluate_checkpoint(model, observed, truth, *, eval_path, traj_path, panels_path,
+                        backend: str = "auto", progress=None) -> dict[str, float]:
+    """Score ``model`` on every split and write three files atomically.
+
+    eval_path: ``EvalResult`` npz (per-frame PSNR in dB, centroid errors in pixels);
+    traj_path: branch-tip trajectories (pixels) at the training wind; panels_path: the
+    qualitative renders. Returns the split means (``EvalResult.summary()``).
+    """
+    render_fn = model_render_fn(model, observed, backend=backend)
+    res = evaluate(render_fn, observed, progress=progress)
+    traj = tip_trajectories(model_means_fn(model, observed), truth, observed, condition=0)
+    panels = render_panels(render_fn, observed)
+    summary = res.summary()
+    bad = [k for k, v in summary.items() if not np.isfinite(v)]
+    if bad:
+        raise FloatingPointError(f"evaluation produced non-finite scores for {bad}; "
+                                 "the checkpoint is likely corrupt: delete it and retrain")
+    res.save(eval_path)
+    traj.save(traj_path)
+    save_npz(panels_path, **panels)
+    return summary
