@@ -1,12 +1,14 @@
 """Snakemake script of rule `train`: fit one model on one tree's observed dataset."""
 import contextlib
 
+import numba
 import torch
 
 from physgs.testbed.dataset import load_observed
 from physgs.train import run_training
 
 torch.set_num_threads(snakemake.threads)  # noqa: F821 (injected by Snakemake)
+numba.set_num_threads(min(snakemake.threads, numba.config.NUMBA_NUM_THREADS))  # noqa: F821
 with open(snakemake.log[0], "w") as log, contextlib.redirect_stderr(log):  # noqa: F821
     res = run_training(
         load_observed(snakemake.input.observed),  # noqa: F821

@@ -79,7 +79,7 @@ def train_model(model: BaseModel, observed, train_cfg: dict, *, conditions: list
     for it in bar:
         c = int(conditions[rng.integers(len(conditions))])
         j = int(rng.integers(observed.n_train))
-        target = torch.from_numpy(np.asarray(observed.frames[c, j])).float() / 255.0  # [H, W, 3]
+        target = torch.from_numpy(np.array(observed.frames[c, j])).float() / 255.0  # [H, W, 3]
         warm = it < warmup
         s = model.canonical_state() if warm else model.gaussians_at(j, winds[c])
         bad = [k for k in ("means", "quats", "scales", "opacities", "colors")
