@@ -21,9 +21,11 @@ include: "workflow/rules/train.smk"
 include: "workflow/rules/evaluate.smk"
 include: "workflow/rules/recovery.smk"
 include: "workflow/rules/report.smk"
+include: "workflow/rules/speed_accuracy.smk"
 
 
 rule all:
     input:
         rules.testbed.input,
         rules.report.input,
+        rules.speed_accuracy.output,
