@@ -130,19 +130,27 @@ def simulate_tree(tb: dict, preset: dict, *, seed: int, tree: str) -> TreeSim:
     w = tb["wind"]
     wf = windmod.make_wind(v0=w["v0"], turbulence_intensity=w["turbulence_intensity"],
                            f_lo_hz=w["f_lo_hz"], f_hi_hz=w["f_hi_hz"], seed_seq=_seed(seed, "wind"))
-    if (L + F) / fps >= 60.0:
-        raise windmod.WindError(f"record of {(L + F) / fps:.1f} s exceeds the 60 s wind period; "
-                                "lower testbed.lead_in_tau or n_train/n_tail")
-    t = np.arange(-L, F) / fps
-    v = wf.speed(t)
-    if v.min() <= 0:
+    P = int(round(windmod.PERIOD_S * fps))  # the wind repeats every P frames
+    if L + F >= P or abs(P - windmod.PERIOD_S * fps) > 1e-9:
+        raise windmod.WindError(f"record of {(L + F) / fps:.1f} s must be shorter than the "
+                                f"{windmod.PERIOD_S:.0f} s wind period, which must be a whole number "
+                                "of frames; lower testbed.lead_in_tau or n_train/n_tail, or use an "
+                                "integer fps")
+    t = np.arange(-L, -L + P + 1) / fps  # one full period from the record start
+    v_period = wf.speed(t)
+    v = v_period[:L + F]
+    if v_period.min() <= 0:
         raise windmod.WindError(f"wind speed reaches {v.min():.2f} m/s <= 0; lower "
                                 "testbed.wind.turbulence_intensity in config/trees.yaml")
     cond = np.asarray(tb["conditions"], dtype=np.float64)
     wind32 = (cond[:, None] * v[None, :]).astype(np.float32)  # [C, L+F]
     vbar = cond * float(w["v0"])
     u = physics.drag_forcing(wind32.astype(np.float64), vbar)  # [C, T], the wind models observe
-    unit = physics.simulate(omega, zeta, u[:, :, None] * omega[None, None, :] ** 2, 1.0 / fps)
+    # the same float32 rounding over one whole period, to start at the periodic steady state
+    vp32 = (cond[:, None] * v_period[None, :]).astype(np.float32).astype(np.float64)
+    up = physics.drag_forcing(vp32, vbar)[:, :, None] * omega ** 2  # [C, P+1, B]
+    x0 = physics.periodic_steady_state(omega, zeta, up, 1.0 / fps)
+    unit = physics.simulate(omega, zeta, u[:, :, None] * omega[None, None, :] ** 2, 1.0 / fps, x0=x0)
     # "RMS swing" = RMS over bones and training frames of each bone's world angle (its own theta
     # plus its ancestors'), what a viewer sees; per-bone theta is smaller on deep chains.
     world = kinematics.cumulative_angle(skel.parent, unit[0, L:L + int(tb["n_train"])])

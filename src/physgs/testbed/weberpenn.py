@@ -179,7 +179,7 @@ def generate(preset: dict, *, seed: int, name: str) -> Skeleton:
         arm = level < n_arm
         seg_bone = np.full(n_seg, attach_bone, dtype=int)
         if arm:
-            step = int(levels[level]["bone_step"]) if level < len(levels) else 1
+            step = int(levels[level].get("bone_step", 1))
             prev = attach_bone
             for k in range(bones_per_stem(n_seg, step)):
                 a, b = k * step, min((k + 1) * step, n_seg)
@@ -227,6 +227,9 @@ def generate(preset: dict, *, seed: int, name: str) -> Skeleton:
         starts = np.array([base_size if (n == 1 and stems[i].parent == -1) else float(lv.get("start", 0.1))
                            for i in parent_ids])
         weights = np.array([stems[i].length for i in parent_ids]) * (1 - starts)
+        if "stems" not in lv:
+            raise PresetError(f"preset '{name}': level {n} has no 'stems' (total child stems at that "
+                              f"level); add it to presets.{name}.levels[{n}] in config/trees.yaml")
         counts = _apportion(int(lv["stems"]), weights)
         for pid, start, cnt in zip(parent_ids, starts, counts):
             ps = stems[pid]

@@ -11,6 +11,9 @@ from dataclasses import dataclass
 import numpy as np
 
 
+PERIOD_S = 60.0  # the realisation repeats every PERIOD_S seconds (frequency grid 1 / PERIOD_S)
+
+
 class WindError(ValueError):
     """Wind settings that cannot be used; the message names the key and the fix."""
 
@@ -36,7 +39,7 @@ class WindField:
 
 
 def make_wind(*, v0: float, turbulence_intensity: float, f_lo_hz: float, f_hi_hz: float,
-              seed_seq: np.random.SeedSequence, period_s: float = 60.0) -> WindField:
+              seed_seq: np.random.SeedSequence, period_s: float = PERIOD_S) -> WindField:
     """A flat-spectrum realisation on the grid f = k / period_s inside [f_lo_hz, f_hi_hz].
 
     period_s (s) must exceed the whole record (lead-in included) so the record never repeats.
