@@ -20,6 +20,12 @@ def _np(x: torch.Tensor) -> np.ndarray:
     return np.ascontiguousarray(x.detach().cpu().numpy(), dtype=np.float64)
 
 
+def _to_torch(x: np.ndarray, like: torch.Tensor) -> torch.Tensor:
+    # Cast in numpy (single-threaded) rather than torch: no OpenMP barrier for a tiny copy.
+    np_dtype = np.float32 if like.dtype == torch.float32 else np.float64
+    return torch.from_numpy(np.ascontiguousarray(x, dtype=np_dtype)).to(like.device)
+
+
 def camera_arrays(camera: Camera):
     """(Rc [3, 3], tc [3], intr [4], lims [4]) float64 for the kernels; lims are gsplat's
     tangent clamps (x-, x+, y-, y+) of the projection Jacobian."""
@@ -61,9 +67,8 @@ class _FastRasterize(torch.autograd.Function):
         comp = (m2, con, o, col, dep, bg, boxes, tile_start, pair_gid, TILE, tiles_x, W, H)
         kernels.forward(*comp, rgb, alpha, depth, acc_c, acc_d, t_final, n_contrib)
         ctx.saved = (m, q, s, cam, camera.near, valid, comp, acc_c, acc_d, t_final)
-        ctx.device, ctx.dtype = means.device, means.dtype
-        return tuple(torch.from_numpy(x).to(means.device, means.dtype)
-                     for x in (rgb, alpha, depth))
+        ctx.like = torch.empty(0, dtype=means.dtype, device=means.device)
+        return tuple(_to_torch(x, means) for x in (rgb, alpha, depth))
 
     @staticmethod
     def backward(ctx, g_rgb, g_alpha, g_depth):
@@ -92,8 +97,7 @@ class _FastRasterize(torch.autograd.Function):
                                  np.ascontiguousarray(G[:, 6]), v_means, v_quats, v_scales)
         g_bg = np.einsum("hwd,hw->d", g_rgb, t_final)
         out = (v_means, v_quats, v_scales, G[:, 5], G[:, kernels.N_GRAD:], g_bg)
-        return tuple(torch.from_numpy(np.ascontiguousarray(x)).to(ctx.device, ctx.dtype)
-                     for x in out) + (None,)
+        return tuple(_to_torch(x, ctx.like) for x in out) + (None,)
 
 
 def rasterize_fast(means: torch.Tensor, quats: torch.Tensor, scales: torch.Tensor,

@@ -158,7 +158,8 @@ def backward(means2d, conics, opac, colors, depths, bg, boxes, tile_start, pair_
     """Explicit backward of :func:`forward`. g_rgb [H, W, D], g_alpha [H, W], g_depth [H, W] are
     upstream gradients (float64). Writes pair_grad [P, 7 + D] per (tile, Gaussian) pair:
     d/d(mx, my, conic a, b, c, opacity, depth, colours). Front-to-back pass: the light behind
-    Gaussian i is total - prefix_i, so no per-pixel list is stored."""
+    Gaussian i (later Gaussians plus background) is the total minus the prefix up to i, so no
+    per-pixel list is stored and no division by (1 - alpha) recovers transmittance."""
     D = colors.shape[1]
     n_tiles = tile_start.shape[0] - 1
     for t in nb.prange(n_tiles):
@@ -169,9 +170,24 @@ def backward(means2d, conics, opac, colors, depths, bg, boxes, tile_start, pair_
         npix = th * tw
         T = np.ones(npix)
         done = np.zeros(npix, np.bool_)
-        pc = np.zeros((npix, D))  # prefix sum c a T, Gaussian i included
-        pd = np.zeros(npix)
-        gacc = np.zeros(N_GRAD + D)
+        # tile-local copies: behind_c (colour still to come, background included), behind_d,
+        # upstream grads, and g_alpha * T_final (d alpha_out / d a_i = T_final / (1 - a_i))
+        behind_c = np.empty((npix, D))
+        up_c = np.empty((npix, D))
+        behind_d = np.empty(npix)
+        up_d = np.empty(npix)
+        up_a = np.empty(npix)
+        for ly in range(th):
+            for lx in range(tw):
+                p = ly * tw + lx
+                tf = t_final[ty0 + ly, tx0 + lx]
+                for c in range(D):
+                    behind_c[p, c] = acc_c[ty0 + ly, tx0 + lx, c] + tf * bg[c]
+                    up_c[p, c] = g_rgb[ty0 + ly, tx0 + lx, c]
+                behind_d[p] = acc_d[ty0 + ly, tx0 + lx]
+                up_d[p] = g_depth[ty0 + ly, tx0 + lx]
+                up_a[p] = g_alpha[ty0 + ly, tx0 + lx] * tf
+        g_col = np.empty(D)
         n_done = 0
         for k in range(tile_start[t], tile_start[t + 1]):
             if n_done == npix:
@@ -185,7 +201,14 @@ def backward(means2d, conics, opac, colors, depths, bg, boxes, tile_start, pair_
             o = opac[g]
             z = depths[g]
             thr = _footprint(o)
-            gacc[:] = 0.0
+            g_mx = 0.0
+            g_my = 0.0
+            g_a = 0.0
+            g_b = 0.0
+            g_c = 0.0
+            g_o = 0.0
+            g_z = 0.0
+            g_col[:] = 0.0
             y0 = max(boxes[g, 2], ty0)
             y1 = min(boxes[g, 3], ty0 + th - 1)
             for py in range(y0, y1 + 1):
@@ -210,29 +233,33 @@ def backward(means2d, conics, opac, colors, depths, bg, boxes, tile_start, pair_
                         continue
                     w = a * Tp
                     inv = 1.0 / (1.0 - a)
-                    tf = t_final[py, px]
-                    dlda = g_alpha[py, px] * tf * inv
+                    dlda = up_a[p] * inv
                     for c in range(D):
-                        gc = g_rgb[py, px, c]
-                        pc[p, c] += w * colors[g, c]
-                        behind = acc_c[py, px, c] - pc[p, c] + tf * bg[c]
-                        dlda += gc * (colors[g, c] * Tp - behind * inv)
-                        gacc[N_GRAD + c] += gc * w
-                    gd = g_depth[py, px]
-                    pd[p] += w * z
-                    dlda += gd * (z * Tp - (acc_d[py, px] - pd[p]) * inv)
-                    gacc[6] += gd * w
+                        col = colors[g, c]
+                        behind_c[p, c] -= w * col
+                        dlda += up_c[p, c] * (col * Tp - behind_c[p, c] * inv)
+                        g_col[c] += up_c[p, c] * w
+                    behind_d[p] -= w * z
+                    dlda += up_d[p] * (z * Tp - behind_d[p] * inv)
+                    g_z += up_d[p] * w
                     T[p] = nt
                     if raw <= ALPHA_MAX:  # the clamp passes no gradient above 0.99
-                        gacc[5] += dlda * G
+                        g_o += dlda * G
                         ds = -0.5 * a * dlda  # dL/dsigma
-                        gacc[2] += ds * dx * dx
-                        gacc[3] += ds * 2.0 * dx * dy
-                        gacc[4] += ds * dy * dy
-                        gacc[0] -= ds * 2.0 * (ca * dx + cb * dy)
-                        gacc[1] -= ds * 2.0 * (cb * dx + cc * dy)
-            for j in range(N_GRAD + D):
-                pair_grad[k, j] = gacc[j]
+                        g_a += ds * dx * dx
+                        g_b += ds * 2.0 * dx * dy
+                        g_c += ds * dy * dy
+                        g_mx -= ds * 2.0 * (ca * dx + cb * dy)
+                        g_my -= ds * 2.0 * (cb * dx + cc * dy)
+            pair_grad[k, 0] = g_mx
+            pair_grad[k, 1] = g_my
+            pair_grad[k, 2] = g_a
+            pair_grad[k, 3] = g_b
+            pair_grad[k, 4] = g_c
+            pair_grad[k, 5] = g_o
+            pair_grad[k, 6] = g_z
+            for c in range(D):
+                pair_grad[k, N_GRAD + c] = g_col[c]
 
 
 @nb.njit(cache=True)
