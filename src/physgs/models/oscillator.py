@@ -25,23 +25,43 @@ import torch
 #: about 2.8; staying near 1 keeps both stability and a small phase error.
 STABILITY_GUARD = 1.0
 
+#: Relative slack on the guard. A model keeps omega in float32 while its substeps are computed
+#: from the float64 bound, so omega at the top of its band can exceed the bound by a float32
+#: rounding (~1e-7); without slack a step chosen by required_substeps exactly at the guard would
+#: be refused mid-training. 1e-6 is far too small to matter for stability (limit ~2.8).
+GUARD_RTOL = 1e-6
+
 
 class StabilityError(ValueError):
     """The RK4 step h = dt / substeps is too long for the largest omega."""
 
 
+def fastest_rate(omega, zeta):
+    """Largest eigenvalue magnitude |lambda| (rad/s) of theta'' + 2 zeta omega theta' + omega^2 theta.
+
+    omega rad/s, zeta dimensionless (scalars or arrays of one shape). Underdamped and critical
+    (zeta <= 1): |lambda| = omega. Over-damped: the stiff real pole omega (zeta + sqrt(zeta^2 - 1)),
+    about 2 zeta omega, which RK4 must resolve too: guarding omega alone lets it blow up.
+    """
+    omega = np.asarray(omega, dtype=np.float64)
+    zeta = np.asarray(zeta, dtype=np.float64)
+    return omega * np.where(zeta > 1.0, zeta + np.sqrt(np.maximum(zeta * zeta - 1.0, 0.0)), 1.0)
+
+
 def required_substeps(omega_max: float, dt: float, limit: float = STABILITY_GUARD) -> int:
     """Smallest number of RK4 substeps per sample so that omega_max * dt / substeps <= limit.
 
-    omega_max: rad/s; dt: seconds between wind samples; limit: bound on omega * h (rad).
+    omega_max: rad/s (for over-damped parts pass ``fastest_rate(omega, zeta)``); dt: seconds
+    between wind samples; limit: bound on omega * h (rad).
     """
     if not (omega_max > 0 and dt > 0 and limit > 0):
         raise ValueError(
             f"required_substeps needs omega_max > 0, dt > 0 and limit > 0; got "
             f"omega_max={omega_max}, dt={dt}, limit={limit}"
         )
-    # The small tolerance keeps exact multiples (e.g. omega*dt == 2*limit) at the lower count.
-    return max(1, math.ceil(omega_max * dt / limit - 1e-12))
+    # Same slack as integrate's check, so the count returned is always accepted there, and exact
+    # multiples (e.g. omega*dt == 2*limit) stay at the lower count.
+    return max(1, math.ceil(omega_max * dt / (limit * (1.0 + GUARD_RTOL))))
 
 
 @numba.njit(cache=True, inline="always")
@@ -164,7 +184,8 @@ def integrate(omega: torch.Tensor, zeta: torch.Tensor, gain: torch.Tensor, wind,
     vbar: m/s, the speed whose square is subtracted from v^2; dt: seconds; substeps: RK4 steps
     per sample. Returns theta [K, T] in rad (dtype of omega), theta[:, j] at sample j.
     Differentiable w.r.t. omega, zeta, gain.
-    Raises StabilityError if max(omega) * dt / substeps > guard.
+    Raises StabilityError if max |lambda| * dt / substeps > guard, |lambda| = fastest_rate(omega,
+    zeta) (= omega unless over-damped).
     """
     if backend not in ("fast", "reference"):
         raise ValueError(f"integrate: backend must be 'fast' or 'reference', got {backend!r}")
@@ -184,16 +205,22 @@ def integrate(omega: torch.Tensor, zeta: torch.Tensor, gain: torch.Tensor, wind,
         )
     if omega.numel() == 0:
         return omega.new_zeros((0, w.shape[0]))
-    om_max = float(omega.detach().max())
     if not float(omega.detach().min()) > 0:
         raise ValueError(f"integrate: omega must be > 0 rad/s; got min {float(omega.min())}")
+    if not float(zeta.detach().min()) >= 0:
+        raise ValueError(f"integrate: zeta must be >= 0; got min {float(zeta.min())}")
+    # Guard the fastest eigenvalue, not omega alone: an over-damped part's stiff pole is faster.
+    rates = fastest_rate(omega.detach().cpu().double().numpy(), zeta.detach().cpu().double().numpy())
+    i = int(np.argmax(rates))
+    rate, om_i, ze_i = float(rates[i]), float(omega[i]), float(zeta[i])
     h = dt / substeps
-    if om_max * h > guard:
-        need = required_substeps(om_max, dt, guard)
+    if rate * h > guard * (1.0 + GUARD_RTOL):
+        need = required_substeps(rate, dt, guard)
         raise StabilityError(
-            f"RK4 step outside the stability guard: max omega {om_max:.4g} rad/s x step "
-            f"h = dt/substeps = {dt:.4g}/{substeps} = {h:.4g} s gives omega*h = {om_max * h:.3g} "
-            f"> {guard}; use substeps >= {need} (or lower the omega upper bound)"
+            f"RK4 step outside the stability guard: part {i} with omega {om_i:.4g} rad/s and "
+            f"zeta {ze_i:.3g} has fastest rate |lambda| = {rate:.4g} rad/s; x step "
+            f"h = dt/substeps = {dt:.4g}/{substeps} = {h:.4g} s gives |lambda|*h = {rate * h:.3g} "
+            f"> {guard}; use substeps >= {need} (or lower the omega / zeta upper bounds)"
         )
     u = w * w - float(vbar) ** 2  # [T] forcing before the gain, m^2/s^2
     if backend == "reference":

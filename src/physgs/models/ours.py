@@ -26,7 +26,7 @@ from torch import nn
 
 from physgs.models.base import BaseModel, ModelContext
 from physgs.models.gaussians import GaussianState, rotate_about_pivot
-from physgs.models.oscillator import STABILITY_GUARD, integrate, required_substeps
+from physgs.models.oscillator import STABILITY_GUARD, fastest_rate, integrate, required_substeps
 from physgs.models.parts import kmeans_parts
 
 
@@ -56,8 +56,10 @@ class OscillatorPrior(BaseModel):
         self.omega_lo, self.omega_hi, self.zeta_lo, self.zeta_hi = lo, hi, zlo, zhi
         self.dt = 1.0 / ctx.fps
         self.guard = float(rk4_guard)
-        # Enough substeps that every omega the bounds allow passes the guard.
-        self.substeps = max(int(substeps), required_substeps(hi, self.dt, self.guard))
+        # Enough substeps that every (omega, zeta) the bounds allow passes the guard (the fastest
+        # rate is at the top of both bounds; above zeta = 1 it exceeds omega).
+        self.substeps = max(int(substeps),
+                            required_substeps(float(fastest_rate(hi, zhi)), self.dt, self.guard))
         xyz = np.asarray(ctx.canonical_xyz, dtype=np.float64)
         if labels is None:
             labels = kmeans_parts(xyz, K, seed, kmeans_n_init)

@@ -6,7 +6,7 @@ import math
 import numpy as np
 import torch
 
-from physgs.models.oscillator import STABILITY_GUARD, required_substeps
+from physgs.models.oscillator import STABILITY_GUARD, fastest_rate, required_substeps
 from physgs.recovery.null import NullResult
 from physgs.recovery.record import RecoveryRecord, run_null, score_recovery
 
@@ -37,7 +37,7 @@ def null_for_config(observed, truth, cfg: dict, config: str) -> NullResult:
     K = int(cfg["models"]["configs"][config]["K"])
     dt = 1.0 / observed.fps
     guard = float(ours.get("rk4_guard", STABILITY_GUARD))
-    substeps = max(int(ours["substeps"]),
-                   required_substeps(2 * math.pi * float(ours["omega_hz"][1]), dt, guard))
+    rate = float(fastest_rate(2 * math.pi * float(ours["omega_hz"][1]), float(ours["zeta"][1])))
+    substeps = max(int(ours["substeps"]), required_substeps(rate, dt, guard))
     return run_null(truth, observed, n_parts=K, zeta_init=float(ours["zeta_init"]),
                     substeps=substeps, seed=int(cfg["seed"]))
