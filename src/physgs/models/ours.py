@@ -85,6 +85,21 @@ class OscillatorPrior(BaseModel):
             members = xyz[labels == p]
             pivots[p] = members[np.argmin(np.linalg.norm(members - base, axis=1))]
         self.pivot = nn.Parameter(torch.tensor(pivots, dtype=torch.float32))
+        # Parts whose motion never reaches the image (physgs.models.visibility): theta = 0 and
+        # their physics parameters take no further updates. Saved in checkpoints.
+        self.register_buffer("frozen", torch.zeros(K, dtype=torch.bool))
+
+    def freeze_parts(self, mask) -> None:
+        """Freeze the parts in ``mask`` [K] bool (added to those already frozen)."""
+        mask = torch.as_tensor(np.asarray(mask, dtype=bool))
+        if mask.shape != (self.K,):
+            raise ValueError(f"freeze mask must be [K = {self.K}], got shape {tuple(mask.shape)}")
+        self.frozen |= mask
+
+    def _load_from_state_dict(self, state_dict, prefix, *args, **kwargs):
+        # checkpoints written before freezing existed have no mask: nothing was frozen
+        state_dict.setdefault(prefix + "frozen", torch.zeros(self.K, dtype=torch.bool))
+        super()._load_from_state_dict(state_dict, prefix, *args, **kwargs)
 
     @property
     def omega(self) -> torch.Tensor:
@@ -110,13 +125,18 @@ class OscillatorPrior(BaseModel):
     def part_theta(self, wind: torch.Tensor) -> torch.Tensor:
         """Swing angles theta [K, L+F] (rad) under one condition's observed wind [L+F] (m/s).
 
-        vbar is the mean of that condition's observed wind.
+        vbar is the mean of that condition's observed wind. Frozen parts have theta = 0.
         """
         wind = torch.as_tensor(wind, dtype=torch.float64)
         if wind.ndim != 1:
             raise ValueError(f"part_theta: wind must be [L+F], got shape {tuple(wind.shape)}")
-        return integrate(self.omega, self.zeta, self.gain, wind, float(wind.mean()), self.dt,
-                         self.substeps, guard=self.guard)
+        theta = integrate(self.omega, self.zeta, self.gain, wind, float(wind.mean()), self.dt,
+                          self.substeps, guard=self.guard)  # [K, L+F]
+        if not bool(self.frozen.any()):
+            return theta
+        # where(), not a product: frozen rows get exactly zero gradient, so with their Adam
+        # moments reset (visibility.freeze_invisible) their parameters stay put
+        return torch.where(self.frozen[:, None], torch.zeros_like(theta), theta)
 
     def deform(self, frame_idx: int, wind: torch.Tensor) -> GaussianState:
         theta = self.part_theta(wind)[:, self.lead_in + frame_idx]  # [K]

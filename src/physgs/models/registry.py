@@ -22,6 +22,10 @@ from physgs.models.static import StaticModel
 MODEL_NAMES = ("static", "mlp", "mlp_wind", "d3dgs", "d3dgs_wind", "ours")
 CONFIG_NAMES = ("single", "joint32", "joint96")
 FORMAT = "physgs-model-v1"
+#: Ours with K chosen from the data (physgs.models.kselect). Kept out of CONFIG_NAMES so the
+#: fixed-K rules and tables do not iterate over it; its K is written into models.configs.auto
+#: by ``kselect.auto_config`` before training, and so travels in the checkpoint.
+AUTO_CONFIG = "auto"
 
 
 def configs_for(model: str) -> tuple[str, ...]:
@@ -44,9 +48,13 @@ def build_model(name: str, observed, cfg: dict, *, config: str = "single", seed:
     cfg: the resolved config's ``models`` section; config: training configuration (sets K);
     seed: k-means seed (ours); labels: precomputed part labels [N] (used when loading).
     """
-    if config not in configs_for(name):
+    if config == AUTO_CONFIG and name == "ours":
+        if not isinstance(cfg["configs"].get(AUTO_CONFIG, {}).get("K"), int):
+            raise ValueError("configuration 'auto' has no chosen K yet: run the kselect rule "
+                             "(physgs.models.kselect.select_k, then auto_config) first")
+    elif config not in configs_for(name):
         raise ValueError(f"model {name!r} is not trained in configuration {config!r}; valid: "
-                         f"{configs_for(name)}")
+                         f"{configs_for(name)}" + (" or 'auto'" if name == "ours" else ""))
     ctx = observed if isinstance(observed, ModelContext) else context_from_observed(observed)
     canon = dict(cfg["canonical"])
     if name == "static":

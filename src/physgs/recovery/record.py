@@ -14,10 +14,15 @@ from physgs.recovery.null import NullResult
 
 @dataclass(frozen=True)
 class RecoveryRecord:
-    """Frequency match and damping summary of one (tree, config) model."""
+    """Frequency match and damping summary of one (tree, config) model.
+
+    n_frozen: parts frozen as invisible (physgs.models.visibility); their theta is 0, so the
+    matcher leaves them untrusted.
+    """
 
     match: MatchResult
     damping: DampingResult
+    n_frozen: int = 0
 
 
 def bone_window(truth, lead_in_frames: int, n_train: int) -> np.ndarray:
@@ -41,12 +46,14 @@ def score_recovery(part_theta: np.ndarray, omega_hat: np.ndarray, zeta_hat: np.n
 
 
 def save_recovery(path, rec: RecoveryRecord) -> None:
-    write_json(path, {"match": rec.match.to_dict(), "damping": rec.damping.to_dict()})
+    write_json(path, {"match": rec.match.to_dict(), "damping": rec.damping.to_dict(),
+                      "n_frozen": int(rec.n_frozen)})
 
 
 def load_recovery(path) -> RecoveryRecord:
     d = _read(path)
-    return RecoveryRecord(MatchResult.from_dict(d["match"]), DampingResult.from_dict(d["damping"]))
+    return RecoveryRecord(MatchResult.from_dict(d["match"]), DampingResult.from_dict(d["damping"]),
+                          int(d.get("n_frozen", 0)))  # records from before freezing: none frozen
 
 
 def save_null(path, res: NullResult) -> None:

@@ -1,6 +1,7 @@
 """Recovery of one trained oscillator prior, and its null control, as the Snakemake rules call them."""
 from __future__ import annotations
 
+import dataclasses
 import math
 
 import numpy as np
@@ -23,8 +24,15 @@ def recover_model(model, observed, truth) -> RecoveryRecord:
         theta = model.part_theta(wind).cpu().numpy()  # [K, L+F]
         omega = model.omega.detach().cpu().numpy().astype(np.float64)
         zeta = model.zeta.detach().cpu().numpy().astype(np.float64)
-    return score_recovery(theta, omega, zeta, truth, int(observed.lead_in_frames),
-                          int(observed.n_train))
+    rec = score_recovery(theta, omega, zeta, truth, int(observed.lead_in_frames),
+                         int(observed.n_train))
+    frozen = getattr(model, "frozen", None)
+    if frozen is None or not bool(frozen.any()):
+        return rec
+    fz = frozen.cpu().numpy()
+    if np.any(rec.match.trusted & fz):  # theta = 0 correlates with nothing; guard the invariant
+        raise RuntimeError("a frozen part was matched as trusted; its theta is not zero")
+    return dataclasses.replace(rec, n_frozen=int(fz.sum()))
 
 
 def null_for_config(observed, truth, cfg: dict, config: str) -> NullResult:

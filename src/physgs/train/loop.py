@@ -44,7 +44,8 @@ def condition_indices(spec: str, n_conditions: int) -> list[int]:
 
 
 def train_model(model: BaseModel, observed, train_cfg: dict, *, conditions: list[int], seed: int,
-                name: str | None = None, progress: bool = True) -> TrainResult:
+                name: str | None = None, progress: bool = True, frame_pool=None,
+                on_iteration=None) -> TrainResult:
     """Fit ``model`` to the training-camera frames of ``observed``.
 
     Each iteration draws (seeded) one condition from ``conditions`` and one recorded frame
@@ -52,6 +53,10 @@ def train_model(model: BaseModel, observed, train_cfg: dict, *, conditions: list
     (1 - w) L1 + w D-SSIM. The first ``warmup`` iterations render the canonical Gaussians only
     (the shared static warm-up). Raises TrainingError naming the model and iteration if the loss
     turns NaN or inf.
+
+    frame_pool: recorded-frame indices (< n_train) to draw from instead of all of them (K
+    selection holds some out). on_iteration(it, model, optimizer) -> dict | None is called
+    before each iteration; the dicts it returns are merged into the statistics (freezing).
     """
     name = name or model.name
     iterations, warmup = int(train_cfg["iterations"]), int(train_cfg["warmup"])
@@ -60,6 +65,12 @@ def train_model(model: BaseModel, observed, train_cfg: dict, *, conditions: list
     n_cond = np.asarray(observed.wind).shape[0]
     if not conditions or min(conditions) < 0 or max(conditions) >= n_cond:
         raise ValueError(f"conditions {conditions} outside the dataset's {n_cond} conditions")
+    if frame_pool is not None:
+        frame_pool = np.asarray(frame_pool, dtype=np.int64)
+        if frame_pool.size == 0 or frame_pool.min() < 0 or frame_pool.max() >= observed.n_train:
+            raise ValueError(f"frame_pool must hold training-frame indices in [0, "
+                             f"{observed.n_train}); got {frame_pool.size} frames")
+    extra: dict = {}
     rng = np.random.default_rng(seed)
     torch.manual_seed(seed)
     groups = model.param_groups(train_cfg["lr"])
@@ -77,8 +88,11 @@ def train_model(model: BaseModel, observed, train_cfg: dict, *, conditions: list
     t0 = time.perf_counter()
     bar = tqdm(range(iterations), desc=f"train {name}", disable=not progress, mininterval=2.0)
     for it in bar:
+        if on_iteration is not None:
+            extra.update(on_iteration(it, model, opt) or {})
         c = int(conditions[rng.integers(len(conditions))])
-        j = int(rng.integers(observed.n_train))
+        j = int(rng.integers(observed.n_train) if frame_pool is None
+                else frame_pool[rng.integers(frame_pool.size)])
         target = torch.from_numpy(np.array(observed.frames[c, j])).float() / 255.0  # [H, W, 3]
         warm = it < warmup
         s = model.canonical_state() if warm else model.gaussians_at(j, winds[c])
@@ -117,6 +131,7 @@ def train_model(model: BaseModel, observed, train_cfg: dict, *, conditions: list
         "conditions": list(conditions), "seed": int(seed), "backend": backend,
         "n_gaussians": int(model.canonical.n), "wind_mean": float(model.ctx.wind_mean),
         "wind_std": float(model.ctx.wind_std), "torch_threads": torch.get_num_threads(),
+        **extra,
     }
     return TrainResult(model, stats, log)
 

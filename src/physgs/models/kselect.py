@@ -1,0 +1,189 @@
+"""Choose the number of parts K of the oscillator prior from the data, beside fixed K.
+
+Config ``models.kselect``: candidates (K values), method (``heldout`` or ``bic``), every (hold
+out every k-th training frame), iterations and warmup (a short training run per candidate),
+tie_db (dB), conditions (which wind conditions the chosen model then trains on).
+
+Both criteria come from the same runs: ours is trained per candidate on the training frames
+minus every k-th (frames k-1, 2k-1, ...), with the same loop, schedule and freezing as the
+full run, only shorter.
+- ``heldout``: mean PSNR (dB) over the held-out frames at the training camera and wind; the
+  smallest K within ``tie_db`` of the best wins (ties go to the smaller model).
+- ``bic``: n log(MSE) + p log n over the training frames scored (n = pixel values, MSE on
+  [0, 1] images), p = 8 K (per part omega, zeta, gain, 2 axis angles, 3 pivot coordinates; the
+  canonical Gaussians are the same for every K and cancel). Pixels are strongly correlated, so
+  n overstates the evidence and BIC leans to large K; held-out frames are the default.
+Both choices are recorded whichever ``method`` picks the K used.
+"""
+from __future__ import annotations
+
+import copy
+import json
+import time
+from dataclasses import asdict, dataclass
+
+import numpy as np
+import torch
+
+from physgs.evaluate.atomic import write_json
+from physgs.evaluate.metrics import psnr
+from physgs.models.registry import AUTO_CONFIG, build_model
+from physgs.models.visibility import freeze_callback
+from physgs.render import rasterization
+
+METHODS = ("heldout", "bic")
+PARAMS_PER_PART = 8  # omega, zeta, gain, swing axis (2), pivot (3)
+
+
+def heldout_split(n_train: int, every: int) -> tuple[np.ndarray, np.ndarray]:
+    """(training frames, held-out frames): indices in [0, n_train), every ``every``-th held out
+    (frames every-1, 2 every-1, ...), so frame 0 and the window's start stay in training."""
+    if not 2 <= every <= n_train:
+        raise ValueError(f"models.kselect.every must lie in [2, n_train = {n_train}], got {every}")
+    idx = np.arange(n_train)
+    held = (idx % every) == every - 1
+    return idx[~held], idx[held]
+
+
+def bic(mse: float, n: int, k_parts: int) -> float:
+    """n log(MSE) + p log n with p = 8 K (see module docstring); lower is better."""
+    if not (mse > 0 and n > 0):
+        raise ValueError(f"bic needs mse > 0 and n > 0, got {mse}, {n}")
+    return float(n * np.log(mse) + PARAMS_PER_PART * k_parts * np.log(n))
+
+
+def choose_heldout(candidates, heldout_psnr, tie_db: float) -> int:
+    """Smallest K whose held-out PSNR (dB) is within ``tie_db`` of the best."""
+    ks, p = np.asarray(candidates), np.asarray(heldout_psnr, dtype=np.float64)
+    if not np.isfinite(p).any():
+        raise ValueError("every K candidate gave a non-finite held-out PSNR; training diverged")
+    ok = p >= np.nanmax(p) - tie_db
+    return int(ks[ok].min())
+
+
+def choose_bic(candidates, bics) -> int:
+    """K with the lowest BIC (ties: the smaller K)."""
+    ks, b = np.asarray(candidates), np.asarray(bics, dtype=np.float64)
+    best = np.nanmin(b)
+    return int(ks[b == best].min())
+
+
+@dataclass(frozen=True)
+class KSelection:
+    """Scores per candidate K (lists aligned with ``candidates``) and the choices.
+
+    heldout_psnr dB; train_mse on [0, 1] images; bic dimensionless; frozen parts per run;
+    wall_s seconds of training per candidate; chosen_k is k_heldout or k_bic per ``method``.
+    """
+
+    candidates: list
+    method: str
+    every: int
+    iterations: int
+    heldout_psnr: list
+    train_mse: list
+    n_pixels: int
+    bic: list
+    frozen: list
+    wall_s: list
+    k_heldout: int
+    k_bic: int
+    chosen_k: int
+
+    def to_dict(self) -> dict:
+        return asdict(self)
+
+    @staticmethod
+    def from_dict(d: dict) -> "KSelection":
+        return KSelection(**{k: d[k] for k in KSelection.__dataclass_fields__})
+
+
+def save_selection(path, sel: KSelection) -> None:
+    write_json(path, sel.to_dict())
+
+
+def load_selection(path) -> KSelection:
+    try:
+        with open(path) as fh:
+            return KSelection.from_dict(json.load(fh))
+    except (OSError, json.JSONDecodeError, KeyError, TypeError) as e:
+        raise ValueError(f"cannot read the K selection {path} ({e}); delete it and re-run the "
+                         "kselect rule") from None
+
+
+def _check_cfg(ks: dict, n_gaussians: int) -> list[int]:
+    cands = sorted({int(k) for k in ks["candidates"]})
+    if not cands or cands[0] < 1:
+        raise ValueError(f"models.kselect.candidates must be positive integers, got "
+                         f"{ks['candidates']}")
+    if cands[-1] > n_gaussians:
+        raise ValueError(f"models.kselect.candidates: K = {cands[-1]} exceeds the {n_gaussians} "
+                         "Gaussians of this tree; drop it from the candidates")
+    if ks["method"] not in METHODS:
+        raise ValueError(f"models.kselect.method must be one of {METHODS}, got {ks['method']!r}")
+    return cands
+
+
+def _mean_mse_psnr(model, observed, frames, backend) -> tuple[float, float]:
+    """(MSE, mean per-frame PSNR dB) of the model at the training camera and wind over frames."""
+    wind = torch.as_tensor(np.asarray(observed.wind[0]), dtype=torch.float32)
+    bg = torch.as_tensor(np.asarray(observed.background), dtype=torch.float32)
+    preds = []
+    with torch.no_grad():
+        for j in frames:
+            g = model.gaussians_at(int(j), wind)
+            out = rasterization(g.means, g.quats, g.scales, g.opacities, g.colors,
+                                observed.train_camera, bg, backend=backend, return_depth=False)
+            preds.append(out.rgb.clamp(0, 1).numpy().astype(np.float64))
+    pred = np.stack(preds)  # [M, H, W, 3]
+    gt = np.asarray(observed.frames[0])[np.asarray(frames)].astype(np.float64) / 255.0
+    return float(np.mean((pred - gt) ** 2)), float(np.mean(psnr(pred, gt)))
+
+
+def select_k(observed, cfg: dict, *, progress: bool = False) -> KSelection:
+    """Train ours once per candidate K on the non-held-out frames and score both criteria.
+
+    observed: ``Observed``; cfg: the resolved config (``seed``, ``models`` incl. ``kselect``,
+    ``train``). Deterministic for the config's seed.
+    """
+    from physgs.train.loop import train_model  # the one training loop (train imports models)
+
+    ks = cfg["models"]["kselect"]
+    cands = _check_cfg(ks, int(np.asarray(observed.canonical_xyz).shape[0]))
+    train_idx, held = heldout_split(int(observed.n_train), int(ks["every"]))
+    tcfg = dict(cfg["train"], iterations=int(ks["iterations"]), warmup=int(ks["warmup"]))
+    scored_train = train_idx[:: max(1, train_idx.size // held.size)][: held.size]
+    seed = int(cfg["seed"])
+    rows = {k: [] for k in ("heldout_psnr", "train_mse", "bic", "frozen", "wall_s")}
+    n_pix = 0
+    for K in cands:
+        mcfg = copy.deepcopy(cfg["models"])
+        mcfg["configs"][AUTO_CONFIG] = {"conditions": "train", "K": K}
+        t0 = time.perf_counter()
+        model = build_model("ours", observed, mcfg, config=AUTO_CONFIG, seed=seed)
+        res = train_model(model, observed, tcfg, conditions=[0], seed=seed, name=f"ours_K{K}",
+                          progress=progress, frame_pool=train_idx,
+                          on_iteration=freeze_callback(observed, mcfg, tcfg))
+        backend = tcfg.get("backend", "auto")
+        _, p_held = _mean_mse_psnr(res.model, observed, held, backend)
+        mse_tr, _ = _mean_mse_psnr(res.model, observed, scored_train, backend)
+        n_pix = int(scored_train.size * np.prod(np.asarray(observed.frames).shape[2:]))
+        rows["heldout_psnr"].append(p_held)
+        rows["train_mse"].append(mse_tr)
+        rows["bic"].append(bic(mse_tr, n_pix, K))
+        rows["frozen"].append(int(res.model.frozen.sum()))
+        rows["wall_s"].append(time.perf_counter() - t0)
+    k_h = choose_heldout(cands, rows["heldout_psnr"], float(ks["tie_db"]))
+    k_b = choose_bic(cands, rows["bic"])
+    return KSelection(candidates=cands, method=ks["method"], every=int(ks["every"]),
+                      iterations=int(ks["iterations"]), n_pixels=n_pix, k_heldout=k_h, k_bic=k_b,
+                      chosen_k=k_h if ks["method"] == "heldout" else k_b, **rows)
+
+
+def auto_config(cfg: dict, sel: KSelection) -> dict:
+    """A copy of the resolved config whose models.configs.auto holds the chosen K (what
+    ``run_training(..., model='ours', config='auto')`` and the checkpoint then carry)."""
+    out = copy.deepcopy(cfg)
+    out["models"]["configs"][AUTO_CONFIG] = {"conditions": cfg["models"]["kselect"]["conditions"],
+                                             "K": int(sel.chosen_k)}
+    return out
