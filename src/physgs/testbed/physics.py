@@ -4,6 +4,7 @@ and linear between samples (first-order hold), which is also what the models' RK
 
 The system is linear time-invariant, so each frame step is exact: x_{k+1} = Phi x_k + G0 u_k +
 G1 (u_{k+1} - u_k) / h with Phi, G0, G1 from one augmented matrix exponential (Van Loan).
+The wind is periodic, so the start state can be the exact periodic steady state (no transient).
 """
 from __future__ import annotations
 

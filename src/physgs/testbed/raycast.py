@@ -34,7 +34,9 @@ def render_mesh(vertices: np.ndarray, faces: np.ndarray, face_colors: np.ndarray
     mesh = trimesh.Trimesh(vertices, faces, process=False)
     tri = RayMeshIntersector(mesh).intersects_first(rays.origins, rays.dirs)  # [R], -1 = miss
     hit = tri >= 0
-    n = mesh.face_normals[tri[hit]]
+    f = faces[tri[hit]]  # normals of the hit faces only (trimesh computes all of them)
+    n = np.cross(vertices[f[:, 1]] - vertices[f[:, 0]], vertices[f[:, 2]] - vertices[f[:, 0]])
+    n /= np.maximum(np.linalg.norm(n, axis=1, keepdims=True), 1e-30)
     shade = ambient + (1 - ambient) * np.abs(n @ light_dir)
     bg = np.asarray(background, dtype=np.float64)
     col = np.broadcast_to(bg, (len(tri), 3)).copy()
