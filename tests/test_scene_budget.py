@@ -219,3 +219,15 @@ def test_select_k_then_train_auto(data, tmp_path):
         select_k(data, bad)
     with pytest.raises(ValueError, match="no chosen K"):
         build_model("ours", data, cfg["models"], config="auto")
+
+
+def test_tab_kselect_rows_and_undefined_entries():
+    from physgs.report.kselect import inputs, tab_kselect
+    rows = {("sparse", "single"): dict(K=32, time_psnr=25.0, median_rel_err=0.05, trusted=10,
+                                       frozen=3, k_heldout=16, k_bic=64),
+            ("sparse", "auto"): dict(K=16, time_psnr=25.5, median_rel_err=float("nan"), trusted=0,
+                                     frozen=16, k_heldout=16, k_bic=64)}
+    t = tab_kselect(rows, ["sparse"], {"sparse": 22}, "heldout")
+    assert t.df["K"].tolist() == [32, 16] and t.df["median_rel_err_pct"].iloc[0] == 5.0
+    assert "10/32" in t.tex and "0/16" in t.tex and "--" in t.tex  # NaN median shown as --
+    assert "results/kselect/sparse.json" in inputs(["sparse"])
