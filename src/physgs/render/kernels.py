@@ -302,10 +302,7 @@ def _mm(A, B, out, ta, tb):  # pragma: no cover - compiled
             out[i, j] = acc
 
 
-CHUNK = 256  # Gaussians per parallel work item (scratch matrices allocated once per chunk)
-
-
-@nb.njit(parallel=True, cache=True)
+@nb.njit(cache=True)
 def project_forward(means, quats, scales, Rc, tc, intr, lims, near, eps2d, means2d, conics,
                     depths, cov2d, valid):  # pragma: no cover - compiled
     """Fused EWA projection, same maths as :func:`physgs.render.project.project_gaussians`.
@@ -317,194 +314,194 @@ def project_forward(means, quats, scales, Rc, tc, intr, lims, near, eps2d, means
     """
     fx, fy, cx, cy = intr[0], intr[1], intr[2], intr[3]
     n = means.shape[0]
-    for ch in nb.prange((n + CHUNK - 1) // CHUNK):
-        Rq = np.empty((3, 3))
-        M = np.empty((3, 3))
-        for i in range(ch * CHUNK, min(n, (ch + 1) * CHUNK)):
-            x = Rc[0, 0] * means[i, 0] + Rc[0, 1] * means[i, 1] + Rc[0, 2] * means[i, 2] + tc[0]
-            y = Rc[1, 0] * means[i, 0] + Rc[1, 1] * means[i, 1] + Rc[1, 2] * means[i, 2] + tc[1]
-            z = Rc[2, 0] * means[i, 0] + Rc[2, 1] * means[i, 1] + Rc[2, 2] * means[i, 2] + tc[2]
-            ok = z > near
-            a = 0.0
-            b = 0.0
-            c = 0.0
-            det = 0.0
-            if ok:
-                qn = math.sqrt(quats[i, 0] ** 2 + quats[i, 1] ** 2 + quats[i, 2] ** 2
-                               + quats[i, 3] ** 2)
-                qn = max(qn, 1e-12)
-                _quat_rotmat(quats[i, 0] / qn, quats[i, 1] / qn, quats[i, 2] / qn,
-                             quats[i, 3] / qn, Rq)
-                _mm(Rc, Rq, M, False, False)
-                for col in range(3):
-                    for row in range(3):
-                        M[row, col] *= scales[i, col]
-                tx = z * min(max(x / z, -lims[0]), lims[1])
-                ty = z * min(max(y / z, -lims[2]), lims[3])
-                # rows of J @ M, J = [[fx/z, 0, -fx tx/z^2], [0, fy/z, -fy ty/z^2]]
-                j00 = fx / z
-                j02 = -fx * tx / (z * z)
-                j11 = fy / z
-                j12 = -fy * ty / (z * z)
-                for col in range(3):
-                    r0 = j00 * M[0, col] + j02 * M[2, col]
-                    r1 = j11 * M[1, col] + j12 * M[2, col]
-                    a += r0 * r0
-                    b += r0 * r1
-                    c += r1 * r1
-                a += eps2d
-                c += eps2d
-                det = a * c - b * b
-                ok = det > 0 and math.isfinite(det)
-            valid[i] = ok
-            if ok:
-                means2d[i, 0] = fx * x / z + cx
-                means2d[i, 1] = fy * y / z + cy
-                conics[i, 0] = c / det
-                conics[i, 1] = -b / det
-                conics[i, 2] = a / det
-                depths[i] = z
-                cov2d[i, 0] = a
-                cov2d[i, 1] = b
-                cov2d[i, 2] = c
-            else:
-                means2d[i, 0] = 0.0
-                means2d[i, 1] = 0.0
-                depths[i] = 0.0
-                for j in range(3):
-                    conics[i, j] = 0.0
-                    cov2d[i, j] = 0.0
+    Rq = np.empty((3, 3))
+    M = np.empty((3, 3))
+    # one flat loop: ~50 ns per Gaussian, not worth threads (or their compile time)
+    for i in range(n):
+        x = Rc[0, 0] * means[i, 0] + Rc[0, 1] * means[i, 1] + Rc[0, 2] * means[i, 2] + tc[0]
+        y = Rc[1, 0] * means[i, 0] + Rc[1, 1] * means[i, 1] + Rc[1, 2] * means[i, 2] + tc[1]
+        z = Rc[2, 0] * means[i, 0] + Rc[2, 1] * means[i, 1] + Rc[2, 2] * means[i, 2] + tc[2]
+        ok = z > near
+        a = 0.0
+        b = 0.0
+        c = 0.0
+        det = 0.0
+        if ok:
+            qn = math.sqrt(quats[i, 0] ** 2 + quats[i, 1] ** 2 + quats[i, 2] ** 2
+                           + quats[i, 3] ** 2)
+            qn = max(qn, 1e-12)
+            _quat_rotmat(quats[i, 0] / qn, quats[i, 1] / qn, quats[i, 2] / qn,
+                         quats[i, 3] / qn, Rq)
+            _mm(Rc, Rq, M, False, False)
+            for col in range(3):
+                for row in range(3):
+                    M[row, col] *= scales[i, col]
+            tx = z * min(max(x / z, -lims[0]), lims[1])
+            ty = z * min(max(y / z, -lims[2]), lims[3])
+            # rows of J @ M, J = [[fx/z, 0, -fx tx/z^2], [0, fy/z, -fy ty/z^2]]
+            j00 = fx / z
+            j02 = -fx * tx / (z * z)
+            j11 = fy / z
+            j12 = -fy * ty / (z * z)
+            for col in range(3):
+                r0 = j00 * M[0, col] + j02 * M[2, col]
+                r1 = j11 * M[1, col] + j12 * M[2, col]
+                a += r0 * r0
+                b += r0 * r1
+                c += r1 * r1
+            a += eps2d
+            c += eps2d
+            det = a * c - b * b
+            ok = det > 0 and math.isfinite(det)
+        valid[i] = ok
+        if ok:
+            means2d[i, 0] = fx * x / z + cx
+            means2d[i, 1] = fy * y / z + cy
+            conics[i, 0] = c / det
+            conics[i, 1] = -b / det
+            conics[i, 2] = a / det
+            depths[i] = z
+            cov2d[i, 0] = a
+            cov2d[i, 1] = b
+            cov2d[i, 2] = c
+        else:
+            means2d[i, 0] = 0.0
+            means2d[i, 1] = 0.0
+            depths[i] = 0.0
+            for j in range(3):
+                conics[i, j] = 0.0
+                cov2d[i, j] = 0.0
 
 
-@nb.njit(parallel=True, cache=True)
+@nb.njit(cache=True)
 def project_backward(means, quats, scales, Rc, tc, intr, lims, near, eps2d, valid, v_means2d,
                      v_conics, v_depths, v_means, v_quats, v_scales):  # pragma: no cover
     """Explicit backward of :func:`project_forward`: upstream v_means2d [N, 2], v_conics [N, 3],
     v_depths [N] -> v_means [N, 3], v_quats [N, 4], v_scales [N, 3] (written; zero if culled).
-    Each Gaussian is independent, so the parallel loop is race-free and deterministic."""
+    Each Gaussian is independent (no accumulation across Gaussians)."""
     fx, fy = intr[0], intr[1]
     n = means.shape[0]
-    for ch in nb.prange((n + CHUNK - 1) // CHUNK):
-        Rq = np.empty((3, 3))
-        RR = np.empty((3, 3))
-        M = np.empty((3, 3))
-        Sc = np.empty((3, 3))
-        J = np.zeros((2, 3))
-        JS = np.empty((2, 3))
-        cov = np.empty((2, 2))
-        Con = np.empty((2, 2))
-        G = np.empty((2, 2))
-        CG = np.empty((2, 2))
-        Vcov = np.empty((2, 2))
-        VJt = np.empty((2, 3))
-        VSc = np.empty((3, 3))
-        VJ = np.empty((2, 3))
-        VM = np.empty((3, 3))
-        VRR = np.empty((3, 3))
-        VRq = np.empty((3, 3))
-        for i in range(ch * CHUNK, min(n, (ch + 1) * CHUNK)):
-            for j in range(3):
-                v_means[i, j] = 0.0
-                v_scales[i, j] = 0.0
-            for j in range(4):
-                v_quats[i, j] = 0.0
-            if not valid[i]:
-                continue
-            x = Rc[0, 0] * means[i, 0] + Rc[0, 1] * means[i, 1] + Rc[0, 2] * means[i, 2] + tc[0]
-            y = Rc[1, 0] * means[i, 0] + Rc[1, 1] * means[i, 1] + Rc[1, 2] * means[i, 2] + tc[1]
-            z = Rc[2, 0] * means[i, 0] + Rc[2, 1] * means[i, 1] + Rc[2, 2] * means[i, 2] + tc[2]
-            qn = max(math.sqrt(quats[i, 0] ** 2 + quats[i, 1] ** 2 + quats[i, 2] ** 2
-                               + quats[i, 3] ** 2), 1e-12)
-            qw, qx, qy, qz = quats[i, 0] / qn, quats[i, 1] / qn, quats[i, 2] / qn, quats[i, 3] / qn
-            _quat_rotmat(qw, qx, qy, qz, Rq)
-            _mm(Rc, Rq, RR, False, False)
-            for col in range(3):
-                for row in range(3):
-                    M[row, col] = RR[row, col] * scales[i, col]
-            ux = x / z
-            uy = y / z
-            cl_x = ux < -lims[0] or ux > lims[1]
-            cl_y = uy < -lims[2] or uy > lims[3]
-            tx = z * min(max(ux, -lims[0]), lims[1])
-            ty = z * min(max(uy, -lims[2]), lims[3])
-            J[0, 0] = fx / z
-            J[0, 2] = -fx * tx / (z * z)
-            J[1, 1] = fy / z
-            J[1, 2] = -fy * ty / (z * z)
-            _mm(M, M, Sc, False, True)  # camera-frame 3D covariance
-            _mm(J, Sc, JS, False, False)
-            _mm(JS, J, cov, False, True)
-            a = cov[0, 0] + eps2d
-            b = cov[0, 1]
-            c = cov[1, 1] + eps2d
-            det = a * c - b * b
-            Con[0, 0] = c / det
-            Con[0, 1] = -b / det
-            Con[1, 0] = -b / det
-            Con[1, 1] = a / det
-            # conic = inverse(cov): dL/dcov = -Con G Con, G the symmetric split of dL/dconic.
-            G[0, 0] = v_conics[i, 0]
-            G[0, 1] = 0.5 * v_conics[i, 1]
-            G[1, 0] = 0.5 * v_conics[i, 1]
-            G[1, 1] = v_conics[i, 2]
-            _mm(Con, G, CG, False, False)
-            _mm(CG, Con, Vcov, False, False)
-            for r in range(2):
-                for q in range(2):
-                    Vcov[r, q] = -Vcov[r, q]
-            # cov = J Sc J^T: dL/dSc = J^T Vcov J, dL/dJ = 2 Vcov J Sc
-            _mm(Vcov, J, VJt, False, False)
-            _mm(J, VJt, VSc, True, False)
-            _mm(VJt, Sc, VJ, False, False)
-            # Sc = M M^T, M = RR diag(s), RR = Rc Rq
-            _mm(VSc, M, VM, False, False)
-            for col in range(3):
-                acc = 0.0
-                for row in range(3):
-                    VM[row, col] *= 2.0
-                    VRR[row, col] = VM[row, col] * scales[i, col]
-                    acc += VM[row, col] * RR[row, col]
-                v_scales[i, col] = acc
-            _mm(Rc, VRR, VRq, True, False)
-            # rotation matrix -> unit quaternion
-            gw = 2 * (-qz * VRq[0, 1] + qy * VRq[0, 2] + qz * VRq[1, 0] - qx * VRq[1, 2]
-                      - qy * VRq[2, 0] + qx * VRq[2, 1])
-            gx = 2 * (qy * VRq[0, 1] + qz * VRq[0, 2] + qy * VRq[1, 0] - 2 * qx * VRq[1, 1]
-                      - qw * VRq[1, 2] + qz * VRq[2, 0] + qw * VRq[2, 1] - 2 * qx * VRq[2, 2])
-            gy = 2 * (-2 * qy * VRq[0, 0] + qx * VRq[0, 1] + qw * VRq[0, 2] + qx * VRq[1, 0]
-                      + qz * VRq[1, 2] - qw * VRq[2, 0] + qz * VRq[2, 1] - 2 * qy * VRq[2, 2])
-            gz = 2 * (-2 * qz * VRq[0, 0] - qw * VRq[0, 1] + qx * VRq[0, 2] + qw * VRq[1, 0]
-                      - 2 * qz * VRq[1, 1] + qy * VRq[1, 2] + qx * VRq[2, 0] + qy * VRq[2, 1])
-            # normalisation q / |q|
-            dot = qw * gw + qx * gx + qy * gy + qz * gz
-            v_quats[i, 0] = (gw - qw * dot) / qn
-            v_quats[i, 1] = (gx - qx * dot) / qn
-            v_quats[i, 2] = (gy - qy * dot) / qn
-            v_quats[i, 3] = (gz - qz * dot) / qn
-            # J entries -> camera position (x, y, z) through z, tx, ty
-            VJ00 = 2.0 * VJ[0, 0]
-            VJ02 = 2.0 * VJ[0, 2]
-            VJ11 = 2.0 * VJ[1, 1]
-            VJ12 = 2.0 * VJ[1, 2]
-            z2 = z * z
-            v_tx = VJ02 * (-fx / z2)
-            v_ty = VJ12 * (-fy / z2)
-            vz = (VJ00 * (-fx / z2) + VJ11 * (-fy / z2)
-                  + VJ02 * (2 * fx * tx / (z2 * z)) + VJ12 * (2 * fy * ty / (z2 * z)))
-            vx = 0.0
-            vy = 0.0
-            if cl_x:
-                vz += v_tx * tx / z  # tx = z * lim
-            else:
-                vx += v_tx
-            if cl_y:
-                vz += v_ty * ty / z
-            else:
-                vy += v_ty
-            # means2d and depth
-            vx += v_means2d[i, 0] * fx / z
-            vy += v_means2d[i, 1] * fy / z
-            vz += -v_means2d[i, 0] * fx * x / z2 - v_means2d[i, 1] * fy * y / z2
-            vz += v_depths[i]
-            for j in range(3):
-                v_means[i, j] = Rc[0, j] * vx + Rc[1, j] * vy + Rc[2, j] * vz
+    # serial: ~150 ns per Gaussian, not worth threads (or their compile time)
+    Rq = np.empty((3, 3))
+    RR = np.empty((3, 3))
+    M = np.empty((3, 3))
+    Sc = np.empty((3, 3))
+    J = np.zeros((2, 3))
+    JS = np.empty((2, 3))
+    cov = np.empty((2, 2))
+    Con = np.empty((2, 2))
+    G = np.empty((2, 2))
+    CG = np.empty((2, 2))
+    Vcov = np.empty((2, 2))
+    VJt = np.empty((2, 3))
+    VSc = np.empty((3, 3))
+    VJ = np.empty((2, 3))
+    VM = np.empty((3, 3))
+    VRR = np.empty((3, 3))
+    VRq = np.empty((3, 3))
+    for i in range(n):
+        for j in range(3):
+            v_means[i, j] = 0.0
+            v_scales[i, j] = 0.0
+        for j in range(4):
+            v_quats[i, j] = 0.0
+        if not valid[i]:
+            continue
+        x = Rc[0, 0] * means[i, 0] + Rc[0, 1] * means[i, 1] + Rc[0, 2] * means[i, 2] + tc[0]
+        y = Rc[1, 0] * means[i, 0] + Rc[1, 1] * means[i, 1] + Rc[1, 2] * means[i, 2] + tc[1]
+        z = Rc[2, 0] * means[i, 0] + Rc[2, 1] * means[i, 1] + Rc[2, 2] * means[i, 2] + tc[2]
+        qn = max(math.sqrt(quats[i, 0] ** 2 + quats[i, 1] ** 2 + quats[i, 2] ** 2
+                           + quats[i, 3] ** 2), 1e-12)
+        qw, qx, qy, qz = quats[i, 0] / qn, quats[i, 1] / qn, quats[i, 2] / qn, quats[i, 3] / qn
+        _quat_rotmat(qw, qx, qy, qz, Rq)
+        _mm(Rc, Rq, RR, False, False)
+        for col in range(3):
+            for row in range(3):
+                M[row, col] = RR[row, col] * scales[i, col]
+        ux = x / z
+        uy = y / z
+        cl_x = ux < -lims[0] or ux > lims[1]
+        cl_y = uy < -lims[2] or uy > lims[3]
+        tx = z * min(max(ux, -lims[0]), lims[1])
+        ty = z * min(max(uy, -lims[2]), lims[3])
+        J[0, 0] = fx / z
+        J[0, 2] = -fx * tx / (z * z)
+        J[1, 1] = fy / z
+        J[1, 2] = -fy * ty / (z * z)
+        _mm(M, M, Sc, False, True)  # camera-frame 3D covariance
+        _mm(J, Sc, JS, False, False)
+        _mm(JS, J, cov, False, True)
+        a = cov[0, 0] + eps2d
+        b = cov[0, 1]
+        c = cov[1, 1] + eps2d
+        det = a * c - b * b
+        Con[0, 0] = c / det
+        Con[0, 1] = -b / det
+        Con[1, 0] = -b / det
+        Con[1, 1] = a / det
+        # conic = inverse(cov): dL/dcov = -Con G Con, G the symmetric split of dL/dconic.
+        G[0, 0] = v_conics[i, 0]
+        G[0, 1] = 0.5 * v_conics[i, 1]
+        G[1, 0] = 0.5 * v_conics[i, 1]
+        G[1, 1] = v_conics[i, 2]
+        _mm(Con, G, CG, False, False)
+        _mm(CG, Con, Vcov, False, False)
+        for r in range(2):
+            for q in range(2):
+                Vcov[r, q] = -Vcov[r, q]
+        # cov = J Sc J^T: dL/dSc = J^T Vcov J, dL/dJ = 2 Vcov J Sc
+        _mm(Vcov, J, VJt, False, False)
+        _mm(J, VJt, VSc, True, False)
+        _mm(VJt, Sc, VJ, False, False)
+        # Sc = M M^T, M = RR diag(s), RR = Rc Rq
+        _mm(VSc, M, VM, False, False)
+        for col in range(3):
+            acc = 0.0
+            for row in range(3):
+                VM[row, col] *= 2.0
+                VRR[row, col] = VM[row, col] * scales[i, col]
+                acc += VM[row, col] * RR[row, col]
+            v_scales[i, col] = acc
+        _mm(Rc, VRR, VRq, True, False)
+        # rotation matrix -> unit quaternion
+        gw = 2 * (-qz * VRq[0, 1] + qy * VRq[0, 2] + qz * VRq[1, 0] - qx * VRq[1, 2]
+                  - qy * VRq[2, 0] + qx * VRq[2, 1])
+        gx = 2 * (qy * VRq[0, 1] + qz * VRq[0, 2] + qy * VRq[1, 0] - 2 * qx * VRq[1, 1]
+                  - qw * VRq[1, 2] + qz * VRq[2, 0] + qw * VRq[2, 1] - 2 * qx * VRq[2, 2])
+        gy = 2 * (-2 * qy * VRq[0, 0] + qx * VRq[0, 1] + qw * VRq[0, 2] + qx * VRq[1, 0]
+                  + qz * VRq[1, 2] - qw * VRq[2, 0] + qz * VRq[2, 1] - 2 * qy * VRq[2, 2])
+        gz = 2 * (-2 * qz * VRq[0, 0] - qw * VRq[0, 1] + qx * VRq[0, 2] + qw * VRq[1, 0]
+                  - 2 * qz * VRq[1, 1] + qy * VRq[1, 2] + qx * VRq[2, 0] + qy * VRq[2, 1])
+        # normalisation q / |q|
+        dot = qw * gw + qx * gx + qy * gy + qz * gz
+        v_quats[i, 0] = (gw - qw * dot) / qn
+        v_quats[i, 1] = (gx - qx * dot) / qn
+        v_quats[i, 2] = (gy - qy * dot) / qn
+        v_quats[i, 3] = (gz - qz * dot) / qn
+        # J entries -> camera position (x, y, z) through z, tx, ty
+        VJ00 = 2.0 * VJ[0, 0]
+        VJ02 = 2.0 * VJ[0, 2]
+        VJ11 = 2.0 * VJ[1, 1]
+        VJ12 = 2.0 * VJ[1, 2]
+        z2 = z * z
+        v_tx = VJ02 * (-fx / z2)
+        v_ty = VJ12 * (-fy / z2)
+        vz = (VJ00 * (-fx / z2) + VJ11 * (-fy / z2)
+              + VJ02 * (2 * fx * tx / (z2 * z)) + VJ12 * (2 * fy * ty / (z2 * z)))
+        vx = 0.0
+        vy = 0.0
+        if cl_x:
+            vz += v_tx * tx / z  # tx = z * lim
+        else:
+            vx += v_tx
+        if cl_y:
+            vz += v_ty * ty / z
+        else:
+            vy += v_ty
+        # means2d and depth
+        vx += v_means2d[i, 0] * fx / z
+        vy += v_means2d[i, 1] * fy / z
+        vz += -v_means2d[i, 0] * fx * x / z2 - v_means2d[i, 1] * fy * y / z2
+        vz += v_depths[i]
+        for j in range(3):
+            v_means[i, j] = Rc[0, j] * vx + Rc[1, j] * vy + Rc[2, j] * vz
