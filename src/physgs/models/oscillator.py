@@ -212,7 +212,7 @@ def integrate(omega: torch.Tensor, zeta: torch.Tensor, gain: torch.Tensor, wind,
     # Guard the fastest eigenvalue, not omega alone: an over-damped part's stiff pole is faster.
     rates = fastest_rate(omega.detach().cpu().double().numpy(), zeta.detach().cpu().double().numpy())
     i = int(np.argmax(rates))
-    rate, om_i, ze_i = float(rates[i]), float(omega[i]), float(zeta[i])
+    rate, om_i, ze_i = float(rates[i]), float(omega.detach()[i]), float(zeta.detach()[i])
     h = dt / substeps
     if rate * h > guard * (1.0 + GUARD_RTOL):
         need = required_substeps(rate, dt, guard)
