@@ -22,6 +22,7 @@ include: "workflow/rules/evaluate.smk"
 include: "workflow/rules/recovery.smk"
 include: "workflow/rules/report.smk"
 include: "workflow/rules/speed_accuracy.smk"
+include: "workflow/rules/kselect.smk"
 
 
 rule all:
@@ -29,3 +30,4 @@ rule all:
         rules.testbed.input,
         rules.report.input,
         rules.speed_accuracy.output,
+        rules.tab_kselect.output,

@@ -15,7 +15,7 @@ rule evaluate:
     wildcard_constraints:
         tree="|".join(CFG["trees"]),
         model="|".join(_models.MODEL_NAMES),
-        config="|".join(_models.CONFIG_NAMES),
+        config="|".join((*_models.CONFIG_NAMES, _models.AUTO_CONFIG)),
     params:
         backend=CFG["train"]["backend"],
     log:

@@ -10,7 +10,7 @@ rule recovery:
         record=_build.RECOVERY,
     wildcard_constraints:
         tree="|".join(CFG["trees"]),
-        config="|".join(_models.CONFIG_NAMES),
+        config="|".join((*_models.CONFIG_NAMES, _models.AUTO_CONFIG)),
     log:
         "logs/recovery/{tree}/ours_{config}.log",
     threads: 1
@@ -29,7 +29,7 @@ rule null_control:
         record=_build.NULL,
     wildcard_constraints:
         tree="|".join(CFG["trees"]),
-        config="|".join(_models.CONFIG_NAMES),
+        config="|".join((*_models.CONFIG_NAMES, _models.AUTO_CONFIG)),
     params:
         cfg=CFG,
     log:
