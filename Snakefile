@@ -16,6 +16,7 @@ validate(CFG, "workflow/schemas/config.schema.yaml")
 TREES = CFG["trees"]
 
 
+include: "workflow/rules/common.smk"
 include: "workflow/rules/testbed.smk"
 include: "workflow/rules/train.smk"
 include: "workflow/rules/evaluate.smk"

@@ -1,7 +1,5 @@
 # Evaluation (SPEC section 4): every split of one trained model, scored through the rasterizer.
 # Reads the ground truth only for branch-tip trajectories; never feeds anything back to training.
-from physgs.report import build as _build
-
 
 rule evaluate:
     input:

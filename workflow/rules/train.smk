@@ -1,22 +1,8 @@
 # Training: one job per (tree, model, configuration). The only input is the observed dataset;
 # the ground-truth physics file (truth.npz) is never an input of a training rule.
-import physgs.models.registry as _models
-
-TRAIN_JOBS = _models.training_jobs()  # 5 baselines x single + ours x (single, joint32, joint96)
-
-
-def _train_input(wildcards):
-    if wildcards.config not in _models.configs_for(wildcards.model):
-        raise ValueError(
-            f"model '{wildcards.model}' is not trained in configuration '{wildcards.config}'; "
-            f"valid: {_models.configs_for(wildcards.model)} (joint configurations are ours only)"
-        )
-    return f"results/testbed/{wildcards.tree}/observed.npz"
-
-
 rule train:
     input:
-        observed=_train_input,
+        observed=train_input,
     output:
         ckpt="results/models/{tree}/{model}_{config}.pt",
         loss="results/models/{tree}/{model}_{config}.loss.csv",
