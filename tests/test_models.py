@@ -156,3 +156,21 @@ def test_checkpoint_roundtrip(tmp_path):
         load_checkpoint(tmp_path / "bad.pt")
     with pytest.raises(FileNotFoundError, match="snakemake"):
         load_checkpoint(tmp_path / "missing.pt")
+
+
+def test_ours_drives_each_condition_with_its_nominal_mean_speed():
+    """vbar = the condition's nominal mean speed, also for a rescaled (unseen) wind."""
+    import dataclasses
+
+    ctx, w = _ctx()
+    nominal = 6.3  # the anemometer record's mean differs from the condition's mean speed
+    ctx = dataclasses.replace(ctx, vbar_ratio=nominal / float(w.mean()))
+    m = build_model("ours", ctx, _cfg(), config="single", seed=0)
+    with torch.no_grad():
+        m.gain_raw.fill_(0.3)
+        for scale in (1.0, 0.71):
+            wind = torch.as_tensor(scale * w, dtype=torch.float64)
+            got = m.part_theta(wind)
+            want = integrate(m.omega.double(), m.zeta.double(), m.gain.double(), wind,
+                             scale * nominal, 1.0 / FPS, m.substeps, backend="reference")
+            torch.testing.assert_close(got.double(), want, rtol=1e-5, atol=1e-7)

@@ -17,7 +17,7 @@ def sparse():
     sim = simulate_tree(cfg["testbed"], cfg["presets"]["sparse"], seed=cfg["seed"], tree="sparse")
     tr = sim.truth
     obs = SimpleNamespace(wind=sim.wind, lead_in_frames=int(tr.lead_in_frames),
-                          n_train=int(cfg["testbed"]["n_train"]), fps=int(tr.fps))
+                          n_train=int(cfg["testbed"]["n_train"]), fps=int(tr.fps), vbar=tr.vbar)
     return tr, obs
 
 
@@ -26,8 +26,8 @@ def test_parts_that_are_bones_are_recovered_exactly(sparse):
     pick = np.array([0, 5, 10, 15, len(tr.omega) - 1])
     om = torch.as_tensor(tr.omega[pick], dtype=torch.float64)
     wind = torch.as_tensor(obs.wind[0], dtype=torch.float64)
-    # the model's vbar (mean observed wind) differs from the testbed's: a constant force offset,
-    # which shifts theta by a constant and leaves the correlation unchanged
+    # any vbar error is a constant force offset: it shifts theta by a constant and leaves the
+    # correlation unchanged, so the record's mean stands in for the nominal speed here
     theta = integrate(om, torch.full_like(om, 0.08), torch.ones_like(om), wind, float(wind.mean()),
                       1 / obs.fps, 2).numpy()
     rec = score_recovery(theta, tr.omega[pick], np.full(5, 0.08), tr,

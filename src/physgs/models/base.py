@@ -18,7 +18,9 @@ class ModelContext:
     n_train training frames; lead_in_frames L (wind column L = recorded frame 1);
     wind_mean, wind_std m/s of the training condition's observed wind (lead-in included);
     wind_force_std m^2/s^2, std of v^2 - mean(v)^2 of that wind (scales the oscillator gain);
-    view_dir [3] unit viewing direction of the training camera (world).
+    view_dir [3] unit viewing direction of the training camera (world);
+    vbar_ratio: the condition's nominal mean speed over the mean of its observed record (the
+    conditions are rescalings of one record, so one ratio serves all; vbar = ratio * mean(wind)).
     """
 
     canonical_xyz: np.ndarray
@@ -29,6 +31,7 @@ class ModelContext:
     wind_std: float
     wind_force_std: float
     view_dir: np.ndarray
+    vbar_ratio: float = 1.0
 
     def to_dict(self) -> dict:
         """Checkpoint-safe form (tensors and Python scalars only)."""
@@ -38,6 +41,7 @@ class ModelContext:
             "lead_in_frames": int(self.lead_in_frames), "wind_mean": float(self.wind_mean),
             "wind_std": float(self.wind_std), "wind_force_std": float(self.wind_force_std),
             "view_dir": torch.tensor(np.asarray(self.view_dir, dtype=np.float64)),
+            "vbar_ratio": float(self.vbar_ratio),
         }
 
     @staticmethod
@@ -46,6 +50,7 @@ class ModelContext:
             np.asarray(d["canonical_xyz"], dtype=np.float32), int(d["fps"]), int(d["n_train"]),
             int(d["lead_in_frames"]), float(d["wind_mean"]), float(d["wind_std"]),
             float(d["wind_force_std"]), np.asarray(d["view_dir"], dtype=np.float64),
+            float(d.get("vbar_ratio", 1.0)),
         )
 
 
@@ -63,6 +68,7 @@ def context_from_observed(obs) -> ModelContext:
         canonical_xyz=np.asarray(obs.canonical_xyz, dtype=np.float32), fps=int(obs.fps),
         n_train=int(obs.n_train), lead_in_frames=int(obs.lead_in_frames), wind_mean=float(w.mean()),
         wind_std=std, wind_force_std=float((w**2 - w.mean() ** 2).std()), view_dir=fwd,
+        vbar_ratio=float(np.asarray(obs.vbar)[0] / w.mean()) if hasattr(obs, "vbar") else 1.0,
     )
 
 

@@ -55,6 +55,7 @@ class OscillatorPrior(BaseModel):
                              f"{zeta_init}")
         self.omega_lo, self.omega_hi, self.zeta_lo, self.zeta_hi = lo, hi, zlo, zhi
         self.dt = 1.0 / ctx.fps
+        self.vbar_ratio = float(ctx.vbar_ratio)
         self.guard = float(rk4_guard)
         # Enough substeps that every (omega, zeta) the bounds allow passes the guard (the fastest
         # rate is at the top of both bounds; above zeta = 1 it exceeds omega).
@@ -125,12 +126,14 @@ class OscillatorPrior(BaseModel):
     def part_theta(self, wind: torch.Tensor) -> torch.Tensor:
         """Swing angles theta [K, L+F] (rad) under one condition's observed wind [L+F] (m/s).
 
-        vbar is the mean of that condition's observed wind. Frozen parts have theta = 0.
+        vbar, the condition's mean speed, is the record's mean times the calibration ratio frozen
+        from the training condition (``ModelContext.vbar_ratio``). Frozen parts have theta = 0.
         """
         wind = torch.as_tensor(wind, dtype=torch.float64)
         if wind.ndim != 1:
             raise ValueError(f"part_theta: wind must be [L+F], got shape {tuple(wind.shape)}")
-        theta = integrate(self.omega, self.zeta, self.gain, wind, float(wind.mean()), self.dt,
+        vbar = self.vbar_ratio * float(wind.mean())
+        theta = integrate(self.omega, self.zeta, self.gain, wind, vbar, self.dt,
                           self.substeps, guard=self.guard)  # [K, L+F]
         if not bool(self.frozen.any()):
             return theta

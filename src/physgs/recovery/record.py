@@ -76,8 +76,8 @@ def run_null(truth, observed, *, n_parts: int, zeta_init: float, substeps: int, 
              n_draws: int | None = None) -> NullResult:
     """The null control for one tree and one K, wired exactly like the trained model.
 
-    Uses the training condition's observed wind (lead-in first), dt = 1 / fps, and
-    vbar = mean of that observed series, as ``OursModel.part_theta`` does; bones over the
+    Uses the training condition's observed wind (lead-in first), dt = 1 / fps, and the
+    condition's mean speed ``observed.vbar[0]``, as the oscillator prior does; bones over the
     training window at the training wind. zeta_init and substeps: the model's config values.
     """
     from physgs.recovery.null import N_DRAWS, null_control
@@ -85,6 +85,7 @@ def run_null(truth, observed, *, n_parts: int, zeta_init: float, substeps: int, 
     wind = np.asarray(observed.wind[0], dtype=np.float64)  # [L+F]
     L, n_train = int(observed.lead_in_frames), int(observed.n_train)
     return null_control(truth.omega, bone_window(truth, L, n_train), wind, n_parts=n_parts,
-                        zeta_init=zeta_init, vbar=float(wind.mean()), dt=1.0 / observed.fps,
+                        zeta_init=zeta_init, vbar=float(np.asarray(observed.vbar)[0]),
+                        dt=1.0 / observed.fps,
                         substeps=substeps, lead_in_frames=L, n_train=n_train, seed=seed,
                         n_draws=N_DRAWS if n_draws is None else n_draws)
