@@ -13,7 +13,7 @@ rule testbed_dataset:
     log:
         "logs/testbed/{tree}.log",
     benchmark:
-        "benchmarks/out/testbed_{tree}.tsv"
+        "results/benchmarks/testbed/{tree}.tsv"
     threads: 1
     resources:
         mem_mb=3000,
