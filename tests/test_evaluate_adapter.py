@@ -45,3 +45,34 @@ def test_self_rendered_dataset_scores_perfectly():
     # soft alpha vs thresholded mask of the same render: sub-pixel centroid difference
     assert np.all(res.centroid_err < 0.5)
     np.testing.assert_allclose(model_means_fn(model, obs)(4, 2), xyz, atol=1e-6)
+
+
+def test_render_cache_never_leaks_across_frames_or_wind():
+    """The adapter deforms each (frame, condition) once; its renders equal uncached ones."""
+    rng = np.random.default_rng(1)
+    n, L, n_train, n_tail, H = 40, 160, 3, 2, 12
+    xyz = (rng.normal(size=(n, 3)) * [0.3, 0.3, 0.6] + [0.0, 0.0, 1.0]).astype(np.float32)
+    w0 = 6.0 + 1.5 * rng.standard_normal(L + n_train + n_tail)
+    wind = np.stack([w0, 0.71 * w0])
+    ctx = ModelContext(xyz, 24, n_train, L, float(w0.mean()), float(w0.std()),
+                       float((w0**2 - w0.mean() ** 2).std()), np.array([0.0, 1.0, 0.0]))
+    cfg = physgs.config.load("config/trees.yaml", "quick")["models"]
+    cam = orbit_camera(0, radius=4, height=1, target=(0, 0, 1), fov_deg=50, width=H, height_px=H)
+    obs = SimpleNamespace(wind=wind, background=np.ones(3))
+    for name in ("ours", "mlp"):
+        model = build_model(name, ctx, cfg, config="single")
+        with torch.no_grad():  # move off the canonical pose so frames and winds differ
+            for p in model.parameters():
+                if p.ndim >= 1 and p.shape[0] in (n,):
+                    continue
+                p.add_(0.05 * torch.randn_like(p))
+        fn = model_render_fn(model, obs)
+        for j, c in [(0, 0), (0, 1), (1, 1), (1, 0), (0, 0)]:
+            got = fn(j, c, cam)[0]
+            g = model.gaussians_at(j, torch.as_tensor(wind[c], dtype=torch.float32))
+            with torch.no_grad():
+                ref = rasterization(g.means, g.quats, g.scales, g.opacities, g.colors, cam,
+                                    np.ones(3)).rgb.clamp(0, 1).numpy()
+            np.testing.assert_allclose(got, ref, atol=1e-6, err_msg=f"{name} frame {j} cond {c}")
+        if name == "ours":  # the wind matters to ours, so the two conditions must differ
+            assert np.abs(fn(1, 0, cam)[0] - fn(1, 1, cam)[0]).max() > 1e-4

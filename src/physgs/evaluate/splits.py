@@ -110,19 +110,20 @@ def evaluate(render_fn: RenderFn, observed, *, progress: Callable[[str], None] |
                          f"{observed.n_train + observed.n_tail}; the dataset is inconsistent")
     cam_psnr = np.empty((C, F))
     cen = np.empty((C, F))
-    for c in range(C):
-        if progress:
-            progress(f"training camera, condition {c}")
-        for j in range(F):
+    # frame-major order, so a render_fn that caches its last deformed frame deforms each once
+    for j in range(F):
+        if progress and j % 50 == 0:
+            progress(f"training camera, frame {j + 1}/{F}, {C} conditions")
+        for c in range(C):
             rgb, alpha = _render(render_fn, j, c, observed.train_camera, (H, W))
             cam_psnr[c, j] = psnr(rgb, frames[c, j])
             cen[c, j] = centroid_error(alpha, observed.masks[c, j])
     A, M = len(observed.heldout_cameras), len(observed.heldout_frame_idx)
     view = np.empty((A, M))
-    for a, cam in enumerate(observed.heldout_cameras):
-        if progress:
-            progress(f"held-out azimuth {observed.heldout_azimuths_deg[a]} deg")
-        for m, j in enumerate(observed.heldout_frame_idx):
+    if progress:
+        progress(f"held-out views: {A} azimuths x {M} frames")
+    for m, j in enumerate(observed.heldout_frame_idx):
+        for a, cam in enumerate(observed.heldout_cameras):
             rgb, _ = _render(render_fn, j, 0, cam, observed.heldout_frames.shape[2:4])
             view[a, m] = psnr(rgb, observed.heldout_frames[a, m])
     return EvalResult(cam_psnr, cen, view, np.asarray(observed.conditions, dtype=np.float64),

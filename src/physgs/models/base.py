@@ -109,6 +109,10 @@ class BaseModel(nn.Module):
                 f"columns with lead-in {self.lead_in})"
             )
 
+    # Whether the deformation reads the wind (a model that does not gives the same Gaussians under
+    # every condition, which lets the evaluation deform each frame once).
+    use_wind: bool = True
+
     def canonical_state(self) -> GaussianState:
         """The undeformed canonical Gaussians (used by the shared static warm-up)."""
         return self.canonical.state()

@@ -11,6 +11,7 @@ class StaticModel(BaseModel):
     """No deformation: every frame shows the canonical Gaussians."""
 
     name = "static"
+    use_wind = False
 
     def deform(self, frame_idx: int, wind: torch.Tensor) -> GaussianState:
         return self.canonical.state()
