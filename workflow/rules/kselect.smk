@@ -44,7 +44,7 @@ rule train_auto:
         "logs/train/{tree}/ours_auto.log",
     benchmark:
         "results/benchmarks/train/{tree}/ours_auto.tsv"
-    threads: 2
+    threads: 1
     resources:
         mem_mb=4000,
         runtime=10 + CFG["train"]["iterations"] // 60,

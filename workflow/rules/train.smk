@@ -16,7 +16,7 @@ rule train:
         "logs/train/{tree}/{model}_{config}.log",
     benchmark:
         "results/benchmarks/train/{tree}/{model}_{config}.tsv"
-    threads: 2
+    threads: 1  # two 1-thread jobs side by side beat one 2-thread job on 2 cores (benchmarks/training.py)
     resources:
         mem_mb=4000,
         # minutes; generous (about 1 s per iteration) so a cluster never kills a default job

@@ -1,6 +1,7 @@
 """Snakemake script of rule `evaluate`: score one checkpoint on every split."""
 import contextlib
 
+import numba
 import torch
 
 from physgs.evaluate.run import evaluate_checkpoint
@@ -9,6 +10,7 @@ from physgs.testbed.dataset import load_observed, load_truth
 
 sm = snakemake  # noqa: F821 (injected by Snakemake)
 torch.set_num_threads(sm.threads)
+numba.set_num_threads(min(sm.threads, numba.config.NUMBA_NUM_THREADS))
 with open(sm.log[0], "w") as log, contextlib.redirect_stderr(log):
     summary = evaluate_checkpoint(
         load_checkpoint(sm.input.ckpt), load_observed(sm.input.observed), load_truth(sm.input.truth),

@@ -1,0 +1,132 @@
+"""The whole DAG end to end on the quick profile, and the plans of single targets.
+
+The quick DAG runs once per session (module fixture) in a scratch copy of the workflow; the
+tests then read what it produced as a reviewer would: every table's rows and columns, finite
+numbers, .tex agreeing with .csv, and every figure present.
+"""
+from __future__ import annotations
+
+import re
+
+import numpy as np
+import pandas as pd
+import pytest
+import yaml
+
+from physgs import config as pconfig
+from physgs.report.build import FIGURES, TABLES
+from workflow_helpers import ROOT, snakemake, workflow_copy
+
+pytestmark = pytest.mark.slow
+QUICK = pconfig.resolve(yaml.safe_load((ROOT / "config" / "trees.yaml").read_text()), "quick")
+TREES = QUICK["trees"]
+MODELS = ["Static pose", "Deformation MLP", "Deformation MLP + wind", "Deformable-3DGS",
+          "Deformable-3DGS + wind", "Ours"]
+
+
+@pytest.fixture(scope="module")
+def run(tmp_path_factory):
+    wd = workflow_copy(tmp_path_factory.mktemp("quick_dag"))
+    snakemake(wd, "--cores", "2", "all", "--config", "profile=quick", timeout=900)
+    return wd
+
+
+def _csv(run, name) -> pd.DataFrame:
+    return pd.read_csv(run / "results" / "tables" / f"{name}.csv")
+
+
+def _tex_numbers(run, name) -> list[float]:
+    tex = (run / "results" / "tables" / f"{name}.tex").read_text()
+    body = tex.split(r"\midrule", 1)[1]
+    return [float(x) for x in re.findall(r"(?<![\w{])[-+]?\d+\.\d+", body)]
+
+
+def test_every_output_exists(run):
+    for name in TABLES:
+        for ext in ("tex", "csv"):
+            assert (run / "results" / "tables" / f"{name}.{ext}").stat().st_size > 0
+    for name in (*FIGURES, "fig_speed_accuracy"):
+        for ext in ("pdf", "png"):
+            assert (run / "results" / "figures" / f"{name}.{ext}").stat().st_size > 1000
+    for tree in TREES:
+        assert (run / "results" / "figures" / f"testbed_{tree}.png").is_file()
+
+
+def test_tab_psnr_rows_columns_and_finite(run):
+    df = _csv(run, "tab_psnr")
+    assert list(df["model"]) == MODELS
+    assert list(df.columns[1:]) == [f"{t}_{s}" for t in TREES for s in ("view", "time")]
+    vals = df.iloc[:, 1:].to_numpy(float)
+    assert np.isfinite(vals).all() and (vals > 5).all() and (vals < 60).all()
+    tex = (run / "results" / "tables" / "tab_psnr.tex").read_text()
+    assert r"\toprule" in tex and r"\bottomrule" in tex and tex.count(r"\textbf{") == 2 * len(TREES)
+
+
+def test_tab_transfer_rows_columns_and_finite(run):
+    df = _csv(run, "tab_transfer")
+    unseen = len(QUICK["testbed"]["conditions"]) - 1
+    assert len(df) == 2 * len(TREES) * unseen
+    assert set(df["split"]) == {"train", "beyond"}
+    models = ["static", "mlp", "mlp_wind", "d3dgs", "d3dgs_wind", "ours"]
+    assert list(df.columns[-6:]) == models
+    assert np.isfinite(df[models].to_numpy(float)).all()
+
+
+def test_tab_margin_is_ours_minus_mlp_wind(run):
+    df = _csv(run, "tab_margin")
+    assert list(df["tree"]) == TREES
+    assert [c for c in df.columns if c.startswith("margin_")] == ["margin_v0", "margin_0.84v0",
+                                                                 "margin_0.71v0"]
+    from physgs.evaluate.splits import load_eval
+    for _, row in df.iterrows():
+        ours = load_eval(run / "results" / "eval" / row["tree"] / "ours_single.npz").summary()
+        base = load_eval(run / "results" / "eval" / row["tree"] / "mlp_wind_single.npz").summary()
+        assert row["margin_v0"] == pytest.approx(ours["train_c0"] - base["train_c0"], abs=1e-4)
+
+
+def test_tab_null_rows_columns_and_finite_where_defined(run):
+    df = _csv(run, "tab_null")
+    configs = list(QUICK["models"]["configs"])
+    assert len(df) == len(TREES) * len(configs)
+    for col in ("trained_parts_trusted", "null_parts_trusted", "nearest_bone_gap_pct"):
+        assert np.isfinite(df[col].to_numpy(float)).all(), col
+    # a median over no trusted part is undefined (empty cell), and only then
+    for who in ("trained", "null"):
+        err = df[f"{who}_median_rel_err_pct"].to_numpy(float)
+        assert np.isfinite(err[df[f"{who}_parts_trusted"].to_numpy(float) >= 1]).all()
+    assert (df["nearest_bone_gap_pct"] >= 0).all()
+
+
+@pytest.mark.parametrize("name", TABLES)
+def test_tex_agrees_with_csv(run, name):
+    df = _csv(run, name)
+    nums = df.select_dtypes("number").to_numpy(float).ravel()
+    nums = nums[np.isfinite(nums)]
+    tex = _tex_numbers(run, name)
+    assert tex, f"{name}.tex has no numbers"
+    # every decimal in the .tex is a rounded CSV value (percentages are written x100)
+    for x in tex:
+        ok = np.isclose(nums, x, atol=0.006) | np.isclose(nums * 100, x, atol=0.006)
+        assert ok.any(), f"{name}.tex shows {x}, which is in no CSV cell"
+
+
+def test_speed_accuracy_csv(run):
+    df = pd.read_csv(run / "results" / "tables" / "speed_accuracy.csv")
+    assert set(df["knob"]) == {"resolution", "iterations", "substeps", "K", "vertices"}
+    assert np.isfinite(df[["wall_s", "psnr_time"]].to_numpy(float)).all()
+    assert (df["wall_s"] > 0).all()
+
+
+def test_tab_null_plan_trains_ours_only():
+    """`snakemake results/tables/tab_null.tex` must train no baseline."""
+    import tempfile
+    from pathlib import Path
+
+    with tempfile.TemporaryDirectory() as d:
+        wd = workflow_copy(Path(d))
+        out = snakemake(wd, "-n", "--cores", "2", "results/tables/tab_null.tex",
+                        "--config", "profile=quick").stdout
+    trained = re.findall(r"results/models/\w+/(\w+?)_(single|joint32|joint96)\.pt", out)
+    assert trained, "the plan trains nothing"
+    assert {m for m, _ in trained} == {"ours"}
+    assert "rule evaluate:" not in out
