@@ -9,7 +9,6 @@ import torch
 from scipy.spatial.transform import Rotation
 
 import physgs.config
-from physgs.camera import look_at
 from physgs.models import build_model, load_checkpoint
 from physgs.models.kselect import (
     PARAMS_PER_PART,
@@ -23,42 +22,15 @@ from physgs.models.kselect import (
     select_k,
 )
 from physgs.models.visibility import freeze_invisible, freeze_schedule, part_image_swing
-from physgs.render import rasterization
 from physgs.recovery.run import recover_model
 from physgs.train import run_training, train_model
 
-FPS, N_TRAIN, N_TAIL, LEAD_IN, RES = 24, 20, 4, 120, 24
-
-
-def _dataset(seed=0):
-    """Observed-like fixture: trunk + crown, the crown swaying as sin(2 pi 0.8 t) * height^2."""
-    rng = np.random.default_rng(seed)
-    trunk = np.stack([np.zeros(30), np.zeros(30), np.linspace(0, 1, 30)], 1)
-    crown = rng.normal(size=(90, 3)) * [0.35, 0.35, 0.3] + [0, 0, 1.4]
-    xyz = np.concatenate([trunk, crown]).astype(np.float32)  # [N, 3]
-    n = xyz.shape[0]
-    col = np.where(np.arange(n)[:, None] < 30, [0.4, 0.25, 0.1], [0.2, 0.6, 0.2])
-    cam = look_at((0.0, -4.5, 1.0), (0.0, 0.0, 1.0), fov_deg=40, width=RES, height=RES)
-    F = N_TRAIN + N_TAIL
-    cond = np.array([1.0, 0.84, 0.71])
-    wind = (6.0 + 1.5 * rng.standard_normal(LEAD_IN + F))[None] * cond[:, None]
-    frames = np.empty((3, F, RES, RES, 3), np.uint8)
-    q = torch.tensor([[1.0, 0, 0, 0]]).repeat(n, 1)
-    for j in range(F):
-        m = xyz.copy()
-        m[:, 0] += 0.12 * xyz[:, 2] ** 2 * math.sin(2 * math.pi * 0.8 * j / FPS)
-        out = rasterization(torch.tensor(m), q, torch.full((n, 3), 0.08), torch.full((n,), 0.8),
-                            torch.tensor(col, dtype=torch.float32), cam, [1.0, 1.0, 1.0],
-                            backend="fast", return_depth=False)
-        frames[:, j] = np.round(out.rgb.numpy() * 255).astype(np.uint8)
-    return SimpleNamespace(fps=FPS, n_train=N_TRAIN, n_tail=N_TAIL, lead_in_frames=LEAD_IN,
-                           conditions=cond, wind=wind.astype(np.float32), frames=frames,
-                           train_camera=cam, background=np.ones(3), canonical_xyz=xyz)
+FPS, N_TRAIN = 24, 20  # as in the conftest swaying dataset
 
 
 @pytest.fixture(scope="module")
-def data():
-    return _dataset()
+def data(swaying):
+    return swaying
 
 
 def _cfg(K=4, iterations=16, warmup=4):

@@ -54,7 +54,7 @@ def test_roundtrip_matches_interface(tiny):
 
 def test_masks_agree_with_projected_geometry(tiny):
     _, d = tiny
-    o, t = load_observed(d / "observed.npz"), load_truth(d / "truth.npz")
+    o = load_observed(d / "observed.npz")
     uv, z = o.train_camera.project(o.canonical_xyz.astype(np.float64))
     assert (z > 0).all()
     px = np.floor(uv).astype(int)

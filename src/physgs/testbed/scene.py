@@ -21,8 +21,6 @@ def frame_cameras(lo: np.ndarray, hi: np.ndarray, max_horizontal: float, azimuth
     rh = float(max_horizontal)
     tan = np.tan(np.deg2rad(fov_deg) / 2)
     D = rh + max(rh, hz) * margin / tan
-    # orbit_camera circles the world z axis; offset the target so every camera sits at D from it
-    radius = D + np.linalg.norm(c[:2])
     cams = []
     for a in azimuths_deg:
         ar = np.deg2rad(a)
