@@ -22,5 +22,8 @@ def test_train_jobs_read_only_the_observed_dataset():
         inputs = re.search(r"input: (.*)", b).group(1)
         assert re.fullmatch(r"results/testbed/\w+/observed\.npz", inputs.strip()), inputs
         assert "truth" not in inputs
-        assert "threads: 2" in b and "mem_mb=" in b and "benchmark:" in b and "log:" in b
+        assert "mem_mb=" in b and "runtime=" in b and "benchmark:" in b and "log:" in b
+    # threads are declared (a 1-thread job prints no threads line in the plan)
+    assert re.search(r"rule train:(?:\n    .*)*\n    threads: \d", (ROOT / "workflow" / "rules" /
+                                                                "train.smk").read_text())
 
