@@ -10,6 +10,7 @@ import torch
 
 from physgs.camera import look_at
 from physgs.render import rasterization
+from workflow_helpers import snakemake, workflow_copy
 
 FPS, N_TRAIN, N_TAIL, LEAD_IN, RES = 24, 20, 4, 150, 24
 
@@ -47,3 +48,12 @@ def swaying_dataset(seed: int = 0) -> SimpleNamespace:
 def swaying():
     """The swaying-tree dataset, built once per session."""
     return swaying_dataset()
+
+
+@pytest.fixture(scope="session")
+def quick_dag(tmp_path_factory):
+    """Every rule of the quick DAG, run once on the sparse tree in a scratch workflow copy."""
+    wd = workflow_copy(tmp_path_factory.mktemp("quick_dag"))
+    snakemake(wd, "--cores", "2", "all", "--config", "profile=quick", 'trees=["sparse"]',
+              timeout=900)
+    return wd

@@ -26,11 +26,8 @@ MODELS = ["Static pose", "Deformation MLP", "Deformation MLP + wind", "Deformabl
 
 
 @pytest.fixture(scope="module")
-def run(tmp_path_factory):
-    wd = workflow_copy(tmp_path_factory.mktemp("quick_dag"))
-    snakemake(wd, "--cores", "2", "all", "--config", "profile=quick", 'trees=["sparse"]',
-              timeout=900)
-    return wd
+def run(quick_dag):
+    return quick_dag
 
 
 def _csv(run, name) -> pd.DataFrame:
