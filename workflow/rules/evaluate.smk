@@ -16,6 +16,8 @@ rule evaluate:
         config="|".join((*_models.CONFIG_NAMES, _models.AUTO_CONFIG)),
     params:
         backend=CFG["train"]["backend"],
+    conda:
+        "../envs/physgs.yaml"
     log:
         "logs/evaluate/{tree}/{model}_{config}.log",
     benchmark:

@@ -16,6 +16,8 @@ rule kselect:
         tree="|".join(CFG["trees"]),
     params:
         cfg=CFG,
+    conda:
+        "../envs/physgs.yaml"
     log:
         "logs/kselect/{tree}.log",
     benchmark:
@@ -40,6 +42,8 @@ rule train_auto:
         tree="|".join(CFG["trees"]),
     params:
         cfg=CFG,
+    conda:
+        "../envs/physgs.yaml"
     log:
         "logs/train/{tree}/ours_auto.log",
     benchmark:
@@ -60,6 +64,8 @@ rule tab_kselect:
         csv="results/tables/tab_kselect.csv",
     params:
         cfg=CFG,
+    conda:
+        "../envs/physgs.yaml"
     log:
         "logs/report/tab_kselect.log",
     threads: 1

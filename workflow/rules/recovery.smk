@@ -11,6 +11,8 @@ rule recovery:
     wildcard_constraints:
         tree="|".join(CFG["trees"]),
         config="|".join((*_models.CONFIG_NAMES, _models.AUTO_CONFIG)),
+    conda:
+        "../envs/physgs.yaml"
     log:
         "logs/recovery/{tree}/ours_{config}.log",
     threads: 1
@@ -32,6 +34,8 @@ rule null_control:
         config="|".join((*_models.CONFIG_NAMES, _models.AUTO_CONFIG)),
     params:
         cfg=CFG,
+    conda:
+        "../envs/physgs.yaml"
     log:
         "logs/recovery/{tree}/null_{config}.log",
     threads: 1

@@ -13,6 +13,8 @@ rule table:
         name="|".join(_build.TABLES),
     params:
         cfg=CFG,
+    conda:
+        "../envs/physgs.yaml"
     log:
         "logs/report/{name}.log",
     threads: 1
@@ -33,6 +35,8 @@ rule figure:
         name="|".join(_build.FIGURES),
     params:
         cfg=CFG,
+    conda:
+        "../envs/physgs.yaml"
     log:
         "logs/report/{name}.log",
     threads: 1

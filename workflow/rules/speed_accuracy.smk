@@ -15,6 +15,8 @@ rule speed_accuracy_point:
         point="|".join(_sa.sweep_points(CFG)),
     params:
         cfg=CFG,
+    conda:
+        "../envs/physgs.yaml"
     log:
         "logs/speed_accuracy/{point}.log",
     benchmark:
@@ -34,6 +36,8 @@ rule speed_accuracy:
         csv="results/tables/speed_accuracy.csv",
         pdf="results/figures/fig_speed_accuracy.pdf",
         png="results/figures/fig_speed_accuracy.png",
+    conda:
+        "../envs/physgs.yaml"
     log:
         "logs/speed_accuracy/collect.log",
     threads: 1

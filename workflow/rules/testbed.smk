@@ -10,6 +10,8 @@ rule testbed_dataset:
         testbed=CFG["testbed"],
         preset=lambda wc: CFG["presets"][wc.tree],
         seed=CFG["seed"],
+    conda:
+        "../envs/physgs.yaml"
     log:
         "logs/testbed/{tree}.log",
     benchmark:
@@ -30,6 +32,8 @@ rule testbed_figure:
         truth="results/testbed/{tree}/truth.npz",
     output:
         figure="results/figures/testbed_{tree}.png",
+    conda:
+        "../envs/physgs.yaml"
     log:
         "logs/testbed/figure_{tree}.log",
     threads: 1

@@ -12,6 +12,8 @@ rule train:
         config="|".join(_models.CONFIG_NAMES),
     params:
         cfg=CFG,
+    conda:
+        "../envs/physgs.yaml"
     log:
         "logs/train/{tree}/{model}_{config}.log",
     benchmark:
