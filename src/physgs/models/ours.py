@@ -30,6 +30,16 @@ from physgs.models.oscillator import STABILITY_GUARD, fastest_rate, integrate, r
 from physgs.models.parts import kmeans_parts
 
 
+def prior_substeps(omega_hz, zeta, substeps: int, dt: float, guard: float = STABILITY_GUARD) -> int:
+    """RK4 substeps per wind sample for the prior's bounds: the configured count, raised until
+    every (omega, zeta) the bounds allow passes the guard. The fastest rate is at the top of both
+    bounds (above zeta = 1 it exceeds omega). omega_hz: [lo, hi] Hz; zeta: [lo, hi]; dt: seconds.
+    The null control integrates with this same step."""
+    hi = 2 * math.pi * float(omega_hz[1])
+    rate = float(fastest_rate(hi, float(zeta[1])))
+    return max(int(substeps), required_substeps(rate, dt, guard))
+
+
 def _logit(p: float) -> float:
     return math.log(p / (1.0 - p))
 
@@ -57,10 +67,7 @@ class OscillatorPrior(BaseModel):
         self.dt = 1.0 / ctx.fps
         self.vbar_ratio = float(ctx.vbar_ratio)
         self.guard = float(rk4_guard)
-        # Enough substeps that every (omega, zeta) the bounds allow passes the guard (the fastest
-        # rate is at the top of both bounds; above zeta = 1 it exceeds omega).
-        self.substeps = max(int(substeps),
-                            required_substeps(float(fastest_rate(hi, zhi)), self.dt, self.guard))
+        self.substeps = prior_substeps(omega_hz, zeta, substeps, self.dt, self.guard)
         xyz = np.asarray(ctx.canonical_xyz, dtype=np.float64)
         if labels is None:
             labels = kmeans_parts(xyz, K, seed, kmeans_n_init)

@@ -2,12 +2,12 @@
 from __future__ import annotations
 
 import dataclasses
-import math
 
 import numpy as np
 import torch
 
-from physgs.models.oscillator import STABILITY_GUARD, fastest_rate, required_substeps
+from physgs.models.oscillator import STABILITY_GUARD
+from physgs.models.ours import prior_substeps
 from physgs.recovery.null import NullResult
 from physgs.recovery.record import RecoveryRecord, run_null, score_recovery
 
@@ -44,8 +44,7 @@ def null_for_config(observed, truth, cfg: dict, config: str) -> NullResult:
     ours = cfg["models"]["ours"]
     K = int(cfg["models"]["configs"][config]["K"])
     dt = 1.0 / observed.fps
-    guard = float(ours.get("rk4_guard", STABILITY_GUARD))
-    rate = float(fastest_rate(2 * math.pi * float(ours["omega_hz"][1]), float(ours["zeta"][1])))
-    substeps = max(int(ours["substeps"]), required_substeps(rate, dt, guard))
+    substeps = prior_substeps(ours["omega_hz"], ours["zeta"], ours["substeps"], dt,
+                              float(ours.get("rk4_guard", STABILITY_GUARD)))
     return run_null(truth, observed, n_parts=K, zeta_init=float(ours["zeta_init"]),
                     substeps=substeps, seed=int(cfg["seed"]))
