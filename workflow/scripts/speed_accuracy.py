@@ -1,7 +1,7 @@
 """Snakemake script of rule `speed_accuracy`: the sweep's CSV and fig_speed_accuracy."""
 import json
 
-from physgs.evaluate.atomic import atomic_path
+from physgs.atomic import atomic_path
 from physgs.speed_accuracy import collect, fig_speed_accuracy
 
 sm = snakemake  # noqa: F821 (injected by Snakemake)

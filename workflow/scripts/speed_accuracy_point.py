@@ -4,7 +4,7 @@ import contextlib
 import numba
 import torch
 
-from physgs.evaluate.atomic import write_json
+from physgs.atomic import write_json
 from physgs.speed_accuracy import run_point
 
 sm = snakemake  # noqa: F821 (injected by Snakemake)

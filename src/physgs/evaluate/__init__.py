@@ -2,7 +2,7 @@
 
 Modules: ``metrics`` (PSNR, silhouette centroids), ``splits`` (view / time / transfer splits,
 ``evaluate``), ``trajectories`` (branch-tip paths in pixels), ``adapter`` (render/means callbacks
-from a model via the shared interfaces), ``atomic`` (safe writes).
+from a model via the shared interfaces); safe writes live in ``physgs.atomic``.
 """
 from physgs.evaluate.adapter import model_means_fn, model_render_fn
 from physgs.evaluate.metrics import centroid_error, psnr, silhouette_centroid

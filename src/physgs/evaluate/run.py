@@ -8,7 +8,7 @@ from __future__ import annotations
 import numpy as np
 
 from physgs.evaluate.adapter import model_means_fn, model_render_fn
-from physgs.evaluate.atomic import save_npz
+from physgs.atomic import save_npz
 from physgs.evaluate.metrics import psnr
 from physgs.evaluate.splits import evaluate
 from physgs.evaluate.trajectories import tip_trajectories

@@ -12,7 +12,7 @@ from typing import Callable
 
 import numpy as np
 
-from physgs.evaluate.atomic import save_npz
+from physgs.atomic import save_npz
 from physgs.evaluate.metrics import centroid_error, psnr, to_float_image
 
 RenderFn = Callable[[int, int, object], tuple[np.ndarray, np.ndarray]]

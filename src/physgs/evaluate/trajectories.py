@@ -6,7 +6,7 @@ from typing import Callable
 
 import numpy as np
 
-from physgs.evaluate.atomic import save_npz
+from physgs.atomic import save_npz
 
 MeansFn = Callable[[int, int], np.ndarray]  # (frame_idx, condition) -> Gaussian means [N, 3]
 

@@ -25,7 +25,7 @@ from dataclasses import asdict, dataclass
 import numpy as np
 import torch
 
-from physgs.evaluate.atomic import write_json
+from physgs.atomic import write_json
 from physgs.evaluate.metrics import psnr
 from physgs.models.registry import AUTO_CONFIG, build_model
 from physgs.models.visibility import freeze_callback

@@ -7,13 +7,12 @@ statistics), the state dict and the training statistics.
 """
 from __future__ import annotations
 
-import os
-import tempfile
 from pathlib import Path
 
 import numpy as np
 import torch
 
+from physgs.atomic import atomic_path
 from physgs.models.base import BaseModel, ModelContext, context_from_observed
 from physgs.models.fields import FieldModel
 from physgs.models.ours import OscillatorPrior
@@ -85,14 +84,8 @@ def save_checkpoint(path, model: BaseModel, *, name: str, config: str, seed: int
         "models_cfg": models_cfg, "train_cfg": train_cfg, "context": model.ctx.to_dict(),
         "state_dict": model.state_dict(), "stats": stats,
     }
-    fd, tmp = tempfile.mkstemp(dir=path.parent, prefix=path.name + ".", suffix=".tmp")
-    os.close(fd)
-    try:
+    with atomic_path(path) as tmp:
         torch.save(blob, tmp)
-        os.replace(tmp, path)
-    except BaseException:
-        Path(tmp).unlink(missing_ok=True)
-        raise
 
 
 def read_checkpoint(path) -> dict:

@@ -6,7 +6,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from physgs.evaluate.atomic import write_json
+from physgs.atomic import write_json
 from physgs.recovery.damping import DampingResult, damping_summary
 from physgs.recovery.matcher import MatchResult, match_parts, training_window
 from physgs.recovery.null import NullResult

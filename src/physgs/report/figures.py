@@ -16,7 +16,7 @@ import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
 from matplotlib.ticker import LogLocator, NullFormatter, ScalarFormatter  # noqa: E402
 
-from physgs.evaluate.atomic import atomic_path  # noqa: E402
+from physgs.atomic import atomic_path  # noqa: E402
 from physgs.report.tables import MODEL_NAMES, MODELS, condition_label  # noqa: E402
 
 COLORS = {"static": "0.55", "mlp": "tab:orange", "mlp_wind": "tab:red", "d3dgs": "tab:purple",

@@ -14,7 +14,7 @@ from typing import Mapping, Sequence
 import numpy as np
 import pandas as pd
 
-from physgs.evaluate.atomic import atomic_path, write_text
+from physgs.atomic import atomic_path, write_text
 
 MODELS = ("static", "mlp", "mlp_wind", "d3dgs", "d3dgs_wind", "ours")
 MODEL_NAMES = {

@@ -258,21 +258,6 @@ def build_dataset(tb: dict, preset: dict, *, seed: int, tree: str, progress: boo
 # Save / load
 
 
-def save_npz_atomic(arrays: dict, path: Path | str) -> Path:
-    """Write arrays to ``path`` via a temporary file in the same folder, then rename."""
-    path = Path(path)
-    path.parent.mkdir(parents=True, exist_ok=True)
-    tmp = path.with_name(path.name + ".part")
-    try:
-        with open(tmp, "wb") as f:
-            np.savez_compressed(f, **arrays)
-        os.replace(tmp, path)
-    finally:
-        if tmp.exists():
-            tmp.unlink()
-    return path
-
-
 def save_dataset(observed: dict, truth: dict, observed_path, truth_path) -> None:
     """Write both files; neither appears unless both were written completely."""
     parts = []

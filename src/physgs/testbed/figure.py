@@ -2,7 +2,6 @@
 ground-truth frames (training camera, three conditions, and held-out views)."""
 from __future__ import annotations
 
-import os
 from pathlib import Path
 
 import matplotlib
@@ -12,6 +11,7 @@ import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
 from matplotlib.collections import LineCollection  # noqa: E402
 
+from physgs.atomic import atomic_path  # noqa: E402
 from physgs.testbed.dataset import Observed, Truth  # noqa: E402
 
 
@@ -69,9 +69,9 @@ def testbed_figure(obs: Observed, truth: Truth, tree: str, path: Path | str) -> 
         ax.axis("off")
     fig.tight_layout()
     path = Path(path)
-    path.parent.mkdir(parents=True, exist_ok=True)
-    tmp = path.with_name(path.stem + ".part.png")
-    fig.savefig(tmp, dpi=110)
-    plt.close(fig)
-    os.replace(tmp, path)
+    try:
+        with atomic_path(path) as tmp:
+            fig.savefig(tmp, dpi=110)
+    finally:
+        plt.close(fig)
     return path

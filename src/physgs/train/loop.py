@@ -3,16 +3,14 @@ from __future__ import annotations
 
 import csv
 import math
-import os
-import tempfile
 import time
 from dataclasses import dataclass
-from pathlib import Path
 
 import numpy as np
 import torch
 from tqdm import tqdm
 
+from physgs.atomic import atomic_path
 from physgs.models.base import BaseModel
 from physgs.render import rasterization
 from physgs.train.losses import photometric_loss
@@ -138,15 +136,7 @@ def train_model(model: BaseModel, observed, train_cfg: dict, *, conditions: list
 
 def write_loss_log(path, log: list[dict]) -> None:
     """Write the loss log as CSV atomically (temporary file, then rename)."""
-    path = Path(path)
-    path.parent.mkdir(parents=True, exist_ok=True)
-    fd, tmp = tempfile.mkstemp(dir=path.parent, prefix=path.name + ".", suffix=".tmp")
-    try:
-        with os.fdopen(fd, "w", newline="") as f:
-            w = csv.DictWriter(f, fieldnames=LOG_FIELDS)
-            w.writeheader()
-            w.writerows(log)
-        os.replace(tmp, path)
-    except BaseException:
-        Path(tmp).unlink(missing_ok=True)
-        raise
+    with atomic_path(path) as tmp, open(tmp, "w", newline="") as f:
+        w = csv.DictWriter(f, fieldnames=LOG_FIELDS)
+        w.writeheader()
+        w.writerows(log)
