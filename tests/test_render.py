@@ -90,8 +90,9 @@ def dense_oracle(means, quats, scales, opac, colors, cam, bg):
     rgb = np.zeros((H, W, 3))
     dep = np.zeros((H, W))
     done = np.zeros((H, W), bool)
-    lx = (cam.cx / cam.fx + 0.3 * W / cam.fx, (W - cam.cx) / cam.fx + 0.3 * W / cam.fx)
-    ly = (cam.cy / cam.fy + 0.3 * H / cam.fy, (H - cam.cy) / cam.fy + 0.3 * H / cam.fy)
+    # Jacobian clamp: image-edge tangent + 0.3 tan(half fov); tan(half fov) = W / (2 fx), H / (2 fy)
+    lx = (cam.cx / cam.fx + 0.15 * W / cam.fx, (W - cam.cx) / cam.fx + 0.15 * W / cam.fx)
+    ly = (cam.cy / cam.fy + 0.15 * H / cam.fy, (H - cam.cy) / cam.fy + 0.15 * H / cam.fy)
     for i in np.argsort(pc[:, 2], kind="stable"):
         x, y, z = pc[i]
         if z <= cam.near:

@@ -12,7 +12,8 @@ import torch
 
 from physgs.camera import Camera
 from physgs.render import kernels
-from physgs.render.project import EPS2D, TILE, pixel_bounds
+from physgs.render.constants import EPS2D, TILE
+from physgs.render.project import fov_clamp_limits, pixel_bounds
 
 
 def _np(x: torch.Tensor) -> np.ndarray:
@@ -28,12 +29,12 @@ def _to_torch(x: np.ndarray, like: torch.Tensor) -> torch.Tensor:
 
 def camera_arrays(camera: Camera):
     """(Rc [3, 3], tc [3], intr [4], lims [4]) float64 for the kernels; lims are gsplat's
-    tangent clamps (x-, x+, y-, y+) of the projection Jacobian."""
-    fx, fy, cx, cy, W, H = camera.fx, camera.fy, camera.cx, camera.cy, camera.width, camera.height
-    lims = np.array([cx / fx + 0.3 * W / fx, (W - cx) / fx + 0.3 * W / fx,
-                     cy / fy + 0.3 * H / fy, (H - cy) / fy + 0.3 * H / fy])
+    tangent clamps (x-, x+, y-, y+) of the projection Jacobian, from
+    :func:`physgs.render.project.fov_clamp_limits` (the reference path uses the same)."""
+    intr = np.array([camera.fx, camera.fy, camera.cx, camera.cy], dtype=np.float64)
+    lims = np.array(fov_clamp_limits(camera), dtype=np.float64)
     return (np.ascontiguousarray(camera.R, dtype=np.float64),
-            np.ascontiguousarray(camera.t, dtype=np.float64), np.array([fx, fy, cx, cy]), lims)
+            np.ascontiguousarray(camera.t, dtype=np.float64), intr, lims)
 
 
 class _FastRasterize(torch.autograd.Function):

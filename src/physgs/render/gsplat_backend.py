@@ -11,7 +11,7 @@ from __future__ import annotations
 import torch
 
 from physgs.camera import Camera
-from physgs.render.project import EPS2D
+from physgs.render.constants import EPS2D
 
 
 def rasterize_gsplat(means: torch.Tensor, quats: torch.Tensor, scales: torch.Tensor,

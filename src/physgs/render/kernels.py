@@ -18,9 +18,10 @@ import math
 import numba as nb
 import numpy as np
 
-ALPHA_MIN = 1.0 / 255.0
-ALPHA_MAX = 0.99
-T_MIN = 1e-4
+# Module globals: numba freezes them into the compiled (and cached) kernels.
+from physgs.render.constants import (ALPHA_MAX, ALPHA_MIN, FOOTPRINT_SLACK, INV_ALPHA_MIN,
+                                     QUAT_NORM_EPS, ROW_SPAN_TOL, T_MIN)
+
 N_GRAD = 7  # per-pair gradient columns before colours: mx, my, conic a, b, c, opacity, depth
 
 
@@ -55,11 +56,11 @@ def bin_tiles(boxes, order, tile, tiles_x, tiles_y):  # pragma: no cover - compi
 
 @nb.njit(cache=True, inline="always")
 def _footprint(o):  # pragma: no cover - compiled
-    """sigma = d^T conic d above which o exp(-sigma / 2) < 1/255, widened by a relative 1e-9 so
+    """sigma = d^T conic d above which o exp(-sigma / 2) < 1/255, widened by FOOTPRINT_SLACK so
     rounding can only add pixels (which the exact alpha test then skips), never drop them."""
-    if o * 255.0 <= 1.0:
+    if o * INV_ALPHA_MIN <= 1.0:
         return -1.0
-    return 2.0 * math.log(255.0 * o) * (1.0 + 1e-9) + 1e-9
+    return 2.0 * math.log(INV_ALPHA_MIN * o) * (1.0 + FOOTPRINT_SLACK) + FOOTPRINT_SLACK
 
 
 @nb.njit(cache=True, inline="always")
@@ -74,7 +75,7 @@ def _row_span(ca, cb, cc, thr, mx, dy, lo, hi):  # pragma: no cover - compiled
     c1 = mx - 0.5 + (-cb * dy + r) / ca
     if not (c1 >= lo and c0 <= hi):  # also catches NaN
         return lo, lo - 1
-    return max(lo, int(math.ceil(c0 - 1e-6))), min(hi, int(math.floor(c1 + 1e-6)))
+    return max(lo, int(math.ceil(c0 - ROW_SPAN_TOL))), min(hi, int(math.floor(c1 + ROW_SPAN_TOL)))
 
 
 @nb.njit(parallel=True, cache=True)
@@ -329,7 +330,7 @@ def project_forward(means, quats, scales, Rc, tc, intr, lims, near, eps2d, means
         if ok:
             qn = math.sqrt(quats[i, 0] ** 2 + quats[i, 1] ** 2 + quats[i, 2] ** 2
                            + quats[i, 3] ** 2)
-            qn = max(qn, 1e-12)
+            qn = max(qn, QUAT_NORM_EPS)
             _quat_rotmat(quats[i, 0] / qn, quats[i, 1] / qn, quats[i, 2] / qn,
                          quats[i, 3] / qn, Rq)
             _mm(Rc, Rq, M, False, False)
@@ -411,7 +412,7 @@ def project_backward(means, quats, scales, Rc, tc, intr, lims, near, eps2d, vali
         y = Rc[1, 0] * means[i, 0] + Rc[1, 1] * means[i, 1] + Rc[1, 2] * means[i, 2] + tc[1]
         z = Rc[2, 0] * means[i, 0] + Rc[2, 1] * means[i, 1] + Rc[2, 2] * means[i, 2] + tc[2]
         qn = max(math.sqrt(quats[i, 0] ** 2 + quats[i, 1] ** 2 + quats[i, 2] ** 2
-                           + quats[i, 3] ** 2), 1e-12)
+                           + quats[i, 3] ** 2), QUAT_NORM_EPS)
         qw, qx, qy, qz = quats[i, 0] / qn, quats[i, 1] / qn, quats[i, 2] / qn, quats[i, 3] / qn
         _quat_rotmat(qw, qx, qy, qz, Rq)
         _mm(Rc, Rq, RR, False, False)

@@ -1,10 +1,12 @@
 """EWA projection of 3D Gaussians to the image plane (vectorised torch, differentiable by autograd).
 
 Follows 3DGS / gsplat: world -> camera (OpenCV: z forward, y down), 3D covariance
-R_q S S^T R_q^T, perspective Jacobian (with gsplat's clamp of x/z, y/z to 1.3x the field of view so
-Gaussians far off to the side do not blow up), +0.3 px^2 dilation of the 2D covariance, conic = its
-inverse. Culled Gaussians (behind the near plane, degenerate) get a mask and finite zero outputs,
-never NaN: every division uses a clamped denominator, so gradients stay finite too.
+R_q S S^T R_q^T, perspective Jacobian evaluated at x/z, y/z clamped to the image edge plus
+0.3 tan(half field of view) (gsplat's ``persp_proj``; 1.3 x the half field of view for a centred
+principal point, as 3DGS), so Gaussians far off to the side do not blow up, +0.3 px^2 dilation of
+the 2D covariance, conic = its inverse. Culled Gaussians (behind the near plane, degenerate) get a
+mask and finite zero outputs, never NaN: every division uses a clamped denominator, so gradients
+stay finite too. Thresholds live in :mod:`physgs.render.constants`.
 """
 from __future__ import annotations
 
@@ -14,12 +16,8 @@ import numpy as np
 import torch
 
 from physgs.camera import Camera
-
-EPS2D = 0.3  # px^2 added to the 2D covariance (anti-aliasing dilation, as 3DGS)
-ALPHA_MIN = 1.0 / 255.0  # a Gaussian's alpha below this at a pixel is skipped
-ALPHA_MAX = 0.99  # alpha is clamped to this (keeps 1 - alpha away from zero)
-T_MIN = 1e-4  # compositing stops before transmittance would fall below this
-TILE = 16  # tile side in pixels
+from physgs.render.constants import (BOX_SLACK_PX, EPS2D, FOV_CLAMP_MARGIN, INV_ALPHA_MIN,
+                                     QUAT_NORM_EPS)
 
 
 @dataclass(frozen=True)
@@ -41,8 +39,12 @@ class Projected:
 
 
 def quat_to_rotmat(quats: torch.Tensor) -> torch.Tensor:
-    """quats [N, 4] (w, x, y, z), any nonzero norm -> rotation matrices [N, 3, 3]."""
-    q = quats / quats.norm(dim=-1, keepdim=True).clamp_min(1e-12)
+    """Quaternions [..., 4] (w, x, y, z), normalised here -> rotation matrices [..., 3, 3].
+
+    The package's one torch implementation (``physgs.models.gaussians`` re-exports it; the numba
+    kernels have a scalar twin, ``kernels._quat_rotmat``). A zero quaternion gives the identity.
+    """
+    q = quats / quats.norm(dim=-1, keepdim=True).clamp_min(QUAT_NORM_EPS)
     w, x, y, z = q.unbind(-1)
     return torch.stack(
         [
@@ -52,6 +54,19 @@ def quat_to_rotmat(quats: torch.Tensor) -> torch.Tensor:
         ],
         dim=-1,
     ).reshape(q.shape[:-1] + (3, 3))
+
+
+def fov_clamp_limits(camera: Camera) -> tuple[float, float, float, float]:
+    """Tangent limits (x-, x+, y-, y+) of the Jacobian's evaluation point: x/z is clamped to
+    [-x-, x+] and y/z to [-y-, y+]. Each is the tangent of the image edge on that side plus
+    FOV_CLAMP_MARGIN x tan(half field of view), tan_fovx = 0.5 W / fx (gsplat's ``persp_proj``;
+    1.3 tan(fov / 2) on every side for a centred principal point, as 3DGS's ``computeCov2D``)."""
+    fx, fy, cx, cy = camera.fx, camera.fy, camera.cx, camera.cy
+    W, H = camera.width, camera.height
+    tan_fovx = 0.5 * W / fx
+    tan_fovy = 0.5 * H / fy
+    return (cx / fx + FOV_CLAMP_MARGIN * tan_fovx, (W - cx) / fx + FOV_CLAMP_MARGIN * tan_fovx,
+            cy / fy + FOV_CLAMP_MARGIN * tan_fovy, (H - cy) / fy + FOV_CLAMP_MARGIN * tan_fovy)
 
 
 def camera_tensors(camera: Camera, like: torch.Tensor) -> tuple[torch.Tensor, torch.Tensor]:
@@ -78,12 +93,8 @@ def project_gaussians(means: torch.Tensor, quats: torch.Tensor, scales: torch.Te
     M = R @ (Rq * scales[:, None, :])  # [N, 3, 3] camera-frame square root of the covariance
 
     fx, fy, cx, cy = camera.fx, camera.fy, camera.cx, camera.cy
-    W, H = camera.width, camera.height
     # gsplat's field-of-view clamp of the Jacobian's evaluation point.
-    lim_x_pos = (W - cx) / fx + 0.3 * W / fx
-    lim_x_neg = cx / fx + 0.3 * W / fx
-    lim_y_pos = (H - cy) / fy + 0.3 * H / fy
-    lim_y_neg = cy / fy + 0.3 * H / fy
+    lim_x_neg, lim_x_pos, lim_y_neg, lim_y_pos = fov_clamp_limits(camera)
     tx = zs * torch.clamp(x / zs, -lim_x_neg, lim_x_pos)
     ty = zs * torch.clamp(y / zs, -lim_y_neg, lim_y_pos)
     zero = torch.zeros_like(zs)
@@ -122,19 +133,21 @@ def pixel_bounds(means2d: np.ndarray, cov2d: np.ndarray, opacities: np.ndarray, 
     out = np.empty((n, 4), dtype=np.int64)
     out[:, 0], out[:, 1], out[:, 2], out[:, 3] = 1, 0, 1, 0
     o = opacities.astype(np.float64)
-    keep = valid & (o * 255.0 > 1.0) & np.isfinite(means2d).all(1)
+    keep = valid & (o * INV_ALPHA_MIN > 1.0) & np.isfinite(means2d).all(1)
     if not keep.any():
         return out
-    thr = 2.0 * np.log(255.0 * o[keep])
+    thr = 2.0 * np.log(INV_ALPHA_MIN * o[keep])
     m = means2d[keep].astype(np.float64)
     cv = cov2d[keep].astype(np.float64)
     rx = np.sqrt(thr * np.maximum(cv[:, 0], 0.0))
     ry = np.sqrt(thr * np.maximum(cv[:, 2], 0.0))
-    # pixel j has centre j + 0.5; one pixel of slack on each side absorbs rounding.
-    x0 = np.floor(np.clip(m[:, 0] - rx - 0.5, -2.0, width + 2.0)) - 1
-    x1 = np.ceil(np.clip(m[:, 0] + rx - 0.5, -2.0, width + 2.0)) + 1
-    y0 = np.floor(np.clip(m[:, 1] - ry - 0.5, -2.0, height + 2.0)) - 1
-    y1 = np.ceil(np.clip(m[:, 1] + ry - 0.5, -2.0, height + 2.0)) + 1
+    # pixel j has centre j + 0.5; BOX_SLACK_PX of slack on each side absorbs rounding (the clip,
+    # just outside the image, only keeps huge extents finite before the int cast).
+    s, lo = BOX_SLACK_PX, -(BOX_SLACK_PX + 1.0)
+    x0 = np.floor(np.clip(m[:, 0] - rx - 0.5, lo, width - lo)) - s
+    x1 = np.ceil(np.clip(m[:, 0] + rx - 0.5, lo, width - lo)) + s
+    y0 = np.floor(np.clip(m[:, 1] - ry - 0.5, lo, height - lo)) - s
+    y1 = np.ceil(np.clip(m[:, 1] + ry - 0.5, lo, height - lo)) + s
     box = np.stack([np.maximum(x0, 0), np.minimum(x1, width - 1),
                     np.maximum(y0, 0), np.minimum(y1, height - 1)], axis=1).astype(np.int64)
     bad = ~np.isfinite(rx) | ~np.isfinite(ry)  # NaN extents cannot be bounded: cover the image

@@ -9,7 +9,8 @@ from __future__ import annotations
 import numpy as np
 import torch
 
-from physgs.render.project import ALPHA_MAX, ALPHA_MIN, T_MIN, TILE, pixel_bounds
+from physgs.render.constants import ALPHA_MAX, ALPHA_MIN, T_MIN, TILE
+from physgs.render.project import pixel_bounds
 
 
 def composite_reference(means2d: torch.Tensor, conics: torch.Tensor, opacities: torch.Tensor,
