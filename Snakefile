@@ -1,6 +1,6 @@
 # physgs: does a dynamic 3DGS reconstruction of a wind-driven tree recover physics?
 # Profiles: --config profile=quick|default|paper (default: config/trees.yaml's `profile`).
-from snakemake.utils import min_version, validate
+from snakemake.utils import min_version
 
 import physgs.config
 
@@ -10,9 +10,9 @@ min_version("9.0")
 configfile: "config/trees.yaml"
 
 
-validate(config, "workflow/schemas/config.schema.yaml")
-CFG = physgs.config.resolve(config, config.get("profile"))
-validate(CFG, "workflow/schemas/config.schema.yaml")
+# validates the raw config and every profile body against the packaged schema, resolves the
+# profile, validates the result and runs the cross-key checks: a bad config stops here
+CFG = physgs.config.load_workflow_config(config)
 TREES = CFG["trees"]
 
 

@@ -1,26 +1,70 @@
-"""Config loading: schema validation and profile resolution."""
+"""Config loading: the packaged schema, profile resolution, unknown keys and cross-key checks."""
+import copy
+import shutil
+import subprocess
+import sys
+import time
 from pathlib import Path
 
 import pytest
 import yaml
 
 from physgs import config as pconfig
+from physgs import config_checks
 
 ROOT = Path(__file__).resolve().parents[1]
 CONFIG = ROOT / "config" / "trees.yaml"
+PROFILES = ("quick", "default", "paper")
 
 
 def _base() -> dict:
     return yaml.safe_load(CONFIG.read_text())
 
 
-def test_shipped_config_validates_for_every_profile():
+def _refused(edit, profile: str | None = None) -> str:
+    """The ConfigError message for the shipped config after ``edit``."""
+    raw = _base()
+    edit(raw)
+    with pytest.raises(pconfig.ConfigError) as e:
+        pconfig.load_workflow_config(raw, profile)
+    return str(e.value)
+
+
+# --- the shipped config, the schema as package data -------------------------------------------
+
+
+@pytest.mark.parametrize("name", PROFILES)
+def test_shipped_config_is_accepted_for_every_profile(name):
     base = _base()
-    for name in base["profiles"]:
-        cfg = pconfig.resolve(base, name)
-        pconfig.validate(cfg)
-        assert cfg["profile"] == name
-        assert "profiles" not in cfg
+    assert set(PROFILES) <= set(base["profiles"])
+    cfg = pconfig.load_workflow_config(base, name)
+    assert cfg["profile"] == name
+    assert "profiles" not in cfg
+    assert config_checks.problems(cfg) == []
+    assert pconfig.load(CONFIG, name) == cfg
+
+
+def test_config_profile_key_selects_the_profile_like_snakemake_config():
+    base = _base()
+    base["profile"] = "quick"  # what `--config profile=quick` puts into Snakemake's config
+    assert pconfig.load_workflow_config(base) == pconfig.load_workflow_config(_base(), "quick")
+
+
+def test_schema_ships_inside_the_package():
+    assert pconfig.SCHEMA.is_file()
+    assert Path(str(pconfig.SCHEMA)).is_relative_to(Path(pconfig.__file__).parent)
+    assert not (ROOT / "workflow" / "schemas" / "config.schema.yaml").exists()
+    assert pconfig.schema()["additionalProperties"] is False
+
+
+def test_partial_schema_drops_required_and_inlines_refs():
+    s = {"type": "object", "required": ["a"], "properties": {
+        "a": {"$ref": "#/$defs/x"}, "b": {"type": "array", "items": {"required": ["c"]}}},
+        "$defs": {"x": {"type": "object", "required": ["y"], "properties": {"y": {}}}}}
+    p = pconfig.partial_schema(s)
+    assert p == {"type": "object", "properties": {
+        "a": {"type": "object", "properties": {"y": {}}}, "b": {"type": "array", "items": {}}}}
+    assert s["required"] == ["a"]  # the input is not changed
 
 
 def test_profile_overrides_only_what_it_names():
@@ -32,11 +76,22 @@ def test_profile_overrides_only_what_it_names():
     assert quick["testbed"]["fps"] == default["testbed"]["fps"] == base["testbed"]["fps"]
 
 
+def test_an_empty_profile_changes_nothing():
+    base = _base()
+    base["profiles"]["default"] = None
+    assert pconfig.load_workflow_config(base, "default") == pconfig.load(CONFIG, "default")
+
+
 def test_schema_violation_names_the_key():
     base = _base()
     base["testbed"]["zeta"] = -0.1
     with pytest.raises(pconfig.ConfigError, match="testbed/zeta"):
         pconfig.validate(base)
+
+
+def test_schema_violation_in_a_profile_body_names_the_profile_key():
+    msg = _refused(lambda c: c["profiles"]["quick"]["train"].update(warmup="ten"), "quick")
+    assert "profiles/quick/train/warmup" in msg and "Fix config/trees.yaml" in msg
 
 
 def test_unknown_profile_is_refused_with_the_choices():
@@ -51,3 +106,186 @@ def test_load_rejects_a_bad_file(tmp_path):
     bad.write_text(yaml.safe_dump(base))
     with pytest.raises(pconfig.ConfigError, match="trees/1"):
         pconfig.load(bad)
+
+
+def test_missing_section_is_named():
+    assert "'models/configs/single'" in _refused(lambda c: c["models"]["configs"].pop("single"))
+    assert "'train/lr/pivot' is missing" in _refused(lambda c: c["train"]["lr"].pop("pivot"))
+
+
+# --- unknown keys, with the nearest valid key ---------------------------------------------------
+
+
+@pytest.mark.parametrize("edit, key, suggestion", [
+    (lambda c: c["profiles"]["quick"].update(trian={"iterations": 5}),
+     "profiles/quick/trian", "profiles/quick/train"),
+    (lambda c: c["profiles"]["quick"]["train"].update(iteration=5),
+     "profiles/quick/train/iteration", "profiles/quick/train/iterations"),
+    (lambda c: c["profiles"]["paper"].update(testbed={"resolutoin": 256}),
+     "profiles/paper/testbed/resolutoin", "profiles/paper/testbed/resolution"),
+    (lambda c: c["profiles"]["quick"]["models"].update(mlp={"widht": 64}),
+     "profiles/quick/models/mlp/widht", "profiles/quick/models/mlp/width"),
+    (lambda c: c["profiles"]["quick"]["presets"]["medium"]["leaves"].update(fractoin=0.2),
+     "profiles/quick/presets/medium/leaves/fractoin", "profiles/quick/presets/medium/leaves/fraction"),
+    (lambda c: c["profiles"]["quick"].update(iterations=5),
+     "profiles/quick/iterations", "profiles/quick/train/iterations"),
+    (lambda c: c.update(seeds=1), "seeds", "seed"),
+    (lambda c: c["train"]["lr"].update(mens=1e-4), "train/lr/mens", "train/lr/means"),
+    (lambda c: c["testbed"]["vertices"].update(sprase=400), "testbed/vertices/sprase",
+     "testbed/vertices/sparse"),
+    (lambda c: c["presets"].update(mediun=c["presets"]["medium"]), "presets/mediun",
+     "presets/medium"),
+    (lambda c: c["testbed"]["wind"].update(v_0=5.0), "testbed/wind/v_0", "testbed/wind/v0"),
+])
+def test_unknown_key_is_refused_with_the_nearest_valid_key(edit, key, suggestion):
+    msg = _refused(edit)
+    assert f"unknown config key '{key}'" in msg
+    assert f"did you mean '{suggestion}'" in msg
+    assert "Fix config/trees.yaml" in msg
+
+
+def test_a_profile_cannot_name_a_profile():
+    msg = _refused(lambda c: c["profiles"]["quick"].update(profile="paper"))
+    assert "unknown config key 'profiles/quick/profile'" in msg
+
+
+def test_nested_key_given_with_config_at_top_level_is_refused_with_how_to_set_it():
+    """`snakemake --config iterations=5` puts `iterations` at the top level of the config."""
+    raw = _base()
+    raw.update(profile="quick", iterations=5)
+    with pytest.raises(pconfig.ConfigError) as e:
+        pconfig.load_workflow_config(raw)
+    msg = str(e.value)
+    assert "unknown config key 'iterations'" in msg
+    assert "did you mean 'train/iterations'" in msg
+    assert "--config" in msg and "profiles/quick/train/iterations" in msg
+    assert "{profiles: {quick: {train: {iterations: 5}}}}" in msg  # the --configfile to pass
+
+
+def test_every_problem_is_reported_at_once():
+    def edit(c):
+        c["profiles"]["quick"]["trian"] = {}
+        c["testbed"]["fsp"] = 24
+    msg = _refused(edit)
+    assert "2 problems" in msg and "profiles/quick/trian" in msg and "testbed/fsp" in msg
+
+
+# --- cross-key checks on the resolved config ----------------------------------------------------
+
+
+def _set(path, value, profile=None):
+    def edit(c):
+        node = c["profiles"][profile] if profile else c
+        for k in path[:-1]:
+            node = node.setdefault(k, {})
+        node[path[-1]] = value
+    return edit
+
+
+@pytest.mark.parametrize("edit, profile, key", [
+    # the K-selection warm-up is its own key, not train/warmup
+    (_set(("models", "kselect", "warmup"), 30, "quick"), "quick", "models/kselect/warmup"),
+    (_set(("models", "kselect", "warmup"), 160), "default", "models/kselect/warmup"),
+    (_set(("train", "warmup"), 40, "quick"), "quick", "train/warmup"),
+    (_set(("train", "warmup"), 40000, "paper"), "paper", "train/warmup"),
+    (_set(("models", "ours", "omega_hz"), [3.0, 0.1]), "default", "models/ours/omega_hz"),
+    (_set(("models", "ours", "omega_init_hz"), 5.0), "default", "models/ours/omega_init_hz"),
+    (_set(("models", "ours", "zeta"), [0.5, 0.01]), "default", "models/ours/zeta"),
+    (_set(("models", "ours", "zeta_init"), 0.6), "default", "models/ours/zeta_init"),
+    (_set(("models", "ours", "freeze_at"), 0.1), "default", "models/ours/freeze_at"),
+    # quick's sparse tree has 400 Gaussians
+    (_set(("models", "configs", "joint96", "K"), 500), "quick", "models/configs/joint96/K"),
+    (_set(("models", "kselect", "candidates"), [4, 401], "quick"), "quick",
+     "models/kselect/candidates/1"),
+    (_set(("speed_accuracy", "knobs", "K"), [8, 3000]), "default", "speed_accuracy/knobs/K/1"),
+    (lambda c: (_set(("models", "configs", "single", "K"), 100)(c),
+                _set(("speed_accuracy", "knobs", "vertices"), [60, 2000])(c)), "default",
+     "speed_accuracy/knobs/vertices/0"),
+    (lambda c: c.update(trees=["medium", "dense"]), "default", "speed_accuracy/tree"),
+    (_set(("speed_accuracy", "tree"), "dense", "quick"), "quick", None),
+    (_set(("testbed", "lead_in_tau"), 20.0), "default", "testbed/lead_in_tau"),
+    (_set(("testbed", "band_hz"), [1.5, 0.35]), "default", "testbed/band_hz"),
+    (_set(("testbed", "wind", "f_lo_hz"), 9.0), "default", "testbed/wind/f_lo_hz"),
+    (_set(("testbed", "conditions"), [1.0]), "default", "testbed/conditions"),
+    (_set(("testbed", "conditions"), [0.84, 1.0]), "quick", "testbed/conditions/0"),
+    (lambda c: c["testbed"]["vertices"].pop("sparse"), "default", "testbed/vertices/sparse"),
+    (lambda c: c["presets"].pop("medium"), "default", "presets/medium"),
+    (lambda c: c["models"]["configs"].pop("single"), "default", "models/configs/single"),
+    (_set(("models", "configs", "auto"), {"conditions": "train", "K": 8}), "default",
+     "models/configs/auto"),
+])
+def test_cross_key_problem_is_refused_naming_the_key(edit, profile, key):
+    if key is None:  # a control: the edit alone is fine
+        raw = _base()
+        edit(raw)
+        pconfig.load_workflow_config(raw, profile)
+        return
+    msg = _refused(edit, profile)
+    assert f"config key '{key}'" in msg, msg
+    assert "Fix config/trees.yaml" in msg
+
+
+def test_kselect_warmup_message_names_its_own_key_and_the_profile_that_set_it():
+    msg = _refused(_set(("models", "kselect", "warmup"), 30, "quick"), "quick")
+    assert "(set by 'profiles/quick/models/kselect/warmup')" in msg
+    assert "models/kselect/iterations = 20" in msg
+    assert "train/warmup" not in msg
+
+
+def test_lead_in_check_uses_the_testbed_formula():
+    from physgs.testbed import physics, wind
+    cfg = pconfig.load(CONFIG, "default")
+    tb = cfg["testbed"]
+    F = tb["n_train"] + tb["n_tail"]
+    P = round(wind.PERIOD_S * tb["fps"])
+    lead = lambda tau: physics.lead_in_frames(2 * 3.141592653589793 * tb["band_hz"][0],
+                                              tb["zeta"], tau, tb["fps"])
+    ok = max(t / 100 for t in range(1, 2000) if lead(t / 100) + F < P)
+    for tau, fine in ((ok, True), (ok + 0.01, False)):
+        c = copy.deepcopy(cfg)
+        c["testbed"]["lead_in_tau"] = tau
+        assert (config_checks.problems(c, [config_checks.lead_in_fits_wind_period]) == []) == fine
+
+
+def test_trees_not_listed_may_keep_their_settings():
+    cfg = pconfig.load_workflow_config({**_base(), "trees": ["sparse"]}, "quick")
+    assert cfg["trees"] == ["sparse"] and "dense" in cfg["presets"]
+
+
+def test_a_listed_tree_without_a_vertex_count_is_named_not_a_key_error():
+    def edit(c):
+        c.update(trees=["dense"])
+        c["speed_accuracy"]["tree"] = "dense"
+        c["testbed"]["vertices"].pop("dense")
+        c["profiles"]["quick"]["testbed"]["vertices"].pop("dense")
+    msg = _refused(edit, "quick")
+    assert "config key 'testbed/vertices/dense'" in msg and "KeyError" not in msg
+
+
+def test_checks_are_one_extensible_list():
+    assert all(callable(f) for f in config_checks.CHECKS)
+    cfg = pconfig.load(CONFIG, "quick")
+    extra = lambda c: iter([(("seed",), "always wrong")])
+    assert config_checks.problems(cfg, [*config_checks.CHECKS, extra]) == [(("seed",), "always wrong")]
+
+
+# --- the Snakefile stops at load time ----------------------------------------------------------
+
+
+def test_snakefile_refuses_a_bad_override_in_seconds_and_writes_nothing(tmp_path):
+    for p in ("Snakefile", "config", "workflow"):
+        src = ROOT / p
+        (shutil.copytree if src.is_dir() else shutil.copy)(src, tmp_path / p)
+    (tmp_path / "bad.yaml").write_text(
+        "profiles: {quick: {models: {kselect: {warmup: 30}}}}\n")
+    t0 = time.perf_counter()
+    r = subprocess.run([sys.executable, "-m", "snakemake", "-n", "--cores", "1", "all",
+                        "--config", "profile=quick", "--configfile", "bad.yaml"],
+                       cwd=tmp_path, capture_output=True, text=True, timeout=60)
+    wall = time.perf_counter() - t0
+    out = r.stdout + r.stderr
+    assert r.returncode != 0
+    assert "ConfigError" in out and "models/kselect/warmup" in out, out
+    assert "profiles/quick/models/kselect/warmup" in out
+    assert wall < 20, f"took {wall:.1f} s"
+    assert not (tmp_path / "results").exists()

@@ -1,0 +1,224 @@
+"""Cross-key checks of a resolved config: what one key's schema cannot say about another.
+
+Each check takes the resolved config (after the profile merge, already schema-valid) and yields
+``(key path, message)`` pairs, the message saying what is wrong and how to fix it; the key path is
+the key to change. :func:`problems` runs every check in :data:`CHECKS`; ``physgs.config`` turns the
+pairs into one ``ConfigError``. They run when the Snakefile loads, so a bad config stops in seconds
+with nothing written, instead of in the first job that needs the value. To add a check, write a
+function here and append it to :data:`CHECKS`.
+"""
+from __future__ import annotations
+
+import math
+from typing import Callable, Iterator
+
+Problem = tuple[tuple, str]
+Check = Callable[[dict], Iterator[Problem]]
+
+
+def trees_have_settings(cfg: dict) -> Iterator[Problem]:
+    """Every tree in ``trees`` has a preset and a vertex count."""
+    vertices, presets = cfg["testbed"]["vertices"], cfg["presets"]
+    for t in cfg["trees"]:
+        if t not in vertices:
+            yield (("testbed", "vertices", t),
+                   f"tree '{t}' is listed in trees but has no target vertex count; add "
+                   f"testbed/vertices/{t} (e.g. {t}: 2000) or drop '{t}' from trees")
+        if t not in presets:
+            yield (("presets", t),
+                   f"tree '{t}' is listed in trees but has no Weber-Penn preset; add presets/{t} "
+                   f"or drop '{t}' from trees")
+
+
+def conditions_have_unseen_wind(cfg: dict) -> Iterator[Problem]:
+    """conditions[0] is the training wind (1.0) and at least one unseen condition follows."""
+    cond = cfg["testbed"]["conditions"]
+    if not math.isclose(float(cond[0]), 1.0, rel_tol=0, abs_tol=1e-12):
+        yield (("testbed", "conditions", 0),
+               f"the first condition is the training wind and must be 1.0, got {cond[0]}; put 1.0 "
+               "first (the multipliers scale the training mean speed testbed/wind/v0)")
+    if len(cond) < 2:
+        yield (("testbed", "conditions"),
+               f"{cond} has no unseen wind condition, which the transfer table (tab_transfer) and "
+               "the joint configurations need; add at least one multiplier after 1.0, e.g. "
+               "[1.0, 0.84, 0.71]")
+
+
+def band_ordered(cfg: dict) -> Iterator[Problem]:
+    """testbed/band_hz and the wind band are (low, high)."""
+    lo, hi = cfg["testbed"]["band_hz"]
+    if not lo < hi:
+        yield (("testbed", "band_hz"),
+               f"[{lo}, {hi}] Hz must be [low, high] with low < high")
+    w = cfg["testbed"]["wind"]
+    if not w["f_lo_hz"] < w["f_hi_hz"]:
+        yield (("testbed", "wind", "f_lo_hz"),
+               f"{w['f_lo_hz']} Hz must be below testbed/wind/f_hi_hz = {w['f_hi_hz']} Hz")
+
+
+def lead_in_fits_wind_period(cfg: dict) -> Iterator[Problem]:
+    """The record (lead-in + window + tail) is shorter than the periodic wind's period.
+
+    The lead-in is ``physgs.testbed.physics.lead_in_frames`` at the slowest a bone can be (the
+    band's lower edge: calibration clamps every bone into the band), so this bounds the longest
+    lead-in any tree gets; ``physgs.testbed.dataset.simulate_tree`` refuses the same record.
+    """
+    from physgs.testbed import physics, wind  # the formulas the testbed itself uses
+
+    tb = cfg["testbed"]
+    lo, hi = tb["band_hz"]
+    if not 0 < lo < hi:
+        return  # band_ordered reports it
+    fps, zeta, tau = int(tb["fps"]), float(tb["zeta"]), float(tb["lead_in_tau"])
+    period = wind.PERIOD_S * fps
+    if abs(period - round(period)) > 1e-9:
+        yield (("testbed", "fps"),
+               f"{fps} fps does not divide the {wind.PERIOD_S:g} s wind period into whole frames; "
+               "use an integer number of frames per second that does")
+        return
+    P = int(round(period))
+    F = int(tb["n_train"]) + int(tb["n_tail"])
+    omega_min = 2 * math.pi * float(lo)
+    L = physics.lead_in_frames(omega_min, zeta, tau, fps)
+    if L + F >= P:
+        tau_max = 1.0 / (zeta * omega_min)
+        room = max(P - F - 1, 0)
+        yield (("testbed", "lead_in_tau"),
+               f"{tau:g} gives a lead-in of {L / fps:.1f} s ({tau:g} x tau_max, tau_max = "
+               f"1/(zeta*2pi*band_hz[0]) = {tau_max:.2f} s), so the record ({L / fps:.1f} s + "
+               f"{F / fps:.1f} s of n_train + n_tail) is not shorter than the {wind.PERIOD_S:g} s "
+               f"wind period; lower testbed/lead_in_tau to at most "
+               f"{room / (tau_max * fps):.3g}, or raise testbed/zeta or testbed/band_hz[0], or "
+               "lower n_train/n_tail")
+
+
+def warmup_below_iterations(cfg: dict) -> Iterator[Problem]:
+    """The static warm-up ends before training does (train and the K-selection runs)."""
+    for section, key in ((("train",), "train"), (("models", "kselect"), "models/kselect")):
+        node = cfg
+        for k in section:
+            node = node[k]
+        it, warm = int(node["iterations"]), int(node["warmup"])
+        if not 0 <= warm < it:
+            yield (section + ("warmup",),
+                   f"{warm} must lie in [0, {key}/iterations = {it}); lower {key}/warmup or raise "
+                   f"{key}/iterations")
+
+
+def freeze_inside_deformation_phase(cfg: dict) -> Iterator[Problem]:
+    """models/ours/freeze_at falls after the warm-up, for train and the K-selection runs alike.
+
+    The freezing iteration is round(freeze_at * iterations), as in
+    ``physgs.models.visibility.freeze_schedule``; freezing is off when freeze_below_px is 0.
+    """
+    o = cfg["models"]["ours"]
+    if float(o["freeze_below_px"]) == 0:
+        return
+    at = float(o["freeze_at"])
+    for node, key in ((cfg["train"], "train"), (cfg["models"]["kselect"], "models/kselect")):
+        it, warm = int(node["iterations"]), int(node["warmup"])
+        if not 0 <= warm < it:
+            continue  # warmup_below_iterations reports it
+        frz = int(round(at * it))
+        if not warm < frz < it:
+            yield (("models", "ours", "freeze_at"),
+                   f"{at:g} freezes at iteration {frz} of {key}/iterations = {it}, outside its "
+                   f"deformation phase ({warm}, {it}); choose freeze_at in ({warm / it:.3g}, 1) "
+                   "or set models/ours/freeze_below_px: 0 to turn freezing off")
+
+
+def ours_bounds_ordered(cfg: dict) -> Iterator[Problem]:
+    """omega_hz and zeta are (low, high) with the initial values strictly inside."""
+    o = cfg["models"]["ours"]
+    for pair, init in (("omega_hz", "omega_init_hz"), ("zeta", "zeta_init")):
+        lo, hi = (float(v) for v in o[pair])
+        x = float(o[init])
+        if not lo < hi:
+            yield (("models", "ours", pair),
+                   f"[{lo:g}, {hi:g}] must be [low, high] with low < high; swap them")
+        elif not lo < x < hi:
+            yield (("models", "ours", init),
+                   f"{x:g} lies outside models/ours/{pair} = [{lo:g}, {hi:g}]; choose a value "
+                   "strictly inside the bounds")
+
+
+def configs_have_single(cfg: dict) -> Iterator[Problem]:
+    """models/configs holds `single` (every model trains in it) and not the reserved `auto`."""
+    configs = cfg["models"]["configs"]
+    if "single" not in configs:
+        yield (("models", "configs", "single"),
+               "missing: every model is trained in configuration 'single'; add "
+               "single: {conditions: train, K: 32} under models/configs")
+    if "auto" in configs:
+        yield (("models", "configs", "auto"),
+               "is reserved for ours with K chosen from the data (models/kselect); rename it")
+
+
+def k_within_gaussians(cfg: dict) -> Iterator[Problem]:
+    """Every K (configurations, K-selection candidates, sweep knob) is at most the Gaussian count.
+
+    The Gaussian count is the tree's target vertex count (testbed/vertices): the smallest among
+    the trees for what runs on every tree, the sweep tree's for the sweep.
+    """
+    vertices = cfg["testbed"]["vertices"]
+    counts = {t: int(vertices[t]) for t in cfg["trees"] if t in vertices}
+    if not counts:
+        return  # trees_have_settings reports it
+    smallest = min(counts.values())
+    tmin = min(counts, key=counts.get)
+    fix = f"the {smallest} Gaussians of tree '{tmin}' (testbed/vertices/{tmin})"
+    for name, c in cfg["models"]["configs"].items():
+        if int(c["K"]) > smallest:
+            yield (("models", "configs", name, "K"),
+                   f"K = {c['K']} parts exceeds {fix}; lower K or raise the vertex count")
+    for i, k in enumerate(cfg["models"]["kselect"]["candidates"]):
+        if int(k) > smallest:
+            yield (("models", "kselect", "candidates", i),
+                   f"K = {k} exceeds {fix}; drop it from the candidates or raise the vertex count")
+    sa = cfg["speed_accuracy"]
+    tree = sa["tree"]
+    if tree in vertices:
+        n = int(vertices[tree])
+        for i, k in enumerate(sa["knobs"].get("K", [])):
+            if int(k) > n:
+                yield (("speed_accuracy", "knobs", "K", i),
+                       f"K = {k} exceeds the {n} Gaussians of the sweep tree '{tree}' "
+                       f"(testbed/vertices/{tree}); lower it")
+    single = cfg["models"]["configs"].get("single")
+    if single is not None:
+        for i, n in enumerate(sa["knobs"].get("vertices", [])):
+            if int(n) < int(single["K"]):
+                yield (("speed_accuracy", "knobs", "vertices", i),
+                       f"{n} Gaussians is fewer than models/configs/single/K = {single['K']} "
+                       "parts, which the sweep trains at every vertex count; raise it")
+
+
+def sweep_tree_is_listed(cfg: dict) -> Iterator[Problem]:
+    """The speed-accuracy sweep runs on a tree the pipeline builds."""
+    tree = cfg["speed_accuracy"]["tree"]
+    if tree not in cfg["trees"]:
+        yield (("speed_accuracy", "tree"),
+               f"'{tree}' is not in trees {cfg['trees']}; choose one of them or add it to trees")
+
+
+#: Every cross-key check, in the order their problems are reported.
+CHECKS: list[Check] = [
+    trees_have_settings,
+    conditions_have_unseen_wind,
+    band_ordered,
+    lead_in_fits_wind_period,
+    warmup_below_iterations,
+    freeze_inside_deformation_phase,
+    ours_bounds_ordered,
+    configs_have_single,
+    k_within_gaussians,
+    sweep_tree_is_listed,
+]
+
+
+def problems(cfg: dict, checks: list[Check] | None = None) -> list[Problem]:
+    """All ``(key path, message)`` problems of a resolved, schema-valid config."""
+    out: list[Problem] = []
+    for chk in CHECKS if checks is None else checks:
+        out.extend(chk(cfg))
+    return out
