@@ -16,6 +16,9 @@ CFG = physgs.config.load_workflow_config(config)
 TREES = CFG["trees"]
 
 
+report: "workflow/report/workflow.rst"
+
+
 include: "workflow/rules/common.smk"
 include: "workflow/rules/testbed.smk"
 include: "workflow/rules/train.smk"
@@ -31,4 +34,4 @@ rule all:
         rules.testbed.input,
         rules.report.input,
         rules.speed_accuracy.output,
-        rules.tab_kselect.output,
+        expand(TABLE, name="tab_kselect", ext=("tex", "csv")),

@@ -54,7 +54,7 @@ def tex_rows(tex):
 
 def test_tab_psnr_bold_and_agreement(tmp_path):
     tab = T.tab_psnr(summaries(), TREES, BONES)
-    assert list(tab.df.model) == [T.MODEL_NAMES[m] for m in T.MODELS]
+    assert list(tab.df.model) == [T.label(m) for m in T.MODELS]
     assert list(tab.df.columns) == ["model", "sparse_view", "sparse_time", "medium_view", "medium_time"]
     T.write_table(tab, tmp_path / "t.tex", tmp_path / "t.csv")
     csv = pd.read_csv(tmp_path / "t.csv")
@@ -108,7 +108,7 @@ def null(med):
 def test_tab_null_bold_lower_error_and_nan_cells(tmp_path):
     rec = {("sparse", "single"): record(3, 0.018), ("medium", "single"): record(0, float("nan"))}
     nl = {("sparse", "single"): null(0.0456), ("medium", "single"): null(0.0177)}
-    tab = T.tab_null(rec, nl, TREES, BONES, configs=["single"])
+    tab = T.tab_null(rec, nl, TREES, BONES, configs={"single": "single ($K{=}32$)"})
     assert tab.df.loc[0, "trained_median_rel_err_pct"] == pytest.approx(1.8)
     assert tab.df.loc[0, "null_median_rel_err_pct"] == pytest.approx(4.56)
     assert tab.df.loc[0, "null_parts_trusted"] == 4 and tab.df.loc[0, "nearest_bone_gap_pct"] == pytest.approx(0.4)
@@ -122,7 +122,7 @@ def test_tab_null_bold_lower_error_and_nan_cells(tmp_path):
     np.testing.assert_allclose(rows[0][0], [round(v, 3) for v in csv.loc[0, cols]], atol=5e-3)
     assert np.isnan(csv.loc[1, "trained_median_rel_err_pct"])
     with pytest.raises(KeyError, match="dense"):
-        T.tab_null(rec, nl, ["sparse", "dense"], BONES, configs=["single"])
+        T.tab_null(rec, nl, ["sparse", "dense"], BONES, configs={"single": "single ($K{=}32$)"})
 
 
 def test_missing_model_names_the_cause():

@@ -10,9 +10,10 @@ from scipy.spatial.transform import Rotation
 
 import physgs.config
 from physgs.models import build_model, load_checkpoint
-from physgs.models.kselect import (
+from physgs.experiments import job_spec, train_and_save
+from physgs.experiments.kselect import (
     PARAMS_PER_PART,
-    auto_config,
+    auto_job,
     bic,
     choose_bic,
     choose_heldout,
@@ -23,7 +24,7 @@ from physgs.models.kselect import (
 )
 from physgs.models.visibility import freeze_invisible, freeze_schedule, part_image_swing
 from physgs.recovery.run import recover_model
-from physgs.train import run_training, train_model
+from physgs.train import train_model
 
 FPS, N_TRAIN = 24, 20  # as in the conftest swaying dataset
 
@@ -145,8 +146,8 @@ def test_freeze_schedule_is_checked():
 def test_run_training_freezes_and_reports(data, tmp_path):
     cfg = _cfg(K=4, iterations=12, warmup=2)
     cfg["models"]["ours"].update(freeze_below_px=1e6, freeze_at=0.5)  # everything is "invisible"
-    res = run_training(data, cfg, model="ours", config="single", progress=False,
-                       checkpoint_path=tmp_path / "o.pt", loss_path=tmp_path / "o.csv")
+    res = train_and_save(data, job_spec(cfg, "ours", "single"), progress=False,
+                         checkpoint_path=tmp_path / "o.pt", loss_path=tmp_path / "o.csv")
     assert res.stats["frozen_parts"] == 4 and res.stats["frozen_at"] == 6
     assert len(res.stats["part_swing_px"]) == 4
     assert load_checkpoint(tmp_path / "o.pt").checkpoint_info["stats"]["frozen_parts"] == 4
@@ -172,7 +173,8 @@ def test_select_k_then_train_auto(data, tmp_path):
                                 "iterations": 14, "warmup": 4, "tie_db": 0.0,
                                 "conditions": "train"}
     cfg["models"]["ours"].update(freeze_below_px=0.0, freeze_at=0.5)
-    sel = select_k(data, cfg)
+    job = job_spec(cfg, "ours", "single")
+    sel = select_k(data, job, cfg["models"]["kselect"])
     assert sel.candidates == [1, 4] and len(sel.heldout_psnr) == 2
     assert np.all(np.isfinite(sel.heldout_psnr)) and np.all(np.isfinite(sel.bic))
     assert sel.k_heldout == [1, 4][int(np.argmax(sel.heldout_psnr))]
@@ -180,21 +182,21 @@ def test_select_k_then_train_auto(data, tmp_path):
     save_selection(tmp_path / "k.json", sel)
     back = load_selection(tmp_path / "k.json")
     assert back == sel
-    acfg = auto_config(cfg, back)
-    run_training(data, acfg, model="ours", config="auto", progress=False,
-                 checkpoint_path=tmp_path / "a.pt", loss_path=tmp_path / "a.csv")
+    train_and_save(data, auto_job(job, back, "train"), progress=False,
+                   checkpoint_path=tmp_path / "a.pt", loss_path=tmp_path / "a.csv")
     model = load_checkpoint(tmp_path / "a.pt")
     assert model.K == sel.chosen_k and model.checkpoint_info["config"] == "auto"
     bad = copy.deepcopy(cfg)
     bad["models"]["kselect"]["candidates"] = [4, 500]
     with pytest.raises(ValueError, match="K = 500 exceeds the 120 Gaussians"):
-        select_k(data, bad)
-    with pytest.raises(ValueError, match="no chosen K"):
+        select_k(data, job, bad["models"]["kselect"])
+    with pytest.raises(ValueError, match="no K was given"):
         build_model("ours", data, cfg["models"], config="auto")
 
 
 def test_tab_kselect_rows_and_undefined_entries():
-    from physgs.report.kselect import inputs, tab_kselect
+    from physgs.report.build import needs
+    from physgs.report.kselect import tab_kselect
     rows = {("sparse", "single"): dict(K=32, time_psnr=25.0, median_rel_err=0.05, trusted=10,
                                        frozen=3, k_heldout=16, k_bic=64),
             ("sparse", "auto"): dict(K=16, time_psnr=25.5, median_rel_err=float("nan"), trusted=0,
@@ -202,4 +204,4 @@ def test_tab_kselect_rows_and_undefined_entries():
     t = tab_kselect(rows, ["sparse"], {"sparse": 22}, "heldout")
     assert t.df["K"].tolist() == [32, 16] and t.df["median_rel_err_pct"].iloc[0] == 5.0
     assert "10/32" in t.tex and "0/16" in t.tex and "--" in t.tex  # NaN median shown as --
-    assert "results/kselect/sparse.json" in inputs(["sparse"])
+    assert ("kselect", "sparse") in needs("tab_kselect", ["sparse"], {})

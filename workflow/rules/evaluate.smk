@@ -1,19 +1,16 @@
 # Evaluation (SPEC section 4): every split of one trained model, scored through the rasterizer.
 # Reads the ground truth only for branch-tip trajectories; never feeds anything back to training.
 
+
 rule evaluate:
     input:
-        ckpt="results/models/{tree}/{model}_{config}.pt",
-        observed="results/testbed/{tree}/observed.npz",
-        truth="results/testbed/{tree}/truth.npz",
+        ckpt=CKPT,
+        observed=OBSERVED,
+        truth=TRUTH,
     output:
-        scores=_build.EVAL,
-        traj=_build.TRAJ,
-        panels=_build.PANELS,
-    wildcard_constraints:
-        tree="|".join(CFG["trees"]),
-        model="|".join(_models.MODEL_NAMES),
-        config="|".join((*_models.CONFIG_NAMES, _models.AUTO_CONFIG)),
+        scores=EVAL,
+        traj=TRAJ,
+        panels=PANELS,
     params:
         backend=CFG["train"]["backend"],
     conda:

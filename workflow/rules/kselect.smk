@@ -1,21 +1,15 @@
-# K chosen from the data (issue 6): ours trained with K from held-out frames or BIC (`auto`),
-# evaluated and scored like the fixed-K runs, and compared with K = 32 in tab_kselect.
-# Include after train.smk, evaluate.smk, recovery.smk and report.smk (uses _build, _models);
-# ours_auto is evaluated and scored by the generic `evaluate` and `recovery` rules.
-from physgs.report import kselect as _ksel
-
-_KS = CFG["models"]["kselect"]
+# K chosen from the data: ours trained with K from held-out training frames or BIC (`auto`),
+# evaluated and scored by the generic `evaluate` and `recovery` rules, and compared with the
+# fixed K in tab_kselect (built by the generic `table` rule).
 
 
 rule kselect:
     input:
-        observed="results/testbed/{tree}/observed.npz",
+        observed=OBSERVED,
     output:
-        selection=_ksel.KSELECT,
-    wildcard_constraints:
-        tree="|".join(CFG["trees"]),
+        selection=KSELECT,
     params:
-        cfg=CFG,
+        settings=kselect_params,
     conda:
         "../envs/physgs.yaml"
     log:
@@ -26,22 +20,23 @@ rule kselect:
     resources:
         mem_mb=4000,
         # minutes; about 1 s per iteration per candidate, generous for a cluster
-        runtime=10 + len(_KS["candidates"]) * _KS["iterations"] // 60,
+        runtime=10 + len(CFG["models"]["kselect"]["candidates"])
+        * CFG["models"]["kselect"]["iterations"]
+        // 60,
     script:
         "../scripts/kselect.py"
 
 
 rule train_auto:
     input:
-        observed="results/testbed/{tree}/observed.npz",
-        selection=_ksel.KSELECT,
+        observed=OBSERVED,
+        selection=KSELECT,
     output:
-        ckpt="results/models/{tree}/ours_auto.pt",
-        loss="results/models/{tree}/ours_auto.loss.csv",
-    wildcard_constraints:
-        tree="|".join(CFG["trees"]),
+        ckpt=CKPT.replace("{model}_{config}", "ours_auto"),
+        loss=LOSS.replace("{model}_{config}", "ours_auto"),
     params:
-        cfg=CFG,
+        job=lambda wc: _job_spec(CFG, "ours", _models.BASE_CONFIG),
+        conditions=CFG["models"]["kselect"]["conditions"],
     conda:
         "../envs/physgs.yaml"
     log:
@@ -54,23 +49,3 @@ rule train_auto:
         runtime=10 + CFG["train"]["iterations"] // 60,
     script:
         "../scripts/train_auto.py"
-
-
-rule tab_kselect:
-    input:
-        _ksel.inputs(TREES),
-    output:
-        tex="results/tables/tab_kselect.tex",
-        csv="results/tables/tab_kselect.csv",
-    params:
-        cfg=CFG,
-    conda:
-        "../envs/physgs.yaml"
-    log:
-        "logs/report/tab_kselect.log",
-    threads: 1
-    resources:
-        mem_mb=1000,
-        runtime=5,
-    script:
-        "../scripts/kselect_table.py"

@@ -1,16 +1,14 @@
 # Recovery (SPEC section 4): match ours' parts to bones by trajectory, against an untrained null.
+# The null control is keyed by K: configurations sharing a K share one null.
 
 
 rule recovery:
     input:
-        ckpt="results/models/{tree}/ours_{config}.pt",
-        observed="results/testbed/{tree}/observed.npz",
-        truth="results/testbed/{tree}/truth.npz",
+        ckpt=CKPT.replace("{model}", "ours"),
+        observed=OBSERVED,
+        truth=TRUTH,
     output:
-        record=_build.RECOVERY,
-    wildcard_constraints:
-        tree="|".join(CFG["trees"]),
-        config="|".join((*_models.CONFIG_NAMES, _models.AUTO_CONFIG)),
+        record=RECOVERY,
     conda:
         "../envs/physgs.yaml"
     log:
@@ -25,19 +23,16 @@ rule recovery:
 
 rule null_control:
     input:
-        observed="results/testbed/{tree}/observed.npz",
-        truth="results/testbed/{tree}/truth.npz",
+        observed=OBSERVED,
+        truth=TRUTH,
     output:
-        record=_build.NULL,
-    wildcard_constraints:
-        tree="|".join(CFG["trees"]),
-        config="|".join((*_models.CONFIG_NAMES, _models.AUTO_CONFIG)),
+        record=NULL,
     params:
-        cfg=CFG,
+        null=null_params,
     conda:
         "../envs/physgs.yaml"
     log:
-        "logs/recovery/{tree}/null_{config}.log",
+        "logs/recovery/{tree}/null_K{K}.log",
     threads: 1
     resources:
         mem_mb=2000,

@@ -1,18 +1,17 @@
-# Tables and figures. Each is a target of its own and declares exactly the files it reads, so
+# Tables and figures. Each is a target of its own and declares exactly the files it reads (need
+# tuples of physgs.report.build, mapped to paths in common.smk), so
 # `snakemake --cores 2 results/tables/tab_null.tex` trains ours and nothing else.
-CONFIGS = list(CFG["models"]["configs"])
 
 
 rule table:
     input:
-        lambda wc: _build.inputs_for(wc.name, TREES, CONFIGS),
+        unpack(report_inputs),
     output:
-        tex="results/tables/{name}.tex",
-        csv="results/tables/{name}.csv",
-    wildcard_constraints:
-        name="|".join(_build.TABLES),
+        tex=TABLE.replace("{ext}", "tex"),
+        csv=report(TABLE.replace("{ext}", "csv"), category="3. Tables", labels={"table": "{name}"}),
     params:
-        cfg=CFG,
+        settings=report_params,
+        stamp=STAMP,
     conda:
         "../envs/physgs.yaml"
     log:
@@ -27,14 +26,13 @@ rule table:
 
 rule figure:
     input:
-        lambda wc: _build.inputs_for(wc.name, TREES, CONFIGS),
+        unpack(report_inputs),
     output:
-        pdf="results/figures/{name}.pdf",
-        png="results/figures/{name}.png",
-    wildcard_constraints:
-        name="|".join(_build.FIGURES),
+        pdf=FIGURE.replace("{ext}", "pdf"),
+        png=report(FIGURE.replace("{ext}", "png"), category="2. Results",
+                   labels={"figure": "{name}"}),
     params:
-        cfg=CFG,
+        settings=report_params,
     conda:
         "../envs/physgs.yaml"
     log:
@@ -49,5 +47,5 @@ rule figure:
 
 rule report:
     input:
-        expand("results/tables/{name}.{ext}", name=_build.TABLES, ext=("tex", "csv")),
-        expand("results/figures/{name}.{ext}", name=_build.FIGURES, ext=("pdf", "png")),
+        expand(TABLE, name=[n for n in _build.TABLES if n != "tab_kselect"], ext=("tex", "csv")),
+        expand(FIGURE, name=_build.FIGURES, ext=("pdf", "png")),

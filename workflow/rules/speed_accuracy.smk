@@ -1,20 +1,15 @@
 # The speed-accuracy trade (SPEC section 5): one knob at a time away from the profile's settings,
-# ours on one tree; `snakemake --cores 2 speed_accuracy`.
-import physgs.speed_accuracy as _sa
-
-SA_TREE = CFG["speed_accuracy"]["tree"]
+# ours on one tree, trained by the tables' recipe; `snakemake --cores 2 speed_accuracy`.
 
 
 rule speed_accuracy_point:
     input:
-        observed=f"results/testbed/{SA_TREE}/observed.npz",
-        truth=f"results/testbed/{SA_TREE}/truth.npz",
+        observed=OBSERVED.format(tree=SA_TREE),
+        truth=TRUTH.format(tree=SA_TREE),
     output:
-        record="results/speed_accuracy/{point}.json",
-    wildcard_constraints:
-        point="|".join(_sa.sweep_points(CFG)),
+        record=SWEEP_POINT,
     params:
-        cfg=CFG,
+        point=sweep_params,
     conda:
         "../envs/physgs.yaml"
     log:
@@ -31,11 +26,11 @@ rule speed_accuracy_point:
 
 rule speed_accuracy:
     input:
-        expand("results/speed_accuracy/{point}.json", point=_sa.sweep_points(CFG)),
+        expand(SWEEP_POINT, point=SWEEP_POINTS),
     output:
-        csv="results/tables/speed_accuracy.csv",
+        csv=report("results/tables/speed_accuracy.csv", category="4. Speed-accuracy trade"),
         pdf="results/figures/fig_speed_accuracy.pdf",
-        png="results/figures/fig_speed_accuracy.png",
+        png=report("results/figures/fig_speed_accuracy.png", category="4. Speed-accuracy trade"),
     conda:
         "../envs/physgs.yaml"
     log:

@@ -4,12 +4,10 @@
 
 rule testbed_dataset:
     output:
-        observed="results/testbed/{tree}/observed.npz",
-        truth="results/testbed/{tree}/truth.npz",
+        observed=OBSERVED,
+        truth=TRUTH,
     params:
-        testbed=CFG["testbed"],
-        preset=lambda wc: CFG["presets"][wc.tree],
-        seed=CFG["seed"],
+        settings=testbed_params,
     conda:
         "../envs/physgs.yaml"
     log:
@@ -20,18 +18,20 @@ rule testbed_dataset:
     resources:
         mem_mb=3000,
         runtime=20,
-    wildcard_constraints:
-        tree="sparse|medium|dense",
     script:
         "../scripts/testbed_dataset.py"
 
 
 rule testbed_figure:
     input:
-        observed="results/testbed/{tree}/observed.npz",
-        truth="results/testbed/{tree}/truth.npz",
+        observed=OBSERVED,
+        truth=TRUTH,
     output:
-        figure="results/figures/testbed_{tree}.png",
+        figure=report(
+            "results/figures/testbed_{tree}.png",
+            category="1. Testbed",
+            labels={"tree": "{tree}"},
+        ),
     conda:
         "../envs/physgs.yaml"
     log:
@@ -40,14 +40,12 @@ rule testbed_figure:
     resources:
         mem_mb=1500,
         runtime=5,
-    wildcard_constraints:
-        tree="sparse|medium|dense",
     script:
         "../scripts/testbed_figure.py"
 
 
 rule testbed:
     input:
-        expand("results/testbed/{tree}/observed.npz", tree=TREES),
-        expand("results/testbed/{tree}/truth.npz", tree=TREES),
+        expand(OBSERVED, tree=TREES),
+        expand(TRUTH, tree=TREES),
         expand("results/figures/testbed_{tree}.png", tree=TREES),

@@ -1,17 +1,19 @@
 # Training: one job per (tree, model, configuration). The only input is the observed dataset;
-# the ground-truth physics file (truth.npz) is never an input of a training rule.
+# the ground-truth physics file (truth.npz) is never an input of a training rule. The job's
+# params are its narrow settings (physgs.experiments.recipe.job_spec): editing another model's
+# settings, the sweep or a table's format leaves it up to date.
+
+
 rule train:
     input:
         observed=train_input,
     output:
-        ckpt="results/models/{tree}/{model}_{config}.pt",
-        loss="results/models/{tree}/{model}_{config}.loss.csv",
+        ckpt=CKPT,
+        loss=LOSS,
     wildcard_constraints:
-        tree="|".join(CFG["trees"]),
-        model="|".join(_models.MODEL_NAMES),
-        config="|".join(_models.CONFIG_NAMES),
+        config="|".join(CONFIGS),  # ours_auto has its own rule (kselect.smk)
     params:
-        cfg=CFG,
+        job=train_params,
     conda:
         "../envs/physgs.yaml"
     log:
@@ -29,5 +31,6 @@ rule train:
 
 rule train_all:
     input:
-        expand("results/models/{tree}/{job}.pt", tree=TREES,
-               job=[f"{m}_{c}" for m, c in TRAIN_JOBS]),
+        expand(CKPT, zip, tree=[t for t in TREES for _ in TRAIN_JOBS],
+               model=[m for _ in TREES for m, _c in TRAIN_JOBS],
+               config=[c for _ in TREES for _m, c in TRAIN_JOBS]),

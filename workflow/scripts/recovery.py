@@ -1,11 +1,12 @@
 """Snakemake script of rule `recovery`: match ours' parts to bones and summarise damping."""
+from physgs.jobs import job
 from physgs.models.registry import load_checkpoint
 from physgs.recovery.record import save_recovery
 from physgs.recovery.run import recover_model
 from physgs.testbed.dataset import load_observed, load_truth
 
 sm = snakemake  # noqa: F821 (injected by Snakemake)
-with open(sm.log[0], "w") as log:
+with job(sm) as log:
     rec = recover_model(load_checkpoint(sm.input.ckpt), load_observed(sm.input.observed),
                         load_truth(sm.input.truth))
     save_recovery(sm.output.record, rec)

@@ -2,10 +2,12 @@
 import json
 
 from physgs.atomic import atomic_path
-from physgs.speed_accuracy import collect, fig_speed_accuracy
+from physgs.experiments.sweep import collect
+from physgs.jobs import job
+from physgs.report.figures import fig_speed_accuracy
 
 sm = snakemake  # noqa: F821 (injected by Snakemake)
-with open(sm.log[0], "w") as log:
+with job(sm) as log:
     records = [json.load(open(p)) for p in sm.input]
     df = collect(records)
     with atomic_path(sm.output.csv) as tmp:

@@ -49,6 +49,20 @@ def render_panels(render_fn, observed) -> dict[str, np.ndarray]:
     return out
 
 
+def training_camera_scores(model, observed, frames, *, condition: int = 0,
+                           backend: str = "auto") -> tuple[np.ndarray, np.ndarray]:
+    """(MSE [M], PSNR dB [M]) of ``model`` at the training camera, per recorded frame in
+    ``frames`` [M] of ``condition``, through the same render callback as the evaluation."""
+    render_fn = model_render_fn(model, observed, backend=backend)
+    mse, score = [], []
+    for j in np.asarray(frames, dtype=np.int64):
+        rgb, _ = render_fn(int(j), condition, observed.train_camera)
+        gt = np.asarray(observed.frames[condition, j], dtype=np.float64) / 255.0
+        mse.append(float(np.mean((rgb - gt) ** 2)))
+        score.append(float(psnr(rgb, observed.frames[condition, j])))
+    return np.asarray(mse), np.asarray(score)
+
+
 def evaluate_checkpoint(model, observed, truth, *, eval_path, traj_path, panels_path,
                         backend: str = "auto", progress=None) -> dict[str, float]:
     """Score ``model`` on every split and write three files atomically.

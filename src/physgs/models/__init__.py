@@ -2,17 +2,18 @@
 from physgs.models.base import BaseModel, ModelContext, context_from_observed
 from physgs.models.gaussians import GaussianState
 from physgs.models.registry import (
-    CONFIG_NAMES,
     MODEL_NAMES,
+    MODELS,
     build_model,
     configs_for,
     load_checkpoint,
+    model_settings,
     save_checkpoint,
     training_jobs,
 )
 
 __all__ = [
-    "BaseModel", "ModelContext", "context_from_observed", "GaussianState", "CONFIG_NAMES",
-    "MODEL_NAMES", "build_model", "configs_for", "load_checkpoint", "save_checkpoint",
-    "training_jobs",
+    "BaseModel", "ModelContext", "context_from_observed", "GaussianState", "MODEL_NAMES",
+    "MODELS", "build_model", "configs_for", "load_checkpoint", "model_settings",
+    "save_checkpoint", "training_jobs",
 ]

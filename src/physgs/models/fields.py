@@ -61,7 +61,7 @@ class FieldModel(BaseModel):
 
     def __init__(self, ctx: ModelContext, canonical_cfg: dict, *, arch: str, pos_bands: int,
                  time_bands: int, depth: int, width: int, skip: int | None, wind: bool,
-                 window_seconds: float, window_values: int, name: str):
+                 window_seconds: float | None, window_values: int | None, name: str):
         super().__init__(ctx, canonical_cfg)
         if arch not in ("mlp", "d3dgs"):
             raise ValueError(f"unknown field architecture {arch!r}; use 'mlp' or 'd3dgs'")
@@ -69,8 +69,11 @@ class FieldModel(BaseModel):
         self.arch = arch
         self.pos_bands, self.time_bands = pos_bands, time_bands
         self.use_wind = wind
-        self.window_values = window_values
-        self.window_step = window_step(window_seconds, window_values, ctx.fps)
+        if wind and (window_seconds is None or window_values is None):
+            raise ValueError(f"{name}: a wind-conditioned field needs models.wind_window")
+        # a wind-blind field has no window (its settings do not carry one)
+        self.window_values = int(window_values) if wind else 0
+        self.window_step = window_step(window_seconds, window_values, ctx.fps) if wind else 0
         xyz = np.asarray(ctx.canonical_xyz, dtype=np.float64)
         lo, hi = xyz.min(0), xyz.max(0)
         self.register_buffer("xyz_center", torch.tensor(0.5 * (lo + hi), dtype=torch.float32))
@@ -79,8 +82,7 @@ class FieldModel(BaseModel):
         # Frozen training-condition statistics: weaker winds stay weaker after standardising.
         self.register_buffer("wind_mean", torch.tensor(ctx.wind_mean, dtype=torch.float32))
         self.register_buffer("wind_std", torch.tensor(ctx.wind_std, dtype=torch.float32))
-        in_dim = fourier_dim(3, pos_bands) + fourier_dim(1, time_bands) + (
-            window_values if wind else 0)
+        in_dim = fourier_dim(3, pos_bands) + fourier_dim(1, time_bands) + self.window_values
         heads = ("dx",) if arch == "mlp" else ("dx", "dq", "ds")
         self.field = DeformationField(in_dim, depth, width, skip, heads)
 

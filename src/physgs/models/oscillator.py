@@ -205,10 +205,13 @@ def integrate(omega: torch.Tensor, zeta: torch.Tensor, gain: torch.Tensor, wind,
         )
     if omega.numel() == 0:
         return omega.new_zeros((0, w.shape[0]))
-    if not float(omega.detach().min()) > 0:
-        raise ValueError(f"integrate: omega must be > 0 rad/s; got min {float(omega.min())}")
-    if not float(zeta.detach().min()) >= 0:
-        raise ValueError(f"integrate: zeta must be >= 0; got min {float(zeta.min())}")
+    om_min, ze_min = float(omega.detach().min()), float(zeta.detach().min())
+    if not om_min > 0:
+        raise ValueError(f"integrate: omega must be > 0 rad/s; got min {om_min}"
+                         + (" (NaN: a parameter upstream is NaN)" if math.isnan(om_min) else ""))
+    if not ze_min >= 0:
+        raise ValueError(f"integrate: zeta must be >= 0; got min {ze_min}"
+                         + (" (NaN: a parameter upstream is NaN)" if math.isnan(ze_min) else ""))
     # Guard the fastest eigenvalue, not omega alone: an over-damped part's stiff pole is faster.
     rates = fastest_rate(omega.detach().cpu().double().numpy(), zeta.detach().cpu().double().numpy())
     i = int(np.argmax(rates))

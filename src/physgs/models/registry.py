@@ -7,6 +7,7 @@ statistics), the state dict and the training statistics.
 """
 from __future__ import annotations
 
+from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
@@ -18,56 +19,108 @@ from physgs.models.fields import FieldModel
 from physgs.models.ours import OscillatorPrior
 from physgs.models.static import StaticModel
 
-MODEL_NAMES = ("static", "mlp", "mlp_wind", "d3dgs", "d3dgs_wind", "ours")
-CONFIG_NAMES = ("single", "joint32", "joint96")
-FORMAT = "physgs-model-v1"
-#: Ours with K chosen from the data (physgs.models.kselect). Kept out of CONFIG_NAMES so the
-#: fixed-K rules and tables do not iterate over it; its K is written into models.configs.auto
-#: by ``kselect.auto_config`` before training, and so travels in the checkpoint.
+@dataclass(frozen=True)
+class ModelSpec:
+    """One model id: its table label, its short column head, what settings it reads."""
+
+    label: str  # full name in tables and figure legends
+    short: str  # column head under a family heading (tab_transfer)
+    family: str  # config section of its architecture ("static", "mlp", "d3dgs", "ours")
+    wind: bool  # reads the observed wind
+
+
+#: The one source of model ids and labels; order = row order of every table.
+MODELS: dict[str, ModelSpec] = {
+    "static": ModelSpec("Static pose", "Static", "static", False),
+    "mlp": ModelSpec("Deformation MLP", "no wind", "mlp", False),
+    "mlp_wind": ModelSpec("Deformation MLP + wind", r"+\,wind", "mlp", True),
+    "d3dgs": ModelSpec("Deformable-3DGS", "no wind", "d3dgs", False),
+    "d3dgs_wind": ModelSpec("Deformable-3DGS + wind", r"+\,wind", "d3dgs", True),
+    "ours": ModelSpec("Ours", "Ours", "ours", True),
+}
+MODEL_NAMES = tuple(MODELS)
+FIELDS = ("mlp", "d3dgs")  # learned deformation-field architectures
+#: Every model is trained in this configuration; ours also in every other one of the config.
+BASE_CONFIG = "single"
+FORMAT = "physgs-model-v2"
+#: Ours with K chosen from the data (physgs.experiments.kselect); its K is passed explicitly.
 AUTO_CONFIG = "auto"
 
 
-def configs_for(model: str) -> tuple[str, ...]:
-    """Training configurations a model is run in: every model `single`, ours also joint ones."""
-    if model not in MODEL_NAMES:
+def label(model: str) -> str:
+    """Table/legend label of a model id."""
+    return MODELS[model].label if model in MODELS else model
+
+
+def config_label(name: str, spec: dict, tex: bool = True) -> str:
+    """'single ($K{=}32$)' / 'joint ($K{=}96$)': derived from the configuration's conditions and K."""
+    kind = "single" if spec["conditions"] == "train" else "joint"
+    return rf"{kind} ($K{{=}}{int(spec['K'])}$)" if tex else f"{kind} (K={int(spec['K'])})"
+
+
+def configs_for(model: str, configs) -> tuple[str, ...]:
+    """Configurations a model is trained in: every model `single`, ours every configuration.
+
+    configs: the names of the config's ``models.configs`` (the one source of configurations).
+    """
+    if model not in MODELS:
         raise ValueError(f"unknown model {model!r}; choose one of {MODEL_NAMES}")
-    return CONFIG_NAMES if model == "ours" else ("single",)
+    return tuple(configs) if model == "ours" else (BASE_CONFIG,)
 
 
-def training_jobs() -> list[tuple[str, str]]:
-    """All (model, configuration) pairs that are trained per tree."""
-    return [(m, c) for m in MODEL_NAMES for c in configs_for(m)]
+def training_jobs(configs) -> list[tuple[str, str]]:
+    """All (model, configuration) pairs trained per tree, for the config's ``models.configs``."""
+    return [(m, c) for m in MODEL_NAMES for c in configs_for(m, configs)]
 
 
-def build_model(name: str, observed, cfg: dict, *, config: str = "single", seed: int = 0,
-                labels: np.ndarray | None = None) -> BaseModel:
+def model_settings(models_cfg: dict, model: str) -> dict:
+    """The part of the ``models`` config section that ``model`` reads (and nothing else), so a
+    workflow job is out of date only when one of its own settings changes."""
+    spec = MODELS[model] if model in MODELS else None
+    if spec is None:
+        raise ValueError(f"unknown model {model!r}; choose one of {MODEL_NAMES}")
+    out = {"canonical": models_cfg["canonical"]}
+    if spec.family != "static":
+        out[spec.family] = models_cfg[spec.family]
+    if spec.wind and spec.family in FIELDS:
+        out["wind_window"] = models_cfg["wind_window"]
+    return out
+
+
+def build_model(name: str, observed, cfg: dict, *, config: str = BASE_CONFIG, K: int | None = None,
+                seed: int = 0, labels: np.ndarray | None = None) -> BaseModel:
     """A freshly initialised model.
 
     name: one of MODEL_NAMES; observed: a testbed ``Observed`` or a ModelContext;
-    cfg: the resolved config's ``models`` section; config: training configuration (sets K);
+    cfg: the ``models`` config section, or ``model_settings`` of it; config: training
+    configuration name; K: number of parts of ours (default: ``cfg['configs'][config]['K']``);
     seed: k-means seed (ours); labels: precomputed part labels [N] (used when loading).
     """
-    if config == AUTO_CONFIG and name == "ours":
-        if not isinstance(cfg["configs"].get(AUTO_CONFIG, {}).get("K"), int):
-            raise ValueError("configuration 'auto' has no chosen K yet: run the kselect rule "
-                             "(physgs.models.kselect.select_k, then auto_config) first")
-    elif config not in configs_for(name):
+    if name not in MODELS:
+        raise ValueError(f"unknown model {name!r}; choose one of {MODEL_NAMES}")
+    if name != "ours" and config != BASE_CONFIG:
         raise ValueError(f"model {name!r} is not trained in configuration {config!r}; valid: "
-                         f"{configs_for(name)}" + (" or 'auto'" if name == "ours" else ""))
+                         f"('{BASE_CONFIG}',) (joint configurations are ours only)")
     ctx = observed if isinstance(observed, ModelContext) else context_from_observed(observed)
     canon = dict(cfg["canonical"])
-    if name == "static":
+    family = MODELS[name].family
+    if family == "static":
         return StaticModel(ctx, canon)
-    if name in ("mlp", "mlp_wind", "d3dgs", "d3dgs_wind"):
-        arch = name.split("_")[0]
-        a = cfg[arch]
-        ww = cfg["wind_window"]
-        return FieldModel(ctx, canon, arch=arch, pos_bands=a["pos_bands"],
+    if family in FIELDS:
+        a = cfg[family]
+        ww = cfg["wind_window"] if MODELS[name].wind else {"seconds": None, "values": None}
+        return FieldModel(ctx, canon, arch=family, pos_bands=a["pos_bands"],
                           time_bands=a["time_bands"], depth=a["depth"], width=a["width"],
-                          skip=a.get("skip"), wind=name.endswith("_wind"),
+                          skip=a.get("skip"), wind=MODELS[name].wind,
                           window_seconds=ww["seconds"], window_values=ww["values"], name=name)
+    if K is None:
+        spec = cfg.get("configs", {}).get(config)
+        if spec is None:
+            raise ValueError(f"ours has no configuration {config!r} and no K was given; valid: "
+                             f"{sorted(cfg.get('configs', {}))}")
+        K = spec["K"]
     o = cfg["ours"]
-    return OscillatorPrior(ctx, canon, K=int(cfg["configs"][config]["K"]), omega_hz=o["omega_hz"],
+    return OscillatorPrior(ctx, canon, K=int(K), omega_hz=o["omega_hz"],
                            zeta=o["zeta"], omega_init_hz=o["omega_init_hz"],
                            zeta_init=o["zeta_init"], substeps=o["substeps"],
                            rk4_guard=o["rk4_guard"], kmeans_n_init=o["kmeans_n_init"], seed=seed,
@@ -76,12 +129,16 @@ def build_model(name: str, observed, cfg: dict, *, config: str = "single", seed:
 
 def save_checkpoint(path, model: BaseModel, *, name: str, config: str, seed: int,
                     models_cfg: dict, train_cfg: dict, stats: dict) -> None:
-    """Write the checkpoint atomically (temporary file in the same folder, then rename)."""
+    """Write the checkpoint atomically (temporary file in the same folder, then rename).
+
+    models_cfg: the settings the model was built from (``model_settings`` or the whole
+    ``models`` section); ours' K is read off the model, so any configuration name reloads.
+    """
     path = Path(path)
     path.parent.mkdir(parents=True, exist_ok=True)
     blob = {
         "format": FORMAT, "model": name, "config": config, "seed": int(seed),
-        "models_cfg": models_cfg, "train_cfg": train_cfg, "context": model.ctx.to_dict(),
+        "K": int(model.K) if hasattr(model, "K") else None, "models_cfg": models_cfg, "train_cfg": train_cfg, "context": model.ctx.to_dict(),
         "state_dict": model.state_dict(), "stats": stats,
     }
     with atomic_path(path) as tmp:
@@ -113,7 +170,7 @@ def load_checkpoint(path) -> BaseModel:
     sd = blob["state_dict"]
     labels = sd["part_labels"].numpy() if "part_labels" in sd else None
     model = build_model(blob["model"], ModelContext.from_dict(blob["context"]), blob["models_cfg"],
-                        config=blob["config"], seed=blob["seed"], labels=labels)
+                        config=blob["config"], K=blob["K"], seed=blob["seed"], labels=labels)
     model.load_state_dict(sd, strict=True)
     model.eval()
     model.checkpoint_info = {k: blob[k] for k in ("model", "config", "seed", "stats",

@@ -35,16 +35,24 @@ def recover_model(model, observed, truth) -> RecoveryRecord:
     return dataclasses.replace(rec, n_frozen=int(fz.sum()))
 
 
-def null_for_config(observed, truth, cfg: dict, config: str) -> NullResult:
-    """The untrained null for the configuration's K, through the solver settings ours uses.
+def null_settings(cfg: dict, K: int) -> dict:
+    """What the null control for K parts reads from the resolved config: ours' solver settings
+    (omega and zeta bounds, zeta_init, substeps, RK4 guard) and the seed. Keyed by K, not by
+    configuration, so configurations sharing a K share one null."""
+    o = cfg["models"]["ours"]
+    return {"K": int(K), "omega_hz": [float(x) for x in o["omega_hz"]],
+            "zeta": [float(x) for x in o["zeta"]], "zeta_init": float(o["zeta_init"]),
+            "substeps": int(o["substeps"]), "rk4_guard": float(o["rk4_guard"]),
+            "seed": int(cfg["seed"])}
 
-    cfg: the resolved config (``models.ours``, ``models.configs``, ``seed``). Substeps are raised
-    exactly as the model raises them, so the null integrates with the trained model's step.
-    """
-    ours = cfg["models"]["ours"]
-    K = int(cfg["models"]["configs"][config]["K"])
+
+def null_control(observed, truth, settings: dict) -> NullResult:
+    """The untrained null for ``settings['K']`` parts (``null_settings``), through the solver
+    settings ours uses: substeps are raised exactly as the model raises them, so the null
+    integrates with the trained model's step."""
     dt = 1.0 / observed.fps
-    substeps = prior_substeps(ours["omega_hz"], ours["zeta"], ours["substeps"], dt,
-                              float(ours.get("rk4_guard", STABILITY_GUARD)))
-    return run_null(truth, observed, n_parts=K, zeta_init=float(ours["zeta_init"]),
-                    substeps=substeps, seed=int(cfg["seed"]))
+    substeps = prior_substeps(settings["omega_hz"], settings["zeta"], settings["substeps"], dt,
+                              float(settings.get("rk4_guard", STABILITY_GUARD)))
+    return run_null(truth, observed, n_parts=int(settings["K"]),
+                    zeta_init=float(settings["zeta_init"]), substeps=substeps,
+                    seed=int(settings["seed"]))

@@ -1,78 +1,140 @@
 """Collect per-job result files into the tables and figures (what the report rules call).
 
-File layout (shared with workflow/rules/*.smk through these templates, relative to the
-working directory): evaluation of a (tree, model, config) job in ``EVAL`` / ``TRAJ`` /
-``PANELS``, recovery of ours in ``RECOVERY`` and the null control in ``NULL``.
+The library never knows where the workflow keeps its files. Each output declares what it
+needs as *need tuples* (``needs``): ``("eval" | "traj" | "panels", tree, model, config)``,
+``("recovery", tree, config)``, ``("null", tree, K)`` and ``("kselect", tree)``. The workflow
+maps each tuple to a path (``workflow/rules/common.smk``) and hands the builders a mapping
+``key(need) -> path``; the builders read only those paths. ``settings_for`` gives the narrow
+settings an output reads, so editing one table's format rebuilds that table only.
 """
 from __future__ import annotations
 
-from typing import Sequence
+from typing import Mapping, Sequence
 
 import numpy as np
 
 from physgs.evaluate.splits import load_eval
 from physgs.evaluate.trajectories import load_trajectories
+from physgs.experiments.kselect import load_selection
+from physgs.models.registry import BASE_CONFIG, MODEL_NAMES, config_label
 from physgs.recovery.record import load_null, load_recovery
-from physgs.report import figures, tables
+from physgs.report import figures, kselect, tables
 
-EVAL = "results/eval/{tree}/{model}_{config}.npz"
-TRAJ = "results/eval/{tree}/{model}_{config}.traj.npz"
-PANELS = "results/eval/{tree}/{model}_{config}.panels.npz"
-RECOVERY = "results/recovery/{tree}/ours_{config}.json"
-NULL = "results/recovery/{tree}/null_{config}.json"
-
-TABLES = ("tab_psnr", "tab_null", "tab_transfer", "tab_margin")
+TABLES = ("tab_psnr", "tab_null", "tab_transfer", "tab_margin", "tab_kselect")
 FIGURES = ("fig_temporal", "fig_teaser", "fig_results", "fig_damping")
-# which models each output needs (all `single`); tab_null and fig_damping need ours' recovery
+#: The fields of each need tuple after its kind (what a workflow path template is formatted with).
+NEED_FIELDS = {"eval": ("tree", "model", "config"), "traj": ("tree", "model", "config"),
+               "panels": ("tree", "model", "config"), "recovery": ("tree", "config"),
+               "null": ("tree", "K"), "kselect": ("tree",)}
+#: Models (trained in the base configuration) whose evaluation an output reads.
 NEEDS_MODELS = {
-    "tab_psnr": tables.MODELS, "tab_transfer": tables.MODELS,
-    "tab_margin": ("mlp_wind", "ours"), "fig_temporal": tables.MODELS,
-    "fig_teaser": tables.MODELS, "fig_results": tables.MODELS,
+    "tab_psnr": MODEL_NAMES, "tab_transfer": MODEL_NAMES, "tab_margin": ("mlp_wind", "ours"),
+    "fig_temporal": MODEL_NAMES, "fig_teaser": MODEL_NAMES, "fig_results": MODEL_NAMES,
 }
+KSELECT_ROWS = (BASE_CONFIG, "auto")
 
 
-def _eval_paths(name: str, trees: Sequence[str]) -> list[str]:
-    models = NEEDS_MODELS.get(name, ())
-    return [EVAL.format(tree=t, model=m, config="single") for t in trees for m in models]
+def key(need: tuple) -> str:
+    """The name of a need in the inputs mapping: its parts joined by '/'."""
+    return "/".join(str(p) for p in need)
 
 
-def inputs_for(name: str, trees: Sequence[str], configs: Sequence[str]) -> list[str]:
-    """The files one table or figure reads: exactly what its rule must declare as input."""
-    files = _eval_paths(name, trees)
+def needs(name: str, trees: Sequence[str], configs: Mapping[str, dict]) -> list[tuple]:
+    """Every result an output reads, as need tuples (see the module docstring).
+
+    configs: the config's ``models.configs`` (name -> {conditions, K}); the null control is
+    keyed by K, so configurations sharing a K share one null.
+    """
+    if name not in (*TABLES, *FIGURES):
+        raise ValueError(f"unknown output '{name}'; choose one of {TABLES + FIGURES}")
+    out = [("eval", t, m, BASE_CONFIG) for t in trees for m in NEEDS_MODELS.get(name, ())]
     if name == "fig_teaser":
-        files += [TRAJ.format(tree=t, model=m, config="single") for t in trees for m in tables.MODELS]
+        out += [("traj", t, m, BASE_CONFIG) for t in trees for m in MODEL_NAMES]
     if name == "fig_results":
-        files += [PANELS.format(tree=t, model=m, config="single") for t in trees for m in tables.MODELS]
+        out += [("panels", t, m, BASE_CONFIG) for t in trees for m in MODEL_NAMES]
     if name in ("tab_null", "fig_damping"):
-        files += [RECOVERY.format(tree=t, config=c) for t in trees for c in configs]
+        out += [("recovery", t, c) for t in trees for c in configs]
     if name == "tab_null":
-        files += [NULL.format(tree=t, config=c) for t in trees for c in configs]
-    return files
+        out += list(dict.fromkeys(("null", t, int(configs[c]["K"])) for t in trees for c in configs))
+    if name == "tab_kselect":
+        for t in trees:
+            out.append(("kselect", t))
+            out += [x for c in KSELECT_ROWS for x in (("eval", t, "ours", c), ("recovery", t, c))]
+    return out
 
 
-def _summaries(trees, models):
-    return {(t, m): load_eval(EVAL.format(tree=t, model=m, config="single")).summary()
+def settings_for(name: str, cfg: dict) -> dict:
+    """The settings output ``name`` reads from the resolved config (and nothing more)."""
+    trees = list(cfg["trees"])
+    out = {"trees": trees, "bones": {t: int(cfg["presets"][t]["bones"]) for t in trees}}
+    if name in TABLES:
+        out["digits"] = int(cfg["report"][name]["digits"])
+    if name in ("tab_null", "fig_damping"):
+        out["configs"] = {c: {"K": int(v["K"]), "conditions": v["conditions"]}
+                          for c, v in cfg["models"]["configs"].items()}
+    if name in ("tab_transfer", "tab_margin", "fig_teaser", "fig_results"):
+        out["conditions"] = [float(c) for c in cfg["testbed"]["conditions"]]
+    if name == "fig_temporal":
+        out["n_train"] = int(cfg["testbed"]["n_train"])
+    if name == "fig_damping":
+        out["zeta"] = float(cfg["testbed"]["zeta"])
+    if name == "tab_kselect":
+        out["method"] = cfg["models"]["kselect"]["method"]
+    return out
+
+
+def _reader(inputs: Mapping[str, str]):
+    def path(*need) -> str:
+        k = key(need)
+        if k not in inputs:
+            raise KeyError(f"no input file for {k!r}; the rule must declare report needs "
+                           f"(physgs.report.build.needs)")
+        return inputs[k]
+    return path
+
+
+def _summaries(path, trees, models):
+    return {(t, m): load_eval(path("eval", t, m, BASE_CONFIG)).summary()
             for t in trees for m in models}
 
 
-def make_table(name: str, cfg: dict, tex_path, csv_path) -> tables.Table:
-    """Build table ``name`` from the result files and write its .tex and .csv."""
-    trees, configs = cfg["trees"], list(cfg["models"]["configs"])
-    bones = {t: int(cfg["presets"][t]["bones"]) for t in trees}
-    conditions = cfg["testbed"]["conditions"]
+def make_table(name: str, inputs: Mapping[str, str], settings: dict, tex_path, csv_path,
+               stamp=None) -> tables.Table:
+    """Build table ``name`` from the files in ``inputs`` (need key -> path) and write its .tex
+    and .csv. settings: ``settings_for(name, cfg)``; stamp: a ``physgs.provenance.Stamp``
+    written into every CSV row (profile, config hash, package version)."""
+    path = _reader(inputs)
+    trees, bones, d = settings["trees"], settings["bones"], settings.get("digits", 2)
     if name == "tab_psnr":
-        table = tables.tab_psnr(_summaries(trees, tables.MODELS), trees, bones)
+        table = tables.tab_psnr(_summaries(path, trees, MODEL_NAMES), trees, bones, digits=d)
     elif name == "tab_transfer":
-        table = tables.tab_transfer(_summaries(trees, tables.MODELS), trees, bones, conditions)
+        table = tables.tab_transfer(_summaries(path, trees, MODEL_NAMES), trees, bones,
+                                    settings["conditions"], digits=d)
     elif name == "tab_margin":
-        table = tables.tab_margin(_summaries(trees, ("mlp_wind", "ours")), trees, bones, conditions)
+        table = tables.tab_margin(_summaries(path, trees, ("mlp_wind", "ours")), trees, bones,
+                                  settings["conditions"], digits=d)
     elif name == "tab_null":
-        rec = {(t, c): load_recovery(RECOVERY.format(tree=t, config=c)) for t in trees for c in configs}
-        null = {(t, c): load_null(NULL.format(tree=t, config=c)) for t in trees for c in configs}
-        table = tables.tab_null(rec, null, trees, bones, configs)
+        configs = settings["configs"]
+        rec = {(t, c): load_recovery(path("recovery", t, c)) for t in trees for c in configs}
+        null = {(t, c): load_null(path("null", t, int(configs[c]["K"])))
+                for t in trees for c in configs}
+        labels = {c: config_label(c, v) for c, v in configs.items()}
+        table = tables.tab_null(rec, null, trees, bones, labels, digits=d)
+    elif name == "tab_kselect":
+        rows = {}
+        for t in trees:
+            sel = load_selection(path("kselect", t))
+            for c in KSELECT_ROWS:
+                ev = load_eval(path("eval", t, "ours", c)).summary()
+                rec = load_recovery(path("recovery", t, c))
+                rows[(t, c)] = {"K": rec.match.n_parts, "time_psnr": ev["time"],
+                                "median_rel_err": rec.match.median_rel_err,
+                                "trusted": rec.match.n_trusted, "frozen": rec.n_frozen,
+                                "k_heldout": sel.k_heldout, "k_bic": sel.k_bic}
+        table = kselect.tab_kselect(rows, trees, bones, settings["method"], digits=d)
     else:
         raise ValueError(f"unknown table '{name}'; choose one of {TABLES}")
-    tables.write_table(table, tex_path, csv_path)
+    tables.write_table(table, tex_path, csv_path, stamp=stamp)
     return table
 
 
@@ -81,38 +143,39 @@ def _teaser_tree(trees: Sequence[str]) -> str:
     return "medium" if "medium" in trees else trees[-1]
 
 
-def make_figure(name: str, cfg: dict, outputs: Sequence[str]) -> None:
-    """Build figure ``name`` from the result files, written to every path in ``outputs``."""
-    trees, configs = cfg["trees"], list(cfg["models"]["configs"])
+def make_figure(name: str, inputs: Mapping[str, str], settings: dict,
+                outputs: Sequence[str]) -> None:
+    """Build figure ``name`` from the files in ``inputs`` (need key -> path), written to every
+    path in ``outputs``. settings: ``settings_for(name, cfg)``."""
+    path = _reader(inputs)
+    trees = settings["trees"]
     if name == "fig_temporal":
-        evals = {(t, m): load_eval(EVAL.format(tree=t, model=m, config="single"))
-                 for t in trees for m in tables.MODELS}
-        curves = {k: e.temporal_psnr for k, e in evals.items()}
-        figures.fig_temporal(curves, trees, int(cfg["testbed"]["n_train"]), outputs)
+        curves = {(t, m): load_eval(path("eval", t, m, BASE_CONFIG)).temporal_psnr
+                  for t in trees for m in MODEL_NAMES}
+        figures.fig_temporal(curves, trees, int(settings["n_train"]), outputs)
     elif name == "fig_teaser":
         t = _teaser_tree(trees)
-        summ = {m: load_eval(EVAL.format(tree=t, model=m, config="single")).summary()
-                for m in tables.MODELS}
-        base = figures.best_baseline(summ, key="time")
+        evals = {m: load_eval(path("eval", t, m, BASE_CONFIG)) for m in MODEL_NAMES}
+        base = figures.best_baseline({m: e.summary() for m, e in evals.items()}, key="time")
         shown = ("ours", base)
-        traj = {m: load_trajectories(TRAJ.format(tree=t, model=m, config="single")) for m in shown}
-        cen = {m: load_eval(EVAL.format(tree=t, model=m, config="single")).centroid_err
-               for m in shown}
-        figures.fig_teaser(traj, cen, cfg["testbed"]["conditions"], outputs, title=f"{t} tree")
+        traj = {m: load_trajectories(path("traj", t, m, BASE_CONFIG)) for m in shown}
+        cen = {m: evals[m].centroid_err for m in shown}
+        figures.fig_teaser(traj, cen, settings["conditions"], outputs, title=f"{t} tree")
     elif name == "fig_results":
         rows, images = [], {}
         for t in trees:
-            panels = {m: np.load(PANELS.format(tree=t, model=m, config="single")) for m in tables.MODELS}
+            panels = {m: np.load(path("panels", t, m, BASE_CONFIG)) for m in MODEL_NAMES}
             for split in ("time", "view", "wind"):
                 row = f"{t}: unseen {split}"
                 rows.append(row)
                 images[(row, "gt")] = (panels["ours"][f"{split}_gt"], None)
-                for m in tables.MODELS:
+                for m in MODEL_NAMES:
                     images[(row, m)] = (panels[m][f"{split}_pred"], float(panels[m][f"{split}_psnr"]))
-        figures.fig_results(rows, ["gt", *tables.MODELS], images, outputs)
+        figures.fig_results(rows, ["gt", *MODEL_NAMES], images, outputs)
     elif name == "fig_damping":
-        damping = {(t, c): load_recovery(RECOVERY.format(tree=t, config=c)).damping
+        configs = list(settings["configs"])
+        damping = {(t, c): load_recovery(path("recovery", t, c)).damping
                    for t in trees for c in configs}
-        figures.fig_damping(damping, trees, configs, float(cfg["testbed"]["zeta"]), outputs)
+        figures.fig_damping(damping, trees, configs, float(settings["zeta"]), outputs)
     else:
         raise ValueError(f"unknown figure '{name}'; choose one of {FIGURES}")

@@ -1,4 +1,5 @@
-"""Figures (SPEC section 4): fig_temporal, fig_teaser, fig_results, fig_damping.
+"""Figures (SPEC sections 4-5): fig_temporal, fig_teaser, fig_results, fig_damping and the
+speed-accuracy sweep's fig_speed_accuracy.
 
 Each ``fig_*`` takes collected results as arrays and a list of output paths; the suffix of a
 path picks its format (.pdf, .png), each written atomically. Matplotlib's Agg backend is used
@@ -17,7 +18,9 @@ import numpy as np  # noqa: E402
 from matplotlib.ticker import LogLocator, NullFormatter, ScalarFormatter  # noqa: E402
 
 from physgs.atomic import atomic_path  # noqa: E402
-from physgs.report.tables import MODEL_NAMES, MODELS, condition_label  # noqa: E402
+from physgs.models.registry import MODEL_NAMES as MODELS  # noqa: E402
+from physgs.models.registry import label  # noqa: E402
+from physgs.report.tables import condition_label  # noqa: E402
 
 COLORS = {"static": "0.55", "mlp": "tab:orange", "mlp_wind": "tab:red", "d3dgs": "tab:purple",
           "d3dgs_wind": "tab:brown", "ours": "tab:blue", "gt": "k"}
@@ -69,7 +72,7 @@ def fig_temporal(curves: Mapping[tuple[str, str], np.ndarray], trees: Sequence[s
             y = np.asarray(curves[(t, m)])
             x = np.arange(1, len(y) + 1)
             ax.plot(x, y, color=COLORS.get(m), lw=1.6 if m == "ours" else 1.0,
-                    ls="--" if m == "static" else "-", label=MODEL_NAMES.get(m, m))
+                    ls="--" if m == "static" else "-", label=label(m))
         ax.axvline(n_train + 0.5, color="k", lw=0.8, ls=":")
         ax.axvspan(n_train + 0.5, len(y) + 0.5, color="0.92", zorder=0)
         ax.set_title(t.capitalize())
@@ -97,7 +100,7 @@ def fig_teaser(trajectories: Mapping[str, object], centroid_err: Mapping[str, np
     n_train = first.n_train
     if tip is None:
         tip = int(np.argmax(np.ptp(first.gt_px, axis=1).sum(-1)))
-    panels = [("Ground truth", first.gt_px[tip])] + [(MODEL_NAMES.get(m, m), trajectories[m].pred_px[tip])
+    panels = [("Ground truth", first.gt_px[tip])] + [(label(m), trajectories[m].pred_px[tip])
                                                      for m in models]
     fig = plt.figure(figsize=(3.0 * len(panels), 5.6))
     gs = fig.add_gridspec(2, 2 * len(panels))
@@ -126,7 +129,7 @@ def fig_teaser(trajectories: Mapping[str, object], centroid_err: Mapping[str, np
         for m in models:
             e = np.asarray(centroid_err[m])[c]
             ax.plot(np.arange(1, len(e) + 1), e, color=COLORS.get(m), lw=1.0,
-                    label=f"{MODEL_NAMES.get(m, m)} (mean {e.mean():.1f} px)")
+                    label=f"{label(m)} (mean {e.mean():.1f} px)")
         ax.axvline(n_train + 0.5, color="k", lw=0.8, ls=":")
         ax.set_title(f"canopy-centroid error, {lab}", fontsize=9)
         ax.set_xlabel("frame")
@@ -171,7 +174,7 @@ def fig_results(rows: Sequence[str], columns: Sequence[str],
                 ax.text(0.03, 0.03, f"{score:.2f}", transform=ax.transAxes, fontsize=7, color=color,
                         bbox=dict(facecolor="white", alpha=0.75, lw=0, pad=1))
             if i == 0:
-                ax.set_title("Ground truth" if c == "gt" else MODEL_NAMES.get(c, c), fontsize=7)
+                ax.set_title("Ground truth" if c == "gt" else label(c), fontsize=7)
             if j == 0:
                 ax.set_ylabel(r, fontsize=7)
     fig.tight_layout(pad=0.3)
@@ -223,5 +226,34 @@ def fig_damping(damping: Mapping[tuple[str, str], object], trees: Sequence[str],
     a1.set_ylabel(r"$\hat\gamma_p = \hat\zeta_p\hat\omega_p$ (1/s)")
     a1.set_title("decay rate against natural frequency", fontsize=9)
     a1.legend(fontsize=6, loc="upper left", bbox_to_anchor=(1.01, 1.0))
+    fig.tight_layout()
+    save_figure(fig, outputs)
+
+
+# --------------------------------------------------------------------------------------------
+def fig_speed_accuracy(df: pd.DataFrame, outputs: Sequence[str | Path]) -> None:
+    """Two panels against wall time (s): PSNR on the time split (dB) and recovery error (%).
+
+    One line per knob through its values (labelled), the base point starred.
+    """
+    fig, axes = plt.subplots(1, 2, figsize=(10, 4))
+    colors = {k: f"C{i}" for i, k in enumerate(sorted(df["knob"].unique()))}
+    for knob, g in df.groupby("knob", sort=False):
+        g = g.sort_values("value")
+        for ax, col, scale in ((axes[0], "psnr_time", 1.0), (axes[1], "rel_err", 100.0)):
+            ax.plot(g["wall_s"], g[col] * scale, "-o", ms=3.5, color=colors[knob], label=knob)
+            for _, r in g.iterrows():
+                ax.annotate(str(int(r["value"])), (r["wall_s"], r[col] * scale), fontsize=6,
+                            xytext=(3, 3), textcoords="offset points", color=colors[knob])
+    base = df[df["is_base"]].iloc[0]
+    for ax, col, scale in ((axes[0], "psnr_time", 1.0), (axes[1], "rel_err", 100.0)):
+        ax.plot([base["wall_s"]], [base[col] * scale], "k*", ms=11, label="profile setting")
+        ax.set_xscale("log")
+        ax.set_xlabel("wall time per point (s, log)")
+        ax.grid(alpha=0.3)
+    axes[0].set_ylabel("PSNR, time split (dB)")
+    axes[1].set_ylabel("median rel. error of omega, trusted parts (%)")
+    axes[0].legend(fontsize=7)
+    fig.suptitle(f"Speed-accuracy trade, ours on the {df['tree'].iloc[0]} tree (one knob at a time)")
     fig.tight_layout()
     save_figure(fig, outputs)

@@ -16,14 +16,9 @@ import pandas as pd
 
 from physgs.atomic import atomic_path, write_text
 
-MODELS = ("static", "mlp", "mlp_wind", "d3dgs", "d3dgs_wind", "ours")
-MODEL_NAMES = {
-    "static": "Static pose", "mlp": "Deformation MLP", "mlp_wind": "Deformation MLP + wind",
-    "d3dgs": "Deformable-3DGS", "d3dgs_wind": "Deformable-3DGS + wind", "ours": "Ours",
-}
-CONFIGS = ("single", "joint32", "joint96")
-CONFIG_NAMES = {"single": r"single ($K{=}32$)", "joint32": r"joint ($K{=}32$)", "joint96": r"joint ($K{=}96$)"}
-CONFIG_K = {"single": 32, "joint32": 32, "joint96": 96}
+from physgs.models.registry import MODEL_NAMES as MODELS
+from physgs.models.registry import MODELS as SPECS
+from physgs.models.registry import label
 
 
 @dataclass(frozen=True)
@@ -74,30 +69,31 @@ def _check(keys: Sequence, have: Mapping, what: str) -> None:
 
 # --------------------------------------------------------------------------------------------
 def tab_psnr(summaries: Mapping[tuple[str, str], Mapping[str, float]], trees: Sequence[str],
-             bones: Mapping[str, int], models: Sequence[str] = MODELS) -> Table:
+             bones: Mapping[str, int], models: Sequence[str] = MODELS, digits: int = 2) -> Table:
     """PSNR (dB) on the view and time splits, one row per model, two columns per tree.
 
     summaries[(tree, model)]: ``EvalResult.summary()`` of the model trained ``single``.
-    Best per column in bold.
+    Best per column in bold; digits: decimals shown in the .tex.
     """
+    fmt = f".{int(digits)}f"
     _check([(t, m) for t in trees for m in models], summaries, "tab_psnr")
     rows = []
     for m in models:
-        r = {"model": MODEL_NAMES[m]}
+        r = {"model": label(m)}
         for t in trees:
             r[f"{t}_view"] = summaries[(t, m)]["view"]
             r[f"{t}_time"] = summaries[(t, m)]["time"]
         rows.append(r)
     df = pd.DataFrame(rows)
     num = [c for c in df.columns if c != "model"]
-    bold = {c: _best_mask(df[c].to_numpy(), ".2f") for c in num}
+    bold = {c: _best_mask(df[c].to_numpy(), fmt) for c in num}
     n = len(trees)
     lines = ["  \\begin{tabular}{l" + "cc" * n + "}", "    \\toprule",
              "    & " + " & ".join(rf"\multicolumn{{2}}{{c}}{{{tree_label(t, bones[t])}}}" for t in trees) + r" \\",
              "    " + "".join(rf"\cmidrule(lr){{{2 + 2 * i}-{3 + 2 * i}}}" for i in range(n)),
              "    & " + " & ".join(["view & time"] * n) + r" \\", "    \\midrule"]
     for i, r in df.iterrows():
-        cells = [_fmt(r[c], ".2f", bold[c][i]) for c in num]
+        cells = [_fmt(r[c], fmt, bold[c][i]) for c in num]
         lines.append(f"    {r['model']} & " + " & ".join(cells) + r" \\")
     lines += ["    \\bottomrule", "  \\end{tabular}", ""]
     cap = (r"PSNR (dB). \emph{view}: held-out azimuths at the training wind inside the training "
@@ -108,10 +104,12 @@ def tab_psnr(summaries: Mapping[tuple[str, str], Mapping[str, float]], trees: Se
 
 # --------------------------------------------------------------------------------------------
 def tab_null(recovery: Mapping[tuple[str, str], object], null: Mapping[tuple[str, str], object],
-             trees: Sequence[str], bones: Mapping[str, int], configs: Sequence[str] = CONFIGS) -> Table:
+             trees: Sequence[str], bones: Mapping[str, int], configs: Mapping[str, str],
+             digits: int = 2) -> Table:
     """Frequency recovery of the trained model against the untrained null, per tree and config.
 
-    recovery[(tree, config)]: ``RecoveryRecord``; null[(tree, config)]: ``NullResult`` (same K).
+    recovery[(tree, config)]: ``RecoveryRecord``; null[(tree, config)]: ``NullResult`` (same K);
+    configs: configuration name -> its LaTeX label (``registry.config_label``), in row order.
     Columns: parts trusted, median relative error (%), log-log R^2 for trained and null (null
     entries are medians over draws), and the median nearest-bone gap (%). Bold: the lower median
     relative error of each trained/null pair.
@@ -143,14 +141,15 @@ def tab_null(recovery: Mapping[tuple[str, str], object], null: Mapping[tuple[str
         sub = df[df.tree == t]
         for j, (_, r) in enumerate(sub.iterrows()):
             pair = np.array([r.trained_median_rel_err_pct, r.null_median_rel_err_pct])
-            b = _best_mask(pair, ".2f", higher=False)
+            b = _best_mask(pair, f".{digits}f", higher=False)
             head = (rf"\multirow{{{len(sub)}}}{{*}}{{{tree_label(t, r.bones)}}}" if j == 0 else "")
             parts_n = _fmt(r.null_parts_trusted, "g")
-            cells = [head, CONFIG_NAMES.get(r.config, r.config),
+            cells = [head, configs[r.config],
                      f"{_fmt(r.trained_parts_trusted, 'g')}/{r.K}",
-                     _pct(r.trained_median_rel_err_pct, b[0]), _fmt(r.trained_loglog_r2, ".3f"),
-                     f"{parts_n}/{r.K}", _pct(r.null_median_rel_err_pct, b[1]),
-                     _fmt(r.null_loglog_r2, ".3f"), _pct(r.nearest_bone_gap_pct, False)]
+                     _pct(r.trained_median_rel_err_pct, b[0], digits),
+                     _fmt(r.trained_loglog_r2, ".3f"), f"{parts_n}/{r.K}",
+                     _pct(r.null_median_rel_err_pct, b[1], digits),
+                     _fmt(r.null_loglog_r2, ".3f"), _pct(r.nearest_bone_gap_pct, False, digits)]
             lines.append("    " + " & ".join(cells) + r" \\")
         if i < len(trees) - 1:
             lines.append("    \\midrule")
@@ -162,18 +161,18 @@ def tab_null(recovery: Mapping[tuple[str, str], object], null: Mapping[tuple[str
     return Table("tab_null", df, _wrap("\n".join(lines), cap, "tab:null"))
 
 
-def _pct(x: float, bold: bool) -> str:
+def _pct(x: float, bold: bool, digits: int = 2) -> str:
     """Percentage cell: '1.80\\%' (bold: '\\textbf{1.80\\%}'), '--' when undefined."""
     if not np.isfinite(x):
         return "--"
-    s = f"{x:.2f}\\%"
+    s = f"{x:.{int(digits)}f}\\%"
     return rf"\textbf{{{s}}}" if bold else s
 
 
 # --------------------------------------------------------------------------------------------
 def tab_transfer(summaries: Mapping[tuple[str, str], Mapping[str, float]], trees: Sequence[str],
                  bones: Mapping[str, int], conditions: Sequence[float],
-                 models: Sequence[str] = MODELS) -> Table:
+                 models: Sequence[str] = MODELS, digits: int = 2) -> Table:
     """Zero-shot transfer PSNR (dB) on the unseen conditions (index >= 1), all models ``single``.
 
     Rows: split (training timestamps / beyond the window) x tree x unseen condition; columns:
@@ -190,22 +189,21 @@ def tab_transfer(summaries: Mapping[tuple[str, str], Mapping[str, float]], trees
                 rows.append(r)
     df = pd.DataFrame(rows)
     names = {"train": r"\shortstack[l]{Training\\timestamps}", "beyond": r"\shortstack[l]{Beyond the\\training window}"}
-    head = {"static": "Static", "mlp": "no wind", "mlp_wind": r"+\,wind", "d3dgs": "no wind",
-            "d3dgs_wind": r"+\,wind", "ours": "Ours"}
+    fmt = f".{int(digits)}f"
     lines = ["  \\begin{tabular}{ll" + "c" * len(models) + "}", "    \\toprule"]
     if tuple(models) == MODELS:
         lines += [r"    & & & \multicolumn{2}{c}{Deformation MLP} & \multicolumn{2}{c}{Deformable-3DGS} & \\",
                   r"    \cmidrule(lr){4-5}\cmidrule(lr){6-7}"]
-    lines += ["    Split & Tree / unseen wind & " + " & ".join(head.get(m, m) for m in models) + r" \\",
+    lines += ["    Split & Tree / unseen wind & " + " & ".join(SPECS[m].short for m in models) + r" \\",
               "    \\midrule"]
     for s_i, split in enumerate(("train", "beyond")):
         sub = df[df.split == split]
         for j, (_, r) in enumerate(sub.iterrows()):
             vals = r[list(models)].to_numpy(dtype=float)
-            b = _best_mask(vals, ".2f")
+            b = _best_mask(vals, fmt)
             lab = rf"\multirow{{{len(sub)}}}{{*}}{{{names[split]}}}" if j == 0 else ""
             lines.append(f"    {lab} & {tree_label(r.tree, r.bones)}, {condition_label(r.condition)} & "
-                         + " & ".join(_fmt(v, ".2f", bb) for v, bb in zip(vals, b)) + r" \\")
+                         + " & ".join(_fmt(v, fmt, bb) for v, bb in zip(vals, b)) + r" \\")
         if s_i == 0:
             lines.append("    \\midrule")
     lines += ["    \\bottomrule", "  \\end{tabular}", ""]
@@ -217,7 +215,7 @@ def tab_transfer(summaries: Mapping[tuple[str, str], Mapping[str, float]], trees
 # --------------------------------------------------------------------------------------------
 def tab_margin(summaries: Mapping[tuple[str, str], Mapping[str, float]], trees: Sequence[str],
                bones: Mapping[str, int], conditions: Sequence[float],
-               ours: str = "ours", baseline: str = "mlp_wind") -> Table:
+               ours: str = "ours", baseline: str = "mlp_wind", digits: int = 2) -> Table:
     """Ours minus Deformation MLP + wind, PSNR (dB) at training timestamps, per tree and condition
     (including the training condition). Positive: ours ahead. No bold (as in the paper)."""
     _check([(t, m) for t in trees for m in (ours, baseline)], summaries, "tab_margin")
@@ -235,7 +233,7 @@ def tab_margin(summaries: Mapping[tuple[str, str], Mapping[str, float]], trees: 
              "    \\midrule"]
     for _, r in df.iterrows():
         lines.append(f"    {tree_label(r.tree, r.bones)} & "
-                     + " & ".join("--" if not np.isfinite(r[c]) else f"${r[c]:+.2f}$" for c in cols) + r" \\")
+                     + " & ".join("--" if not np.isfinite(r[c]) else f"${r[c]:+.{int(digits)}f}$" for c in cols) + r" \\")
     lines += ["    \\bottomrule", "  \\end{tabular}", ""]
     cap = (r"Margin against the wind-conditioned baseline: ours minus Deformation MLP\,$+$\,wind, "
            r"PSNR (dB) at training timestamps, on the training condition and the two unseen ones. "
@@ -244,8 +242,16 @@ def tab_margin(summaries: Mapping[tuple[str, str], Mapping[str, float]], trees: 
 
 
 # --------------------------------------------------------------------------------------------
-def write_table(table: Table, tex_path: str | Path, csv_path: str | Path) -> None:
-    """Write the table's .tex and .csv, each atomically (temp file then rename)."""
-    write_text(tex_path, table.tex)
+def write_table(table: Table, tex_path: str | Path, csv_path: str | Path, stamp=None) -> None:
+    """Write the table's .tex and .csv, each atomically (temp file then rename).
+
+    stamp: a ``physgs.provenance.Stamp``; its fields become the CSV's last columns (one value
+    per row) and a comment line of the .tex.
+    """
+    df, tex = table.df, table.tex
+    if stamp is not None:
+        df = df.assign(**stamp.to_dict())
+        tex = "% " + ", ".join(f"{k}={v}" for k, v in stamp.to_dict().items()) + "\n" + tex
+    write_text(tex_path, tex)
     with atomic_path(csv_path) as tmp:
-        table.df.to_csv(tmp, index=False, float_format="%.6g")
+        df.to_csv(tmp, index=False, float_format="%.6g")

@@ -17,10 +17,10 @@ from typing import Sequence
 
 import numpy as np
 import pandas as pd
-import torch
 
-from physgs.evaluate.adapter import model_render_fn
-from physgs.evaluate.metrics import psnr
+from physgs.evaluate.run import training_camera_scores
+from physgs.experiments.recipe import canonical, fit, job_spec
+from physgs.models.registry import BASE_CONFIG
 
 KNOBS = ("resolution", "iterations", "substeps", "K", "vertices")
 TESTBED_KNOBS = ("resolution", "vertices")
@@ -34,7 +34,7 @@ def knob_value(cfg: dict, tree: str, knob: str) -> int:
         "vertices": lambda: cfg["testbed"]["vertices"][tree],
         "iterations": lambda: cfg["train"]["iterations"],
         "substeps": lambda: cfg["models"]["ours"]["substeps"],
-        "K": lambda: cfg["models"]["configs"]["single"]["K"],
+        "K": lambda: cfg["models"]["configs"][BASE_CONFIG]["K"],
     }[knob]()
 
 
@@ -55,7 +55,7 @@ def with_knob(cfg: dict, tree: str, knob: str, value: int) -> dict:
     elif knob == "substeps":
         out["models"]["ours"]["substeps"] = value
     else:
-        out["models"]["configs"]["single"]["K"] = value
+        out["models"]["configs"][BASE_CONFIG]["K"] = value
     return out
 
 
@@ -84,54 +84,58 @@ def parse_point(name: str) -> tuple[str | None, int | None]:
     return knob, int(value)
 
 
-def time_split_psnr(model, observed, backend: str = "auto") -> float:
-    """Mean PSNR (dB) over the tail frames at the training camera and wind."""
-    render = model_render_fn(model, observed, backend=backend)
-    j0 = int(observed.n_train)
-    scores = [psnr(render(j, 0, observed.train_camera)[0], observed.frames[0, j])
-              for j in range(j0, j0 + int(observed.n_tail))]
-    return float(np.mean(scores))
-
-
-def run_point(cfg: dict, name: str, observed_path, truth_path, *, progress: bool = False) -> dict:
-    """Train and score one sweep point; returns a flat record (seconds, dB, fractions).
-
-    cfg: resolved config (reads ``speed_accuracy.tree``); observed_path/truth_path: the tree's
-    pipeline dataset, reused unless the knob changes the testbed.
-    """
-    from physgs.models.registry import build_model
-    from physgs.recovery.run import recover_model
-    from physgs.testbed.dataset import build_dataset, load_observed, load_truth, save_dataset
-    from physgs.train.loop import train_model
-
+def point_settings(cfg: dict, name: str) -> dict:
+    """What sweep point ``name`` reads, as a sorted plain dict (the workflow's params): its knob
+    values, ours' training job at those values (``recipe.job_spec``, the tables' recipe) and,
+    for a knob that changes the testbed, the testbed settings to rebuild it with."""
     tree = cfg["speed_accuracy"]["tree"]
     knob, value = parse_point(name)
     pcfg = cfg if knob is None else with_knob(cfg, tree, knob, value)
-    rec = {"point": name, "knob": knob or BASE, "tree": tree,
-           **{k: int(knob_value(pcfg, tree, k)) for k in KNOBS}}
+    out = {"point": name, "knob": knob or BASE, "tree": tree,
+           "values": {k: int(knob_value(pcfg, tree, k)) for k in KNOBS},
+           "job": job_spec(pcfg, "ours", BASE_CONFIG)}
+    if knob in TESTBED_KNOBS:
+        out["testbed"] = {"testbed": pcfg["testbed"], "preset": pcfg["presets"][tree],
+                          "seed": int(pcfg["seed"])}
+    return canonical(out)
+
+
+def run_point(point: dict, observed_path, truth_path, *, progress: bool = False) -> dict:
+    """Train and score one sweep point; returns a flat record (seconds, dB, fractions).
+
+    point: ``point_settings``; observed_path/truth_path: the tree's pipeline dataset, reused
+    unless the knob changes the testbed. Ours is trained by ``recipe.fit``, freezing included,
+    so each point is the model the tables report at those settings.
+    """
+    from physgs.recovery.run import recover_model
+    from physgs.testbed.dataset import build_dataset, load_observed, load_truth, save_dataset
+
+    name, tree = point["point"], point["tree"]
+    rec = {"point": name, "knob": point["knob"], "tree": tree, **point["values"]}
     with tempfile.TemporaryDirectory(prefix="physgs-sweep-") as tmp:
         t0 = time.perf_counter()
-        if knob in TESTBED_KNOBS:
-            obs, tru = build_dataset(pcfg["testbed"], pcfg["presets"][tree], seed=int(pcfg["seed"]),
-                                     tree=tree, progress=progress)
+        if "testbed" in point:
+            tb = point["testbed"]
+            obs, tru = build_dataset(tb["testbed"], tb["preset"], seed=int(tb["seed"]), tree=tree,
+                                     progress=progress)
             observed_path, truth_path = Path(tmp) / "observed.npz", Path(tmp) / "truth.npz"
             save_dataset(obs, tru, observed_path, truth_path)
-        rec["testbed_s"] = time.perf_counter() - t0 if knob in TESTBED_KNOBS else 0.0
+        rec["testbed_s"] = time.perf_counter() - t0 if "testbed" in point else 0.0
         observed, truth = load_observed(observed_path), load_truth(truth_path)
-        seed = int(pcfg["seed"])
         t0 = time.perf_counter()
-        model = build_model("ours", observed, pcfg["models"], config="single", seed=seed)
-        res = train_model(model, observed, pcfg["train"], conditions=[0], seed=seed,
-                          name=f"ours_single[{name}]", progress=progress)
+        res = fit(observed, point["job"], progress=progress, name=f"ours_single[{name}]")
         rec["train_s"] = time.perf_counter() - t0
         t0 = time.perf_counter()
-        with torch.no_grad():
-            rec["psnr_time"] = time_split_psnr(res.model, observed, pcfg["train"]["backend"])
+        tail = np.arange(observed.n_train, observed.n_train + observed.n_tail)
+        _, p_time = training_camera_scores(res.model, observed, tail,
+                                           backend=point["job"]["train"]["backend"])
+        rec["psnr_time"] = float(np.mean(p_time))
         r = recover_model(res.model, observed, truth)
         rec["eval_s"] = time.perf_counter() - t0
     rec["rel_err"] = float(r.match.median_rel_err)
     rec["trusted"] = int(r.match.n_trusted)
     rec["parts"] = int(r.match.n_parts)
+    rec["frozen"] = int(res.stats.get("frozen_parts", 0))
     rec["wall_s"] = rec["testbed_s"] + rec["train_s"] + rec["eval_s"]
     return rec
 
@@ -147,37 +151,5 @@ def collect(records: Sequence[dict]) -> pd.DataFrame:
             rows.append({**r, "knob": knob, "value": r[knob], "is_base": r["point"] == BASE})
     df = pd.DataFrame(rows).sort_values(["knob", "value"], kind="stable").reset_index(drop=True)
     cols = ["knob", "value", "is_base", "wall_s", "train_s", "testbed_s", "eval_s", "psnr_time",
-            "rel_err", "trusted", "parts", "tree", *KNOBS]
+            "rel_err", "trusted", "parts", "frozen", "tree", *KNOBS]
     return df[cols]
-
-
-def fig_speed_accuracy(df: pd.DataFrame, outputs: Sequence[str | Path]) -> None:
-    """Two panels against wall time (s): PSNR on the time split (dB) and recovery error (%).
-
-    One line per knob through its values (labelled), the base point starred.
-    """
-    import matplotlib.pyplot as plt
-
-    from physgs.report.figures import save_figure
-
-    fig, axes = plt.subplots(1, 2, figsize=(10, 4))
-    colors = dict(zip(KNOBS, ["tab:blue", "tab:orange", "tab:green", "tab:red", "tab:purple"]))
-    for knob, g in df.groupby("knob", sort=False):
-        g = g.sort_values("value")
-        for ax, col, scale in ((axes[0], "psnr_time", 1.0), (axes[1], "rel_err", 100.0)):
-            ax.plot(g["wall_s"], g[col] * scale, "-o", ms=3.5, color=colors[knob], label=knob)
-            for _, r in g.iterrows():
-                ax.annotate(str(int(r["value"])), (r["wall_s"], r[col] * scale), fontsize=6,
-                            xytext=(3, 3), textcoords="offset points", color=colors[knob])
-    base = df[df["is_base"]].iloc[0]
-    for ax, col, scale in ((axes[0], "psnr_time", 1.0), (axes[1], "rel_err", 100.0)):
-        ax.plot([base["wall_s"]], [base[col] * scale], "k*", ms=11, label="profile setting")
-        ax.set_xscale("log")
-        ax.set_xlabel("wall time per point (s, log)")
-        ax.grid(alpha=0.3)
-    axes[0].set_ylabel("PSNR, time split (dB)")
-    axes[1].set_ylabel("median rel. error of omega, trusted parts (%)")
-    axes[0].legend(fontsize=7)
-    fig.suptitle(f"Speed-accuracy trade, ours on the {df['tree'].iloc[0]} tree (one knob at a time)")
-    fig.tight_layout()
-    save_figure(fig, outputs)

@@ -4,9 +4,10 @@ Config ``models.kselect``: candidates (K values), method (``heldout`` or ``bic``
 out every k-th training frame), iterations and warmup (a short training run per candidate),
 tie_db (dB), conditions (which wind conditions the chosen model then trains on).
 
-Both criteria come from the same runs: ours is trained per candidate on the training frames
-minus every k-th (frames k-1, 2k-1, ...), with the same loop, schedule and freezing as the
-full run, only shorter.
+Both criteria come from the same runs: ours is trained per candidate by the one recipe
+(``physgs.experiments.recipe.fit``: seeding, loop, schedule and freezing as the full run, only
+shorter) on the training frames minus every k-th (frames k-1, 2k-1, ...), and scored through
+the evaluation's render callback.
 - ``heldout``: mean PSNR (dB) over the held-out frames at the training camera and wind; the
   smallest K within ``tie_db`` of the best wins (ties go to the smaller model).
 - ``bic``: n log(MSE) + p log n over the training frames scored (n = pixel values, MSE on
@@ -17,19 +18,16 @@ Both choices are recorded whichever ``method`` picks the K used.
 """
 from __future__ import annotations
 
-import copy
 import json
 import time
 from dataclasses import asdict, dataclass
 
 import numpy as np
-import torch
 
 from physgs.atomic import write_json
-from physgs.evaluate.metrics import psnr
-from physgs.models.registry import AUTO_CONFIG, build_model
-from physgs.models.visibility import freeze_callback
-from physgs.render import rasterization
+from physgs.evaluate.run import training_camera_scores
+from physgs.experiments.recipe import Job, fit
+from physgs.models.registry import AUTO_CONFIG
 
 METHODS = ("heldout", "bic")
 PARAMS_PER_PART = 8  # omega, zeta, gain, swing axis (2), pivot (3)
@@ -124,53 +122,32 @@ def _check_cfg(ks: dict, n_gaussians: int) -> list[int]:
     return cands
 
 
-def _mean_mse_psnr(model, observed, frames, backend) -> tuple[float, float]:
-    """(MSE, mean per-frame PSNR dB) of the model at the training camera and wind over frames."""
-    wind = torch.as_tensor(np.asarray(observed.wind[0]), dtype=torch.float32)
-    bg = torch.as_tensor(np.asarray(observed.background), dtype=torch.float32)
-    preds = []
-    with torch.no_grad():
-        for j in frames:
-            g = model.gaussians_at(int(j), wind)
-            out = rasterization(g.means, g.quats, g.scales, g.opacities, g.colors,
-                                observed.train_camera, bg, backend=backend, return_depth=False)
-            preds.append(out.rgb.clamp(0, 1).numpy().astype(np.float64))
-    pred = np.stack(preds)  # [M, H, W, 3]
-    gt = np.asarray(observed.frames[0])[np.asarray(frames)].astype(np.float64) / 255.0
-    return float(np.mean((pred - gt) ** 2)), float(np.mean(psnr(pred, gt)))
-
-
-def select_k(observed, cfg: dict, *, progress: bool = False) -> KSelection:
+def select_k(observed, job: Job | dict, kselect: dict, *, progress: bool = False) -> KSelection:
     """Train ours once per candidate K on the non-held-out frames and score both criteria.
 
-    observed: ``Observed``; cfg: the resolved config (``seed``, ``models`` incl. ``kselect``,
-    ``train``). Deterministic for the config's seed.
+    observed: ``Observed``; job: ours' training job (``recipe.job_spec``: settings, train,
+    seed; its K and configuration are replaced per candidate); kselect: the
+    ``models.kselect`` section. Each candidate is trained by ``recipe.fit`` (freezing
+    included) with the section's shorter schedule. Deterministic for the job's seed.
     """
-    from physgs.train.loop import train_model  # the one training loop (train imports models)
-
-    ks = cfg["models"]["kselect"]
+    job = Job.from_dict(job) if isinstance(job, dict) else job
+    ks = kselect
     cands = _check_cfg(ks, int(np.asarray(observed.canonical_xyz).shape[0]))
     train_idx, held = heldout_split(int(observed.n_train), int(ks["every"]))
-    tcfg = dict(cfg["train"], iterations=int(ks["iterations"]), warmup=int(ks["warmup"]))
+    tcfg = dict(job.train, iterations=int(ks["iterations"]), warmup=int(ks["warmup"]))
     scored_train = train_idx[:: max(1, train_idx.size // held.size)][: held.size]
-    seed = int(cfg["seed"])
+    backend = tcfg.get("backend", "auto")
     rows = {k: [] for k in ("heldout_psnr", "train_mse", "bic", "frozen", "wall_s")}
-    n_pix = 0
+    n_pix = int(scored_train.size * np.prod(np.asarray(observed.frames).shape[2:]))
     for K in cands:
-        mcfg = copy.deepcopy(cfg["models"])
-        mcfg["configs"][AUTO_CONFIG] = {"conditions": "train", "K": K}
         t0 = time.perf_counter()
-        model = build_model("ours", observed, mcfg, config=AUTO_CONFIG, seed=seed)
-        res = train_model(model, observed, tcfg, conditions=[0], seed=seed, name=f"ours_K{K}",
-                          progress=progress, frame_pool=train_idx,
-                          on_iteration=freeze_callback(observed, mcfg, tcfg))
-        backend = tcfg.get("backend", "auto")
-        _, p_held = _mean_mse_psnr(res.model, observed, held, backend)
-        mse_tr, _ = _mean_mse_psnr(res.model, observed, scored_train, backend)
-        n_pix = int(scored_train.size * np.prod(np.asarray(observed.frames).shape[2:]))
-        rows["heldout_psnr"].append(p_held)
-        rows["train_mse"].append(mse_tr)
-        rows["bic"].append(bic(mse_tr, n_pix, K))
+        cand = job.replace(K=int(K), config=AUTO_CONFIG, conditions="train", train=tcfg)
+        res = fit(observed, cand, frame_pool=train_idx, progress=progress, name=f"ours_K{K}")
+        _, p_held = training_camera_scores(res.model, observed, held, backend=backend)
+        mse_tr, _ = training_camera_scores(res.model, observed, scored_train, backend=backend)
+        rows["heldout_psnr"].append(float(np.mean(p_held)))
+        rows["train_mse"].append(float(np.mean(mse_tr)))
+        rows["bic"].append(bic(float(np.mean(mse_tr)), n_pix, K))
         rows["frozen"].append(int(res.model.frozen.sum()))
         rows["wall_s"].append(time.perf_counter() - t0)
     k_h = choose_heldout(cands, rows["heldout_psnr"], float(ks["tie_db"]))
@@ -180,10 +157,7 @@ def select_k(observed, cfg: dict, *, progress: bool = False) -> KSelection:
                       chosen_k=k_h if ks["method"] == "heldout" else k_b, **rows)
 
 
-def auto_config(cfg: dict, sel: KSelection) -> dict:
-    """A copy of the resolved config whose models.configs.auto holds the chosen K (what
-    ``run_training(..., model='ours', config='auto')`` and the checkpoint then carry)."""
-    out = copy.deepcopy(cfg)
-    out["models"]["configs"][AUTO_CONFIG] = {"conditions": cfg["models"]["kselect"]["conditions"],
-                                             "K": int(sel.chosen_k)}
-    return out
+def auto_job(job: Job | dict, sel: KSelection, conditions: str) -> dict:
+    """Ours' training job with the chosen K (configuration 'auto'), as ``recipe.job_spec``."""
+    job = Job.from_dict(job) if isinstance(job, dict) else job
+    return job.replace(K=int(sel.chosen_k), config=AUTO_CONFIG, conditions=conditions).to_dict()

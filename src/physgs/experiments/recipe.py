@@ -1,0 +1,109 @@
+"""The one training recipe: what a job needs to know, and fit = seed, build, train (freezing
+included), in that order, for every model and every caller."""
+from __future__ import annotations
+
+from dataclasses import asdict, dataclass, field
+
+from physgs.models.registry import MODELS, build_model, configs_for, model_settings, save_checkpoint
+from physgs.models.visibility import freeze_callback
+from physgs.train.loop import TrainResult, condition_indices, train_model, write_loss_log
+from physgs.train.seeding import seed_everything
+
+
+def canonical(x):
+    """``x`` with every dict's keys sorted (recursively): a stable repr, so Snakemake's params
+    check sees a job as changed only when a value changes, never when keys are reordered."""
+    if isinstance(x, dict):
+        return {k: canonical(x[k]) for k in sorted(x)}
+    if isinstance(x, (list, tuple)):
+        return [canonical(v) for v in x]
+    return x
+
+
+@dataclass(frozen=True)
+class Job:
+    """Everything one training job reads, and nothing more.
+
+    model: a registry id; config: configuration name (labels the run); K: ours' parts (None for
+    the rest); conditions: 'train' or 'all'; seed: every random source of the job (model
+    initialisation, k-means, frame draws); settings: ``model_settings`` of the models section;
+    train: the ``train`` section.
+    """
+
+    model: str
+    config: str
+    conditions: str
+    seed: int
+    settings: dict = field(repr=False)
+    train: dict = field(repr=False)
+    K: int | None = None
+
+    @property
+    def name(self) -> str:
+        return f"{self.model}_{self.config}"
+
+    def to_dict(self) -> dict:
+        return canonical(asdict(self))
+
+    @staticmethod
+    def from_dict(d: dict) -> "Job":
+        return Job(**{k: d[k] for k in Job.__dataclass_fields__})
+
+    def replace(self, **kw) -> "Job":
+        return Job.from_dict({**asdict(self), **kw})
+
+
+def job_spec(cfg: dict, model: str, config: str, seed: int | None = None) -> dict:
+    """The narrow settings of one (model, configuration) training job, as a sorted plain dict.
+
+    cfg: the resolved config. What the workflow passes as the train rule's params: editing a
+    key outside it (another model's architecture, a table's format, the sweep) leaves the job
+    up to date.
+    """
+    configs = cfg["models"]["configs"]
+    if config not in configs_for(model, configs):
+        raise ValueError(f"model {model!r} is not trained in configuration {config!r}; valid: "
+                         f"{configs_for(model, configs)} (joint configurations are ours only)")
+    spec = configs[config]
+    return Job(model=model, config=config, conditions=spec["conditions"],
+               seed=int(cfg["seed"] if seed is None else seed),
+               settings=model_settings(cfg["models"], model), train=cfg["train"],
+               K=int(spec["K"]) if model == "ours" else None).to_dict()
+
+
+def fit(observed, job: Job | dict, *, frame_pool=None, progress: bool = True,
+        name: str | None = None) -> TrainResult:
+    """Seed, build and train one model on ``observed`` (a testbed ``Observed``).
+
+    Every random source is seeded from ``job.seed`` before the model is built, so the same job
+    gives bitwise-equal weights in any process. Ours freezes parts whose swing stays under
+    ``models.ours.freeze_below_px`` pixels (``freeze_at``); frame_pool restricts the training
+    frames (K selection holds some out). Returns the TrainResult (model in eval mode).
+    """
+    job = Job.from_dict(job) if isinstance(job, dict) else job
+    if job.model not in MODELS:
+        raise ValueError(f"unknown model {job.model!r}")
+    seed_everything(job.seed)
+    model = build_model(job.model, observed, job.settings, config=job.config, K=job.K,
+                        seed=job.seed)
+    conds = condition_indices(job.conditions, len(observed.conditions))
+    hook = freeze_callback(observed, job.settings, job.train) if job.model == "ours" else None
+    result = train_model(model, observed, job.train, conditions=conds, seed=job.seed,
+                         name=name or job.name, progress=progress, frame_pool=frame_pool,
+                         on_iteration=hook)
+    if job.model == "ours":
+        result.stats["frozen_parts"] = int(result.model.frozen.sum())
+    return result
+
+
+def train_and_save(observed, job: Job | dict, *, checkpoint_path, loss_path,
+                   progress: bool = True) -> TrainResult:
+    """``fit``, then write the loss log and the checkpoint (each atomically, the checkpoint
+    last). Nothing is written if training fails."""
+    job = Job.from_dict(job) if isinstance(job, dict) else job
+    result = fit(observed, job, progress=progress)
+    write_loss_log(loss_path, result.log)
+    save_checkpoint(checkpoint_path, result.model, name=job.model, config=job.config,
+                    seed=job.seed, models_cfg=job.settings, train_cfg=job.train,
+                    stats=result.stats)
+    return result

@@ -1,0 +1,34 @@
+"""The prologue every workflow script shares: thread counts from the rule, output to the job's
+log, and any traceback into that log before the job fails."""
+from __future__ import annotations
+
+import contextlib
+import os
+import sys
+import traceback
+
+
+@contextlib.contextmanager
+def job(sm):
+    """Run a Snakemake script's body: ``with job(snakemake) as log: ...``.
+
+    Sets torch's and numba's thread counts to the rule's ``threads``, sends stdout and stderr
+    (progress bars included) to ``sm.log[0]``, and writes the traceback of a failure there too
+    (not only to the console) before re-raising it.
+    """
+    threads = max(1, int(getattr(sm, "threads", 1)))
+    os.environ.setdefault("OMP_WAIT_POLICY", "PASSIVE")  # spin-waiting starves the other job
+    import numba
+    import torch
+
+    torch.set_num_threads(threads)
+    numba.set_num_threads(min(threads, numba.config.NUMBA_NUM_THREADS))
+    with open(sm.log[0], "w") as log, contextlib.redirect_stderr(log), \
+            contextlib.redirect_stdout(log):
+        try:
+            yield log
+        except BaseException:
+            traceback.print_exc(file=log)
+            log.flush()
+            print(f"job failed; see {sm.log[0]}", file=sys.__stderr__)
+            raise
