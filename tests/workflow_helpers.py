@@ -11,9 +11,12 @@ ROOT = Path(__file__).resolve().parents[1]
 
 
 def workflow_copy(dest: Path) -> Path:
-    """Copy Snakefile, workflow/ and config/ into ``dest`` (results land there, not in the repo)."""
+    """Copy Snakefile, workflow/, config/ and the profiles link into ``dest`` (results land
+    there, not in the repo)."""
     dest.mkdir(parents=True, exist_ok=True)
     shutil.copy(ROOT / "Snakefile", dest / "Snakefile")
+    if not (dest / "profiles").exists():  # where Snakemake looks for profiles/default
+        (dest / "profiles").symlink_to(os.readlink(ROOT / "profiles"))
     for d in ("workflow", "config"):
         shutil.copytree(ROOT / d, dest / d, dirs_exist_ok=True,
                         ignore=shutil.ignore_patterns("__pycache__"))

@@ -1,0 +1,88 @@
+"""Targeted reruns: on a finished quick DAG, a config edit plans only the jobs that read the
+edited key (each rule's params are its narrow settings), and profiles name only real rules."""
+from __future__ import annotations
+
+import re
+from pathlib import Path
+
+import pytest
+import yaml
+
+import physgs.config
+from physgs.experiments import job_spec
+from workflow_helpers import ROOT, snakemake
+
+pytestmark = pytest.mark.slow
+QUICK = ["--config", "profile=quick", 'trees=["sparse"]']  # as the quick_dag fixture ran
+
+
+def _dry_run(wd: Path, override: dict) -> str:
+    """The dry-run plan of `all` with ``override`` merged into the config."""
+    f = wd / "override.yaml"
+    f.write_text(yaml.safe_dump(override))
+    try:
+        return snakemake(wd, "-n", "--cores", "2", "all", "--configfile", "config/trees.yaml",
+                         str(f), *QUICK).stdout
+    finally:
+        f.unlink()
+
+
+def _plan(wd: Path, override: dict) -> dict[str, int]:
+    """Job counts per rule of the plan ({} when nothing is to be done)."""
+    out = _dry_run(wd, override)
+    if "Nothing to be done" in out:
+        return {}
+    table = out.split("Job stats:", 1)[1].split("total", 1)[0]
+    return {r: int(n) for r, n in re.findall(r"(?m)^(\w+)\s+(\d+)\s*$", table)}
+
+
+def _trained(wd: Path, override: dict) -> set[str]:
+    """The checkpoints the plan (re)trains, as '<model>_<config>'."""
+    return set(re.findall(r"results/models/\w+/(\w+?)\.pt", _dry_run(wd, override)))
+
+
+def test_an_unchanged_config_plans_nothing(quick_dag):
+    assert _plan(quick_dag, {}) == {}
+
+
+def test_sweep_knobs_plan_no_training(quick_dag):
+    plan = _plan(quick_dag, {"profiles": {"quick": {"speed_accuracy": {"knobs": {"K": [8, 16]}}}}})
+    assert plan == {"speed_accuracy_point": 1, "speed_accuracy": 1, "all": 1}, plan
+
+
+def test_mlp_width_retrains_the_mlp_models_only(quick_dag):
+    trained = _trained(quick_dag, {"models": {"mlp": {"width": 96}}})
+    assert trained == {"mlp_single", "mlp_wind_single"}, trained
+
+
+def test_table_format_rebuilds_that_table_only(quick_dag):
+    plan = _plan(quick_dag, {"report": {"tab_psnr": {"digits": 3}}})
+    assert plan == {"table": 1, "all": 1}, plan
+
+
+def test_job_params_ignore_key_order():
+    cfg = physgs.config.load(ROOT / "config" / "trees.yaml", "default")
+    rev = {k: cfg[k] for k in reversed(list(cfg))}
+    rev["models"] = {k: cfg["models"][k] for k in reversed(list(cfg["models"]))}
+    rev["train"] = {k: cfg["train"][k] for k in reversed(list(cfg["train"]))}
+    for model in ("ours", "mlp_wind"):
+        assert repr(job_spec(rev, model, "single")) == repr(job_spec(cfg, model, "single"))
+
+
+def test_every_rule_a_profile_names_exists(tmp_path):
+    rules = set(snakemake(ROOT, "--list-rules", "--config", "profile=quick").stdout.split())
+    for prof in sorted((ROOT / "workflow" / "profiles").glob("*/config.yaml")):
+        spec = yaml.safe_load(prof.read_text()) or {}
+        named = set(spec.get("set-threads", {})) | set(spec.get("set-resources", {}))
+        assert named <= rules, f"{prof}: no rule named {sorted(named - rules)}"
+
+
+def test_a_bare_snakemake_call_uses_the_default_profile(tmp_path):
+    """`snakemake <target>` with no --cores works: profiles/default (-> workflow/profiles) sets
+    them, as the README says."""
+    from workflow_helpers import workflow_copy
+
+    wd = workflow_copy(tmp_path)
+    out = snakemake(wd, "-n", "results/tables/tab_null.tex", "--config", "profile=quick")
+    text = out.stdout + out.stderr
+    assert "Using workflow specific profile" in text and "profiles/default" in text, text[-2000:]
