@@ -12,12 +12,33 @@ from typing import Iterator
 import numpy as np
 
 
+def current_umask() -> int:
+    """The process's file-mode creation mask.
+
+    Read from /proc/self/status ("Umask:", Linux 4.7+) where available; otherwise by setting it
+    and restoring it at once (``os.umask`` has no read-only form). That fallback is
+    process-global: a thread creating a file between the two calls would get mode 0666 & ~0o077;
+    acceptable here (the pipeline writes from one thread), and it never runs on Linux.
+    """
+    try:
+        with open("/proc/self/status") as f:
+            for line in f:
+                if line.startswith("Umask:"):
+                    return int(line.split()[1], 8)
+    except (OSError, ValueError, IndexError):
+        pass
+    old = os.umask(0o077)
+    os.umask(old)
+    return old
+
+
 @contextmanager
 def atomic_path(path: str | os.PathLike) -> Iterator[Path]:
     """Yield a temporary path beside ``path``; on success rename it onto ``path``.
 
     The temporary name keeps the final suffix, so writers that pick a format from the
-    extension (matplotlib, numpy) behave as for the real name. On error it is removed.
+    extension (matplotlib, numpy) behave as for the real name. On error it is removed. The
+    output gets the mode of an ordinary new file: 0666 less the process's umask.
     """
     path = Path(path)
     path.parent.mkdir(parents=True, exist_ok=True)
@@ -25,6 +46,10 @@ def atomic_path(path: str | os.PathLike) -> Iterator[Path]:
     os.close(fd)
     tmp = Path(tmp)
     try:
+        # mkstemp creates the file 0600; give it the mode an ordinary open() would (0666 less
+        # the umask), so collaborators in the group can read the output. Writers reopen the
+        # path, which keeps the mode, and the rename keeps it too.
+        os.chmod(tmp, 0o666 & ~current_umask())
         yield tmp
         os.replace(tmp, path)
     finally:

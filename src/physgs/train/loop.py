@@ -13,6 +13,7 @@ from tqdm import tqdm
 from physgs.atomic import atomic_path
 from physgs.models.base import BaseModel
 from physgs.render import rasterization
+from physgs.train.divergence import SUSPECT_GROWN, Divergence, DivergenceGuard
 from physgs.train.losses import photometric_loss
 from physgs.train.schedule import lr_factor
 
@@ -20,7 +21,12 @@ LOG_FIELDS = ("iteration", "phase", "condition", "frame", "loss", "l1", "dssim",
 
 
 class TrainingError(RuntimeError):
-    """Training cannot go on (e.g. the loss turned NaN or inf); no checkpoint is written."""
+    """Training cannot go on (the loss turned NaN or inf, the fit diverged, or the model's
+    forward pass failed); no checkpoint is written."""
+
+#: Canonical-set field of a GaussianState -> the parameter group (train.lr key) that trains it.
+_STATE_GROUP = {"means": "means", "quats": "quats", "scales": "scales", "opacities": "opacities",
+                "colors": "colors"}
 
 
 @dataclass
@@ -49,8 +55,10 @@ def train_model(model: BaseModel, observed, train_cfg: dict, *, conditions: list
     Each iteration draws (seeded) one condition from ``conditions`` and one recorded frame
     j < n_train, renders the model at the training camera and steps Adam on
     (1 - w) L1 + w D-SSIM. The first ``warmup`` iterations render the canonical Gaussians only
-    (the shared static warm-up). Raises TrainingError naming the model and iteration if the loss
-    turns NaN or inf.
+    (the shared static warm-up). Raises TrainingError naming the model, the iteration and the
+    likely ``train.lr`` setting if the loss turns NaN or inf, if the fit diverges (non-finite or
+    exploding parameters, Gaussians far outside the scene, a loss far above its warm-up level:
+    ``physgs.train.divergence``), or if the model's forward pass raises (chained).
 
     frame_pool: recorded-frame indices (< n_train) to draw from instead of all of them (K
     selection holds some out). on_iteration(it, model, optimizer) -> dict | None is called
@@ -75,6 +83,16 @@ def train_model(model: BaseModel, observed, train_cfg: dict, *, conditions: list
     for g in groups:
         g["base_lr"] = g["lr"]
     opt = torch.optim.Adam(groups, eps=1e-15)
+    lr_cfg = train_cfg["lr"]
+    group_of = {id(p): g["name"] for g in groups for p in g["params"]}
+    named = [(n, p) for n, p in model.named_parameters() if id(p) in group_of]
+    guard = DivergenceGuard.build(model.ctx.canonical_xyz, _abs_maxes(named),
+                                  {n: group_of[id(p)] for n, p in named}, warmup)
+
+    def diverged(it: int, d: Divergence, when: str = "at") -> TrainingError:
+        return TrainingError(f"model '{name}': training diverged {when} iteration {it}: {d.what}; "
+                             f"{_likely(d.groups, lr_cfg)}; no checkpoint written")
+
     winds = torch.as_tensor(np.asarray(observed.wind), dtype=torch.float32)  # [C, L+F]
     bg = torch.as_tensor(np.asarray(observed.background), dtype=torch.float32)
     cam = observed.train_camera
@@ -93,28 +111,48 @@ def train_model(model: BaseModel, observed, train_cfg: dict, *, conditions: list
                 else frame_pool[rng.integers(frame_pool.size)])
         target = torch.from_numpy(np.array(observed.frames[c, j])).float() / 255.0  # [H, W, 3]
         warm = it < warmup
-        s = model.canonical_state() if warm else model.gaussians_at(j, winds[c])
-        bad = [k for k in ("means", "quats", "scales", "opacities", "colors")
-               if not torch.isfinite(getattr(s, k)).all()]
-        if bad:
+        # the groups that shape this iteration's Gaussians, most grown first
+        shaping = (guard.suspects(_STATE_GROUP.values()) if warm
+                   else guard.deformation_suspects())
+        try:
+            s = model.canonical_state() if warm else model.gaussians_at(j, winds[c])
+        except Exception as e:  # e.g. integrate: omega ... got min nan
+            grown = max(guard.growth().values(), default=1.0)
+            note = ("" if grown > SUSPECT_GROWN else f" (no parameter has grown past "
+                    f"{grown:.2g}x its initial scale: if the rate is not the cause, the error "
+                    "itself is)")
             raise TrainingError(
-                f"model '{name}': Gaussian {', '.join(bad)} became NaN or inf at iteration {it}; "
-                "no checkpoint written. Lower the learning rates in config train.lr"
-            )
+                f"model '{name}': its {'canonical state' if warm else 'deformation'} failed at "
+                f"iteration {it} (condition {c}, frame {j}) with {type(e).__name__}: {e}; "
+                f"{_likely(shaping, lr_cfg)}{note}; no checkpoint written"
+            ) from e
+        bad = [k for k in _STATE_GROUP if not _finite(getattr(s, k))]
+        if bad:
+            raise diverged(it, Divergence(
+                f"Gaussian {', '.join(bad)} became NaN or inf",
+                guard.suspects([_STATE_GROUP[k] for k in bad] if warm
+                               else [*shaping, *(_STATE_GROUP[k] for k in bad)])))
+        d = guard.check_means(s.means.detach().cpu().numpy())
+        if d is not None:
+            raise diverged(it, d)
         out = rasterization(s.means, s.quats, s.scales, s.opacities, s.colors, cam, bg,
                             backend=backend, return_depth=False)
         loss, l1, dssim = photometric_loss(out.rgb, target, w_ssim)
         if not math.isfinite(loss.item()):
-            raise TrainingError(
-                f"model '{name}': loss became {float(loss)} at iteration {it} (condition {c}, "
-                f"frame {j}); no checkpoint written. Lower the learning rates in config train.lr "
-                "or check the dataset for corrupt frames"
-            )
+            raise diverged(it, Divergence(
+                f"the loss became {float(loss)} (condition {c}, frame {j}; if no setting below "
+                "explains it, check the dataset for corrupt frames)", shaping))
+        d = guard.check_loss(it, loss.item())
+        if d is not None:
+            raise diverged(it, d)
         for g in opt.param_groups:
             g["lr"] = g["base_lr"] * lr_factor(g["name"], it, iterations, warmup, final)
         opt.zero_grad(set_to_none=True)
         loss.backward()
         opt.step()
+        d = guard.check_params(_abs_maxes(named))
+        if d is not None:
+            raise diverged(it, d, "in the update of")
         log.append({"iteration": it, "phase": "warmup" if warm else "deform", "condition": c,
                     "frame": j, "loss": loss.item(), "l1": l1.item(), "dssim": dssim.item(),
                     "seconds": time.perf_counter() - t0})
@@ -132,6 +170,37 @@ def train_model(model: BaseModel, observed, train_cfg: dict, *, conditions: list
         **extra,
     }
     return TrainResult(model, stats, log)
+
+
+def _finite(x: torch.Tensor) -> bool:
+    # numpy on the CPU: a small torch op can cost milliseconds of OpenMP barrier on a busy machine
+    x = x.detach()
+    return bool(np.isfinite(x.numpy()).all()) if x.device.type == "cpu" else bool(
+        torch.isfinite(x).all())
+
+
+def _abs_maxes(named) -> dict[str, float]:
+    """Parameter name -> largest |value| (NaN or inf when it holds one)."""
+    out = {}
+    for n, p in named:
+        x = p.detach()
+        if x.numel() == 0:
+            out[n] = 0.0
+        elif x.device.type == "cpu":
+            out[n] = float(np.max(np.abs(x.numpy())))
+        else:
+            out[n] = float(x.abs().max())
+    return out
+
+
+def _likely(groups, lr_cfg: dict) -> str:
+    """'likely setting: train.lr.physics (now 1e+06) or train.lr.pivot (now 0.00016); lower it'
+    for parameter groups (= train.lr keys), most likely first."""
+    if not groups:
+        return "likely setting: the learning rates in train.lr; lower them"
+    parts = [f"train.lr.{g}" + (f" (now {lr_cfg[g]:g})" if isinstance(lr_cfg.get(g), (int, float))
+                                else "") for g in groups]
+    return "likely setting: " + " or ".join(parts) + "; lower it"
 
 
 def write_loss_log(path, log: list[dict]) -> None:
