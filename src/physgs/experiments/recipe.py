@@ -4,7 +4,14 @@ from __future__ import annotations
 
 from dataclasses import asdict, dataclass, field
 
-from physgs.models.registry import MODELS, build_model, configs_for, model_settings, save_checkpoint
+from physgs.models.registry import (
+    build_model,
+    configs_for,
+    is_reference,
+    model_settings,
+    save_checkpoint,
+    spec_of,
+)
 from physgs.models.visibility import freeze_callback
 from physgs.train.loop import TrainResult, condition_indices, train_model, write_loss_log
 from physgs.train.seeding import seed_everything
@@ -24,10 +31,10 @@ def canonical(x):
 class Job:
     """Everything one training job reads, and nothing more.
 
-    model: a registry id; config: configuration name (labels the run); K: ours' parts (None for
-    the rest); conditions: 'train' or 'all'; seed: every random source of the job (model
-    initialisation, k-means, frame draws); settings: ``model_settings`` of the models section;
-    train: the ``train`` section.
+    model: a registry id (a method, or a reference such as truth_motion); config: configuration
+    name (labels the run); K: ours' parts (None for the rest); conditions: 'train' or 'all';
+    seed: every random source of the job (model initialisation, k-means, frame draws);
+    settings: ``model_settings`` of the models section; train: the ``train`` section.
     """
 
     model: str
@@ -58,7 +65,7 @@ def job_spec(cfg: dict, model: str, config: str, seed: int | None = None) -> dic
 
     cfg: the resolved config. What the workflow passes as the train rule's params: editing a
     key outside it (another model's architecture, a table's format, the sweep) leaves the job
-    up to date.
+    up to date. References (``truth_motion``) are trained in ``single`` only.
     """
     configs = cfg["models"]["configs"]
     if config not in configs_for(model, configs):
@@ -71,21 +78,26 @@ def job_spec(cfg: dict, model: str, config: str, seed: int | None = None) -> dic
                K=int(spec["K"]) if model == "ours" else None).to_dict()
 
 
-def fit(observed, job: Job | dict, *, frame_pool=None, progress: bool = True,
+def fit(observed, job: Job | dict, *, truth=None, frame_pool=None, progress: bool = True,
         name: str | None = None) -> TrainResult:
     """Seed, build and train one model on ``observed`` (a testbed ``Observed``).
 
     Every random source is seeded from ``job.seed`` before the model is built, so the same job
     gives bitwise-equal weights in any process. Ours freezes parts whose swing stays under
     ``models.ours.freeze_below_px`` pixels (``freeze_at``); frame_pool restricts the training
-    frames (K selection holds some out). Returns the TrainResult (model in eval mode).
+    frames (K selection holds some out). truth: the dataset's ``Truth`` (truth.npz), required by
+    a reference (truth_motion) and refused for a method. Returns the TrainResult (model in eval
+    mode).
     """
     job = Job.from_dict(job) if isinstance(job, dict) else job
-    if job.model not in MODELS:
-        raise ValueError(f"unknown model {job.model!r}")
+    spec_of(job.model)  # unknown ids raise, naming the valid ones
+    if truth is not None and not is_reference(job.model):
+        raise ValueError(f"model {job.model!r} is a method: its training may not read the ground "
+                         "truth (truth.npz); only references (truth_motion) do")
     seed_everything(job.seed)
+    # a reference without a truth raises here, saying it needs truth.npz
     model = build_model(job.model, observed, job.settings, config=job.config, K=job.K,
-                        seed=job.seed)
+                        seed=job.seed, truth=truth if is_reference(job.model) else None)
     conds = condition_indices(job.conditions, len(observed.conditions))
     hook = freeze_callback(observed, job.settings, job.train) if job.model == "ours" else None
     result = train_model(model, observed, job.train, conditions=conds, seed=job.seed,
@@ -97,11 +109,12 @@ def fit(observed, job: Job | dict, *, frame_pool=None, progress: bool = True,
 
 
 def train_and_save(observed, job: Job | dict, *, checkpoint_path, loss_path,
-                   progress: bool = True) -> TrainResult:
+                   progress: bool = True, truth=None) -> TrainResult:
     """``fit``, then write the loss log and the checkpoint (each atomically, the checkpoint
-    last). Nothing is written if training fails."""
+    last). Nothing is written if training fails. truth: as in ``fit`` (references only); the
+    checkpoint of a reference carries its motion, so it reloads without truth.npz."""
     job = Job.from_dict(job) if isinstance(job, dict) else job
-    result = fit(observed, job, progress=progress)
+    result = fit(observed, job, truth=truth, progress=progress)
     write_loss_log(loss_path, result.log)
     save_checkpoint(checkpoint_path, result.model, name=job.model, config=job.config,
                     seed=job.seed, models_cfg=job.settings, train_cfg=job.train,

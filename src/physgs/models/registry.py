@@ -1,5 +1,10 @@
 """Model names, construction from the config, and checkpoints.
 
+Two kinds of model id: the methods (``MODELS``, what every table iterates) and the references
+(``REFERENCES``: ``truth_motion``, the ceiling, built from ``truth.npz`` and trained by its own
+workflow rule). ``build_model``, ``model_settings``, ``label``, ``configs_for`` and
+``load_checkpoint`` accept both; ``training_jobs`` lists the methods only.
+
 A checkpoint (torch.save of plain dicts and tensors, loadable with weights_only=True) holds:
 format, model name, training configuration name, seed, the ``models`` config section, the
 ``train`` config section, the ModelContext (canonical positions, fps, frame counts, frozen wind
@@ -18,6 +23,7 @@ from physgs.models.base import BaseModel, ModelContext, context_from_observed
 from physgs.models.fields import FieldModel
 from physgs.models.ours import OscillatorPrior
 from physgs.models.static import StaticModel
+from physgs.models.truth_motion import TrueMotion, TruthMotionModel
 
 @dataclass(frozen=True)
 class ModelSpec:
@@ -39,6 +45,13 @@ MODELS: dict[str, ModelSpec] = {
     "ours": ModelSpec("Ours", "Ours", "ours", True),
 }
 MODEL_NAMES = tuple(MODELS)
+#: Reference models: not methods (no recovery, null or method result depends on them), so kept
+#: out of MODELS / MODEL_NAMES. truth_motion moves the canonical Gaussians by the ground-truth
+#: skinning (physgs.models.truth_motion): the ceiling; the only model that reads truth.npz.
+REFERENCES: dict[str, ModelSpec] = {
+    "truth_motion": ModelSpec("True motion (ceiling)", "True motion", "truth_motion", True),
+}
+REFERENCE_NAMES = tuple(REFERENCES)
 FIELDS = ("mlp", "d3dgs")  # learned deformation-field architectures
 #: Every model is trained in this configuration; ours also in every other one of the config.
 BASE_CONFIG = "single"
@@ -47,9 +60,24 @@ FORMAT = "physgs-model-v2"
 AUTO_CONFIG = "auto"
 
 
+def is_reference(model: str) -> bool:
+    """Whether ``model`` is a reference id (``REFERENCES``), not a method."""
+    return model in REFERENCES
+
+
+def spec_of(model: str) -> ModelSpec:
+    """The ModelSpec of a method or reference id (ValueError naming the valid ids)."""
+    spec = MODELS.get(model) or REFERENCES.get(model)
+    if spec is None:
+        raise ValueError(f"unknown model {model!r}; choose one of {MODEL_NAMES} or a reference "
+                         f"{REFERENCE_NAMES}")
+    return spec
+
+
 def label(model: str) -> str:
-    """Table/legend label of a model id."""
-    return MODELS[model].label if model in MODELS else model
+    """Table/legend label of a model id (method or reference)."""
+    spec = MODELS.get(model) or REFERENCES.get(model)
+    return spec.label if spec is not None else model
 
 
 def config_label(name: str, spec: dict, tex: bool = True) -> str:
@@ -59,27 +87,28 @@ def config_label(name: str, spec: dict, tex: bool = True) -> str:
 
 
 def configs_for(model: str, configs) -> tuple[str, ...]:
-    """Configurations a model is trained in: every model `single`, ours every configuration.
+    """Configurations a model is trained in: every model (references too) `single`, ours every
+    configuration.
 
     configs: the names of the config's ``models.configs`` (the one source of configurations).
     """
-    if model not in MODELS:
-        raise ValueError(f"unknown model {model!r}; choose one of {MODEL_NAMES}")
+    spec_of(model)
     return tuple(configs) if model == "ours" else (BASE_CONFIG,)
 
 
 def training_jobs(configs) -> list[tuple[str, str]]:
-    """All (model, configuration) pairs trained per tree, for the config's ``models.configs``."""
+    """All (model, configuration) pairs trained per tree, for the config's ``models.configs``
+    (methods only: references have their own workflow rule)."""
     return [(m, c) for m in MODEL_NAMES for c in configs_for(m, configs)]
 
 
 def model_settings(models_cfg: dict, model: str) -> dict:
     """The part of the ``models`` config section that ``model`` reads (and nothing else), so a
     workflow job is out of date only when one of its own settings changes."""
-    spec = MODELS[model] if model in MODELS else None
-    if spec is None:
-        raise ValueError(f"unknown model {model!r}; choose one of {MODEL_NAMES}")
+    spec = spec_of(model)
     out = {"canonical": models_cfg["canonical"]}
+    if spec.family in REFERENCES:  # the canonical set only: the motion comes from truth.npz
+        return out
     if spec.family != "static":
         out[spec.family] = models_cfg[spec.family]
     if spec.wind and spec.family in FIELDS:
@@ -88,21 +117,37 @@ def model_settings(models_cfg: dict, model: str) -> dict:
 
 
 def build_model(name: str, observed, cfg: dict, *, config: str = BASE_CONFIG, K: int | None = None,
-                seed: int = 0, labels: np.ndarray | None = None) -> BaseModel:
+                seed: int = 0, labels: np.ndarray | None = None, truth=None) -> BaseModel:
     """A freshly initialised model.
 
-    name: one of MODEL_NAMES; observed: a testbed ``Observed`` or a ModelContext;
-    cfg: the ``models`` config section, or ``model_settings`` of it; config: training
-    configuration name; K: number of parts of ours (default: ``cfg['configs'][config]['K']``);
-    seed: k-means seed (ours); labels: precomputed part labels [N] (used when loading).
+    name: one of MODEL_NAMES or REFERENCE_NAMES; observed: a testbed ``Observed`` or a
+    ModelContext; cfg: the ``models`` config section, or ``model_settings`` of it; config:
+    training configuration name; K: number of parts of ours (default:
+    ``cfg['configs'][config]['K']``); seed: k-means seed (ours); labels: precomputed part labels
+    [N] (used when loading); truth: references only, and required by them: the dataset's
+    ``Truth`` (``load_truth`` of truth.npz; ``observed`` must then be the ``Observed``), or the
+    ``TrueMotion`` a checkpoint stores. A method given a truth raises (methods never read it).
     """
-    if name not in MODELS:
-        raise ValueError(f"unknown model {name!r}; choose one of {MODEL_NAMES}")
+    spec_of(name)
     if name != "ours" and config != BASE_CONFIG:
         raise ValueError(f"model {name!r} is not trained in configuration {config!r}; valid: "
                          f"('{BASE_CONFIG}',) (joint configurations are ours only)")
+    if truth is not None and not is_reference(name):
+        raise ValueError(f"model {name!r} is a method: it may not read the ground truth "
+                         f"(truth.npz); only the references {REFERENCE_NAMES} do")
     ctx = observed if isinstance(observed, ModelContext) else context_from_observed(observed)
     canon = dict(cfg["canonical"])
+    if is_reference(name):
+        if truth is None:
+            raise ValueError(f"the reference {name!r} moves the Gaussians by the ground truth: it "
+                             "needs the dataset's truth.npz (pass truth=load_truth(<tree>/"
+                             "truth.npz)); the dataset has no truth file or none was given")
+        if not isinstance(truth, TrueMotion):
+            if isinstance(observed, ModelContext):
+                raise ValueError(f"building {name!r} from truth.npz needs the Observed dataset "
+                                 "(its per-condition winds), not a ModelContext")
+            truth = TrueMotion.from_truth(truth, observed)
+        return TruthMotionModel(ctx, canon, truth)
     family = MODELS[name].family
     if family == "static":
         return StaticModel(ctx, canon)
@@ -169,8 +214,11 @@ def load_checkpoint(path) -> BaseModel:
     blob = read_checkpoint(path)
     sd = blob["state_dict"]
     labels = sd["part_labels"].numpy() if "part_labels" in sd else None
+    # a reference's motion is in its own buffers: no truth.npz needed to reload it
+    motion = TrueMotion.from_state_dict(sd) if is_reference(blob["model"]) else None
     model = build_model(blob["model"], ModelContext.from_dict(blob["context"]), blob["models_cfg"],
-                        config=blob["config"], K=blob["K"], seed=blob["seed"], labels=labels)
+                        config=blob["config"], K=blob["K"], seed=blob["seed"], labels=labels,
+                        truth=motion)
     model.load_state_dict(sd, strict=True)
     model.eval()
     model.checkpoint_info = {k: blob[k] for k in ("model", "config", "seed", "stats",
