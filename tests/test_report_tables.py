@@ -130,3 +130,45 @@ def test_missing_model_names_the_cause():
     del S[("sparse", "mlp")]
     with pytest.raises(KeyError, match="mlp"):
         T.tab_psnr(S, TREES, BONES)
+
+
+def test_tab_psnr_reference_row_is_separate_and_never_bold():
+    S = summaries()
+    for t in TREES:
+        S[(t, "truth_motion")] = {"view": 40.0, "time": 40.0}  # above every method
+    tab = T.tab_psnr(S, TREES, BONES, references=("truth_motion",))
+    assert list(tab.df.model)[-1] == T.label("truth_motion") and tab.df.reference.iloc[-1]
+    assert r"\textbf{40.00}" not in tab.tex and r"\emph{True motion" in tab.tex
+    assert tab.tex.count(r"\textbf{") == 2 * len(TREES)  # still one bold per column, a method
+
+
+def test_tab_fit_fraction_of_the_ceiling():
+    models = ("static", "mlp", "ours")
+    rows = {}
+    for t in TREES:
+        for m, fit in zip((*models, "truth_motion"), (20.0, 22.0, 26.0, 30.0)):
+            rows[(t, m)] = {"fit": fit, "heldout": fit - 0.5, "view": 21.0, "time": 21.5,
+                            "train_s": 12.0}
+    tab = T.tab_fit(rows, TREES, BONES, models, "truth_motion")
+    frac = dict(zip(tab.df.model[tab.df.tree == "sparse"], tab.df.ceiling_frac))
+    # (model - static) / (ceiling - static): 0, 2/10, 6/10, 1
+    assert frac == pytest.approx({"static": 0.0, "mlp": 0.2, "ours": 0.6, "truth_motion": 1.0})
+    assert "60\\%" in tab.tex and "20\\%" in tab.tex
+
+
+def test_fit_row_splits_trained_and_held_out_frames(tmp_path):
+    from physgs.evaluate.splits import EvalResult
+    from physgs.report.build import fit_row
+
+    n_train, n_tail = 30, 5
+    cam = np.full((3, n_train + n_tail), 5.0)
+    cam[0, :n_train] = 10.0
+    cam[0, 9:n_train:10] = 20.0  # frames 9, 19, 29: the held-out ones (every 10th)
+    ev = EvalResult(camera_psnr=cam, centroid_err=np.zeros_like(cam), view_psnr=np.full((2, 3), 7.0),
+                    conditions=np.array(COND), heldout_azimuths_deg=np.array([-5.0, 5.0]),
+                    heldout_frame_idx=np.array([0, 10, 20]), n_train=n_train, n_tail=n_tail)
+    ev.save(tmp_path / "e.npz")
+    pd.DataFrame({"seconds": [1.0, 2.0, 42.5]}).to_csv(tmp_path / "l.csv", index=False)
+    r = fit_row(tmp_path / "e.npz", tmp_path / "l.csv", n_train, 10)
+    assert r["fit"] == pytest.approx(10.0) and r["heldout"] == pytest.approx(20.0)
+    assert r["train_s"] == 42.5 and r["view"] == pytest.approx(7.0)

@@ -13,6 +13,17 @@ def _dry_run(*targets):
          "--", *targets], cwd=ROOT, capture_output=True, text=True, timeout=120)
 
 
+def test_only_the_reference_rule_reads_the_truth():
+    """The true-motion ceiling is trained by its own rule, the only one that reads truth.npz."""
+    r = _dry_run("results/models/sparse/truth_motion_single.pt")
+    assert r.returncode == 0, r.stderr[-2000:] + r.stdout[-2000:]
+    assert "rule train_reference:" in r.stdout and "rule train:" not in r.stdout
+    text = (ROOT / "workflow" / "rules" / "train.smk").read_text()
+    rules = re.split(r"\nrule ", text)
+    readers = [b.split(":", 1)[0] for b in rules[1:] if "TRUTH" in b.split("output:", 1)[0]]
+    assert readers == ["train_reference"], readers
+
+
 def test_train_jobs_read_only_the_observed_dataset():
     r = _dry_run("train_all")
     assert r.returncode == 0, r.stderr[-2000:] + r.stdout[-2000:]

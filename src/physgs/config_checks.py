@@ -105,6 +105,14 @@ def warmup_below_iterations(cfg: dict) -> Iterator[Problem]:
                    f"{key}/iterations")
 
 
+def holdout_leaves_training_frames(cfg: dict) -> Iterator[Problem]:
+    """Held-out training frames (train.holdout_every) leave most of the window to train on."""
+    every, n = int(cfg["train"]["holdout_every"]), int(cfg["testbed"]["n_train"])
+    if every != 0 and not 2 <= every <= n:
+        yield (("train", "holdout_every"),
+               f"{every} must be 0 (no held-out frames) or lie in [2, testbed/n_train = {n}]")
+
+
 def freeze_inside_deformation_phase(cfg: dict) -> Iterator[Problem]:
     """models/ours/freeze_at falls after the warm-up, for train and the K-selection runs alike.
 
@@ -208,6 +216,7 @@ CHECKS: list[Check] = [
     band_ordered,
     lead_in_fits_wind_period,
     warmup_below_iterations,
+    holdout_leaves_training_frames,
     freeze_inside_deformation_phase,
     ours_bounds_ordered,
     configs_have_single,

@@ -35,7 +35,7 @@ SWEEP_POINT = "results/speed_accuracy/{point}.json"
 TABLE = "results/tables/{name}.{ext}"
 FIGURE = "results/figures/{name}.{ext}"
 #: need kind (physgs.report.build.needs) -> path template
-NEED_PATHS = {"eval": EVAL, "traj": TRAJ, "panels": PANELS, "recovery": RECOVERY,
+NEED_PATHS = {"eval": EVAL, "traj": TRAJ, "panels": PANELS, "loss": LOSS, "recovery": RECOVERY,
               "null": NULL, "kselect": KSELECT}
 SA_TREE = CFG["speed_accuracy"]["tree"]
 SWEEP_POINTS = _sweep.sweep_points(CFG)
@@ -43,7 +43,7 @@ SWEEP_POINTS = _sweep.sweep_points(CFG)
 
 wildcard_constraints:
     tree="|".join(TREES),
-    model="|".join(_models.MODEL_NAMES),
+    model="|".join([*_models.MODEL_NAMES, *_models.REFERENCE_NAMES]),
     config="|".join([*CONFIGS, _models.AUTO_CONFIG]),
     K=r"\d+",
     point="|".join(SWEEP_POINTS),

@@ -11,6 +11,7 @@ rule train:
         ckpt=CKPT,
         loss=LOSS,
     wildcard_constraints:
+        model="|".join(_models.MODEL_NAMES),  # methods; the reference has its own rule
         config="|".join(CONFIGS),  # ours_auto has its own rule (kselect.smk)
     params:
         job=train_params,
@@ -27,6 +28,33 @@ rule train:
         runtime=10 + CFG["train"]["iterations"] // 60,
     script:
         "../scripts/train.py"
+
+
+# The true-motion ceiling (a reference, not a method): the only training rule that reads
+# truth.npz. No method, recovery or null result depends on it.
+rule train_reference:
+    input:
+        observed=OBSERVED,
+        truth=TRUTH,
+    output:
+        ckpt=CKPT.replace("{config}", _models.BASE_CONFIG),
+        loss=LOSS.replace("{config}", _models.BASE_CONFIG),
+    wildcard_constraints:
+        model="|".join(_models.REFERENCE_NAMES),
+    params:
+        job=lambda wc: _job_spec(CFG, wc.model, _models.BASE_CONFIG),
+    conda:
+        "../envs/physgs.yaml"
+    log:
+        "logs/train/{tree}/{model}_single.log",
+    benchmark:
+        "results/benchmarks/train/{tree}/{model}_single.tsv"
+    threads: 1
+    resources:
+        mem_mb=4000,
+        runtime=10 + CFG["train"]["iterations"] // 60,
+    script:
+        "../scripts/train_reference.py"
 
 
 rule train_all:

@@ -26,21 +26,11 @@ import numpy as np
 
 from physgs.atomic import write_json
 from physgs.evaluate.run import training_camera_scores
-from physgs.experiments.recipe import Job, fit
+from physgs.experiments.recipe import Job, fit, heldout_split  # noqa: F401 (re-exported)
 from physgs.models.registry import AUTO_CONFIG
 
 METHODS = ("heldout", "bic")
 PARAMS_PER_PART = 8  # omega, zeta, gain, swing axis (2), pivot (3)
-
-
-def heldout_split(n_train: int, every: int) -> tuple[np.ndarray, np.ndarray]:
-    """(training frames, held-out frames): indices in [0, n_train), every ``every``-th held out
-    (frames every-1, 2 every-1, ...), so frame 0 and the window's start stay in training."""
-    if not 2 <= every <= n_train:
-        raise ValueError(f"models.kselect.every must lie in [2, n_train = {n_train}], got {every}")
-    idx = np.arange(n_train)
-    held = (idx % every) == every - 1
-    return idx[~held], idx[held]
 
 
 def bic(mse: float, n: int, k_parts: int) -> float:

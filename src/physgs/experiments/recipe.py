@@ -4,6 +4,8 @@ from __future__ import annotations
 
 from dataclasses import asdict, dataclass, field
 
+import numpy as np
+
 from physgs.models.registry import (
     build_model,
     configs_for,
@@ -78,6 +80,16 @@ def job_spec(cfg: dict, model: str, config: str, seed: int | None = None) -> dic
                K=int(spec["K"]) if model == "ours" else None).to_dict()
 
 
+def heldout_split(n_train: int, every: int) -> tuple[np.ndarray, np.ndarray]:
+    """(training frames, held-out frames): indices in [0, n_train), every ``every``-th held out
+    (frames every-1, 2 every-1, ...), so frame 0 and the window's start stay in training."""
+    if not 2 <= every <= n_train:
+        raise ValueError(f"every (train.holdout_every, models.kselect.every) must lie in [2, n_train = {n_train}], got {every}")
+    idx = np.arange(n_train)
+    held = (idx % every) == every - 1
+    return idx[~held], idx[held]
+
+
 def fit(observed, job: Job | dict, *, truth=None, frame_pool=None, progress: bool = True,
         name: str | None = None) -> TrainResult:
     """Seed, build and train one model on ``observed`` (a testbed ``Observed``).
@@ -85,7 +97,8 @@ def fit(observed, job: Job | dict, *, truth=None, frame_pool=None, progress: boo
     Every random source is seeded from ``job.seed`` before the model is built, so the same job
     gives bitwise-equal weights in any process. Ours freezes parts whose swing stays under
     ``models.ours.freeze_below_px`` pixels (``freeze_at``); frame_pool restricts the training
-    frames (K selection holds some out). truth: the dataset's ``Truth`` (truth.npz), required by
+    frames; by default every ``train.holdout_every``-th training frame is held out (0 = none),
+    so the fit and the interpolation to unseen in-window frames can be told apart. truth: the dataset's ``Truth`` (truth.npz), required by
     a reference (truth_motion) and refused for a method. Returns the TrainResult (model in eval
     mode).
     """
@@ -99,6 +112,9 @@ def fit(observed, job: Job | dict, *, truth=None, frame_pool=None, progress: boo
     model = build_model(job.model, observed, job.settings, config=job.config, K=job.K,
                         seed=job.seed, truth=truth if is_reference(job.model) else None)
     conds = condition_indices(job.conditions, len(observed.conditions))
+    every = int(job.train.get("holdout_every", 0))
+    if frame_pool is None and every:
+        frame_pool = heldout_split(int(observed.n_train), every)[0]
     hook = freeze_callback(observed, job.settings, job.train) if job.model == "ours" else None
     result = train_model(model, observed, job.train, conditions=conds, seed=job.seed,
                          name=name or job.name, progress=progress, frame_pool=frame_pool,

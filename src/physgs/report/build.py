@@ -12,24 +12,29 @@ from __future__ import annotations
 from typing import Mapping, Sequence
 
 import numpy as np
+import pandas as pd
 
 from physgs.evaluate.splits import load_eval
 from physgs.evaluate.trajectories import load_trajectories
 from physgs.experiments.kselect import load_selection
-from physgs.models.registry import BASE_CONFIG, MODEL_NAMES, config_label
+from physgs.experiments.recipe import heldout_split
+from physgs.models.registry import BASE_CONFIG, MODEL_NAMES, REFERENCE_NAMES, config_label
 from physgs.recovery.record import load_null, load_recovery
 from physgs.report import figures, kselect, tables
 
-TABLES = ("tab_psnr", "tab_null", "tab_transfer", "tab_margin", "tab_kselect")
+TABLES = ("tab_psnr", "tab_null", "tab_transfer", "tab_margin", "tab_kselect", "tab_fit")
 FIGURES = ("fig_temporal", "fig_teaser", "fig_results", "fig_damping")
 #: The fields of each need tuple after its kind (what a workflow path template is formatted with).
 NEED_FIELDS = {"eval": ("tree", "model", "config"), "traj": ("tree", "model", "config"),
-               "panels": ("tree", "model", "config"), "recovery": ("tree", "config"),
+               "panels": ("tree", "model", "config"), "loss": ("tree", "model", "config"),
+               "recovery": ("tree", "config"),
                "null": ("tree", "K"), "kselect": ("tree",)}
 #: Models (trained in the base configuration) whose evaluation an output reads.
 NEEDS_MODELS = {
-    "tab_psnr": MODEL_NAMES, "tab_transfer": MODEL_NAMES, "tab_margin": ("mlp_wind", "ours"),
-    "fig_temporal": MODEL_NAMES, "fig_teaser": MODEL_NAMES, "fig_results": MODEL_NAMES,
+    "tab_psnr": (*MODEL_NAMES, *REFERENCE_NAMES), "tab_transfer": MODEL_NAMES,
+    "tab_margin": ("mlp_wind", "ours"), "fig_temporal": (*MODEL_NAMES, *REFERENCE_NAMES),
+    "fig_teaser": MODEL_NAMES, "fig_results": MODEL_NAMES,
+    "tab_fit": (*MODEL_NAMES, *REFERENCE_NAMES),
 }
 KSELECT_ROWS = (BASE_CONFIG, "auto")
 
@@ -52,6 +57,8 @@ def needs(name: str, trees: Sequence[str], configs: Mapping[str, dict]) -> list[
         out += [("traj", t, m, BASE_CONFIG) for t in trees for m in MODEL_NAMES]
     if name == "fig_results":
         out += [("panels", t, m, BASE_CONFIG) for t in trees for m in MODEL_NAMES]
+    if name == "tab_fit":
+        out += [("loss", t, m, BASE_CONFIG) for t in trees for m in NEEDS_MODELS[name]]
     if name in ("tab_null", "fig_damping"):
         out += [("recovery", t, c) for t in trees for c in configs]
     if name == "tab_null":
@@ -74,8 +81,10 @@ def settings_for(name: str, cfg: dict) -> dict:
                           for c, v in cfg["models"]["configs"].items()}
     if name in ("tab_transfer", "tab_margin", "fig_teaser", "fig_results"):
         out["conditions"] = [float(c) for c in cfg["testbed"]["conditions"]]
-    if name == "fig_temporal":
+    if name in ("fig_temporal", "tab_fit"):
         out["n_train"] = int(cfg["testbed"]["n_train"])
+    if name == "tab_fit":
+        out["holdout_every"] = int(cfg["train"]["holdout_every"])
     if name == "fig_damping":
         out["zeta"] = float(cfg["testbed"]["zeta"])
     if name == "tab_kselect":
@@ -98,6 +107,22 @@ def _summaries(path, trees, models):
             for t in trees for m in models}
 
 
+def fit_row(eval_path, loss_path, n_train: int, holdout_every: int) -> dict:
+    """One tab_fit row from a model's evaluation and loss log: fit and held-out-frame PSNR (dB,
+    training camera and wind, frames < n_train), view and time PSNR (dB), training seconds."""
+    ev = load_eval(eval_path)
+    cam = np.asarray(ev.camera_psnr[0, :n_train], dtype=np.float64)  # [n_train] dB
+    if holdout_every:
+        trained, held = heldout_split(n_train, holdout_every)
+    else:
+        trained, held = np.arange(n_train), np.arange(0)
+    s = ev.summary()
+    secs = pd.read_csv(loss_path)["seconds"]
+    return {"fit": float(cam[trained].mean()),
+            "heldout": float(cam[held].mean()) if held.size else float("nan"),
+            "view": s["view"], "time": s["time"], "train_s": float(secs.iloc[-1])}
+
+
 def make_table(name: str, inputs: Mapping[str, str], settings: dict, tex_path, csv_path,
                stamp=None) -> tables.Table:
     """Build table ``name`` from the files in ``inputs`` (need key -> path) and write its .tex
@@ -106,7 +131,14 @@ def make_table(name: str, inputs: Mapping[str, str], settings: dict, tex_path, c
     path = _reader(inputs)
     trees, bones, d = settings["trees"], settings["bones"], settings.get("digits", 2)
     if name == "tab_psnr":
-        table = tables.tab_psnr(_summaries(path, trees, MODEL_NAMES), trees, bones, digits=d)
+        table = tables.tab_psnr(_summaries(path, trees, (*MODEL_NAMES, *REFERENCE_NAMES)), trees,
+                                bones, digits=d, references=REFERENCE_NAMES)
+    elif name == "tab_fit":
+        rows = {(t, m): fit_row(path("eval", t, m, BASE_CONFIG), path("loss", t, m, BASE_CONFIG),
+                                int(settings["n_train"]), int(settings["holdout_every"]))
+                for t in trees for m in NEEDS_MODELS[name]}
+        table = tables.tab_fit(rows, trees, bones, MODEL_NAMES, REFERENCE_NAMES[0], digits=d,
+                               holdout_every=int(settings["holdout_every"]))
     elif name == "tab_transfer":
         table = tables.tab_transfer(_summaries(path, trees, MODEL_NAMES), trees, bones,
                                     settings["conditions"], digits=d)
@@ -151,7 +183,7 @@ def make_figure(name: str, inputs: Mapping[str, str], settings: dict,
     trees = settings["trees"]
     if name == "fig_temporal":
         curves = {(t, m): load_eval(path("eval", t, m, BASE_CONFIG)).temporal_psnr
-                  for t in trees for m in MODEL_NAMES}
+                  for t in trees for m in NEEDS_MODELS[name]}
         figures.fig_temporal(curves, trees, int(settings["n_train"]), outputs)
     elif name == "fig_teaser":
         t = _teaser_tree(trees)

@@ -19,6 +19,7 @@ from matplotlib.ticker import LogLocator, NullFormatter, ScalarFormatter  # noqa
 
 from physgs.atomic import atomic_path  # noqa: E402
 from physgs.models.registry import MODEL_NAMES as MODELS  # noqa: E402
+from physgs.models.registry import REFERENCE_NAMES  # noqa: E402
 from physgs.models.registry import label  # noqa: E402
 from physgs.report.tables import condition_label  # noqa: E402
 
@@ -62,7 +63,8 @@ def fig_temporal(curves: Mapping[tuple[str, str], np.ndarray], trees: Sequence[s
     """Per-frame PSNR (dB) at the training camera and wind, one panel per tree.
 
     curves[(tree, model)]: [F] PSNR over recorded frames 1..F; the window boundary (after frame
-    n_train) is marked and the tail shaded.
+    n_train) is marked and the tail shaded. A reference present in ``curves`` (the true-motion
+    ceiling) is drawn as a thin black dotted line.
     """
     fig, axes = plt.subplots(1, len(trees), figsize=(4.2 * len(trees), 3.2), squeeze=False, sharey=False)
     for ax, t in zip(axes[0], trees):
@@ -73,6 +75,9 @@ def fig_temporal(curves: Mapping[tuple[str, str], np.ndarray], trees: Sequence[s
             x = np.arange(1, len(y) + 1)
             ax.plot(x, y, color=COLORS.get(m), lw=1.6 if m == "ours" else 1.0,
                     ls="--" if m == "static" else "-", label=label(m))
+        for m in REFERENCE_NAMES:
+            if (t, m) in curves:
+                ax.plot(x, np.asarray(curves[(t, m)]), color="k", lw=0.8, ls=":", label=label(m))
         ax.axvline(n_train + 0.5, color="k", lw=0.8, ls=":")
         ax.axvspan(n_train + 0.5, len(y) + 0.5, color="0.92", zorder=0)
         ax.set_title(t.capitalize())

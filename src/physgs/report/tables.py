@@ -69,37 +69,102 @@ def _check(keys: Sequence, have: Mapping, what: str) -> None:
 
 # --------------------------------------------------------------------------------------------
 def tab_psnr(summaries: Mapping[tuple[str, str], Mapping[str, float]], trees: Sequence[str],
-             bones: Mapping[str, int], models: Sequence[str] = MODELS, digits: int = 2) -> Table:
+             bones: Mapping[str, int], models: Sequence[str] = MODELS, digits: int = 2,
+             references: Sequence[str] = ()) -> Table:
     """PSNR (dB) on the view and time splits, one row per model, two columns per tree.
 
     summaries[(tree, model)]: ``EvalResult.summary()`` of the model trained ``single``.
-    Best per column in bold; digits: decimals shown in the .tex.
+    Best per column (among the methods) in bold; references (the true-motion ceiling) follow
+    as separate rows below a rule, never bold; digits: decimals shown in the .tex.
     """
     fmt = f".{int(digits)}f"
-    _check([(t, m) for t in trees for m in models], summaries, "tab_psnr")
+    _check([(t, m) for t in trees for m in (*models, *references)], summaries, "tab_psnr")
     rows = []
-    for m in models:
-        r = {"model": label(m)}
+    for m in (*models, *references):
+        r = {"model": label(m), "reference": m in references}
         for t in trees:
             r[f"{t}_view"] = summaries[(t, m)]["view"]
             r[f"{t}_time"] = summaries[(t, m)]["time"]
         rows.append(r)
     df = pd.DataFrame(rows)
-    num = [c for c in df.columns if c != "model"]
-    bold = {c: _best_mask(df[c].to_numpy(), fmt) for c in num}
+    num = [c for c in df.columns if c not in ("model", "reference")]
+    methods = ~df["reference"].to_numpy(bool)
+    bold = {}
+    for c in num:
+        b = np.zeros(len(df), bool)
+        b[methods] = _best_mask(df.loc[methods, c].to_numpy(), fmt)
+        bold[c] = b
     n = len(trees)
     lines = ["  \\begin{tabular}{l" + "cc" * n + "}", "    \\toprule",
              "    & " + " & ".join(rf"\multicolumn{{2}}{{c}}{{{tree_label(t, bones[t])}}}" for t in trees) + r" \\",
              "    " + "".join(rf"\cmidrule(lr){{{2 + 2 * i}-{3 + 2 * i}}}" for i in range(n)),
              "    & " + " & ".join(["view & time"] * n) + r" \\", "    \\midrule"]
     for i, r in df.iterrows():
+        if r["reference"] and (i == 0 or not df["reference"].iloc[i - 1]):
+            lines.append("    \\midrule")
         cells = [_fmt(r[c], fmt, bold[c][i]) for c in num]
-        lines.append(f"    {r['model']} & " + " & ".join(cells) + r" \\")
+        name = rf"\emph{{{r['model']}}}" if r["reference"] else r["model"]
+        lines.append(f"    {name} & " + " & ".join(cells) + r" \\")
     lines += ["    \\bottomrule", "  \\end{tabular}", ""]
+    # the CSV marks reference rows in a last column (only when there are any)
+    df = df[[*(c for c in df.columns if c != "reference"), *(["reference"] if references else [])]]
     cap = (r"PSNR (dB). \emph{view}: held-out azimuths at the training wind inside the training "
            r"window. \emph{time}: frames beyond the training window at the training wind and camera. "
-           r"Best per column in bold.")
+           r"Best per column in bold."
+           + (r" In italics, a reference (not a method, never bold): the canonical Gaussians moved "
+              r"by the ground-truth motion, appearance trained by the same recipe." if references
+              else ""))
     return Table("tab_psnr", df, _wrap("\n".join(lines), cap, "tab:psnr"))
+
+
+# --------------------------------------------------------------------------------------------
+def tab_fit(rows: Mapping[tuple[str, str], Mapping[str, float]], trees: Sequence[str],
+            bones: Mapping[str, int], models: Sequence[str], reference: str, digits: int = 2,
+            static: str = "static", holdout_every: int = 10) -> Table:
+    """How much of the achievable fit each model reaches, per tree and model.
+
+    rows[(tree, model)]: fit (dB: mean PSNR over the trained training-window frames at the
+    training camera and wind), heldout (dB: the same over the held-out training-window frames),
+    view, time (dB: the evaluation splits), train_s (seconds of training). ceiling_frac is
+    (model - static) / (reference - static) on ``fit``: 1 reaches the true-motion ceiling, 0 is
+    no better than the static pose. The reference row is listed for scale.
+    """
+    _check([(t, m) for t in trees for m in (*models, reference)], rows, "tab_fit")
+    recs = []
+    for t in trees:
+        ceil, stat = rows[(t, reference)]["fit"], rows[(t, static)]["fit"]
+        for m in (*models, reference):
+            r = rows[(t, m)]
+            gain = ceil - stat
+            recs.append({"tree": t, "bones": bones[t], "model": m, "reference": m == reference,
+                         "fit_psnr_db": r["fit"], "heldout_psnr_db": r["heldout"],
+                         "ceiling_frac": (r["fit"] - stat) / gain if gain > 0 else np.nan,
+                         "view_psnr_db": r["view"], "time_psnr_db": r["time"],
+                         "train_s": r["train_s"]})
+    df = pd.DataFrame(recs)
+    fmt = f".{int(digits)}f"
+    lines = ["  \\begin{tabular}{llcccccr}", "    \\toprule",
+             r"    Tree & Model & Fit & Held-out frames & Of ceiling & View & Time & Train (s) \\",
+             "    \\midrule"]
+    for i, t in enumerate(trees):
+        sub = df[df.tree == t]
+        for j, (_, r) in enumerate(sub.iterrows()):
+            head = rf"\multirow{{{len(sub)}}}{{*}}{{{tree_label(t, r.bones)}}}" if j == 0 else ""
+            name = rf"\emph{{{label(r.model)}}}" if r.reference else label(r.model)
+            frac = "--" if not np.isfinite(r.ceiling_frac) else f"{100 * r.ceiling_frac:.0f}\\%"
+            lines.append("    " + " & ".join([
+                head, name, _fmt(r.fit_psnr_db, fmt), _fmt(r.heldout_psnr_db, fmt), frac,
+                _fmt(r.view_psnr_db, fmt), _fmt(r.time_psnr_db, fmt), f"{r.train_s:.0f}"]) + r" \\")
+        if i < len(trees) - 1:
+            lines.append("    \\midrule")
+    lines += ["    \\bottomrule", "  \\end{tabular}", ""]
+    cap = (r"Fit to the training window, PSNR (dB) at the training camera and wind. \emph{Fit}: "
+           r"the training-window frames each model was trained on; \emph{Held-out frames}: every "
+           + f"{holdout_every}th" + r" training-window frame, never trained on; \emph{Of ceiling}: "
+           r"(model $-$ static) / "
+           r"(true motion $-$ static) on the fit. \emph{View}, \emph{Time}: the evaluation splits. "
+           r"In italics the reference: the canonical Gaussians moved by the ground-truth motion.")
+    return Table("tab_fit", df, _wrap("\n".join(lines), cap, "tab:fit"))
 
 
 # --------------------------------------------------------------------------------------------
