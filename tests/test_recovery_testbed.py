@@ -7,6 +7,8 @@ import torch
 
 import physgs.config
 from physgs.models.oscillator import integrate
+from physgs.recovery.matcher import match_parts, training_window
+from physgs.recovery.null import draw_null_omegas, nearest_bone_gap
 from physgs.recovery.record import bone_window, run_null, score_recovery
 from physgs.testbed.dataset import simulate_tree
 
@@ -33,8 +35,10 @@ def test_parts_that_are_bones_are_recovered_exactly(sparse):
     rec = score_recovery(theta, tr.omega[pick], np.full(5, 0.08), tr,
                          obs.lead_in_frames, obs.n_train)
     m = rec.match
-    assert m.n_trusted == 5 and np.all(m.corr > 0.999)
-    np.testing.assert_allclose(m.omega_true, tr.omega[pick], rtol=1e-12)  # equal-omega twins are fine
+    # integrated from rest over a 1.5 tau_max lead-in, the slowest bones keep a trace of their
+    # start transient (exp(-1.5) at omega_min), so the match is near, not exactly, perfect
+    assert m.n_trusted == 5 and np.all(m.corr > 0.995)
+    np.testing.assert_allclose(m.omega_true, tr.omega[pick], rtol=1e-12)
     assert m.median_rel_err < 1e-12
     assert rec.damping.median_zeta == pytest.approx(0.08)
     assert bone_window(tr, obs.lead_in_frames, obs.n_train).shape == (len(tr.omega), obs.n_train)
@@ -47,6 +51,17 @@ def test_null_on_sparse_tree_is_seeded_and_bounded_by_the_grid(sparse):
     np.testing.assert_array_equal(a.median_rel_err, b.median_rel_err)
     assert a.omega.shape == (8, 32)
     assert tr.omega.min() <= a.omega.min() and a.omega.max() <= tr.omega.max()
-    # correlation finds a bone at least as close as the nearest one only by luck; never closer
-    assert a.median_median_rel_err >= 0.9 * a.nearest_bone_gap
     assert np.all(np.isfinite(a.median_rel_err))
+    # per part, the matched bone is never closer than the nearest bone: rel_err >= gap (one draw,
+    # rebuilt here with the same solver and matcher)
+    om = draw_null_omegas(tr.omega, 32, 8, 0)[0]
+    w = torch.as_tensor(obs.wind[0], dtype=torch.float64)
+    th = integrate(torch.as_tensor(om), torch.full((32,), 0.1, dtype=torch.float64),
+                   torch.ones(32, dtype=torch.float64), w, float(obs.vbar[0]), 1 / obs.fps, 2).numpy()
+    m = match_parts(training_window(th, obs.lead_in_frames, obs.n_train),
+                    bone_window(tr, obs.lead_in_frames, obs.n_train), om, tr.omega)
+    assert m.median_rel_err == a.median_rel_err[0]
+    assert np.all(m.rel_err >= nearest_bone_gap(om, tr.omega) - 1e-12)
+    # over trusted parts only, the median error can sit below the median gap (trust favours parts
+    # near a bone; the paper's sparse tree: null 4.5% against a 5.4% gap), but not far below
+    assert a.median_median_rel_err >= 0.5 * a.nearest_bone_gap

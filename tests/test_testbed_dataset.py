@@ -1,4 +1,5 @@
-"""Dataset: a tiny end-to-end build, the interface fields, load errors, no partial outputs."""
+"""Dataset: a tiny end-to-end build, the interface fields, load errors, no partial outputs,
+Gaussians stored in a permuted order, framing."""
 import copy
 import shutil
 import subprocess
@@ -10,7 +11,7 @@ import pytest
 import yaml
 
 from physgs.config import load
-from physgs.testbed import dataset, kinematics
+from physgs.testbed import dataset, kinematics, scene, stats
 from physgs.testbed.dataset import DatasetError, build_dataset, load_observed, load_truth, save_dataset
 
 ROOT = Path(__file__).resolve().parents[1]
@@ -20,7 +21,9 @@ CFG = load(ROOT / "config/trees.yaml", "quick")
 @pytest.fixture(scope="module")
 def tiny(tmp_path_factory):
     tb = copy.deepcopy(CFG["testbed"])
-    tb.update(n_train=20, n_tail=4, resolution=16, supersample=1, heldout_azimuths_deg=[-30, 60])
+    # at 16 px a 0.9 fill leaves under a pixel of margin; 0.75 keeps the border test meaningful
+    tb.update(n_train=20, n_tail=4, resolution=16, supersample=1, heldout_azimuths_deg=[-30, 60],
+              fill_height=0.75)
     obs, tru = build_dataset(tb, CFG["presets"]["sparse"], seed=0, tree="sparse", progress=False)
     d = tmp_path_factory.mktemp("tb")
     save_dataset(obs, tru, d / "observed.npz", d / "truth.npz")
@@ -39,8 +42,19 @@ def test_roundtrip_matches_interface(tiny):
     assert o.heldout_frames.shape == (2, 2, 16, 16, 3) and len(o.heldout_cameras) == 2
     assert t.theta.shape == (C, L + F, 22)
     np.testing.assert_array_equal(o.conditions, tb["conditions"])
-    # canonical positions = vertices posed at recorded frame 0 of the training wind
-    np.testing.assert_allclose(o.canonical_xyz, kinematics.pose_vertices(t, t.theta[0, L]), atol=1e-6)
+    # canonical positions = vertices posed at recorded frame 0 of the training wind, in Gaussian
+    # order: Gaussian i is mesh vertex gaussian_vertex[i]
+    posed = kinematics.pose_vertices(t, t.theta[0, L])
+    np.testing.assert_allclose(o.canonical_xyz, posed[t.gaussian_vertex], atol=1e-6)
+    np.testing.assert_allclose(o.canonical_xyz, kinematics.pose_gaussians(t, t.theta[0, L]), atol=1e-6)
+    np.testing.assert_allclose(o.canonical_xyz[t.vertex_gaussian], posed, atol=1e-6)
+    assert not np.array_equal(t.gaussian_vertex, np.arange(len(posed)))
+    # the observed file holds no permutation and no bone label
+    with np.load(d / "observed.npz") as z:
+        assert not {"gaussian_vertex", "vertex_gaussian", "vertex_bone"} & set(z.files)
+    # framing: the swept tree spans fill_height of the training image's height
+    lo, hi = stats.swept_image_extent(t, o.train_camera)
+    assert (hi[1] - lo[1]) / 16 == pytest.approx(tb["fill_height"], abs=1e-6)
     # the tree is in every frame, and never touches the image border (framing with margin)
     assert o.masks.reshape(C * F, -1).any(axis=1).all()
     for m in (o.masks, o.heldout_masks):
@@ -86,6 +100,69 @@ def test_missing_and_corrupt_files_name_the_file_and_fix(tmp_path, tiny):
     np.savez(tmp_path / "truth.npz", **z)
     with pytest.raises(DatasetError, match=r"lacks \['omega'\]"):
         load_truth(tmp_path / "truth.npz")
+    z = dict(np.load(d / "truth.npz"))
+    z["gaussian_vertex"] = z["gaussian_vertex"].copy()
+    z["gaussian_vertex"][:2] = z["gaussian_vertex"][0]  # not a permutation any more
+    np.savez(tmp_path / "truth.npz", **z)
+    with pytest.raises(DatasetError, match=r"gaussian_vertex is not a permutation.*rebuild"):
+        load_truth(tmp_path / "truth.npz")
+
+
+def _box(w, d, h):
+    g = np.array(np.meshgrid([-w / 2, w / 2], [-d / 2, d / 2], [0.0, h])).reshape(3, -1).T
+    return g + [0.3, -0.2, 0.0]
+
+
+def test_framing_fills_the_training_height_exactly():
+    pts = _box(1.0, 1.0, 3.0)
+    cams = scene.frame_cameras(pts, [0.0, -30, 30], fov_deg=40, resolution=128, fill_height=0.9)
+    uv, z = cams[0].project(pts)
+    assert np.ptp(uv[:, 1]) / 128 == pytest.approx(0.9, abs=1e-9)
+    assert uv[:, 1].min() == pytest.approx(128 - uv[:, 1].max(), abs=1e-6)  # centred
+    # every camera on one orbit (same distance and height) about the box's vertical centre line
+    c = np.array([0.3, -0.2])
+    r = [np.linalg.norm(cam.center[:2] - c) for cam in cams]
+    np.testing.assert_allclose(r, r[0], rtol=1e-12)
+    np.testing.assert_allclose([cam.center[2] for cam in cams], cams[0].center[2], rtol=1e-12)
+    for cam in cams:
+        uv, _ = cam.project(pts)
+        assert (uv >= 0.5).all() and (uv <= 127.5).all()
+    # a smaller fill moves the camera back; the field of view never changes
+    far = scene.frame_cameras(pts, [0.0], fov_deg=40, resolution=128, fill_height=0.6)[0]
+    assert np.linalg.norm(far.center[:2] - c) > r[0] and far.fy == cams[0].fy
+
+
+def test_framing_shifts_the_camera_height_for_a_held_out_view():
+    # a tree whose top reaches toward the camera at +60 degrees: that view clips when the
+    # training view is centred, so the camera rises (the training view stays at 0.9 of its height)
+    u = 1.2 * np.array([np.sin(np.pi / 3), -np.cos(np.pi / 3)])  # toward the +60 camera
+    c = np.array([0.3, -0.2])
+    pts = np.concatenate([_box(0.4, 0.4, 2.0), [[*(c + u), 3.0], [*(c - u), 0.0]]])
+    cams = scene.frame_cameras(pts, [0.0, 60], fov_deg=40, resolution=128, fill_height=0.9)
+    uv, _ = cams[0].project(pts)
+    assert np.ptp(uv[:, 1]) / 128 == pytest.approx(0.9, abs=1e-9)
+    assert uv[:, 1].min() > 128 - uv[:, 1].max() + 4  # no longer centred: the camera rose
+    uv, _ = cams[1].project(pts)
+    assert uv[:, 1].min() == pytest.approx(0.5, abs=1e-6)  # just inside the +60 view's margin
+
+
+def test_framing_error_names_the_key_and_the_fix():
+    flat = _box(6.0, 0.2, 1.0)  # wide and low: it leaves the image sideways at 0.9 height fill
+    with pytest.raises(scene.FramingError, match=r"testbed\.fill_height = 0\.9.*training camera.*lower "
+                       r"testbed\.fill_height.*at most 0\.\d+ fits"):
+        scene.frame_cameras(flat, [0.0], fov_deg=40, resolution=128, fill_height=0.9)
+    deep = _box(0.5, 6.0, 3.0)  # deep along the training axis: side views see it wide
+    with pytest.raises(scene.FramingError, match=r"held-out view at azimuth [+-]60 deg"):
+        scene.frame_cameras(deep, [0.0, -60, 60], fov_deg=40, resolution=128, fill_height=0.9)
+    msg = ""
+    try:
+        scene.frame_cameras(deep, [0.0, -60, 60], fov_deg=40, resolution=128, fill_height=0.9)
+    except scene.FramingError as e:
+        msg = str(e)
+    best = float(msg.split("at most ")[1].split(" ")[0])
+    scene.frame_cameras(deep, [0.0, -60, 60], fov_deg=40, resolution=128, fill_height=best - 1e-3)
+    with pytest.raises(scene.FramingError, match=r"must lie in \(0, 1\)"):
+        scene.frame_cameras(deep, [0.0], fov_deg=40, resolution=128, fill_height=1.2)
 
 
 def test_failed_save_leaves_nothing(tmp_path, monkeypatch):

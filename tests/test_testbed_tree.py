@@ -5,7 +5,7 @@ import numpy as np
 import pytest
 
 from physgs.config import load
-from physgs.testbed import kinematics
+from physgs.testbed import kinematics, stats
 from physgs.testbed.dataset import simulate_tree
 from physgs.testbed.weberpenn import PresetError, generate
 
@@ -60,6 +60,52 @@ def test_bad_bone_count_names_cause():
     p = copy.deepcopy(CFG["presets"]["sparse"])
     p["levels"][0]["curve_res"] = 5
     with pytest.raises(PresetError, match=r"yields 23 animated bones but declares bones: 22"):
+        generate(p, seed=0, name="sparse")
+
+
+def test_sparse_clones_vary_and_match_the_papers_frequency_grid(sims):
+    tr = sims["sparse"].truth
+    # per-clone length variation: no two bones share a natural frequency
+    assert stats.distinct_count(tr.omega) == tr.omega.size == 22
+    # the median gap an arbitrary frequency leaves to the nearest bone: the paper's sparse tree
+    # has 5.40%; ours must be close (within half a point)
+    assert abs(stats.median_nearest_bone_gap(tr.omega) - 0.054) < 0.005
+    assert tr.omega_clamped.sum() == 0
+
+
+def test_clone_variation_never_changes_the_bone_count():
+    p = copy.deepcopy(CFG["presets"]["sparse"])
+    for lv, cv in ((0.0, 0.0), (0.03, 8.0), (0.5, 30.0), (0.95, 60.0)):
+        p["split"].update(length_v=lv, curve_v_deg=cv)
+        for seed in range(8):
+            assert generate(p, seed=seed, name="sparse").n_bones == 22
+
+
+def test_clone_variation_is_seeded_and_touches_only_the_clones():
+    p = copy.deepcopy(CFG["presets"]["sparse"])
+    p["split"].update(length_v=0.0, curve_v_deg=float(p["levels"][0].get("curve_v_deg", 0)))
+    exact = generate(p, seed=0, name="sparse")
+    n_trunk = int(p["levels"][0]["curve_res"])
+    per = int(p["split"]["curve_res"])
+    c1, c2 = slice(n_trunk, n_trunk + per), slice(n_trunk + per, n_trunk + 2 * per)
+    # no variation: the two clones are exact twins in length and radius (identical frequencies)
+    np.testing.assert_allclose(exact.length[c1], exact.length[c2], rtol=1e-12)
+    np.testing.assert_allclose(exact.radius[c1], exact.radius[c2], rtol=1e-12)
+    p["split"]["length_v"] = 0.1
+    a, b = generate(p, seed=0, name="sparse"), generate(p, seed=0, name="sparse")
+    np.testing.assert_array_equal(a.length, b.length)  # seeded
+    assert abs(a.length[c1][0] / a.length[c2][0] - 1) > 1e-6  # the clones differ now
+    assert np.all(np.abs(a.length[c1] / exact.length[c1] - 1) <= 0.1 + 1e-12)
+    # the trunk (drawn before the clones) and the bend draws are the tree's own: unchanged
+    np.testing.assert_array_equal(a.head[:n_trunk], exact.head[:n_trunk])
+    np.testing.assert_array_equal(a.radius, exact.radius)
+
+
+@pytest.mark.parametrize("key,value", [("length_v", 1.0), ("length_v", -0.1), ("curve_v_deg", -1.0)])
+def test_bad_clone_variation_names_the_key(key, value):
+    p = copy.deepcopy(CFG["presets"]["sparse"])
+    p["split"][key] = value
+    with pytest.raises(PresetError, match=rf"split\.{key} = .*fix presets\.sparse\.split\.{key}"):
         generate(p, seed=0, name="sparse")
 
 

@@ -15,13 +15,15 @@ MeansFn = Callable[[int, int], np.ndarray]  # (frame_idx, condition) -> Gaussian
 class Trajectories:
     """Tip paths projected by the training camera, pixels (x right, y down).
 
-    gt_px, pred_px: [P, F, 2] for the tip vertices ``tips`` [P] over recorded frames 0..F-1 of
-    ``condition``; frames < n_train lie in the training window, the rest in the tail.
+    gt_px, pred_px: [P, F, 2] for the tip vertices ``tips`` [P] (mesh vertex indices) over
+    recorded frames 0..F-1 of ``condition``; frames < n_train lie in the training window, the rest
+    in the tail. The prediction is the model's Gaussian of each tip vertex
+    (``truth.vertex_gaussian[tips]``: the observed Gaussians are stored in a random order).
     """
 
     gt_px: np.ndarray  # [P, F, 2]
     pred_px: np.ndarray  # [P, F, 2]
-    tips: np.ndarray  # [P] vertex (= Gaussian) indices
+    tips: np.ndarray  # [P] mesh vertex indices
     condition: int
     n_train: int
 
@@ -65,15 +67,17 @@ def tip_trajectories(means_fn: MeansFn, truth, observed, *, condition: int = 0,
                      tips: np.ndarray | None = None, pose_fn: Callable | None = None) -> Trajectories:
     """Ground-truth and predicted branch-tip paths in pixels at the training camera.
 
-    means_fn(frame_idx, condition) -> [N, 3] numpy Gaussian means of the model (one Gaussian per
-    mesh vertex, so vertex index = Gaussian index). tips: vertex indices [P] (default
-    ``truth.tip_vertices``). Covers all F = n_train + n_tail recorded frames.
+    means_fn(frame_idx, condition) -> [N, 3] numpy Gaussian means of the model, in Gaussian order
+    (one Gaussian per mesh vertex, in the seeded random order of ``canonical_xyz``). tips: mesh
+    vertex indices [P] (default ``truth.tip_vertices``); the Gaussian of vertex v is
+    ``truth.vertex_gaussian[v]``. Covers all F = n_train + n_tail recorded frames.
     """
     tips = np.asarray(truth.tip_vertices if tips is None else tips, dtype=np.int64)
+    gauss = np.asarray(truth.vertex_gaussian, dtype=np.int64)[tips]  # the tips' Gaussians
     F = int(observed.n_train + observed.n_tail)
     cam = observed.train_camera
     gt = gt_tip_positions(truth, tips, condition, int(observed.lead_in_frames), F, pose_fn)
-    pred = np.stack([np.asarray(means_fn(j, condition))[tips] for j in range(F)], axis=1)  # [P, F, 3]
+    pred = np.stack([np.asarray(means_fn(j, condition))[gauss] for j in range(F)], axis=1)  # [P, F, 3]
     P = len(tips)
     gt_px, _ = cam.project(gt.reshape(-1, 3))
     pred_px, _ = cam.project(pred.reshape(-1, 3).astype(np.float64))

@@ -7,6 +7,13 @@ stored wind and theta have L lead-in columns first, so column L + j is recorded 
 The ground truth starts at the periodic steady state of the (60 s periodic) wind, i.e. it is the
 response to an infinitely long past; the L = 1.5 tau_max lead-in columns let a model that
 integrates from rest at column 0 reach that steady state before the recorded window opens.
+
+Gaussian order: the observed Gaussians (``canonical_xyz``) are the mesh vertices in a seeded random
+order, so their index carries no bone label (mesh order groups vertices by bone). The permutation
+lives only in ``truth.npz``: Gaussian i is mesh vertex ``gaussian_vertex[i]``, and mesh vertex v is
+Gaussian ``vertex_gaussian[v]``. Everything indexed by mesh vertex (``vertex_bone``,
+``rest_vertices``, ``tip_vertices``, ``kinematics.pose_vertices``) stays in mesh order;
+``kinematics.pose_gaussians`` poses in Gaussian order.
 """
 from __future__ import annotations
 
@@ -23,7 +30,7 @@ from physgs.camera import Camera
 from physgs.testbed import kinematics, physics, raycast, scene, weberpenn, wind as windmod
 from physgs.testbed.mesh import TreeMesh, build_mesh
 
-FORMAT_VERSION = 1
+FORMAT_VERSION = 2  # 2: Gaussians in a seeded random order (gaussian_vertex), fill_height framing
 REBUILD = "rebuild it with `snakemake --cores 2 testbed` (delete the bad file first)"
 
 
@@ -43,7 +50,8 @@ class Observed:
     wind [C, L+F] float32 m/s (column L = recorded frame 0); vbar [C] m/s the condition's nominal
     mean speed (the drag forcing is v^2 - vbar^2); frames [C, F, H, W, 3] uint8; masks [C, F, H, W]
     bool; heldout_frames [A, M, H, W, 3]; heldout_masks [A, M, H, W]; canonical_xyz [N, 3] float32
-    (m), vertex positions at recorded frame 0 of the training condition.
+    (m), vertex positions at recorded frame 0 of the training condition, in Gaussian order (a
+    seeded random order of the mesh vertices; the permutation is in the truth file only).
     """
 
     fps: int
@@ -70,9 +78,11 @@ class Truth:
     """Ground truth (never read by training). omega [B] rad/s, zeta [B], gain [B] (rad/s^2 per
     m^2/s^2), theta [C, L+F, B] rad (same columns as wind), bone_head / bone_tail [B, 3] m (rest),
     bone_parent [B] (-1 root), bone_level [B], bone_radius / bone_length [B] m, swing_axis [3],
-    vertex_bone [N], rest_vertices [N, 3] m, faces [M, 3], vertex_colors [N, 3], tip_vertices [P],
-    omega_clamped [B] bool, omega_c (calibration constant c in omega = c r / L^2), g0, fps,
-    lead_in_frames, vbar [C] m/s."""
+    vertex_bone [N], rest_vertices [N, 3] m, faces [M, 3], vertex_colors [N, 3], tip_vertices [P]
+    (all in mesh order: vertex indices), omega_clamped [B] bool, omega_c (calibration constant c in
+    omega = c r / L^2), g0, fps, lead_in_frames, vbar [C] m/s; gaussian_vertex [N] (the mesh vertex
+    of each observed Gaussian: canonical_xyz[i] is vertex gaussian_vertex[i]) and vertex_gaussian
+    [N] (its inverse: the Gaussian of each mesh vertex)."""
 
     omega: np.ndarray
     zeta: np.ndarray
@@ -96,6 +106,8 @@ class Truth:
     fps: int
     lead_in_frames: int
     vbar: np.ndarray
+    gaussian_vertex: np.ndarray
+    vertex_gaussian: np.ndarray
 
 
 # --------------------------------------------------------------------------------------------
@@ -170,13 +182,18 @@ def simulate_tree(tb: dict, preset: dict, *, seed: int, tree: str) -> TreeSim:
     order = tip_cands[np.argsort(az)]
     P = min(6, len(order))
     tips = order[np.linspace(0, len(order) - 1, P).round().astype(int)] if P else order
+    # observed Gaussian order: its own seeded stream, so it changes nothing else in the tree
+    gaussian_vertex = np.random.default_rng(_seed(seed, tree, "gaussian_order")).permutation(
+        len(mesh.vertices))
+    vertex_gaussian = np.argsort(gaussian_vertex)
 
     truth = Truth(omega=omega, zeta=zeta, gain=g0 * omega ** 2, theta=theta,
                   bone_head=skel.head, bone_tail=skel.tail, bone_parent=skel.parent,
                   bone_level=skel.level, bone_radius=skel.radius, bone_length=skel.length,
                   swing_axis=axis, vertex_bone=mesh.vertex_bone, rest_vertices=mesh.vertices,
                   faces=mesh.faces, vertex_colors=mesh.vertex_colors, tip_vertices=tips,
-                  omega_clamped=clamped, omega_c=c, g0=float(g0), fps=fps, lead_in_frames=L, vbar=vbar)
+                  omega_clamped=clamped, omega_c=c, g0=float(g0), fps=fps, lead_in_frames=L, vbar=vbar,
+                  gaussian_vertex=gaussian_vertex, vertex_gaussian=vertex_gaussian)
     return TreeSim(skel, mesh, truth, wind32, cond)
 
 
@@ -184,20 +201,13 @@ def simulate_tree(tb: dict, preset: dict, *, seed: int, tree: str) -> TreeSim:
 # Rendering
 
 
-def _motion_bounds(truth: Truth, L: int, chunk: int = 32):
-    """Bounds of every posed vertex over all recorded frames and conditions."""
-    lo, hi = np.full(3, np.inf), np.full(3, -np.inf)
+def swept_points(truth: Truth, chunk: int = 25) -> np.ndarray:
+    """Vertices [K, 3] (m) of the convex hull of every posed vertex over every recorded frame of
+    every condition (lead-in excluded): the tree's swept extent, as the framing needs it."""
+    L = truth.lead_in_frames
     th = truth.theta[:, L:].reshape(-1, truth.theta.shape[-1])
-    for i in range(0, len(th), chunk):
-        V = kinematics.pose_vertices(truth, th[i:i + chunk])
-        lo = np.minimum(lo, V.min(axis=(0, 1)))
-        hi = np.maximum(hi, V.max(axis=(0, 1)))
-    c = 0.5 * (lo + hi)
-    rh = 0.0
-    for i in range(0, len(th), chunk):
-        V = kinematics.pose_vertices(truth, th[i:i + chunk])
-        rh = max(rh, float(np.linalg.norm(V[..., :2] - c[:2], axis=-1).max()))
-    return lo, hi, rh
+    return scene.convex_hull_points(kinematics.pose_vertices(truth, th[i:i + chunk])
+                                    for i in range(0, len(th), chunk))
 
 
 def build_dataset(tb: dict, preset: dict, *, seed: int, tree: str, progress: bool = True):
@@ -207,10 +217,13 @@ def build_dataset(tb: dict, preset: dict, *, seed: int, tree: str, progress: boo
     L, fps = tr.lead_in_frames, tr.fps
     n_train, n_tail = int(tb["n_train"]), int(tb["n_tail"])
     F = n_train + n_tail
-    lo, hi, rh = _motion_bounds(tr, L)
+    if "fill_height" not in tb:
+        raise scene.FramingError("config key testbed.fill_height is missing (fraction of the training "
+                                 "image height the swept tree spans, e.g. 0.9); add it to "
+                                 "config/trees.yaml")
     az = np.asarray(tb["heldout_azimuths_deg"], dtype=np.float64)
-    cams = scene.frame_cameras(lo, hi, rh, [0.0, *az], fov_deg=float(tb["fov_deg"]),
-                               resolution=int(tb["resolution"]))
+    cams = scene.frame_cameras(swept_points(tr), [0.0, *az], fov_deg=float(tb["fov_deg"]),
+                               resolution=int(tb["resolution"]), fill_height=float(tb["fill_height"]))
     train_cam, held_cams = cams[0], cams[1:]
     ss, bg = int(tb["supersample"]), np.asarray(tb["background"], dtype=np.float64)
     face_colors = tr.vertex_colors[tr.faces].mean(axis=1)
@@ -240,7 +253,7 @@ def build_dataset(tb: dict, preset: dict, *, seed: int, tree: str, progress: boo
             bar.update()
     bar.close()
 
-    canonical = kinematics.pose_vertices(tr, tr.theta[0, L]).astype(np.float32)
+    canonical = kinematics.pose_gaussians(tr, tr.theta[0, L]).astype(np.float32)
     observed = dict(format_version=FORMAT_VERSION, fps=fps, n_train=n_train, n_tail=n_tail,
                     lead_in_frames=L, conditions=sim.conditions, vbar=tr.vbar, wind=sim.wind,
                     frames=frames, masks=masks, heldout_azimuths_deg=az, heldout_frame_idx=held_idx,
@@ -347,5 +360,10 @@ def load_truth(path: Path | str) -> Truth:
     _check(path, d["bone_head"].shape == (B, 3) and len(d["bone_parent"]) == B, "bone arrays disagree")
     _check(path, len(d["vertex_bone"]) == len(d["rest_vertices"]), "vertex_bone does not match rest_vertices")
     _check(path, bool((d["vertex_bone"] >= 0).all() and (d["vertex_bone"] < B).all()), "vertex_bone out of range")
+    N = len(d["rest_vertices"])
+    gv, vg = d["gaussian_vertex"], d["vertex_gaussian"]
+    _check(path, gv.shape == (N,) and vg.shape == (N,) and np.array_equal(np.sort(gv), np.arange(N))
+           and np.array_equal(gv[vg], np.arange(N)),
+           "gaussian_vertex is not a permutation of the vertices with inverse vertex_gaussian")
     scalars = {"omega_c": float, "g0": float, "fps": int, "lead_in_frames": int}
     return Truth(**{k: scalars[k](d[k]) if k in scalars else d[k] for k in keys})

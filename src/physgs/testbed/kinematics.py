@@ -92,3 +92,11 @@ def pose_vertices(truth, theta_b: np.ndarray) -> np.ndarray:
     """
     return pose_points(truth.rest_vertices, truth.vertex_bone, truth.bone_head, truth.bone_tail,
                        truth.bone_parent, truth.swing_axis, theta_b)
+
+
+def pose_gaussians(truth, theta_b: np.ndarray) -> np.ndarray:
+    """The observed Gaussians posed by bone angles theta_b [..., B] (rad) -> [..., N, 3] (m), in
+    Gaussian order (the order of ``canonical_xyz``): ``pose_vertices`` permuted by
+    ``truth.gaussian_vertex``. This is the ground-truth motion of each Gaussian (the true-motion
+    reference moves the canonical Gaussians with it)."""
+    return pose_vertices(truth, theta_b)[..., np.asarray(truth.gaussian_vertex), :]

@@ -10,6 +10,14 @@ Exact bone counts: the number of stems per level is fixed by the preset (``stems
 over the parent stems in proportion to their length (largest remainder, no random splits), so
 bones = sum over armature levels of stems x ceil(curve_res / bone_step). The generator counts the
 bones it actually built and stops with :class:`PresetError` if that differs from ``bones``.
+
+Split clones (``split``) vary per clone as Weber-Penn stems do: ``length_v`` scales each clone's
+length by 1 + U(-length_v, length_v) and ``curve_v_deg`` sets its random bend (default: the trunk
+level's ``curve_v_deg``). The length draws come from their own seeded stream and the bend reuses
+the draws made without variation, so every other random draw of the tree stays the same (stems
+on a longer clone still grow with it). Neither can change a bone count: a clone has
+ceil(curve_res / bone_step) bones whatever its length or bend, and length_v < 1 keeps every
+clone's length positive.
 """
 from __future__ import annotations
 
@@ -206,7 +214,19 @@ def generate(preset: dict, *, seed: int, name: str) -> Skeleton:
     # Split clones at the trunk's end (still level 0): a fork.
     split = preset.get("split") or {}
     n_clones = int(split.get("clones", 0))
+    length_v = float(split.get("length_v", 0.0))
+    clone_curve_v = float(split.get("curve_v_deg", lv0.get("curve_v_deg", 0)))
+    if not 0.0 <= length_v < 1.0:
+        raise PresetError(f"preset '{name}': split.length_v = {length_v} must lie in [0, 1) (a clone's "
+                          "length is scaled by 1 + U(-length_v, length_v), which must stay positive); "
+                          f"fix presets.{name}.split.length_v in config/trees.yaml")
+    if clone_curve_v < 0:
+        raise PresetError(f"preset '{name}': split.curve_v_deg = {clone_curve_v} must be >= 0; "
+                          f"fix presets.{name}.split.curve_v_deg in config/trees.yaml")
     if n_clones:
+        # per-clone length variation from its own stream: every other draw is as without it
+        crng = np.random.default_rng(np.random.SeedSequence([int(seed), _stable_id(name), 2]))
+        clone_scale = 1.0 + crng.uniform(-1.0, 1.0, n_clones) * length_v
         tip_dir = _unit(trunk_pts[-1] - trunk_pts[-2])
         side = _rot(_perp(tip_dir), tip_dir, math.radians(float(split.get("azimuth_deg", 0.0))))
         tip_bone = int(stems[0].segment_bone[-1])
@@ -214,9 +234,11 @@ def generate(preset: dict, *, seed: int, name: str) -> Skeleton:
             phi = 2 * math.pi * i / n_clones
             axis = _unit(_rot(np.cross(tip_dir, side), tip_dir, phi))
             d = _rot(tip_dir, axis, math.radians(float(split["angle_deg"])))
-            Lc = float(split["length"]) * L0
+            Lc = float(split["length"]) * L0 * clone_scale[i]
+            # the same draws from the tree stream as without variation (curve_res normals per
+            # clone), scaled by the clone's curve_v_deg
             pts = _polyline(trunk_pts[-1], d, Lc, int(split["curve_res"]), float(lv0.get("curve_deg", 0)),
-                            float(lv0.get("curve_v_deg", 0)), rng)
+                            clone_curve_v, rng)
             add_stem(pts, r0 * (1 - taper) * float(split.get("radius", 0.8)), 0, 0, tip_bone,
                      float(split.get("taper", taper)))
 
