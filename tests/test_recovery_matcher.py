@@ -93,3 +93,19 @@ def test_damping_constant_ratio_and_constant_rate():
     assert d2.median_zeta == pytest.approx(np.median(rate / omega))
     with pytest.raises(ValueError, match="positive"):
         damping_summary(omega, -np.ones(4), 0.08)
+
+
+def test_restricted_scores_only_parts_on_visible_bones():
+    from physgs.recovery.matcher import MatchResult, restricted
+
+    m = MatchResult(bone=np.array([0, 1, 2, 2]), corr=np.array([0.9, 0.9, 0.5, 0.95]),
+                    trusted=np.array([True, True, False, True]),
+                    omega_hat=np.ones(4), omega_true=np.ones(4),
+                    rel_err=np.array([0.01, 0.20, 0.50, 0.03]), n_trusted=3, n_parts=4,
+                    median_rel_err=0.03, loglog_r2=float("nan"))
+    # bone 1 invisible: the trusted parts on bones 0 and 2 remain (errors 0.01 and 0.03)
+    n, med = restricted(m, np.array([True, False, True]))
+    assert n == 2 and med == pytest.approx(0.02)
+    assert restricted(m, np.ones(3, bool)) == (3, pytest.approx(0.03))  # everything visible
+    n, med = restricted(m, np.zeros(3, bool))
+    assert n == 0 and np.isnan(med)

@@ -23,6 +23,7 @@ STAMP = _provenance.stamp(CFG)  # not a rerun trigger (see physgs.provenance.Sta
 # ---- file layout ------------------------------------------------------------------------------
 OBSERVED = "results/testbed/{tree}/observed.npz"
 TRUTH = "results/testbed/{tree}/truth.npz"
+STATS = "results/testbed/{tree}/stats.json"
 CKPT = "results/models/{tree}/{model}_{config}.pt"
 LOSS = "results/models/{tree}/{model}_{config}.loss.csv"
 EVAL = "results/eval/{tree}/{model}_{config}.npz"
@@ -36,7 +37,7 @@ TABLE = "results/tables/{name}.{ext}"
 FIGURE = "results/figures/{name}.{ext}"
 #: need kind (physgs.report.build.needs) -> path template
 NEED_PATHS = {"eval": EVAL, "traj": TRAJ, "panels": PANELS, "loss": LOSS, "recovery": RECOVERY,
-              "null": NULL, "kselect": KSELECT}
+              "null": NULL, "kselect": KSELECT, "stats": STATS}
 SA_TREE = CFG["speed_accuracy"]["tree"]
 SWEEP_POINTS = _sweep.sweep_points(CFG)
 

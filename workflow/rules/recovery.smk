@@ -7,6 +7,7 @@ rule recovery:
         ckpt=CKPT.replace("{model}", "ours"),
         observed=OBSERVED,
         truth=TRUTH,
+        stats=STATS,
     output:
         record=RECOVERY,
     conda:
@@ -25,6 +26,7 @@ rule null_control:
     input:
         observed=OBSERVED,
         truth=TRUTH,
+        stats=STATS,
     output:
         record=NULL,
     params:

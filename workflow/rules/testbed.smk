@@ -22,10 +22,31 @@ rule testbed_dataset:
         "../scripts/testbed_dataset.py"
 
 
+rule testbed_stats:
+    input:
+        observed=OBSERVED,
+        truth=TRUTH,
+    output:
+        stats=STATS,
+    conda:
+        "../envs/physgs.yaml"
+    log:
+        "logs/testbed/stats_{tree}.log",
+    benchmark:
+        "results/benchmarks/testbed/stats_{tree}.tsv"
+    threads: 1
+    resources:
+        mem_mb=3000,
+        runtime=10,
+    script:
+        "../scripts/testbed_stats.py"
+
+
 rule testbed_figure:
     input:
         observed=OBSERVED,
         truth=TRUTH,
+        stats=STATS,
     output:
         figure=report(
             "results/figures/testbed_{tree}.png",
@@ -48,4 +69,6 @@ rule testbed:
     input:
         expand(OBSERVED, tree=TREES),
         expand(TRUTH, tree=TREES),
+        expand(STATS, tree=TREES),
         expand("results/figures/testbed_{tree}.png", tree=TREES),
+        expand(TABLE, name="tab_testbed", ext=("tex", "csv")),

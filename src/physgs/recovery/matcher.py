@@ -110,3 +110,13 @@ def match_parts(part_theta: np.ndarray, bone_theta: np.ndarray, omega_hat: np.nd
     med = float(np.median(rel[trusted])) if n else float("nan")
     r2 = loglog_r2(omega_hat[trusted], omega_true[trusted])
     return MatchResult(bone, corr, trusted, omega_hat, omega_true, rel, n, K, med, r2)
+
+
+def restricted(m: MatchResult, bone_mask: np.ndarray) -> tuple[int, float]:
+    """(trusted parts matched to a bone in ``bone_mask`` [B] bool, their median relative error).
+
+    The median is NaN when no such part is trusted. Used to score recovery only on bones whose
+    own motion is visible in the training camera (``physgs.testbed.stats``).
+    """
+    sel = np.asarray(m.trusted, bool) & np.asarray(bone_mask, bool)[np.asarray(m.bone, int)]
+    return int(sel.sum()), float(np.median(m.rel_err[sel])) if sel.any() else float("nan")

@@ -12,7 +12,7 @@ from dataclasses import asdict, dataclass
 import numpy as np
 import torch
 
-from physgs.recovery.matcher import TRUST_THRESHOLD, match_parts, training_window
+from physgs.recovery.matcher import TRUST_THRESHOLD, match_parts, restricted, training_window
 
 N_DRAWS = 8
 
@@ -42,6 +42,8 @@ class NullResult:
     n_parts: int
     nearest_bone_gap: float  # median over draws and parts
     seed: int
+    n_trusted_visible: np.ndarray | None = None  # [D] restricted to visible bones (or None)
+    median_rel_err_visible: np.ndarray | None = None  # [D]
 
     @property
     def median_n_trusted(self) -> float:
@@ -54,6 +56,19 @@ class NullResult:
         return float(np.median(v)) if v.size else float("nan")
 
     @property
+    def median_n_trusted_visible(self) -> float:
+        """Median over draws of the parts trusted on visible bones (NaN without visibility)."""
+        v = self.n_trusted_visible
+        return float(np.median(v)) if v is not None else float("nan")
+
+    @property
+    def median_median_rel_err_visible(self) -> float:
+        """Median over draws of the median error on visible bones (NaN without visibility)."""
+        v = self.median_rel_err_visible
+        v = v[np.isfinite(v)] if v is not None else np.array([])
+        return float(np.median(v)) if v.size else float("nan")
+
+    @property
     def median_loglog_r2(self) -> float:
         v = self.loglog_r2[np.isfinite(self.loglog_r2)]
         return float(np.median(v)) if v.size else float("nan")
@@ -63,28 +78,32 @@ class NullResult:
 
     @staticmethod
     def from_dict(d: dict) -> "NullResult":
+        opt = {k: (np.asarray(d[k], float) if d.get(k) is not None else None)
+               for k in ("n_trusted_visible", "median_rel_err_visible")}
         return NullResult(np.asarray(d["n_trusted"]), np.asarray(d["median_rel_err"], float),
                           np.asarray(d["loglog_r2"], float), np.asarray(d["omega"], float),
-                          int(d["n_parts"]), float(d["nearest_bone_gap"]), int(d["seed"]))
+                          int(d["n_parts"]), float(d["nearest_bone_gap"]), int(d["seed"]), **opt)
 
 
 def null_control(omega_bones: np.ndarray, bone_theta: np.ndarray, wind: np.ndarray, *, n_parts: int,
                  zeta_init: float, vbar: float, dt: float, substeps: int, lead_in_frames: int,
                  n_train: int, seed: int, n_draws: int = N_DRAWS, gain: float = 1.0,
-                 threshold: float = TRUST_THRESHOLD) -> NullResult:
+                 threshold: float = TRUST_THRESHOLD,
+                 bone_visible: np.ndarray | None = None) -> NullResult:
     """Run the untrained null through ``physgs.models.oscillator.integrate`` and the matcher.
 
     omega_bones [B] rad/s; bone_theta [B, n_train] rad, the bones' angles over the training
     window at the training wind; wind [L+F] m/s at the frame rate (training condition, lead-in
     first); vbar m/s and dt = 1/fps s and substeps exactly as the trained model uses them.
     gain only scales theta, which correlation ignores. Seeded: same seed, same draws.
+    bone_visible [B] bool: also score each draw on the bones whose own motion is visible.
     """
     from physgs.models.oscillator import integrate  # the trained model's own solver
 
     omega_bones = np.asarray(omega_bones, dtype=np.float64)
     draws = draw_null_omegas(omega_bones, n_parts, n_draws, seed)  # [D, K]
     w = torch.as_tensor(np.asarray(wind), dtype=torch.float64)
-    n_tr, med, r2 = [], [], []
+    n_tr, med, r2, vis = [], [], [], []
     for om in draws:
         with torch.no_grad():
             theta = integrate(torch.as_tensor(om), torch.full((n_parts,), float(zeta_init), dtype=torch.float64),
@@ -95,5 +114,9 @@ def null_control(omega_bones: np.ndarray, bone_theta: np.ndarray, wind: np.ndarr
         n_tr.append(m.n_trusted)
         med.append(m.median_rel_err)
         r2.append(m.loglog_r2)
+        if bone_visible is not None:
+            vis.append(restricted(m, bone_visible))
     gap = float(np.median(nearest_bone_gap(draws, omega_bones)))
-    return NullResult(np.asarray(n_tr), np.asarray(med), np.asarray(r2), draws, int(n_parts), gap, int(seed))
+    v_n, v_med = (np.asarray(x, float) for x in zip(*vis)) if vis else (None, None)
+    return NullResult(np.asarray(n_tr), np.asarray(med), np.asarray(r2), draws, int(n_parts), gap,
+                      int(seed), v_n, v_med)

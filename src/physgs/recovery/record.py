@@ -1,6 +1,7 @@
 """Score one trained model's recovery against the truth file, and store results as JSON."""
 from __future__ import annotations
 
+import dataclasses
 import json
 from dataclasses import dataclass
 
@@ -8,7 +9,7 @@ import numpy as np
 
 from physgs.atomic import write_json
 from physgs.recovery.damping import DampingResult, damping_summary
-from physgs.recovery.matcher import MatchResult, match_parts, training_window
+from physgs.recovery.matcher import MatchResult, match_parts, restricted, training_window
 from physgs.recovery.null import NullResult
 
 
@@ -17,12 +18,21 @@ class RecoveryRecord:
     """Frequency match and damping summary of one (tree, config) model.
 
     n_frozen: parts frozen as invisible (physgs.models.visibility); their theta is 0, so the
-    matcher leaves them untrusted.
+    matcher leaves them untrusted. n_trusted_visible / median_rel_err_visible: the same scores
+    restricted to parts matched to bones whose own motion is visible (>= 1 px in the training
+    camera; -1 / NaN when no visibility was given).
     """
 
     match: MatchResult
     damping: DampingResult
     n_frozen: int = 0
+    n_trusted_visible: int = -1
+    median_rel_err_visible: float = float("nan")
+
+    def with_visibility(self, bone_visible: np.ndarray) -> "RecoveryRecord":
+        """This record with the scores restricted to visible bones (``bone_visible`` [B] bool)."""
+        n, med = restricted(self.match, bone_visible)
+        return dataclasses.replace(self, n_trusted_visible=n, median_rel_err_visible=med)
 
 
 def bone_window(truth, lead_in_frames: int, n_train: int) -> np.ndarray:
@@ -47,13 +57,17 @@ def score_recovery(part_theta: np.ndarray, omega_hat: np.ndarray, zeta_hat: np.n
 
 def save_recovery(path, rec: RecoveryRecord) -> None:
     write_json(path, {"match": rec.match.to_dict(), "damping": rec.damping.to_dict(),
-                      "n_frozen": int(rec.n_frozen)})
+                      "n_frozen": int(rec.n_frozen),
+                      "n_trusted_visible": int(rec.n_trusted_visible),
+                      "median_rel_err_visible": rec.median_rel_err_visible})
 
 
 def load_recovery(path) -> RecoveryRecord:
     d = _read(path)
     return RecoveryRecord(MatchResult.from_dict(d["match"]), DampingResult.from_dict(d["damping"]),
-                          int(d.get("n_frozen", 0)))  # records from before freezing: none frozen
+                          int(d.get("n_frozen", 0)),  # records from before freezing: none frozen
+                          int(d.get("n_trusted_visible", -1)),
+                          float(d.get("median_rel_err_visible", float("nan"))))
 
 
 def save_null(path, res: NullResult) -> None:
@@ -73,7 +87,7 @@ def _read(path) -> dict:
 
 
 def run_null(truth, observed, *, n_parts: int, zeta_init: float, substeps: int, seed: int,
-             n_draws: int | None = None) -> NullResult:
+             n_draws: int | None = None, bone_visible: np.ndarray | None = None) -> NullResult:
     """The null control for one tree and one K, wired exactly like the trained model.
 
     Uses the training condition's observed wind (lead-in first), dt = 1 / fps, and the
@@ -88,4 +102,5 @@ def run_null(truth, observed, *, n_parts: int, zeta_init: float, substeps: int, 
                         zeta_init=zeta_init, vbar=float(np.asarray(observed.vbar)[0]),
                         dt=1.0 / observed.fps,
                         substeps=substeps, lead_in_frames=L, n_train=n_train, seed=seed,
-                        n_draws=N_DRAWS if n_draws is None else n_draws)
+                        n_draws=N_DRAWS if n_draws is None else n_draws,
+                        bone_visible=bone_visible)

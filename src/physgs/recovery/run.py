@@ -12,10 +12,11 @@ from physgs.recovery.null import NullResult
 from physgs.recovery.record import RecoveryRecord, run_null, score_recovery
 
 
-def recover_model(model, observed, truth) -> RecoveryRecord:
+def recover_model(model, observed, truth, bone_visible=None) -> RecoveryRecord:
     """Match the trained parts to bones (training wind, training window) and summarise damping.
 
-    model: a trained ``ours`` model (``part_theta``, ``omega`` rad/s, ``zeta``).
+    model: a trained ``ours`` model (``part_theta``, ``omega`` rad/s, ``zeta``); bone_visible
+    [B] bool (``physgs.testbed.stats``): also score the parts matched to visible bones.
     """
     if not hasattr(model, "part_theta"):
         raise TypeError(f"recovery needs the oscillator prior ('ours'); got {type(model).__name__}")
@@ -26,6 +27,8 @@ def recover_model(model, observed, truth) -> RecoveryRecord:
         zeta = model.zeta.detach().cpu().numpy().astype(np.float64)
     rec = score_recovery(theta, omega, zeta, truth, int(observed.lead_in_frames),
                          int(observed.n_train))
+    if bone_visible is not None:
+        rec = rec.with_visibility(bone_visible)
     frozen = getattr(model, "frozen", None)
     if frozen is None or not bool(frozen.any()):
         return rec
@@ -46,7 +49,7 @@ def null_settings(cfg: dict, K: int) -> dict:
             "seed": int(cfg["seed"])}
 
 
-def null_control(observed, truth, settings: dict) -> NullResult:
+def null_control(observed, truth, settings: dict, bone_visible=None) -> NullResult:
     """The untrained null for ``settings['K']`` parts (``null_settings``), through the solver
     settings ours uses: substeps are raised exactly as the model raises them, so the null
     integrates with the trained model's step."""
@@ -55,4 +58,4 @@ def null_control(observed, truth, settings: dict) -> NullResult:
                               float(settings.get("rk4_guard", STABILITY_GUARD)))
     return run_null(truth, observed, n_parts=int(settings["K"]),
                     zeta_init=float(settings["zeta_init"]), substeps=substeps,
-                    seed=int(settings["seed"]))
+                    seed=int(settings["seed"]), bone_visible=bone_visible)

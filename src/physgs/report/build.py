@@ -21,14 +21,16 @@ from physgs.experiments.recipe import heldout_split
 from physgs.models.registry import BASE_CONFIG, MODEL_NAMES, REFERENCE_NAMES, config_label
 from physgs.recovery.record import load_null, load_recovery
 from physgs.report import figures, kselect, tables
+from physgs.testbed.stats import load_stats
 
-TABLES = ("tab_psnr", "tab_null", "tab_transfer", "tab_margin", "tab_kselect", "tab_fit")
+TABLES = ("tab_testbed", "tab_psnr", "tab_null", "tab_transfer", "tab_margin", "tab_kselect",
+          "tab_fit")
 FIGURES = ("fig_temporal", "fig_teaser", "fig_results", "fig_damping")
 #: The fields of each need tuple after its kind (what a workflow path template is formatted with).
 NEED_FIELDS = {"eval": ("tree", "model", "config"), "traj": ("tree", "model", "config"),
                "panels": ("tree", "model", "config"), "loss": ("tree", "model", "config"),
                "recovery": ("tree", "config"),
-               "null": ("tree", "K"), "kselect": ("tree",)}
+               "null": ("tree", "K"), "kselect": ("tree",), "stats": ("tree",)}
 #: Models (trained in the base configuration) whose evaluation an output reads.
 NEEDS_MODELS = {
     "tab_psnr": (*MODEL_NAMES, *REFERENCE_NAMES), "tab_transfer": MODEL_NAMES,
@@ -63,6 +65,8 @@ def needs(name: str, trees: Sequence[str], configs: Mapping[str, dict]) -> list[
         out += [("recovery", t, c) for t in trees for c in configs]
     if name == "tab_null":
         out += list(dict.fromkeys(("null", t, int(configs[c]["K"])) for t in trees for c in configs))
+    if name == "tab_testbed":
+        out += [("stats", t) for t in trees]
     if name == "tab_kselect":
         for t in trees:
             out.append(("kselect", t))
@@ -130,7 +134,10 @@ def make_table(name: str, inputs: Mapping[str, str], settings: dict, tex_path, c
     written into every CSV row (profile, config hash, package version)."""
     path = _reader(inputs)
     trees, bones, d = settings["trees"], settings["bones"], settings.get("digits", 2)
-    if name == "tab_psnr":
+    if name == "tab_testbed":
+        table = tables.tab_testbed({t: load_stats(path("stats", t)) for t in trees}, trees,
+                                   digits=d)
+    elif name == "tab_psnr":
         table = tables.tab_psnr(_summaries(path, trees, (*MODEL_NAMES, *REFERENCE_NAMES)), trees,
                                 bones, digits=d, references=REFERENCE_NAMES)
     elif name == "tab_fit":

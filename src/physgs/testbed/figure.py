@@ -15,8 +15,14 @@ from physgs.atomic import atomic_path  # noqa: E402
 from physgs.testbed.dataset import Observed, Truth  # noqa: E402
 
 
-def testbed_figure(obs: Observed, truth: Truth, tree: str, path: Path | str) -> Path:
-    """Write the figure to ``path`` (PNG, via a temporary file) and return the path."""
+def testbed_figure(obs: Observed, truth: Truth, tree: str, path: Path | str,
+                   stats: dict | None = None) -> Path:
+    """Write the figure to ``path`` (PNG, via a temporary file) and return the path.
+
+    stats: ``physgs.testbed.stats.testbed_stats`` of the tree; when given, the skeleton is
+    coloured by how visible each bone's own motion is (pixels) beside its frequency, and the
+    headline statistics are printed under the title.
+    """
     f_hz = truth.omega / (2 * np.pi)
     fig = plt.figure(figsize=(12, 6.2))
     gs = fig.add_gridspec(2, 6, height_ratios=[1.25, 1])
@@ -36,7 +42,13 @@ def testbed_figure(obs: Observed, truth: Truth, tree: str, path: Path | str) -> 
     fig.colorbar(lc, ax=ax, label="natural frequency (Hz)", shrink=0.8)
 
     ax = fig.add_subplot(gs[0, 2:4])
-    ax.hist(f_hz, bins=np.linspace(0.3, 1.55, 26), color="tab:green", edgecolor="k")
+    ax.hist(f_hz, bins=np.linspace(0.3, 1.55, 26), color="tab:green", edgecolor="k",
+            label="all bones")
+    if stats is not None:
+        ax.hist(f_hz[np.asarray(stats["visible"], bool)], bins=np.linspace(0.3, 1.55, 26),
+                color="tab:orange", edgecolor="k", alpha=0.8,
+                label=f"own motion >= {stats['visible_threshold_px']:g} px")
+        ax.legend(fontsize=7)
     ax.set_xlabel("natural frequency f = omega / 2 pi (Hz)")
     ax.set_ylabel("bones")
     ax.set_title(f"min {f_hz.min():.2f}, median {np.median(f_hz):.2f}, max {f_hz.max():.2f} Hz"
@@ -67,6 +79,14 @@ def testbed_figure(obs: Observed, truth: Truth, tree: str, path: Path | str) -> 
         ax.imshow(img)
         ax.set_title(title, fontsize=8)
         ax.axis("off")
+    if stats is not None:
+        fig.suptitle(
+            f"{stats['distinct_frequencies']} distinct frequencies, span "
+            f"{stats['f_span']:.2f}x; median nearest-bone gap {100 * stats['nearest_bone_gap']:.2f}%; "
+            f"median own-motion visibility {stats['visible_px_median']:.2f} px, "
+            f"{100 * stats['visible_below_px_fraction']:.0f}% of bones under "
+            f"{stats['visible_threshold_px']:g} px; tree spans {100 * stats['height_fill']:.0f}% "
+            "of the image height", fontsize=9, y=0.995)
     fig.tight_layout()
     path = Path(path)
     try:

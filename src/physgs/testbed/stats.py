@@ -216,3 +216,23 @@ def testbed_stats(observed, truth, *, visible_threshold_px: float = 1.0) -> dict
         mesh_order_share=neighbour_bone_share(vb),
         swing_deg=swing, visible_px=vis, visible=vis >= visible_threshold_px,
     )
+
+
+def save_stats(path, stats: dict) -> None:
+    """Write ``testbed_stats`` as JSON (arrays as lists), atomically."""
+    from physgs.atomic import write_json
+
+    write_json(path, {k: (v.tolist() if isinstance(v, np.ndarray) else v) for k, v in stats.items()})
+
+
+def load_stats(path) -> dict:
+    """Read ``save_stats``'s JSON back; per-bone lists become arrays."""
+    import json
+
+    try:
+        with open(path) as fh:
+            d = json.load(fh)
+    except (OSError, json.JSONDecodeError) as e:
+        raise ValueError(f"cannot read testbed statistics {path}: {e}; delete it and re-run "
+                         "its rule") from e
+    return {k: (np.asarray(v) if isinstance(v, list) else v) for k, v in d.items()}
