@@ -35,7 +35,7 @@ def test_quick_dag_through_cluster_generic_executor(tmp_path, quick_dag):
         "--jobs", "2", "--latency-wait", "30", "--seconds-between-status-checks", "1",
         "--default-resources", "mem_mb=2000", "runtime=20",
         "--config", "profile=quick", 'trees=["sparse"]', "--",
-        "results/recovery/sparse/ours_single.json", "results/recovery/sparse/null_single.json",
+        "results/recovery/sparse/ours_single.json", "results/recovery/sparse/null_K32.json",
         timeout=900,
     )
     log = proc.stdout + proc.stderr
@@ -43,6 +43,6 @@ def test_quick_dag_through_cluster_generic_executor(tmp_path, quick_dag):
     assert "cluster-generic" in log or "Submitted job" in log
     assert log.count("Submitted job") == 3, log[-3000:]  # train, recovery, null
     rec = load_recovery(wd / "results" / "recovery" / "sparse" / "ours_single.json")
-    null = load_null(wd / "results" / "recovery" / "sparse" / "null_single.json")
+    null = load_null(wd / "results" / "recovery" / "sparse" / "null_K32.json")
     assert rec.match.n_parts == 32 and 0 <= rec.match.n_trusted <= 32
     assert null.nearest_bone_gap > 0
