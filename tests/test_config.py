@@ -213,6 +213,9 @@ def _set(path, value, profile=None):
     (lambda c: c["models"]["configs"].pop("single"), "default", "models/configs/single"),
     (_set(("models", "configs", "auto"), {"conditions": "train", "K": 8}), "default",
      "models/configs/auto"),
+    # a preset that cannot reach its bone count (here: one more bone than it builds)
+    (_set(("presets", "sparse", "bones"), 23), "default", "presets/sparse"),
+    (_set(("train", "holdout_every"), 1), "default", "train/holdout_every"),
 ])
 def test_cross_key_problem_is_refused_naming_the_key(edit, profile, key):
     if key is None:  # a control: the edit alone is fine

@@ -201,6 +201,21 @@ def k_within_gaussians(cfg: dict) -> Iterator[Problem]:
                        "parts, which the sweep trains at every vertex count; raise it")
 
 
+def presets_reach_bone_counts(cfg: dict) -> Iterator[Problem]:
+    """Every listed tree's preset builds its exact bone count (clone variation included). The
+    skeleton alone is built (well under a second for all three trees), not the mesh or frames."""
+    from physgs.testbed.weberpenn import PresetError, generate
+
+    for tree in cfg["trees"]:
+        preset = cfg["presets"].get(tree)
+        if preset is None:
+            continue  # trees_have_settings reports it
+        try:
+            generate(preset, seed=int(cfg["seed"]), name=tree)
+        except PresetError as e:
+            yield (("presets", tree), str(e))
+
+
 def sweep_tree_is_listed(cfg: dict) -> Iterator[Problem]:
     """The speed-accuracy sweep runs on a tree the pipeline builds."""
     tree = cfg["speed_accuracy"]["tree"]
@@ -222,6 +237,7 @@ CHECKS: list[Check] = [
     configs_have_single,
     k_within_gaussians,
     sweep_tree_is_listed,
+    presets_reach_bone_counts,
 ]
 
 
