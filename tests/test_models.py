@@ -6,28 +6,20 @@ import pytest
 import torch
 from scipy.spatial.transform import Rotation
 
-import physgs.config
-from physgs.models import MODEL_NAMES, ModelContext, build_model, load_checkpoint, save_checkpoint
+from physgs.models import MODEL_NAMES, build_model, load_checkpoint, save_checkpoint
 from physgs.models.encoding import fourier
 from physgs.models.gaussians import quat_to_rotmat, rotate_about_pivot
 from physgs.models.oscillator import integrate
 from physgs.models.parts import kmeans_parts
 from physgs.models.windwindow import wind_window, window_columns, window_step
+from oracles import model_context, quick_models_cfg
 
 LEAD_IN = 160
 FPS = 24
 
 
 def _ctx(n=200, seed=0):
-    rng = np.random.default_rng(seed)
-    xyz = rng.normal(size=(n, 3)) * [0.5, 0.5, 1.0] + [0.0, 0.0, 2.0]
-    w = 6.0 + 1.5 * rng.standard_normal(LEAD_IN + 350)
-    return ModelContext(xyz.astype(np.float32), FPS, 300, LEAD_IN, float(w.mean()), float(w.std()),
-                        float((w**2 - w.mean() ** 2).std()), np.array([0.0, 1.0, 0.0])), w
-
-
-def _cfg():
-    return physgs.config.load("config/trees.yaml", "quick")["models"]
+    return model_context(n, seed, LEAD_IN)
 
 
 def _cov(q, s):
@@ -69,7 +61,7 @@ def test_fourier_features_match_explicit_formula():
 @pytest.mark.parametrize("name", MODEL_NAMES)
 def test_every_model_starts_exactly_at_the_canonical_pose(name):
     ctx, w = _ctx()
-    model = build_model(name, ctx, _cfg(), seed=0)
+    model = build_model(name, ctx, quick_models_cfg(), seed=0)
     c = model.canonical_state()
     for j in (0, 150, 349):
         g = model.gaussians_at(j, torch.tensor(w))
@@ -98,7 +90,7 @@ def test_wind_window_ends_at_t_steps_three_frames_and_reads_the_lead_in():
 
 def test_wind_models_see_the_wind_and_use_frozen_training_statistics():
     ctx, w = _ctx()
-    model = build_model("mlp_wind", ctx, _cfg())
+    model = build_model("mlp_wind", ctx, quick_models_cfg())
     f_train = model.features(5, torch.tensor(w, dtype=torch.float32))
     f_weak = model.features(5, torch.tensor(0.71 * w, dtype=torch.float32))
     win = f_train[0, -48:]
@@ -119,7 +111,7 @@ def test_kmeans_parts_deterministic_and_checked():
 
 def test_ours_bounds_guard_and_theta():
     ctx, w = _ctx()
-    cfg = _cfg()
+    cfg = quick_models_cfg()
     model = build_model("ours", ctx, cfg, config="joint96")
     assert model.K == 96 and model.part_labels.shape == (200,)
     lo, hi = (2 * math.pi * f for f in cfg["ours"]["omega_hz"])
@@ -140,13 +132,13 @@ def test_ours_bounds_guard_and_theta():
 def test_checkpoint_roundtrip(tmp_path):
     ctx, w = _ctx()
     for name in ("ours", "d3dgs_wind"):
-        model = build_model(name, ctx, _cfg())
+        model = build_model(name, ctx, quick_models_cfg())
         with torch.no_grad():
             for p in model.parameters():
                 p.add_(0.01 * torch.randn_like(p))
         path = tmp_path / f"{name}.pt"
-        save_checkpoint(path, model, name=name, config="single", seed=0, models_cfg=_cfg(),
-                        train_cfg={}, stats={"iterations": 1})
+        save_checkpoint(path, model, name=name, config="single", seed=0,
+                        models_cfg=quick_models_cfg(), train_cfg={}, stats={"iterations": 1})
         back = load_checkpoint(path)
         a = model.gaussians_at(200, torch.tensor(w))
         b = back.gaussians_at(200, torch.tensor(w))
@@ -165,7 +157,7 @@ def test_ours_drives_each_condition_with_its_nominal_mean_speed():
     ctx, w = _ctx()
     nominal = 6.3  # the anemometer record's mean differs from the condition's mean speed
     ctx = dataclasses.replace(ctx, vbar_ratio=nominal / float(w.mean()))
-    m = build_model("ours", ctx, _cfg(), config="single", seed=0)
+    m = build_model("ours", ctx, quick_models_cfg(), config="single", seed=0)
     with torch.no_grad():
         m.gain_raw.fill_(0.3)
         for scale in (1.0, 0.71):

@@ -1,40 +1,22 @@
 """RK4 oscillator solver against independent oracles (scipy lsim, closed form), gradients, guard."""
 import numpy as np
 import pytest
-import scipy.signal
 import torch
 
 from physgs.models.oscillator import StabilityError, integrate, required_substeps
+from oracles import gusty_wind, step_response, t64, wind_lsim
 
 FPS = 24
 DT = 1.0 / FPS
 
 
-def _wind(T, seed=0):
-    rng = np.random.default_rng(seed)
-    return 6.0 + 1.5 * rng.standard_normal(T)  # [T] m/s
-
-
-def _lsim(omega, zeta, gain, wind, vbar, dt):
-    """float64 oracle: exact first-order-hold solution via scipy (matrix exponential)."""
-    A = [[0.0, 1.0], [-omega**2, -2 * zeta * omega]]
-    sys = scipy.signal.StateSpace(A, [[0.0], [gain]], [[1.0, 0.0]], [[0.0]])
-    t = np.arange(len(wind)) * dt
-    _, y, _ = scipy.signal.lsim(sys, wind**2 - vbar**2, t, X0=[0.0, 0.0], interp=True)
-    return y
-
-
-def _t(x):
-    return torch.tensor(np.atleast_1d(x), dtype=torch.float64)
-
-
 def test_rk4_matches_lsim_with_fourth_order_convergence():
-    wind = _wind(240)
+    wind = gusty_wind(240)
     omega, zeta, gain = 2 * np.pi * 1.2, 0.08, 0.05
-    ref = _lsim(omega, zeta, gain, wind, 6.0, DT)
+    ref = wind_lsim(omega, zeta, gain, wind, 6.0, DT)
     errs = []
     for n in (1, 2, 4, 8):
-        th = integrate(_t(omega), _t(zeta), _t(gain), wind, 6.0, DT, n)[0].numpy()
+        th = integrate(t64(omega), t64(zeta), t64(gain), wind, 6.0, DT, n)[0].numpy()
         errs.append(np.abs(th - ref).max())
     assert errs[-1] < 1e-6 * np.abs(ref).max()
     ratios = np.array(errs[:-1]) / np.array(errs[1:])
@@ -48,18 +30,14 @@ def test_matches_closed_form_unforced_response(zeta):
     # response released from theta0 = -F/omega^2, theta0' = 0:
     #   theta_free(t) = theta0 exp(-zeta omega t) (cos wd t + zeta omega / wd sin wd t).
     T, v, omega, gain = 200, 5.0, 4.0, 0.02
-    th = integrate(_t(omega), _t(zeta), _t(gain), np.full(T, v), 0.0, DT, 4)[0].numpy()
+    th = integrate(t64(omega), t64(zeta), t64(gain), np.full(T, v), 0.0, DT, 4)[0].numpy()
     t = np.arange(T) * DT
-    wd = omega * np.sqrt(1 - zeta**2)
-    F = gain * v**2
-    theta0 = -F / omega**2
-    free = theta0 * np.exp(-zeta * omega * t) * (np.cos(wd * t) + zeta * omega / wd * np.sin(wd * t))
-    exact = F / omega**2 + free
+    exact = step_response(omega, zeta, gain * v**2, t)
     assert np.abs(th - exact).max() < 1e-6 * np.abs(exact).max()
 
 
 def test_fast_and_reference_agree_in_value_and_gradient():
-    wind = _wind(60, seed=1)
+    wind = gusty_wind(60, seed=1)
     p = [torch.tensor(a, dtype=torch.float64, requires_grad=True)
          for a in ([3.0, 7.0, 11.0], [0.05, 0.1, 0.3], [0.01, -0.02, 0.03])]
     weights = torch.randn(3, 60, dtype=torch.float64, generator=torch.Generator().manual_seed(0))
@@ -79,7 +57,7 @@ def test_fast_and_reference_agree_in_value_and_gradient():
 
 
 def test_gradcheck_float64():
-    wind = _wind(40, seed=2)
+    wind = gusty_wind(40, seed=2)
 
     def f(om, ze, g):
         return integrate(om, ze, g, wind, 6.0, DT, 2)
@@ -91,7 +69,8 @@ def test_gradcheck_float64():
 
 def test_starts_at_rest_and_keeps_float32():
     om = torch.tensor([5.0, 9.0])
-    th = integrate(om, torch.tensor([0.1, 0.1]), torch.tensor([0.1, 0.1]), _wind(30), 6.0, DT, 1)
+    th = integrate(om, torch.tensor([0.1, 0.1]), torch.tensor([0.1, 0.1]), gusty_wind(30), 6.0,
+                   DT, 1)
     assert th.dtype == torch.float32 and th.shape == (2, 30)
     assert torch.all(th[:, 0] == 0) and torch.all(th[:, 1:].abs().sum(1) > 0)
 
@@ -100,11 +79,11 @@ def test_stability_guard_names_the_fix():
     om = torch.tensor([2.0, 30.0])
     z = torch.tensor([0.1, 0.1])
     with pytest.raises(StabilityError, match=r"substeps >= 2"):
-        integrate(om, z, z, _wind(10), 6.0, DT, 1)  # 30/24 = 1.25 > 1
+        integrate(om, z, z, gusty_wind(10), 6.0, DT, 1)  # 30/24 = 1.25 > 1
     n = required_substeps(30.0, DT, 1.0)
     assert n == 2 and 30.0 * DT / n <= 1.0
     assert required_substeps(24.0, DT, 1.0) == 1  # exactly at the guard is allowed
     assert required_substeps(100.0, 0.1, 0.5) == 20
-    integrate(om, z, z, _wind(10), 6.0, DT, n)  # no error
+    integrate(om, z, z, gusty_wind(10), 6.0, DT, n)  # no error
     with pytest.raises(ValueError, match="omega must be > 0"):
-        integrate(torch.tensor([-1.0]), z[:1], z[:1], _wind(10), 6.0, DT, 1)
+        integrate(torch.tensor([-1.0]), z[:1], z[:1], gusty_wind(10), 6.0, DT, 1)

@@ -1,16 +1,10 @@
 """Matcher and damping summary on constructed trajectories with known answers (scipy oracle)."""
 import numpy as np
 import pytest
-from scipy import signal, stats
+from scipy import stats
 
 from physgs.recovery import damping_summary, loglog_r2, match_parts, pearson_matrix
-
-
-def oscillator_response(omega, zeta, forcing, dt):
-    """scipy.signal.lsim of theta'' + 2 zeta omega theta' + omega^2 theta = f (independent oracle)."""
-    t = np.arange(len(forcing)) * dt
-    sys = signal.lti([1.0], [1.0, 2 * zeta * omega, omega**2])
-    return signal.lsim(sys, forcing, t)[1]
+from oracles import forced_lsim
 
 
 @pytest.fixture(scope="module")
@@ -19,7 +13,7 @@ def bones():
     dt, T = 1 / 24, 600
     forcing = rng.standard_normal(T)
     omega = 2 * np.pi * np.array([0.35, 0.5, 0.7, 1.0, 1.5])
-    theta = np.stack([oscillator_response(w, 0.08, forcing, dt) for w in omega])[:, 200:]
+    theta = np.stack([forced_lsim(w, 0.08, forcing, dt) for w in omega])[:, 200:]
     return omega, theta
 
 

@@ -1,14 +1,10 @@
 """Null control against an independent oracle (scipy lsim + numpy corrcoef)."""
 import numpy as np
 import pytest
-from scipy import signal, stats
+from scipy import stats
 
 from physgs.recovery.null import draw_null_omegas, nearest_bone_gap, null_control
-
-
-def lsim(omega, zeta, u, dt):
-    t = np.arange(len(u)) * dt
-    return signal.lsim(signal.lti([1.0], [1.0, 2 * zeta * omega, omega**2]), u, t)[1]
+from oracles import forced_lsim
 
 
 def test_draws_log_uniform_seeded_and_in_range():
@@ -37,7 +33,7 @@ def test_null_control_matches_oracle():
     vbar = 6.0
     u = wind**2 - vbar**2  # lsim's first-order hold = the solver's linear v^2 interpolation
     omega_b = 2 * np.pi * np.geomspace(0.35, 1.5, 12)
-    bone_theta = np.stack([lsim(w, 0.08, u, dt) for w in omega_b])[:, L:L + n_train]
+    bone_theta = np.stack([forced_lsim(w, 0.08, u, dt) for w in omega_b])[:, L:L + n_train]
     K, D, zeta0, seed = 5, 8, 0.15, 11
     res = null_control(omega_b, bone_theta, wind, n_parts=K, zeta_init=zeta0, vbar=vbar, dt=dt,
                        substeps=2, lead_in_frames=L, n_train=n_train, seed=seed, n_draws=D)
@@ -45,7 +41,7 @@ def test_null_control_matches_oracle():
     np.testing.assert_array_equal(res.omega, draws)
     exp_n, exp_med, exp_r2 = [], [], []
     for om in draws:
-        parts = np.stack([lsim(w, zeta0, u, dt) for w in om])[:, L:L + n_train]
+        parts = np.stack([forced_lsim(w, zeta0, u, dt) for w in om])[:, L:L + n_train]
         c = np.abs(np.corrcoef(parts, bone_theta)[:K, K:])
         best = c.argmax(1)
         ok = c[np.arange(K), best] >= 0.7

@@ -2,11 +2,11 @@
 import numpy as np
 import pytest
 import torch
-from scipy.spatial.transform import Rotation
 
 from physgs.camera import Camera, look_at
 from physgs.render import rasterization
 from physgs.render.scenes import random_scene
+from oracles import pixel_centres, rotation_wxyz
 
 BACKENDS = ["reference", "fast"]
 F64 = torch.float64
@@ -24,11 +24,6 @@ def gaussians(means, scales, opac, colors, quats=None):
         quats, dtype=F64)
     return [means, quats, torch.tensor(scales, dtype=F64), torch.tensor(opac, dtype=F64),
             torch.tensor(colors, dtype=F64)]
-
-
-def pixel_centres(cam):
-    yy, xx = np.meshgrid(np.arange(cam.height) + 0.5, np.arange(cam.width) + 0.5, indexing="ij")
-    return xx, yy
 
 
 @pytest.mark.parametrize("backend", BACKENDS)
@@ -81,7 +76,7 @@ def dense_oracle(means, quats, scales, opac, colors, cam, bg):
     quaternion convention (x, y, z, w), plain loops over depth order."""
     means, quats, scales, opac, colors, bg = (np.asarray(x, np.float64) for x in
                                               (means, quats, scales, opac, colors, bg))
-    Rw = Rotation.from_quat(quats[:, [1, 2, 3, 0]]).as_matrix()
+    Rw = rotation_wxyz(quats).as_matrix()
     cov3 = Rw @ (scales[:, :, None] ** 2 * np.transpose(Rw, (0, 2, 1)))
     pc = means @ cam.R.T + cam.t
     xx, yy = pixel_centres(cam)

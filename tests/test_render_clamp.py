@@ -10,12 +10,12 @@ Gaussian. An earlier version clamped at 1.6 tan(fov / 2); the clamped cases belo
 import numpy as np
 import pytest
 import torch
-from scipy.spatial.transform import Rotation
 
 from physgs.camera import look_at
 from physgs.render import kernels, rasterization
 from physgs.render.fast import camera_arrays
 from physgs.render.project import project_gaussians
+from oracles import pixel_centres, rotation_wxyz
 
 F64 = torch.float64
 FOV_TAN_HALF_0P5 = float(np.degrees(2 * np.arctan(0.5)))  # vertical fov with tan(fov / 2) = 0.5
@@ -46,7 +46,7 @@ def oracle(cam, mean, quat, scale, opacity, lim):
     Returns (cov2d [2, 2] px^2 incl. the 0.3 px^2 dilation, alpha [H, W], rgb [H, W, 3]).
     """
     x, y, z = mean
-    R = Rotation.from_quat([quat[1], quat[2], quat[3], quat[0]]).as_matrix()  # scipy: x, y, z, w
+    R = rotation_wxyz(quat).as_matrix()  # scipy: x, y, z, w
     sigma = R @ np.diag(np.square(scale)) @ R.T
     u, v = x / z, y / z
     if lim is not None:
@@ -55,7 +55,7 @@ def oracle(cam, mean, quat, scale, opacity, lim):
     J = np.array([[f / z, 0.0, -f * u / z], [0.0, f / z, -f * v / z]])
     cov = J @ sigma @ J.T + 0.3 * np.eye(2)
     mx, my = f * x / z + cam.width / 2, f * y / z + cam.height / 2
-    yy, xx = np.meshgrid(np.arange(cam.height) + 0.5, np.arange(cam.width) + 0.5, indexing="ij")
+    xx, yy = pixel_centres(cam)
     d = np.stack([xx - mx, yy - my], axis=-1)
     q = np.einsum("...i,ij,...j->...", d, np.linalg.inv(cov), d)
     alpha = np.minimum(0.99, opacity * np.exp(-0.5 * q))

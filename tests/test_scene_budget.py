@@ -8,7 +8,6 @@ import pytest
 import torch
 from scipy.spatial.transform import Rotation
 
-import physgs.config
 from physgs.models import build_model, load_checkpoint
 from physgs.experiments import job_spec, train_and_save
 from physgs.experiments.kselect import (
@@ -25,8 +24,7 @@ from physgs.experiments.kselect import (
 from physgs.models.visibility import freeze_invisible, freeze_schedule, part_image_swing
 from physgs.recovery.run import recover_model
 from physgs.train import train_model
-
-FPS, N_TRAIN = 24, 20  # as in the conftest swaying dataset
+from oracles import quick_train_cfg
 
 
 @pytest.fixture(scope="module")
@@ -35,10 +33,7 @@ def data(swaying):
 
 
 def _cfg(K=4, iterations=16, warmup=4):
-    cfg = physgs.config.load("config/trees.yaml", "quick")
-    cfg["train"].update(iterations=iterations, warmup=warmup, backend="fast")
-    cfg["models"]["configs"]["single"]["K"] = K
-    return cfg
+    return quick_train_cfg(iterations, warmup, K=K)
 
 
 # -- image swing --------------------------------------------------------------------------------
@@ -124,7 +119,8 @@ def test_frozen_parts_count_as_untrusted_in_recovery(data):
     from physgs.models.oscillator import integrate
     om = model.omega.detach().double()
     bones = integrate(om, torch.full((4,), 0.1, dtype=torch.float64),
-                      torch.ones(4, dtype=torch.float64), w, float(w.mean()), 1 / FPS, 2).numpy()
+                      torch.ones(4, dtype=torch.float64), w, float(w.mean()), 1 / data.fps,
+                      2).numpy()
     truth = SimpleNamespace(omega=om.numpy(), zeta=np.full(4, 0.1), theta=bones.T[None])
     rec = recover_model(model, data, truth)
     assert rec.n_frozen == 1 and not rec.match.trusted[0] and rec.match.corr[0] == 0.0

@@ -1,6 +1,5 @@
 """Dataset: a tiny end-to-end build, the interface fields, load errors, no partial outputs,
 Gaussians stored in a permuted order, framing."""
-import copy
 import shutil
 import subprocess
 import sys
@@ -10,24 +9,17 @@ import numpy as np
 import pytest
 import yaml
 
-from physgs.config import load
 from physgs.testbed import dataset, kinematics, scene, stats
-from physgs.testbed.dataset import DatasetError, build_dataset, load_observed, load_truth, save_dataset
+from physgs.testbed.dataset import DatasetError, load_observed, load_truth, save_dataset
+from oracles import tiny_testbed
 
 ROOT = Path(__file__).resolve().parents[1]
-CFG = load(ROOT / "config/trees.yaml", "quick")
 
 
 @pytest.fixture(scope="module")
 def tiny(tmp_path_factory):
-    tb = copy.deepcopy(CFG["testbed"])
     # at 16 px a 0.9 fill leaves under a pixel of margin; 0.75 keeps the border test meaningful
-    tb.update(n_train=20, n_tail=4, resolution=16, supersample=1, heldout_azimuths_deg=[-30, 60],
-              fill_height=0.75)
-    obs, tru = build_dataset(tb, CFG["presets"]["sparse"], seed=0, tree="sparse", progress=False)
-    d = tmp_path_factory.mktemp("tb")
-    save_dataset(obs, tru, d / "observed.npz", d / "truth.npz")
-    return tb, d
+    return tiny_testbed(tmp_path_factory.mktemp("tb"), resolution=16, fill_height=0.75)
 
 
 def test_roundtrip_matches_interface(tiny):

@@ -1,6 +1,5 @@
 """Testbed statistics: the order leak, distinct frequencies, the nearest-bone gap and the visible
 motion against hand-computable cases; the stored Gaussian order carries no bone label."""
-import copy
 from types import SimpleNamespace
 
 import numpy as np
@@ -10,7 +9,8 @@ from physgs.camera import look_at
 from physgs.config import load
 from physgs.recovery.null import nearest_bone_gap
 from physgs.testbed import stats
-from physgs.testbed.dataset import build_dataset, load_observed, load_truth, save_dataset, simulate_tree
+from physgs.testbed.dataset import load_observed, load_truth, simulate_tree
+from oracles import simulate_trees, tiny_testbed
 
 CFG = load("config/trees.yaml", "default")
 
@@ -38,8 +38,7 @@ def test_expected_share_is_the_mean_over_random_orders():
 
 @pytest.fixture(scope="module")
 def sims():
-    tb = CFG["testbed"]
-    return {t: simulate_tree(tb, CFG["presets"][t], seed=CFG["seed"], tree=t) for t in CFG["trees"]}
+    return simulate_trees(CFG)
 
 
 def test_stored_gaussian_order_carries_no_bone_label(sims):
@@ -168,13 +167,7 @@ def test_swing_is_rms_of_own_angle():
 
 @pytest.fixture(scope="module")
 def tiny(tmp_path_factory):
-    cfg = load("config/trees.yaml", "quick")
-    tb = copy.deepcopy(cfg["testbed"])
-    tb.update(n_train=20, n_tail=4, resolution=24, supersample=1, heldout_azimuths_deg=[-30, 60],
-              fill_height=0.8)
-    obs, tru = build_dataset(tb, cfg["presets"]["sparse"], seed=0, tree="sparse", progress=False)
-    d = tmp_path_factory.mktemp("tbstats")
-    save_dataset(obs, tru, d / "observed.npz", d / "truth.npz")
+    tb, d = tiny_testbed(tmp_path_factory.mktemp("tbstats"), resolution=24, fill_height=0.8)
     return tb, load_observed(d / "observed.npz"), load_truth(d / "truth.npz")
 
 

@@ -6,8 +6,8 @@ import pytest
 
 from physgs.config import load
 from physgs.testbed import kinematics, stats
-from physgs.testbed.dataset import simulate_tree
 from physgs.testbed.weberpenn import PresetError, generate
+from oracles import simulate_trees
 
 CFG = load("config/trees.yaml", "default")
 TB = CFG["testbed"]
@@ -15,7 +15,7 @@ TB = CFG["testbed"]
 
 @pytest.fixture(scope="module")
 def sims():
-    return {t: simulate_tree(TB, CFG["presets"][t], seed=CFG["seed"], tree=t) for t in CFG["trees"]}
+    return simulate_trees(CFG)
 
 
 def test_exact_bone_counts(sims):

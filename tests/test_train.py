@@ -6,14 +6,12 @@ import numpy as np
 import pytest
 import torch
 
-import physgs.config
 from physgs.experiments import job_spec, train_and_save
 from physgs.models import MODEL_NAMES, build_model, load_checkpoint
 from physgs.render import rasterization
 from physgs.train import TrainingError, photometric_loss, ssim, train_model
 from physgs.train.seeding import seed_everything
-
-FPS, N_TRAIN = 24, 20  # as in the conftest swaying dataset
+from oracles import quick_train_cfg
 
 
 @pytest.fixture(scope="module")
@@ -22,16 +20,13 @@ def data(swaying):
 
 
 def _cfg(iterations=24, warmup=6):
-    cfg = physgs.config.load("config/trees.yaml", "quick")
-    cfg["train"].update(iterations=iterations, warmup=warmup, backend="fast")
-    cfg["models"]["configs"]["single"]["K"] = 4
-    return cfg
+    return quick_train_cfg(iterations, warmup)
 
 
 def _eval_loss(model, data):
     with torch.no_grad():
         tot = 0.0
-        for j in range(0, N_TRAIN, 4):
+        for j in range(0, data.n_train, 4):
             s = model.gaussians_at(j, torch.tensor(data.wind[0]))
             out = rasterization(s.means, s.quats, s.scales, s.opacities, s.colors,
                                 data.train_camera, data.background, return_depth=False)

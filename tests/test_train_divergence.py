@@ -4,11 +4,11 @@ import numpy as np
 import pytest
 import torch
 
-import physgs.config
 import physgs.train.divergence as dv
 from physgs.models import build_model
 from physgs.train import TrainingError, train_model
 from physgs.train.divergence import Divergence, DivergenceGuard
+from oracles import quick_train_cfg
 
 # -- the guard on synthetic arrays ---------------------------------------------------------------
 
@@ -163,11 +163,7 @@ def data(swaying):
 
 
 def _cfg(iterations=12, warmup=4, **lr):
-    cfg = physgs.config.load("config/trees.yaml", "quick")
-    cfg["train"].update(iterations=iterations, warmup=warmup, backend="fast")
-    cfg["train"]["lr"].update(lr)
-    cfg["models"]["configs"]["single"]["K"] = 4
-    return cfg
+    return quick_train_cfg(iterations, warmup, **lr)
 
 
 def _train(name, data, cfg, **kw):

@@ -32,6 +32,7 @@ from physgs.models.registry import label
 from physgs.render import rasterization
 from physgs.testbed import kinematics
 from physgs.train import photometric_loss
+from oracles import rotation_wxyz
 
 FPS, N_TRAIN, N_TAIL, LEAD_IN, RES = 24, 8, 2, 6, 24
 F = N_TRAIN + N_TAIL
@@ -160,14 +161,14 @@ def test_orientations_rotate_with_the_bone_chain(pair):
     q0 = Rotation.random(model.canonical.n, random_state=2).as_quat()  # (x, y, z, w)
     with torch.no_grad():  # non-identity canonical orientations make the check stronger
         model.canonical.quats.copy_(torch.tensor(q0[:, [3, 0, 1, 2]], dtype=torch.float32))
-    R0 = Rotation.from_quat(model.canonical.quats.detach().numpy()[:, [1, 2, 3, 0]])
+    R0 = rotation_wxyz(model.canonical.quats.detach().numpy())
     axis = np.asarray(truth.swing_axis)
     v = rng.standard_normal((model.canonical.n, 3))
     winds = _winds(observed)
     for c, j in [(0, 0), (0, 5), (1, 3), (2, 9)]:
         with torch.no_grad():
             q = model.gaussians_at(j, winds[c]).quats.numpy()
-        change = Rotation.from_quat(q[:, [1, 2, 3, 0]]) * R0.inv()
+        change = rotation_wxyz(q) * R0.inv()
         want = Rotation.from_rotvec(axis[None] * _dphi(truth, c, j)[:, None]).apply(v)
         np.testing.assert_allclose(change.apply(v), want, atol=1e-5, rtol=0,
                                    err_msg=f"condition {c}, frame {j}")
