@@ -86,3 +86,14 @@ def test_a_bare_snakemake_call_uses_the_default_profile(tmp_path):
     out = snakemake(wd, "-n", "results/tables/tab_null.tex", "--config", "profile=quick")
     text = out.stdout + out.stderr
     assert "Using workflow specific profile" in text and "profiles/default" in text, text[-2000:]
+
+
+def test_freeze_at_retrains_ours_and_no_baseline(quick_dag):
+    trained = _trained(quick_dag, {"models": {"ours": {"freeze_at": 0.6}}})
+    assert trained and all(t.startswith("ours_") for t in trained), trained
+
+
+def test_kselect_tie_retrains_only_the_auto_model(quick_dag):
+    plan = _plan(quick_dag, {"models": {"kselect": {"tie_db": 0.2}}})
+    assert plan.get("kselect") and "train" not in plan and "speed_accuracy_point" not in plan, plan
+    assert _trained(quick_dag, {"models": {"kselect": {"tie_db": 0.2}}}) == {"ours_auto"}
