@@ -84,7 +84,8 @@ def heldout_split(n_train: int, every: int) -> tuple[np.ndarray, np.ndarray]:
     """(training frames, held-out frames): indices in [0, n_train), every ``every``-th held out
     (frames every-1, 2 every-1, ...), so frame 0 and the window's start stay in training."""
     if not 2 <= every <= n_train:
-        raise ValueError(f"every (train.holdout_every, models.kselect.every) must lie in [2, n_train = {n_train}], got {every}")
+        raise ValueError(f"every (train.holdout_every, models.kselect.every) must lie in "
+                         f"[2, n_train = {n_train}], got {every}")
     idx = np.arange(n_train)
     held = (idx % every) == every - 1
     return idx[~held], idx[held]
@@ -98,9 +99,9 @@ def fit(observed, job: Job | dict, *, truth=None, frame_pool=None, progress: boo
     gives bitwise-equal weights in any process. Ours freezes parts whose swing stays under
     ``models.ours.freeze_below_px`` pixels (``freeze_at``); frame_pool restricts the training
     frames; by default every ``train.holdout_every``-th training frame is held out (0 = none),
-    so the fit and the interpolation to unseen in-window frames can be told apart. truth: the dataset's ``Truth`` (truth.npz), required by
-    a reference (truth_motion) and refused for a method. Returns the TrainResult (model in eval
-    mode).
+    so the fit and the interpolation to unseen in-window frames can be told apart. truth: the
+    dataset's ``Truth`` (truth.npz), required by a reference (truth_motion) and refused for a
+    method. Returns the TrainResult (model in eval mode).
     """
     job = Job.from_dict(job) if isinstance(job, dict) else job
     spec_of(job.model)  # unknown ids raise, naming the valid ones
