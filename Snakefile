@@ -35,3 +35,4 @@ rule all:
         rules.report.input,
         rules.speed_accuracy.output,
         expand(TABLE, name="tab_kselect", ext=("tex", "csv")),
+        rules.claims.output,

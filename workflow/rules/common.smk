@@ -37,7 +37,8 @@ TABLE = "results/tables/{name}.{ext}"
 FIGURE = "results/figures/{name}.{ext}"
 #: need kind (physgs.report.build.needs) -> path template
 NEED_PATHS = {"eval": EVAL, "traj": TRAJ, "panels": PANELS, "loss": LOSS, "recovery": RECOVERY,
-              "null": NULL, "kselect": KSELECT, "stats": STATS}
+              "null": NULL, "kselect": KSELECT, "stats": STATS,
+              "table": TABLE.replace("{ext}", "csv")}
 SA_TREE = CFG["speed_accuracy"]["tree"]
 SWEEP_POINTS = _sweep.sweep_points(CFG)
 
@@ -62,13 +63,18 @@ def train_input(wildcards):
     return OBSERVED.format(tree=wildcards.tree)
 
 
-def report_inputs(wildcards):
-    """need key -> path of every file table or figure ``name`` reads."""
+def need_paths(needs):
+    """need key -> path for need tuples of physgs.report.build."""
     out = {}
-    for need in _build.needs(wildcards.name, TREES, CONFIGS):
+    for need in needs:
         fields = dict(zip(_build.NEED_FIELDS[need[0]], need[1:]))
         out[_build.key(need)] = NEED_PATHS[need[0]].format(**fields)
     return out
+
+
+def report_inputs(wildcards):
+    """need key -> path of every file table or figure ``name`` reads."""
+    return need_paths(_build.needs(wildcards.name, TREES, CONFIGS))
 
 
 # ---- narrow params: each job sees only the settings it reads -------------------------------

@@ -49,3 +49,26 @@ rule report:
     input:
         expand(TABLE, name=[n for n in _build.TABLES if n != "tab_kselect"], ext=("tex", "csv")),
         expand(FIGURE, name=_build.FIGURES, ext=("pdf", "png")),
+
+
+# The claims ledger: every quantitative claim of the paper with its measured value, seed
+# interval and a verdict computed by code (physgs.report.claims).
+rule claims:
+    input:
+        unpack(lambda wc: need_paths(_build.claims_needs(TREES, CONFIGS))),
+    output:
+        md=report("results/claims.md", category="5. Claims"),
+        csv="results/claims.csv",
+    params:
+        trees=TREES,
+        stamp=STAMP,
+    conda:
+        "../envs/physgs.yaml"
+    log:
+        "logs/report/claims.log",
+    threads: 1
+    resources:
+        mem_mb=1000,
+        runtime=5,
+    script:
+        "../scripts/claims.py"

@@ -30,7 +30,11 @@ FIGURES = ("fig_temporal", "fig_teaser", "fig_results", "fig_damping")
 NEED_FIELDS = {"eval": ("tree", "model", "config"), "traj": ("tree", "model", "config"),
                "panels": ("tree", "model", "config"), "loss": ("tree", "model", "config"),
                "recovery": ("tree", "config"),
-               "null": ("tree", "K"), "kselect": ("tree",), "stats": ("tree",)}
+               "null": ("tree", "K"), "kselect": ("tree",), "stats": ("tree",),
+               "table": ("name",)}
+#: Tables the claims ledger reads (their CSVs), and the configuration whose damping it reads.
+CLAIMS_TABLES = ("tab_psnr", "tab_transfer", "tab_margin", "tab_null", "tab_testbed")
+CLAIMS_CONFIG = "joint32"
 #: Models (trained in the base configuration) whose evaluation an output reads.
 NEEDS_MODELS = {
     "tab_psnr": (*MODEL_NAMES, *REFERENCE_NAMES), "tab_transfer": MODEL_NAMES,
@@ -44,6 +48,35 @@ KSELECT_ROWS = (BASE_CONFIG, "auto")
 def key(need: tuple) -> str:
     """The name of a need in the inputs mapping: its parts joined by '/'."""
     return "/".join(str(p) for p in need)
+
+
+def claims_needs(trees: Sequence[str], configs: Mapping[str, dict]) -> list[tuple]:
+    """What the claims ledger reads: the tables' CSVs and ours' recovery (damping) in the joint
+    K=32 configuration (the paper's), or the base configuration when the config has none."""
+    c = CLAIMS_CONFIG if CLAIMS_CONFIG in configs else BASE_CONFIG
+    return [("table", n) for n in CLAIMS_TABLES] + [("recovery", t, c) for t in trees]
+
+
+def make_claims(inputs: Mapping[str, str], trees: Sequence[str], md_path, csv_path,
+                stamp=None):
+    """Build the claims ledger (``physgs.report.claims``) from the files in ``inputs`` (need
+    key -> path, ``claims_needs``) and write results/claims.md and .csv; returns the ledger."""
+    from physgs.atomic import atomic_path, write_text
+    from physgs.report import claims
+
+    tabs = {n: pd.read_csv(inputs[key(("table", n))]) for n in CLAIMS_TABLES}
+    damping = {}
+    for k, p in inputs.items():
+        if k.startswith("recovery/"):
+            d = load_recovery(p).damping
+            damping[k.split("/")[1]] = [{"median_zeta": d.median_zeta, "zeta_true": d.zeta_true,
+                                         "loglog_exponent": d.loglog_exponent}]
+    df = claims.ledger(claims.measure(tabs, damping, trees))
+    sd = stamp.to_dict() if stamp is not None else None
+    write_text(md_path, claims.ledger_markdown(df, sd))
+    with atomic_path(csv_path) as tmp:
+        (df.assign(**sd) if sd else df).to_csv(tmp, index=False, float_format="%.6g")
+    return df
 
 
 def needs(name: str, trees: Sequence[str], configs: Mapping[str, dict]) -> list[tuple]:
