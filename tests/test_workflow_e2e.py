@@ -158,7 +158,8 @@ def test_claims_ledger_has_a_computed_verdict_per_claim(run):
     assert len(df) >= 10 and df["id"].is_unique
     ok = ("holds", "fails", "undecided")
     assert df["verdict"].str.split(":").str[0].isin(ok).all(), df["verdict"].tolist()
-    # one seed: every claim that needs variance says so rather than guessing
+    # one seed: every claim that needs variance says so (or that it was not measured: a median
+    # over no trusted part) rather than guessing
     needs = df[~df["id"].str.startswith("nearest_bone_gap")]
-    assert needs["verdict"].str.startswith("undecided: one seed").all()
+    assert needs["verdict"].str.match(r"undecided: (one seed|not measured)").all()
     assert "| claim | paper | measured |" in (run / "results" / "claims.md").read_text()
