@@ -56,8 +56,9 @@ def test_mlp_width_retrains_the_mlp_models_only(quick_dag):
 
 
 def test_table_format_rebuilds_that_table_only(quick_dag):
+    """The table, and the claims ledger that reads its CSV; nothing upstream, no other table."""
     plan = _plan(quick_dag, {"report": {"tab_psnr": {"digits": 3}}})
-    assert plan == {"table": 1, "all": 1}, plan
+    assert plan == {"table": 1, "claims": 1, "all": 1}, plan
 
 
 def test_job_params_ignore_key_order():
