@@ -3,7 +3,6 @@ log, and any traceback into that log before the job fails."""
 from __future__ import annotations
 
 import contextlib
-import os
 import sys
 import traceback
 
@@ -17,7 +16,6 @@ def job(sm):
     (not only to the console) before re-raising it.
     """
     threads = max(1, int(getattr(sm, "threads", 1)))
-    os.environ.setdefault("OMP_WAIT_POLICY", "PASSIVE")  # spin-waiting starves the other job
     import numba
     import torch
 

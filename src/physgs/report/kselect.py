@@ -9,7 +9,7 @@ from typing import Mapping, Sequence
 
 import pandas as pd
 
-from physgs.report.tables import Table, _fmt, _pct, _wrap, tree_label
+from physgs.report.tables import Table, _fmt, _pct, _tree_blocks, _wrap
 
 ROWS = (("single", "fixed $K$"), ("auto", "chosen $K$"))
 
@@ -31,17 +31,10 @@ def tab_kselect(rows: Mapping[tuple[str, str], dict], trees: Sequence[str],
     lines = ["  \\begin{tabular}{llccccc}", "    \\toprule",
              r"    Tree & Model & $K$ & PSNR time & Med.\ rel.\ err. & Trusted & Frozen \\",
              "    \\midrule"]
-    for i, t in enumerate(trees):
-        sub = df[df.tree == t]
-        for j, (_, r) in enumerate(sub.iterrows()):
-            head = rf"\multirow{{2}}{{*}}{{{tree_label(t, r.bones)}}}" if j == 0 else ""
-            label = dict(ROWS)[r.config]
-            lines.append("    " + " & ".join([
-                head, label, str(r.K), _fmt(r.time_psnr_db, f".{digits}f"),
-                _pct(r.median_rel_err_pct, False, digits), f"{r.parts_trusted}/{r.K}",
-                str(r.parts_frozen)]) + r" \\")
-        if i < len(trees) - 1:
-            lines.append("    \\midrule")
+    lines += _tree_blocks(df, trees, lambda r: [
+        dict(ROWS)[r.config], str(r.K), _fmt(r.time_psnr_db, f".{digits}f"),
+        _pct(r.median_rel_err_pct, False, digits), f"{r.parts_trusted}/{r.K}",
+        str(r.parts_frozen)])
     lines += ["    \\bottomrule", "  \\end{tabular}", ""]
     cap = (rf"Ours with fixed $K$ against $K$ chosen from the data (method: {method}; the "
            r"CSV also lists the choice by held-out frames and by BIC). PSNR (dB) on the time split; "

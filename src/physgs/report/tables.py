@@ -61,6 +61,20 @@ def _wrap(tabular: str, caption: str, label: str) -> str:
             + f"  \\caption{{{caption}}}\n  \\label{{{label}}}\n\\end{{table}}\n")
 
 
+def _tree_blocks(df: pd.DataFrame, trees: Sequence[str], cells) -> list[str]:
+    """LaTeX body rows grouped by tree: a \\multirow tree label on each block's first row, a
+    \\midrule between trees. cells(row) -> the row's cells after the tree column."""
+    lines = []
+    for i, t in enumerate(trees):
+        sub = df[df.tree == t]
+        for j, (_, r) in enumerate(sub.iterrows()):
+            head = rf"\multirow{{{len(sub)}}}{{*}}{{{tree_label(t, r.bones)}}}" if j == 0 else ""
+            lines.append("    " + " & ".join([head, *cells(r)]) + r" \\")
+        if i < len(trees) - 1:
+            lines.append("    \\midrule")
+    return lines
+
+
 def _check(keys: Sequence, have: Mapping, what: str) -> None:
     missing = [k for k in keys if k not in have]
     if missing:
@@ -146,17 +160,13 @@ def tab_fit(rows: Mapping[tuple[str, str], Mapping[str, float]], trees: Sequence
     lines = ["  \\begin{tabular}{llcccccr}", "    \\toprule",
              r"    Tree & Model & Fit & Held-out frames & Of ceiling & View & Time & Train (s) \\",
              "    \\midrule"]
-    for i, t in enumerate(trees):
-        sub = df[df.tree == t]
-        for j, (_, r) in enumerate(sub.iterrows()):
-            head = rf"\multirow{{{len(sub)}}}{{*}}{{{tree_label(t, r.bones)}}}" if j == 0 else ""
-            name = rf"\emph{{{label(r.model)}}}" if r.reference else label(r.model)
-            frac = "--" if not np.isfinite(r.ceiling_frac) else f"{100 * r.ceiling_frac:.0f}\\%"
-            lines.append("    " + " & ".join([
-                head, name, _fmt(r.fit_psnr_db, fmt), _fmt(r.heldout_psnr_db, fmt), frac,
-                _fmt(r.view_psnr_db, fmt), _fmt(r.time_psnr_db, fmt), f"{r.train_s:.0f}"]) + r" \\")
-        if i < len(trees) - 1:
-            lines.append("    \\midrule")
+    def cells(r):
+        name = rf"\emph{{{label(r.model)}}}" if r.reference else label(r.model)
+        frac = "--" if not np.isfinite(r.ceiling_frac) else f"{100 * r.ceiling_frac:.0f}\\%"
+        return [name, _fmt(r.fit_psnr_db, fmt), _fmt(r.heldout_psnr_db, fmt), frac,
+                _fmt(r.view_psnr_db, fmt), _fmt(r.time_psnr_db, fmt), f"{r.train_s:.0f}"]
+
+    lines += _tree_blocks(df, trees, cells)
     lines += ["    \\bottomrule", "  \\end{tabular}", ""]
     cap = (r"Fit to the training window, PSNR (dB) at the training camera and wind. \emph{Fit}: "
            r"the training-window frames each model was trained on; \emph{Held-out frames}: every "
@@ -208,24 +218,18 @@ def tab_null(recovery: Mapping[tuple[str, str], object], null: Mapping[tuple[str
              r"    \cmidrule(lr){3-5}\cmidrule(lr){6-8}\cmidrule(lr){10-11}",
              r"    Tree & Config & Parts & Med.\ rel.\ err. & log-log $R^2$ & Parts & Med.\ rel.\ err. "
              r"& log-log $R^2$ & Gap & Trained & Null \\", "    \\midrule"]
-    for i, t in enumerate(trees):
-        sub = df[df.tree == t]
-        for j, (_, r) in enumerate(sub.iterrows()):
-            pair = np.array([r.trained_median_rel_err_pct, r.null_median_rel_err_pct])
-            b = _best_mask(pair, f".{digits}f", higher=False)
-            head = (rf"\multirow{{{len(sub)}}}{{*}}{{{tree_label(t, r.bones)}}}" if j == 0 else "")
-            parts_n = _fmt(r.null_parts_trusted, "g")
-            cells = [head, configs[r.config],
-                     f"{_fmt(r.trained_parts_trusted, 'g')}/{r.K}",
-                     _pct(r.trained_median_rel_err_pct, b[0], digits),
-                     _fmt(r.trained_loglog_r2, ".3f"), f"{parts_n}/{r.K}",
-                     _pct(r.null_median_rel_err_pct, b[1], digits),
-                     _fmt(r.null_loglog_r2, ".3f"), _pct(r.nearest_bone_gap_pct, False, digits),
-                     _pct(r.trained_median_rel_err_visible_pct, False, digits),
-                     _pct(r.null_median_rel_err_visible_pct, False, digits)]
-            lines.append("    " + " & ".join(cells) + r" \\")
-        if i < len(trees) - 1:
-            lines.append("    \\midrule")
+    def cells(r):
+        pair = np.array([r.trained_median_rel_err_pct, r.null_median_rel_err_pct])
+        b = _best_mask(pair, f".{digits}f", higher=False)
+        return [configs[r.config], f"{_fmt(r.trained_parts_trusted, 'g')}/{r.K}",
+                _pct(r.trained_median_rel_err_pct, b[0], digits),
+                _fmt(r.trained_loglog_r2, ".3f"), f"{_fmt(r.null_parts_trusted, 'g')}/{r.K}",
+                _pct(r.null_median_rel_err_pct, b[1], digits),
+                _fmt(r.null_loglog_r2, ".3f"), _pct(r.nearest_bone_gap_pct, False, digits),
+                _pct(r.trained_median_rel_err_visible_pct, False, digits),
+                _pct(r.null_median_rel_err_visible_pct, False, digits)]
+
+    lines += _tree_blocks(df, trees, cells)
     lines += ["    \\bottomrule", "  \\end{tabular}", ""]
     cap = (r"Frequency recovery against an untrained null. Parts: parts trusted ($|\mathrm{corr}|\geq0.7$) "
            r"of $K$. Median relative error over trusted parts; $R^2$ of $\log\hat\omega_p$ against "
