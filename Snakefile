@@ -34,5 +34,6 @@ rule all:
         rules.testbed.input,
         rules.report.input,
         rules.speed_accuracy.output,
+        rules.fit_curve.output,
         expand(TABLE, name="tab_kselect", ext=("tex", "csv")),
         rules.claims.output,

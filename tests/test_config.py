@@ -82,10 +82,17 @@ def test_an_empty_profile_changes_nothing():
     assert pconfig.load_workflow_config(base, "default") == pconfig.load(CONFIG, "default")
 
 
-def test_schema_violation_names_the_key():
+@pytest.mark.parametrize("path, value", [
+    (("testbed", "zeta"), -0.1),
+    (("train", "warmup"), -5),  # a recipe setting out of range
+    (("train", "lr_final_ratio"), 0.0),
+    (("speed_accuracy", "fit_curve", "iterations"), [500, 1]),
+    (("speed_accuracy", "fit_curve", "models"), ["mlp", "truth_motion"]),
+])
+def test_schema_violation_names_the_key(path, value):
     base = _base()
-    base["testbed"]["zeta"] = -0.1
-    with pytest.raises(pconfig.ConfigError, match="testbed/zeta"):
+    _set(path, value)(base)
+    with pytest.raises(pconfig.ConfigError, match="/".join(path)):
         pconfig.validate(base)
 
 
@@ -216,6 +223,10 @@ def _set(path, value, profile=None):
     # a preset that cannot reach its bone count (here: one more bone than it builds)
     (_set(("presets", "sparse", "bones"), 23), "default", "presets/sparse"),
     (_set(("train", "holdout_every"), 1), "default", "train/holdout_every"),
+    # the fit curve's profile point is the pipeline's own job on its tree; three budgets at least
+    (lambda c: c.update(trees=["sparse", "dense"]), "default", "speed_accuracy/fit_curve/tree"),
+    (_set(("speed_accuracy", "fit_curve", "iterations"), [1500]), "default",
+     "speed_accuracy/fit_curve/iterations"),
 ])
 def test_cross_key_problem_is_refused_naming_the_key(edit, profile, key):
     if key is None:  # a control: the edit alone is fine

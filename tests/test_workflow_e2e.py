@@ -163,3 +163,22 @@ def test_claims_ledger_has_a_computed_verdict_per_claim(run):
     needs = df[~df["id"].str.startswith("nearest_bone_gap")]
     assert needs["verdict"].str.match(r"undecided: (one seed|not measured)").all()
     assert "| claim | paper | measured |" in (run / "results" / "claims.md").read_text()
+
+
+def test_fit_curve_passes_through_the_tables_numbers(run):
+    """Three budgets per swept model; the profile's point is the pipeline's own job, so its fit
+    is tab_fit's cell for that model, not a retrained copy."""
+    df = pd.read_csv(run / "results" / "tables" / "fit_curve.csv")
+    fc = QUICK["speed_accuracy"]["fit_curve"]
+    own = QUICK["train"]["iterations"]
+    for m in fc["models"]:
+        g = df[df["model"] == m]
+        assert sorted(g["iterations"]) == sorted({*fc["iterations"], own})
+        assert list(g.loc[g["is_profile"], "iterations"]) == [own]
+    assert np.isfinite(df[["fit", "heldout", "time", "train_s"]].to_numpy(float)).all()
+    fit = _csv(run, "tab_fit")
+    for _, r in df[df["is_profile"]].iterrows():
+        cell = fit[(fit["tree"] == fc["tree"]) & (fit["model"] == r["model"])]
+        assert cell["fit_psnr_db"].item() == pytest.approx(r["fit"], abs=1e-4)
+    for ext in ("pdf", "png"):
+        assert (run / "results" / "figures" / f"fig_fit_curve.{ext}").stat().st_size > 1000

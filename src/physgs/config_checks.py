@@ -224,6 +224,21 @@ def sweep_tree_is_listed(cfg: dict) -> Iterator[Problem]:
                f"'{tree}' is not in trees {cfg['trees']}; choose one of them or add it to trees")
 
 
+def fit_curve_is_runnable(cfg: dict) -> Iterator[Problem]:
+    """The fit curve's tree is built by the pipeline (its profile-budget point is the pipeline's
+    own job) and its budgets give at least three points with the profile's."""
+    fc = cfg["speed_accuracy"]["fit_curve"]
+    if fc["tree"] not in cfg["trees"]:
+        yield (("speed_accuracy", "fit_curve", "tree"),
+               f"'{fc['tree']}' is not in trees {cfg['trees']}; choose one of them or add it to "
+               "trees")
+    own = int(cfg["train"]["iterations"])
+    if len({*map(int, fc["iterations"]), own}) < 3:
+        yield (("speed_accuracy", "fit_curve", "iterations"),
+               f"{fc['iterations']} and the profile's own budget (train/iterations = {own}) make "
+               "fewer than three budgets; list at least two others")
+
+
 #: Every cross-key check, in the order their problems are reported.
 CHECKS: list[Check] = [
     trees_have_settings,
@@ -237,6 +252,7 @@ CHECKS: list[Check] = [
     configs_have_single,
     k_within_gaussians,
     sweep_tree_is_listed,
+    fit_curve_is_runnable,
     presets_reach_bone_counts,
 ]
 

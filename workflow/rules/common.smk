@@ -2,6 +2,7 @@
 # owns the file layout; the library receives the files (and only the settings) a job reads.
 import os
 
+import physgs.experiments.fit_curve as _fit_curve
 import physgs.experiments.kselect as _kselect
 import physgs.experiments.sweep as _sweep
 import physgs.models.registry as _models
@@ -33,6 +34,7 @@ RECOVERY = "results/recovery/{tree}/ours_{config}.json"
 NULL = "results/recovery/{tree}/null_K{K}.json"
 KSELECT = "results/kselect/{tree}.json"
 SWEEP_POINT = "results/speed_accuracy/{point}.json"
+FIT_POINT = "results/fit_curve/{tree}/{model}_it{iterations}.json"
 TABLE = "results/tables/{name}.{ext}"
 FIGURE = "results/figures/{name}.{ext}"
 #: need kind (physgs.report.build.needs) -> path template
@@ -41,6 +43,9 @@ NEED_PATHS = {"eval": EVAL, "traj": TRAJ, "panels": PANELS, "loss": LOSS, "recov
               "table": TABLE.replace("{ext}", "csv")}
 SA_TREE = CFG["speed_accuracy"]["tree"]
 SWEEP_POINTS = _sweep.sweep_points(CFG)
+FC = CFG["speed_accuracy"]["fit_curve"]
+#: the fit curve's profile-budget point is the pipeline's own job: these models' evaluations
+FC_PROFILE_MODELS = ["static", *FC["models"], *_models.REFERENCE_NAMES]
 
 
 wildcard_constraints:
@@ -49,6 +54,7 @@ wildcard_constraints:
     config="|".join([*CONFIGS, _models.AUTO_CONFIG]),
     K=r"\d+",
     point="|".join(SWEEP_POINTS),
+    iterations=r"\d+",
     name="|".join([*_build.TABLES, *_build.FIGURES]),
 
 
@@ -97,6 +103,22 @@ def report_params(wildcards):
 
 def sweep_params(wildcards):
     return _sweep.point_settings(CFG, wildcards.point)
+
+
+def fit_point_params(wildcards):
+    return _fit_curve.point_job(CFG, wildcards.model, int(wildcards.iterations))
+
+
+def fit_curve_inputs(wildcards):
+    """The extra-budget points, and the pipeline's own evaluation and loss log of each model at
+    the profile's budget."""
+    tree, cfg = FC["tree"], _models.BASE_CONFIG
+    return {
+        "points": expand(FIT_POINT, tree=tree, model=FC["models"],
+                         iterations=_fit_curve.extra_budgets(CFG)),
+        **{f"eval_{m}": EVAL.format(tree=tree, model=m, config=cfg) for m in FC_PROFILE_MODELS},
+        **{f"loss_{m}": LOSS.format(tree=tree, model=m, config=cfg) for m in FC_PROFILE_MODELS},
+    }
 
 
 def testbed_params(wildcards):

@@ -41,3 +41,51 @@ rule speed_accuracy:
         runtime=5,
     script:
         "../scripts/speed_accuracy.py"
+
+
+# The fit curve (issue "opponents, not foils"): each model's in-window and time-split PSNR against
+# its training budget on one tree; the profile's own budget is the pipeline's job, not retrained.
+rule fit_curve_point:
+    input:
+        observed=OBSERVED,
+    output:
+        record=FIT_POINT,
+    params:
+        job=fit_point_params,
+    conda:
+        "../envs/physgs.yaml"
+    log:
+        "logs/fit_curve/{tree}/{model}_it{iterations}.log",
+    benchmark:
+        "results/benchmarks/fit_curve/{tree}/{model}_it{iterations}.tsv"
+    threads: 1
+    resources:
+        mem_mb=4000,
+        runtime=lambda wc: 10 + int(wc.iterations) // 30,
+    script:
+        "../scripts/fit_curve_point.py"
+
+
+rule fit_curve:
+    input:
+        unpack(fit_curve_inputs),
+    output:
+        csv=report("results/tables/fit_curve.csv", category="4. Speed-accuracy trade"),
+        pdf="results/figures/fig_fit_curve.pdf",
+        png=report("results/figures/fig_fit_curve.png", category="4. Speed-accuracy trade"),
+    params:
+        tree=FC["tree"],
+        models=FC_PROFILE_MODELS,
+        iterations=CFG["train"]["iterations"],
+        n_train=CFG["testbed"]["n_train"],
+        holdout_every=CFG["train"]["holdout_every"],
+    conda:
+        "../envs/physgs.yaml"
+    log:
+        "logs/fit_curve/collect.log",
+    threads: 1
+    resources:
+        mem_mb=1000,
+        runtime=5,
+    script:
+        "../scripts/fit_curve.py"

@@ -4,7 +4,6 @@ from __future__ import annotations
 import warnings
 
 import numpy as np
-from sklearn.cluster import KMeans
 
 
 def kmeans_parts(xyz: np.ndarray, k: int, seed: int, n_init: int = 4) -> np.ndarray:
@@ -21,6 +20,10 @@ def kmeans_parts(xyz: np.ndarray, k: int, seed: int, n_init: int = 4) -> np.ndar
             f"K = {k} parts exceeds the {n} Gaussians; lower K in config models.configs or raise "
             "testbed.vertices"
         )
+    # imported here: sklearn costs ~2 s of start-up, and most workflow jobs (evaluation, tables,
+    # every learned field) import this module without ever forming parts
+    from sklearn.cluster import KMeans
+
     with warnings.catch_warnings():
         warnings.simplefilter("error")  # sklearn warns when it finds fewer distinct clusters than K
         try:

@@ -1,0 +1,95 @@
+"""The fit curve: how each model's fit to its training window grows with the training budget.
+
+For one tree (``speed_accuracy.fit_curve.tree``), each listed model is trained ``single`` at each
+listed budget (training iterations; the static warm-up keeps its fraction, as in the sweep) by
+the tables' recipe, and scored at the training camera and wind: on the trained frames (fit), on
+the every-``holdout_every``-th frames held out of training (interpolation), and on the tail (the
+time split). The profile's own budget is not retrained: its point is the pipeline's own job,
+read from that job's evaluation and loss log, so the curve passes through the tables' numbers.
+"""
+from __future__ import annotations
+
+import time
+from typing import Mapping, Sequence
+
+import numpy as np
+import pandas as pd
+
+from physgs.evaluate.run import training_camera_scores
+from physgs.experiments.recipe import canonical, fit, heldout_split, job_spec
+from physgs.experiments.sweep import with_knob
+from physgs.models.registry import BASE_CONFIG
+
+COLUMNS = ("model", "iterations", "is_profile", "fit", "heldout", "time", "train_s", "tree")
+
+
+def budgets(cfg: dict) -> list[int]:
+    """Every budget on the curve, ascending: the listed ones and the profile's own."""
+    fc = cfg["speed_accuracy"]["fit_curve"]
+    return sorted({*map(int, fc["iterations"]), int(cfg["train"]["iterations"])})
+
+
+def extra_budgets(cfg: dict) -> list[int]:
+    """The budgets that need a training job of their own (all but the profile's)."""
+    return [b for b in budgets(cfg) if b != int(cfg["train"]["iterations"])]
+
+
+def point_job(cfg: dict, model: str, iterations: int) -> dict:
+    """The training job (``recipe.job_spec``) of ``model`` at ``iterations``, as a sorted dict."""
+    tree = cfg["speed_accuracy"]["fit_curve"]["tree"]
+    return canonical(job_spec(with_knob(cfg, tree, "iterations", iterations), model, BASE_CONFIG))
+
+
+def run_point(job: Mapping, observed, *, progress: bool = False) -> dict:
+    """Train ``job`` on ``observed`` and score it; a flat record (dB, seconds).
+
+    fit / heldout: mean PSNR over the trained / held-out training-window frames; time: over the
+    tail frames; all at the training camera and wind. train_s: wall time of the training.
+    """
+    t0 = time.perf_counter()
+    res = fit(observed, dict(job), progress=progress,
+              name=f"{job['model']}_{job['config']}[{job['train']['iterations']} it]")
+    train_s = time.perf_counter() - t0
+    n = int(observed.n_train)
+    every = int(job["train"].get("holdout_every", 0))
+    trained, held = heldout_split(n, every) if every else (np.arange(n), np.arange(0))
+    backend = job["train"]["backend"]
+    _, p_fit = training_camera_scores(res.model, observed, trained, backend=backend)
+    _, p_held = (training_camera_scores(res.model, observed, held, backend=backend)
+                 if held.size else (None, np.array([np.nan])))
+    tail = np.arange(n, n + int(observed.n_tail))
+    _, p_time = training_camera_scores(res.model, observed, tail, backend=backend)
+    return {"model": job["model"], "iterations": int(job["train"]["iterations"]),
+            "fit": float(np.mean(p_fit)), "heldout": float(np.mean(p_held)),
+            "time": float(np.mean(p_time)), "train_s": float(train_s)}
+
+
+def collect(points: Sequence[dict], profile_rows: Mapping[str, dict], profile_iterations: int,
+            tree: str) -> pd.DataFrame:
+    """One row per (model, budget), sorted.
+
+    points: ``run_point`` records; profile_rows: model -> the pipeline's own row at the profile's
+    budget (``report.build.fit_row``: fit, heldout, time, train_s), references included.
+    """
+    rows = [{**{k: p[k] for k in ("model", "iterations", "fit", "heldout", "time", "train_s")},
+             "is_profile": False, "tree": tree} for p in points]
+    for m, r in profile_rows.items():
+        rows.append({"model": m, "iterations": int(profile_iterations), "fit": r["fit"],
+                     "heldout": r["heldout"], "time": r["time"], "train_s": r["train_s"],
+                     "is_profile": True, "tree": tree})
+    dup = pd.DataFrame(rows).duplicated(["model", "iterations"])
+    if dup.any():
+        raise ValueError(f"fit curve: budget {profile_iterations} given twice for a model; the "
+                         "profile's budget comes from the pipeline, not from a point")
+    df = pd.DataFrame(rows, columns=list(COLUMNS))
+    return df.sort_values(["model", "iterations"], kind="stable").reset_index(drop=True)
+
+
+def ceiling_fraction(df: pd.DataFrame, static: str = "static",
+                     ceiling: str = "truth_motion") -> pd.Series:
+    """(fit - static) / (ceiling - static) per row, against the profile-budget static and
+    ceiling rows (the fraction of the achievable in-window gain); NaN without them."""
+    prof = df[df["is_profile"]].set_index("model")["fit"]
+    if static not in prof or ceiling not in prof:
+        return pd.Series(np.nan, index=df.index)
+    return (df["fit"] - prof[static]) / (prof[ceiling] - prof[static])

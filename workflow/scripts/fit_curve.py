@@ -1,0 +1,21 @@
+"""Snakemake script of rule `fit_curve`: the fit curve's CSV and fig_fit_curve."""
+import json
+
+from physgs.atomic import atomic_path
+from physgs.experiments.fit_curve import ceiling_fraction, collect
+from physgs.jobs import job
+from physgs.report.build import fit_row
+from physgs.report.figures import fig_fit_curve
+
+sm = snakemake  # noqa: F821 (injected by Snakemake)
+p = sm.params
+with job(sm) as log:
+    points = [json.load(open(f)) for f in sm.input.points]
+    own = {m: fit_row(sm.input[f"eval_{m}"], sm.input[f"loss_{m}"], p.n_train, p.holdout_every)
+           for m in p.models}
+    df = collect(points, own, p.iterations, p.tree)
+    df["of_ceiling"] = ceiling_fraction(df)
+    with atomic_path(sm.output.csv) as tmp:
+        df.to_csv(tmp, index=False, float_format="%.6g")
+    fig_fit_curve(df, [sm.output.pdf, sm.output.png])
+    print(df.to_string(), file=log)
