@@ -187,3 +187,32 @@ def test_testbed_stats_fields(tiny):
     assert 0 < s["width_fill"] < 1 and 0 < s["coverage"] < 1
     assert s["coverage"] == pytest.approx(o.masks[0, :20].mean())
     assert s["mesh_order_share"] > 0.8 and s["order_share"] < 3 * s["order_share_random"]
+
+
+def test_displacement_energy_below_splits_two_tones_by_their_amplitudes():
+    """Oracle: two sinusoids on exact rFFT bins (1 Hz, amplitude 1; 3 Hz, amplitude 2) carry
+    energies in the ratio 1 : 4, so a cutoff between them keeps 1/5 of the energy."""
+    from physgs.testbed.stats import displacement_energy_below
+    fps, T = 24.0, 240
+    t = np.arange(T) / fps
+    x = np.zeros((T, 2, 3))
+    x[:, 0, 0] = np.sin(2 * np.pi * 1.0 * t)
+    x[:, 1, 2] = 2.0 * np.cos(2 * np.pi * 3.0 * t) + 5.0  # the offset is removed
+    share = displacement_energy_below(x, fps, [0.5, 2.0, 3.0, 12.0])
+    np.testing.assert_allclose(share, [0.0, 0.2, 1.0, 1.0], atol=1e-12)
+    with pytest.raises(ValueError, match="do not move"):
+        displacement_energy_below(np.ones((T, 2, 3)), fps, [1.0])
+
+
+def test_time_band_top_matches_the_encodings_fastest_sine():
+    """The encoding's top feature sin(2^(b-1) pi t) completes 2^(b-1)/2 cycles over t in [0, 1]:
+    count its zero crossings over the window and convert to Hz."""
+    import torch
+    from physgs.models.encoding import fourier
+    from physgs.testbed.stats import time_band_top_hz
+    n, fps, bands = 300, 24.0, 4
+    t = torch.linspace(0, 1, 20001)[:, None].double()
+    top = fourier(t, bands)[:, 1 + 2 * (bands - 1)]  # [x, (sin, cos) per band]: the last sine
+    crossings = int((np.diff(np.sign(top.numpy()[1:-1])) != 0).sum())  # 2 per cycle
+    assert time_band_top_hz(bands, n, fps) == pytest.approx(
+        (crossings + 1) / 2 / ((n - 1) / fps), rel=1e-9)

@@ -172,6 +172,38 @@ def swept_image_extent(truth, camera, *, chunk: int = 25) -> tuple[np.ndarray, n
 # Everything
 
 
+def displacement_energy_below(positions: np.ndarray, fps: float, cutoffs_hz) -> np.ndarray:
+    """Share of the displacement energy of moving points at or below each cutoff frequency.
+
+    positions: [T, N, 3] (m) over T uniformly spaced frames at ``fps`` (frames/s); the mean
+    position of each point is removed, then the energy is summed over points and axes per rFFT
+    bin. Returns [len(cutoffs_hz)] fractions in [0, 1]. Used to ask how much of the true motion a
+    time encoding whose top band is f Hz can reach without building harmonics of its own.
+    """
+    d = np.asarray(positions, dtype=np.float64)
+    d = d - d.mean(0)
+    energy = (np.abs(np.fft.rfft(d, axis=0)) ** 2).reshape(d.shape[0] // 2 + 1, -1).sum(1)
+    freq = np.fft.rfftfreq(d.shape[0], 1.0 / fps)  # [T//2 + 1] Hz
+    total = energy.sum()
+    if total <= 0:
+        raise ValueError("displacement_energy_below: the points do not move")
+    return np.array([energy[freq <= c].sum() / total for c in np.atleast_1d(cutoffs_hz)])
+
+
+def time_band_top_hz(bands: int, n_train: int, fps: float) -> float:
+    """Highest frequency (Hz) of a Fourier time encoding with ``bands`` bands
+    (``physgs.models.encoding.fourier``: sin(2^k pi t), k < bands) over a training window of
+    n_train frames mapped to t in [0, 1]: 2^(bands-1) / 2 cycles per (n_train - 1) / fps s."""
+    if bands < 1:
+        raise ValueError(f"time_band_top_hz: bands must be >= 1, got {bands}")
+    return 2.0 ** (bands - 1) / 2.0 / ((n_train - 1) / fps)
+
+
+def truth_motion_window(truth, n_train: int, condition: int = 0) -> np.ndarray:
+    """Ground-truth Gaussian positions [n_train, N, 3] (m) over the training window."""
+    return kinematics.pose_gaussians(truth, _window(truth, n_train, condition))
+
+
 def testbed_stats(observed, truth, *, visible_threshold_px: float = 1.0) -> dict:
     """Statistics of one tree (see the module docstring for every definition).
 
