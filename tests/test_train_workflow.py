@@ -4,6 +4,8 @@ import subprocess
 import sys
 from pathlib import Path
 
+import pytest
+
 ROOT = Path(__file__).resolve().parents[1]
 
 
@@ -13,28 +15,41 @@ def _dry_run(*targets):
          "--", *targets], cwd=ROOT, capture_output=True, text=True, timeout=120)
 
 
-def test_only_the_reference_rule_reads_the_truth():
-    """The true-motion ceiling is trained by its own rule, the only one that reads truth.npz."""
-    r = _dry_run("results/models/sparse/truth_motion_single.pt")
+@pytest.fixture(scope="module")
+def plan():
+    """One dry run of every training job and the true-motion ceiling (each dry run costs
+    seconds of DAG building, so both tests read this one)."""
+    r = _dry_run("train_all", *[f"results/models/{t}/truth_motion_single.pt"
+                                for t in ("sparse", "medium", "dense")])
     assert r.returncode == 0, r.stderr[-2000:] + r.stdout[-2000:]
-    assert "rule train_reference:" in r.stdout and "rule train:" not in r.stdout
+    return r.stdout
+
+
+def _blocks(out, rule):
+    return re.findall(rf"rule {rule}:\n((?:    .*\n)+)", out)
+
+
+def test_only_the_reference_rule_reads_the_truth(plan):
+    """The true-motion ceiling is trained by its own rule, the only one that reads truth.npz."""
+    ref = _blocks(plan, "train_reference")
+    assert len(ref) == 3
+    for b in ref:
+        inputs = re.search(r"input: (.*)", b).group(1)
+        assert "truth.npz" in inputs and "truth_motion_single.pt" in b
     text = (ROOT / "workflow" / "rules" / "train.smk").read_text()
     rules = re.split(r"\nrule ", text)
     readers = [b.split(":", 1)[0] for b in rules[1:] if "TRUTH" in b.split("output:", 1)[0]]
     assert readers == ["train_reference"], readers
 
 
-def test_train_jobs_read_only_the_observed_dataset():
-    r = _dry_run("train_all")
-    assert r.returncode == 0, r.stderr[-2000:] + r.stdout[-2000:]
-    blocks = re.findall(r"rule train:\n((?:    .*\n)+)", r.stdout)
+def test_train_jobs_read_only_the_observed_dataset(plan):
+    blocks = _blocks(plan, "train")
     assert len(blocks) == 24  # 3 trees x (5 baselines single + ours single/joint32/joint96)
     for b in blocks:
         inputs = re.search(r"input: (.*)", b).group(1)
         assert re.fullmatch(r"results/testbed/\w+/observed\.npz", inputs.strip()), inputs
-        assert "truth" not in inputs
+        assert "truth" not in inputs and "truth_motion" not in b
         assert "mem_mb=" in b and "runtime=" in b and "benchmark:" in b and "log:" in b
     # threads are declared (a 1-thread job prints no threads line in the plan)
     assert re.search(r"rule train:(?:\n    .*)*\n    threads: \d", (ROOT / "workflow" / "rules" /
                                                                 "train.smk").read_text())
-

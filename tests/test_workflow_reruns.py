@@ -16,15 +16,37 @@ pytestmark = pytest.mark.slow
 QUICK = ["--config", "profile=quick", 'trees=["sparse"]']  # as the quick_dag fixture ran
 
 
-def _dry_run(wd: Path, override: dict) -> str:
+#: every config edit whose plan a test reads; their dry runs run two at a time (``plans``)
+EDITS = {
+    "unchanged": {},
+    "sweep_K": {"profiles": {"quick": {"speed_accuracy": {"knobs": {"K": [8, 16]}}}}},
+    "mlp_width": {"models": {"mlp": {"width": 96}}},
+    "table_digits": {"report": {"tab_psnr": {"digits": 3}}},
+    "freeze_at": {"models": {"ours": {"freeze_at": 0.6}}},
+    "kselect_tie": {"models": {"kselect": {"tie_db": 0.2}}},
+}
+
+
+def _dry_run(wd: Path, override: dict, name: str = "override") -> str:
     """The dry-run plan of `all` with ``override`` merged into the config."""
-    f = wd / "override.yaml"
+    f = wd / f"{name}.yaml"
     f.write_text(yaml.safe_dump(override))
     try:
-        return snakemake(wd, "-n", "--cores", "2", "all", "--configfile", "config/trees.yaml",
-                         str(f), *QUICK).stdout
+        return snakemake(wd, "-n", "--nolock", "--cores", "2", "all", "--configfile",
+                         "config/trees.yaml", str(f), *QUICK).stdout
     finally:
         f.unlink()
+
+
+@pytest.fixture(scope="module")
+def plans(quick_dag) -> dict[str, str]:
+    """edit name -> dry-run output on the finished quick DAG; each dry run is seconds of
+    single-threaded DAG building, so two run side by side."""
+    from concurrent.futures import ThreadPoolExecutor
+
+    with ThreadPoolExecutor(2) as pool:
+        futures = {k: pool.submit(_dry_run, quick_dag, v, f"edit_{k}") for k, v in EDITS.items()}
+        return {k: f.result() for k, f in futures.items()}
 
 
 def _counts(out: str) -> dict[str, int]:
@@ -40,31 +62,25 @@ def _checkpoints(out: str) -> set[str]:
     return set(re.findall(r"results/models/\w+/(\w+?)\.pt", out))
 
 
-def _plan(wd: Path, override: dict) -> dict[str, int]:
-    return _counts(_dry_run(wd, override))
 
 
-def _trained(wd: Path, override: dict) -> set[str]:
-    return _checkpoints(_dry_run(wd, override))
+def test_an_unchanged_config_plans_nothing(plans):
+    assert _counts(plans["unchanged"]) == {}
 
 
-def test_an_unchanged_config_plans_nothing(quick_dag):
-    assert _plan(quick_dag, {}) == {}
-
-
-def test_sweep_knobs_plan_no_training(quick_dag):
-    plan = _plan(quick_dag, {"profiles": {"quick": {"speed_accuracy": {"knobs": {"K": [8, 16]}}}}})
+def test_sweep_knobs_plan_no_training(plans):
+    plan = _counts(plans["sweep_K"])
     assert plan == {"speed_accuracy_point": 1, "speed_accuracy": 1, "all": 1}, plan
 
 
-def test_mlp_width_retrains_the_mlp_models_only(quick_dag):
-    trained = _trained(quick_dag, {"models": {"mlp": {"width": 96}}})
+def test_mlp_width_retrains_the_mlp_models_only(plans):
+    trained = _checkpoints(plans["mlp_width"])
     assert trained == {"mlp_single", "mlp_wind_single"}, trained
 
 
-def test_table_format_rebuilds_that_table_only(quick_dag):
+def test_table_format_rebuilds_that_table_only(plans):
     """The table, and the claims ledger that reads its CSV; nothing upstream, no other table."""
-    plan = _plan(quick_dag, {"report": {"tab_psnr": {"digits": 3}}})
+    plan = _counts(plans["table_digits"])
     assert plan == {"table": 1, "claims": 1, "all": 1}, plan
 
 
@@ -96,13 +112,13 @@ def test_a_bare_snakemake_call_uses_the_default_profile(tmp_path):
     assert "Using workflow specific profile" in text and "profiles/default" in text, text[-2000:]
 
 
-def test_freeze_at_retrains_ours_and_no_baseline(quick_dag):
-    trained = _trained(quick_dag, {"models": {"ours": {"freeze_at": 0.6}}})
+def test_freeze_at_retrains_ours_and_no_baseline(plans):
+    trained = _checkpoints(plans["freeze_at"])
     assert trained and all(t.startswith("ours_") for t in trained), trained
 
 
-def test_kselect_tie_retrains_only_the_auto_model(quick_dag):
-    out = _dry_run(quick_dag, {"models": {"kselect": {"tie_db": 0.2}}})
+def test_kselect_tie_retrains_only_the_auto_model(plans):
+    out = plans["kselect_tie"]
     plan = _counts(out)
     assert plan.get("kselect") and "train" not in plan and "speed_accuracy_point" not in plan, plan
     assert _checkpoints(out) == {"ours_auto"}

@@ -33,7 +33,7 @@ NEED_FIELDS = {"eval": ("tree", "model", "config"), "traj": ("tree", "model", "c
                "null": ("tree", "K"), "kselect": ("tree",), "stats": ("tree",),
                "table": ("name",)}
 #: Tables the claims ledger reads (their CSVs), and the configuration whose damping it reads.
-CLAIMS_TABLES = ("tab_psnr", "tab_transfer", "tab_margin", "tab_null", "tab_testbed")
+CLAIMS_TABLES = ("tab_psnr", "tab_transfer", "tab_margin", "tab_null", "tab_testbed", "tab_fit")
 CLAIMS_CONFIG = "joint32"
 #: Models (trained in the base configuration) whose evaluation an output reads.
 NEEDS_MODELS = {

@@ -42,6 +42,7 @@ DAMPING_OFF = 0.10  # |median zeta_hat - zeta| / zeta above this: damping not re
 RATE_EXPONENT = 0.5  # gamma ~ omega^p with p below this: the decay rate is nearly omega-free
 NULL_MATCH_PP = 0.5  # the trained model beats the null by less than this (points): "matches"
 GAP_RTOL = 0.25  # a nearest-bone gap within 25% of the paper's reproduces it
+FIT_BAR = 0.5  # an opponent reaches this fraction of the true-motion ceiling's in-window gain
 
 
 @dataclass(frozen=True)
@@ -102,7 +103,7 @@ def _psnr(df, tree, model, split):
 def measure(tables: Mapping[str, pd.DataFrame], damping: Mapping[str, Mapping[str, float]],
             trees: Sequence[str]) -> list[tuple[Claim, list[float]]]:
     """Every claim with its per-seed values, from the tables' CSVs (tab_psnr, tab_transfer,
-    tab_margin, tab_null, tab_testbed) and ours' damping summaries (tree -> median_zeta,
+    tab_margin, tab_null, tab_testbed and, when given, tab_fit) and ours' damping summaries (tree -> median_zeta,
     loglog_exponent, zeta_true, for the joint K=32 configuration)."""
     out: list[tuple[Claim, list[float]]] = []
 
@@ -180,6 +181,18 @@ def measure(tables: Mapping[str, pd.DataFrame], damping: Mapping[str, Mapping[st
                           "nearly frequency-independent", "recovery (joint32): exponent p",
                           RATE_EXPONENT, "<", "exponent"),
                     [v["loglog_exponent"] for v in dmp]))
+
+    if "tab_fit" in tables:  # the premise of every comparison: the fields fit their window
+        for t in trees:
+            for m in (*LEARNED, "ours"):
+                add(Claim(f"fits_window/{t}/{m}",
+                          f"{t}: {LABELS[m]} fits its training window (reaches {FIT_BAR:.0%} of "
+                          "the true-motion ceiling's in-window gain over static)",
+                          "the fields 'fit the training window well'",
+                          "tab_fit: (fit - static) / (ceiling - static) on the trained frames",
+                          FIT_BAR, ">", "fraction"), "tab_fit",
+                    lambda d, t=t, m=m: float(d.loc[(d["tree"] == t) & (d["model"] == m),
+                                                    "ceiling_frac"].iloc[0]))
 
     tr = tables["tab_transfer"]
     beyond = tr[tr["split"] == "beyond"] if "split" in tr.columns else tr
