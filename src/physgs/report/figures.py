@@ -293,6 +293,11 @@ def fig_fit_curve(df: pd.DataFrame, outputs: Sequence[str | Path]) -> None:
     for ax in axes:
         ax.set_xscale("log")
         ax.grid(alpha=0.3)
+    budgets = sorted(df["iterations"].unique())
+    for ax in axes[:2]:  # tick the budgets themselves, not powers of ten
+        ax.set_xticks(budgets)
+        ax.xaxis.set_major_formatter(ScalarFormatter())
+        ax.xaxis.set_minor_formatter(NullFormatter())
     axes[0].set_xlabel("training iterations (log)")
     axes[1].set_xlabel("training iterations (log)")
     axes[2].set_xlabel("training wall time (s, log)")
