@@ -27,7 +27,7 @@ import numpy as np
 from tqdm import tqdm
 
 from physgs.camera import Camera
-from physgs.testbed import kinematics, physics, raycast, scene, weberpenn, wind as windmod
+from physgs.testbed import kinematics, physics, scene, weberpenn, wind as windmod
 from physgs.testbed.mesh import TreeMesh, build_mesh
 
 FORMAT_VERSION = 2  # 2: Gaussians in a seeded random order (gaussian_vertex), fill_height framing
@@ -225,6 +225,9 @@ def build_dataset(tb: dict, preset: dict, *, seed: int, tree: str, progress: boo
     cams = scene.frame_cameras(swept_points(tr), [0.0, *az], fov_deg=float(tb["fov_deg"]),
                                resolution=int(tb["resolution"]), fill_height=float(tb["fill_height"]))
     train_cam, held_cams = cams[0], cams[1:]
+    # imported here: Embree and trimesh cost ~1 s of start-up, and most jobs only load datasets
+    from physgs.testbed import raycast
+
     ss, bg = int(tb["supersample"]), np.asarray(tb["background"], dtype=np.float64)
     face_colors = tr.vertex_colors[tr.faces].mean(axis=1)
     held_idx = np.arange(0, n_train, int(tb["heldout_every"]))

@@ -9,7 +9,6 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 import numpy as np
-import trimesh
 
 from physgs.testbed.weberpenn import Skeleton, Stem
 
@@ -35,7 +34,9 @@ class TreeMesh:
     rings_per_segment: int
     n_leaves: int
 
-    def to_trimesh(self) -> trimesh.Trimesh:
+    def to_trimesh(self) -> "trimesh.Trimesh":  # noqa: F821
+        import trimesh  # here: ~1 s of start-up that jobs reading a dataset never need
+
         return trimesh.Trimesh(self.vertices, self.faces, vertex_colors=self.vertex_colors,
                                process=False)
 
