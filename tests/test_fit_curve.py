@@ -1,6 +1,5 @@
 """The fit curve's bookkeeping: budgets, the tables' recipe at each budget, scoring, collection."""
 import numpy as np
-import pandas as pd
 import pytest
 
 import physgs.config
@@ -85,6 +84,12 @@ def test_collect_joins_points_and_the_pipelines_own_rows():
         fc.collect([dict(pts[0], iterations=1500)], own, 1500, "medium")
 
 
+def test_ceiling_fraction_is_nan_without_a_gain_to_measure():
+    from physgs.evaluate.metrics import ceiling_fraction
+    assert np.isnan(ceiling_fraction(20.0, 18.0, 18.0))  # the ceiling does not beat static
+    assert ceiling_fraction(20.0, 18.0, 22.0) == 0.5
+
+
 def test_ceiling_fraction_is_nan_without_the_references():
     df = fc.collect([], {"mlp": _row(21.0)}, 1500, "medium")
     assert fc.ceiling_fraction(df).isna().all()
@@ -99,4 +104,3 @@ def test_fig_fit_curve_writes_both_formats(tmp_path):
     outs = [tmp_path / "f.pdf", tmp_path / "f.png"]
     fig_fit_curve(df, outs)
     assert all(o.stat().st_size > 1000 for o in outs)
-    assert isinstance(df, pd.DataFrame)

@@ -60,3 +60,13 @@ def centroid_error(alpha_pred: np.ndarray, mask_gt: np.ndarray) -> float:
     if np.shape(alpha_pred) != np.shape(mask_gt):
         raise ValueError(f"alpha shape {np.shape(alpha_pred)} != mask shape {np.shape(mask_gt)}")
     return float(np.linalg.norm(silhouette_centroid(alpha_pred) - silhouette_centroid(mask_gt)))
+
+
+def ceiling_fraction(fit, static, ceiling):
+    """(fit - static) / (ceiling - static): the fraction of the true-motion ceiling's PSNR gain
+    over the static pose that a model reaches (dB in, unitless out; arrays broadcast). NaN where
+    the ceiling does not beat the static pose (no gain to measure against)."""
+    fit, static, ceiling = (np.asarray(x, dtype=np.float64) for x in (fit, static, ceiling))
+    gain = ceiling - static
+    with np.errstate(divide="ignore", invalid="ignore"):
+        return np.where(gain > 0, (fit - static) / gain, np.nan)

@@ -15,8 +15,9 @@ from typing import Mapping, Sequence
 import numpy as np
 import pandas as pd
 
+from physgs.evaluate.metrics import ceiling_fraction as _fraction
 from physgs.evaluate.run import training_camera_scores
-from physgs.experiments.recipe import canonical, fit, heldout_split, job_spec
+from physgs.experiments.recipe import fit, heldout_split, job_spec
 from physgs.experiments.sweep import with_knob
 from physgs.models.registry import BASE_CONFIG
 
@@ -37,7 +38,7 @@ def extra_budgets(cfg: dict) -> list[int]:
 def point_job(cfg: dict, model: str, iterations: int) -> dict:
     """The training job (``recipe.job_spec``) of ``model`` at ``iterations``, as a sorted dict."""
     tree = cfg["speed_accuracy"]["fit_curve"]["tree"]
-    return canonical(job_spec(with_knob(cfg, tree, "iterations", iterations), model, BASE_CONFIG))
+    return job_spec(with_knob(cfg, tree, "iterations", iterations), model, BASE_CONFIG)
 
 
 def run_point(job: Mapping, observed, *, progress: bool = False) -> dict:
@@ -77,11 +78,10 @@ def collect(points: Sequence[dict], profile_rows: Mapping[str, dict], profile_it
         rows.append({"model": m, "iterations": int(profile_iterations), "fit": r["fit"],
                      "heldout": r["heldout"], "time": r["time"], "train_s": r["train_s"],
                      "is_profile": True, "tree": tree})
-    dup = pd.DataFrame(rows).duplicated(["model", "iterations"])
-    if dup.any():
+    df = pd.DataFrame(rows, columns=list(COLUMNS))
+    if df.duplicated(["model", "iterations"]).any():
         raise ValueError(f"fit curve: budget {profile_iterations} given twice for a model; the "
                          "profile's budget comes from the pipeline, not from a point")
-    df = pd.DataFrame(rows, columns=list(COLUMNS))
     return df.sort_values(["model", "iterations"], kind="stable").reset_index(drop=True)
 
 
@@ -92,4 +92,4 @@ def ceiling_fraction(df: pd.DataFrame, static: str = "static",
     prof = df[df["is_profile"]].set_index("model")["fit"]
     if static not in prof or ceiling not in prof:
         return pd.Series(np.nan, index=df.index)
-    return (df["fit"] - prof[static]) / (prof[ceiling] - prof[static])
+    return pd.Series(_fraction(df["fit"], prof[static], prof[ceiling]), index=df.index)

@@ -272,38 +272,33 @@ def fig_fit_curve(df: pd.DataFrame, outputs: Sequence[str | Path]) -> None:
     iterations, and the fit against training wall time (s). The static pose and the true-motion
     ceiling at the profile's budget are horizontal lines; the profile's budget is starred.
     """
-    fig, axes = plt.subplots(1, 3, figsize=(13, 3.8))
+    panels = (("iterations", "fit", "training iterations (log)", "PSNR, trained frames (dB)"),
+              ("iterations", "time", "training iterations (log)", "PSNR, time split (dB)"),
+              ("train_s", "fit", "training wall time (s, log)", "PSNR, trained frames (dB)"))
+    fig, axes = plt.subplots(1, len(panels), figsize=(13, 3.8))
     refs = {"static": ("0.55", "--"), **{r: ("k", ":") for r in REFERENCE_NAMES}}
     prof = df[df["is_profile"]].set_index("model")
-    for m, g in df.groupby("model", sort=False):
-        if m in refs:
-            continue
-        g = g.sort_values("iterations")
-        c = COLORS.get(m)
-        for ax, x, y in ((axes[0], "iterations", "fit"), (axes[1], "iterations", "time"),
-                         (axes[2], "train_s", "fit")):
-            ax.plot(g[x], g[y], "-o", ms=3.5, color=c, lw=1.6 if m == "ours" else 1.0,
-                    label=label(m))
-            p = g[g["is_profile"]]
-            ax.plot(p[x], p[y], "*", ms=10, color=c)
-    for m, (c, ls) in refs.items():
-        if m in prof.index:
-            for ax, y in ((axes[0], "fit"), (axes[1], "time"), (axes[2], "fit")):
-                ax.axhline(prof.loc[m, y], color=c, ls=ls, lw=1.0, label=label(m))
-    for ax in axes:
-        ax.set_xscale("log")
-        ax.grid(alpha=0.3)
     budgets = sorted(df["iterations"].unique())
-    for ax in axes[:2]:  # tick the budgets themselves, not powers of ten
-        ax.set_xticks(budgets)
-        ax.xaxis.set_major_formatter(ScalarFormatter())
-        ax.xaxis.set_minor_formatter(NullFormatter())
-    axes[0].set_xlabel("training iterations (log)")
-    axes[1].set_xlabel("training iterations (log)")
-    axes[2].set_xlabel("training wall time (s, log)")
-    axes[0].set_ylabel("PSNR, trained frames (dB)")
-    axes[1].set_ylabel("PSNR, time split (dB)")
-    axes[2].set_ylabel("PSNR, trained frames (dB)")
+    for ax, (x, y, xlabel, ylabel) in zip(axes, panels):
+        for m, g in df.groupby("model", sort=False):
+            if m in refs:
+                continue
+            g = g.sort_values("iterations")
+            ax.plot(g[x], g[y], "-o", ms=3.5, color=COLORS.get(m),
+                    lw=1.6 if m == "ours" else 1.0, label=label(m))
+            p = g[g["is_profile"]]
+            ax.plot(p[x], p[y], "*", ms=10, color=COLORS.get(m))
+        for m, (c, ls) in refs.items():
+            if m in prof.index:
+                ax.axhline(prof.loc[m, y], color=c, ls=ls, lw=1.0, label=label(m))
+        ax.set_xscale("log")
+        if x == "iterations":  # tick the budgets themselves, not powers of ten
+            ax.set_xticks(budgets)
+            ax.xaxis.set_major_formatter(ScalarFormatter())
+            ax.xaxis.set_minor_formatter(NullFormatter())
+        ax.set_xlabel(xlabel)
+        ax.set_ylabel(ylabel)
+        ax.grid(alpha=0.3)
     axes[0].legend(fontsize=7)
     fig.suptitle(f"Fit curve on the {df['tree'].iloc[0]} tree (star: the profile's budget)")
     fig.tight_layout()

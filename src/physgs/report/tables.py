@@ -17,6 +17,7 @@ import pandas as pd
 from physgs.atomic import atomic_path, write_text
 
 from physgs.models.registry import MODEL_NAMES as MODELS
+from physgs.evaluate.metrics import ceiling_fraction
 from physgs.models.registry import MODELS as SPECS
 from physgs.models.registry import label
 
@@ -149,10 +150,9 @@ def tab_fit(rows: Mapping[tuple[str, str], Mapping[str, float]], trees: Sequence
         ceil, stat = rows[(t, reference)]["fit"], rows[(t, static)]["fit"]
         for m in (*models, reference):
             r = rows[(t, m)]
-            gain = ceil - stat
             recs.append({"tree": t, "bones": bones[t], "model": m, "reference": m == reference,
                          "fit_psnr_db": r["fit"], "heldout_psnr_db": r["heldout"],
-                         "ceiling_frac": (r["fit"] - stat) / gain if gain > 0 else np.nan,
+                         "ceiling_frac": float(ceiling_fraction(r["fit"], stat, ceil)),
                          "view_psnr_db": r["view"], "time_psnr_db": r["time"],
                          "train_s": r["train_s"]})
     df = pd.DataFrame(recs)
