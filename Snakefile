@@ -12,7 +12,9 @@ configfile: "config/trees.yaml"
 
 # validates the raw config and every profile body against the packaged schema, resolves the
 # profile, validates the result and runs the cross-key checks: a bad config stops here
-CFG = physgs.config.load_workflow_config(config)
+# (a command-line --config seeds=[...] beats the profile's seeds: physgs.config)
+CFG = physgs.config.load_workflow_config(
+    config, command_line=workflow.config_settings.overwrite_config)
 TREES = CFG["trees"]
 
 

@@ -68,11 +68,11 @@ def _row(fit, held=0.0, time=0.0, s=1.0):
 
 
 def test_collect_joins_points_and_the_pipelines_own_rows():
-    pts = [{"model": "mlp", "iterations": 500, "fit": 19.0, "heldout": 18.5, "time": 18.0,
-            "train_s": 50.0},
-           {"model": "mlp", "iterations": 3000, "fit": 23.0, "heldout": 21.0, "time": 17.0,
-            "train_s": 300.0}]
-    own = {"static": _row(18.0), "mlp": _row(21.0), "truth_motion": _row(28.0)}
+    pts = [{"model": "mlp", "seed": 0, "iterations": 500, "fit": 19.0, "heldout": 18.5,
+            "time": 18.0, "train_s": 50.0},
+           {"model": "mlp", "seed": 0, "iterations": 3000, "fit": 23.0, "heldout": 21.0,
+            "time": 17.0, "train_s": 300.0}]
+    own = {0: {"static": _row(18.0), "mlp": _row(21.0), "truth_motion": _row(28.0)}}
     df = fc.collect(pts, own, 1500, "medium")
     mlp = df[df["model"] == "mlp"]
     assert list(mlp["iterations"]) == [500, 1500, 3000]
@@ -84,6 +84,17 @@ def test_collect_joins_points_and_the_pipelines_own_rows():
         fc.collect([dict(pts[0], iterations=1500)], own, 1500, "medium")
 
 
+def test_ceiling_fraction_pairs_each_seed_with_its_own_references():
+    pts = [{"model": "mlp", "seed": s, "iterations": 500, "fit": 20.0, "heldout": 0.0,
+            "time": 0.0, "train_s": 1.0} for s in (0, 1)]
+    own = {0: {"static": _row(18.0), "truth_motion": _row(28.0)},   # seed 0: gain 10 dB
+           1: {"static": _row(19.0), "truth_motion": _row(21.0)}}   # seed 1: gain 2 dB
+    df = fc.collect(pts, own, 1500, "medium")
+    frac = fc.ceiling_fraction(df)
+    got = dict(zip(df.loc[df.model == "mlp", "seed"], frac[df.model == "mlp"]))
+    assert got == pytest.approx({0: 0.2, 1: 0.5})
+
+
 def test_ceiling_fraction_is_nan_without_a_gain_to_measure():
     from physgs.evaluate.metrics import ceiling_fraction
     assert np.isnan(ceiling_fraction(20.0, 18.0, 18.0))  # the ceiling does not beat static
@@ -91,15 +102,17 @@ def test_ceiling_fraction_is_nan_without_a_gain_to_measure():
 
 
 def test_ceiling_fraction_is_nan_without_the_references():
-    df = fc.collect([], {"mlp": _row(21.0)}, 1500, "medium")
+    df = fc.collect([], {0: {"mlp": _row(21.0)}}, 1500, "medium")
     assert fc.ceiling_fraction(df).isna().all()
 
 
 def test_fig_fit_curve_writes_both_formats(tmp_path):
     from physgs.report.figures import fig_fit_curve
-    pts = [{"model": m, "iterations": it, "fit": 20.0 + it / 1000, "heldout": 19.0,
-            "time": 18.0, "train_s": it / 10} for m in ("mlp", "ours") for it in (500, 3000)]
-    own = {m: _row(20.0) for m in ("static", "mlp", "ours", "truth_motion")}
+    pts = [{"model": m, "seed": s, "iterations": it, "fit": 20.0 + it / 1000 + s / 10,
+            "heldout": 19.0, "time": 18.0, "train_s": it / 10} for m in ("mlp", "ours")
+           for it in (500, 3000) for s in (0, 1)]
+    own = {s: {m: _row(20.0 + s) for m in ("static", "mlp", "ours", "truth_motion")}
+           for s in (0, 1)}
     df = fc.collect(pts, own, 1500, "medium")
     outs = [tmp_path / "f.pdf", tmp_path / "f.png"]
     fig_fit_curve(df, outs)

@@ -34,7 +34,8 @@ def summaries():
 def tex_rows(tex):
     """Numeric cells of each body row of a booktabs tabular, in order, and which were bold.
 
-    A cell counts when, stripped of bold/math/percent markup, it is a number or 'n/K'.
+    A cell counts when, stripped of bold/math/percent markup, it is a number or 'n/K'; a
+    'mean $\\pm$ sd' cell counts as two numbers.
     """
     body = tex.split("\\midrule", 1)[1].split("\\bottomrule")[0]
     out = []
@@ -44,52 +45,133 @@ def tex_rows(tex):
         nums, bold = [], []
         for c in line.split("&"):
             plain = re.sub(r"\\textbf\{(.*)\}", r"\1", c.strip()).replace("$", "").replace("\\%", "")
-            m = re.fullmatch(r"([-+]?\d+(?:\.\d+)?)(?:/\d+)?", plain)
-            if m:
-                nums.append(float(m.group(1)))
-                bold.append("textbf" in c)
+            plain = plain.replace("^{\\dagger}", "")  # the undecided mark
+            for part in plain.split("\\pm"):
+                m = re.fullmatch(r"([-+]?\d+(?:\.\d+)?)(?:/\d+)?", part.strip())
+                if m:
+                    nums.append(float(m.group(1)))
+                    bold.append("textbf" in c)
         out.append((nums, bold))
     return out
 
 
-def test_tab_psnr_bold_and_agreement(tmp_path):
-    tab = T.tab_psnr(summaries(), TREES, BONES)
-    assert list(tab.df.model) == [T.label(m) for m in T.MODELS]
-    assert list(tab.df.columns) == ["model", "sparse_view", "sparse_time", "medium_view", "medium_time"]
+def per_seed(n_seeds, noise=0.0):
+    """{seed: summaries()} with seed-specific noise (0: the same values for every seed)."""
+    rng = np.random.default_rng(1)
+    out = {}
+    for s in range(n_seeds):
+        S = summaries()
+        shift = rng.normal(0, 1.0)  # a seed-wide offset every model shares (pairing cancels it)
+        out[s] = {k: {kk: v + shift + noise * rng.normal() for kk, v in d.items()}
+                  for k, d in S.items()}
+    return out
+
+
+def test_one_seed_tab_psnr_agrees_and_bolds_nothing(tmp_path):
+    tab = T.tab_psnr(per_seed(1), TREES, BONES)
+    cols = ["sparse_view", "sparse_time", "medium_view", "medium_time"]
+    assert list(tab.df.columns) == ["seed", "model", *cols, "difference"]
+    assert list(tab.df.model[:6]) == [T.label(m) for m in T.MODELS]
     T.write_table(tab, tmp_path / "t.tex", tmp_path / "t.csv")
     csv = pd.read_csv(tmp_path / "t.csv")
     rows = tex_rows((tmp_path / "t.tex").read_text())
-    assert len(rows) == len(csv) == 6
+    assert len(rows) == len(csv) == 8  # six models, two differences
     for (nums, bold), (_, r) in zip(rows, csv.iterrows()):
-        np.testing.assert_allclose(nums, np.round(r.iloc[1:].to_numpy(float), 2), atol=1e-9)
-    ours = rows[-1]
-    assert ours[0][3] == 31.0 and ours[1][3]
-    # exactly one bold per column (no ties in this data), and it is the column maximum
-    for j, col in enumerate(csv.columns[1:]):
-        flags = [b[j] for _, b in rows]
-        assert sum(flags) == 1 and flags[int(csv[col].idxmax())]
+        np.testing.assert_allclose(nums, np.round(r[cols].to_numpy(float), 2), atol=1e-9)
+        assert not any(bold)  # one seed: no interval, nothing decided
+    S = per_seed(1)[0]
+    ours_static = S[("medium", "ours")]["time"] - S[("medium", "static")]["time"]
+    assert csv.loc[6, "medium_time"] == pytest.approx(ours_static)
+    best_view = max(S[("sparse", m)]["view"] for m in ("mlp", "mlp_wind", "d3dgs", "d3dgs_wind"))
+    assert csv.loc[7, "sparse_view"] == pytest.approx(S[("sparse", "ours")]["view"] - best_view)
+    assert T.seedstats.UNDECIDED in tab.tex
 
 
-def test_tab_transfer_rows_and_bold():
-    tab = T.tab_transfer(summaries(), TREES, BONES, COND)
-    assert len(tab.df) == 2 * len(TREES) * 2
-    assert list(tab.df.columns) == ["split", "tree", "bones", "condition", *T.MODELS]
+def test_seeds_give_mean_sd_and_a_decided_best(tmp_path):
+    data = per_seed(4, noise=0.05)
+    tab = T.tab_psnr(data, TREES, BONES)
+    assert sorted(tab.df.seed.unique()) == [0, 1, 2, 3] and len(tab.df) == 4 * 8
+    ours = tab.df[tab.df.model == T.label("ours")]["medium_time"].to_numpy()
+    m, sd = ours.mean(), ours.std(ddof=1)  # independent of the module: numpy
+    assert f"{m:.2f} $\\pm$ {sd:.2f}" in tab.tex
+    # ours is 31 + shift + noise on every seed: ~5 dB above every other model, paired -> bold
+    assert rf"\textbf{{{m:.2f} $\pm$ {sd:.2f}}}" in tab.tex
+
+
+def test_an_undecided_best_is_not_bold():
+    data = per_seed(3, noise=2.0)  # noise far above the gaps between the best two
+    for s in data:  # two models tied on average in one column
+        data[s][("sparse", "mlp")]["view"] = 40.0 + (1.0 if s % 2 else -1.0)
+        data[s][("sparse", "mlp_wind")]["view"] = 40.0
+    tab = T.tab_psnr(data, TREES, BONES)
+    line = [ln for ln in tab.tex.splitlines() if ln.strip().startswith(T.label("mlp") + " &")][0]
+    assert "textbf" not in line.split("&")[1]
+
+
+def test_paired_differences_use_scipy_t_interval():
+    from scipy import stats
+
+    data = per_seed(5, noise=0.3)
+    tab = T.tab_margin(data, TREES, BONES, COND)
+    d = tab.df[tab.df.tree == "medium"]["margin_0.84v0"].to_numpy()
+    exp = [data[s][("medium", "ours")]["train_c1"] - data[s][("medium", "mlp_wind")]["train_c1"]
+           for s in range(5)]
+    np.testing.assert_allclose(d, exp)
+    lo, hi = stats.t.interval(0.95, len(d) - 1, loc=d.mean(), scale=stats.sem(d))
+    cell = f"${d.mean():+.2f}$ [{lo:.2f}, {hi:.2f}]"
+    assert cell in tab.tex
+    assert (rf"\textbf{{{cell}}}" in tab.tex) == (lo > 0 or hi < 0)
+
+
+def test_pairing_decides_what_unpaired_seeds_cannot():
+    """A large seed-wide offset shared by both models hides a constant 0.5 dB margin from any
+    unpaired comparison; per-seed pairing recovers it exactly."""
+    base = per_seed(4, noise=0.0)
+    for s, S in base.items():
+        for c in range(3):
+            S[("sparse", "ours")][f"train_c{c}"] = S[("sparse", "mlp_wind")][f"train_c{c}"] + 0.5
+    from scipy import stats
+
+    tab = T.tab_margin(base, ["sparse"], BONES, COND)
+    np.testing.assert_allclose(tab.df["margin_v0"], 0.5)
+    assert tab.df["seed"].tolist() == [0, 1, 2, 3]
+    assert r"\textbf{$+0.50$ [0.50, 0.50]}" in tab.tex
+    ours = [base[s][("sparse", "ours")]["train_c0"] for s in base]
+    mlpw = [base[s][("sparse", "mlp_wind")]["train_c0"] for s in base]
+    assert stats.ttest_ind(ours, mlpw).pvalue > 0.05  # unpaired, the offsets drown the margin
+
+
+def test_tab_transfer_rows_and_decided_bold():
+    data = per_seed(3, noise=0.01)
+    tab = T.tab_transfer(data, TREES, BONES, COND)
+    assert len(tab.df) == 3 * 2 * len(TREES) * 2
+    assert list(tab.df.columns) == ["seed", "split", "tree", "bones", "condition", *T.MODELS]
+    first = tab.df[tab.df.seed == 0]
     rows = tex_rows(tab.tex)
-    for (nums, bold), (_, r) in zip(rows, tab.df.iterrows()):
-        vals = r[list(T.MODELS)].to_numpy(float)
-        np.testing.assert_allclose(nums, np.round(vals, 2))
-        assert bold[int(np.argmax(vals))]
+    for (nums, bold), (i, r) in zip(rows, first.iterrows()):
+        vals = tab.df[(tab.df.split == r.split) & (tab.df.tree == r.tree)
+                      & (tab.df.condition == r.condition)][list(T.MODELS)].to_numpy(float)
+        np.testing.assert_allclose(nums[::2], np.round(vals.mean(0), 2))  # mean, then sd
+        top = np.sort(vals.mean(0))
+        if top[-1] - top[-2] > 0.1:  # a gap ten times the noise: decided
+            assert bold[2 * int(np.argmax(vals.mean(0)))] and sum(bold) == 2
     r = tab.df[(tab.df.split == "beyond") & (tab.df.tree == "sparse") & (tab.df.condition == 0.71)]
-    assert float(r.d3dgs.iloc[0]) == 30.0
+    assert (r.d3dgs - r[["static", "mlp", "ours"]].max(axis=1) > 2).all()
 
 
 def test_tab_margin_values():
-    S = summaries()
+    S = per_seed(1)
     tab = T.tab_margin(S, TREES, BONES, COND)
-    assert list(tab.df.columns) == ["tree", "bones", "margin_v0", "margin_0.84v0", "margin_0.71v0"]
-    exp = S[("medium", "ours")]["train_c1"] - S[("medium", "mlp_wind")]["train_c1"]
+    assert list(tab.df.columns) == ["seed", "tree", "bones", "margin_v0", "margin_0.84v0",
+                                    "margin_0.71v0"]
+    exp = S[0][("medium", "ours")]["train_c1"] - S[0][("medium", "mlp_wind")]["train_c1"]
     assert tab.df.loc[1, "margin_0.84v0"] == pytest.approx(exp)
-    assert f"${exp:+.2f}$" in tab.tex
+    assert f"${exp:+.2f}$" + T.seedstats.UNDECIDED in tab.tex
+
+
+def test_results_not_keyed_by_seed_are_refused():
+    with pytest.raises(TypeError, match="keyed by training seed"):
+        T.tab_psnr(summaries(), TREES, BONES)
 
 
 def record(n_trusted, med):
@@ -105,41 +187,56 @@ def null(med):
                       np.ones((3, 4)), 4, 0.004, 0)
 
 
-def test_tab_null_bold_lower_error_and_nan_cells(tmp_path):
-    rec = {("sparse", "single"): record(3, 0.018), ("medium", "single"): record(0, float("nan"))}
-    nl = {("sparse", "single"): null(0.0456), ("medium", "single"): null(0.0177)}
-    tab = T.tab_null(rec, nl, TREES, BONES, configs={"single": "single ($K{=}32$)"})
-    assert tab.df.loc[0, "trained_median_rel_err_pct"] == pytest.approx(1.8)
-    assert tab.df.loc[0, "null_median_rel_err_pct"] == pytest.approx(4.56)
-    assert tab.df.loc[0, "null_parts_trusted"] == 4 and tab.df.loc[0, "nearest_bone_gap_pct"] == pytest.approx(0.4)
-    assert r"\textbf{1.80\%}" in tab.tex and r"\textbf{4.56\%}" not in tab.tex
-    assert r"\textbf{1.77\%}" in tab.tex and "--" in tab.tex  # trained has no trusted part
+def test_tab_null_per_seed_difference_and_nan_cells(tmp_path):
+    cfg = {"single": "single ($K{=}32$)"}
+    rec = {s: {("sparse", "single"): record(3, 0.018 + 0.001 * s),
+               ("medium", "single"): record(0, float("nan"))} for s in range(3)}
+    nl = {s: {("sparse", "single"): null(0.0456 + 0.002 * s), ("medium", "single"): null(0.0177)}
+          for s in range(3)}
+    tab = T.tab_null(rec, nl, TREES, BONES, configs=cfg)
+    sp = tab.df[tab.df.tree == "sparse"]
+    np.testing.assert_allclose(sp.trained_median_rel_err_pct, [1.8, 1.9, 2.0])
+    np.testing.assert_allclose(sp.null_median_rel_err_pct, [4.56, 4.76, 4.96])
+    np.testing.assert_allclose(sp.trained_minus_null_pp, [-2.76, -2.86, -2.96])
+    assert (sp.null_parts_trusted == 4).all() and sp.nearest_bone_gap_pct.iloc[0] == pytest.approx(0.4)
+    # trained beats the null on every seed by ~2.9 points with sd 0.1: decided, bold
+    assert r"\textbf{$-2.86$" in tab.tex
+    assert "1.90 $\\pm$ 0.10\\%" in tab.tex
     T.write_table(tab, tmp_path / "n.tex", tmp_path / "n.csv")
     csv = pd.read_csv(tmp_path / "n.csv")
-    rows = tex_rows((tmp_path / "n.tex").read_text())
-    cols = ["trained_parts_trusted", "trained_median_rel_err_pct", "trained_loglog_r2", "null_parts_trusted",
-            "null_median_rel_err_pct", "null_loglog_r2", "nearest_bone_gap_pct"]
-    np.testing.assert_allclose(rows[0][0], [round(v, 3) for v in csv.loc[0, cols]], atol=5e-3)
-    assert np.isnan(csv.loc[1, "trained_median_rel_err_pct"])
+    assert np.isnan(csv[csv.tree == "medium"].trained_median_rel_err_pct).all()
+    assert "--" in tab.tex  # the medium model has no trusted part
     with pytest.raises(KeyError, match="dense"):
-        T.tab_null(rec, nl, ["sparse", "dense"], BONES, configs={"single": "single ($K{=}32$)"})
+        T.tab_null(rec, nl, ["sparse", "dense"], BONES, configs=cfg)
+
+
+def test_tab_null_refuses_a_null_with_another_k():
+    cfg = {"single": "single ($K{=}32$)"}
+    rec = {0: {("sparse", "single"): record(3, 0.018)}}
+    other = NullResult(np.array([4]), np.array([0.04]), np.array([0.9]), np.ones((1, 8)), 8, 0.004, 0)
+    with pytest.raises(ValueError, match="K=8"):
+        T.tab_null(rec, {0: {("sparse", "single"): other}}, ["sparse"], BONES, configs=cfg)
 
 
 def test_missing_model_names_the_cause():
-    S = summaries()
-    del S[("sparse", "mlp")]
+    S = per_seed(2)
+    del S[1][("sparse", "mlp")]
     with pytest.raises(KeyError, match="mlp"):
         T.tab_psnr(S, TREES, BONES)
 
 
 def test_tab_psnr_reference_row_is_separate_and_never_bold():
-    S = summaries()
-    for t in TREES:
-        S[(t, "truth_motion")] = {"view": 40.0, "time": 40.0}  # above every method
+    S = per_seed(3, noise=0.01)
+    for s in S:
+        for t in TREES:
+            S[s][(t, "truth_motion")] = {"view": 40.0 + 0.1 * s, "time": 40.0}  # above every method
     tab = T.tab_psnr(S, TREES, BONES, references=("truth_motion",))
-    assert list(tab.df.model)[-1] == T.label("truth_motion") and tab.df.reference.iloc[-1]
-    assert r"\textbf{40.00}" not in tab.tex and r"\emph{True motion" in tab.tex
-    assert tab.tex.count(r"\textbf{") == 2 * len(TREES)  # still one bold per column, a method
+    first = tab.df[tab.df.seed == 0]
+    assert first.reference.tolist() == [False] * 6 + [True, False, False]
+    assert r"\textbf{40.10" not in tab.tex and r"\emph{True motion" in tab.tex
+    # one bold per column at most, on a method row (the reference is never a candidate)
+    body = [ln for ln in tab.tex.splitlines() if "textbf" in ln]
+    assert all(not ln.strip().startswith(r"\emph") for ln in body)
 
 
 def test_tab_fit_fraction_of_the_ceiling():
@@ -149,7 +246,7 @@ def test_tab_fit_fraction_of_the_ceiling():
         for m, fit in zip((*models, "truth_motion"), (20.0, 22.0, 26.0, 30.0)):
             rows[(t, m)] = {"fit": fit, "heldout": fit - 0.5, "view": 21.0, "time": 21.5,
                             "train_s": 12.0}
-    tab = T.tab_fit(rows, TREES, BONES, models, "truth_motion")
+    tab = T.tab_fit({0: rows}, TREES, BONES, models, "truth_motion")
     frac = dict(zip(tab.df.model[tab.df.tree == "sparse"], tab.df.ceiling_frac))
     # (model - static) / (ceiling - static): 0, 2/10, 6/10, 1
     assert frac == pytest.approx({"static": 0.0, "mlp": 0.2, "ours": 0.6, "truth_motion": 1.0})

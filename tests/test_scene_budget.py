@@ -197,7 +197,13 @@ def test_tab_kselect_rows_and_undefined_entries():
                                        frozen=3, k_heldout=16, k_bic=64),
             ("sparse", "auto"): dict(K=16, time_psnr=25.5, median_rel_err=float("nan"), trusted=0,
                                      frozen=16, k_heldout=16, k_bic=64)}
-    t = tab_kselect(rows, ["sparse"], {"sparse": 22}, "heldout")
+    t = tab_kselect({0: rows}, ["sparse"], {"sparse": 22}, "heldout")
     assert t.df["K"].tolist() == [32, 16] and t.df["median_rel_err_pct"].iloc[0] == 5.0
     assert "10/32" in t.tex and "0/16" in t.tex and "--" in t.tex  # NaN median shown as --
-    assert ("kselect", "sparse") in needs("tab_kselect", ["sparse"], {})
+    assert ("kselect", "sparse", 3) in needs("tab_kselect", ["sparse"], {}, [3])
+    # a second seed that chose another K: both choices shown, the rest averaged
+    rows1 = {k: dict(v) for k, v in rows.items()}
+    rows1[("sparse", "auto")].update(K=64, time_psnr=26.5)
+    t2 = tab_kselect({0: rows, 1: rows1}, ["sparse"], {"sparse": 22}, "heldout")
+    assert t2.df["seed"].tolist() == [0, 0, 1, 1] and "16/64" in t2.tex
+    assert "26.00 $\\pm$ 0.71" in t2.tex

@@ -260,17 +260,23 @@ def resolve(cfg: dict, profile: str | None = None) -> dict:
 
 
 def load_workflow_config(config: dict, profile: str | None = None, *,
-                         source: str = DEFAULT_SOURCE) -> dict:
+                         source: str = DEFAULT_SOURCE, command_line: dict | None = None) -> dict:
     """The one way in: validate a raw config, resolve its profile, validate and check the result.
 
     config: the raw config (what Snakemake's ``config`` holds: ``config/trees.yaml`` plus any
     ``--config KEY=VALUE``, which arrive as top-level keys); profile: overrides
-    ``config['profile']``. Returns the resolved config; raises ConfigError before anything runs.
+    ``config['profile']``; command_line: the command line's own overrides (Snakemake's
+    ``workflow.config_settings.overwrite_config``): their top-level values that are not sections
+    (``seeds``, ``seed``, ...) beat the profile's, so ``--config seeds=[0,1,2]`` means those
+    seeds under any profile. Returns the resolved config; raises ConfigError before anything runs.
     """
     if profile is not None and isinstance(config, dict):
         config = {**config, "profile": profile}
     validate(config, source=source)
     resolved = resolve(config, config.get("profile"))
+    for k, v in (command_line or {}).items():
+        if k != "profile" and not isinstance(v, dict):
+            resolved[k] = copy.deepcopy(v)
     validate(resolved, raw=config, source=source)
     check(resolved, raw=config, source=source)
     return resolved

@@ -17,24 +17,31 @@ from physgs.report import build as _build
 os.environ.setdefault("OMP_WAIT_POLICY", "PASSIVE")
 
 TREES = list(CFG["trees"])
+SEEDS = [int(s) for s in CFG["seeds"]]  # training seeds; the testbed's is CFG["seed"]
+TESTBED_SEEDS = bool(CFG["testbed_seeds"])
 CONFIGS = dict(CFG["models"]["configs"])  # name -> {conditions, K}
 TRAIN_JOBS = _models.training_jobs(CONFIGS)
 STAMP = _provenance.stamp(CFG)  # not a rerun trigger (see physgs.provenance.Stamp)
 
 # ---- file layout ------------------------------------------------------------------------------
+# The testbed is one fixed instance per tree (testbed seed CFG["seed"]); every result of a
+# training seed lives under seed{seed}/. With testbed_seeds, seed s also has its own instance.
 OBSERVED = "results/testbed/{tree}/observed.npz"
 TRUTH = "results/testbed/{tree}/truth.npz"
 STATS = "results/testbed/{tree}/stats.json"
-CKPT = "results/models/{tree}/{model}_{config}.pt"
-LOSS = "results/models/{tree}/{model}_{config}.loss.csv"
-EVAL = "results/eval/{tree}/{model}_{config}.npz"
-TRAJ = "results/eval/{tree}/{model}_{config}.traj.npz"
-PANELS = "results/eval/{tree}/{model}_{config}.panels.npz"
-RECOVERY = "results/recovery/{tree}/ours_{config}.json"
-NULL = "results/recovery/{tree}/null_K{K}.json"
-KSELECT = "results/kselect/{tree}.json"
-SWEEP_POINT = "results/speed_accuracy/{point}.json"
-FIT_POINT = "results/fit_curve/{tree}/{model}_it{iterations}.json"
+SEEDED_OBSERVED = "results/testbed/{tree}/seed{seed}/observed.npz"
+SEEDED_TRUTH = "results/testbed/{tree}/seed{seed}/truth.npz"
+SEEDED_STATS = "results/testbed/{tree}/seed{seed}/stats.json"
+CKPT = "results/models/{tree}/seed{seed}/{model}_{config}.pt"
+LOSS = "results/models/{tree}/seed{seed}/{model}_{config}.loss.csv"
+EVAL = "results/eval/{tree}/seed{seed}/{model}_{config}.npz"
+TRAJ = "results/eval/{tree}/seed{seed}/{model}_{config}.traj.npz"
+PANELS = "results/eval/{tree}/seed{seed}/{model}_{config}.panels.npz"
+RECOVERY = "results/recovery/{tree}/seed{seed}/ours_{config}.json"
+NULL = "results/recovery/{tree}/seed{seed}/null_K{K}.json"
+KSELECT = "results/kselect/{tree}/seed{seed}.json"
+SWEEP_POINT = "results/speed_accuracy/seed{seed}/{point}.json"
+FIT_POINT = "results/fit_curve/{tree}/seed{seed}/{model}_it{iterations}.json"
 TABLE = "results/tables/{name}.{ext}"
 FIGURE = "results/figures/{name}.{ext}"
 #: need kind (physgs.report.build.needs) -> path template
@@ -55,10 +62,34 @@ wildcard_constraints:
     K=r"\d+",
     point="|".join(SWEEP_POINTS),
     iterations=r"\d+",
+    seed=r"\d+",
     name="|".join([*_build.TABLES, *_build.FIGURES]),
 
 
 # ---- input functions ----------------------------------------------------------------------
+def testbed_files(tree, seed):
+    """{observed, truth, stats} paths of the instance training seed ``seed`` reads: the tree's
+    one instance, or with testbed_seeds the instance built with testbed seed ``seed``."""
+    if TESTBED_SEEDS:
+        return {"observed": SEEDED_OBSERVED.format(tree=tree, seed=seed),
+                "truth": SEEDED_TRUTH.format(tree=tree, seed=seed),
+                "stats": SEEDED_STATS.format(tree=tree, seed=seed)}
+    return {"observed": OBSERVED.format(tree=tree), "truth": TRUTH.format(tree=tree),
+            "stats": STATS.format(tree=tree)}
+
+
+def observed_input(wildcards):
+    return testbed_files(wildcards.tree, wildcards.seed)["observed"]
+
+
+def truth_input(wildcards):
+    return testbed_files(wildcards.tree, wildcards.seed)["truth"]
+
+
+def stats_input(wildcards):
+    return testbed_files(wildcards.tree, wildcards.seed)["stats"]
+
+
 def train_input(wildcards):
     """The observed dataset of the tree; refuses (model, config) pairs that are never trained."""
     if wildcards.config not in _models.configs_for(wildcards.model, CONFIGS):
@@ -66,7 +97,7 @@ def train_input(wildcards):
             f"model '{wildcards.model}' is not trained in configuration '{wildcards.config}'; "
             f"valid: {_models.configs_for(wildcards.model, CONFIGS)} (joint configurations "
             "are ours only)")
-    return OBSERVED.format(tree=wildcards.tree)
+    return observed_input(wildcards)
 
 
 def need_paths(needs):
@@ -80,21 +111,21 @@ def need_paths(needs):
 
 def report_inputs(wildcards):
     """need key -> path of every file table or figure ``name`` reads."""
-    return need_paths(_build.needs(wildcards.name, TREES, CONFIGS))
+    return need_paths(_build.needs(wildcards.name, TREES, CONFIGS, SEEDS))
 
 
 # ---- narrow params: each job sees only the settings it reads -------------------------------
 def train_params(wildcards):
-    return _job_spec(CFG, wildcards.model, wildcards.config)
+    return _job_spec(CFG, wildcards.model, wildcards.config, seed=int(wildcards.seed))
 
 
 def kselect_params(wildcards):
-    return _canonical({"job": _job_spec(CFG, "ours", _models.BASE_CONFIG),
+    return _canonical({"job": _job_spec(CFG, "ours", _models.BASE_CONFIG, seed=int(wildcards.seed)),
                        "kselect": CFG["models"]["kselect"]})
 
 
 def null_params(wildcards):
-    return _null_settings(CFG, int(wildcards.K))
+    return _null_settings(CFG, int(wildcards.K), seed=int(wildcards.seed))
 
 
 def report_params(wildcards):
@@ -102,26 +133,44 @@ def report_params(wildcards):
 
 
 def sweep_params(wildcards):
-    return _sweep.point_settings(CFG, wildcards.point)
+    return _sweep.point_settings(CFG, wildcards.point, seed=int(wildcards.seed),
+                                 testbed_seeds=TESTBED_SEEDS)
+
+
+def sweep_inputs(wildcards):
+    """The sweep tree's dataset for this seed's points."""
+    f = testbed_files(SA_TREE, wildcards.seed)
+    return {"observed": f["observed"], "truth": f["truth"]}
+
+
+def sweep_collect_inputs(wildcards):
+    """Every sweep point of every seed, and the untrained null of the sweep tree at the
+    profile's K per seed (the chance level the recovery panel draws)."""
+    k = int(CONFIGS[_models.BASE_CONFIG]["K"])
+    return {"points": expand(SWEEP_POINT, seed=SEEDS, point=SWEEP_POINTS),
+            "nulls": expand(NULL, tree=SA_TREE, seed=SEEDS, K=k)}
 
 
 def fit_point_params(wildcards):
-    return _fit_curve.point_job(CFG, wildcards.model, int(wildcards.iterations))
+    return _fit_curve.point_job(CFG, wildcards.model, int(wildcards.iterations),
+                                seed=int(wildcards.seed))
 
 
 def fit_curve_inputs(wildcards):
-    """The extra-budget points, and the pipeline's own evaluation and loss log of each model at
-    the profile's budget."""
+    """The extra-budget points of every seed, and the pipeline's own evaluation and loss log of
+    each model and seed at the profile's budget (keys eval_{model}_{seed}, loss_{model}_{seed})."""
     tree, cfg = FC["tree"], _models.BASE_CONFIG
-    return {
-        "points": expand(FIT_POINT, tree=tree, model=FC["models"],
-                         iterations=_fit_curve.extra_budgets(CFG)),
-        **{f"eval_{m}": EVAL.format(tree=tree, model=m, config=cfg) for m in FC_PROFILE_MODELS},
-        **{f"loss_{m}": LOSS.format(tree=tree, model=m, config=cfg) for m in FC_PROFILE_MODELS},
-    }
+    out = {"points": expand(FIT_POINT, tree=tree, seed=SEEDS, model=FC["models"],
+                            iterations=_fit_curve.extra_budgets(CFG))}
+    for s in SEEDS:
+        for m in FC_PROFILE_MODELS:
+            out[f"eval_{m}_{s}"] = EVAL.format(tree=tree, seed=s, model=m, config=cfg)
+            out[f"loss_{m}_{s}"] = LOSS.format(tree=tree, seed=s, model=m, config=cfg)
+    return out
 
 
 def testbed_params(wildcards):
     t = wildcards.tree  # only this tree's vertex count: another tree's edit leaves it alone
     tb = {**CFG["testbed"], "vertices": {t: CFG["testbed"]["vertices"][t]}}
-    return _canonical({"testbed": tb, "preset": CFG["presets"][t], "seed": int(CFG["seed"])})
+    seed = int(getattr(wildcards, "seed", CFG["seed"]))  # a seeded instance (testbed_seeds)
+    return _canonical({"testbed": tb, "preset": CFG["presets"][t], "seed": seed})

@@ -5,8 +5,8 @@
 rule evaluate:
     input:
         ckpt=CKPT,
-        observed=OBSERVED,
-        truth=TRUTH,
+        observed=observed_input,
+        truth=truth_input,
     output:
         scores=EVAL,
         traj=TRAJ,
@@ -16,9 +16,9 @@ rule evaluate:
     conda:
         "../envs/physgs.yaml"
     log:
-        "logs/evaluate/{tree}/{model}_{config}.log",
+        "logs/evaluate/{tree}/seed{seed}/{model}_{config}.log",
     benchmark:
-        "results/benchmarks/evaluate/{tree}/{model}_{config}.tsv"
+        "results/benchmarks/evaluate/{tree}/seed{seed}/{model}_{config}.tsv"
     threads: 1
     resources:
         mem_mb=3000,

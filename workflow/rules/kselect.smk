@@ -5,7 +5,7 @@
 
 rule kselect:
     input:
-        observed=OBSERVED,
+        observed=observed_input,
     output:
         selection=KSELECT,
     params:
@@ -13,9 +13,9 @@ rule kselect:
     conda:
         "../envs/physgs.yaml"
     log:
-        "logs/kselect/{tree}.log",
+        "logs/kselect/{tree}/seed{seed}.log",
     benchmark:
-        "results/benchmarks/kselect/{tree}.tsv"
+        "results/benchmarks/kselect/{tree}/seed{seed}.tsv"
     threads: 2
     resources:
         mem_mb=4000,
@@ -29,20 +29,20 @@ rule kselect:
 
 rule train_auto:
     input:
-        observed=OBSERVED,
+        observed=observed_input,
         selection=KSELECT,
     output:
         ckpt=CKPT.replace("{model}_{config}", "ours_auto"),
         loss=LOSS.replace("{model}_{config}", "ours_auto"),
     params:
-        job=lambda wc: _job_spec(CFG, "ours", _models.BASE_CONFIG),
+        job=lambda wc: _job_spec(CFG, "ours", _models.BASE_CONFIG, seed=int(wc.seed)),
         conditions=CFG["models"]["kselect"]["conditions"],
     conda:
         "../envs/physgs.yaml"
     log:
-        "logs/train/{tree}/ours_auto.log",
+        "logs/train/{tree}/seed{seed}/ours_auto.log",
     benchmark:
-        "results/benchmarks/train/{tree}/ours_auto.tsv"
+        "results/benchmarks/train/{tree}/seed{seed}/ours_auto.tsv"
     threads: 1
     resources:
         mem_mb=4000,

@@ -1,19 +1,20 @@
 # Recovery (SPEC section 4): match ours' parts to bones by trajectory, against an untrained null.
-# The null control is keyed by K: configurations sharing a K share one null.
+# The null control is keyed by K and seed: configurations sharing a K share one null, and each
+# training seed draws its own (paired with that seed's trained model in tab_null).
 
 
 rule recovery:
     input:
         ckpt=CKPT.replace("{model}", "ours"),
-        observed=OBSERVED,
-        truth=TRUTH,
-        stats=STATS,
+        observed=observed_input,
+        truth=truth_input,
+        stats=stats_input,
     output:
         record=RECOVERY,
     conda:
         "../envs/physgs.yaml"
     log:
-        "logs/recovery/{tree}/ours_{config}.log",
+        "logs/recovery/{tree}/seed{seed}/ours_{config}.log",
     threads: 1
     resources:
         mem_mb=2000,
@@ -24,9 +25,9 @@ rule recovery:
 
 rule null_control:
     input:
-        observed=OBSERVED,
-        truth=TRUTH,
-        stats=STATS,
+        observed=observed_input,
+        truth=truth_input,
+        stats=stats_input,
     output:
         record=NULL,
     params:
@@ -34,7 +35,7 @@ rule null_control:
     conda:
         "../envs/physgs.yaml"
     log:
-        "logs/recovery/{tree}/null_K{K}.log",
+        "logs/recovery/{tree}/seed{seed}/null_K{K}.log",
     threads: 1
     resources:
         mem_mb=2000,

@@ -55,7 +55,7 @@ rule report:
 # interval and a verdict computed by code (physgs.report.claims).
 rule claims:
     input:
-        unpack(lambda wc: need_paths(_build.claims_needs(TREES, CONFIGS))),
+        unpack(lambda wc: need_paths(_build.claims_needs(TREES, CONFIGS, SEEDS))),
     output:
         md=report("results/claims.md", category="5. Claims"),
         csv="results/claims.csv",

@@ -4,8 +4,7 @@
 
 rule speed_accuracy_point:
     input:
-        observed=OBSERVED.format(tree=SA_TREE),
-        truth=TRUTH.format(tree=SA_TREE),
+        unpack(sweep_inputs),
     output:
         record=SWEEP_POINT,
     params:
@@ -13,9 +12,9 @@ rule speed_accuracy_point:
     conda:
         "../envs/physgs.yaml"
     log:
-        "logs/speed_accuracy/{point}.log",
+        "logs/speed_accuracy/seed{seed}/{point}.log",
     benchmark:
-        "results/benchmarks/speed_accuracy/{point}.tsv"
+        "results/benchmarks/speed_accuracy/seed{seed}/{point}.tsv"
     threads: 1  # two points run side by side on 2 cores (better throughput than 2 threads each)
     resources:
         mem_mb=4000,
@@ -26,7 +25,7 @@ rule speed_accuracy_point:
 
 rule speed_accuracy:
     input:
-        expand(SWEEP_POINT, point=SWEEP_POINTS),
+        unpack(sweep_collect_inputs),
     output:
         csv=report("results/tables/speed_accuracy.csv", category="4. Speed-accuracy trade"),
         pdf="results/figures/fig_speed_accuracy.pdf",
@@ -47,7 +46,7 @@ rule speed_accuracy:
 # its training budget on one tree; the profile's own budget is the pipeline's job, not retrained.
 rule fit_curve_point:
     input:
-        observed=OBSERVED,
+        observed=observed_input,
     output:
         record=FIT_POINT,
     params:
@@ -55,9 +54,9 @@ rule fit_curve_point:
     conda:
         "../envs/physgs.yaml"
     log:
-        "logs/fit_curve/{tree}/{model}_it{iterations}.log",
+        "logs/fit_curve/{tree}/seed{seed}/{model}_it{iterations}.log",
     benchmark:
-        "results/benchmarks/fit_curve/{tree}/{model}_it{iterations}.tsv"
+        "results/benchmarks/fit_curve/{tree}/seed{seed}/{model}_it{iterations}.tsv"
     threads: 1
     resources:
         mem_mb=4000,
@@ -76,6 +75,7 @@ rule fit_curve:
     params:
         tree=FC["tree"],
         models=FC_PROFILE_MODELS,
+        seeds=SEEDS,
         iterations=CFG["train"]["iterations"],
         n_train=CFG["testbed"]["n_train"],
         holdout_every=CFG["train"]["holdout_every"],

@@ -42,6 +42,29 @@ rule testbed_stats:
         "../scripts/testbed_stats.py"
 
 
+# testbed_seeds: one instance per training seed, built by the same code with testbed seed {seed}
+use rule testbed_dataset as testbed_dataset_seeded with:
+    output:
+        observed=SEEDED_OBSERVED,
+        truth=SEEDED_TRUTH,
+    log:
+        "logs/testbed/{tree}_seed{seed}.log",
+    benchmark:
+        "results/benchmarks/testbed/{tree}_seed{seed}.tsv"
+
+
+use rule testbed_stats as testbed_stats_seeded with:
+    input:
+        observed=SEEDED_OBSERVED,
+        truth=SEEDED_TRUTH,
+    output:
+        stats=SEEDED_STATS,
+    log:
+        "logs/testbed/stats_{tree}_seed{seed}.log",
+    benchmark:
+        "results/benchmarks/testbed/stats_{tree}_seed{seed}.tsv"
+
+
 rule testbed_figure:
     input:
         observed=OBSERVED,

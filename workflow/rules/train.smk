@@ -18,9 +18,9 @@ rule train:
     conda:
         "../envs/physgs.yaml"
     log:
-        "logs/train/{tree}/{model}_{config}.log",
+        "logs/train/{tree}/seed{seed}/{model}_{config}.log",
     benchmark:
-        "results/benchmarks/train/{tree}/{model}_{config}.tsv"
+        "results/benchmarks/train/{tree}/seed{seed}/{model}_{config}.tsv"
     threads: 1  # two 1-thread jobs side by side beat one 2-thread job on 2 cores (benchmarks/training.py)
     resources:
         mem_mb=4000,
@@ -34,21 +34,21 @@ rule train:
 # truth.npz. No method, recovery or null result depends on it.
 rule train_reference:
     input:
-        observed=OBSERVED,
-        truth=TRUTH,
+        observed=observed_input,
+        truth=truth_input,
     output:
         ckpt=CKPT.replace("{config}", _models.BASE_CONFIG),
         loss=LOSS.replace("{config}", _models.BASE_CONFIG),
     wildcard_constraints:
         model="|".join(_models.REFERENCE_NAMES),
     params:
-        job=lambda wc: _job_spec(CFG, wc.model, _models.BASE_CONFIG),
+        job=lambda wc: _job_spec(CFG, wc.model, _models.BASE_CONFIG, seed=int(wc.seed)),
     conda:
         "../envs/physgs.yaml"
     log:
-        "logs/train/{tree}/{model}_single.log",
+        "logs/train/{tree}/seed{seed}/{model}_single.log",
     benchmark:
-        "results/benchmarks/train/{tree}/{model}_single.tsv"
+        "results/benchmarks/train/{tree}/seed{seed}/{model}_single.tsv"
     threads: 1
     resources:
         mem_mb=4000,
@@ -59,6 +59,5 @@ rule train_reference:
 
 rule train_all:
     input:
-        expand(CKPT, zip, tree=[t for t in TREES for _ in TRAIN_JOBS],
-               model=[m for _ in TREES for m, _c in TRAIN_JOBS],
-               config=[c for _ in TREES for _m, c in TRAIN_JOBS]),
+        [CKPT.format(tree=t, seed=s, model=m, config=c)
+         for t in TREES for s in SEEDS for m, c in TRAIN_JOBS],

@@ -11,8 +11,8 @@ sm = snakemake  # noqa: F821 (injected by Snakemake)
 p = sm.params
 with job(sm) as log:
     points = [json.load(open(f)) for f in sm.input.points]
-    own = {m: fit_row(sm.input[f"eval_{m}"], sm.input[f"loss_{m}"], p.n_train, p.holdout_every)
-           for m in p.models}
+    own = {s: {m: fit_row(sm.input[f"eval_{m}_{s}"], sm.input[f"loss_{m}_{s}"], p.n_train,
+                          p.holdout_every) for m in p.models} for s in p.seeds}
     df = collect(points, own, p.iterations, p.tree)
     df["of_ceiling"] = ceiling_fraction(df)
     with atomic_path(sm.output.csv) as tmp:

@@ -21,7 +21,8 @@ from physgs.experiments.recipe import fit, heldout_split, job_spec
 from physgs.experiments.sweep import with_knob
 from physgs.models.registry import BASE_CONFIG
 
-COLUMNS = ("model", "iterations", "is_profile", "fit", "heldout", "time", "train_s", "tree")
+COLUMNS = ("seed", "model", "iterations", "is_profile", "fit", "heldout", "time", "train_s",
+           "tree")
 
 
 def budgets(cfg: dict) -> list[int]:
@@ -35,10 +36,11 @@ def extra_budgets(cfg: dict) -> list[int]:
     return [b for b in budgets(cfg) if b != int(cfg["train"]["iterations"])]
 
 
-def point_job(cfg: dict, model: str, iterations: int) -> dict:
-    """The training job (``recipe.job_spec``) of ``model`` at ``iterations``, as a sorted dict."""
+def point_job(cfg: dict, model: str, iterations: int, seed: int | None = None) -> dict:
+    """The training job (``recipe.job_spec``) of ``model`` at ``iterations`` with training seed
+    ``seed`` (default ``cfg['seed']``), as a sorted dict."""
     tree = cfg["speed_accuracy"]["fit_curve"]["tree"]
-    return job_spec(with_knob(cfg, tree, "iterations", iterations), model, BASE_CONFIG)
+    return job_spec(with_knob(cfg, tree, "iterations", iterations), model, BASE_CONFIG, seed=seed)
 
 
 def run_point(job: Mapping, observed, *, progress: bool = False) -> dict:
@@ -60,36 +62,42 @@ def run_point(job: Mapping, observed, *, progress: bool = False) -> dict:
                  if held.size else (None, np.array([np.nan])))
     tail = np.arange(n, n + int(observed.n_tail))
     _, p_time = training_camera_scores(res.model, observed, tail, backend=backend)
-    return {"model": job["model"], "iterations": int(job["train"]["iterations"]),
+    return {"model": job["model"], "seed": int(job["seed"]),
+            "iterations": int(job["train"]["iterations"]),
             "fit": float(np.mean(p_fit)), "heldout": float(np.mean(p_held)),
             "time": float(np.mean(p_time)), "train_s": float(train_s)}
 
 
-def collect(points: Sequence[dict], profile_rows: Mapping[str, dict], profile_iterations: int,
-            tree: str) -> pd.DataFrame:
-    """One row per (model, budget), sorted.
+def collect(points: Sequence[dict], profile_rows: Mapping[int, Mapping[str, dict]],
+            profile_iterations: int, tree: str) -> pd.DataFrame:
+    """One row per (seed, model, budget), sorted.
 
-    points: ``run_point`` records; profile_rows: model -> the pipeline's own row at the profile's
-    budget (``report.build.fit_row``: fit, heldout, time, train_s), references included.
+    points: ``run_point`` records (each names its seed); profile_rows: seed -> model -> the
+    pipeline's own row at the profile's budget (``report.build.fit_row``: fit, heldout, time,
+    train_s), references included.
     """
-    rows = [{**{k: p[k] for k in ("model", "iterations", "fit", "heldout", "time", "train_s")},
-             "is_profile": False, "tree": tree} for p in points]
-    for m, r in profile_rows.items():
-        rows.append({"model": m, "iterations": int(profile_iterations), "fit": r["fit"],
-                     "heldout": r["heldout"], "time": r["time"], "train_s": r["train_s"],
-                     "is_profile": True, "tree": tree})
+    keep = ("model", "iterations", "fit", "heldout", "time", "train_s")
+    rows = [{"seed": int(p["seed"]), **{k: p[k] for k in keep}, "is_profile": False,
+             "tree": tree} for p in points]
+    for seed, by_model in profile_rows.items():
+        for m, r in by_model.items():
+            rows.append({"seed": int(seed), "model": m, "iterations": int(profile_iterations),
+                         "fit": r["fit"], "heldout": r["heldout"], "time": r["time"],
+                         "train_s": r["train_s"], "is_profile": True, "tree": tree})
     df = pd.DataFrame(rows, columns=list(COLUMNS))
-    if df.duplicated(["model", "iterations"]).any():
-        raise ValueError(f"fit curve: budget {profile_iterations} given twice for a model; the "
-                         "profile's budget comes from the pipeline, not from a point")
-    return df.sort_values(["model", "iterations"], kind="stable").reset_index(drop=True)
+    if df.duplicated(["seed", "model", "iterations"]).any():
+        raise ValueError(f"fit curve: budget {profile_iterations} given twice for a model and "
+                         "seed; the profile's budget comes from the pipeline, not from a point")
+    return df.sort_values(["model", "iterations", "seed"], kind="stable").reset_index(drop=True)
 
 
 def ceiling_fraction(df: pd.DataFrame, static: str = "static",
                      ceiling: str = "truth_motion") -> pd.Series:
-    """(fit - static) / (ceiling - static) per row, against the profile-budget static and
-    ceiling rows (the fraction of the achievable in-window gain); NaN without them."""
-    prof = df[df["is_profile"]].set_index("model")["fit"]
-    if static not in prof or ceiling not in prof:
-        return pd.Series(np.nan, index=df.index)
-    return pd.Series(_fraction(df["fit"], prof[static], prof[ceiling]), index=df.index)
+    """(fit - static) / (ceiling - static) per row, against the same seed's profile-budget static
+    and ceiling rows (the fraction of the achievable in-window gain); NaN without them."""
+    prof = df[df["is_profile"]].set_index(["seed", "model"])["fit"]
+    out = pd.Series(np.nan, index=df.index)
+    for seed, g in df.groupby("seed"):
+        if (seed, static) in prof.index and (seed, ceiling) in prof.index:
+            out[g.index] = _fraction(g["fit"], prof[(seed, static)], prof[(seed, ceiling)])
+    return out

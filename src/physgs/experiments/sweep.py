@@ -84,19 +84,23 @@ def parse_point(name: str) -> tuple[str | None, int | None]:
     return knob, int(value)
 
 
-def point_settings(cfg: dict, name: str) -> dict:
+def point_settings(cfg: dict, name: str, seed: int | None = None,
+                   testbed_seeds: bool = False) -> dict:
     """What sweep point ``name`` reads, as a sorted plain dict (the workflow's params): its knob
-    values, ours' training job at those values (``recipe.job_spec``, the tables' recipe) and,
-    for a knob that changes the testbed, the testbed settings to rebuild it with."""
+    values, ours' training job at those values (``recipe.job_spec``, the tables' recipe, with
+    training seed ``seed``, default ``cfg['seed']``) and, for a knob that changes the testbed,
+    the testbed settings to rebuild it with (testbed seed ``cfg['seed']``, or ``seed`` when
+    ``testbed_seeds``: each seed then has its own tree instance)."""
     tree = cfg["speed_accuracy"]["tree"]
     knob, value = parse_point(name)
     pcfg = cfg if knob is None else with_knob(cfg, tree, knob, value)
     out = {"point": name, "knob": knob or BASE, "tree": tree,
            "values": {k: int(knob_value(pcfg, tree, k)) for k in KNOBS},
-           "job": job_spec(pcfg, "ours", BASE_CONFIG)}
+           "job": job_spec(pcfg, "ours", BASE_CONFIG, seed=seed)}
     if knob in TESTBED_KNOBS:
+        tb_seed = int(seed) if testbed_seeds and seed is not None else int(pcfg["seed"])
         out["testbed"] = {"testbed": pcfg["testbed"], "preset": pcfg["presets"][tree],
-                          "seed": int(pcfg["seed"])}
+                          "seed": tb_seed}
     return canonical(out)
 
 
@@ -111,7 +115,8 @@ def run_point(point: dict, observed_path, truth_path, *, progress: bool = False)
     from physgs.testbed.dataset import build_dataset, load_observed, load_truth, save_dataset
 
     name, tree = point["point"], point["tree"]
-    rec = {"point": name, "knob": point["knob"], "tree": tree, **point["values"]}
+    rec = {"point": name, "knob": point["knob"], "tree": tree, "seed": int(point["job"]["seed"]),
+           **point["values"]}
     with tempfile.TemporaryDirectory(prefix="physgs-sweep-") as tmp:
         t0 = time.perf_counter()
         if "testbed" in point:
@@ -141,15 +146,36 @@ def run_point(point: dict, observed_path, truth_path, *, progress: bool = False)
 
 
 def collect(records: Sequence[dict]) -> pd.DataFrame:
-    """One row per (knob, value), the base point repeated under every knob it anchors."""
-    base = [r for r in records if r["point"] == BASE]
-    if len(base) != 1:
-        raise ValueError("speed-accuracy records need exactly one 'base' point")
+    """One row per (seed, knob, value), the base point of each seed repeated under every knob it
+    anchors; records of one seed or several (each record names its ``seed``)."""
+    by_seed: dict[int, list[dict]] = {}
+    for r in records:
+        by_seed.setdefault(int(r.get("seed", 0)), []).append(r)
     rows = []
-    for knob in KNOBS:
-        for r in [*base, *[r for r in records if r["knob"] == knob]]:
-            rows.append({**r, "knob": knob, "value": r[knob], "is_base": r["point"] == BASE})
-    df = pd.DataFrame(rows).sort_values(["knob", "value"], kind="stable").reset_index(drop=True)
-    cols = ["knob", "value", "is_base", "wall_s", "train_s", "testbed_s", "eval_s", "psnr_time",
-            "rel_err", "trusted", "parts", "frozen", "tree", *KNOBS]
-    return df[cols]
+    for seed in sorted(by_seed):
+        recs = by_seed[seed]
+        base = [r for r in recs if r["point"] == BASE]
+        if len(base) != 1:
+            raise ValueError(f"speed-accuracy records of seed {seed} need exactly one 'base' "
+                             f"point, got {len(base)}")
+        for knob in KNOBS:
+            for r in [*base, *[r for r in recs if r["knob"] == knob]]:
+                rows.append({**r, "seed": seed, "knob": knob, "value": r[knob],
+                             "is_base": r["point"] == BASE})
+    df = pd.DataFrame(rows).sort_values(["knob", "value", "seed"], kind="stable")
+    cols = ["seed", "knob", "value", "is_base", "wall_s", "train_s", "testbed_s", "eval_s",
+            "psnr_time", "rel_err", "trusted", "parts", "frozen", "tree", *KNOBS]
+    return df[cols].reset_index(drop=True)
+
+
+def null_level(nulls: Sequence) -> dict:
+    """The untrained null's chance level for the recovery panel, from ``NullResult`` s (one per
+    seed): the median over every draw of each draw's median relative error, and the central 95%
+    of those draws (fractions). A sweep point inside the band is indistinguishable from chance."""
+    v = np.concatenate([np.asarray(n.median_rel_err, float) for n in nulls])
+    v = v[np.isfinite(v)]
+    if not v.size:
+        return {"median": np.nan, "low": np.nan, "high": np.nan, "draws": 0}
+    lo, med, hi = np.percentile(v, [2.5, 50, 97.5])
+    return {"median": float(med), "low": float(lo), "high": float(hi), "draws": int(v.size),
+            "K": int(nulls[0].n_parts)}

@@ -38,15 +38,16 @@ def recover_model(model, observed, truth, bone_visible=None) -> RecoveryRecord:
     return dataclasses.replace(rec, n_frozen=int(fz.sum()))
 
 
-def null_settings(cfg: dict, K: int) -> dict:
+def null_settings(cfg: dict, K: int, seed: int | None = None) -> dict:
     """What the null control for K parts reads from the resolved config: ours' solver settings
-    (omega and zeta bounds, zeta_init, substeps, RK4 guard) and the seed. Keyed by K, not by
-    configuration, so configurations sharing a K share one null."""
+    (omega and zeta bounds, zeta_init, substeps, RK4 guard) and the seed (a training seed: each
+    seed draws its own null, paired with that seed's model; default ``cfg['seed']``). Keyed by K,
+    not by configuration, so configurations sharing a K share one null."""
     o = cfg["models"]["ours"]
     return {"K": int(K), "omega_hz": [float(x) for x in o["omega_hz"]],
             "zeta": [float(x) for x in o["zeta"]], "zeta_init": float(o["zeta_init"]),
             "substeps": int(o["substeps"]), "rk4_guard": float(o["rk4_guard"]),
-            "seed": int(cfg["seed"])}
+            "seed": int(cfg["seed"] if seed is None else seed)}
 
 
 def null_control(observed, truth, settings: dict, bone_visible=None) -> NullResult:

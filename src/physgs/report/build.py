@@ -1,8 +1,9 @@
 """Collect per-job result files into the tables and figures (what the report rules call).
 
 The library never knows where the workflow keeps its files. Each output declares what it
-needs as *need tuples* (``needs``): ``("eval" | "traj" | "panels", tree, model, config)``,
-``("recovery", tree, config)``, ``("null", tree, K)`` and ``("kselect", tree)``. The workflow
+needs as *need tuples* (``needs``): ``("eval" | "traj" | "panels" | "loss", tree, model, config,
+seed)``, ``("recovery", tree, config, seed)``, ``("null", tree, K, seed)``, ``("kselect", tree,
+seed)``, ``("stats", tree)`` and ``("table", name)``; seed is a training seed. The workflow
 maps each tuple to a path (``workflow/rules/common.smk``) and hands the builders a mapping
 ``key(need) -> path``; the builders read only those paths. ``settings_for`` gives the narrow
 settings an output reads, so editing one table's format rebuilds that table only.
@@ -27,11 +28,16 @@ TABLES = ("tab_testbed", "tab_psnr", "tab_null", "tab_transfer", "tab_margin", "
           "tab_fit")
 FIGURES = ("fig_temporal", "fig_teaser", "fig_results", "fig_damping")
 #: The fields of each need tuple after its kind (what a workflow path template is formatted with).
-NEED_FIELDS = {"eval": ("tree", "model", "config"), "traj": ("tree", "model", "config"),
-               "panels": ("tree", "model", "config"), "loss": ("tree", "model", "config"),
-               "recovery": ("tree", "config"),
-               "null": ("tree", "K"), "kselect": ("tree",), "stats": ("tree",),
+NEED_FIELDS = {"eval": ("tree", "model", "config", "seed"),
+               "traj": ("tree", "model", "config", "seed"),
+               "panels": ("tree", "model", "config", "seed"),
+               "loss": ("tree", "model", "config", "seed"),
+               "recovery": ("tree", "config", "seed"),
+               "null": ("tree", "K", "seed"), "kselect": ("tree", "seed"), "stats": ("tree",),
                "table": ("name",)}
+#: Figures that show one training seed (qualitative: images, trajectories, a damping scatter);
+#: they show the first seed listed.
+ONE_SEED_FIGURES = ("fig_teaser", "fig_results", "fig_damping")
 #: Tables the claims ledger reads (their CSVs), and the configuration whose damping it reads.
 CLAIMS_TABLES = ("tab_psnr", "tab_transfer", "tab_margin", "tab_null", "tab_testbed", "tab_fit")
 CLAIMS_CONFIG = "joint32"
@@ -50,11 +56,14 @@ def key(need: tuple) -> str:
     return "/".join(str(p) for p in need)
 
 
-def claims_needs(trees: Sequence[str], configs: Mapping[str, dict]) -> list[tuple]:
-    """What the claims ledger reads: the tables' CSVs and ours' recovery (damping) in the joint
-    K=32 configuration (the paper's), or the base configuration when the config has none."""
+def claims_needs(trees: Sequence[str], configs: Mapping[str, dict],
+                 seeds: Sequence[int]) -> list[tuple]:
+    """What the claims ledger reads: the tables' CSVs and ours' recovery (damping) of every seed
+    in the joint K=32 configuration (the paper's), or the base configuration when the config
+    has none."""
     c = CLAIMS_CONFIG if CLAIMS_CONFIG in configs else BASE_CONFIG
-    return [("table", n) for n in CLAIMS_TABLES] + [("recovery", t, c) for t in trees]
+    return ([("table", n) for n in CLAIMS_TABLES]
+            + [("recovery", t, c, int(s)) for t in trees for s in seeds])
 
 
 def make_claims(inputs: Mapping[str, str], trees: Sequence[str], md_path, csv_path,
@@ -65,12 +74,13 @@ def make_claims(inputs: Mapping[str, str], trees: Sequence[str], md_path, csv_pa
     from physgs.report import claims
 
     tabs = {n: pd.read_csv(inputs[key(("table", n))]) for n in CLAIMS_TABLES}
-    damping = {}
-    for k, p in inputs.items():
+    damping: dict[str, list] = {}
+    for k, p in sorted(inputs.items()):  # recovery/<tree>/<config>/<seed>: one entry per seed
         if k.startswith("recovery/"):
             d = load_recovery(p).damping
-            damping[k.split("/")[1]] = [{"median_zeta": d.median_zeta, "zeta_true": d.zeta_true,
-                                         "loglog_exponent": d.loglog_exponent}]
+            damping.setdefault(k.split("/")[1], []).append(
+                {"median_zeta": d.median_zeta, "zeta_true": d.zeta_true,
+                 "loglog_exponent": d.loglog_exponent})
     df = claims.ledger(claims.measure(tabs, damping, trees))
     sd = stamp.to_dict() if stamp is not None else None
     write_text(md_path, claims.ledger_markdown(df, sd))
@@ -79,31 +89,40 @@ def make_claims(inputs: Mapping[str, str], trees: Sequence[str], md_path, csv_pa
     return df
 
 
-def needs(name: str, trees: Sequence[str], configs: Mapping[str, dict]) -> list[tuple]:
+def needs(name: str, trees: Sequence[str], configs: Mapping[str, dict],
+          seeds: Sequence[int]) -> list[tuple]:
     """Every result an output reads, as need tuples (see the module docstring).
 
     configs: the config's ``models.configs`` (name -> {conditions, K}); the null control is
-    keyed by K, so configurations sharing a K share one null.
+    keyed by K, so configurations sharing a K share one null. seeds: the training seeds; the
+    figures of ``ONE_SEED_FIGURES`` read the first only.
     """
     if name not in (*TABLES, *FIGURES):
         raise ValueError(f"unknown output '{name}'; choose one of {TABLES + FIGURES}")
-    out = [("eval", t, m, BASE_CONFIG) for t in trees for m in NEEDS_MODELS.get(name, ())]
-    if name == "fig_teaser":
-        out += [("traj", t, m, BASE_CONFIG) for t in trees for m in MODEL_NAMES]
-    if name == "fig_results":
-        out += [("panels", t, m, BASE_CONFIG) for t in trees for m in MODEL_NAMES]
-    if name == "tab_fit":
-        out += [("loss", t, m, BASE_CONFIG) for t in trees for m in NEEDS_MODELS[name]]
-    if name in ("tab_null", "fig_damping"):
-        out += [("recovery", t, c) for t in trees for c in configs]
-    if name == "tab_null":
-        out += list(dict.fromkeys(("null", t, int(configs[c]["K"])) for t in trees for c in configs))
+    if not seeds:
+        raise ValueError("needs: no training seeds given")
+    seeds = [int(seeds[0])] if name in ONE_SEED_FIGURES else [int(s) for s in seeds]
+    out = []
+    for s in seeds:
+        out += [("eval", t, m, BASE_CONFIG, s) for t in trees for m in NEEDS_MODELS.get(name, ())]
+        if name == "fig_teaser":
+            out += [("traj", t, m, BASE_CONFIG, s) for t in trees for m in MODEL_NAMES]
+        if name == "fig_results":
+            out += [("panels", t, m, BASE_CONFIG, s) for t in trees for m in MODEL_NAMES]
+        if name == "tab_fit":
+            out += [("loss", t, m, BASE_CONFIG, s) for t in trees for m in NEEDS_MODELS[name]]
+        if name in ("tab_null", "fig_damping"):
+            out += [("recovery", t, c, s) for t in trees for c in configs]
+        if name == "tab_null":
+            out += list(dict.fromkeys(("null", t, int(configs[c]["K"]), s)
+                                      for t in trees for c in configs))
+        if name == "tab_kselect":
+            for t in trees:
+                out.append(("kselect", t, s))
+                out += [x for c in KSELECT_ROWS
+                        for x in (("eval", t, "ours", c, s), ("recovery", t, c, s))]
     if name == "tab_testbed":
         out += [("stats", t) for t in trees]
-    if name == "tab_kselect":
-        for t in trees:
-            out.append(("kselect", t))
-            out += [x for c in KSELECT_ROWS for x in (("eval", t, "ours", c), ("recovery", t, c))]
     return out
 
 
@@ -111,6 +130,10 @@ def settings_for(name: str, cfg: dict) -> dict:
     """The settings output ``name`` reads from the resolved config (and nothing more)."""
     trees = list(cfg["trees"])
     out = {"trees": trees, "bones": {t: int(cfg["presets"][t]["bones"]) for t in trees}}
+    if name not in ("tab_testbed", *ONE_SEED_FIGURES):
+        out["seeds"] = [int(x) for x in cfg["seeds"]]
+    elif name in ONE_SEED_FIGURES:
+        out["seeds"] = [int(cfg["seeds"][0])]
     if name in TABLES:
         out["digits"] = int(cfg["report"][name]["digits"])
     if name in ("tab_null", "fig_damping"):
@@ -139,9 +162,10 @@ def _reader(inputs: Mapping[str, str]):
     return path
 
 
-def _summaries(path, trees, models):
-    return {(t, m): load_eval(path("eval", t, m, BASE_CONFIG)).summary()
-            for t in trees for m in models}
+def _summaries(path, trees, models, seeds):
+    """{seed: {(tree, model): summary}} of the models trained ``single``."""
+    return {s: {(t, m): load_eval(path("eval", t, m, BASE_CONFIG, s)).summary()
+                for t in trees for m in models} for s in seeds}
 
 
 def fit_row(eval_path, loss_path, n_train: int, holdout_every: int) -> dict:
@@ -167,42 +191,47 @@ def make_table(name: str, inputs: Mapping[str, str], settings: dict, tex_path, c
     written into every CSV row (profile, config hash, package version)."""
     path = _reader(inputs)
     trees, bones, d = settings["trees"], settings["bones"], settings.get("digits", 2)
+    seeds = [int(x) for x in settings.get("seeds", ())]
     if name == "tab_testbed":
         table = tables.tab_testbed({t: load_stats(path("stats", t)) for t in trees}, trees,
                                    digits=d)
     elif name == "tab_psnr":
-        table = tables.tab_psnr(_summaries(path, trees, (*MODEL_NAMES, *REFERENCE_NAMES)), trees,
-                                bones, digits=d, references=REFERENCE_NAMES)
+        table = tables.tab_psnr(_summaries(path, trees, (*MODEL_NAMES, *REFERENCE_NAMES), seeds),
+                                trees, bones, digits=d, references=REFERENCE_NAMES)
     elif name == "tab_fit":
-        rows = {(t, m): fit_row(path("eval", t, m, BASE_CONFIG), path("loss", t, m, BASE_CONFIG),
-                                int(settings["n_train"]), int(settings["holdout_every"]))
-                for t in trees for m in NEEDS_MODELS[name]}
+        rows = {s: {(t, m): fit_row(path("eval", t, m, BASE_CONFIG, s),
+                                    path("loss", t, m, BASE_CONFIG, s),
+                                    int(settings["n_train"]), int(settings["holdout_every"]))
+                    for t in trees for m in NEEDS_MODELS[name]} for s in seeds}
         table = tables.tab_fit(rows, trees, bones, MODEL_NAMES, REFERENCE_NAMES[0], digits=d,
                                holdout_every=int(settings["holdout_every"]))
     elif name == "tab_transfer":
-        table = tables.tab_transfer(_summaries(path, trees, MODEL_NAMES), trees, bones,
+        table = tables.tab_transfer(_summaries(path, trees, MODEL_NAMES, seeds), trees, bones,
                                     settings["conditions"], digits=d)
     elif name == "tab_margin":
-        table = tables.tab_margin(_summaries(path, trees, ("mlp_wind", "ours")), trees, bones,
-                                  settings["conditions"], digits=d)
+        table = tables.tab_margin(_summaries(path, trees, ("mlp_wind", "ours"), seeds), trees,
+                                  bones, settings["conditions"], digits=d)
     elif name == "tab_null":
         configs = settings["configs"]
-        rec = {(t, c): load_recovery(path("recovery", t, c)) for t in trees for c in configs}
-        null = {(t, c): load_null(path("null", t, int(configs[c]["K"])))
-                for t in trees for c in configs}
+        rec = {s: {(t, c): load_recovery(path("recovery", t, c, s)) for t in trees for c in configs}
+               for s in seeds}
+        null = {s: {(t, c): load_null(path("null", t, int(configs[c]["K"]), s))
+                    for t in trees for c in configs} for s in seeds}
         labels = {c: config_label(c, v) for c, v in configs.items()}
         table = tables.tab_null(rec, null, trees, bones, labels, digits=d)
     elif name == "tab_kselect":
         rows = {}
-        for t in trees:
-            sel = load_selection(path("kselect", t))
-            for c in KSELECT_ROWS:
-                ev = load_eval(path("eval", t, "ours", c)).summary()
-                rec = load_recovery(path("recovery", t, c))
-                rows[(t, c)] = {"K": rec.match.n_parts, "time_psnr": ev["time"],
-                                "median_rel_err": rec.match.median_rel_err,
-                                "trusted": rec.match.n_trusted, "frozen": rec.n_frozen,
-                                "k_heldout": sel.k_heldout, "k_bic": sel.k_bic}
+        for s in seeds:
+            rows[s] = {}
+            for t in trees:
+                sel = load_selection(path("kselect", t, s))
+                for c in KSELECT_ROWS:
+                    ev = load_eval(path("eval", t, "ours", c, s)).summary()
+                    rec = load_recovery(path("recovery", t, c, s))
+                    rows[s][(t, c)] = {"K": rec.match.n_parts, "time_psnr": ev["time"],
+                                       "median_rel_err": rec.match.median_rel_err,
+                                       "trusted": rec.match.n_trusted, "frozen": rec.n_frozen,
+                                       "k_heldout": sel.k_heldout, "k_bic": sel.k_bic}
         table = kselect.tab_kselect(rows, trees, bones, settings["method"], digits=d)
     else:
         raise ValueError(f"unknown table '{name}'; choose one of {TABLES}")
@@ -221,22 +250,26 @@ def make_figure(name: str, inputs: Mapping[str, str], settings: dict,
     path in ``outputs``. settings: ``settings_for(name, cfg)``."""
     path = _reader(inputs)
     trees = settings["trees"]
+    seeds = [int(x) for x in settings["seeds"]]
+    s0 = seeds[0]  # what the one-seed figures show
     if name == "fig_temporal":
-        curves = {(t, m): load_eval(path("eval", t, m, BASE_CONFIG)).temporal_psnr
+        curves = {(t, m): np.stack([load_eval(path("eval", t, m, BASE_CONFIG, s)).temporal_psnr
+                                    for s in seeds])
                   for t in trees for m in NEEDS_MODELS[name]}
         figures.fig_temporal(curves, trees, int(settings["n_train"]), outputs)
     elif name == "fig_teaser":
         t = _teaser_tree(trees)
-        evals = {m: load_eval(path("eval", t, m, BASE_CONFIG)) for m in MODEL_NAMES}
+        evals = {m: load_eval(path("eval", t, m, BASE_CONFIG, s0)) for m in MODEL_NAMES}
         base = figures.best_baseline({m: e.summary() for m, e in evals.items()}, key="time")
         shown = ("ours", base)
-        traj = {m: load_trajectories(path("traj", t, m, BASE_CONFIG)) for m in shown}
+        traj = {m: load_trajectories(path("traj", t, m, BASE_CONFIG, s0)) for m in shown}
         cen = {m: evals[m].centroid_err for m in shown}
-        figures.fig_teaser(traj, cen, settings["conditions"], outputs, title=f"{t} tree")
+        figures.fig_teaser(traj, cen, settings["conditions"], outputs,
+                           title=f"{t} tree, training seed {s0}")
     elif name == "fig_results":
         rows, images = [], {}
         for t in trees:
-            panels = {m: np.load(path("panels", t, m, BASE_CONFIG)) for m in MODEL_NAMES}
+            panels = {m: np.load(path("panels", t, m, BASE_CONFIG, s0)) for m in MODEL_NAMES}
             for split in ("time", "view", "wind"):
                 row = f"{t}: unseen {split}"
                 rows.append(row)
@@ -246,7 +279,7 @@ def make_figure(name: str, inputs: Mapping[str, str], settings: dict,
         figures.fig_results(rows, ["gt", *MODEL_NAMES], images, outputs)
     elif name == "fig_damping":
         configs = list(settings["configs"])
-        damping = {(t, c): load_recovery(path("recovery", t, c)).damping
+        damping = {(t, c): load_recovery(path("recovery", t, c, s0)).damping
                    for t in trees for c in configs}
         figures.fig_damping(damping, trees, configs, float(settings["zeta"]), outputs)
     else:

@@ -18,9 +18,8 @@ from typing import Callable, Mapping, Sequence
 
 import numpy as np
 import pandas as pd
-from scipy import stats
-
 from physgs.report import paper
+from physgs.report.seeds import interval
 
 LEARNED = ("mlp", "mlp_wind", "d3dgs", "d3dgs_wind")
 LABELS = {"static": "Static pose", "mlp": "Deformation MLP", "mlp_wind": "Deformation MLP + wind",
@@ -58,20 +57,6 @@ class Claim:
     side: str
     unit: str
     needs_variance: bool = True
-
-
-def interval(values: Sequence[float], level: float = 0.95) -> tuple[float, float, float, float]:
-    """(mean, sd, low, high) over seeds; the interval is Student's t on the mean (NaN bounds
-    with one value)."""
-    v = np.asarray([x for x in values if np.isfinite(x)], dtype=np.float64)
-    if v.size == 0:
-        return (np.nan,) * 4
-    m = float(v.mean())
-    if v.size == 1:
-        return m, np.nan, np.nan, np.nan
-    sd = float(v.std(ddof=1))
-    h = float(stats.t.ppf(0.5 + level / 2, v.size - 1)) * sd / np.sqrt(v.size)
-    return m, sd, m - h, m + h
 
 
 def verdict(claim: Claim, values: Sequence[float]) -> str:

@@ -63,22 +63,29 @@ def fig_temporal(curves: Mapping[tuple[str, str], np.ndarray], trees: Sequence[s
                  outputs: Sequence[str | Path], models: Sequence[str] = MODELS) -> None:
     """Per-frame PSNR (dB) at the training camera and wind, one panel per tree.
 
-    curves[(tree, model)]: [F] PSNR over recorded frames 1..F; the window boundary (after frame
-    n_train) is marked and the tail shaded. A reference present in ``curves`` (the true-motion
-    ceiling) is drawn as a thin black dotted line.
+    curves[(tree, model)]: [S, F] PSNR over recorded frames 1..F, one row per training seed
+    (or [F] for one seed); the mean over seeds is drawn, with a band from the lowest to the
+    highest seed when there are several. The window boundary (after frame n_train) is marked
+    and the tail shaded. A reference present in ``curves`` (the true-motion ceiling) is drawn as
+    a thin black dotted line.
     """
     fig, axes = plt.subplots(1, len(trees), figsize=(4.2 * len(trees), 3.2), squeeze=False, sharey=False)
+    n_seeds = 1
     for ax, t in zip(axes[0], trees):
         for m in models:
             if (t, m) not in curves:
                 raise KeyError(f"fig_temporal: no per-frame PSNR for ({t}, {m})")
-            y = np.asarray(curves[(t, m)])
+            Y = np.atleast_2d(np.asarray(curves[(t, m)], dtype=np.float64))  # [S, F]
+            n_seeds, y = len(Y), Y.mean(0)
             x = np.arange(1, len(y) + 1)
             ax.plot(x, y, color=COLORS.get(m), lw=1.6 if m == "ours" else 1.0,
                     ls="--" if m == "static" else "-", label=label(m))
+            if len(Y) > 1:  # the seeds' spread
+                ax.fill_between(x, Y.min(0), Y.max(0), color=COLORS.get(m), alpha=0.2, lw=0)
         for m in REFERENCE_NAMES:
             if (t, m) in curves:
-                ax.plot(x, np.asarray(curves[(t, m)]), color="k", lw=0.8, ls=":", label=label(m))
+                Y = np.atleast_2d(np.asarray(curves[(t, m)], dtype=np.float64))
+                ax.plot(x, Y.mean(0), color="k", lw=0.8, ls=":", label=label(m))
         ax.axvline(n_train + 0.5, color="k", lw=0.8, ls=":")
         ax.axvspan(n_train + 0.5, len(y) + 0.5, color="0.92", zorder=0)
         ax.set_title(t.capitalize())
@@ -86,6 +93,9 @@ def fig_temporal(curves: Mapping[tuple[str, str], np.ndarray], trees: Sequence[s
         ax.set_xlim(1, len(y))
     axes[0, 0].set_ylabel("PSNR (dB)")
     axes[0, -1].legend(fontsize=7, loc="lower left")
+    if n_seeds > 1:
+        fig.suptitle(f"mean over {n_seeds} training seeds; bands: lowest to highest seed",
+                     fontsize=8)
     fig.tight_layout()
     save_figure(fig, outputs)
 
@@ -237,30 +247,59 @@ def fig_damping(damping: Mapping[tuple[str, str], object], trees: Sequence[str],
 
 
 # --------------------------------------------------------------------------------------------
-def fig_speed_accuracy(df: pd.DataFrame, outputs: Sequence[str | Path]) -> None:
+def _seed_mean(df: pd.DataFrame, by: list[str], cols: Sequence[str]) -> pd.DataFrame:
+    """Mean and sd (ddof 1; 0 with one seed) of ``cols`` over seeds per ``by`` group, as columns
+    <col> and <col>_sd, groups in first-seen order."""
+    g = df.groupby(by, sort=False)
+    out = g[list(cols)].mean()
+    sd = g[list(cols)].std(ddof=1).fillna(0.0).add_suffix("_sd")
+    rest = g[[c for c in df.columns if c not in (*by, *cols, "seed")]].first()
+    return pd.concat([out, sd, rest], axis=1).reset_index()
+
+
+def fig_speed_accuracy(df: pd.DataFrame, outputs: Sequence[str | Path],
+                       null: Mapping[str, float] | None = None) -> None:
     """Two panels against wall time (s): PSNR on the time split (dB) and recovery error (%).
 
-    One line per knob through its values (labelled), the base point starred.
+    df: ``experiments.sweep.collect`` (one row per seed, knob and value). One line per knob
+    through its values (labelled, mean over seeds; error bars: sd over seeds on both axes), the
+    base point starred. null: ``sweep.null_level``; the untrained null's median and the central
+    95% of its draws are drawn on the recovery panel, so a point inside the band reads as chance.
     """
+    n_seeds = df["seed"].nunique() if "seed" in df.columns else 1
+    if "seed" not in df.columns:
+        df = df.assign(seed=0)
+    m = _seed_mean(df.assign(rel_pct=100 * df["rel_err"]), ["knob", "value"],
+                   ("wall_s", "psnr_time", "rel_pct"))
     fig, axes = plt.subplots(1, 2, figsize=(10, 4))
-    colors = {k: f"C{i}" for i, k in enumerate(sorted(df["knob"].unique()))}
-    for knob, g in df.groupby("knob", sort=False):
+    colors = {k: f"C{i}" for i, k in enumerate(sorted(m["knob"].unique()))}
+    for knob, g in m.groupby("knob", sort=False):
         g = g.sort_values("value")
-        for ax, col, scale in ((axes[0], "psnr_time", 1.0), (axes[1], "rel_err", 100.0)):
-            ax.plot(g["wall_s"], g[col] * scale, "-o", ms=3.5, color=colors[knob], label=knob)
+        for ax, col in ((axes[0], "psnr_time"), (axes[1], "rel_pct")):
+            ax.errorbar(g["wall_s"], g[col], yerr=g[f"{col}_sd"] if n_seeds > 1 else None,
+                        xerr=g["wall_s_sd"] if n_seeds > 1 else None, fmt="-o", ms=3.5,
+                        capsize=2, lw=1.0, color=colors[knob], label=knob)
             for _, r in g.iterrows():
-                ax.annotate(str(int(r["value"])), (r["wall_s"], r[col] * scale), fontsize=6,
+                ax.annotate(str(int(r["value"])), (r["wall_s"], r[col]), fontsize=6,
                             xytext=(3, 3), textcoords="offset points", color=colors[knob])
-    base = df[df["is_base"]].iloc[0]
-    for ax, col, scale in ((axes[0], "psnr_time", 1.0), (axes[1], "rel_err", 100.0)):
-        ax.plot([base["wall_s"]], [base[col] * scale], "k*", ms=11, label="profile setting")
+    base = m[m["is_base"]].iloc[0]
+    for ax, col in ((axes[0], "psnr_time"), (axes[1], "rel_pct")):
+        ax.plot([base["wall_s"]], [base[col]], "k*", ms=11, label="profile setting")
         ax.set_xscale("log")
         ax.set_xlabel("wall time per point (s, log)")
         ax.grid(alpha=0.3)
+    if null is not None and np.isfinite(null.get("median", np.nan)):
+        axes[1].axhline(100 * null["median"], color="0.3", ls="--", lw=1.0,
+                        label=f"untrained null, K={null.get('K', '?')} (median)")
+        axes[1].axhspan(100 * null["low"], 100 * null["high"], color="0.6", alpha=0.25, lw=0,
+                        label=f"null: central 95% of {null['draws']} draws")
+        axes[1].legend(fontsize=7)
     axes[0].set_ylabel("PSNR, time split (dB)")
     axes[1].set_ylabel("median rel. error of omega, trusted parts (%)")
     axes[0].legend(fontsize=7)
-    fig.suptitle(f"Speed-accuracy trade, ours on the {df['tree'].iloc[0]} tree (one knob at a time)")
+    seeds = f"; mean +- sd over {n_seeds} training seeds" if n_seeds > 1 else "; one seed"
+    fig.suptitle(f"Speed-accuracy trade, ours on the {df['tree'].iloc[0]} tree (one knob at a "
+                 f"time{seeds})")
     fig.tight_layout()
     save_figure(fig, outputs)
 
@@ -269,12 +308,17 @@ def fig_fit_curve(df: pd.DataFrame, outputs: Sequence[str | Path]) -> None:
     """The fit curve (``physgs.experiments.fit_curve``): three panels, one line per model.
 
     In-window fit PSNR (dB, trained frames) and time-split PSNR (dB, the tail) against training
-    iterations, and the fit against training wall time (s). The static pose and the true-motion
-    ceiling at the profile's budget are horizontal lines; the profile's budget is starred.
+    iterations, and the fit against training wall time (s). df: ``experiments.fit_curve.collect``
+    (one row per seed, model and budget): points are means over seeds, error bars the sd. The
+    static pose and the true-motion ceiling at the profile's budget are horizontal lines; the
+    profile's budget is starred.
     """
     panels = (("iterations", "fit", "training iterations (log)", "PSNR, trained frames (dB)"),
               ("iterations", "time", "training iterations (log)", "PSNR, time split (dB)"),
               ("train_s", "fit", "training wall time (s, log)", "PSNR, trained frames (dB)"))
+    n_seeds = df["seed"].nunique() if "seed" in df.columns else 1
+    df = _seed_mean(df if "seed" in df.columns else df.assign(seed=0), ["model", "iterations"],
+                    ("fit", "time", "train_s"))
     fig, axes = plt.subplots(1, len(panels), figsize=(13, 3.8))
     refs = {"static": ("0.55", "--"), **{r: ("k", ":") for r in REFERENCE_NAMES}}
     prof = df[df["is_profile"]].set_index("model")
@@ -284,8 +328,11 @@ def fig_fit_curve(df: pd.DataFrame, outputs: Sequence[str | Path]) -> None:
             if m in refs:
                 continue
             g = g.sort_values("iterations")
-            ax.plot(g[x], g[y], "-o", ms=3.5, color=COLORS.get(m),
-                    lw=1.6 if m == "ours" else 1.0, label=label(m))
+            bars = n_seeds > 1
+            ax.errorbar(g[x], g[y], yerr=g[f"{y}_sd"] if bars else None,
+                        xerr=g[f"{x}_sd"] if bars and x != "iterations" else None, fmt="-o",
+                        ms=3.5, capsize=2, color=COLORS.get(m),
+                        lw=1.6 if m == "ours" else 1.0, label=label(m))
             p = g[g["is_profile"]]
             ax.plot(p[x], p[y], "*", ms=10, color=COLORS.get(m))
         for m, (c, ls) in refs.items():
@@ -300,6 +347,7 @@ def fig_fit_curve(df: pd.DataFrame, outputs: Sequence[str | Path]) -> None:
         ax.set_ylabel(ylabel)
         ax.grid(alpha=0.3)
     axes[0].legend(fontsize=7)
-    fig.suptitle(f"Fit curve on the {df['tree'].iloc[0]} tree (star: the profile's budget)")
+    seeds = f"; mean +- sd over {n_seeds} training seeds" if n_seeds > 1 else "; one seed"
+    fig.suptitle(f"Fit curve on the {df['tree'].iloc[0]} tree (star: the profile's budget{seeds})")
     fig.tight_layout()
     save_figure(fig, outputs)

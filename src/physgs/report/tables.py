@@ -15,11 +15,11 @@ import numpy as np
 import pandas as pd
 
 from physgs.atomic import atomic_path, write_text
-
-from physgs.models.registry import MODEL_NAMES as MODELS
 from physgs.evaluate.metrics import ceiling_fraction
+from physgs.models.registry import MODEL_NAMES as MODELS
 from physgs.models.registry import MODELS as SPECS
 from physgs.models.registry import label
+from physgs.report import seeds as seedstats
 
 
 @dataclass(frozen=True)
@@ -83,160 +83,262 @@ def _check(keys: Sequence, have: Mapping, what: str) -> None:
 
 
 # --------------------------------------------------------------------------------------------
-def tab_psnr(summaries: Mapping[tuple[str, str], Mapping[str, float]], trees: Sequence[str],
-             bones: Mapping[str, int], models: Sequence[str] = MODELS, digits: int = 2,
-             references: Sequence[str] = ()) -> Table:
+# Every builder takes its results per training seed ({seed: {key: value}}): the CSV holds one row
+# per seed (a ``seed`` column first), the .tex the mean +- sd over seeds, differences paired per
+# seed with their 95% interval (physgs.report.seeds). "Best" is bold only when its paired
+# difference to the runner-up is decided.
+
+
+def _seeds(per_seed: Mapping[int, Mapping], what: str) -> list[int]:
+    if not per_seed:
+        raise ValueError(f"{what}: no seeds given")
+    bad = [s for s in per_seed if not isinstance(s, (int, np.integer))]
+    if bad:
+        raise TypeError(f"{what}: results must be keyed by training seed first ({{seed: {{...}}}}), "
+                        f"got key {bad[0]!r}")
+    return sorted(int(s) for s in per_seed)
+
+
+def _by_seed(df: pd.DataFrame, col: str, n_seeds: int) -> np.ndarray:
+    """[S, R] values of ``col``: one row per seed, one column per table row (each seed's block
+    lists the same rows in the same order)."""
+    return df[col].to_numpy(dtype=np.float64).reshape(n_seeds, -1)
+
+
+def _first(df: pd.DataFrame) -> pd.DataFrame:
+    """The first seed's block: the table's row identities, in order."""
+    return df[df["seed"] == df["seed"].iloc[0]].reset_index(drop=True)
+
+
+def _best_cols(V: np.ndarray, rows: np.ndarray, higher: bool = True) -> np.ndarray:
+    """[R] bool: among ``rows`` [R] bool, the row whose mean is best when decided (V [S, R])."""
+    out = np.zeros(V.shape[1], bool)
+    idx = np.flatnonzero(rows)
+    b = seedstats.decided_best(V[:, idx], higher=higher)
+    if b is not None:
+        out[idx[b]] = True
+    return out
+
+
+def _seed_note(n_seeds: int) -> str:
+    if n_seeds < 2:
+        return (r" One training seed: no interval, so no difference is decided and nothing is "
+                r"bold.")
+    return (rf" Mean $\pm$ sd over {n_seeds} training seeds; differences paired per seed, with "
+            r"their 95\% interval; bold only when the interval excludes 0, $^{\dagger}$ when it "
+            r"does not (undecided).")
+
+
+def tab_psnr(per_seed: Mapping[int, Mapping[tuple[str, str], Mapping[str, float]]],
+             trees: Sequence[str], bones: Mapping[str, int], models: Sequence[str] = MODELS,
+             digits: int = 2, references: Sequence[str] = ()) -> Table:
     """PSNR (dB) on the view and time splits, one row per model, two columns per tree.
 
-    summaries[(tree, model)]: ``EvalResult.summary()`` of the model trained ``single``.
-    Best per column (among the methods) in bold; references (the true-motion ceiling) follow
-    as separate rows below a rule, never bold; digits: decimals shown in the .tex.
+    per_seed[seed][(tree, model)]: ``EvalResult.summary()`` of the model trained ``single`` with
+    that training seed. Below the models: references (the true-motion ceiling; never bold) and
+    two paired differences, ours - static and ours - the best learned field (per seed, the
+    learned field with the highest PSNR in that column). The best method per column is bold when
+    its paired difference to the runner-up is decided; digits: decimals shown in the .tex.
     """
     fmt = f".{int(digits)}f"
-    _check([(t, m) for t in trees for m in (*models, *references)], summaries, "tab_psnr")
+    seeds = _seeds(per_seed, "tab_psnr")
+    for s in seeds:
+        _check([(t, m) for t in trees for m in (*models, *references)], per_seed[s],
+               f"tab_psnr (seed {s})")
+    learned = [m for m in models if m not in ("static", "ours")]
+    cols = [f"{t}_{sp}" for t in trees for sp in ("view", "time")]
     rows = []
-    for m in (*models, *references):
-        r = {"model": label(m), "reference": m in references}
-        for t in trees:
-            r[f"{t}_view"] = summaries[(t, m)]["view"]
-            r[f"{t}_time"] = summaries[(t, m)]["time"]
-        rows.append(r)
+    for s in seeds:
+        S = per_seed[s]
+        val = {m: {f"{t}_{sp}": S[(t, m)][sp] for t in trees for sp in ("view", "time")}
+               for m in (*models, *references)}
+        for m in (*models, *references):
+            rows.append({"seed": s, "model": label(m), **val[m], "reference": m in references,
+                         "difference": False})
+        if "ours" in models and "static" in models:
+            rows.append({"seed": s, "model": f"{label('ours')} - {label('static')}",
+                         **{c: val["ours"][c] - val["static"][c] for c in cols},
+                         "reference": False, "difference": True})
+        if "ours" in models and learned:
+            rows.append({"seed": s, "model": f"{label('ours')} - best learned field",
+                         **{c: val["ours"][c] - max(val[m][c] for m in learned) for c in cols},
+                         "reference": False, "difference": True})
     df = pd.DataFrame(rows)
-    num = [c for c in df.columns if c not in ("model", "reference")]
-    methods = ~df["reference"].to_numpy(bool)
-    bold = {}
-    for c in num:
-        b = np.zeros(len(df), bool)
-        b[methods] = _best_mask(df.loc[methods, c].to_numpy(), fmt)
-        bold[c] = b
+    first = _first(df)
+    ref, diff = first["reference"].to_numpy(bool), first["difference"].to_numpy(bool)
+    V = {c: _by_seed(df, c, len(seeds)) for c in cols}
+    bold = {c: _best_cols(V[c], ~ref & ~diff) for c in cols}
     n = len(trees)
     lines = ["  \\begin{tabular}{l" + "cc" * n + "}", "    \\toprule",
              "    & " + " & ".join(rf"\multicolumn{{2}}{{c}}{{{tree_label(t, bones[t])}}}" for t in trees) + r" \\",
              "    " + "".join(rf"\cmidrule(lr){{{2 + 2 * i}-{3 + 2 * i}}}" for i in range(n)),
              "    & " + " & ".join(["view & time"] * n) + r" \\", "    \\midrule"]
-    for i, r in df.iterrows():
-        if r["reference"] and (i == 0 or not df["reference"].iloc[i - 1]):
+    for i, r in first.iterrows():
+        if i > 0 and (ref[i], diff[i]) != (ref[i - 1], diff[i - 1]):
             lines.append("    \\midrule")
-        cells = [_fmt(r[c], fmt, bold[c][i]) for c in num]
-        name = rf"\emph{{{r['model']}}}" if r["reference"] else r["model"]
+        if diff[i]:
+            cells = [seedstats.difference(V[c][:, i], fmt) for c in cols]
+            name = r["model"].replace(" - ", " $-$ ")
+        else:
+            cells = [seedstats.pm(V[c][:, i], fmt, bold[c][i]) for c in cols]
+            name = rf"\emph{{{r['model']}}}" if ref[i] else r["model"]
         lines.append(f"    {name} & " + " & ".join(cells) + r" \\")
     lines += ["    \\bottomrule", "  \\end{tabular}", ""]
-    # the CSV marks reference rows in a last column (only when there are any)
-    df = df[[*(c for c in df.columns if c != "reference"), *(["reference"] if references else [])]]
+    if not references:
+        df = df.drop(columns="reference")
     cap = (r"PSNR (dB). \emph{view}: held-out azimuths at the training wind inside the training "
            r"window. \emph{time}: frames beyond the training window at the training wind and camera. "
-           r"Best per column in bold."
+           r"Best method per column in bold."
            + (r" In italics, a reference (not a method, never bold): the canonical Gaussians moved "
               r"by the ground-truth motion, appearance trained by the same recipe." if references
-              else ""))
+              else "")
+           + r" Last rows: paired differences (dB); the best learned field is taken per seed."
+           + _seed_note(len(seeds)))
     return Table("tab_psnr", df, _wrap("\n".join(lines), cap, "tab:psnr"))
 
 
 # --------------------------------------------------------------------------------------------
-def tab_fit(rows: Mapping[tuple[str, str], Mapping[str, float]], trees: Sequence[str],
-            bones: Mapping[str, int], models: Sequence[str], reference: str, digits: int = 2,
-            static: str = "static", holdout_every: int = 10) -> Table:
+def tab_fit(per_seed: Mapping[int, Mapping[tuple[str, str], Mapping[str, float]]],
+            trees: Sequence[str], bones: Mapping[str, int], models: Sequence[str],
+            reference: str, digits: int = 2, static: str = "static",
+            holdout_every: int = 10) -> Table:
     """How much of the achievable fit each model reaches, per tree and model.
 
-    rows[(tree, model)]: fit (dB: mean PSNR over the trained training-window frames at the
-    training camera and wind), heldout (dB: the same over the held-out training-window frames),
-    view, time (dB: the evaluation splits), train_s (seconds of training). ceiling_frac is
-    (model - static) / (reference - static) on ``fit``: 1 reaches the true-motion ceiling, 0 is
-    no better than the static pose. The reference row is listed for scale.
+    per_seed[seed][(tree, model)]: fit (dB: mean PSNR over the trained training-window frames at
+    the training camera and wind), heldout (dB: the same over the held-out training-window
+    frames), view, time (dB: the evaluation splits), train_s (seconds of training).
+    ceiling_frac is (model - static) / (reference - static) on ``fit``, per seed against that
+    seed's static pose and ceiling: 1 reaches the true-motion ceiling, 0 is no better than the
+    static pose. The reference row is listed for scale.
     """
-    _check([(t, m) for t in trees for m in (*models, reference)], rows, "tab_fit")
+    seeds = _seeds(per_seed, "tab_fit")
     recs = []
-    for t in trees:
-        ceil, stat = rows[(t, reference)]["fit"], rows[(t, static)]["fit"]
-        for m in (*models, reference):
-            r = rows[(t, m)]
-            recs.append({"tree": t, "bones": bones[t], "model": m, "reference": m == reference,
-                         "fit_psnr_db": r["fit"], "heldout_psnr_db": r["heldout"],
-                         "ceiling_frac": float(ceiling_fraction(r["fit"], stat, ceil)),
-                         "view_psnr_db": r["view"], "time_psnr_db": r["time"],
-                         "train_s": r["train_s"]})
+    for s in seeds:
+        rows = per_seed[s]
+        _check([(t, m) for t in trees for m in (*models, reference)], rows, f"tab_fit (seed {s})")
+        for t in trees:
+            ceil, stat = rows[(t, reference)]["fit"], rows[(t, static)]["fit"]
+            for m in (*models, reference):
+                r = rows[(t, m)]
+                recs.append({"seed": s, "tree": t, "bones": bones[t], "model": m,
+                             "reference": m == reference, "fit_psnr_db": r["fit"],
+                             "heldout_psnr_db": r["heldout"],
+                             "ceiling_frac": float(ceiling_fraction(r["fit"], stat, ceil)),
+                             "view_psnr_db": r["view"], "time_psnr_db": r["time"],
+                             "train_s": r["train_s"]})
     df = pd.DataFrame(recs)
+    first = _first(df)
+    V = {c: _by_seed(df, c, len(seeds)) for c in ("fit_psnr_db", "heldout_psnr_db", "ceiling_frac",
+                                                  "view_psnr_db", "time_psnr_db", "train_s")}
     fmt = f".{int(digits)}f"
     lines = ["  \\begin{tabular}{llcccccr}", "    \\toprule",
              r"    Tree & Model & Fit & Held-out frames & Of ceiling & View & Time & Train (s) \\",
              "    \\midrule"]
-    def cells(r):
-        name = rf"\emph{{{label(r.model)}}}" if r.reference else label(r.model)
-        frac = "--" if not np.isfinite(r.ceiling_frac) else f"{100 * r.ceiling_frac:.0f}\\%"
-        return [name, _fmt(r.fit_psnr_db, fmt), _fmt(r.heldout_psnr_db, fmt), frac,
-                _fmt(r.view_psnr_db, fmt), _fmt(r.time_psnr_db, fmt), f"{r.train_s:.0f}"]
+    first["_i"] = np.arange(len(first))
 
-    lines += _tree_blocks(df, trees, cells)
+    def cells(r):
+        i = r._i
+        name = rf"\emph{{{label(r.model)}}}" if r.reference else label(r.model)
+        frac = seedstats.pm(100 * V["ceiling_frac"][:, i], ".0f")
+        return [name, *(seedstats.pm(V[c][:, i], fmt)
+                        for c in ("fit_psnr_db", "heldout_psnr_db")),
+                frac if frac == "--" else frac + r"\%",
+                *(seedstats.pm(V[c][:, i], fmt) for c in ("view_psnr_db", "time_psnr_db")),
+                seedstats.pm(V["train_s"][:, i], ".0f")]
+
+    lines += _tree_blocks(first, trees, cells)
     lines += ["    \\bottomrule", "  \\end{tabular}", ""]
     cap = (r"Fit to the training window, PSNR (dB) at the training camera and wind. \emph{Fit}: "
            r"the training-window frames each model was trained on; \emph{Held-out frames}: every "
            + f"{holdout_every}th" + r" training-window frame, never trained on; \emph{Of ceiling}: "
            r"(model $-$ static) / "
            r"(true motion $-$ static) on the fit. \emph{View}, \emph{Time}: the evaluation splits. "
-           r"In italics the reference: the canonical Gaussians moved by the ground-truth motion.")
+           r"In italics the reference: the canonical Gaussians moved by the ground-truth motion."
+           + (rf" Mean $\pm$ sd over {len(seeds)} training seeds." if len(seeds) > 1 else
+              " One training seed."))
     return Table("tab_fit", df, _wrap("\n".join(lines), cap, "tab:fit"))
 
 
 # --------------------------------------------------------------------------------------------
-def tab_null(recovery: Mapping[tuple[str, str], object], null: Mapping[tuple[str, str], object],
-             trees: Sequence[str], bones: Mapping[str, int], configs: Mapping[str, str],
-             digits: int = 2) -> Table:
+def tab_null(recovery: Mapping[int, Mapping[tuple[str, str], object]],
+             null: Mapping[int, Mapping[tuple[str, str], object]], trees: Sequence[str],
+             bones: Mapping[str, int], configs: Mapping[str, str], digits: int = 2) -> Table:
     """Frequency recovery of the trained model against the untrained null, per tree and config.
 
-    recovery[(tree, config)]: ``RecoveryRecord``; null[(tree, config)]: ``NullResult`` (same K);
-    configs: configuration name -> its LaTeX label (``registry.config_label``), in row order.
-    Columns: parts trusted, median relative error (%), log-log R^2 for trained and null (null
-    entries are medians over draws), and the median nearest-bone gap (%). Bold: the lower median
-    relative error of each trained/null pair.
+    recovery[seed][(tree, config)]: ``RecoveryRecord`` of that seed's model; null[seed][(tree,
+    config)]: ``NullResult`` drawn with that seed and the model's K; configs: configuration name
+    -> its LaTeX label (``registry.config_label``), in row order. Columns: parts trusted, median
+    relative error (%), log-log R^2 for trained and null (null entries are medians over draws),
+    trained - null (percentage points, paired per seed: negative means the trained model beats
+    chance), and the median nearest-bone gap (%).
     """
+    seeds = _seeds(recovery, "tab_null")
     keys = [(t, c) for t in trees for c in configs]
-    _check(keys, recovery, "tab_null (trained recovery)")
-    _check(keys, null, "tab_null (null control)")
     rows = []
-    for t, c in keys:
-        m, nl = recovery[(t, c)].match, null[(t, c)]
-        if nl.n_parts != m.n_parts:
-            raise ValueError(f"tab_null: null for {t}/{c} has K={nl.n_parts} but the model has "
-                             f"K={m.n_parts}; re-run the null with the model's K")
-        rows.append({"tree": t, "bones": bones[t], "config": c, "K": m.n_parts,
-                     "trained_parts_trusted": float(m.n_trusted),
-                     "trained_median_rel_err_pct": 100 * m.median_rel_err,
-                     "trained_loglog_r2": m.loglog_r2,
-                     "null_parts_trusted": nl.median_n_trusted,
-                     "null_median_rel_err_pct": 100 * nl.median_median_rel_err,
-                     "null_loglog_r2": nl.median_loglog_r2,
-                     "nearest_bone_gap_pct": 100 * nl.nearest_bone_gap,
-                     "trained_parts_trusted_visible": float(recovery[(t, c)].n_trusted_visible),
-                     "trained_median_rel_err_visible_pct":
-                         100 * recovery[(t, c)].median_rel_err_visible,
-                     "null_parts_trusted_visible": nl.median_n_trusted_visible,
-                     "null_median_rel_err_visible_pct": 100 * nl.median_median_rel_err_visible})
+    for s in seeds:
+        _check(keys, recovery.get(s, {}), f"tab_null (trained recovery, seed {s})")
+        _check(keys, null.get(s, {}), f"tab_null (null control, seed {s})")
+        for t, c in keys:
+            rec, nl = recovery[s][(t, c)], null[s][(t, c)]
+            m = rec.match
+            if nl.n_parts != m.n_parts:
+                raise ValueError(f"tab_null: null for {t}/{c} (seed {s}) has K={nl.n_parts} but the "
+                                 f"model has K={m.n_parts}; re-run the null with the model's K")
+            tr, nu = 100 * m.median_rel_err, 100 * nl.median_median_rel_err
+            rows.append({"seed": s, "tree": t, "bones": bones[t], "config": c, "K": m.n_parts,
+                         "trained_parts_trusted": float(m.n_trusted),
+                         "trained_median_rel_err_pct": tr, "trained_loglog_r2": m.loglog_r2,
+                         "null_parts_trusted": nl.median_n_trusted,
+                         "null_median_rel_err_pct": nu, "null_loglog_r2": nl.median_loglog_r2,
+                         "trained_minus_null_pp": tr - nu,
+                         "nearest_bone_gap_pct": 100 * nl.nearest_bone_gap,
+                         "trained_parts_trusted_visible": float(rec.n_trusted_visible),
+                         "trained_median_rel_err_visible_pct": 100 * rec.median_rel_err_visible,
+                         "null_parts_trusted_visible": nl.median_n_trusted_visible,
+                         "null_median_rel_err_visible_pct": 100 * nl.median_median_rel_err_visible})
     df = pd.DataFrame(rows)
-    lines = ["  \\begin{tabular}{llccccccccc}", "    \\toprule",
-             r"    & & \multicolumn{3}{c}{Trained} & \multicolumn{3}{c}{Untrained null} & "
+    first = _first(df)
+    first["_i"] = np.arange(len(first))
+    V = {c: _by_seed(df, c, len(seeds)) for c in df.columns
+         if c not in ("seed", "tree", "bones", "config", "K")}
+    d = int(digits)
+    lines = ["  \\begin{tabular}{llcccccccccc}", "    \\toprule",
+             r"    & & \multicolumn{3}{c}{Trained} & \multicolumn{3}{c}{Untrained null} & & "
              r"& \multicolumn{2}{c}{Visible bones} \\",
-             r"    \cmidrule(lr){3-5}\cmidrule(lr){6-8}\cmidrule(lr){10-11}",
+             r"    \cmidrule(lr){3-5}\cmidrule(lr){6-8}\cmidrule(lr){11-12}",
              r"    Tree & Config & Parts & Med.\ rel.\ err. & log-log $R^2$ & Parts & Med.\ rel.\ err. "
-             r"& log-log $R^2$ & Gap & Trained & Null \\", "    \\midrule"]
-    def cells(r):
-        pair = np.array([r.trained_median_rel_err_pct, r.null_median_rel_err_pct])
-        b = _best_mask(pair, f".{digits}f", higher=False)
-        return [configs[r.config], f"{_fmt(r.trained_parts_trusted, 'g')}/{r.K}",
-                _pct(r.trained_median_rel_err_pct, b[0], digits),
-                _fmt(r.trained_loglog_r2, ".3f"), f"{_fmt(r.null_parts_trusted, 'g')}/{r.K}",
-                _pct(r.null_median_rel_err_pct, b[1], digits),
-                _fmt(r.null_loglog_r2, ".3f"), _pct(r.nearest_bone_gap_pct, False, digits),
-                _pct(r.trained_median_rel_err_visible_pct, False, digits),
-                _pct(r.null_median_rel_err_visible_pct, False, digits)]
+             r"& log-log $R^2$ & Trained $-$ null & Gap & Trained & Null \\", "    \\midrule"]
 
-    lines += _tree_blocks(df, trees, cells)
+    def pct(col, i):
+        c = seedstats.pm(V[col][:, i], f".{d}f")
+        return c if c == "--" else c + r"\%"
+
+    def parts(col, i, K):
+        m = np.nanmean(V[col][:, i]) if np.isfinite(V[col][:, i]).any() else np.nan
+        return f"{_fmt(m, '.3g')}/{K}"
+
+    def cells(r):
+        i = r._i
+        return [configs[r.config], parts("trained_parts_trusted", i, r.K),
+                pct("trained_median_rel_err_pct", i),
+                seedstats.pm(V["trained_loglog_r2"][:, i], ".3f"),
+                parts("null_parts_trusted", i, r.K), pct("null_median_rel_err_pct", i),
+                seedstats.pm(V["null_loglog_r2"][:, i], ".3f"),
+                seedstats.difference(V["trained_minus_null_pp"][:, i], f".{d}f"),
+                _pct(float(np.nanmean(V["nearest_bone_gap_pct"][:, i])), False, d),
+                pct("trained_median_rel_err_visible_pct", i),
+                pct("null_median_rel_err_visible_pct", i)]
+
+    lines += _tree_blocks(first, trees, cells)
     lines += ["    \\bottomrule", "  \\end{tabular}", ""]
     cap = (r"Frequency recovery against an untrained null. Parts: parts trusted ($|\mathrm{corr}|\geq0.7$) "
-           r"of $K$. Median relative error over trusted parts; $R^2$ of $\log\hat\omega_p$ against "
-           r"$\log\omega_p$. Null entries are medians over 8 draws; Gap: median nearest-bone gap. "
-           r"Bold marks the lower error of each trained/null pair. Visible bones: the median errors "
-           r"restricted to parts matched to bones whose own motion moves at least a pixel in the "
-           r"training camera (the CSV also gives the part counts).")
+           r"of $K$ (mean over seeds). Median relative error over trusted parts; $R^2$ of "
+           r"$\log\hat\omega_p$ against $\log\omega_p$. Null entries are medians over 8 draws "
+           r"of each seed, with the trained model's $K$; Trained $-$ null: percentage points, "
+           r"paired per seed (negative: the trained model beats chance); Gap: median nearest-bone "
+           r"gap. Visible bones: the median errors restricted to parts matched to bones whose own "
+           r"motion moves at least a pixel in the training camera (the CSV also gives the part "
+           r"counts)." + _seed_note(len(seeds)))
     return Table("tab_null", df, _wrap("\n".join(lines), cap, "tab:null"))
 
 
@@ -249,24 +351,31 @@ def _pct(x: float, bold: bool, digits: int = 2) -> str:
 
 
 # --------------------------------------------------------------------------------------------
-def tab_transfer(summaries: Mapping[tuple[str, str], Mapping[str, float]], trees: Sequence[str],
-                 bones: Mapping[str, int], conditions: Sequence[float],
+def tab_transfer(per_seed: Mapping[int, Mapping[tuple[str, str], Mapping[str, float]]],
+                 trees: Sequence[str], bones: Mapping[str, int], conditions: Sequence[float],
                  models: Sequence[str] = MODELS, digits: int = 2) -> Table:
     """Zero-shot transfer PSNR (dB) on the unseen conditions (index >= 1), all models ``single``.
 
-    Rows: split (training timestamps / beyond the window) x tree x unseen condition; columns:
-    models. Best per row in bold.
+    per_seed[seed][(tree, model)]: ``EvalResult.summary()``. Rows: split (training timestamps /
+    beyond the window) x tree x unseen condition; columns: models. The best per row is bold when
+    its paired difference to the runner-up is decided.
     """
-    _check([(t, m) for t in trees for m in models], summaries, "tab_transfer")
+    seeds = _seeds(per_seed, "tab_transfer")
     rows = []
-    for split, key in (("train", "train_c"), ("beyond", "beyond_c")):
-        for t in trees:
-            for c in range(1, len(conditions)):
-                r = {"split": split, "tree": t, "bones": bones[t], "condition": float(conditions[c])}
-                for m in models:
-                    r[m] = summaries[(t, m)][f"{key}{c}"]
-                rows.append(r)
+    for s in seeds:
+        S = per_seed[s]
+        _check([(t, m) for t in trees for m in models], S, f"tab_transfer (seed {s})")
+        for split, key in (("train", "train_c"), ("beyond", "beyond_c")):
+            for t in trees:
+                for c in range(1, len(conditions)):
+                    r = {"seed": s, "split": split, "tree": t, "bones": bones[t],
+                         "condition": float(conditions[c])}
+                    for m in models:
+                        r[m] = S[(t, m)][f"{key}{c}"]
+                    rows.append(r)
     df = pd.DataFrame(rows)
+    first = _first(df)
+    V = np.stack([_by_seed(df, m, len(seeds)) for m in models], axis=-1)  # [S, R, M]
     names = {"train": r"\shortstack[l]{Training\\timestamps}", "beyond": r"\shortstack[l]{Beyond the\\training window}"}
     fmt = f".{int(digits)}f"
     lines = ["  \\begin{tabular}{ll" + "c" * len(models) + "}", "    \\toprule"]
@@ -276,47 +385,56 @@ def tab_transfer(summaries: Mapping[tuple[str, str], Mapping[str, float]], trees
     lines += ["    Split & Tree / unseen wind & " + " & ".join(SPECS[m].short for m in models) + r" \\",
               "    \\midrule"]
     for s_i, split in enumerate(("train", "beyond")):
-        sub = df[df.split == split]
-        for j, (_, r) in enumerate(sub.iterrows()):
-            vals = r[list(models)].to_numpy(dtype=float)
-            b = _best_mask(vals, fmt)
-            lab = rf"\multirow{{{len(sub)}}}{{*}}{{{names[split]}}}" if j == 0 else ""
+        idx = np.flatnonzero(first["split"].to_numpy() == split)
+        for j, i in enumerate(idx):
+            r = first.iloc[i]
+            best = seedstats.decided_best(V[:, i, :])
+            lab = rf"\multirow{{{len(idx)}}}{{*}}{{{names[split]}}}" if j == 0 else ""
             lines.append(f"    {lab} & {tree_label(r.tree, r.bones)}, {condition_label(r.condition)} & "
-                         + " & ".join(_fmt(v, fmt, bb) for v, bb in zip(vals, b)) + r" \\")
+                         + " & ".join(seedstats.pm(V[:, i, k], fmt, best == k)
+                                      for k in range(len(models))) + r" \\")
         if s_i == 0:
             lines.append("    \\midrule")
     lines += ["    \\bottomrule", "  \\end{tabular}", ""]
     cap = (r"Zero-shot transfer to unseen wind, PSNR (dB); every model is fit to $v_0$ only. "
-           r"Top: training timestamps; bottom: frames beyond the training window. Best per row in bold.")
+           r"Top: training timestamps; bottom: frames beyond the training window. Best per row in "
+           r"bold." + _seed_note(len(seeds)))
     return Table("tab_transfer", df, _wrap("\n".join(lines), cap, "tab:transfer"))
 
 
 # --------------------------------------------------------------------------------------------
-def tab_margin(summaries: Mapping[tuple[str, str], Mapping[str, float]], trees: Sequence[str],
-               bones: Mapping[str, int], conditions: Sequence[float],
+def tab_margin(per_seed: Mapping[int, Mapping[tuple[str, str], Mapping[str, float]]],
+               trees: Sequence[str], bones: Mapping[str, int], conditions: Sequence[float],
                ours: str = "ours", baseline: str = "mlp_wind", digits: int = 2) -> Table:
     """Ours minus Deformation MLP + wind, PSNR (dB) at training timestamps, per tree and condition
-    (including the training condition). Positive: ours ahead. No bold (as in the paper)."""
-    _check([(t, m) for t in trees for m in (ours, baseline)], summaries, "tab_margin")
+    (including the training condition), paired per seed. Positive: ours ahead. A margin is bold
+    when its 95% interval excludes 0, marked undecided when not."""
+    seeds = _seeds(per_seed, "tab_margin")
     rows = []
-    for t in trees:
-        r = {"tree": t, "bones": bones[t]}
-        for c, mult in enumerate(conditions):
-            r[f"margin_{condition_label(mult, tex=False)}"] = (summaries[(t, ours)][f"train_c{c}"]
-                                                               - summaries[(t, baseline)][f"train_c{c}"])
-        rows.append(r)
+    for s in seeds:
+        S = per_seed[s]
+        _check([(t, m) for t in trees for m in (ours, baseline)], S, f"tab_margin (seed {s})")
+        for t in trees:
+            r = {"seed": s, "tree": t, "bones": bones[t]}
+            for c, mult in enumerate(conditions):
+                r[f"margin_{condition_label(mult, tex=False)}"] = (S[(t, ours)][f"train_c{c}"]
+                                                                   - S[(t, baseline)][f"train_c{c}"])
+            rows.append(r)
     df = pd.DataFrame(rows)
+    first = _first(df)
     cols = [c for c in df.columns if c.startswith("margin_")]
+    V = {c: _by_seed(df, c, len(seeds)) for c in cols}
+    fmt = f".{int(digits)}f"
     lines = ["  \\begin{tabular}{l" + "c" * len(cols) + "}", "    \\toprule",
              r"    Ours $-$ (Deformation MLP $+$\,wind) & " + " & ".join(condition_label(m) for m in conditions) + r" \\",
              "    \\midrule"]
-    for _, r in df.iterrows():
+    for i, r in first.iterrows():
         lines.append(f"    {tree_label(r.tree, r.bones)} & "
-                     + " & ".join("--" if not np.isfinite(r[c]) else f"${r[c]:+.{int(digits)}f}$" for c in cols) + r" \\")
+                     + " & ".join(seedstats.difference(V[c][:, i], fmt) for c in cols) + r" \\")
     lines += ["    \\bottomrule", "  \\end{tabular}", ""]
     cap = (r"Margin against the wind-conditioned baseline: ours minus Deformation MLP\,$+$\,wind, "
            r"PSNR (dB) at training timestamps, on the training condition and the two unseen ones. "
-           r"Positive means ours is ahead.")
+           r"Positive means ours is ahead." + _seed_note(len(seeds)))
     return Table("tab_margin", df, _wrap("\n".join(lines), cap, "tab:margin"))
 
 
