@@ -96,6 +96,28 @@ def test_schema_violation_names_the_key(path, value):
         pconfig.validate(base)
 
 
+@pytest.mark.parametrize("seeds", [[], [0, 0], [0, "a"], [1.5], 3, [-1]])
+def test_bad_seeds_stop_at_load_naming_the_key(seeds):
+    """An empty, repeated or non-integer seed list is refused before any job, whether it comes
+    from the file or from the command line."""
+    for cmd in (None, {"seeds": seeds}):
+        raw = _base()
+        raw["seeds"] = seeds
+        with pytest.raises(pconfig.ConfigError, match=r"config key 'seeds"):
+            pconfig.load_workflow_config(raw, command_line=cmd)
+
+
+def test_command_line_seeds_beat_the_profiles():
+    raw = _base()
+    assert pconfig.load_workflow_config(raw, "quick")["seeds"] == [0]
+    assert pconfig.load_workflow_config(raw, "paper")["seeds"] == [0, 1, 2, 3, 4]
+    got = pconfig.load_workflow_config(raw, "quick", command_line={"seeds": [3, 1]})
+    assert got["seeds"] == [3, 1]
+    bad = pconfig.load_workflow_config  # a bad command-line value is validated like the file's
+    with pytest.raises(pconfig.ConfigError, match="seeds"):
+        bad(raw, "quick", command_line={"seeds": [2, 2]})
+
+
 def test_schema_violation_in_a_profile_body_names_the_profile_key():
     msg = _refused(lambda c: c["profiles"]["quick"]["train"].update(warmup="ten"), "quick")
     assert "profiles/quick/train/warmup" in msg and "Fix config/trees.yaml" in msg
@@ -136,7 +158,7 @@ def test_missing_section_is_named():
      "profiles/quick/presets/medium/leaves/fractoin", "profiles/quick/presets/medium/leaves/fraction"),
     (lambda c: c["profiles"]["quick"].update(iterations=5),
      "profiles/quick/iterations", "profiles/quick/train/iterations"),
-    (lambda c: c.update(seeds=1), "seeds", "seed"),
+    (lambda c: c.update(seds=[0, 1]), "seds", "seeds"),
     (lambda c: c["train"]["lr"].update(mens=1e-4), "train/lr/mens", "train/lr/means"),
     (lambda c: c["testbed"]["vertices"].update(sprase=400), "testbed/vertices/sprase",
      "testbed/vertices/sparse"),

@@ -19,7 +19,7 @@ def _dry_run(*targets):
 def plan():
     """One dry run of every training job and the true-motion ceiling (each dry run costs
     seconds of DAG building, so both tests read this one)."""
-    r = _dry_run("train_all", *[f"results/models/{t}/truth_motion_single.pt"
+    r = _dry_run("train_all", *[f"results/models/{t}/seed0/truth_motion_single.pt"
                                 for t in ("sparse", "medium", "dense")])
     assert r.returncode == 0, r.stderr[-2000:] + r.stdout[-2000:]
     return r.stdout

@@ -35,14 +35,15 @@ def test_quick_dag_through_cluster_generic_executor(tmp_path, quick_dag):
         "--jobs", "2", "--latency-wait", "30", "--seconds-between-status-checks", "1",
         "--default-resources", "mem_mb=2000", "runtime=20",
         "--config", "profile=quick", 'trees=["sparse"]', "--",
-        "results/recovery/sparse/ours_single.json", "results/recovery/sparse/null_K32.json",
+        "results/recovery/sparse/seed0/ours_single.json",
+        "results/recovery/sparse/seed0/null_K32.json",
         timeout=900,
     )
     log = proc.stdout + proc.stderr
     # every job went through the plugin, each with its own external job id
     assert "cluster-generic" in log or "Submitted job" in log
     assert log.count("Submitted job") == 3, log[-3000:]  # train, recovery, null
-    rec = load_recovery(wd / "results" / "recovery" / "sparse" / "ours_single.json")
-    null = load_null(wd / "results" / "recovery" / "sparse" / "null_K32.json")
+    rec = load_recovery(wd / "results" / "recovery" / "sparse" / "seed0" / "ours_single.json")
+    null = load_null(wd / "results" / "recovery" / "sparse" / "seed0" / "null_K32.json")
     assert rec.match.n_parts == 32 and 0 <= rec.match.n_trusted <= 32
     assert null.nearest_bone_gap > 0

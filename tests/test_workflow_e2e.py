@@ -53,14 +53,22 @@ def test_every_output_exists(run):
 
 def test_tab_psnr_rows_columns_and_finite(run):
     df = _csv(run, "tab_psnr")
-    assert list(df["model"]) == [*MODELS, "True motion (ceiling)"]  # the reference row last
-    assert list(df["reference"]) == [False] * len(MODELS) + [True]
+    # the models, the reference, then the two paired differences; one seed
+    assert list(df["model"]) == [*MODELS, "True motion (ceiling)", "Ours - Static pose",
+                                 "Ours - best learned field"]
+    assert list(df["reference"]) == [False] * len(MODELS) + [True, False, False]
+    assert list(df["difference"]) == [False] * (len(MODELS) + 1) + [True, True]
+    assert set(df["seed"]) == set(QUICK["seeds"])
     cols = [f"{t}_{s}" for t in TREES for s in ("view", "time")]
-    assert list(df.columns[1:1 + len(cols)]) == cols
-    vals = df[cols].to_numpy(float)
+    assert list(df.columns[2:2 + len(cols)]) == cols
+    vals = df.loc[~df["difference"], cols].to_numpy(float)
     assert np.isfinite(vals).all() and (vals > 5).all() and (vals < 60).all()
+    diff = df.loc[df["difference"], cols].to_numpy(float)
+    ours, static = (df.loc[df["model"] == m, cols].to_numpy(float) for m in ("Ours", "Static pose"))
+    np.testing.assert_allclose(diff[0], (ours - static)[0], atol=1e-4)
     tex = (run / "results" / "tables" / "tab_psnr.tex").read_text()
-    assert r"\toprule" in tex and r"\bottomrule" in tex and tex.count(r"\textbf{") == 2 * len(TREES)
+    # one seed: no interval, so no best is decided and nothing is bold
+    assert r"\toprule" in tex and r"\bottomrule" in tex and r"\textbf{" not in tex
 
 
 def test_tab_transfer_rows_columns_and_finite(run):
@@ -80,8 +88,9 @@ def test_tab_margin_is_ours_minus_mlp_wind(run):
                                                                  "margin_0.71v0"]
     from physgs.evaluate.splits import load_eval
     for _, row in df.iterrows():
-        ours = load_eval(run / "results" / "eval" / row["tree"] / "ours_single.npz").summary()
-        base = load_eval(run / "results" / "eval" / row["tree"] / "mlp_wind_single.npz").summary()
+        ev = run / "results" / "eval" / row["tree"] / f"seed{row['seed']}"
+        ours = load_eval(ev / "ours_single.npz").summary()
+        base = load_eval(ev / "mlp_wind_single.npz").summary()
         assert row["margin_v0"] == pytest.approx(ours["train_c0"] - base["train_c0"], abs=1e-4)
 
 
@@ -127,7 +136,7 @@ def test_tab_null_plan_trains_ours_only():
         wd = workflow_copy(Path(d))
         out = snakemake(wd, "-n", "--cores", "2", "results/tables/tab_null.tex",
                         "--config", "profile=quick").stdout
-    trained = re.findall(r"results/models/\w+/(\w+?)_(single|joint32|joint96)\.pt", out)
+    trained = re.findall(r"results/models/\w+/seed\d+/(\w+?)_(single|joint32|joint96)\.pt", out)
     assert trained, "the plan trains nothing"
     assert {m for m, _ in trained} == {"ours"}
     assert "rule evaluate:" not in out
@@ -182,3 +191,29 @@ def test_fit_curve_passes_through_the_tables_numbers(run):
         assert cell["fit_psnr_db"].item() == pytest.approx(r["fit"], abs=1e-4)
     for ext in ("pdf", "png"):
         assert (run / "results" / "figures" / f"fig_fit_curve.{ext}").stat().st_size > 1000
+
+
+def test_a_second_seed_pairs_with_the_first(run, tmp_path):
+    """`--config seeds=[0,1]` on the finished one-seed DAG trains seed 1 only; tab_margin then
+    holds both seeds, seed 0's row is the one-seed table's (same command, same numbers) and the
+    .tex gives the paired mean with its 95% interval."""
+    import shutil
+
+    from scipy import stats
+
+    wd = workflow_copy(tmp_path / "wf")
+    shutil.copytree(run / "results", wd / "results")
+    one = _csv(run, "tab_margin")
+    out = snakemake(wd, "--cores", "2", "results/tables/tab_margin.tex", "--config",
+                    "profile=quick", 'trees=["sparse"]', "seeds=[0,1]")
+    out = out.stdout + out.stderr
+    trained = set(re.findall(r"results/models/\w+/(seed\d+)/\w+\.pt", out))
+    assert trained == {"seed1"}, trained
+    two = pd.read_csv(wd / "results" / "tables" / "tab_margin.csv")
+    assert list(two["seed"]) == [0, 1]
+    cols = ["margin_v0", "margin_0.84v0", "margin_0.71v0"]
+    np.testing.assert_allclose(two.loc[0, cols].to_numpy(float), one.loc[0, cols].to_numpy(float))
+    d = two["margin_v0"].to_numpy(float)
+    lo, hi = stats.t.interval(0.95, 1, loc=d.mean(), scale=stats.sem(d))
+    tex = (wd / "results" / "tables" / "tab_margin.tex").read_text()
+    assert f"${d.mean():+.2f}$ [{lo:.2f}, {hi:.2f}]" in tex

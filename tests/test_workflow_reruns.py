@@ -59,7 +59,7 @@ def _counts(out: str) -> dict[str, int]:
 
 def _checkpoints(out: str) -> set[str]:
     """The checkpoints a dry-run's output (re)trains, as '<model>_<config>'."""
-    return set(re.findall(r"results/models/\w+/(\w+?)\.pt", out))
+    return set(re.findall(r"results/models/\w+/seed\d+/(\w+?)\.pt", out))
 
 
 
