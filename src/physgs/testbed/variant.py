@@ -126,10 +126,12 @@ def shape_wind(v: np.ndarray, t: np.ndarray, v0: float, tr: Transient) -> np.nda
 
     v [T] m/s the unmodified speed at times t [T] s; v0 m/s its mean. Exactly v0 through the
     calm (w = gust = 0 there), so the drag forcing v^2 - v0^2 is exactly 0; never below
-    min(v, v0), so a positive wind stays positive.
+    min(v, v0), so a positive wind stays positive; v itself outside the transient.
     """
     v = np.asarray(v, dtype=np.float64)
-    return v0 + turbulence_weight(t, tr) * (v - v0) + tr.gust_gain * v0 * gust_shape(t, tr)
+    w, g = turbulence_weight(t, tr), gust_shape(t, tr)
+    shaped = v0 + w * (v - v0) + tr.gust_gain * v0 * g
+    return np.where((w == 1.0) & (g == 0.0), v, shaped)  # untouched samples stay bit-identical
 
 
 def calm_frames(tr: Transient, fps: int) -> tuple[int, int]:
