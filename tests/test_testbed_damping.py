@@ -54,11 +54,12 @@ def test_faithful_variant_is_the_default_code_path():
     for every bone, the lead-in from omega_min, the unmodified wind."""
     tb = _tb("faithful")
     legacy = {k: v for k, v in tb.items() if k not in ("variant", "damping")}
-    a, b = _arrays(_sim(tb)), _arrays(_sim(legacy))
+    sim = _sim(tb)
+    a, b = _arrays(sim), _arrays(_sim(legacy))
     assert a.keys() == b.keys()
     for k in a:
         assert np.array_equal(a[k], b[k]) and np.asarray(a[k]).dtype == np.asarray(b[k]).dtype, k
-    tr = _sim(tb).truth
+    tr = sim.truth
     np.testing.assert_array_equal(tr.zeta, np.full(len(tr.omega), tb["zeta"]))
     assert tr.lead_in_frames == physics.lead_in_frames(tr.omega.min(), tb["zeta"],
                                                        tb["lead_in_tau"], FPS)
@@ -152,13 +153,19 @@ def test_calm_window_has_no_forcing_and_the_wind_is_shared_by_every_condition(da
         np.testing.assert_allclose(damped.wind[c], damped.wind[0].astype(np.float64) * k, rtol=1e-6)
 
 
-def _free_decay(theta, omega, zeta, h):
-    """Closed-form homogeneous solution e^{-zeta w t} (A cos w_d t + B sin w_d t) through the
-    first two samples of theta [T, B] (A from sample 0, B from sample 1), at t = k h, k < T.
-    Independent of the testbed's simulator. Returns (prediction [T, B], amplitude sqrt(A^2+B^2) [B])."""
+def _through(two, omega, zeta, h):
+    """(A, B) [B] of the free response e^{-zeta w t} (A cos w_d t + B sin w_d t) through two
+    consecutive samples two [2, B] (t = 0 and h); its amplitude at t = 0 is hypot(A, B)."""
     g, wd = zeta * omega, omega * np.sqrt(1 - zeta ** 2)
-    A = theta[0]
-    B = (theta[1] * np.exp(g * h) - A * np.cos(wd * h)) / np.sin(wd * h)
+    return two[0], (two[1] * np.exp(g * h) - two[0] * np.cos(wd * h)) / np.sin(wd * h)
+
+
+def _free_decay(theta, omega, zeta, h):
+    """Closed-form homogeneous solution through the first two samples of theta [T, B], at
+    t = k h, k < T. Independent of the testbed's simulator. Returns (prediction [T, B],
+    amplitude hypot(A, B) [B] at sample 0)."""
+    A, B = _through(theta[:2], omega, zeta, h)
+    g, wd = zeta * omega, omega * np.sqrt(1 - zeta ** 2)
     t = np.arange(len(theta))[:, None] * h
     return np.exp(-g * t) * (A * np.cos(wd * t) + B * np.sin(wd * t)), np.hypot(A, B)
 
@@ -175,21 +182,13 @@ def test_every_bone_decays_freely_through_the_calm(damped):
     assert (amp >= MIN_CALM_START_AMPLITUDE * rms).all(), (amp / rms).min()
     # and it really is a decay at each bone's own rate: the envelope shrinks by exp(-zeta w T)
     T = (j1 - j0 - 2) / FPS  # from the calm's first sample to its last but one
-    env = np.hypot(*_quadrature(calm[-2:], tr.omega, tr.zeta, 1.0 / FPS))
+    env = np.hypot(*_through(calm[-2:], tr.omega, tr.zeta, 1.0 / FPS))
     np.testing.assert_allclose(env / amp, np.exp(-tr.zeta * tr.omega * T), rtol=1e-6)
     # control: the faithful variant's wind over the same frames forces the bones
     f = _sim(_tb("faithful")).truth
     fc = f.theta[0, f.lead_in_frames + j0:f.lead_in_frames + j1]
     fp, famp = _free_decay(fc, f.omega, f.zeta, 1.0 / FPS)
     assert np.abs(fc - fp).max() > 100 * FREE_DECAY_RTOL * famp.max()
-
-
-def _quadrature(two, omega, zeta, h):
-    """(A, B) of the free response through two consecutive samples two [2, B], taking the first
-    as t = 0: the amplitude there is hypot(A, B)."""
-    g, wd = zeta * omega, omega * np.sqrt(1 - zeta ** 2)
-    A = two[0]
-    return A, (two[1] * np.exp(g * h) - A * np.cos(wd * h)) / np.sin(wd * h)
 
 
 def test_start_state_is_the_steady_state_of_the_unmodified_wind():
@@ -201,6 +200,22 @@ def test_start_state_is_the_steady_state_of_the_unmodified_wind():
     wa, wb = a.truth.theta[:, La:], b.truth.theta[:, Lb:]
     assert np.abs(wa - wb).max() < 1e-6 * np.abs(wa).max()
     np.testing.assert_array_equal(a.wind[:, La:], b.wind[:, Lb:])
+
+
+def test_the_record_before_the_gust_does_not_depend_on_the_transient(damped):
+    """Causality: moving the transient later changes nothing before the first gust, so the start
+    state is the unmodified wind's (a steady state of the shaped wind, made periodic, would move
+    with the gust). Compared before the rms calibration, which the transient does move."""
+    late = _tb()
+    late["damping"]["transient"]["start_s"] = START_S + 1.5  # calm 4.5-9.5 s, still in the window
+    b = _sim(late)
+    a, L = damped, damped.truth.lead_in_frames
+    assert b.truth.lead_in_frames == L
+    j = int(round((START_S - CFG["testbed"]["damping"]["transient"]["gust_s"]) * FPS))
+    np.testing.assert_array_equal(a.wind[:, :L + j + 1], b.wind[:, :L + j + 1])
+    unit_a, unit_b = a.truth.theta / a.truth.g0, b.truth.theta / b.truth.g0
+    np.testing.assert_allclose(unit_a[:, :L + j + 1], unit_b[:, :L + j + 1], rtol=1e-12, atol=0)
+    assert not np.allclose(unit_a[:, L + j + FPS], unit_b[:, L + j + FPS], rtol=1e-3)
 
 
 def test_rms_swing_calibration_is_unchanged(damped):

@@ -110,8 +110,7 @@ def turbulence_weight(t: np.ndarray, tr: Transient) -> np.ndarray:
     down = 1.0 - _rise((t - (tr.start_s - tr.gust_s)) / tr.gust_s)
     end = tr.start_s + tr.calm_s
     up = _rise((t - end) / tr.ramp_s) if tr.ramp_s > 0 else (t > end).astype(np.float64)
-    w = np.where(t < tr.start_s, down, np.where(t <= end, 0.0, up))
-    return w
+    return np.where(t < tr.start_s, down, np.where(t <= end, 0.0, up))
 
 
 def gust_shape(t: np.ndarray, tr: Transient) -> np.ndarray:
