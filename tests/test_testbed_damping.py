@@ -221,8 +221,8 @@ def test_the_record_before_the_gust_does_not_depend_on_the_transient(damped):
 def test_rms_swing_calibration_is_unchanged(damped):
     tr, L = damped.truth, damped.truth.lead_in_frames
     world = kinematics.cumulative_angle(tr.bone_parent, tr.theta[0, L:L + N_TRAIN])
-    assert np.degrees(np.sqrt(np.mean(world ** 2))) == pytest.approx(CFG["testbed"]["rms_swing_deg"],
-                                                                     rel=1e-9)
+    rms_deg = np.degrees(np.sqrt(np.mean(world ** 2)))
+    assert rms_deg == pytest.approx(CFG["testbed"]["rms_swing_deg"], rel=1e-9)
 
 
 def test_a_transient_before_the_record_is_refused():

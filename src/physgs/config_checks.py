@@ -60,9 +60,10 @@ def lead_in_fits_wind_period(cfg: dict) -> Iterator[Problem]:
     """The record (lead-in + window + tail) is shorter than the periodic wind's period.
 
     The lead-in is ``physgs.testbed.physics.lead_in_frames`` at the slowest a bone can decay
-    (the band's lower edge: calibration clamps every bone into the band; the lowest zeta: testbed/zeta,
-    or for the damping variant the low end of testbed/damping/zeta_range), so this bounds the
-    longest lead-in any tree gets; ``physgs.testbed.dataset.simulate_tree`` refuses the same record.
+    (the band's lower edge: calibration clamps every bone into the band; the lowest zeta:
+    testbed/zeta, or for the damping variant the low end of testbed/damping/zeta_range), so this
+    bounds the longest lead-in any tree gets; ``physgs.testbed.dataset.simulate_tree`` refuses
+    the same record.
     """
     from physgs.testbed import physics, wind  # the formulas the testbed itself uses
 

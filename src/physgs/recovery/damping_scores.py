@@ -102,7 +102,8 @@ def damping_scores(bone: np.ndarray, trusted: np.ndarray, zeta_hat: np.ndarray,
     bone = np.asarray(bone, dtype=np.int64)
     trusted = np.asarray(trusted, dtype=bool)
     zeta_hat, omega_hat = _positive("zeta_hat", zeta_hat), _positive("omega_hat", omega_hat)
-    zeta_bones, omega_bones = _positive("zeta_bones", zeta_bones), _positive("omega_bones", omega_bones)
+    zeta_bones = _positive("zeta_bones", zeta_bones)
+    omega_bones = _positive("omega_bones", omega_bones)
     K, B = len(bone), len(zeta_bones)
     if trusted.shape != (K,) or zeta_hat.shape != (K,) or omega_hat.shape != (K,):
         raise ValueError(f"bone {bone.shape}, trusted {trusted.shape}, zeta_hat {zeta_hat.shape} "

@@ -45,7 +45,7 @@ def effective_settings(tb: dict) -> dict:
 
 
 def draw_zeta(zeta_range, n_bones: int, seed_seq: np.random.SeedSequence) -> np.ndarray:
-    """[n_bones] damping ratios, log-uniform on [lo, hi] = zeta_range (0 < lo <= hi <= 1), seeded."""
+    """[n_bones] damping ratios, log-uniform on [lo, hi] = zeta_range, 0 < lo <= hi <= 1, seeded."""
     lo, hi = (float(z) for z in zeta_range)
     if not 0 < lo <= hi <= 1:
         raise ValueError(f"zeta_range {list(zeta_range)} must satisfy 0 < lo <= hi <= 1; fix "
