@@ -325,3 +325,84 @@ def test_snakefile_refuses_a_bad_override_in_seconds_and_writes_nothing(tmp_path
     assert "profiles/quick/models/kselect/warmup" in out
     assert wall < 20, f"took {wall:.1f} s"
     assert not (tmp_path / "results").exists()
+
+
+# --- the damping testbed variant (testbed/variant, testbed/damping) -----------------------------
+
+
+def _damping(**transient):
+    """Edit: the damping variant, with `transient` keys overridden (zeta_range via the key)."""
+    def edit(c):
+        c["testbed"]["variant"] = "damping"
+        zr = transient.pop("zeta_range", None)
+        if zr is not None:
+            c["testbed"]["damping"]["zeta_range"] = zr
+        c["testbed"]["damping"]["transient"].update(transient)
+    return edit
+
+
+def test_the_shipped_damping_variant_is_accepted_and_faithful_is_the_default():
+    cfg = pconfig.load(CONFIG, "default")
+    assert cfg["testbed"]["variant"] == "faithful"
+    raw = _base()
+    _damping()(raw)
+    assert pconfig.load_workflow_config(raw, "default")["testbed"]["variant"] == "damping"
+    # a config without the new keys (older checkouts) is the faithful testbed, still accepted
+    raw = _base()
+    raw["testbed"].pop("variant")
+    raw["testbed"].pop("damping")
+    assert "variant" not in pconfig.load_workflow_config(raw, "default")["testbed"]
+
+
+@pytest.mark.parametrize("edit, key, fix", [
+    (_damping(zeta_range=[0.2, 0.03]), "testbed/damping/zeta_range", "swap them"),
+    (_damping(zeta_range=[0.05, 0.05]), "testbed/damping/zeta_range", "variant: faithful"),
+    (_damping(zeta_range=[0.0, 0.2]), "testbed/damping/zeta_range", "must lie in (0, 1]"),
+    (_damping(zeta_range=[0.03, 1.5]), "testbed/damping/zeta_range", "must lie in (0, 1]"),
+    (_damping(start_s=-1.0), "testbed/damping/transient/start_s", "raise start_s to at least 1"),
+    (_damping(start_s=0.5), "testbed/damping/transient/start_s", "raise start_s to at least 1"),
+    # 8 + 5 s ends after the 12.5 s window: both shifts fit, and so does a longer window
+    (_damping(start_s=8.0), "testbed/damping/transient/calm_s",
+     "lower start_s to at most 7.5, or lower calm_s to at most 4.5, or raise testbed/n_train to "
+     "at least 312"),
+    # one period of band_hz[0] = 0.35 Hz is 2.86 s
+    (_damping(calm_s=2.0), "testbed/damping/transient/calm_s", "raise calm_s to at least 2.86"),
+    (_damping(calm_s=0.0), "testbed/damping/transient/calm_s", "raise calm_s to at least 2.86"),
+])
+def test_bad_damping_settings_stop_at_load_naming_the_key_and_the_fix(edit, key, fix):
+    msg = _refused(edit)
+    assert f"config key '{key}'" in msg, msg
+    assert fix in msg, msg
+    assert "Fix config/trees.yaml" in msg
+
+
+def test_a_bad_zeta_range_is_refused_even_for_the_faithful_variant():
+    msg = _refused(lambda c: c["testbed"]["damping"].update(zeta_range=[0.3, 0.1]))
+    assert "config key 'testbed/damping/zeta_range'" in msg
+
+
+def test_the_transient_is_checked_only_for_the_damping_variant():
+    # quick's 2.5 s window holds no 5 s calm: fine while faithful, refused as damping
+    pconfig.load(CONFIG, "quick")
+    msg = _refused(_damping(), "quick")
+    assert "config key 'testbed/damping/transient/calm_s'" in msg
+    assert "n_train / fps = 2.5 s" in msg and "raise testbed/n_train to at least 264" in msg
+
+
+def test_the_damping_variant_needs_its_settings():
+    def edit(c):
+        c["testbed"]["variant"] = "damping"
+        c["testbed"].pop("damping")
+    assert "config key 'testbed/damping' is missing" in _refused(edit)
+    assert "testbed/variant" in _refused(lambda c: c["testbed"].update(variant="windy"))
+
+
+def test_the_damping_lead_in_uses_the_lowest_zeta_of_the_range():
+    # zeta 0.005 at 0.35 Hz: tau_max 91 s, a lead-in far beyond the 60 s wind period; the same
+    # value as testbed/zeta would be refused too, but only the range matters for this variant
+    msg = _refused(_damping(zeta_range=[0.005, 0.2]))
+    assert "config key 'testbed/lead_in_tau'" in msg and "testbed/damping/zeta_range[0]" in msg
+    raw = _base()
+    raw["testbed"]["zeta"] = 0.005  # unused by the damping variant
+    _damping()(raw)
+    pconfig.load_workflow_config(raw, "default")

@@ -59,9 +59,11 @@ def band_ordered(cfg: dict) -> Iterator[Problem]:
 def lead_in_fits_wind_period(cfg: dict) -> Iterator[Problem]:
     """The record (lead-in + window + tail) is shorter than the periodic wind's period.
 
-    The lead-in is ``physgs.testbed.physics.lead_in_frames`` at the slowest a bone can be (the
-    band's lower edge: calibration clamps every bone into the band), so this bounds the longest
-    lead-in any tree gets; ``physgs.testbed.dataset.simulate_tree`` refuses the same record.
+    The lead-in is ``physgs.testbed.physics.lead_in_frames`` at the slowest a bone can decay
+    (the band's lower edge: calibration clamps every bone into the band; the lowest zeta:
+    testbed/zeta, or for the damping variant the low end of testbed/damping/zeta_range), so this
+    bounds the longest lead-in any tree gets; ``physgs.testbed.dataset.simulate_tree`` refuses
+    the same record.
     """
     from physgs.testbed import physics, wind  # the formulas the testbed itself uses
 
@@ -69,13 +71,19 @@ def lead_in_fits_wind_period(cfg: dict) -> Iterator[Problem]:
     lo, hi = tb["band_hz"]
     if not 0 < lo < hi:
         return  # band_ordered reports it
-    fps, zeta, tau = int(tb["fps"]), float(tb["zeta"]), float(tb["lead_in_tau"])
+    fps, tau = int(tb["fps"]), float(tb["lead_in_tau"])
     period = wind.PERIOD_S * fps
     if abs(period - round(period)) > 1e-9:
         yield (("testbed", "fps"),
                f"{fps} fps does not divide the {wind.PERIOD_S:g} s wind period into whole frames; "
                "use an integer number of frames per second that does")
         return
+    damping = tb.get("variant", "faithful") == "damping"
+    # the damping variant's slowest decay is at the lowest zeta it can draw
+    zeta = min(float(z) for z in tb["damping"]["zeta_range"]) if damping else float(tb["zeta"])
+    if not zeta > 0:
+        return  # damping_range_valid reports it
+    raise_zeta = "testbed/damping/zeta_range[0]" if damping else "testbed/zeta"
     P = int(round(period))
     F = int(tb["n_train"]) + int(tb["n_tail"])
     omega_min = 2 * math.pi * float(lo)
@@ -88,8 +96,69 @@ def lead_in_fits_wind_period(cfg: dict) -> Iterator[Problem]:
                f"1/(zeta*2pi*band_hz[0]) = {tau_max:.2f} s), so the record ({L / fps:.1f} s + "
                f"{F / fps:.1f} s of n_train + n_tail) is not shorter than the {wind.PERIOD_S:g} s "
                f"wind period; lower testbed/lead_in_tau to at most "
-               f"{room / (tau_max * fps):.3g}, or raise testbed/zeta or testbed/band_hz[0], or "
+               f"{room / (tau_max * fps):.3g}, or raise {raise_zeta} or testbed/band_hz[0], or "
                "lower n_train/n_tail")
+
+
+#: The calm must last at least this many periods of the slowest band frequency (band_hz[0]) to
+#: show a free decay: over less, the slowest bones do not complete one oscillation.
+MIN_CALM_PERIODS = 1.0
+
+
+def damping_range_valid(cfg: dict) -> Iterator[Problem]:
+    """testbed/damping/zeta_range is (low, high) with 0 < low < high <= 1 (checked whatever the
+    variant: it is a typo either way; a constant zeta is the faithful variant's testbed/zeta)."""
+    tb = cfg["testbed"]
+    if "damping" not in tb:
+        return
+    lo, hi = (float(z) for z in tb["damping"]["zeta_range"])
+    if not (0 < lo <= 1 and 0 < hi <= 1):
+        yield (("testbed", "damping", "zeta_range"),
+               f"[{lo:g}, {hi:g}] must lie in (0, 1] (damping ratios of under-damped bones); "
+               "choose e.g. [0.03, 0.2]")
+    elif not lo < hi:
+        yield (("testbed", "damping", "zeta_range"),
+               f"[{lo:g}, {hi:g}] must be [low, high] with low < high; swap them, or for one zeta "
+               "on every bone use variant: faithful with testbed/zeta")
+
+
+def damping_transient_fits(cfg: dict) -> Iterator[Problem]:
+    """For the damping variant: the gust and the calm (testbed/damping/transient, seconds from
+    recorded frame 0) lie inside the training window [0, n_train / fps], and the calm lasts at
+    least MIN_CALM_PERIODS periods of band_hz[0], so every bone's free decay is recorded."""
+    tb = cfg["testbed"]
+    if tb.get("variant", "faithful") != "damping":
+        return
+    tr = tb["damping"]["transient"]
+    start, calm, gust = float(tr["start_s"]), float(tr["calm_s"]), float(tr["gust_s"])
+    window = int(tb["n_train"]) / int(tb["fps"])
+    key = ("testbed", "damping", "transient")
+    if start - gust < 0:
+        yield (key + ("start_s",),
+               f"{start:g} s puts the gust (gust_s = {gust:g} s before the calm) at "
+               f"{start - gust:g} s, before recorded frame 0; raise start_s to at least "
+               f"{gust:g} or shorten gust_s")
+    lo_hz = float(tb["band_hz"][0])
+    shortest = MIN_CALM_PERIODS / lo_hz if lo_hz > 0 else 0.0
+    if start - gust >= 0 and start + calm > window + 1e-9:
+        fixes = []  # only the fixes that leave a valid transient
+        if window - calm >= gust:
+            fixes.append(f"lower start_s to at most {window - calm:g}")
+        if window - start >= shortest:
+            fixes.append(f"lower calm_s to at most {window - start:g}")
+        n_min = math.ceil((start + calm) * int(tb["fps"]) - 1e-9)
+        fixes.append(f"raise testbed/n_train to at least {n_min}")
+        yield (key + ("calm_s",),
+               f"the calm [{start:g}, {start + calm:g}] s ends after the training window "
+               f"(n_train / fps = {window:g} s), so the free decay is not all recorded; "
+               + ", or ".join(fixes))
+    if calm < shortest:
+        yield (key + ("calm_s",),
+               f"{calm:g} s of calm is shorter than one period of the slowest band frequency "
+               f"(1 / band_hz[0] = {shortest:.2f} s), too short to show the slow bones decay; "
+               f"raise calm_s to at least {shortest:.2f}"
+               + (f" (and testbed/n_train to fit it: the window is {window:g} s)"
+                  if shortest + gust > window else ""))
 
 
 def warmup_below_iterations(cfg: dict) -> Iterator[Problem]:
@@ -245,6 +314,8 @@ CHECKS: list[Check] = [
     conditions_have_unseen_wind,
     band_ordered,
     lead_in_fits_wind_period,
+    damping_range_valid,
+    damping_transient_fits,
     warmup_below_iterations,
     holdout_leaves_training_frames,
     freeze_inside_deformation_phase,

@@ -7,6 +7,9 @@ stored wind and theta have L lead-in columns first, so column L + j is recorded 
 The ground truth starts at the periodic steady state of the (60 s periodic) wind, i.e. it is the
 response to an infinitely long past; the L = 1.5 tau_max lead-in columns let a model that
 integrates from rest at column 0 reach that steady state before the recorded window opens.
+The damping variant (``physgs.testbed.variant``) keeps that start state and records a gust
+dropping to calm inside the training window; its lead-in follows the slowest decay rate,
+min_b zeta_b omega_b.
 
 Gaussian order: the observed Gaussians (``canonical_xyz``) are the mesh vertices in a seeded random
 order, so their index carries no bone label (mesh order groups vertices by bone). The permutation
@@ -27,7 +30,7 @@ import numpy as np
 from tqdm import tqdm
 
 from physgs.camera import Camera
-from physgs.testbed import kinematics, physics, scene, weberpenn, wind as windmod
+from physgs.testbed import kinematics, physics, scene, variant, weberpenn, wind as windmod
 from physgs.testbed.mesh import TreeMesh, build_mesh
 
 FORMAT_VERSION = 2  # 2: Gaussians in a seeded random order (gaussian_vertex), fill_height framing
@@ -130,7 +133,9 @@ class TreeSim:
 def simulate_tree(tb: dict, preset: dict, *, seed: int, tree: str) -> TreeSim:
     """Geometry, physics and wind for one tree (everything but the frames).
 
-    tb: the resolved ``testbed`` config section; preset: ``presets.<tree>``.
+    tb: the resolved ``testbed`` config section; preset: ``presets.<tree>``. ``tb["variant"]``
+    (``physgs.testbed.variant``; default faithful) chooses a constant zeta and the unmodified
+    wind, or per-bone zeta and a gust dropping to calm inside the training window.
     """
     skel = weberpenn.generate(preset, seed=seed, name=tree)
     leaves = preset.get("leaves") or {}
@@ -139,9 +144,11 @@ def simulate_tree(tb: dict, preset: dict, *, seed: int, tree: str) -> TreeSim:
                       leaf_scale=float(leaves.get("scale", 0.1)), seed_seq=_seed(seed, tree, "mesh"))
     omega, c, clamped = physics.calibrate_omega(skel.radius, skel.length, tb["band_hz"])
     B = skel.n_bones
-    zeta = np.full(B, float(tb["zeta"]))
+    # per-bone zeta (damping variant) from its own seeded stream: it changes nothing else
+    zeta = variant.bone_zeta(tb, B, _seed(seed, tree, "zeta"))
     fps, F = int(tb["fps"]), int(tb["n_train"]) + int(tb["n_tail"])
-    L = physics.lead_in_frames(omega.min(), float(tb["zeta"]), float(tb["lead_in_tau"]), fps)
+    # the slowest decay rate zeta_b omega_b sets the lead-in (omega_min for a constant zeta)
+    L = variant.lead_in_frames(omega, zeta, float(tb["lead_in_tau"]), fps)
 
     w = tb["wind"]
     wf = windmod.make_wind(v0=w["v0"], turbulence_intensity=w["turbulence_intensity"],
@@ -158,6 +165,15 @@ def simulate_tree(tb: dict, preset: dict, *, seed: int, tree: str) -> TreeSim:
     if v_period.min() <= 0:
         raise windmod.WindError(f"wind speed reaches {v.min():.2f} m/s <= 0; lower "
                                 "testbed.wind.turbulence_intensity in config/trees.yaml")
+    transient = variant.transient_of(tb)
+    if transient is not None:
+        # the recorded wind (what models observe) carries the gust and the calm; the start
+        # state below stays the periodic steady state of the unmodified wind, which is the
+        # exact state at the record start because the transient begins inside the window
+        if transient.start_s - transient.gust_s < 0:
+            raise windmod.WindError("testbed.damping.transient starts before recorded frame 0; "
+                                    "raise start_s to at least gust_s in config/trees.yaml")
+        v = variant.shape_wind(v, t[:L + F], float(w["v0"]), transient)
     cond = np.asarray(tb["conditions"], dtype=np.float64)
     wind32 = (cond[:, None] * v[None, :]).astype(np.float32)  # [C, L+F]
     vbar = cond * float(w["v0"])
