@@ -78,7 +78,7 @@ def lead_in_fits_wind_period(cfg: dict) -> Iterator[Problem]:
                f"{fps} fps does not divide the {wind.PERIOD_S:g} s wind period into whole frames; "
                "use an integer number of frames per second that does")
         return
-    damping = tb.get("variant", "faithful") == "damping"
+    damping = _damping_built(cfg)
     # the damping variant's slowest decay is at the lowest zeta it can draw
     zeta = min(float(z) for z in tb["damping"]["zeta_range"]) if damping else float(tb["zeta"])
     if not zeta > 0:
@@ -98,6 +98,28 @@ def lead_in_fits_wind_period(cfg: dict) -> Iterator[Problem]:
                f"wind period; lower testbed/lead_in_tau to at most "
                f"{room / (tau_max * fps):.3g}, or raise {raise_zeta} or testbed/band_hz[0], or "
                "lower n_train/n_tail")
+
+
+def _damping_built(cfg: dict) -> bool:
+    """Whether any damping-variant testbed is built: every tree (testbed/variant: damping) or
+    the damping benchmark's <tree>_damping copies (damping_benchmark/trees)."""
+    return (cfg["testbed"].get("variant", "faithful") == "damping"
+            or bool(cfg.get("damping_benchmark", {}).get("trees")))
+
+
+def damping_benchmark_is_runnable(cfg: dict) -> Iterator[Problem]:
+    """The damping benchmark's trees are built faithfully too (tab_damping compares the two) and
+    its configurations are ours' configurations."""
+    db = cfg.get("damping_benchmark") or {}
+    for t in db.get("trees", []):
+        if t not in cfg["trees"]:
+            yield (("damping_benchmark", "trees"),
+                   f"'{t}' is not in trees {cfg['trees']}: tab_damping compares each damping "
+                   "testbed with the same tree's faithful one; add it to trees or drop it here")
+    for c in db.get("configs", []):
+        if c not in cfg["models"]["configs"]:
+            yield (("damping_benchmark", "configs"),
+                   f"'{c}' is not one of models/configs {sorted(cfg['models']['configs'])}")
 
 
 #: The calm must last at least this many periods of the slowest band frequency (band_hz[0]) to
@@ -127,7 +149,7 @@ def damping_transient_fits(cfg: dict) -> Iterator[Problem]:
     recorded frame 0) lie inside the training window [0, n_train / fps], and the calm lasts at
     least MIN_CALM_PERIODS periods of band_hz[0], so every bone's free decay is recorded."""
     tb = cfg["testbed"]
-    if tb.get("variant", "faithful") != "damping":
+    if not _damping_built(cfg):
         return
     tr = tb["damping"]["transient"]
     start, calm, gust = float(tr["start_s"]), float(tr["calm_s"]), float(tr["gust_s"])
@@ -324,6 +346,7 @@ CHECKS: list[Check] = [
     k_within_gaussians,
     sweep_tree_is_listed,
     fit_curve_is_runnable,
+    damping_benchmark_is_runnable,
     presets_reach_bone_counts,
 ]
 

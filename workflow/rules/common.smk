@@ -7,6 +7,7 @@ import physgs.experiments.kselect as _kselect
 import physgs.experiments.sweep as _sweep
 import physgs.models.registry as _models
 import physgs.provenance as _provenance
+import physgs.testbed.variant as _variant
 from physgs.experiments.recipe import canonical as _canonical
 from physgs.experiments.recipe import job_spec as _job_spec
 from physgs.recovery.run import null_settings as _null_settings
@@ -17,6 +18,10 @@ from physgs.report import build as _build
 os.environ.setdefault("OMP_WAIT_POLICY", "PASSIVE")
 
 TREES = list(CFG["trees"])
+# the damping benchmark: each listed tree is also built as <tree>_damping (the damping variant)
+DAMPING = CFG["damping_benchmark"]
+DAMPING_TREES = [_variant.damping_id(t) for t in DAMPING["trees"]]
+TESTBEDS = [*TREES, *DAMPING_TREES]  # every testbed id a rule may see as {tree}
 SEEDS = [int(s) for s in CFG["seeds"]]  # training seeds; the testbed's is CFG["seed"]
 TESTBED_SEEDS = bool(CFG["testbed_seeds"])
 CONFIGS = dict(CFG["models"]["configs"])  # name -> {conditions, K}
@@ -56,7 +61,7 @@ FC_PROFILE_MODELS = ["static", *FC["models"], *_models.REFERENCE_NAMES]
 
 
 wildcard_constraints:
-    tree="|".join(TREES),
+    tree="|".join(TESTBEDS),
     model="|".join([*_models.MODEL_NAMES, *_models.REFERENCE_NAMES]),
     config="|".join([*CONFIGS, _models.AUTO_CONFIG]),
     K=r"\d+",
@@ -111,6 +116,8 @@ def need_paths(needs):
 
 def report_inputs(wildcards):
     """need key -> path of every file table or figure ``name`` reads."""
+    if wildcards.name == "tab_damping":
+        return need_paths(_build.damping_needs(DAMPING["trees"], DAMPING["configs"], SEEDS))
     return need_paths(_build.needs(wildcards.name, TREES, CONFIGS, SEEDS))
 
 
@@ -170,7 +177,23 @@ def fit_curve_inputs(wildcards):
 
 
 def testbed_params(wildcards):
-    t = wildcards.tree  # only this tree's vertex count: another tree's edit leaves it alone
+    """The settings testbed {tree} is built from: <tree>_damping is <tree> with the damping
+    variant; the faithful variant's params omit the damping block (it changes nothing there)."""
+    t, variant = _variant.parse_id(wildcards.tree)
+    # only this tree's vertex count: another tree's edit leaves it alone
     tb = {**CFG["testbed"], "vertices": {t: CFG["testbed"]["vertices"][t]}}
+    if variant == _variant.DAMPING:
+        tb["variant"] = _variant.DAMPING
     seed = int(getattr(wildcards, "seed", CFG["seed"]))  # a seeded instance (testbed_seeds)
-    return _canonical({"testbed": tb, "preset": CFG["presets"][t], "seed": seed})
+    return _canonical({"testbed": _variant.effective_settings(tb), "preset": CFG["presets"][t],
+                       "seed": seed, "tree": t})
+
+
+def recovery_damping_params(wildcards):
+    """Per-part damping scores and their null for the damping benchmark's testbeds (both
+    variants); None elsewhere."""
+    t, _ = _variant.parse_id(wildcards.tree)
+    if t not in DAMPING["trees"] or wildcards.config not in DAMPING["configs"]:
+        return None
+    return {"zeta_range": [float(z) for z in CFG["testbed"]["damping"]["zeta_range"]],
+            "seed": int(wildcards.seed)}

@@ -11,6 +11,8 @@ rule recovery:
         stats=stats_input,
     output:
         record=RECOVERY,
+    params:
+        damping=recovery_damping_params,
     conda:
         "../envs/physgs.yaml"
     log:

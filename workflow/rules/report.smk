@@ -47,7 +47,8 @@ rule figure:
 
 rule report:
     input:
-        expand(TABLE, name=[n for n in _build.TABLES if n != "tab_kselect"], ext=("tex", "csv")),
+        expand(TABLE, ext=("tex", "csv"), name=[n for n in _build.TABLES if n != "tab_kselect"
+                                                and (n != "tab_damping" or DAMPING["trees"])]),
         expand(FIGURE, name=_build.FIGURES, ext=("pdf", "png")),
 
 

@@ -90,8 +90,8 @@ rule testbed_figure:
 
 rule testbed:
     input:
-        expand(OBSERVED, tree=TREES),
-        expand(TRUTH, tree=TREES),
-        expand(STATS, tree=TREES),
-        expand("results/figures/testbed_{tree}.png", tree=TREES),
+        expand(OBSERVED, tree=TESTBEDS),
+        expand(TRUTH, tree=TESTBEDS),
+        expand(STATS, tree=TESTBEDS),
+        expand("results/figures/testbed_{tree}.png", tree=TESTBEDS),
         expand(TABLE, name="tab_testbed", ext=("tex", "csv")),

@@ -9,7 +9,8 @@ from physgs.testbed.stats import load_stats
 sm = snakemake  # noqa: F821 (injected by Snakemake)
 with job(sm) as log:
     rec = recover_model(load_checkpoint(sm.input.ckpt), load_observed(sm.input.observed),
-                        load_truth(sm.input.truth), load_stats(sm.input.stats)["visible"])
+                        load_truth(sm.input.truth), load_stats(sm.input.stats)["visible"],
+                        damping=sm.params.damping)
     save_recovery(sm.output.record, rec)
     print(f"trusted {rec.match.n_trusted}/{rec.match.n_parts}, median rel err "
           f"{rec.match.median_rel_err:.4f}, log-log R2 {rec.match.loglog_r2:.3f}, "

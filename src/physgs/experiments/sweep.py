@@ -21,6 +21,7 @@ import pandas as pd
 from physgs.evaluate.run import training_camera_scores
 from physgs.experiments.recipe import canonical, fit, job_spec
 from physgs.models.registry import BASE_CONFIG
+from physgs.testbed.variant import effective_settings
 
 KNOBS = ("resolution", "iterations", "substeps", "K", "vertices")
 TESTBED_KNOBS = ("resolution", "vertices")
@@ -99,8 +100,8 @@ def point_settings(cfg: dict, name: str, seed: int | None = None,
            "job": job_spec(pcfg, "ours", BASE_CONFIG, seed=seed)}
     if knob in TESTBED_KNOBS:
         tb_seed = int(seed) if testbed_seeds and seed is not None else int(pcfg["seed"])
-        out["testbed"] = {"testbed": pcfg["testbed"], "preset": pcfg["presets"][tree],
-                          "seed": tb_seed}
+        out["testbed"] = {"testbed": effective_settings(pcfg["testbed"]),
+                          "preset": pcfg["presets"][tree], "seed": tb_seed}
     return canonical(out)
 
 

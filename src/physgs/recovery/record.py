@@ -9,6 +9,7 @@ import numpy as np
 
 from physgs.atomic import write_json
 from physgs.recovery.damping import DampingResult, damping_summary
+from physgs.recovery.damping_scores import DampingNull, DampingScores
 from physgs.recovery.matcher import MatchResult, match_parts, restricted, training_window
 from physgs.recovery.null import NullResult
 
@@ -28,6 +29,10 @@ class RecoveryRecord:
     n_frozen: int = 0
     n_trusted_visible: int = -1
     median_rel_err_visible: float = float("nan")
+    #: per-part damping against the per-bone truth and its untrained null (tab_damping); None
+    #: when the recovery was not asked for them
+    damping_scores: DampingScores | None = None
+    damping_null: DampingNull | None = None
 
     def with_visibility(self, bone_visible: np.ndarray) -> "RecoveryRecord":
         """This record with the scores restricted to visible bones (``bone_visible`` [B] bool)."""
@@ -59,7 +64,11 @@ def save_recovery(path, rec: RecoveryRecord) -> None:
     write_json(path, {"match": rec.match.to_dict(), "damping": rec.damping.to_dict(),
                       "n_frozen": int(rec.n_frozen),
                       "n_trusted_visible": int(rec.n_trusted_visible),
-                      "median_rel_err_visible": rec.median_rel_err_visible})
+                      "median_rel_err_visible": rec.median_rel_err_visible,
+                      "damping_scores": (rec.damping_scores.to_dict()
+                                         if rec.damping_scores is not None else None),
+                      "damping_null": (rec.damping_null.to_dict()
+                                       if rec.damping_null is not None else None)})
 
 
 def load_recovery(path) -> RecoveryRecord:
@@ -67,7 +76,11 @@ def load_recovery(path) -> RecoveryRecord:
     return RecoveryRecord(MatchResult.from_dict(d["match"]), DampingResult.from_dict(d["damping"]),
                           int(d.get("n_frozen", 0)),  # records from before freezing: none frozen
                           int(d.get("n_trusted_visible", -1)),
-                          float(d.get("median_rel_err_visible", float("nan"))))
+                          float(d.get("median_rel_err_visible", float("nan"))),
+                          DampingScores.from_dict(d["damping_scores"])
+                          if d.get("damping_scores") else None,
+                          DampingNull.from_dict(d["damping_null"])
+                          if d.get("damping_null") else None)
 
 
 def save_null(path, res: NullResult) -> None:

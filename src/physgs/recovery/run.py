@@ -12,11 +12,15 @@ from physgs.recovery.null import NullResult
 from physgs.recovery.record import RecoveryRecord, run_null, score_recovery
 
 
-def recover_model(model, observed, truth, bone_visible=None) -> RecoveryRecord:
+def recover_model(model, observed, truth, bone_visible=None, damping: dict | None = None
+                  ) -> RecoveryRecord:
     """Match the trained parts to bones (training wind, training window) and summarise damping.
 
     model: a trained ``ours`` model (``part_theta``, ``omega`` rad/s, ``zeta``); bone_visible
     [B] bool (``physgs.testbed.stats``): also score the parts matched to visible bones.
+    damping: {zeta_range, seed} to also score each trusted part's zeta against its bone's true
+    zeta and against the untrained null drawn log-uniformly from zeta_range with that seed
+    (``physgs.recovery.damping_scores``; tab_damping).
     """
     if not hasattr(model, "part_theta"):
         raise TypeError(f"recovery needs the oscillator prior ('ours'); got {type(model).__name__}")
@@ -29,6 +33,15 @@ def recover_model(model, observed, truth, bone_visible=None) -> RecoveryRecord:
                          int(observed.n_train))
     if bone_visible is not None:
         rec = rec.with_visibility(bone_visible)
+    if damping is not None:
+        from physgs.recovery.damping_scores import damping_null, score_match
+
+        zb, ob = np.asarray(truth.zeta, np.float64), np.asarray(truth.omega, np.float64)
+        m = rec.match
+        rec = dataclasses.replace(
+            rec, damping_scores=score_match(m, zeta, zb, ob),
+            damping_null=damping_null(m.bone, m.trusted, m.omega_hat, zb, ob,
+                                      damping["zeta_range"], seed=int(damping["seed"])))
     frozen = getattr(model, "frozen", None)
     if frozen is None or not bool(frozen.any()):
         return rec

@@ -25,7 +25,7 @@ from physgs.report import figures, kselect, tables
 from physgs.testbed.stats import load_stats
 
 TABLES = ("tab_testbed", "tab_psnr", "tab_null", "tab_transfer", "tab_margin", "tab_kselect",
-          "tab_fit")
+          "tab_fit", "tab_damping")
 FIGURES = ("fig_temporal", "fig_teaser", "fig_results", "fig_damping")
 #: The fields of each need tuple after its kind (what a workflow path template is formatted with).
 NEED_FIELDS = {"eval": ("tree", "model", "config", "seed"),
@@ -54,6 +54,16 @@ KSELECT_ROWS = tuple(c for c, _ in kselect.ROWS)  # fixed K (single), chosen K (
 def key(need: tuple) -> str:
     """The name of a need in the inputs mapping: its parts joined by '/'."""
     return "/".join(str(p) for p in need)
+
+
+def damping_needs(trees: Sequence[str], configs: Sequence[str],
+                  seeds: Sequence[int]) -> list[tuple]:
+    """What tab_damping reads: ours' recovery on each benchmark tree's faithful and damping
+    testbeds (``physgs.testbed.variant.damping_id``), per configuration and seed."""
+    from physgs.testbed.variant import damping_id
+
+    return [("recovery", tb, c, int(s)) for t in trees for tb in (t, damping_id(t))
+            for c in configs for s in seeds]
 
 
 def claims_needs(trees: Sequence[str], configs: Mapping[str, dict],
@@ -99,6 +109,8 @@ def needs(name: str, trees: Sequence[str], configs: Mapping[str, dict],
     """
     if name not in (*TABLES, *FIGURES):
         raise ValueError(f"unknown output '{name}'; choose one of {TABLES + FIGURES}")
+    if name == "tab_damping":
+        raise ValueError("tab_damping reads the damping benchmark's testbeds: use damping_needs")
     if not seeds:
         raise ValueError("needs: no training seeds given")
     seeds = [int(seeds[0])] if name in ONE_SEED_FIGURES else [int(s) for s in seeds]
@@ -128,8 +140,11 @@ def needs(name: str, trees: Sequence[str], configs: Mapping[str, dict],
 
 def settings_for(name: str, cfg: dict) -> dict:
     """The settings output ``name`` reads from the resolved config (and nothing more)."""
-    trees = list(cfg["trees"])
+    trees = list(cfg["damping_benchmark"]["trees"] if name == "tab_damping" else cfg["trees"])
     out = {"trees": trees, "bones": {t: int(cfg["presets"][t]["bones"]) for t in trees}}
+    if name == "tab_damping":
+        out["configs"] = {c: config_label(c, cfg["models"]["configs"][c])
+                          for c in cfg["damping_benchmark"]["configs"]}
     if name not in ("tab_testbed", *ONE_SEED_FIGURES):
         out["seeds"] = [int(x) for x in cfg["seeds"]]
     elif name in ONE_SEED_FIGURES:
@@ -219,6 +234,14 @@ def make_table(name: str, inputs: Mapping[str, str], settings: dict, tex_path, c
                     for t in trees for c in configs} for s in seeds}
         labels = {c: config_label(c, v) for c, v in configs.items()}
         table = tables.tab_null(rec, null, trees, bones, labels, digits=d)
+    elif name == "tab_damping":
+        from physgs.report.damping import tab_damping
+        from physgs.testbed.variant import DAMPING, FAITHFUL, damping_id
+
+        ids = {FAITHFUL: lambda t: t, DAMPING: damping_id}
+        rows = {s: {(t, v, c): load_recovery(path("recovery", ids[v](t), c, s))
+                    for t in trees for v in ids for c in settings["configs"]} for s in seeds}
+        table = tab_damping(rows, trees, bones, settings["configs"], digits=d)
     elif name == "tab_kselect":
         rows = {}
         for s in seeds:

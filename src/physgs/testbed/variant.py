@@ -23,6 +23,23 @@ FAITHFUL, DAMPING = "faithful", "damping"
 VARIANTS = (FAITHFUL, DAMPING)
 
 
+#: a damping benchmark's testbed id: the tree's name and this suffix (``damping_id``)
+DAMPING_SUFFIX = "_damping"
+
+
+def damping_id(tree: str) -> str:
+    """The testbed id of ``tree``'s damping variant ('medium' -> 'medium_damping')."""
+    return tree + DAMPING_SUFFIX
+
+
+def parse_id(testbed: str) -> tuple[str, str]:
+    """(tree, variant) of a testbed id: 'medium_damping' -> ('medium', 'damping'), 'medium' ->
+    ('medium', 'faithful'). The damping copy shares the tree's geometry, frequencies and wind."""
+    if testbed.endswith(DAMPING_SUFFIX):
+        return testbed[: -len(DAMPING_SUFFIX)], DAMPING
+    return testbed, FAITHFUL
+
+
 def variant_of(tb: dict) -> str:
     """The variant a ``testbed`` config section asks for (``faithful`` when it names none)."""
     v = tb.get("variant", FAITHFUL)
