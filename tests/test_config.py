@@ -271,6 +271,7 @@ def test_kselect_warmup_message_names_its_own_key_and_the_profile_that_set_it():
 def test_lead_in_check_uses_the_testbed_formula():
     from physgs.testbed import physics, wind
     cfg = pconfig.load(CONFIG, "default")
+    cfg["damping_benchmark"]["trees"] = []  # the faithful testbed alone: testbed/zeta decides
     tb = cfg["testbed"]
     F = tb["n_train"] + tb["n_tail"]
     P = round(wind.PERIOD_S * tb["fps"])
@@ -351,7 +352,19 @@ def test_the_shipped_damping_variant_is_accepted_and_faithful_is_the_default():
     raw = _base()
     raw["testbed"].pop("variant")
     raw["testbed"].pop("damping")
+    raw["damping_benchmark"]["trees"] = []
     assert "variant" not in pconfig.load_workflow_config(raw, "default")["testbed"]
+    # ... but the damping benchmark needs the damping block, and says so
+    raw["damping_benchmark"]["trees"] = ["medium"]
+    with pytest.raises(pconfig.ConfigError, match="damping_benchmark/trees.*testbed/damping"):
+        pconfig.load_workflow_config(raw, "default")
+
+
+def test_damping_benchmark_trees_and_configs_must_exist():
+    msg = _refused(lambda c: c["damping_benchmark"].update(trees=["medium"], configs=["joint64"]))
+    assert "damping_benchmark/configs" in msg and "joint64" in msg
+    msg = _refused(lambda c: c.update(trees=["sparse"]))
+    assert "damping_benchmark/trees" in msg and "'medium' is not in trees" in msg
 
 
 @pytest.mark.parametrize("edit, key, fix", [

@@ -38,7 +38,8 @@ def test_only_the_reference_rule_reads_the_truth(plan):
         assert "truth.npz" in inputs and "truth_motion_single.pt" in b
     text = (ROOT / "workflow" / "rules" / "train.smk").read_text()
     rules = re.split(r"\nrule ", text)
-    readers = [b.split(":", 1)[0] for b in rules[1:] if "TRUTH" in b.split("output:", 1)[0]]
+    readers = [b.split(":", 1)[0] for b in rules[1:]
+               if re.search(r"TRUTH|truth_input", b.split("output:", 1)[0])]
     assert readers == ["train_reference"], readers
 
 

@@ -78,7 +78,7 @@ def lead_in_fits_wind_period(cfg: dict) -> Iterator[Problem]:
                f"{fps} fps does not divide the {wind.PERIOD_S:g} s wind period into whole frames; "
                "use an integer number of frames per second that does")
         return
-    damping = _damping_built(cfg)
+    damping = _damping_built(cfg) and "damping" in tb
     # the damping variant's slowest decay is at the lowest zeta it can draw
     zeta = min(float(z) for z in tb["damping"]["zeta_range"]) if damping else float(tb["zeta"])
     if not zeta > 0:
@@ -111,6 +111,10 @@ def damping_benchmark_is_runnable(cfg: dict) -> Iterator[Problem]:
     """The damping benchmark's trees are built faithfully too (tab_damping compares the two) and
     its configurations are ours' configurations."""
     db = cfg.get("damping_benchmark") or {}
+    if db.get("trees") and "damping" not in cfg["testbed"]:
+        yield (("damping_benchmark", "trees"),
+               f"{db['trees']} are built as damping testbeds, which read testbed/damping "
+               "(zeta_range, transient); add that block or set damping_benchmark/trees: []")
     for t in db.get("trees", []):
         if t not in cfg["trees"]:
             yield (("damping_benchmark", "trees"),
@@ -149,8 +153,8 @@ def damping_transient_fits(cfg: dict) -> Iterator[Problem]:
     recorded frame 0) lie inside the training window [0, n_train / fps], and the calm lasts at
     least MIN_CALM_PERIODS periods of band_hz[0], so every bone's free decay is recorded."""
     tb = cfg["testbed"]
-    if not _damping_built(cfg):
-        return
+    if not _damping_built(cfg) or "damping" not in tb:
+        return  # damping_benchmark_is_runnable reports a missing block
     tr = tb["damping"]["transient"]
     start, calm, gust = float(tr["start_s"]), float(tr["calm_s"]), float(tr["gust_s"])
     window = int(tb["n_train"]) / int(tb["fps"])
