@@ -9,10 +9,10 @@ import pytest
 ROOT = Path(__file__).resolve().parents[1]
 
 
-def _dry_run(*targets):
+def _dry_run(*targets, profile="quick"):
     return subprocess.run(
-        [sys.executable, "-m", "snakemake", "-n", "--cores", "2", "--config", "profile=quick",
-         "--", *targets], cwd=ROOT, capture_output=True, text=True, timeout=120)
+        [sys.executable, "-m", "snakemake", "-n", "--cores", "2", "--config", f"profile={profile}",
+         "--", *targets], cwd=ROOT, capture_output=True, text=True, timeout=300)
 
 
 @pytest.fixture(scope="module")
@@ -54,3 +54,21 @@ def test_train_jobs_read_only_the_observed_dataset(plan):
     # threads are declared (a 1-thread job prints no threads line in the plan)
     assert re.search(r"rule train:(?:\n    .*)*\n    threads: \d", (ROOT / "workflow" / "rules" /
                                                                 "train.smk").read_text())
+
+
+def test_tab_damping_plans_ours_on_both_testbeds_of_each_tree():
+    """tab_damping (default profile: the quick one builds no damping testbed) trains ours alone,
+    in the benchmark's configurations, per seed, on each tree and its <tree>_damping copy, whose
+    dataset is built by the same testbed rule with the damping variant."""
+    from physgs import config as pconfig
+
+    cfg = pconfig.load(ROOT / "config" / "trees.yaml", "default")
+    db = cfg["damping_benchmark"]
+    r = _dry_run("results/tables/tab_damping.tex", profile="default")
+    assert r.returncode == 0, r.stderr[-2000:] + r.stdout[-2000:]
+    trained = set(re.findall(r"results/models/(\w+)/seed(\d+)/(\w+?)_(\w+)\.pt", r.stdout))
+    want = {(tb, str(s), "ours", c) for t in db["trees"] for tb in (t, f"{t}_damping")
+            for s in cfg["seeds"] for c in db["configs"]}
+    assert trained == want
+    built = [b for b in _blocks(r.stdout, "testbed_dataset") if "_damping/observed" in b]
+    assert len(built) == len(db["trees"])

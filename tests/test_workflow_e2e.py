@@ -21,6 +21,8 @@ from workflow_helpers import ROOT, snakemake, workflow_copy
 pytestmark = pytest.mark.slow
 QUICK = pconfig.resolve(yaml.safe_load((ROOT / "config" / "trees.yaml").read_text()), "quick")
 TREES = ["sparse"]
+# the quick profile builds no damping testbed (its 2.5 s window cannot hold a calm): no tab_damping
+BUILT = [n for n in TABLES if n != "tab_damping" or QUICK["damping_benchmark"]["trees"]]
 MODELS = ["Static pose", "Deformation MLP", "Deformation MLP + wind", "Deformable-3DGS",
           "Deformable-3DGS + wind", "Ours"]
 
@@ -41,7 +43,8 @@ def _tex_numbers(run, name) -> list[float]:
 
 
 def test_every_output_exists(run):
-    for name in TABLES:
+    assert "tab_damping" not in BUILT  # see BUILT; tests/test_train_workflow.py plans it
+    for name in BUILT:
         for ext in ("tex", "csv"):
             assert (run / "results" / "tables" / f"{name}.{ext}").stat().st_size > 0
     for name in (*FIGURES, "fig_speed_accuracy"):
@@ -107,7 +110,7 @@ def test_tab_null_rows_columns_and_finite_where_defined(run):
     assert (df["nearest_bone_gap_pct"] >= 0).all()
 
 
-@pytest.mark.parametrize("name", TABLES)
+@pytest.mark.parametrize("name", BUILT)
 def test_tex_agrees_with_csv(run, name):
     df = _csv(run, name)
     nums = df.select_dtypes("number").to_numpy(float).ravel()
@@ -148,12 +151,12 @@ def test_snakemake_report_collects_tables_and_figures(run, tmp_path):
     snakemake(run, "--report", str(html), "--config", "profile=quick", 'trees=["sparse"]')
     text = html.read_text(errors="replace")
     for name in ("1. Testbed", "2. Results", "3. Tables", "4. Speed-accuracy trade",
-                 "testbed_sparse", *TABLES, *FIGURES):
+                 "testbed_sparse", *BUILT, *FIGURES):
         assert name in text, f"the report lacks {name}"
 
 
 def test_every_table_csv_carries_the_provenance_stamp(run):
-    for name in TABLES:
+    for name in BUILT:
         df = pd.read_csv(run / "results" / "tables" / f"{name}.csv", dtype={"config_hash": str})
         assert set(df["profile"]) == {"quick"}, name
         assert df["config_hash"].str.fullmatch(r"[0-9a-f]{12}").all(), name
