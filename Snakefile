@@ -14,7 +14,7 @@ configfile: "config/trees.yaml"
 # profile, validates the result and runs the cross-key checks: a bad config stops here
 # (a command-line --config seeds=[...] beats the profile's seeds: physgs.config)
 CFG = physgs.config.load_workflow_config(
-    config, command_line=workflow.config_settings.overwrite_config)
+    config, command_line=dict(workflow.config_settings.config))
 TREES = CFG["trees"]
 
 

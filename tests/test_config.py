@@ -116,6 +116,11 @@ def test_command_line_seeds_beat_the_profiles():
     bad = pconfig.load_workflow_config  # a bad command-line value is validated like the file's
     with pytest.raises(pconfig.ConfigError, match="seeds"):
         bad(raw, "quick", command_line={"seeds": [2, 2]})
+    # Snakemake hands `--config seeds=[0,1]` over as strings (YAML BaseLoader)
+    assert bad({**raw, "seeds": ["0", "1"]}, "quick",
+               command_line={"seeds": ["0", "1"]})["seeds"] == [0, 1]
+    with pytest.raises(pconfig.ConfigError, match="seeds/0"):
+        bad({**raw, "seeds": ["1.5"]}, "quick", command_line={"seeds": ["1.5"]})
 
 
 def test_schema_violation_in_a_profile_body_names_the_profile_key():

@@ -259,6 +259,20 @@ def resolve(cfg: dict, profile: str | None = None) -> dict:
     return out
 
 
+_INT = re.compile(r"[+-]?\d+")
+
+
+def _from_command_line(value):
+    """A ``--config`` value as the YAML file would hold it: Snakemake parses a list value with
+    YAML's BaseLoader, so ``seeds=[0,1]`` arrives as ['0', '1']; integer strings become ints
+    (anything else, '1.5' or 'a', stays a string for the schema to refuse)."""
+    if isinstance(value, str) and _INT.fullmatch(value.strip()):
+        return int(value)
+    if isinstance(value, (list, tuple)):
+        return [_from_command_line(v) for v in value]
+    return value
+
+
 def load_workflow_config(config: dict, profile: str | None = None, *,
                          source: str = DEFAULT_SOURCE, command_line: dict | None = None) -> dict:
     """The one way in: validate a raw config, resolve its profile, validate and check the result.
@@ -266,17 +280,20 @@ def load_workflow_config(config: dict, profile: str | None = None, *,
     config: the raw config (what Snakemake's ``config`` holds: ``config/trees.yaml`` plus any
     ``--config KEY=VALUE``, which arrive as top-level keys); profile: overrides
     ``config['profile']``; command_line: the command line's own overrides (Snakemake's
-    ``workflow.config_settings.overwrite_config``): their top-level values that are not sections
-    (``seeds``, ``seed``, ...) beat the profile's, so ``--config seeds=[0,1,2]`` means those
-    seeds under any profile. Returns the resolved config; raises ConfigError before anything runs.
+    ``workflow.config_settings.config``, the ``--config KEY=VALUE`` pairs only): their top-level
+    values that are not sections (``seeds``, ``seed``, ...) beat the profile's, so ``--config
+    seeds=[0,1,2]`` means those seeds under any profile. Returns the resolved config; raises
+    ConfigError before anything runs.
     """
+    cl = {k: _from_command_line(v) for k, v in dict(command_line or {}).items()
+          if k != "profile" and not isinstance(v, dict)}
     if profile is not None and isinstance(config, dict):
         config = {**config, "profile": profile}
+    if cl and isinstance(config, dict):
+        config = {**config, **cl}
     validate(config, source=source)
     resolved = resolve(config, config.get("profile"))
-    for k, v in (command_line or {}).items():
-        if k != "profile" and not isinstance(v, dict):
-            resolved[k] = copy.deepcopy(v)
+    resolved.update(copy.deepcopy(cl))
     validate(resolved, raw=config, source=source)
     check(resolved, raw=config, source=source)
     return resolved
