@@ -45,7 +45,7 @@ def test_collect_repeats_the_base_under_every_knob():
     base = {"point": "base", "knob": "base", "wall_s": 10.0, "psnr_time": 25.0, "rel_err": 0.03,
             "train_s": 9.0, "testbed_s": 0.0, "eval_s": 1.0, "trusted": 5, "parts": 8, "frozen": 1,
             "tree": "sparse", "resolution": 128, "iterations": 100, "substeps": 2, "K": 8,
-            "vertices": 2000}
+            "vertices": 2000, "seed": 0}
     k4 = dict(base, point="K-4", knob="K", K=4, wall_s=6.0)
     df = sa.collect([k4, base])
     assert len(df) == len(sa.KNOBS) + 1
@@ -61,6 +61,8 @@ def test_collect_repeats_the_base_under_every_knob():
     assert sorted(kb["seed"]) == [0, 1] and sorted(kb["psnr_time"]) == [25.0, 26.0]
     with pytest.raises(ValueError, match="seed 1 need exactly one 'base'"):
         sa.collect([dict(base, seed=0), dict(k4, seed=1)])
+    with pytest.raises(ValueError, match="names no seed"):
+        sa.collect([{k: v for k, v in base.items() if k != "seed"}])
 
 
 def test_null_level_is_the_central_95_percent_of_every_draw():

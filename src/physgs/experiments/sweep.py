@@ -148,10 +148,12 @@ def run_point(point: dict, observed_path, truth_path, *, progress: bool = False)
 
 def collect(records: Sequence[dict]) -> pd.DataFrame:
     """One row per (seed, knob, value), the base point of each seed repeated under every knob it
-    anchors; records of one seed or several (each record names its ``seed``)."""
+    anchors; records of one seed or several (each record names its ``seed``: ``run_point``)."""
     by_seed: dict[int, list[dict]] = {}
     for r in records:
-        by_seed.setdefault(int(r.get("seed", 0)), []).append(r)
+        if "seed" not in r:
+            raise ValueError(f"sweep record {r.get('point')!r} names no seed; re-run its point")
+        by_seed.setdefault(int(r["seed"]), []).append(r)
     rows = []
     for seed in sorted(by_seed):
         recs = by_seed[seed]

@@ -18,7 +18,7 @@ import numpy as np
 import pandas as pd
 
 from physgs.report import seeds as seedstats
-from physgs.report.tables import Table, _check, _wrap, tree_label
+from physgs.report.tables import Table, _by_seed, _check, _seeds, _wrap, tree_label
 from physgs.testbed.variant import DAMPING, FAITHFUL
 
 VARIANTS = (FAITHFUL, DAMPING)
@@ -33,9 +33,7 @@ def tab_damping(per_seed: Mapping[int, Mapping[tuple[str, str, str], object]],
     variant 'faithful' or 'damping'; configs: name -> LaTeX label, in row order. One CSV row per
     seed, tree, variant and configuration; the .tex gives mean +- sd over seeds and the paired
     trained - null difference with its 95% interval."""
-    seeds = sorted(per_seed)
-    if not seeds:
-        raise ValueError("tab_damping: no seeds given")
+    seeds = _seeds(per_seed, "tab_damping")
     keys = [(t, v, c) for t in trees for v in VARIANTS for c in configs]
     rows = []
     for s in seeds:
@@ -56,7 +54,7 @@ def tab_damping(per_seed: Mapping[int, Mapping[tuple[str, str, str], object]],
                          "null_gamma_exponent": nl.median_gamma_exponent,
                          "gamma_exponent_true": sc.gamma_exponent_true})
     df = pd.DataFrame(rows)
-    V = {c: df[c].to_numpy(np.float64).reshape(len(seeds), -1) for c in COLUMNS}
+    V = {c: _by_seed(df, c, len(seeds)) for c in COLUMNS}
     fmt, pct = f".{int(digits)}f", lambda x: x if x == "--" else x + r"\%"
     lines = ["  \\begin{tabular}{lllccccccc}", "    \\toprule",
              r"    & & & & \multicolumn{3}{c}{Med.\ rel.\ err.\ of $\hat\zeta$} & "

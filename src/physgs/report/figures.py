@@ -266,9 +266,7 @@ def fig_speed_accuracy(df: pd.DataFrame, outputs: Sequence[str | Path],
     base point starred. null: ``sweep.null_level``; the untrained null's median and the central
     95% of its draws are drawn on the recovery panel, so a point inside the band reads as chance.
     """
-    n_seeds = df["seed"].nunique() if "seed" in df.columns else 1
-    if "seed" not in df.columns:
-        df = df.assign(seed=0)
+    n_seeds = df["seed"].nunique()
     m = _seed_mean(df.assign(rel_pct=100 * df["rel_err"]), ["knob", "value"],
                    ("wall_s", "psnr_time", "rel_pct"))
     fig, axes = plt.subplots(1, 2, figsize=(10, 4))
@@ -316,9 +314,8 @@ def fig_fit_curve(df: pd.DataFrame, outputs: Sequence[str | Path]) -> None:
     panels = (("iterations", "fit", "training iterations (log)", "PSNR, trained frames (dB)"),
               ("iterations", "time", "training iterations (log)", "PSNR, time split (dB)"),
               ("train_s", "fit", "training wall time (s, log)", "PSNR, trained frames (dB)"))
-    n_seeds = df["seed"].nunique() if "seed" in df.columns else 1
-    df = _seed_mean(df if "seed" in df.columns else df.assign(seed=0), ["model", "iterations"],
-                    ("fit", "time", "train_s"))
+    n_seeds = df["seed"].nunique()
+    df = _seed_mean(df, ["model", "iterations"], ("fit", "time", "train_s"))
     fig, axes = plt.subplots(1, len(panels), figsize=(13, 3.8))
     refs = {"static": ("0.55", "--"), **{r: ("k", ":") for r in REFERENCE_NAMES}}
     prof = df[df["is_profile"]].set_index("model")

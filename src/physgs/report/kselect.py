@@ -11,7 +11,7 @@ import numpy as np
 import pandas as pd
 
 from physgs.report import seeds as seedstats
-from physgs.report.tables import Table, _tree_blocks, _wrap
+from physgs.report.tables import Table, _by_seed, _first, _seeds, _tree_blocks, _wrap
 
 ROWS = (("single", "fixed $K$"), ("auto", "chosen $K$"))
 
@@ -21,7 +21,7 @@ def tab_kselect(per_seed: Mapping[int, Mapping[tuple[str, str], dict]], trees: S
     """per_seed[seed][(tree, config)]: K, time_psnr (dB), median_rel_err (fraction), trusted,
     frozen, k_heldout, k_bic. One LaTeX row per tree and configuration: K as chosen by each seed
     (slash-separated when the seeds disagree), the rest mean +- sd over seeds."""
-    seeds = sorted(per_seed)
+    seeds = _seeds(per_seed, "tab_kselect")
     recs = []
     for s in seeds:
         for t in trees:
@@ -33,9 +33,9 @@ def tab_kselect(per_seed: Mapping[int, Mapping[tuple[str, str], dict]], trees: S
                              "parts_trusted": int(r["trusted"]), "parts_frozen": int(r["frozen"]),
                              "k_heldout": r["k_heldout"], "k_bic": r["k_bic"]})
     df = pd.DataFrame(recs)
-    first = df[df["seed"] == seeds[0]].reset_index(drop=True)
+    first = _first(df)
     first["_i"] = np.arange(len(first))
-    V = {c: df[c].to_numpy(np.float64).reshape(len(seeds), -1)
+    V = {c: _by_seed(df, c, len(seeds))
          for c in ("K", "time_psnr_db", "median_rel_err_pct", "parts_trusted", "parts_frozen")}
     fmt = f".{digits}f"
 
