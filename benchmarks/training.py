@@ -24,7 +24,7 @@ import physgs.config
 from physgs.models import build_model, training_jobs
 from physgs.models.oscillator import integrate
 from physgs.testbed import scene
-from physgs.testbed.dataset import simulate_tree
+from physgs.testbed.dataset import simulate_tree, swept_points
 from physgs.train import train_model
 
 
@@ -33,11 +33,9 @@ def tree_dataset(cfg: dict, tree: str) -> SimpleNamespace:
     tb = cfg["testbed"]
     sim = simulate_tree(tb, cfg["presets"][tree], seed=cfg["seed"], tree=tree)
     xyz = sim.truth.rest_vertices.astype(np.float32)
-    lo, hi = xyz.min(0), xyz.max(0)
-    c = 0.5 * (lo + hi)
-    rh = float(np.linalg.norm(xyz[:, :2] - c[:2], axis=1).max())
-    cam = scene.frame_cameras(lo, hi, rh, [0.0], fov_deg=tb["fov_deg"],
-                              resolution=tb["resolution"])[0]
+    # the testbed's own framing (swept extent of every frame and condition)
+    cam = scene.frame_cameras(swept_points(sim.truth), [0.0], fov_deg=tb["fov_deg"],
+                              resolution=tb["resolution"], fill_height=tb["fill_height"])[0]
     R = tb["resolution"]
     F = tb["n_train"] + tb["n_tail"]
     frame = np.full((R, R, 3), 128, np.uint8)
