@@ -1,0 +1,105 @@
+"""What a pipeline run cost, from Snakemake's per-job benchmark files.
+
+Every heavy rule writes ``results/benchmarks/<stage>/.../<job>.tsv`` (Snakemake ``benchmark:``),
+one row with the job's wall seconds ``s`` and ``cpu_time`` (seconds). The path says what the job
+was: its stage (first folder), its training seed (a ``seed<N>`` folder, or a ``_seed<N>`` suffix
+for a seeded testbed) and whether it belongs to the damping benchmark (a ``<tree>_damping`` tree).
+From those rows this module answers the questions a user asks before adding seeds: how many
+job-seconds one seed costs, what is shared by all seeds (the testbeds), and what the damping
+benchmark adds. Light jobs without a benchmark (tables, figures, recovery) are not counted: the
+measured wall time of the run says how much they and the scheduling add.
+"""
+from __future__ import annotations
+
+import csv
+import re
+from dataclasses import dataclass
+from pathlib import Path
+
+_SEED = re.compile(r"(?:^|_)seed(\d+)$")
+
+
+@dataclass(frozen=True)
+class JobCost:
+    """One benchmarked job: ``stage`` (train, evaluate, ...), ``seed`` (None = shared by every
+    seed), ``damping`` (part of the damping benchmark), wall and CPU seconds, and its path."""
+    stage: str
+    seed: int | None
+    damping: bool
+    wall_s: float
+    cpu_s: float
+    path: str
+
+
+def _seed_of(parts: tuple[str, ...]) -> int | None:
+    for part in parts:
+        m = _SEED.search(part)
+        if m:
+            return int(m.group(1))
+    return None
+
+
+def read_costs(benchmark_dir) -> list[JobCost]:
+    """Every ``*.tsv`` under ``benchmark_dir`` as a JobCost. Raises FileNotFoundError if the folder
+    is missing and ValueError naming the file if one has no ``s`` column or no data row."""
+    root = Path(benchmark_dir)
+    if not root.is_dir():
+        raise FileNotFoundError(f"{root}: no benchmark folder (run the pipeline first)")
+    jobs = []
+    for f in sorted(root.rglob("*.tsv")):
+        with f.open() as fh:
+            rows = list(csv.DictReader(fh, delimiter="\t"))
+        if not rows or "s" not in rows[-1]:
+            raise ValueError(f"{f}: not a Snakemake benchmark file (needs a header with `s` and a row)")
+        row = rows[-1]  # one row per run (benchmark repeats would add rows: the last counts)
+        rel = f.relative_to(root)
+        parts = rel.with_suffix("").parts
+        cpu = row.get("cpu_time", "")
+        jobs.append(JobCost(stage=parts[0], seed=_seed_of(parts[1:]),
+                            damping=any(p.split("_seed")[0].endswith("_damping") for p in parts[1:]),
+                            wall_s=float(row["s"]),
+                            cpu_s=float(cpu) if cpu not in ("", "NA", "-") else float("nan"),
+                            path=str(rel)))
+    if not jobs:
+        raise FileNotFoundError(f"{root}: no benchmark files (*.tsv)")
+    return jobs
+
+
+def summarise(jobs: list[JobCost]) -> dict:
+    """Job-seconds (wall) by stage and seed, shared (seed None) and damping-benchmark totals.
+
+    Returns {"by_stage": {stage: {seed or "shared": s}}, "per_seed": {seed: s},
+    "shared_s": s, "damping_s": s, "damping_per_seed": {seed: s}, "total_s": s}; seconds are job
+    wall seconds summed (on c cores a perfectly packed run takes total_s / c)."""
+    by_stage: dict[str, dict] = {}
+    per_seed: dict[int, float] = {}
+    damping_per_seed: dict[int, float] = {}
+    shared = damping = 0.0
+    for j in jobs:
+        key = "shared" if j.seed is None else j.seed
+        by_stage.setdefault(j.stage, {}).setdefault(key, 0.0)
+        by_stage[j.stage][key] += j.wall_s
+        if j.seed is None:
+            shared += j.wall_s
+        else:
+            per_seed[j.seed] = per_seed.get(j.seed, 0.0) + j.wall_s
+        if j.damping:
+            damping += j.wall_s
+            if j.seed is not None:
+                damping_per_seed[j.seed] = damping_per_seed.get(j.seed, 0.0) + j.wall_s
+    return {"by_stage": by_stage, "per_seed": dict(sorted(per_seed.items())), "shared_s": shared,
+            "damping_s": damping, "damping_per_seed": dict(sorted(damping_per_seed.items())),
+            "total_s": shared + sum(per_seed.values())}
+
+
+def extra_seed_wall_s(summary: dict, *, run_wall_s: float) -> float:
+    """Wall seconds one more seed adds to a run like the measured one: the mean per-seed
+    job-seconds scaled by the run's own ratio of wall time to job-seconds (which carries the
+    core count, the packing of jobs and the unbenchmarked light jobs). Raises ValueError without
+    a seed or with a non-positive wall time."""
+    if not summary["per_seed"]:
+        raise ValueError("no per-seed jobs: nothing to scale")
+    if not run_wall_s > 0:
+        raise ValueError(f"run_wall_s = {run_wall_s}: the run's measured wall time must be > 0")
+    mean_seed = sum(summary["per_seed"].values()) / len(summary["per_seed"])
+    return mean_seed * run_wall_s / summary["total_s"]
