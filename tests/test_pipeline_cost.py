@@ -1,6 +1,4 @@
 """physgs.experiments.cost: job-seconds from Snakemake benchmark files, by stage and seed."""
-import math
-
 import pytest
 
 from physgs.experiments.cost import extra_seed_wall_s, read_costs, summarise
@@ -8,10 +6,10 @@ from physgs.experiments.cost import extra_seed_wall_s, read_costs, summarise
 HEADER = "s\th:m:s\tmax_rss\tmax_vms\tmax_uss\tmax_pss\tio_in\tio_out\tmean_load\tcpu_time\n"
 
 
-def _write(root, rel, s, cpu=1.0):
+def _write(root, rel, s):
     f = root / rel
     f.parent.mkdir(parents=True, exist_ok=True)
-    f.write_text(HEADER + f"{s}\t0:00:00\t1\t1\t1\t1\t0\t0\t50\t{cpu}\n")
+    f.write_text(HEADER + f"{s}\t0:00:00\t1\t1\t1\t1\t0\t0\t50\t1.0\n")
 
 
 @pytest.fixture
@@ -23,8 +21,9 @@ def bench(tmp_path):
     _write(tmp_path, "train/sparse/seed1/ours_single.tsv", 120.0)
     _write(tmp_path, "train/sparse_damping/seed0/ours_single.tsv", 80.0)
     _write(tmp_path, "evaluate/sparse/seed0/ours_single.tsv", 20.0)
-    _write(tmp_path, "speed_accuracy/seed1/K-8.tsv", 30.0, cpu="NA")
+    _write(tmp_path, "speed_accuracy/seed1/K-8.tsv", 30.0)
     _write(tmp_path, "testbed/sparse_seed1.tsv", 60.0)
+    _write(tmp_path, "testbed/stats_sparse_damping_seed1.tsv", 4.0)
     return tmp_path
 
 
@@ -35,23 +34,24 @@ def test_stage_seed_and_damping_come_from_the_path(bench):
     assert jobs["testbed/sparse_seed1.tsv"].seed == 1          # a seeded testbed is that seed's
     assert jobs["train/sparse_damping/seed0/ours_single.tsv"].damping
     assert jobs["testbed/sparse_damping.tsv"].damping and not jobs["testbed/sparse.tsv"].damping
-    assert math.isnan(jobs["speed_accuracy/seed1/K-8.tsv"].cpu_s)
+    assert jobs["testbed/stats_sparse_damping_seed1.tsv"].damping
+    assert jobs["testbed/stats_sparse_damping_seed1.tsv"].seed == 1
 
 
 def test_sums_by_seed_shared_and_damping(bench):
     s = summarise(read_costs(bench))
     assert s["shared_s"] == pytest.approx(50 + 5 + 40)
-    assert s["per_seed"] == pytest.approx({0: 100 + 80 + 20, 1: 120 + 30 + 60})
-    assert s["damping_s"] == pytest.approx(40 + 80)
-    assert s["damping_per_seed"] == pytest.approx({0: 80})
+    assert s["per_seed"] == pytest.approx({0: 100 + 80 + 20, 1: 120 + 30 + 60 + 4})
+    assert s["damping_s"] == pytest.approx(40 + 80 + 4)
+    assert s["damping_per_seed"] == pytest.approx({0: 80, 1: 4})
     assert s["by_stage"]["train"] == pytest.approx({0: 180, 1: 120})
-    assert s["total_s"] == pytest.approx(95 + 200 + 210)
+    assert s["total_s"] == pytest.approx(95 + 200 + 214)
 
 
 def test_one_more_seed_scales_by_the_runs_own_packing(bench):
     s = summarise(read_costs(bench))
-    # mean seed 205 job-s; the run took 303 s of wall for 505 job-s (0.6 wall per job-second)
-    assert extra_seed_wall_s(s, run_wall_s=303.0) == pytest.approx(205 * 303 / 505)
+    # mean seed 207 job-s; the run took 305.4 s of wall for 509 job-s (0.6 wall per job-second)
+    assert extra_seed_wall_s(s, run_wall_s=305.4) == pytest.approx(207 * 305.4 / 509)
     with pytest.raises(ValueError, match="run_wall_s"):
         extra_seed_wall_s(s, run_wall_s=0)
 

@@ -1,7 +1,7 @@
 """What a pipeline run cost, from Snakemake's per-job benchmark files.
 
 Every heavy rule writes ``results/benchmarks/<stage>/.../<job>.tsv`` (Snakemake ``benchmark:``),
-one row with the job's wall seconds ``s`` and ``cpu_time`` (seconds). The path says what the job
+one row with the job's wall seconds ``s``. The path says what the job
 was: its stage (first folder), its training seed (a ``seed<N>`` folder, or a ``_seed<N>`` suffix
 for a seeded testbed) and whether it belongs to the damping benchmark (a ``<tree>_damping`` tree).
 From those rows this module answers the questions a user asks before adding seeds: how many
@@ -16,18 +16,19 @@ import re
 from dataclasses import dataclass
 from pathlib import Path
 
+from physgs.testbed.variant import DAMPING, parse_id
+
 _SEED = re.compile(r"(?:^|_)seed(\d+)$")
 
 
 @dataclass(frozen=True)
 class JobCost:
     """One benchmarked job: ``stage`` (train, evaluate, ...), ``seed`` (None = shared by every
-    seed), ``damping`` (part of the damping benchmark), wall and CPU seconds, and its path."""
+    seed), ``damping`` (part of the damping benchmark), wall seconds, and its path."""
     stage: str
     seed: int | None
     damping: bool
     wall_s: float
-    cpu_s: float
     path: str
 
 
@@ -37,6 +38,13 @@ def _seed_of(parts: tuple[str, ...]) -> int | None:
         if m:
             return int(m.group(1))
     return None
+
+
+def _is_damping(part: str) -> bool:
+    """Whether a path part names a damping testbed: a tree folder ('medium_damping') or a testbed
+    job ('stats_medium_damping_seed1'), read by the testbed ids' own parser."""
+    testbed = _SEED.sub("", part).removeprefix("stats_")
+    return parse_id(testbed)[1] == DAMPING
 
 
 def read_costs(benchmark_dir) -> list[JobCost]:
@@ -54,12 +62,9 @@ def read_costs(benchmark_dir) -> list[JobCost]:
         row = rows[-1]  # one row per run (benchmark repeats would add rows: the last counts)
         rel = f.relative_to(root)
         parts = rel.with_suffix("").parts
-        cpu = row.get("cpu_time", "")
         jobs.append(JobCost(stage=parts[0], seed=_seed_of(parts[1:]),
-                            damping=any(p.split("_seed")[0].endswith("_damping") for p in parts[1:]),
-                            wall_s=float(row["s"]),
-                            cpu_s=float(cpu) if cpu not in ("", "NA", "-") else float("nan"),
-                            path=str(rel)))
+                            damping=any(_is_damping(p) for p in parts[1:]),
+                            wall_s=float(row["s"]), path=str(rel)))
     if not jobs:
         raise FileNotFoundError(f"{root}: no benchmark files (*.tsv)")
     return jobs
@@ -77,8 +82,8 @@ def summarise(jobs: list[JobCost]) -> dict:
     shared = damping = 0.0
     for j in jobs:
         key = "shared" if j.seed is None else j.seed
-        by_stage.setdefault(j.stage, {}).setdefault(key, 0.0)
-        by_stage[j.stage][key] += j.wall_s
+        stage = by_stage.setdefault(j.stage, {})
+        stage[key] = stage.get(key, 0.0) + j.wall_s
         if j.seed is None:
             shared += j.wall_s
         else:
