@@ -94,7 +94,7 @@ def main() -> None:
     cfg = physgs.config.load("config/trees.yaml", args.profile)
     trees = args.trees or cfg["trees"]
     it_total, warm = cfg["train"]["iterations"], cfg["train"]["warmup"]
-    jobs = training_jobs()
+    jobs = training_jobs(cfg["models"]["configs"])
     print(f"profile {args.profile}: {cfg['testbed']['resolution']} px, {it_total} iterations "
           f"({warm} warm-up), {args.threads} thread(s) per job; CPU s/iter (wall s/iter)")
     print(f"{'tree':<7} {'N':>6} " + " ".join(f"{m + '_' + c:>17}" for m, c in jobs))
