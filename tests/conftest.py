@@ -2,15 +2,20 @@
 from __future__ import annotations
 
 import math
+import os
 from types import SimpleNamespace
 
 import numpy as np
 import pytest
 import torch
+from filelock import FileLock
 
 from physgs.camera import look_at
 from physgs.render import rasterization
 from workflow_helpers import snakemake, workflow_copy
+
+if os.environ.get("PYTEST_XDIST_WORKER"):
+    torch.set_num_threads(1)  # two workers on two cores: one thread each, no oversubscription
 
 FPS, N_TRAIN, N_TAIL, LEAD_IN, RES = 24, 20, 4, 150, 24
 
@@ -44,6 +49,13 @@ def swaying_dataset(seed: int = 0) -> SimpleNamespace:
                            train_camera=cam, background=np.ones(3), canonical_xyz=xyz)
 
 
+def pytest_collection_modifyitems(items):
+    """The tests that read the quick DAG first (stable otherwise): the first worker to reach one
+    builds the DAG on both cores while the files after them wait their turn (pytest-xdist hands
+    out whole files in this order: ``--dist loadfile --no-loadscope-reorder``)."""
+    items.sort(key=lambda item: "quick_dag" not in item.fixturenames)
+
+
 @pytest.fixture(scope="session")
 def swaying():
     """The swaying-tree dataset, built once per session."""
@@ -52,8 +64,24 @@ def swaying():
 
 @pytest.fixture(scope="session")
 def quick_dag(tmp_path_factory):
-    """Every rule of the quick DAG, run once on the sparse tree in a scratch workflow copy."""
-    wd = workflow_copy(tmp_path_factory.mktemp("quick_dag"))
-    snakemake(wd, "--cores", "2", "all", "--config", "profile=quick", 'trees=["sparse"]',
-              timeout=900)
+    """Every rule of the quick DAG, run once on the sparse tree in a scratch workflow copy.
+
+    Built once per test session: under pytest-xdist (the suite runs on two workers) the first
+    worker that asks builds it in the folder the workers share, and the others wait on a file
+    lock and read the same copy; a build that failed fails them too, without a second try."""
+    root = tmp_path_factory.getbasetemp()
+    if os.environ.get("PYTEST_XDIST_WORKER"):
+        root = root.parent  # the session's folder, shared by its workers
+    wd, failed = root / "quick_dag", root / "quick_dag.failed"
+    with FileLock(str(root / "quick_dag.lock")):
+        if failed.exists():
+            pytest.fail(f"the quick DAG failed to build in another worker:\n{failed.read_text()}")
+        if not (wd / ".built").exists():
+            try:
+                snakemake(workflow_copy(wd), "--cores", "2", "all", "--config", "profile=quick",
+                          'trees=["sparse"]', timeout=900)
+            except AssertionError as err:
+                failed.write_text(str(err))
+                raise
+            (wd / ".built").touch()
     return wd

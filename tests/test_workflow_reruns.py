@@ -27,25 +27,24 @@ EDITS = {
 }
 
 
-def _dry_run(wd: Path, override: dict, name: str = "override") -> str:
-    """The dry-run plan of `all` with ``override`` merged into the config."""
-    f = wd / f"{name}.yaml"
-    f.write_text(yaml.safe_dump(override))
-    try:
-        return snakemake(wd, "-n", "--nolock", "--cores", "2", "all", "--configfile",
-                         "config/trees.yaml", str(f), *QUICK).stdout
-    finally:
-        f.unlink()
+def _dry_run(wd: Path, override: Path) -> str:
+    """The dry-run plan of `all` with the config file ``override`` merged into the config."""
+    return snakemake(wd, "-n", "--nolock", "--cores", "2", "all", "--configfile",
+                     "config/trees.yaml", str(override), *QUICK).stdout
 
 
 @pytest.fixture(scope="module")
-def plans(quick_dag) -> dict[str, str]:
+def plans(quick_dag, tmp_path_factory) -> dict[str, str]:
     """edit name -> dry-run output on the finished quick DAG; each dry run is seconds of
-    single-threaded DAG building, so two run side by side."""
+    single-threaded DAG building, so two run side by side. The edits are written outside the
+    DAG's folder, which other tests' workers read at the same time."""
     from concurrent.futures import ThreadPoolExecutor
 
+    edits = tmp_path_factory.mktemp("edits")
+    for k, v in EDITS.items():
+        (edits / f"{k}.yaml").write_text(yaml.safe_dump(v))
     with ThreadPoolExecutor(2) as pool:
-        futures = {k: pool.submit(_dry_run, quick_dag, v, f"edit_{k}") for k, v in EDITS.items()}
+        futures = {k: pool.submit(_dry_run, quick_dag, edits / f"{k}.yaml") for k in EDITS}
         return {k: f.result() for k, f in futures.items()}
 
 

@@ -16,7 +16,6 @@ import numpy as np
 import pandas as pd
 
 from physgs.evaluate.metrics import ceiling_fraction as _fraction
-from physgs.evaluate.run import training_camera_scores
 from physgs.experiments.recipe import fit, heldout_split, job_spec
 from physgs.experiments.sweep import with_knob
 from physgs.models.registry import BASE_CONFIG
@@ -49,6 +48,8 @@ def run_point(job: Mapping, observed, *, progress: bool = False) -> dict:
     fit / heldout: mean PSNR over the trained / held-out training-window frames; time: over the
     tail frames; all at the training camera and wind. train_s: wall time of the training.
     """
+    from physgs.evaluate.run import training_camera_scores  # torch: only when training
+
     t0 = time.perf_counter()
     res = fit(observed, dict(job), progress=progress,
               name=f"{job['model']}_{job['config']}[{job['train']['iterations']} it]")

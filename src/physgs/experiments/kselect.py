@@ -25,7 +25,6 @@ from dataclasses import asdict, dataclass
 import numpy as np
 
 from physgs.atomic import write_json
-from physgs.evaluate.run import training_camera_scores
 from physgs.experiments.recipe import Job, fit, heldout_split  # noqa: F401 (re-exported)
 from physgs.models.registry import AUTO_CONFIG
 
@@ -120,6 +119,8 @@ def select_k(observed, job: Job | dict, kselect: dict, *, progress: bool = False
     ``models.kselect`` section. Each candidate is trained by ``recipe.fit`` (freezing
     included) with the section's shorter schedule. Deterministic for the job's seed.
     """
+    from physgs.evaluate.run import training_camera_scores  # torch: only when training
+
     job = Job.from_dict(job) if isinstance(job, dict) else job
     ks = kselect
     cands = _check_cfg(ks, int(np.asarray(observed.canonical_xyz).shape[0]))

@@ -1,8 +1,12 @@
 """The one training recipe: what a job needs to know, and fit = seed, build, train (freezing
-included), in that order, for every model and every caller."""
+included), in that order, for every model and every caller.
+
+The workflow imports ``job_spec`` and ``canonical`` to plan jobs; the training machinery (torch)
+loads inside ``fit`` and ``train_and_save``, so a dry run does not pay its start-up."""
 from __future__ import annotations
 
 from dataclasses import asdict, dataclass, field
+from typing import TYPE_CHECKING
 
 import numpy as np
 
@@ -14,9 +18,9 @@ from physgs.models.registry import (
     save_checkpoint,
     spec_of,
 )
-from physgs.models.visibility import freeze_callback
-from physgs.train.loop import TrainResult, condition_indices, train_model, write_loss_log
-from physgs.train.seeding import seed_everything
+
+if TYPE_CHECKING:
+    from physgs.train.loop import TrainResult
 
 
 def canonical(x):
@@ -103,6 +107,10 @@ def fit(observed, job: Job | dict, *, truth=None, frame_pool=None, progress: boo
     dataset's ``Truth`` (truth.npz), required by a reference (truth_motion) and refused for a
     method. Returns the TrainResult (model in eval mode).
     """
+    from physgs.models.visibility import freeze_callback
+    from physgs.train.loop import condition_indices, train_model
+    from physgs.train.seeding import seed_everything
+
     job = Job.from_dict(job) if isinstance(job, dict) else job
     spec_of(job.model)  # unknown ids raise, naming the valid ones
     if truth is not None and not is_reference(job.model):
@@ -130,6 +138,8 @@ def train_and_save(observed, job: Job | dict, *, checkpoint_path, loss_path,
     """``fit``, then write the loss log and the checkpoint (each atomically, the checkpoint
     last). Nothing is written if training fails. truth: as in ``fit`` (references only); the
     checkpoint of a reference carries its motion, so it reloads without truth.npz."""
+    from physgs.train.loop import write_loss_log
+
     job = Job.from_dict(job) if isinstance(job, dict) else job
     result = fit(observed, job, truth=truth, progress=progress)
     write_loss_log(loss_path, result.log)

@@ -18,7 +18,6 @@ from typing import Sequence
 import numpy as np
 import pandas as pd
 
-from physgs.evaluate.run import training_camera_scores
 from physgs.experiments.recipe import canonical, fit, job_spec
 from physgs.models.registry import BASE_CONFIG
 from physgs.testbed.variant import effective_settings
@@ -112,6 +111,8 @@ def run_point(point: dict, observed_path, truth_path, *, progress: bool = False)
     unless the knob changes the testbed. Ours is trained by ``recipe.fit``, freezing included,
     so each point is the model the tables report at those settings.
     """
+    from physgs.evaluate.run import training_camera_scores  # torch: only when training
+
     from physgs.recovery.run import recover_model
     from physgs.testbed.dataset import build_dataset, load_observed, load_truth, save_dataset
 

@@ -9,21 +9,23 @@ A checkpoint (torch.save of plain dicts and tensors, loadable with weights_only=
 format, model name, training configuration name, seed, the ``models`` config section, the
 ``train`` config section, the ModelContext (canonical positions, fps, frame counts, frozen wind
 statistics), the state dict and the training statistics.
+
+The ids and labels import nothing heavy: the workflow reads them to plan jobs. The model classes
+and torch load inside the functions that build, save or read a model.
 """
 from __future__ import annotations
 
 from dataclasses import dataclass
 from pathlib import Path
 
+from typing import TYPE_CHECKING
+
 import numpy as np
-import torch
 
 from physgs.atomic import atomic_path
-from physgs.models.base import BaseModel, ModelContext, context_from_observed
-from physgs.models.fields import FieldModel
-from physgs.models.ours import OscillatorPrior
-from physgs.models.static import StaticModel
-from physgs.models.truth_motion import TrueMotion, TruthMotionModel
+
+if TYPE_CHECKING:
+    from physgs.models.base import BaseModel
 
 @dataclass(frozen=True)
 class ModelSpec:
@@ -128,6 +130,12 @@ def build_model(name: str, observed, cfg: dict, *, config: str = BASE_CONFIG, K:
     ``Truth`` (``load_truth`` of truth.npz; ``observed`` must then be the ``Observed``), or the
     ``TrueMotion`` a checkpoint stores. A method given a truth raises (methods never read it).
     """
+    from physgs.models.base import ModelContext, context_from_observed
+    from physgs.models.fields import FieldModel
+    from physgs.models.ours import OscillatorPrior
+    from physgs.models.static import StaticModel
+    from physgs.models.truth_motion import TrueMotion, TruthMotionModel
+
     spec_of(name)
     if name != "ours" and config != BASE_CONFIG:
         raise ValueError(f"model {name!r} is not trained in configuration {config!r}; valid: "
@@ -179,6 +187,8 @@ def save_checkpoint(path, model: BaseModel, *, name: str, config: str, seed: int
     models_cfg: the settings the model was built from (``model_settings`` or the whole
     ``models`` section); ours' K is read off the model, so any configuration name reloads.
     """
+    import torch
+
     path = Path(path)
     path.parent.mkdir(parents=True, exist_ok=True)
     blob = {
@@ -192,6 +202,8 @@ def save_checkpoint(path, model: BaseModel, *, name: str, config: str, seed: int
 
 def read_checkpoint(path) -> dict:
     """The raw checkpoint dict; clear errors for a missing or corrupt file."""
+    import torch
+
     path = Path(path)
     if not path.is_file():
         raise FileNotFoundError(
@@ -211,6 +223,9 @@ def load_checkpoint(path) -> BaseModel:
 
     The returned model also carries ``checkpoint_info`` (name, config, seed, stats, cfgs).
     """
+    from physgs.models.base import ModelContext
+    from physgs.models.truth_motion import TrueMotion
+
     blob = read_checkpoint(path)
     sd = blob["state_dict"]
     labels = sd["part_labels"].numpy() if "part_labels" in sd else None

@@ -10,7 +10,6 @@ from __future__ import annotations
 from dataclasses import asdict, dataclass
 
 import numpy as np
-import torch
 
 from physgs.recovery.matcher import TRUST_THRESHOLD, match_parts, restricted, training_window
 
@@ -98,6 +97,8 @@ def null_control(omega_bones: np.ndarray, bone_theta: np.ndarray, wind: np.ndarr
     gain only scales theta, which correlation ignores. Seeded: same seed, same draws.
     bone_visible [B] bool: also score each draw on the bones whose own motion is visible.
     """
+    import torch  # here, not at the top: reading a null record needs no torch
+
     from physgs.models.oscillator import integrate  # the trained model's own solver
 
     omega_bones = np.asarray(omega_bones, dtype=np.float64)

@@ -1,15 +1,17 @@
-"""Recovery of one trained oscillator prior, and its null control, as the Snakemake rules call them."""
+"""Recovery of one trained oscillator prior, and its null control, as the Snakemake rules call them.
+
+The workflow imports ``null_settings`` to plan jobs; the solver and torch load inside the
+functions that run it, so a dry run does not pay torch's start-up."""
 from __future__ import annotations
 
 import dataclasses
+from typing import TYPE_CHECKING
 
 import numpy as np
-import torch
 
-from physgs.models.oscillator import STABILITY_GUARD
-from physgs.models.ours import prior_substeps
-from physgs.recovery.null import NullResult
-from physgs.recovery.record import RecoveryRecord, run_null, score_recovery
+if TYPE_CHECKING:
+    from physgs.recovery.null import NullResult
+    from physgs.recovery.record import RecoveryRecord
 
 
 def recover_model(model, observed, truth, bone_visible=None, damping: dict | None = None
@@ -22,6 +24,10 @@ def recover_model(model, observed, truth, bone_visible=None, damping: dict | Non
     zeta and against the untrained null drawn log-uniformly from zeta_range with that seed
     (``physgs.recovery.damping_scores``; tab_damping).
     """
+    import torch
+
+    from physgs.recovery.record import score_recovery
+
     if not hasattr(model, "part_theta"):
         raise TypeError(f"recovery needs the oscillator prior ('ours'); got {type(model).__name__}")
     with torch.no_grad():
@@ -67,6 +73,10 @@ def null_control(observed, truth, settings: dict, bone_visible=None) -> NullResu
     """The untrained null for ``settings['K']`` parts (``null_settings``), through the solver
     settings ours uses: substeps are raised exactly as the model raises them, so the null
     integrates with the trained model's step."""
+    from physgs.models.oscillator import STABILITY_GUARD
+    from physgs.models.ours import prior_substeps
+    from physgs.recovery.record import run_null
+
     dt = 1.0 / observed.fps
     substeps = prior_substeps(settings["omega_hz"], settings["zeta"], settings["substeps"], dt,
                               float(settings.get("rk4_guard", STABILITY_GUARD)))

@@ -10,7 +10,7 @@ settings an output reads, so editing one table's format rebuilds that table only
 """
 from __future__ import annotations
 
-from typing import Mapping, Sequence
+from typing import TYPE_CHECKING, Mapping, Sequence
 
 import numpy as np
 import pandas as pd
@@ -21,8 +21,11 @@ from physgs.experiments.kselect import load_selection
 from physgs.experiments.recipe import heldout_split
 from physgs.models.registry import BASE_CONFIG, MODEL_NAMES, REFERENCE_NAMES, config_label
 from physgs.recovery.record import load_null, load_recovery
-from physgs.report import figures, kselect, tables
+from physgs.report import kselect
 from physgs.testbed.stats import load_stats
+
+if TYPE_CHECKING:
+    from physgs.report.tables import Table
 
 TABLES = ("tab_testbed", "tab_psnr", "tab_null", "tab_transfer", "tab_margin", "tab_kselect",
           "tab_fit", "tab_damping")
@@ -200,10 +203,12 @@ def fit_row(eval_path, loss_path, n_train: int, holdout_every: int) -> dict:
 
 
 def make_table(name: str, inputs: Mapping[str, str], settings: dict, tex_path, csv_path,
-               stamp=None) -> tables.Table:
+               stamp=None) -> Table:
     """Build table ``name`` from the files in ``inputs`` (need key -> path) and write its .tex
     and .csv. settings: ``settings_for(name, cfg)``; stamp: a ``physgs.provenance.Stamp``
     written into every CSV row (profile, config hash, package version)."""
+    from physgs.report import tables
+
     path = _reader(inputs)
     trees, bones, d = settings["trees"], settings["bones"], settings.get("digits", 2)
     seeds = [int(x) for x in settings.get("seeds", ())]
@@ -271,6 +276,8 @@ def make_figure(name: str, inputs: Mapping[str, str], settings: dict,
                 outputs: Sequence[str]) -> None:
     """Build figure ``name`` from the files in ``inputs`` (need key -> path), written to every
     path in ``outputs``. settings: ``settings_for(name, cfg)``."""
+    from physgs.report import figures  # matplotlib: not for the workflow's planning imports
+
     path = _reader(inputs)
     trees = settings["trees"]
     seeds = [int(x) for x in settings["seeds"]]

@@ -11,7 +11,6 @@ from __future__ import annotations
 from typing import Sequence
 
 import numpy as np
-from scipy import stats
 
 LEVEL = 0.95  # two-sided confidence level of every interval
 UNDECIDED = r"$^{\dagger}$"  # .tex mark of a difference whose interval contains 0 (or one seed)
@@ -30,6 +29,8 @@ def interval(values: Sequence[float], level: float = LEVEL) -> tuple[float, floa
     m = float(v.mean())
     if v.size == 1:
         return m, np.nan, np.nan, np.nan
+    from scipy import stats  # here: the workflow plans with modules that import this one
+
     sd = float(v.std(ddof=1))
     h = float(stats.t.ppf(0.5 + level / 2, v.size - 1)) * sd / np.sqrt(v.size)
     return m, sd, m - h, m + h

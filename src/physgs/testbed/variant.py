@@ -17,8 +17,6 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from physgs.testbed import physics
-
 FAITHFUL, DAMPING = "faithful", "damping"
 VARIANTS = (FAITHFUL, DAMPING)
 
@@ -164,5 +162,7 @@ def lead_in_frames(omega: np.ndarray, zeta: np.ndarray, lead_in_tau: float, fps:
     omega [B] rad/s, zeta [B]. For a constant zeta this is exactly
     ``physics.lead_in_frames(omega.min(), zeta, ...)`` (same operands, same rounding).
     """
+    from physgs.testbed import physics  # torch: the workflow imports this module to plan jobs
+
     i = int(np.argmin(np.asarray(zeta) * np.asarray(omega)))
     return physics.lead_in_frames(float(omega[i]), float(zeta[i]), lead_in_tau, fps)
