@@ -49,11 +49,21 @@ def swaying_dataset(seed: int = 0) -> SimpleNamespace:
                            train_camera=cam, background=np.ones(3), canonical_xyz=xyz)
 
 
+@pytest.hookimpl(tryfirst=True)  # before pytest-xdist reads the groups
 def pytest_collection_modifyitems(items):
-    """The tests that read the quick DAG first (stable otherwise): the first worker to reach one
-    builds the DAG on both cores while the files after them wait their turn (pytest-xdist hands
-    out whole files in this order: ``--dist loadfile --no-loadscope-reorder``)."""
-    items.sort(key=lambda item: "quick_dag" not in item.fixturenames)
+    """Order and group the tests for the suite's two workers (``--dist loadgroup``, order kept).
+
+    One test that reads the quick DAG goes first, so one worker builds the DAG on both cores
+    while the other runs the tests that need no DAG; the rest of the DAG's readers go last and
+    are shared by both workers. A module with a module-scoped fixture stays on one worker, so
+    its fixture is built once."""
+    dag = [it for it in items if "quick_dag" in it.fixturenames]
+    rest = [it for it in items if "quick_dag" not in it.fixturenames]
+    items[:] = dag[:1] + rest + dag[1:]
+    for it in items:
+        defs = it._fixtureinfo.name2fixturedefs.values()
+        if any(d[-1].scope == "module" for d in defs):
+            it.add_marker(pytest.mark.xdist_group(it.module.__name__))
 
 
 @pytest.fixture(scope="session")

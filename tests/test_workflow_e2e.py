@@ -27,8 +27,8 @@ MODELS = ["Static pose", "Deformation MLP", "Deformation MLP + wind", "Deformabl
           "Deformable-3DGS + wind", "Ours"]
 
 
-@pytest.fixture(scope="module")
-def run(quick_dag):
+@pytest.fixture
+def run(quick_dag):  # function scope: the suite's workers share these tests one by one
     return quick_dag
 
 
