@@ -70,7 +70,7 @@ def tab_damping(per_seed: Mapping[int, Mapping[tuple[str, str, str], object]],
         p_true = np.nanmean(V["gamma_exponent_true"][:, i])
         lines.append("    " + " & ".join([
             head, v if i % len(configs) == 0 else "", configs[c],
-            seedstats.pm(V["trusted"][:, i], ".3g"),
+            seedstats.pm(V["trusted"][:, i], ".1f"),  # a mean count: one decimal
             pct(seedstats.pm(V["rel_err_pct"][:, i], ".0f")),
             pct(seedstats.pm(V["null_rel_err_pct"][:, i], ".0f")),
             seedstats.difference(V["trained_minus_null_pp"][:, i], ".0f"),
