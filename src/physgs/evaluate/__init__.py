@@ -4,27 +4,14 @@ Modules: ``metrics`` (PSNR, silhouette centroids), ``splits`` (view / time / tra
 ``evaluate``), ``trajectories`` (branch-tip paths in pixels), ``adapter`` (render/means callbacks
 from a model via the shared interfaces); safe writes live in ``physgs.atomic``.
 
-The names load on first use (PEP 562): the report jobs read evaluation records with
+The names load on first use (lazy_loader): the report jobs read evaluation records with
 ``splits.load_eval`` and should not pay torch's start-up for it.
 """
-import importlib
+import lazy_loader
 
-#: public name -> the submodule that defines it
-_WHERE = {
-    "psnr": "metrics", "silhouette_centroid": "metrics", "centroid_error": "metrics",
-    "EvalResult": "splits", "evaluate": "splits", "load_eval": "splits",
-    "Trajectories": "trajectories", "tip_trajectories": "trajectories",
-    "load_trajectories": "trajectories",
-    "model_render_fn": "adapter", "model_means_fn": "adapter",
-}
-__all__ = list(_WHERE)
-
-
-def __getattr__(name: str):
-    if name not in _WHERE:
-        raise AttributeError(f"module 'physgs.evaluate' has no attribute {name!r}")
-    return getattr(importlib.import_module(f"physgs.evaluate.{_WHERE[name]}"), name)
-
-
-def __dir__():
-    return sorted(set(globals()) | set(__all__))
+__getattr__, __dir__, __all__ = lazy_loader.attach(__name__, submod_attrs={
+    "metrics": ["psnr", "silhouette_centroid", "centroid_error"],
+    "splits": ["EvalResult", "evaluate", "load_eval"],
+    "trajectories": ["Trajectories", "tip_trajectories", "load_trajectories"],
+    "adapter": ["model_render_fn", "model_means_fn"],
+})
