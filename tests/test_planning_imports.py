@@ -21,10 +21,14 @@ def _workflow_imports() -> list[str]:
 def test_the_workflows_imports_load_no_heavy_library():
     imports = _workflow_imports()
     assert len(imports) >= 5, imports  # the parse found the imports it is about
-    code = "\n".join([*imports, "import sys",
+    # the Snakefile's own first step: validate and check the shipped config (its checks reuse
+    # the testbed's formulas, whose modules must not load torch either)
+    load = ("physgs.config.load_workflow_config(yaml.safe_load(open('config/trees.yaml')), "
+            "'default', source='config/trees.yaml')")
+    code = "\n".join([*imports, "import yaml", load, "import sys",
                       f"print(sorted(m for m in {HEAVY!r} if m in sys.modules))"])
     out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True,
-                         check=True).stdout
+                         check=True, cwd=ROOT).stdout
     assert out.strip() == "[]", f"planning imports load {out.strip()}"
 
 
