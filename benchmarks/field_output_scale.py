@@ -13,10 +13,8 @@ so it scores only training-window frames.
 from __future__ import annotations
 
 import argparse
-import runpy
-import sys
-from pathlib import Path
 
+import fit_recipe  # its sibling: run as python benchmarks/<this>.py
 from physgs.models.fields import DeformationField
 
 
@@ -31,8 +29,7 @@ def main() -> None:
         return {name: args.scale * out for name, out in forward(self, x).items()}
 
     DeformationField.forward = scaled
-    sys.argv = ["fit_recipe.py", *rest]
-    runpy.run_path(str(Path(__file__).with_name("fit_recipe.py")), run_name="__main__")
+    fit_recipe.main(rest)
 
 
 if __name__ == "__main__":

@@ -36,14 +36,15 @@ def _set(cfg: dict, assignment: str) -> None:
     node[last] = yaml.safe_load(value)
 
 
-def main() -> None:
+def main(argv: list[str] | None = None) -> None:
+    """Run with ``argv`` (default: the command line); the recipe-candidate scripts call it."""
     ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawTextHelpFormatter)
     ap.add_argument("dataset", type=Path, help="folder with observed.npz (and truth.npz)")
     ap.add_argument("--models", default="static,mlp,mlp_wind,d3dgs,d3dgs_wind,ours,truth_motion")
     ap.add_argument("--profile", default="default")
     ap.add_argument("--set", action="append", default=[], help="KEY.PATH=VALUE override")
     ap.add_argument("--every", type=int, default=3, help="score every k-th trained frame")
-    args = ap.parse_args()
+    args = ap.parse_args(argv)
     cfg = physgs.config.load("config/trees.yaml", args.profile)
     for a in args.set:
         _set(cfg, a)

@@ -12,13 +12,11 @@ training-window frames.
 from __future__ import annotations
 
 import argparse
-import runpy
-import sys
-from pathlib import Path
 
 import torch
 import torch.nn.functional as F
 
+import fit_recipe  # its sibling: run as python benchmarks/<this>.py
 import physgs.train.loop
 from physgs.train.losses import ssim
 
@@ -43,8 +41,7 @@ def main() -> None:
     args, rest = ap.parse_known_args()
     # the training loop looks the loss up in its own module at every iteration
     physgs.train.loop.photometric_loss = pyramid_loss([int(k) for k in args.levels.split(",")])
-    sys.argv = ["fit_recipe.py", *rest]
-    runpy.run_path(str(Path(__file__).with_name("fit_recipe.py")), run_name="__main__")
+    fit_recipe.main(rest)
 
 
 if __name__ == "__main__":
