@@ -116,6 +116,7 @@ def fit(observed, job: Job | dict, *, truth=None, frame_pool=None, progress: boo
     if truth is not None and not is_reference(job.model):
         raise ValueError(f"model {job.model!r} is a method: its training may not read the ground "
                          "truth (truth.npz); only references (truth_motion) do")
+    _check_precision(job)
     seed_everything(job.seed)
     # a reference without a truth raises here, saying it needs truth.npz
     model = build_model(job.model, observed, job.settings, config=job.config, K=job.K,
@@ -131,6 +132,24 @@ def fit(observed, job: Job | dict, *, truth=None, frame_pool=None, progress: boo
     if job.model == "ours":
         result.stats["frozen_parts"] = int(result.model.frozen.sum())
     return result
+
+
+def _check_precision(job: Job) -> None:
+    """Stop before training a bfloat16 field on a CPU that would emulate bf16 (~48x slower than
+    float32: a default run would take days), naming the setting to change."""
+    family = spec_of(job.model).family
+    if (job.settings.get(family) or {}).get("precision", "float32") != "bfloat16":
+        return
+    from physgs.models.fields import native_bf16
+
+    if not native_bf16():
+        import torch
+
+        raise RuntimeError(
+            f"models.{family}.precision is bfloat16, but this CPU (torch capability "
+            f"{torch.backends.cpu.get_cpu_capability()}) has no native bf16 matmuls: autocast "
+            f"would emulate them, ~48x slower than float32. Set models.{family}.precision: "
+            "float32 in the config, or run on a CPU with AVX-512 BF16 or AMX")
 
 
 def train_and_save(observed, job: Job | dict, *, checkpoint_path, loss_path,

@@ -4,6 +4,11 @@ Input per Gaussian: Fourier features of its canonical position (normalised to ab
 the canonical bounding box, detached as in Deformable-3DGS) and of t_norm, plus, for the + wind
 variants, the standardised 48-value wind history (shared by all Gaussians of a frame).
 Output heads start at zero, so at initialisation every field returns the canonical pose.
+
+``precision: bfloat16`` runs the hidden layers' matmuls under CPU/CUDA autocast in bfloat16 (the
+weights, their gradients and Adam stay float32; the inputs and the heads stay float32, so the
+offsets keep float32 resolution). On a CPU with native bf16 dot products (AVX-512 BF16 / AMX) the
+Deformable-3DGS field's forward + backward runs ~2.4x faster (``benchmarks/field_precision.py``).
 """
 from __future__ import annotations
 
@@ -17,6 +22,13 @@ from physgs.models.gaussians import GaussianState
 from physgs.models.windwindow import wind_window, window_step
 
 HEAD_DIMS = {"dx": 3, "dq": 4, "ds": 3}
+PRECISIONS = ("float32", "bfloat16")  # models.<mlp|d3dgs>.precision
+
+
+def native_bf16() -> bool:
+    """Whether this CPU runs bf16 matmuls natively (oneDNN's own probe: AVX-512 BF16 or AMX
+    class hardware). Without it autocast emulates them, ~48x slower than float32."""
+    return bool(torch.backends.mkldnn.is_available() and torch.ops.mkldnn._is_mkldnn_bf16_supported())
 
 
 class DeformationField(nn.Module):
@@ -27,8 +39,11 @@ class DeformationField(nn.Module):
     """
 
     def __init__(self, in_dim: int, depth: int, width: int, skip: int | None,
-                 heads: tuple[str, ...]):
+                 heads: tuple[str, ...], precision: str = "float32"):
         super().__init__()
+        if precision not in PRECISIONS:
+            raise ValueError(f"field precision {precision!r}: use one of {PRECISIONS}")
+        self.precision = precision
         if skip is not None and not 0 <= skip < depth - 1:
             raise ValueError(f"skip layer {skip} must lie in [0, depth - 1) = [0, {depth - 1})")
         self.skip = skip
@@ -43,12 +58,15 @@ class DeformationField(nn.Module):
             nn.init.zeros_(h.weight)
             nn.init.zeros_(h.bias)
 
-    def forward(self, x: torch.Tensor) -> dict[str, torch.Tensor]:  # x [N, in_dim]
+    def forward(self, x: torch.Tensor) -> dict[str, torch.Tensor]:  # x [N, in_dim] float32
         h = x
-        for i, layer in enumerate(self.layers):
-            h = torch.relu(layer(h))
-            if self.skip is not None and i == self.skip:
-                h = torch.cat([x, h], dim=-1)
+        with torch.autocast(x.device.type, dtype=torch.bfloat16,
+                            enabled=self.precision == "bfloat16"):
+            for i, layer in enumerate(self.layers):
+                h = torch.relu(layer(h))
+                if self.skip is not None and i == self.skip:
+                    h = torch.cat([x.to(h.dtype), h], dim=-1)
+        h = h.to(x.dtype)  # the heads (offsets in scene units) run in the input's float32
         return {name: head(h) for name, head in self.heads.items()}
 
 
@@ -61,7 +79,8 @@ class FieldModel(BaseModel):
 
     def __init__(self, ctx: ModelContext, canonical_cfg: dict, *, arch: str, pos_bands: int,
                  time_bands: int, depth: int, width: int, skip: int | None, wind: bool,
-                 window_seconds: float | None, window_values: int | None, name: str):
+                 window_seconds: float | None, window_values: int | None, name: str,
+                 precision: str = "float32"):
         super().__init__(ctx, canonical_cfg)
         if arch not in ("mlp", "d3dgs"):
             raise ValueError(f"unknown field architecture {arch!r}; use 'mlp' or 'd3dgs'")
@@ -84,7 +103,7 @@ class FieldModel(BaseModel):
         self.register_buffer("wind_std", torch.tensor(ctx.wind_std, dtype=torch.float32))
         in_dim = fourier_dim(3, pos_bands) + fourier_dim(1, time_bands) + self.window_values
         heads = ("dx",) if arch == "mlp" else ("dx", "dq", "ds")
-        self.field = DeformationField(in_dim, depth, width, skip, heads)
+        self.field = DeformationField(in_dim, depth, width, skip, heads, precision)
 
     def features(self, frame_idx: int, wind: torch.Tensor) -> torch.Tensor:
         """Field input [N, in_dim] at recorded frame ``frame_idx``."""

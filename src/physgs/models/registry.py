@@ -165,7 +165,8 @@ def build_model(name: str, observed, cfg: dict, *, config: str = BASE_CONFIG, K:
         return FieldModel(ctx, canon, arch=family, pos_bands=a["pos_bands"],
                           time_bands=a["time_bands"], depth=a["depth"], width=a["width"],
                           skip=a.get("skip"), wind=MODELS[name].wind,
-                          window_seconds=ww["seconds"], window_values=ww["values"], name=name)
+                          window_seconds=ww["seconds"], window_values=ww["values"], name=name,
+                          precision=a.get("precision", "float32"))
     if K is None:
         spec = cfg.get("configs", {}).get(config)
         if spec is None:
