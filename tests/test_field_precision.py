@@ -94,6 +94,31 @@ def test_training_a_bf16_field_without_native_bf16_stops_naming_the_setting(monk
     assert "precision" not in str(e.value)
 
 
+def test_the_plan_stops_before_any_job_on_a_cpu_without_bf16_and_the_overlay_is_the_way_out(
+        monkeypatch):
+    """The workflow's plan-time check (Snakefile) refuses the default's bf16 fields on such a
+    CPU, naming both keys and config/float32.yaml; that overlay, merged over trees.yaml as
+    --configfile does, gives float32 fields that pass."""
+    import physgs.models.fields as fields
+    from physgs.experiments.recipe import check_precision_supported
+
+    monkeypatch.setattr(fields, "native_bf16", lambda: False)
+    raw = yaml.safe_load((ROOT / "config" / "trees.yaml").read_text())
+    default = pconfig.load_workflow_config(copy.deepcopy(raw), "default")
+    with pytest.raises(RuntimeError) as e:
+        check_precision_supported(default["models"])
+    msg = str(e.value)
+    assert "models.mlp.precision and models.d3dgs.precision" in msg
+    assert "config/float32.yaml" in msg
+    overlay = yaml.safe_load((ROOT / "config" / "float32.yaml").read_text())
+    for family, body in overlay["models"].items():
+        raw["models"][family].update(body)
+    check_precision_supported(pconfig.load_workflow_config(raw, "default")["models"])  # no raise
+    quick = pconfig.load_workflow_config(
+        yaml.safe_load((ROOT / "config" / "trees.yaml").read_text()), "quick")
+    check_precision_supported(quick["models"])  # the tests' profile runs on any CPU
+
+
 def test_bf16_field_gives_bitwise_equal_gradients_when_run_twice():
     _, b16 = _pair()
     x = torch.rand(300, 40) * 2 - 1

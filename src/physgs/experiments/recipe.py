@@ -135,21 +135,30 @@ def fit(observed, job: Job | dict, *, truth=None, frame_pool=None, progress: boo
 
 
 def _check_precision(job: Job) -> None:
-    """Stop before training a bfloat16 field on a CPU that would emulate bf16 (~48x slower than
-    float32: a default run would take days), naming the setting to change."""
-    family = spec_of(job.model).family
-    if (job.settings.get(family) or {}).get("precision", "float32") != "bfloat16":
+    """Stop before training a bfloat16 field on a CPU that would emulate bf16."""
+    check_precision_supported(job.settings, families=(spec_of(job.model).family,))
+
+
+def check_precision_supported(settings: dict, families: tuple[str, ...] = ("mlp", "d3dgs")) -> None:
+    """Raise RuntimeError if any of ``families`` asks for ``precision: bfloat16`` in the models
+    settings ``settings`` and this CPU has no native bf16 (autocast would emulate it, ~48x
+    slower than float32: a default run would take days), naming the key and the way out. torch
+    is imported only when some family asks for bf16, so planning a float32 run stays light."""
+    asked = [f for f in families if (settings.get(f) or {}).get("precision", "float32") == "bfloat16"]
+    if not asked:
         return
     from physgs.models.fields import native_bf16
 
     if not native_bf16():
         import torch
 
+        keys = " and ".join(f"models.{f}.precision" for f in asked)
         raise RuntimeError(
-            f"models.{family}.precision is bfloat16, but this CPU (torch capability "
+            f"{keys} is bfloat16, but this CPU (torch capability "
             f"{torch.backends.cpu.get_cpu_capability()}) has no native bf16 matmuls: autocast "
-            f"would emulate them, ~48x slower than float32. Set models.{family}.precision: "
-            "float32 in the config, or run on a CPU with AVX-512 BF16 or AMX")
+            "would emulate them, ~48x slower than float32. Run with `--configfile "
+            "config/float32.yaml` (or set precision: float32 in config/trees.yaml), or on a CPU "
+            "with AVX-512 BF16 or AMX")
 
 
 def train_and_save(observed, job: Job | dict, *, checkpoint_path, loss_path,
