@@ -117,3 +117,27 @@ def test_fig_fit_curve_writes_both_formats(tmp_path):
     outs = [tmp_path / "f.pdf", tmp_path / "f.png"]
     fig_fit_curve(df, outs)
     assert all(o.stat().st_size > 1000 for o in outs)
+
+
+def test_fig_fit_curve_labels_wall_time_in_plain_seconds(monkeypatch):
+    """Seconds that span under a decade (40-560 s, as in a default run) get readable ticks:
+    every labelled tick of the wall-time axis is a plain number, and minor ticks carry none
+    (matplotlib's log defaults label minor ticks as 4x10^1, 6x10^1, ... that overlap)."""
+    from physgs.report import figures
+    captured = []
+    monkeypatch.setattr(figures, "save_figure", lambda fig, outputs: captured.append(fig))
+    pts = [{"model": m, "seed": s, "iterations": it, "fit": 20.0 + it / 1000, "heldout": 19.0,
+            "time": 18.0, "train_s": secs} for m, secs0 in (("mlp", 40.0), ("d3dgs", 140.0))
+           for it, secs in ((1500, secs0), (6000, secs0 * 4)) for s in (0, 1)]
+    own = {s: {m: _row(20.0 + s) for m in ("static", "mlp", "d3dgs", "truth_motion")}
+           for s in (0, 1)}
+    figures.fig_fit_curve(fc.collect(pts, own, 3000, "medium"), ["unused.png"])
+    fig = captured[0]
+    fig.canvas.draw()
+    ax = fig.axes[2]
+    lo, hi = ax.get_xlim()
+    major = [t.get_text() for t in ax.get_xticklabels() if lo <= t.get_position()[0] <= hi]
+    minor = [t.get_text() for t in ax.get_xticklabels(minor=True)]
+    assert len([t for t in major if t]) >= 3
+    assert all(float(t) > 0 for t in major if t)
+    assert not any(minor)
