@@ -10,6 +10,7 @@ training-window frames.
 
     python benchmarks/band_anneal.py --fraction 0.5 results/testbed/medium --models mlp_wind
 """
+
 from __future__ import annotations
 
 import argparse
@@ -24,10 +25,15 @@ from physgs.models.encoding import fourier
 
 
 def main() -> None:
-    ap = argparse.ArgumentParser(description=__doc__, add_help=False,
-                                 formatter_class=argparse.RawTextHelpFormatter)
-    ap.add_argument("--fraction", type=float, default=0.5,
-                    help="share of the deformation iterations over which the bands open")
+    ap = argparse.ArgumentParser(
+        description=__doc__, add_help=False, formatter_class=argparse.RawTextHelpFormatter
+    )
+    ap.add_argument(
+        "--fraction",
+        type=float,
+        default=0.5,
+        help="share of the deformation iterations over which the bands open",
+    )
     args, rest = ap.parse_known_args()
     progress = {"p": 1.0}  # 0 -> 1 over the annealing; 1 outside training
 
@@ -37,8 +43,10 @@ def main() -> None:
             return enc
         d = x.shape[-1]
         alpha = progress["p"] * bands
-        w = torch.tensor([(1 - math.cos(math.pi * min(max(alpha - k, 0.0), 1.0))) / 2
-                          for k in range(bands)], dtype=x.dtype)  # [bands]
+        w = torch.tensor(
+            [(1 - math.cos(math.pi * min(max(alpha - k, 0.0), 1.0))) / 2 for k in range(bands)],
+            dtype=x.dtype,
+        )  # [bands]
         w = torch.cat([torch.ones(d, dtype=x.dtype), w.repeat_interleave(2 * d)])
         return enc * w
 

@@ -10,6 +10,7 @@ so it scores only training-window frames.
 
     python benchmarks/field_output_scale.py --scale 0.25 results/testbed/medium --models mlp_wind
 """
+
 from __future__ import annotations
 
 import argparse
@@ -19,8 +20,9 @@ from physgs.models.fields import DeformationField
 
 
 def main() -> None:
-    ap = argparse.ArgumentParser(description=__doc__, add_help=False,
-                                 formatter_class=argparse.RawTextHelpFormatter)
+    ap = argparse.ArgumentParser(
+        description=__doc__, add_help=False, formatter_class=argparse.RawTextHelpFormatter
+    )
     ap.add_argument("--scale", type=float, default=1.0, help="factor on every field output")
     args, rest = ap.parse_known_args()
     forward = DeformationField.forward

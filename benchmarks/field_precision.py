@@ -10,6 +10,7 @@ prints the speed-up and the bf16 outputs' error relative to float32 (max |diff| 
 Whether bf16 changes a *trained* model beyond seed noise is measured with
 ``benchmarks/fit_recipe.py --set models.d3dgs.precision=bfloat16`` (README).
 """
+
 from __future__ import annotations
 
 import argparse
@@ -26,6 +27,7 @@ def fwd_bwd_ms(field: DeformationField, x: torch.Tensor, reps: int) -> float:
     def step():
         field.zero_grad()
         sum(o.square().sum() for o in field(x).values()).backward()
+
     for _ in range(2):
         step()
     best = float("inf")
@@ -44,22 +46,30 @@ def main() -> None:
     torch.set_num_threads(args.threads)
     cfg = physgs.config.load("config/trees.yaml", "default")
     m = cfg["models"]
-    print(f"# torch {torch.__version__}, CPU capability {torch.backends.cpu.get_cpu_capability()}, "
-          f"native bf16: {native_bf16()}, {args.threads} thread(s)")
-    print(f"{'field':12s} {'N':>6s} {'fp32 ms':>8s} {'bf16 ms':>8s} {'speed-up':>8s} {'rel err':>8s}")
+    print(
+        f"# torch {torch.__version__}, CPU capability {torch.backends.cpu.get_cpu_capability()}, "
+        f"native bf16: {native_bf16()}, {args.threads} thread(s)"
+    )
+    print(
+        f"{'field':12s} {'N':>6s} {'fp32 ms':>8s} {'bf16 ms':>8s} {'speed-up':>8s} {'rel err':>8s}"
+    )
     for arch in ("mlp", "d3dgs"):
         a = m[arch]
         heads = ("dx",) if arch == "mlp" else ("dx", "dq", "ds")
         for wind in (False, True):
-            in_dim = (fourier_dim(3, a["pos_bands"]) + fourier_dim(1, a["time_bands"])
-                      + (m["wind_window"]["values"] if wind else 0))
+            in_dim = (
+                fourier_dim(3, a["pos_bands"])
+                + fourier_dim(1, a["time_bands"])
+                + (m["wind_window"]["values"] if wind else 0)
+            )
             for tree, n in cfg["testbed"]["vertices"].items():
                 torch.manual_seed(0)
                 f32 = DeformationField(in_dim, a["depth"], a["width"], a.get("skip"), heads)
                 for h in f32.heads.values():
                     torch.nn.init.normal_(h.weight, std=0.05)
-                b16 = DeformationField(in_dim, a["depth"], a["width"], a.get("skip"), heads,
-                                       "bfloat16")
+                b16 = DeformationField(
+                    in_dim, a["depth"], a["width"], a.get("skip"), heads, "bfloat16"
+                )
                 b16.load_state_dict(f32.state_dict())
                 x = torch.rand(n, in_dim) * 2 - 1
                 with torch.no_grad():

@@ -9,6 +9,7 @@ splits: this is what recipe settings are chosen on.
     python benchmarks/fit_recipe.py results/testbed/medium --models static,mlp,truth_motion \
         --set train.iterations=3000 --set train.lr.deform=2e-3
 """
+
 from __future__ import annotations
 
 import argparse
@@ -68,8 +69,10 @@ def main(argv: list[str] | None = None) -> None:
     if "static" in res and "truth_motion" in res:
         s, c = res["static"][0], res["truth_motion"][0]
         for m, (f, h, _) in res.items():
-            print(f"{m:14s} of ceiling: fit {100 * (f - s) / (c - s):5.0f}%  held "
-                  f"{100 * (h - res['static'][1]) / (res['truth_motion'][1] - res['static'][1]):5.0f}%")
+            print(
+                f"{m:14s} of ceiling: fit {100 * (f - s) / (c - s):5.0f}%  held "
+                f"{100 * (h - res['static'][1]) / (res['truth_motion'][1] - res['static'][1]):5.0f}%"
+            )
 
 
 if __name__ == "__main__":

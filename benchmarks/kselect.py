@@ -6,6 +6,7 @@ Prints one row per candidate K (training + scoring seconds, held-out PSNR, BIC, 
 and the total per tree. Budget (issue 6): quick well under a minute per tree; default all three
 trees within about 5 minutes on 2 cores.
 """
+
 import argparse
 import time
 
@@ -25,8 +26,10 @@ def main() -> None:
     torch.set_num_threads(a.threads)
     cfg = physgs.config.load("config/trees.yaml", a.profile)
     ks = cfg["models"]["kselect"]
-    print(f"profile {a.profile}: candidates {ks['candidates']}, {ks['iterations']} iterations "
-          f"each, method {ks['method']}")
+    print(
+        f"profile {a.profile}: candidates {ks['candidates']}, {ks['iterations']} iterations "
+        f"each, method {ks['method']}"
+    )
     print(f"{'file':40s} {'K':>4s} {'seconds':>8s} {'heldout dB':>10s} {'BIC':>12s} {'frozen':>6s}")
     for path in a.observed:
         obs = load_observed(path)
@@ -34,10 +37,14 @@ def main() -> None:
         sel = select_k(obs, cfg)
         total = time.perf_counter() - t0
         for i, k in enumerate(sel.candidates):
-            print(f"{path[-40:]:40s} {k:4d} {sel.wall_s[i]:8.1f} {sel.heldout_psnr[i]:10.3f} "
-                  f"{sel.bic[i]:12.4g} {sel.frozen[i]:6d}")
-        print(f"{path[-40:]:40s} total {total:.1f} s; chosen K {sel.chosen_k} (heldout "
-              f"{sel.k_heldout}, bic {sel.k_bic})")
+            print(
+                f"{path[-40:]:40s} {k:4d} {sel.wall_s[i]:8.1f} {sel.heldout_psnr[i]:10.3f} "
+                f"{sel.bic[i]:12.4g} {sel.frozen[i]:6d}"
+            )
+        print(
+            f"{path[-40:]:40s} total {total:.1f} s; chosen K {sel.chosen_k} (heldout "
+            f"{sel.k_heldout}, bic {sel.k_bic})"
+        )
 
 
 if __name__ == "__main__":

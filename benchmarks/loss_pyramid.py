@@ -9,6 +9,7 @@ training-window frames.
 
     python benchmarks/loss_pyramid.py --levels 1,2,4,8 results/testbed/medium --models mlp_wind
 """
+
 from __future__ import annotations
 
 import argparse
@@ -26,8 +27,10 @@ def pyramid_loss(levels: list[int]):
 
     def loss(render: torch.Tensor, target: torch.Tensor, ssim_weight: float = 0.2):
         r, t = render.permute(2, 0, 1)[None], target.permute(2, 0, 1)[None]  # [1, 3, H, W]
-        l1s = [((F.avg_pool2d(r, k) - F.avg_pool2d(t, k)) if k > 1 else (r - t)).abs().mean()
-               for k in levels]
+        l1s = [
+            ((F.avg_pool2d(r, k) - F.avg_pool2d(t, k)) if k > 1 else (r - t)).abs().mean()
+            for k in levels
+        ]
         dssim = 1.0 - ssim(render, target)
         return (1 - ssim_weight) * torch.stack(l1s).mean() + ssim_weight * dssim, l1s[0], dssim
 
@@ -35,8 +38,9 @@ def pyramid_loss(levels: list[int]):
 
 
 def main() -> None:
-    ap = argparse.ArgumentParser(description=__doc__, add_help=False,
-                                 formatter_class=argparse.RawTextHelpFormatter)
+    ap = argparse.ArgumentParser(
+        description=__doc__, add_help=False, formatter_class=argparse.RawTextHelpFormatter
+    )
     ap.add_argument("--levels", default="1,2,4,8", help="pooling factors, 1 = full resolution")
     args, rest = ap.parse_known_args()
     # the training loop looks the loss up in its own module at every iteration

@@ -8,6 +8,7 @@ rest through harmonics its ReLU layers build, which is slow to learn (spectral b
 
     python benchmarks/motion_spectrum.py results/testbed/sparse results/testbed/medium
 """
+
 from __future__ import annotations
 
 import argparse
@@ -27,13 +28,15 @@ def main() -> None:
     n, fps = int(cfg["testbed"]["n_train"]), float(cfg["testbed"]["fps"])
     fields = {m: int(cfg["models"][m]["time_bands"]) for m in ("mlp", "d3dgs")}
     tops = {m: time_band_top_hz(b, n, fps) for m, b in fields.items()}
-    print(f"{'dataset':24s} {'median Hz':>9s} " + " ".join(
-        f"{f'<= {m} top ({tops[m]:.2f} Hz)':>24s}" for m in fields))
+    print(
+        f"{'dataset':24s} {'median Hz':>9s} "
+        + " ".join(f"{f'<= {m} top ({tops[m]:.2f} Hz)':>24s}" for m in fields)
+    )
     for d in args.datasets:
         x = truth_motion_window(load_truth(d / "truth.npz"), n)
         grid = [i / 100 for i in range(0, 1201)]  # Hz, for the median
         shares = displacement_energy_below(x, fps, [*tops.values(), *grid])  # one FFT
-        share, cum = shares[:len(tops)], shares[len(tops):]
+        share, cum = shares[: len(tops)], shares[len(tops) :]
         median = next(f for f, c in zip(grid, cum) if c >= 0.5)
         print(f"{str(d):24s} {median:9.2f} " + " ".join(f"{100 * s:23.1f}%" for s in share))
 

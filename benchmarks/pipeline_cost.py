@@ -7,6 +7,7 @@ seconds by stage, per training seed and shared (testbeds), the damping benchmark
 given the run's measured wall time (``--wall-s``, e.g. from ``/usr/bin/time``), the wall time one
 more seed would add on the same machine and core count.
 """
+
 from __future__ import annotations
 
 import argparse
@@ -27,18 +28,27 @@ def main() -> None:
     seeds = list(summary["per_seed"])
     cols = ["shared", *seeds]
     print("job minutes (sum of benchmarked job wall times)")
-    print(f"{'stage':<16}" + "".join(f"{('seed ' + str(c)) if c != 'shared' else c:>10}" for c in cols))
+    print(
+        f"{'stage':<16}"
+        + "".join(f"{('seed ' + str(c)) if c != 'shared' else c:>10}" for c in cols)
+    )
     for stage, row in sorted(summary["by_stage"].items()):
         print(f"{stage:<16}" + "".join(f"{_min(row.get(c, 0.0)):>10}" for c in cols))
-    print(f"{'total':<16}{_min(summary['shared_s']):>10}"
-          + "".join(f"{_min(summary['per_seed'][s]):>10}" for s in seeds))
-    print(f"\nall jobs: {_min(summary['total_s']).strip()} job-min; damping benchmark: "
-          f"{_min(summary['damping_s']).strip()} job-min "
-          f"({', '.join(f'seed {s}: {_min(v).strip()}' for s, v in summary['damping_per_seed'].items())})")
+    print(
+        f"{'total':<16}{_min(summary['shared_s']):>10}"
+        + "".join(f"{_min(summary['per_seed'][s]):>10}" for s in seeds)
+    )
+    print(
+        f"\nall jobs: {_min(summary['total_s']).strip()} job-min; damping benchmark: "
+        f"{_min(summary['damping_s']).strip()} job-min "
+        f"({', '.join(f'seed {s}: {_min(v).strip()}' for s, v in summary['damping_per_seed'].items())})"
+    )
     if args.wall_s:
         extra = extra_seed_wall_s(summary, run_wall_s=args.wall_s)
-        print(f"run wall time {_min(args.wall_s).strip()} min = {args.wall_s / summary['total_s']:.2f} x "
-              f"job time; one more seed adds ~{_min(extra).strip()} min of wall time")
+        print(
+            f"run wall time {_min(args.wall_s).strip()} min = {args.wall_s / summary['total_s']:.2f} x "
+            f"job time; one more seed adds ~{_min(extra).strip()} min of wall time"
+        )
 
 
 if __name__ == "__main__":

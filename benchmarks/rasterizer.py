@@ -8,6 +8,7 @@ physgs.render.scenes. Usage:
 
     python benchmarks/rasterizer.py [--reps 7] [--ref-reps 2] [--sizes 2000,10000,30000]
 """
+
 from __future__ import annotations
 
 import argparse
@@ -49,9 +50,13 @@ def one(backend: str, n: int, res: int, reps: int) -> dict:
         for p in params:
             p.grad = None
     peak = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024 - base
-    return {"fwd_ms": 1e3 * statistics.median(fwd), "fb_ms": 1e3 * statistics.median(fb),
-            "fb_min_ms": 1e3 * min(fb),
-            "peak_mib": max(peak, 0.0), "alpha_mean": float(out.alpha.mean())}
+    return {
+        "fwd_ms": 1e3 * statistics.median(fwd),
+        "fb_ms": 1e3 * statistics.median(fb),
+        "fb_min_ms": 1e3 * min(fb),
+        "peak_mib": max(peak, 0.0),
+        "alpha_mean": float(out.alpha.mean()),
+    }
 
 
 def main() -> None:
@@ -60,14 +65,17 @@ def main() -> None:
     ap.add_argument("--ref-reps", type=int, default=2, help="timed calls per reference cell")
     ap.add_argument("--sizes", default="2000,10000,30000")
     ap.add_argument("--res", default="128,256")
-    ap.add_argument("--one", nargs=4, metavar=("BACKEND", "N", "RES", "REPS"),
-                    help=argparse.SUPPRESS)
+    ap.add_argument(
+        "--one", nargs=4, metavar=("BACKEND", "N", "RES", "REPS"), help=argparse.SUPPRESS
+    )
     a = ap.parse_args()
     if a.one:
         print(json.dumps(one(a.one[0], int(a.one[1]), int(a.one[2]), int(a.one[3]))))
         return
-    print(f"{'N':>6} {'res':>4} | {'fast fwd':>9} {'fast f+b':>9} {'(min)':>7} {'MiB':>6} | "
-          f"{'ref fwd':>9} {'ref f+b':>9} {'MiB':>6} | {'speed-up f+b':>12}")
+    print(
+        f"{'N':>6} {'res':>4} | {'fast fwd':>9} {'fast f+b':>9} {'(min)':>7} {'MiB':>6} | "
+        f"{'ref fwd':>9} {'ref f+b':>9} {'MiB':>6} | {'speed-up f+b':>12}"
+    )
     for res in (int(r) for r in a.res.split(",")):
         for n in (int(s) for s in a.sizes.split(",")):
             row = {}
@@ -76,10 +84,13 @@ def main() -> None:
                 out = subprocess.run(cmd, capture_output=True, text=True, check=True)
                 row[backend] = json.loads(out.stdout.strip().splitlines()[-1])
             f, r = row["fast"], row["reference"]
-            print(f"{n:>6} {res:>4} | {f['fwd_ms']:>9.1f} {f['fb_ms']:>9.1f} "
-                  f"{f['fb_min_ms']:>7.1f} {f['peak_mib']:>6.0f} | "
-                  f"{r['fwd_ms']:>9.1f} {r['fb_ms']:>9.1f} {r['peak_mib']:>6.0f} | "
-                  f"{r['fb_ms'] / f['fb_ms']:>11.1f}x", flush=True)
+            print(
+                f"{n:>6} {res:>4} | {f['fwd_ms']:>9.1f} {f['fb_ms']:>9.1f} "
+                f"{f['fb_min_ms']:>7.1f} {f['peak_mib']:>6.0f} | "
+                f"{r['fwd_ms']:>9.1f} {r['fb_ms']:>9.1f} {r['peak_mib']:>6.0f} | "
+                f"{r['fb_ms'] / f['fb_ms']:>11.1f}x",
+                flush=True,
+            )
 
 
 if __name__ == "__main__":

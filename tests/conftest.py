@@ -1,4 +1,5 @@
 """Shared fixtures: a small rasterized 'swaying tree' dataset that stands in for the testbed."""
+
 from __future__ import annotations
 
 import math
@@ -28,8 +29,9 @@ def swaying_dataset(seed: int = 0) -> SimpleNamespace:
     crown = rng.normal(size=(90, 3)) * [0.35, 0.35, 0.3] + [0, 0, 1.4]
     xyz = np.concatenate([trunk, crown]).astype(np.float32)  # [N, 3]
     n = xyz.shape[0]
-    col = torch.tensor(np.where(np.arange(n)[:, None] < 30, [0.4, 0.25, 0.1], [0.2, 0.6, 0.2]),
-                       dtype=torch.float32)
+    col = torch.tensor(
+        np.where(np.arange(n)[:, None] < 30, [0.4, 0.25, 0.1], [0.2, 0.6, 0.2]), dtype=torch.float32
+    )
     cam = look_at((0.0, -4.5, 1.0), (0.0, 0.0, 1.0), fov_deg=40, width=RES, height=RES)
     F = N_TRAIN + N_TAIL
     cond = np.array([1.0, 0.84, 0.71])
@@ -41,12 +43,30 @@ def swaying_dataset(seed: int = 0) -> SimpleNamespace:
         for j in range(F):
             m = xyz.copy()
             m[:, 0] += cond[c] * 0.12 * xyz[:, 2] ** 2 * math.sin(2 * math.pi * 0.8 * j / FPS)
-            out = rasterization(torch.tensor(m), q, s, o, col, cam, [1.0, 1.0, 1.0],
-                                backend="fast", return_depth=False)
+            out = rasterization(
+                torch.tensor(m),
+                q,
+                s,
+                o,
+                col,
+                cam,
+                [1.0, 1.0, 1.0],
+                backend="fast",
+                return_depth=False,
+            )
             frames[c, j] = np.round(out.rgb.numpy() * 255).astype(np.uint8)
-    return SimpleNamespace(fps=FPS, n_train=N_TRAIN, n_tail=N_TAIL, lead_in_frames=LEAD_IN,
-                           conditions=cond, wind=wind.astype(np.float32), frames=frames,
-                           train_camera=cam, background=np.ones(3), canonical_xyz=xyz)
+    return SimpleNamespace(
+        fps=FPS,
+        n_train=N_TRAIN,
+        n_tail=N_TAIL,
+        lead_in_frames=LEAD_IN,
+        conditions=cond,
+        wind=wind.astype(np.float32),
+        frames=frames,
+        train_camera=cam,
+        background=np.ones(3),
+        canonical_xyz=xyz,
+    )
 
 
 @pytest.hookimpl(tryfirst=True)  # before pytest-xdist reads the groups
@@ -88,8 +108,16 @@ def quick_dag(tmp_path_factory):
             pytest.fail(f"the quick DAG failed to build in another worker:\n{failed.read_text()}")
         if not (wd / ".built").exists():
             try:
-                snakemake(workflow_copy(wd), "--cores", "2", "all", "--config", "profile=quick",
-                          'trees=["sparse"]', timeout=900)
+                snakemake(
+                    workflow_copy(wd),
+                    "--cores",
+                    "2",
+                    "all",
+                    "--config",
+                    "profile=quick",
+                    'trees=["sparse"]',
+                    timeout=900,
+                )
             except AssertionError as err:
                 failed.write_text(str(err))
                 raise

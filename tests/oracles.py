@@ -5,6 +5,7 @@ small builders they share. Each oracle's docstring says what it is independent o
 ``from oracles import ...``: tests/ has no __init__.py, so pytest puts it on sys.path (as for
 workflow_helpers).
 """
+
 from __future__ import annotations
 
 import copy
@@ -24,6 +25,7 @@ ROOT = Path(__file__).resolve().parents[1]
 
 # -- the damped oscillator theta'' + 2 zeta omega theta' + omega^2 theta = f ----------------------
 
+
 def gusty_wind(T, seed=0):
     """Synthetic gusty wind [T] m/s: 6 + 1.5 N(0, 1), seeded."""
     rng = np.random.default_rng(seed)
@@ -35,7 +37,7 @@ def wind_lsim(omega, zeta, gain, wind, vbar, dt):
     scipy.signal.lsim's exact first-order-hold LTI solution (matrix exponential) of the state-space
     system. Independent of physgs's RK4 solver (physgs.models.oscillator) and of the testbed's
     simulator (physgs.testbed.physics)."""
-    A = [[0.0, 1.0], [-omega**2, -2 * zeta * omega]]
+    A = [[0.0, 1.0], [-(omega**2), -2 * zeta * omega]]
     sys = scipy.signal.StateSpace(A, [[0.0], [gain]], [[1.0, 0.0]], [[0.0]])
     t = np.arange(len(wind)) * dt
     _, y, _ = scipy.signal.lsim(sys, wind**2 - vbar**2, t, X0=[0.0, 0.0], interp=True)
@@ -74,6 +76,7 @@ def t64(x):
 
 # -- models ---------------------------------------------------------------------------------------
 
+
 def quick_config():
     """config/trees.yaml resolved under the quick profile."""
     return physgs.config.load(ROOT / "config" / "trees.yaml", "quick")
@@ -101,11 +104,20 @@ def model_context(n, seed, lead_in, wind=None):
     rng = np.random.default_rng(seed)
     xyz = rng.normal(size=(n, 3)) * [0.5, 0.5, 1.0] + [0.0, 0.0, 2.0]
     w = 6.0 + 1.5 * rng.standard_normal(lead_in + 350) if wind is None else wind
-    return ModelContext(xyz.astype(np.float32), 24, 300, lead_in, float(w.mean()), float(w.std()),
-                        float((w**2 - w.mean() ** 2).std()), np.array([0.0, 1.0, 0.0])), w
+    return ModelContext(
+        xyz.astype(np.float32),
+        24,
+        300,
+        lead_in,
+        float(w.mean()),
+        float(w.std()),
+        float((w**2 - w.mean() ** 2).std()),
+        np.array([0.0, 1.0, 0.0]),
+    ), w
 
 
 # -- rendering ------------------------------------------------------------------------------------
+
 
 def pixel_centres(cam):
     """(x, y) of every pixel centre [H, W], at half-integer pixel coordinates."""
@@ -121,6 +133,7 @@ def rotation_wxyz(q):
 
 # -- testbed --------------------------------------------------------------------------------------
 
+
 def simulate_trees(cfg):
     """{tree: simulation} for every tree of a resolved config (physics only, no frames)."""
     tb = cfg["testbed"]
@@ -133,8 +146,14 @@ def tiny_testbed(tmp_dir, resolution, fill_height):
     saved as tmp_dir/observed.npz and tmp_dir/truth.npz. Returns (testbed config, tmp_dir)."""
     cfg = quick_config()
     tb = copy.deepcopy(cfg["testbed"])
-    tb.update(n_train=20, n_tail=4, resolution=resolution, supersample=1,
-              heldout_azimuths_deg=[-30, 60], fill_height=fill_height)
+    tb.update(
+        n_train=20,
+        n_tail=4,
+        resolution=resolution,
+        supersample=1,
+        heldout_azimuths_deg=[-30, 60],
+        fill_height=fill_height,
+    )
     obs, tru = build_dataset(tb, cfg["presets"]["sparse"], seed=0, tree="sparse", progress=False)
     save_dataset(obs, tru, tmp_dir / "observed.npz", tmp_dir / "truth.npz")
     return tb, tmp_dir

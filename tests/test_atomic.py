@@ -1,4 +1,5 @@
 """Atomic writes: outputs get the mode of an ordinary new file (0666 less the umask)."""
+
 import os
 import stat
 
@@ -35,8 +36,9 @@ WRITERS = {
 }
 
 
-@pytest.mark.parametrize("mask, expected", [(0o022, 0o644), (0o027, 0o640), (0o077, 0o600),
-                                            (0o002, 0o664)])
+@pytest.mark.parametrize(
+    "mask, expected", [(0o022, 0o644), (0o027, 0o640), (0o077, 0o600), (0o002, 0o664)]
+)
 @pytest.mark.parametrize("writer", sorted(WRITERS))
 def test_outputs_get_the_umask_mode(tmp_path, umask, mask, expected, writer):
     umask(mask)

@@ -1,4 +1,5 @@
 """Config loading: the packaged schema, profile resolution, unknown keys and cross-key checks."""
+
 import copy
 import shutil
 import subprocess
@@ -58,12 +59,23 @@ def test_schema_ships_inside_the_package():
 
 
 def test_partial_schema_drops_required_and_inlines_refs():
-    s = {"type": "object", "required": ["a"], "properties": {
-        "a": {"$ref": "#/$defs/x"}, "b": {"type": "array", "items": {"required": ["c"]}}},
-        "$defs": {"x": {"type": "object", "required": ["y"], "properties": {"y": {}}}}}
+    s = {
+        "type": "object",
+        "required": ["a"],
+        "properties": {
+            "a": {"$ref": "#/$defs/x"},
+            "b": {"type": "array", "items": {"required": ["c"]}},
+        },
+        "$defs": {"x": {"type": "object", "required": ["y"], "properties": {"y": {}}}},
+    }
     p = pconfig.partial_schema(s)
-    assert p == {"type": "object", "properties": {
-        "a": {"type": "object", "properties": {"y": {}}}, "b": {"type": "array", "items": {}}}}
+    assert p == {
+        "type": "object",
+        "properties": {
+            "a": {"type": "object", "properties": {"y": {}}},
+            "b": {"type": "array", "items": {}},
+        },
+    }
     assert s["required"] == ["a"]  # the input is not changed
 
 
@@ -82,13 +94,16 @@ def test_an_empty_profile_changes_nothing():
     assert pconfig.load_workflow_config(base, "default") == pconfig.load(CONFIG, "default")
 
 
-@pytest.mark.parametrize("path, value", [
-    (("testbed", "zeta"), -0.1),
-    (("train", "warmup"), -5),  # a recipe setting out of range
-    (("train", "lr_final_ratio"), 0.0),
-    (("speed_accuracy", "fit_curve", "iterations"), [500, 1]),
-    (("speed_accuracy", "fit_curve", "models"), ["mlp", "truth_motion"]),
-])
+@pytest.mark.parametrize(
+    "path, value",
+    [
+        (("testbed", "zeta"), -0.1),
+        (("train", "warmup"), -5),  # a recipe setting out of range
+        (("train", "lr_final_ratio"), 0.0),
+        (("speed_accuracy", "fit_curve", "iterations"), [500, 1]),
+        (("speed_accuracy", "fit_curve", "models"), ["mlp", "truth_motion"]),
+    ],
+)
 def test_schema_violation_names_the_key(path, value):
     base = _base()
     _set(path, value)(base)
@@ -117,8 +132,9 @@ def test_command_line_seeds_beat_the_profiles():
     with pytest.raises(pconfig.ConfigError, match="seeds"):
         bad(raw, "quick", command_line={"seeds": [2, 2]})
     # Snakemake hands `--config seeds=[0,1]` over as strings (YAML BaseLoader)
-    assert bad({**raw, "seeds": ["0", "1"]}, "quick",
-               command_line={"seeds": ["0", "1"]})["seeds"] == [0, 1]
+    assert bad({**raw, "seeds": ["0", "1"]}, "quick", command_line={"seeds": ["0", "1"]})[
+        "seeds"
+    ] == [0, 1]
     with pytest.raises(pconfig.ConfigError, match="seeds/0"):
         bad({**raw, "seeds": ["1.5"]}, "quick", command_line={"seeds": ["1.5"]})
 
@@ -150,27 +166,54 @@ def test_missing_section_is_named():
 # --- unknown keys, with the nearest valid key ---------------------------------------------------
 
 
-@pytest.mark.parametrize("edit, key, suggestion", [
-    (lambda c: c["profiles"]["quick"].update(trian={"iterations": 5}),
-     "profiles/quick/trian", "profiles/quick/train"),
-    (lambda c: c["profiles"]["quick"]["train"].update(iteration=5),
-     "profiles/quick/train/iteration", "profiles/quick/train/iterations"),
-    (lambda c: c["profiles"]["paper"].update(testbed={"resolutoin": 256}),
-     "profiles/paper/testbed/resolutoin", "profiles/paper/testbed/resolution"),
-    (lambda c: c["profiles"]["quick"]["models"].update(mlp={"widht": 64}),
-     "profiles/quick/models/mlp/widht", "profiles/quick/models/mlp/width"),
-    (lambda c: c["profiles"]["quick"]["presets"]["medium"]["leaves"].update(fractoin=0.2),
-     "profiles/quick/presets/medium/leaves/fractoin", "profiles/quick/presets/medium/leaves/fraction"),
-    (lambda c: c["profiles"]["quick"].update(iterations=5),
-     "profiles/quick/iterations", "profiles/quick/train/iterations"),
-    (lambda c: c.update(seds=[0, 1]), "seds", "seeds"),
-    (lambda c: c["train"]["lr"].update(mens=1e-4), "train/lr/mens", "train/lr/means"),
-    (lambda c: c["testbed"]["vertices"].update(sprase=400), "testbed/vertices/sprase",
-     "testbed/vertices/sparse"),
-    (lambda c: c["presets"].update(mediun=c["presets"]["medium"]), "presets/mediun",
-     "presets/medium"),
-    (lambda c: c["testbed"]["wind"].update(v_0=5.0), "testbed/wind/v_0", "testbed/wind/v0"),
-])
+@pytest.mark.parametrize(
+    "edit, key, suggestion",
+    [
+        (
+            lambda c: c["profiles"]["quick"].update(trian={"iterations": 5}),
+            "profiles/quick/trian",
+            "profiles/quick/train",
+        ),
+        (
+            lambda c: c["profiles"]["quick"]["train"].update(iteration=5),
+            "profiles/quick/train/iteration",
+            "profiles/quick/train/iterations",
+        ),
+        (
+            lambda c: c["profiles"]["paper"].update(testbed={"resolutoin": 256}),
+            "profiles/paper/testbed/resolutoin",
+            "profiles/paper/testbed/resolution",
+        ),
+        (
+            lambda c: c["profiles"]["quick"]["models"].update(mlp={"widht": 64}),
+            "profiles/quick/models/mlp/widht",
+            "profiles/quick/models/mlp/width",
+        ),
+        (
+            lambda c: c["profiles"]["quick"]["presets"]["medium"]["leaves"].update(fractoin=0.2),
+            "profiles/quick/presets/medium/leaves/fractoin",
+            "profiles/quick/presets/medium/leaves/fraction",
+        ),
+        (
+            lambda c: c["profiles"]["quick"].update(iterations=5),
+            "profiles/quick/iterations",
+            "profiles/quick/train/iterations",
+        ),
+        (lambda c: c.update(seds=[0, 1]), "seds", "seeds"),
+        (lambda c: c["train"]["lr"].update(mens=1e-4), "train/lr/mens", "train/lr/means"),
+        (
+            lambda c: c["testbed"]["vertices"].update(sprase=400),
+            "testbed/vertices/sprase",
+            "testbed/vertices/sparse",
+        ),
+        (
+            lambda c: c["presets"].update(mediun=c["presets"]["medium"]),
+            "presets/mediun",
+            "presets/medium",
+        ),
+        (lambda c: c["testbed"]["wind"].update(v_0=5.0), "testbed/wind/v_0", "testbed/wind/v0"),
+    ],
+)
 def test_unknown_key_is_refused_with_the_nearest_valid_key(edit, key, suggestion):
     msg = _refused(edit)
     assert f"unknown config key '{key}'" in msg
@@ -200,6 +243,7 @@ def test_every_problem_is_reported_at_once():
     def edit(c):
         c["profiles"]["quick"]["trian"] = {}
         c["testbed"]["fsp"] = 24
+
     msg = _refused(edit)
     assert "2 problems" in msg and "profiles/quick/trian" in msg and "testbed/fsp" in msg
 
@@ -213,48 +257,66 @@ def _set(path, value, profile=None):
         for k in path[:-1]:
             node = node.setdefault(k, {})
         node[path[-1]] = value
+
     return edit
 
 
-@pytest.mark.parametrize("edit, profile, key", [
-    # the K-selection warm-up is its own key, not train/warmup
-    (_set(("models", "kselect", "warmup"), 30, "quick"), "quick", "models/kselect/warmup"),
-    (_set(("models", "kselect", "warmup"), 160), "default", "models/kselect/warmup"),
-    (_set(("train", "warmup"), 40, "quick"), "quick", "train/warmup"),
-    (_set(("train", "warmup"), 40000, "paper"), "paper", "train/warmup"),
-    (_set(("models", "ours", "omega_hz"), [3.0, 0.1]), "default", "models/ours/omega_hz"),
-    (_set(("models", "ours", "omega_init_hz"), 5.0), "default", "models/ours/omega_init_hz"),
-    (_set(("models", "ours", "zeta"), [0.5, 0.01]), "default", "models/ours/zeta"),
-    (_set(("models", "ours", "zeta_init"), 0.6), "default", "models/ours/zeta_init"),
-    (_set(("models", "ours", "freeze_at"), 0.1), "default", "models/ours/freeze_at"),
-    # quick's sparse tree has 400 Gaussians
-    (_set(("models", "configs", "joint96", "K"), 500), "quick", "models/configs/joint96/K"),
-    (_set(("models", "kselect", "candidates"), [4, 401], "quick"), "quick",
-     "models/kselect/candidates/1"),
-    (_set(("speed_accuracy", "knobs", "K"), [8, 3000]), "default", "speed_accuracy/knobs/K/1"),
-    (lambda c: (_set(("models", "configs", "single", "K"), 100)(c),
-                _set(("speed_accuracy", "knobs", "vertices"), [60, 2000])(c)), "default",
-     "speed_accuracy/knobs/vertices/0"),
-    (lambda c: c.update(trees=["medium", "dense"]), "default", "speed_accuracy/tree"),
-    (_set(("speed_accuracy", "tree"), "dense", "quick"), "quick", None),
-    (_set(("testbed", "lead_in_tau"), 20.0), "default", "testbed/lead_in_tau"),
-    (_set(("testbed", "band_hz"), [1.5, 0.35]), "default", "testbed/band_hz"),
-    (_set(("testbed", "wind", "f_lo_hz"), 9.0), "default", "testbed/wind/f_lo_hz"),
-    (_set(("testbed", "conditions"), [1.0]), "default", "testbed/conditions"),
-    (_set(("testbed", "conditions"), [0.84, 1.0]), "quick", "testbed/conditions/0"),
-    (lambda c: c["testbed"]["vertices"].pop("sparse"), "default", "testbed/vertices/sparse"),
-    (lambda c: c["presets"].pop("medium"), "default", "presets/medium"),
-    (lambda c: c["models"]["configs"].pop("single"), "default", "models/configs/single"),
-    (_set(("models", "configs", "auto"), {"conditions": "train", "K": 8}), "default",
-     "models/configs/auto"),
-    # a preset that cannot reach its bone count (here: one more bone than it builds)
-    (_set(("presets", "sparse", "bones"), 23), "default", "presets/sparse"),
-    (_set(("train", "holdout_every"), 1), "default", "train/holdout_every"),
-    # the fit curve's profile point is the pipeline's own job on its tree; three budgets at least
-    (lambda c: c.update(trees=["sparse", "dense"]), "default", "speed_accuracy/fit_curve/tree"),
-    (_set(("speed_accuracy", "fit_curve", "iterations"), [1500]), "default",
-     "speed_accuracy/fit_curve/iterations"),
-])
+@pytest.mark.parametrize(
+    "edit, profile, key",
+    [
+        # the K-selection warm-up is its own key, not train/warmup
+        (_set(("models", "kselect", "warmup"), 30, "quick"), "quick", "models/kselect/warmup"),
+        (_set(("models", "kselect", "warmup"), 160), "default", "models/kselect/warmup"),
+        (_set(("train", "warmup"), 40, "quick"), "quick", "train/warmup"),
+        (_set(("train", "warmup"), 40000, "paper"), "paper", "train/warmup"),
+        (_set(("models", "ours", "omega_hz"), [3.0, 0.1]), "default", "models/ours/omega_hz"),
+        (_set(("models", "ours", "omega_init_hz"), 5.0), "default", "models/ours/omega_init_hz"),
+        (_set(("models", "ours", "zeta"), [0.5, 0.01]), "default", "models/ours/zeta"),
+        (_set(("models", "ours", "zeta_init"), 0.6), "default", "models/ours/zeta_init"),
+        (_set(("models", "ours", "freeze_at"), 0.1), "default", "models/ours/freeze_at"),
+        # quick's sparse tree has 400 Gaussians
+        (_set(("models", "configs", "joint96", "K"), 500), "quick", "models/configs/joint96/K"),
+        (
+            _set(("models", "kselect", "candidates"), [4, 401], "quick"),
+            "quick",
+            "models/kselect/candidates/1",
+        ),
+        (_set(("speed_accuracy", "knobs", "K"), [8, 3000]), "default", "speed_accuracy/knobs/K/1"),
+        (
+            lambda c: (
+                _set(("models", "configs", "single", "K"), 100)(c),
+                _set(("speed_accuracy", "knobs", "vertices"), [60, 2000])(c),
+            ),
+            "default",
+            "speed_accuracy/knobs/vertices/0",
+        ),
+        (lambda c: c.update(trees=["medium", "dense"]), "default", "speed_accuracy/tree"),
+        (_set(("speed_accuracy", "tree"), "dense", "quick"), "quick", None),
+        (_set(("testbed", "lead_in_tau"), 20.0), "default", "testbed/lead_in_tau"),
+        (_set(("testbed", "band_hz"), [1.5, 0.35]), "default", "testbed/band_hz"),
+        (_set(("testbed", "wind", "f_lo_hz"), 9.0), "default", "testbed/wind/f_lo_hz"),
+        (_set(("testbed", "conditions"), [1.0]), "default", "testbed/conditions"),
+        (_set(("testbed", "conditions"), [0.84, 1.0]), "quick", "testbed/conditions/0"),
+        (lambda c: c["testbed"]["vertices"].pop("sparse"), "default", "testbed/vertices/sparse"),
+        (lambda c: c["presets"].pop("medium"), "default", "presets/medium"),
+        (lambda c: c["models"]["configs"].pop("single"), "default", "models/configs/single"),
+        (
+            _set(("models", "configs", "auto"), {"conditions": "train", "K": 8}),
+            "default",
+            "models/configs/auto",
+        ),
+        # a preset that cannot reach its bone count (here: one more bone than it builds)
+        (_set(("presets", "sparse", "bones"), 23), "default", "presets/sparse"),
+        (_set(("train", "holdout_every"), 1), "default", "train/holdout_every"),
+        # the fit curve's profile point is the pipeline's own job on its tree; three budgets at least
+        (lambda c: c.update(trees=["sparse", "dense"]), "default", "speed_accuracy/fit_curve/tree"),
+        (
+            _set(("speed_accuracy", "fit_curve", "iterations"), [1500]),
+            "default",
+            "speed_accuracy/fit_curve/iterations",
+        ),
+    ],
+)
 def test_cross_key_problem_is_refused_naming_the_key(edit, profile, key):
     if key is None:  # a control: the edit alone is fine
         raw = _base()
@@ -275,13 +337,15 @@ def test_kselect_warmup_message_names_its_own_key_and_the_profile_that_set_it():
 
 def test_lead_in_check_uses_the_testbed_formula():
     from physgs.testbed import physics, wind
+
     cfg = pconfig.load(CONFIG, "default")
     cfg["damping_benchmark"]["trees"] = []  # the faithful testbed alone: testbed/zeta decides
     tb = cfg["testbed"]
     F = tb["n_train"] + tb["n_tail"]
     P = round(wind.PERIOD_S * tb["fps"])
-    lead = lambda tau: physics.lead_in_frames(2 * 3.141592653589793 * tb["band_hz"][0],
-                                              tb["zeta"], tau, tb["fps"])
+    lead = lambda tau: physics.lead_in_frames(
+        2 * 3.141592653589793 * tb["band_hz"][0], tb["zeta"], tau, tb["fps"]
+    )
     ok = max(t / 100 for t in range(1, 2000) if lead(t / 100) + F < P)
     for tau, fine in ((ok, True), (ok + 0.01, False)):
         c = copy.deepcopy(cfg)
@@ -300,6 +364,7 @@ def test_a_listed_tree_without_a_vertex_count_is_named_not_a_key_error():
         c["speed_accuracy"]["tree"] = "dense"
         c["testbed"]["vertices"].pop("dense")
         c["profiles"]["quick"]["testbed"]["vertices"].pop("dense")
+
     msg = _refused(edit, "quick")
     assert "config key 'testbed/vertices/dense'" in msg and "KeyError" not in msg
 
@@ -308,7 +373,9 @@ def test_checks_are_one_extensible_list():
     assert all(callable(f) for f in config_checks.CHECKS)
     cfg = pconfig.load(CONFIG, "quick")
     extra = lambda c: iter([(("seed",), "always wrong")])
-    assert config_checks.problems(cfg, [*config_checks.CHECKS, extra]) == [(("seed",), "always wrong")]
+    assert config_checks.problems(cfg, [*config_checks.CHECKS, extra]) == [
+        (("seed",), "always wrong")
+    ]
 
 
 # --- the Snakefile stops at load time ----------------------------------------------------------
@@ -318,12 +385,27 @@ def test_snakefile_refuses_a_bad_override_in_seconds_and_writes_nothing(tmp_path
     for p in ("Snakefile", "config", "workflow"):
         src = ROOT / p
         (shutil.copytree if src.is_dir() else shutil.copy)(src, tmp_path / p)
-    (tmp_path / "bad.yaml").write_text(
-        "profiles: {quick: {models: {kselect: {warmup: 30}}}}\n")
+    (tmp_path / "bad.yaml").write_text("profiles: {quick: {models: {kselect: {warmup: 30}}}}\n")
     t0 = time.perf_counter()
-    r = subprocess.run([sys.executable, "-m", "snakemake", "-n", "--cores", "1", "all",
-                        "--config", "profile=quick", "--configfile", "bad.yaml"],
-                       cwd=tmp_path, capture_output=True, text=True, timeout=60)
+    r = subprocess.run(
+        [
+            sys.executable,
+            "-m",
+            "snakemake",
+            "-n",
+            "--cores",
+            "1",
+            "all",
+            "--config",
+            "profile=quick",
+            "--configfile",
+            "bad.yaml",
+        ],
+        cwd=tmp_path,
+        capture_output=True,
+        text=True,
+        timeout=60,
+    )
     wall = time.perf_counter() - t0
     out = r.stdout + r.stderr
     assert r.returncode != 0
@@ -338,12 +420,14 @@ def test_snakefile_refuses_a_bad_override_in_seconds_and_writes_nothing(tmp_path
 
 def _damping(**transient):
     """Edit: the damping variant, with `transient` keys overridden (zeta_range via the key)."""
+
     def edit(c):
         c["testbed"]["variant"] = "damping"
         zr = transient.pop("zeta_range", None)
         if zr is not None:
             c["testbed"]["damping"]["zeta_range"] = zr
         c["testbed"]["damping"]["transient"].update(transient)
+
     return edit
 
 
@@ -372,21 +456,31 @@ def test_damping_benchmark_trees_and_configs_must_exist():
     assert "damping_benchmark/trees" in msg and "'medium' is not in trees" in msg
 
 
-@pytest.mark.parametrize("edit, key, fix", [
-    (_damping(zeta_range=[0.2, 0.03]), "testbed/damping/zeta_range", "swap them"),
-    (_damping(zeta_range=[0.05, 0.05]), "testbed/damping/zeta_range", "variant: faithful"),
-    (_damping(zeta_range=[0.0, 0.2]), "testbed/damping/zeta_range", "must lie in (0, 1]"),
-    (_damping(zeta_range=[0.03, 1.5]), "testbed/damping/zeta_range", "must lie in (0, 1]"),
-    (_damping(start_s=-1.0), "testbed/damping/transient/start_s", "raise start_s to at least 1"),
-    (_damping(start_s=0.5), "testbed/damping/transient/start_s", "raise start_s to at least 1"),
-    # 8 + 5 s ends after the 12.5 s window: both shifts fit, and so does a longer window
-    (_damping(start_s=8.0), "testbed/damping/transient/calm_s",
-     "lower start_s to at most 7.5, or lower calm_s to at most 4.5, or raise testbed/n_train to "
-     "at least 312"),
-    # one period of band_hz[0] = 0.35 Hz is 2.86 s
-    (_damping(calm_s=2.0), "testbed/damping/transient/calm_s", "raise calm_s to at least 2.86"),
-    (_damping(calm_s=0.0), "testbed/damping/transient/calm_s", "raise calm_s to at least 2.86"),
-])
+@pytest.mark.parametrize(
+    "edit, key, fix",
+    [
+        (_damping(zeta_range=[0.2, 0.03]), "testbed/damping/zeta_range", "swap them"),
+        (_damping(zeta_range=[0.05, 0.05]), "testbed/damping/zeta_range", "variant: faithful"),
+        (_damping(zeta_range=[0.0, 0.2]), "testbed/damping/zeta_range", "must lie in (0, 1]"),
+        (_damping(zeta_range=[0.03, 1.5]), "testbed/damping/zeta_range", "must lie in (0, 1]"),
+        (
+            _damping(start_s=-1.0),
+            "testbed/damping/transient/start_s",
+            "raise start_s to at least 1",
+        ),
+        (_damping(start_s=0.5), "testbed/damping/transient/start_s", "raise start_s to at least 1"),
+        # 8 + 5 s ends after the 12.5 s window: both shifts fit, and so does a longer window
+        (
+            _damping(start_s=8.0),
+            "testbed/damping/transient/calm_s",
+            "lower start_s to at most 7.5, or lower calm_s to at most 4.5, or raise testbed/n_train to "
+            "at least 312",
+        ),
+        # one period of band_hz[0] = 0.35 Hz is 2.86 s
+        (_damping(calm_s=2.0), "testbed/damping/transient/calm_s", "raise calm_s to at least 2.86"),
+        (_damping(calm_s=0.0), "testbed/damping/transient/calm_s", "raise calm_s to at least 2.86"),
+    ],
+)
 def test_bad_damping_settings_stop_at_load_naming_the_key_and_the_fix(edit, key, fix):
     msg = _refused(edit)
     assert f"config key '{key}'" in msg, msg
@@ -411,6 +505,7 @@ def test_the_damping_variant_needs_its_settings():
     def edit(c):
         c["testbed"]["variant"] = "damping"
         c["testbed"].pop("damping")
+
     assert "config key 'testbed/damping' is missing" in _refused(edit)
     assert "testbed/variant" in _refused(lambda c: c["testbed"].update(variant="windy"))
 

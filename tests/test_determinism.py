@@ -1,5 +1,6 @@
 """Same job, same numbers: every model's training job is bitwise reproducible whatever the
 process's random state, and its seed is the only thing that moves it."""
+
 import numpy as np
 import pytest
 import torch

@@ -1,11 +1,19 @@
 """Metrics and splits against hand-computed values."""
+
 from types import SimpleNamespace
 
 import numpy as np
 import pytest
 
 from physgs.camera import orbit_camera
-from physgs.evaluate import EvalResult, centroid_error, evaluate, load_eval, psnr, silhouette_centroid
+from physgs.evaluate import (
+    EvalResult,
+    centroid_error,
+    evaluate,
+    load_eval,
+    psnr,
+    silhouette_centroid,
+)
 
 
 def test_psnr_hand_computed():
@@ -54,18 +62,29 @@ def fake_observed(rng):
     F = n_train + n_tail
     cam = orbit_camera(0, radius=5, height=1, target=(0, 0, 1), fov_deg=40, width=W, height_px=H)
     az = [-15.0, 15.0]
-    hcams = [orbit_camera(a, radius=5, height=1, target=(0, 0, 1), fov_deg=40, width=W, height_px=H)
-             for a in az]
+    hcams = [
+        orbit_camera(a, radius=5, height=1, target=(0, 0, 1), fov_deg=40, width=W, height_px=H)
+        for a in az
+    ]
     hidx = np.array([0, 3])
     masks = np.zeros((C, F, H, W), bool)
     for c in range(C):
         for j in range(F):
             masks[c, j] = disk(H, W, 8.0, 8.0 + 0.0 * j, 3.0)
     return SimpleNamespace(
-        fps=24, n_train=n_train, n_tail=n_tail, lead_in_frames=4, conditions=np.array([1.0, 0.84, 0.71]),
-        frames=rng.integers(60, 190, (C, F, H, W, 3), dtype=np.uint8), masks=masks, train_camera=cam,
-        heldout_azimuths_deg=np.array(az), heldout_cameras=hcams, heldout_frame_idx=hidx,
-        heldout_frames=rng.integers(60, 190, (2, 2, H, W, 3), dtype=np.uint8))
+        fps=24,
+        n_train=n_train,
+        n_tail=n_tail,
+        lead_in_frames=4,
+        conditions=np.array([1.0, 0.84, 0.71]),
+        frames=rng.integers(60, 190, (C, F, H, W, 3), dtype=np.uint8),
+        masks=masks,
+        train_camera=cam,
+        heldout_azimuths_deg=np.array(az),
+        heldout_cameras=hcams,
+        heldout_frame_idx=hidx,
+        heldout_frames=rng.integers(60, 190, (2, 2, H, W, 3), dtype=np.uint8),
+    )
 
 
 def test_evaluate_routes_every_split(tmp_path):
@@ -87,14 +106,18 @@ def test_evaluate_routes_every_split(tmp_path):
         return rgb, alpha
 
     res = evaluate(render_fn, obs)
+
     def db(d):
         return -10 * np.log10(d**2)
+
     np.testing.assert_allclose(res.view_psnr, db(0.05), atol=1e-9)
     np.testing.assert_allclose(res.time_psnr, db(0.02), atol=1e-9)
     np.testing.assert_allclose(res.temporal_psnr[: obs.n_train], db(0.01), atol=1e-9)
     np.testing.assert_allclose(res.train_timestamps_psnr[2], db(0.03), atol=1e-9)
     np.testing.assert_allclose(res.beyond_window_psnr[1], db(0.04), atol=1e-9)
-    np.testing.assert_allclose(res.centroid_err, np.array([0.0, 1.0, 2.0])[:, None] * np.ones((1, 8)), atol=1e-9)
+    np.testing.assert_allclose(
+        res.centroid_err, np.array([0.0, 1.0, 2.0])[:, None] * np.ones((1, 8)), atol=1e-9
+    )
     s = res.summary()
     assert s["beyond_c2"] == pytest.approx(db(0.06)) and s["centroid_c1"] == pytest.approx(1.0)
     res.save(tmp_path / "e.npz")

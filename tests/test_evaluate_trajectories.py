@@ -1,5 +1,6 @@
 """Branch-tip trajectories: ground truth taken at the right wind column, projected by the camera,
 and the prediction read from each tip vertex's own Gaussian (Gaussians are stored permuted)."""
+
 from types import SimpleNamespace
 
 import numpy as np
@@ -23,8 +24,12 @@ def test_tip_trajectories_known_motion():
         R = np.array([[np.cos(a), 0, np.sin(a)], [0, 1, 0], [-np.sin(a), 0, np.cos(a)]])
         return truth.rest_vertices @ R.T
 
-    truth = SimpleNamespace(theta=theta, rest_vertices=rest, tip_vertices=np.array([1, 2]),
-                            vertex_gaussian=np.argsort(gaussian_vertex))
+    truth = SimpleNamespace(
+        theta=theta,
+        rest_vertices=rest,
+        tip_vertices=np.array([1, 2]),
+        vertex_gaussian=np.argsort(gaussian_vertex),
+    )
     obs = SimpleNamespace(n_train=n_train, n_tail=n_tail, lead_in_frames=L, train_camera=cam)
     f = cam.fx
 
@@ -42,6 +47,11 @@ def test_tip_trajectories_known_motion():
     # right Gaussians were read (mesh-order indexing would pair tip 1 with vertex 0's path)
     np.testing.assert_allclose(tr.error_px(), f * 0.01, atol=1e-9)
     # control: means in mesh order (the permutation forgotten) put the tips on the wrong paths
-    forgot = tip_trajectories(lambda j, c: pose_fn(truth, [0.01 * (L + j)]) + [0.0, 0.0, 0.1], truth,
-                              obs, condition=1, pose_fn=pose_fn)
+    forgot = tip_trajectories(
+        lambda j, c: pose_fn(truth, [0.01 * (L + j)]) + [0.0, 0.0, 0.1],
+        truth,
+        obs,
+        condition=1,
+        pose_fn=pose_fn,
+    )
     assert forgot.error_px().min() > 1.0

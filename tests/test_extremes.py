@@ -3,6 +3,7 @@
 Oracles are independent of the solver: scipy.signal.lsim (exact first-order-hold solution by
 matrix exponential, float64) and closed-form step responses. Bounds are derived in each test.
 """
+
 import math
 from types import SimpleNamespace
 
@@ -46,6 +47,7 @@ def _rk4_bound(omega_h, zeta, n_steps):
 
 # -- damping extremes --------------------------------------------------------------------------
 
+
 def test_nearly_undamped_matches_lsim_and_closed_form():
     zeta, omega, n = 1e-4, 2 * math.pi * 0.7, 4
     wind = gusty_wind(T_REC)
@@ -81,8 +83,10 @@ def test_critically_and_over_damped_match_closed_form_and_lsim(zeta):
     # (error / 16 per halving of h, RK4) and an absolute level against lsim
     wind = gusty_wind(T_REC, seed=3)
     ref = wind_lsim(omega, zeta, g, wind, 6.0, DT)
-    errs = [_rel(integrate(t64(omega), t64(zeta), t64(g), wind, 6.0, DT, k)[0].numpy(), ref)
-            for k in (4, 8, 16)]
+    errs = [
+        _rel(integrate(t64(omega), t64(zeta), t64(g), wind, 6.0, DT, k)[0].numpy(), ref)
+        for k in (4, 8, 16)
+    ]
     assert errs[-1] < 1e-6
     ratios = np.array(errs[:-1]) / np.array(errs[1:])
     assert np.all((ratios > 12) & (ratios < 20)), ratios
@@ -113,6 +117,7 @@ def test_model_substeps_cover_an_over_damped_zeta_bound():
 
 
 # -- step size at the band's ends ---------------------------------------------------------------
+
 
 @pytest.mark.parametrize("omega", [2 * math.pi * 0.1, 2 * math.pi * 3.0, 24.0])
 @pytest.mark.parametrize("zeta", [0.01, 0.08, 0.5])
@@ -173,9 +178,17 @@ def test_model_omega_beyond_the_band_is_clamped_to_its_ends_with_finite_gradient
 
 # -- wind extremes ------------------------------------------------------------------------------
 
+
 def test_zero_wind_gives_exactly_zero_theta_and_the_canonical_pose():
-    th = integrate(t64([0.7, 5.0, 18.0]), t64([1e-4, 0.08, 2.5]), t64([1.0, -2.0, 3.0]),
-                   np.zeros(T_REC), 0.0, DT, 5)
+    th = integrate(
+        t64([0.7, 5.0, 18.0]),
+        t64([1e-4, 0.08, 2.5]),
+        t64([1.0, -2.0, 3.0]),
+        np.zeros(T_REC),
+        0.0,
+        DT,
+        5,
+    )
     assert torch.equal(th, torch.zeros_like(th))
     ctx, _ = _ctx()
     model = build_model("ours", ctx, quick_models_cfg())
@@ -186,14 +199,20 @@ def test_zero_wind_gives_exactly_zero_theta_and_the_canonical_pose():
     s = model.gaussians_at(300, zero)
     c = model.canonical_state()
     assert torch.equal(s.means, c.means)
-    assert torch.allclose(s.quats / s.quats.norm(dim=-1, keepdim=True),
-                          c.quats / c.quats.norm(dim=-1, keepdim=True), atol=0)
+    assert torch.allclose(
+        s.quats / s.quats.norm(dim=-1, keepdim=True),
+        c.quats / c.quats.norm(dim=-1, keepdim=True),
+        atol=0,
+    )
 
 
 def test_three_times_the_training_wind_is_finite_and_scales_as_the_drag_law():
     """Forcing is gain (v^2 - vbar^2): tripling v (and so its mean vbar) multiplies it by 9."""
-    omega, zeta, g = (t64([2 * math.pi * 0.35, 2 * math.pi * 1.5]), t64([0.08, 0.08]),
-                      t64([0.01, 0.01]))
+    omega, zeta, g = (
+        t64([2 * math.pi * 0.35, 2 * math.pi * 1.5]),
+        t64([0.08, 0.08]),
+        t64([0.01, 0.01]),
+    )
     w1 = gusty_wind(T_REC)
     w3 = 3.0 * w1
     th1 = integrate(omega, zeta, g, w1, float(w1.mean()), DT, 2).numpy()
@@ -207,10 +226,12 @@ def test_three_times_the_training_wind_is_finite_and_scales_as_the_drag_law():
 
 # -- number of parts ----------------------------------------------------------------------------
 
+
 def test_one_part_works_end_to_end():
     ctx, w = _ctx()
-    model = build_model("ours", ctx, quick_models_cfg() | {"configs": {"single": {
-        "conditions": "train", "K": 1}}})
+    model = build_model(
+        "ours", ctx, quick_models_cfg() | {"configs": {"single": {"conditions": "train", "K": 1}}}
+    )
     assert model.K == 1 and torch.equal(model.part_labels, torch.zeros(200, dtype=torch.long))
     with torch.no_grad():
         model.gain_raw.fill_(0.05)
@@ -219,9 +240,11 @@ def test_one_part_works_end_to_end():
     s = model.gaussians_at(100, torch.tensor(w))
     s.means.sum().backward()
     assert torch.isfinite(s.means).all() and model.gain_raw.grad is not None
+
     # rigid: one rotation about one pivot keeps every pairwise distance
     def dist(x):
         return torch.cdist(x, x, compute_mode="donot_use_mm_for_euclid_dist")
+
     assert torch.allclose(dist(s.means), dist(model.canonical_state().means), atol=1e-5)
 
 
@@ -234,6 +257,7 @@ def test_more_parts_than_gaussians_stops_naming_k_and_n():
 
 
 # -- precision ----------------------------------------------------------------------------------
+
 
 def test_float32_against_float64_over_the_whole_recording():
     """Drift bound: each float32 RK4 step rounds the state at ~eps32 relative; the errors are
@@ -253,8 +277,13 @@ def test_float32_against_float64_over_the_whole_recording():
     ref_lsim_ok = _rel(ref[5], wind_lsim(om[5], ze[5], 1.0, wind, 6.0, DT)) < 1e-4
     assert ref_lsim_ok  # the float64 baseline itself is right
     scale = np.abs(ref).max(axis=1)
-    ref32 = integrate(*args32, torch.tensor(wind, dtype=torch.float32), 6.0, DT, n_sub,
-                      backend="reference").double().numpy()
+    ref32 = (
+        integrate(
+            *args32, torch.tensor(wind, dtype=torch.float32), 6.0, DT, n_sub, backend="reference"
+        )
+        .double()
+        .numpy()
+    )
     drift = np.abs(ref32 - ref).max(axis=1) / scale
     assert np.all(drift < 10 * math.sqrt(n_sub * (T_REC - 1)) * EPS32), drift
     fast32 = integrate(*args32, wind, 6.0, DT, n_sub)
@@ -263,6 +292,7 @@ def test_float32_against_float64_over_the_whole_recording():
 
 
 # -- the matcher on a constant trajectory -------------------------------------------------------
+
 
 def _truth(B=6, seed=0):
     rng = np.random.default_rng(seed)
@@ -301,6 +331,7 @@ def test_untrained_model_recovery_is_untrusted_not_nan():
 
 
 # -- fixtures -----------------------------------------------------------------------------------
+
 
 def _ctx(n=200, seed=0):
     return model_context(n, seed, LEAD_IN, wind=gusty_wind(T_REC, seed=seed))

@@ -1,5 +1,6 @@
 """bfloat16 deformation fields: close to a float32 oracle, float32 where precision matters, and
 refused (naming the setting) on a CPU that would emulate bf16."""
+
 import copy
 from pathlib import Path
 
@@ -68,8 +69,16 @@ def test_bf16_field_starts_exactly_at_the_canonical_pose_and_reloads_as_bf16(nam
     assert m.field.precision == "bfloat16"
     st = m.deform(5, torch.as_tensor(wind[None], dtype=torch.float32)[0])
     assert torch.equal(st.means, m.canonical.means)  # zero heads: exactly no offset
-    save_checkpoint(tmp_path / "m.pt", m, name=name, config="single", seed=0, models_cfg=cfg,
-                    train_cfg={}, stats={})
+    save_checkpoint(
+        tmp_path / "m.pt",
+        m,
+        name=name,
+        config="single",
+        seed=0,
+        models_cfg=cfg,
+        train_cfg={},
+        stats={},
+    )
     assert load_checkpoint(tmp_path / "m.pt").field.precision == "bfloat16"
 
 
@@ -95,7 +104,8 @@ def test_training_a_bf16_field_without_native_bf16_stops_naming_the_setting(monk
 
 
 def test_the_plan_stops_before_any_job_on_a_cpu_without_bf16_and_the_overlay_is_the_way_out(
-        monkeypatch):
+    monkeypatch,
+):
     """The workflow's plan-time check (Snakefile) refuses the default's bf16 fields on such a
     CPU, naming both keys and config/float32.yaml; that overlay, merged over trees.yaml as
     --configfile does, gives float32 fields that pass."""
@@ -115,7 +125,8 @@ def test_the_plan_stops_before_any_job_on_a_cpu_without_bf16_and_the_overlay_is_
         raw["models"][family].update(body)
     check_precision_supported(pconfig.load_workflow_config(raw, "default")["models"])  # no raise
     quick = pconfig.load_workflow_config(
-        yaml.safe_load((ROOT / "config" / "trees.yaml").read_text()), "quick")
+        yaml.safe_load((ROOT / "config" / "trees.yaml").read_text()), "quick"
+    )
     check_precision_supported(quick["models"])  # the tests' profile runs on any CPU
 
 

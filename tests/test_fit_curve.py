@@ -1,4 +1,5 @@
 """The fit curve's bookkeeping: budgets, the tables' recipe at each budget, scoring, collection."""
+
 import numpy as np
 import pytest
 
@@ -30,8 +31,10 @@ def test_a_point_is_the_tables_job_with_the_budget_alone_changed(cfg):
         assert j["train"]["iterations"] == 3000
         frac = cfg["train"]["warmup"] / own  # the static warm-up keeps its fraction
         assert j["train"]["warmup"] == round(frac * 3000)
-        strip = lambda d: {**d, "train": {k: v for k, v in d["train"].items()
-                                          if k not in ("iterations", "warmup")}}
+        strip = lambda d: {
+            **d,
+            "train": {k: v for k, v in d["train"].items() if k not in ("iterations", "warmup")},
+        }
         assert strip(j) == strip(ref)
 
 
@@ -47,16 +50,25 @@ def test_run_point_scores_trained_heldout_and_tail_frames(swaying):
     from physgs.experiments import fit
     from physgs.render import rasterization
     import torch
+
     res = fit(swaying, job, progress=False)
     s = res.model.canonical_state()
     with torch.no_grad():
-        img = rasterization(s.means, s.quats, s.scales, s.opacities, s.colors,
-                            swaying.train_camera, torch.as_tensor(swaying.background,
-                                                                  dtype=torch.float32),
-                            backend="fast", return_depth=False).rgb.numpy()
+        img = rasterization(
+            s.means,
+            s.quats,
+            s.scales,
+            s.opacities,
+            s.colors,
+            swaying.train_camera,
+            torch.as_tensor(swaying.background, dtype=torch.float32),
+            backend="fast",
+            return_depth=False,
+        ).rgb.numpy()
     trained, held = heldout_split(swaying.n_train, 4)
-    score = lambda frames: np.mean([psnr(img, np.asarray(swaying.frames[0, j]) / 255.0)
-                                    for j in frames])
+    score = lambda frames: np.mean(
+        [psnr(img, np.asarray(swaying.frames[0, j]) / 255.0) for j in frames]
+    )
     tail = np.arange(swaying.n_train, swaying.n_train + swaying.n_tail)
     assert rec["fit"] == pytest.approx(score(trained), abs=1e-3)
     assert rec["heldout"] == pytest.approx(score(held), abs=1e-3)
@@ -68,10 +80,26 @@ def _row(fit, held=0.0, time=0.0, s=1.0):
 
 
 def test_collect_joins_points_and_the_pipelines_own_rows():
-    pts = [{"model": "mlp", "seed": 0, "iterations": 500, "fit": 19.0, "heldout": 18.5,
-            "time": 18.0, "train_s": 50.0},
-           {"model": "mlp", "seed": 0, "iterations": 3000, "fit": 23.0, "heldout": 21.0,
-            "time": 17.0, "train_s": 300.0}]
+    pts = [
+        {
+            "model": "mlp",
+            "seed": 0,
+            "iterations": 500,
+            "fit": 19.0,
+            "heldout": 18.5,
+            "time": 18.0,
+            "train_s": 50.0,
+        },
+        {
+            "model": "mlp",
+            "seed": 0,
+            "iterations": 3000,
+            "fit": 23.0,
+            "heldout": 21.0,
+            "time": 17.0,
+            "train_s": 300.0,
+        },
+    ]
     own = {0: {"static": _row(18.0), "mlp": _row(21.0), "truth_motion": _row(28.0)}}
     df = fc.collect(pts, own, 1500, "medium")
     mlp = df[df["model"] == "mlp"]
@@ -85,10 +113,22 @@ def test_collect_joins_points_and_the_pipelines_own_rows():
 
 
 def test_ceiling_fraction_pairs_each_seed_with_its_own_references():
-    pts = [{"model": "mlp", "seed": s, "iterations": 500, "fit": 20.0, "heldout": 0.0,
-            "time": 0.0, "train_s": 1.0} for s in (0, 1)]
-    own = {0: {"static": _row(18.0), "truth_motion": _row(28.0)},   # seed 0: gain 10 dB
-           1: {"static": _row(19.0), "truth_motion": _row(21.0)}}   # seed 1: gain 2 dB
+    pts = [
+        {
+            "model": "mlp",
+            "seed": s,
+            "iterations": 500,
+            "fit": 20.0,
+            "heldout": 0.0,
+            "time": 0.0,
+            "train_s": 1.0,
+        }
+        for s in (0, 1)
+    ]
+    own = {
+        0: {"static": _row(18.0), "truth_motion": _row(28.0)},  # seed 0: gain 10 dB
+        1: {"static": _row(19.0), "truth_motion": _row(21.0)},
+    }  # seed 1: gain 2 dB
     df = fc.collect(pts, own, 1500, "medium")
     frac = fc.ceiling_fraction(df)
     got = dict(zip(df.loc[df.model == "mlp", "seed"], frac[df.model == "mlp"]))
@@ -97,6 +137,7 @@ def test_ceiling_fraction_pairs_each_seed_with_its_own_references():
 
 def test_ceiling_fraction_is_nan_without_a_gain_to_measure():
     from physgs.evaluate.metrics import ceiling_fraction
+
     assert np.isnan(ceiling_fraction(20.0, 18.0, 18.0))  # the ceiling does not beat static
     assert ceiling_fraction(20.0, 18.0, 22.0) == 0.5
 
@@ -108,11 +149,24 @@ def test_ceiling_fraction_is_nan_without_the_references():
 
 def test_fig_fit_curve_writes_both_formats(tmp_path):
     from physgs.report.figures import fig_fit_curve
-    pts = [{"model": m, "seed": s, "iterations": it, "fit": 20.0 + it / 1000 + s / 10,
-            "heldout": 19.0, "time": 18.0, "train_s": it / 10} for m in ("mlp", "ours")
-           for it in (500, 3000) for s in (0, 1)]
-    own = {s: {m: _row(20.0 + s) for m in ("static", "mlp", "ours", "truth_motion")}
-           for s in (0, 1)}
+
+    pts = [
+        {
+            "model": m,
+            "seed": s,
+            "iterations": it,
+            "fit": 20.0 + it / 1000 + s / 10,
+            "heldout": 19.0,
+            "time": 18.0,
+            "train_s": it / 10,
+        }
+        for m in ("mlp", "ours")
+        for it in (500, 3000)
+        for s in (0, 1)
+    ]
+    own = {
+        s: {m: _row(20.0 + s) for m in ("static", "mlp", "ours", "truth_motion")} for s in (0, 1)
+    }
     df = fc.collect(pts, own, 1500, "medium")
     outs = [tmp_path / "f.pdf", tmp_path / "f.png"]
     fig_fit_curve(df, outs)
@@ -124,13 +178,26 @@ def test_fig_fit_curve_labels_wall_time_in_plain_seconds(monkeypatch):
     every labelled tick of the wall-time axis is a plain number, and minor ticks carry none
     (matplotlib's log defaults label minor ticks as 4x10^1, 6x10^1, ... that overlap)."""
     from physgs.report import figures
+
     captured = []
     monkeypatch.setattr(figures, "save_figure", lambda fig, outputs: captured.append(fig))
-    pts = [{"model": m, "seed": s, "iterations": it, "fit": 20.0 + it / 1000, "heldout": 19.0,
-            "time": 18.0, "train_s": secs} for m, secs0 in (("mlp", 40.0), ("d3dgs", 140.0))
-           for it, secs in ((1500, secs0), (6000, secs0 * 4)) for s in (0, 1)]
-    own = {s: {m: _row(20.0 + s) for m in ("static", "mlp", "d3dgs", "truth_motion")}
-           for s in (0, 1)}
+    pts = [
+        {
+            "model": m,
+            "seed": s,
+            "iterations": it,
+            "fit": 20.0 + it / 1000,
+            "heldout": 19.0,
+            "time": 18.0,
+            "train_s": secs,
+        }
+        for m, secs0 in (("mlp", 40.0), ("d3dgs", 140.0))
+        for it, secs in ((1500, secs0), (6000, secs0 * 4))
+        for s in (0, 1)
+    ]
+    own = {
+        s: {m: _row(20.0 + s) for m in ("static", "mlp", "d3dgs", "truth_motion")} for s in (0, 1)
+    }
     figures.fig_fit_curve(fc.collect(pts, own, 3000, "medium"), ["unused.png"])
     fig = captured[0]
     fig.canvas.draw()

@@ -1,4 +1,5 @@
 """Model components: rotations, canonical pose at init, wind window, parts, ours, checkpoints."""
+
 import math
 
 import numpy as np
@@ -31,8 +32,9 @@ def test_rotating_an_elongated_gaussian_keeps_it_on_its_axis():
     # A needle along the branch direction d, centred 1 unit from the pivot along d.
     d = torch.tensor([[0.6, 0.0, 0.8]], dtype=torch.float64)
     pivot = torch.tensor([[0.1, -0.2, 0.3]], dtype=torch.float64)
-    q0 = torch.tensor(Rotation.align_vectors([d[0].numpy()], [[1.0, 0, 0]])[0].as_quat(
-        scalar_first=True))[None]
+    q0 = torch.tensor(
+        Rotation.align_vectors([d[0].numpy()], [[1.0, 0, 0]])[0].as_quat(scalar_first=True)
+    )[None]
     scales = torch.tensor([[1.0, 0.05, 0.05]], dtype=torch.float64)
     axis = torch.tensor([[0.0, 1.0, 0.0]], dtype=torch.float64)
     angle = torch.tensor([0.7], dtype=torch.float64)
@@ -65,8 +67,12 @@ def test_every_model_starts_exactly_at_the_canonical_pose(name):
     c = model.canonical_state()
     for j in (0, 150, 349):
         g = model.gaussians_at(j, torch.tensor(w))
-        for a, b in ((g.means, c.means), (g.scales, c.scales), (g.opacities, c.opacities),
-                     (g.colors, c.colors)):
+        for a, b in (
+            (g.means, c.means),
+            (g.scales, c.scales),
+            (g.opacities, c.opacities),
+            (g.colors, c.colors),
+        ):
             assert torch.equal(a, b)
         # Identity rotation composed with a zero-angle swing stays exactly identity.
         assert torch.equal(g.quats, c.quats)
@@ -80,8 +86,9 @@ def test_wind_window_ends_at_t_steps_three_frames_and_reads_the_lead_in():
     assert cols[0] == LEAD_IN - 141 and cols[0] >= 0  # frame 1 reads 141 frames into the lead-in
     wind = torch.arange(LEAD_IN + 350, dtype=torch.float32)  # value = column index
     w = wind_window(wind, 10, LEAD_IN, 2.0, 4.0, 48, step)
-    assert torch.equal(w * 4.0 + 2.0, torch.tensor(window_columns(10, LEAD_IN, 48, 3),
-                                                   dtype=torch.float32))
+    assert torch.equal(
+        w * 4.0 + 2.0, torch.tensor(window_columns(10, LEAD_IN, 48, 3), dtype=torch.float32)
+    )
     with pytest.raises(ValueError, match="lead-in"):
         window_columns(0, 100, 48, step)
     with pytest.raises(ValueError, match="subsample evenly"):
@@ -124,8 +131,9 @@ def test_ours_bounds_guard_and_theta():
     theta = model.part_theta(torch.tensor(w))
     assert theta.shape == (96, w.size) and torch.isfinite(theta).all()
     # vbar is that condition's mean wind; same numbers as a direct solver call.
-    direct = integrate(model.omega, model.zeta, model.gain, w, float(w.mean()), 1 / FPS,
-                       model.substeps)
+    direct = integrate(
+        model.omega, model.zeta, model.gain, w, float(w.mean()), 1 / FPS, model.substeps
+    )
     assert torch.allclose(theta, direct)
 
 
@@ -137,8 +145,16 @@ def test_checkpoint_roundtrip(tmp_path):
             for p in model.parameters():
                 p.add_(0.01 * torch.randn_like(p))
         path = tmp_path / f"{name}.pt"
-        save_checkpoint(path, model, name=name, config="single", seed=0,
-                        models_cfg=quick_models_cfg(), train_cfg={}, stats={"iterations": 1})
+        save_checkpoint(
+            path,
+            model,
+            name=name,
+            config="single",
+            seed=0,
+            models_cfg=quick_models_cfg(),
+            train_cfg={},
+            stats={"iterations": 1},
+        )
         back = load_checkpoint(path)
         a = model.gaussians_at(200, torch.tensor(w))
         b = back.gaussians_at(200, torch.tensor(w))
@@ -163,6 +179,14 @@ def test_ours_drives_each_condition_with_its_nominal_mean_speed():
         for scale in (1.0, 0.71):
             wind = torch.as_tensor(scale * w, dtype=torch.float64)
             got = m.part_theta(wind)
-            want = integrate(m.omega.double(), m.zeta.double(), m.gain.double(), wind,
-                             scale * nominal, 1.0 / FPS, m.substeps, backend="reference")
+            want = integrate(
+                m.omega.double(),
+                m.zeta.double(),
+                m.gain.double(),
+                wind,
+                scale * nominal,
+                1.0 / FPS,
+                m.substeps,
+                backend="reference",
+            )
             torch.testing.assert_close(got.double(), want, rtol=1e-5, atol=1e-7)

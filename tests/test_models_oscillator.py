@@ -1,4 +1,5 @@
 """RK4 oscillator solver against independent oracles (scipy lsim, closed form), gradients, guard."""
+
 import numpy as np
 import pytest
 import torch
@@ -38,8 +39,10 @@ def test_matches_closed_form_unforced_response(zeta):
 
 def test_fast_and_reference_agree_in_value_and_gradient():
     wind = gusty_wind(60, seed=1)
-    p = [torch.tensor(a, dtype=torch.float64, requires_grad=True)
-         for a in ([3.0, 7.0, 11.0], [0.05, 0.1, 0.3], [0.01, -0.02, 0.03])]
+    p = [
+        torch.tensor(a, dtype=torch.float64, requires_grad=True)
+        for a in ([3.0, 7.0, 11.0], [0.05, 0.1, 0.3], [0.01, -0.02, 0.03])
+    ]
     weights = torch.randn(3, 60, dtype=torch.float64, generator=torch.Generator().manual_seed(0))
     grads = []
     for backend in ("fast", "reference"):
@@ -62,15 +65,18 @@ def test_gradcheck_float64():
     def f(om, ze, g):
         return integrate(om, ze, g, wind, 6.0, DT, 2)
 
-    args = tuple(torch.tensor(a, dtype=torch.float64, requires_grad=True)
-                 for a in ([2.5, 8.0], [0.08, 0.2], [0.02, -0.01]))
+    args = tuple(
+        torch.tensor(a, dtype=torch.float64, requires_grad=True)
+        for a in ([2.5, 8.0], [0.08, 0.2], [0.02, -0.01])
+    )
     assert torch.autograd.gradcheck(f, args, eps=1e-6, atol=1e-7, rtol=1e-5)
 
 
 def test_starts_at_rest_and_keeps_float32():
     om = torch.tensor([5.0, 9.0])
-    th = integrate(om, torch.tensor([0.1, 0.1]), torch.tensor([0.1, 0.1]), gusty_wind(30), 6.0,
-                   DT, 1)
+    th = integrate(
+        om, torch.tensor([0.1, 0.1]), torch.tensor([0.1, 0.1]), gusty_wind(30), 6.0, DT, 1
+    )
     assert th.dtype == torch.float32 and th.shape == (2, 30)
     assert torch.all(th[:, 0] == 0) and torch.all(th[:, 1:].abs().sum(1) > 0)
 

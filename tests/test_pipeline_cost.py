@@ -1,4 +1,5 @@
 """physgs.experiments.cost: job-seconds from Snakemake benchmark files, by stage and seed."""
+
 import pytest
 
 from physgs.experiments.cost import extra_seed_wall_s, read_costs, summarise
@@ -31,7 +32,7 @@ def test_stage_seed_and_damping_come_from_the_path(bench):
     jobs = {j.path: j for j in read_costs(bench)}
     assert jobs["train/sparse/seed1/ours_single.tsv"].seed == 1
     assert jobs["testbed/sparse.tsv"].seed is None
-    assert jobs["testbed/sparse_seed1.tsv"].seed == 1          # a seeded testbed is that seed's
+    assert jobs["testbed/sparse_seed1.tsv"].seed == 1  # a seeded testbed is that seed's
     assert jobs["train/sparse_damping/seed0/ours_single.tsv"].damping
     assert jobs["testbed/sparse_damping.tsv"].damping and not jobs["testbed/sparse.tsv"].damping
     assert jobs["testbed/stats_sparse_damping_seed1.tsv"].damping

@@ -1,5 +1,6 @@
 """Planning is cheap: what the Snakefile imports to plan jobs loads no torch, matplotlib or scipy,
 so a dry run (and every Snakemake call of the suite) does not pay seconds of their start-up."""
+
 from __future__ import annotations
 
 import re
@@ -23,12 +24,22 @@ def test_the_workflows_imports_load_no_heavy_library():
     assert len(imports) >= 5, imports  # the parse found the imports it is about
     # the Snakefile's own first step: validate and check the shipped config (its checks reuse
     # the testbed's formulas, whose modules must not load torch either)
-    load = ("physgs.config.load_workflow_config(yaml.safe_load(open('config/trees.yaml')), "
-            "'default', source='config/trees.yaml')")
-    code = "\n".join([*imports, "import yaml", load, "import sys",
-                      f"print(sorted(m for m in {HEAVY!r} if m in sys.modules))"])
-    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True,
-                         check=True, cwd=ROOT).stdout
+    load = (
+        "physgs.config.load_workflow_config(yaml.safe_load(open('config/trees.yaml')), "
+        "'default', source='config/trees.yaml')"
+    )
+    code = "\n".join(
+        [
+            *imports,
+            "import yaml",
+            load,
+            "import sys",
+            f"print(sorted(m for m in {HEAVY!r} if m in sys.modules))",
+        ]
+    )
+    out = subprocess.run(
+        [sys.executable, "-c", code], capture_output=True, text=True, check=True, cwd=ROOT
+    ).stdout
     assert out.strip() == "[]", f"planning imports load {out.strip()}"
 
 

@@ -1,14 +1,23 @@
 """Per-part damping scores (physgs.recovery.damping_scores) against hand-built answers and
 scipy / numpy references; the untrained damping null."""
+
 import json
 
 import numpy as np
 import pytest
 import scipy.stats
 
-from physgs.recovery.damping_scores import (MIN_CORR_PARTS, DampingNull, DampingScores,
-                                            damping_null, damping_scores, draw_null_zetas,
-                                            log_correlation, loglog_exponent, score_match)
+from physgs.recovery.damping_scores import (
+    MIN_CORR_PARTS,
+    DampingNull,
+    DampingScores,
+    damping_null,
+    damping_scores,
+    draw_null_zetas,
+    log_correlation,
+    loglog_exponent,
+    score_match,
+)
 from physgs.recovery.matcher import match_parts
 from physgs.recovery.null import draw_null_omegas
 
@@ -48,7 +57,7 @@ def test_gamma_exponent_of_an_exact_power_law(p):
     """gamma_hat = c omega_hat^p exactly: p comes back; p = 1 is a constant ratio, p = 0 a
     frequency-independent decay rate (the paper's diagnosis)."""
     omega = 2 * np.pi * np.linspace(0.35, 1.5, 9)
-    zeta_hat = 0.3 * omega ** p / omega  # gamma = 0.3 omega^p
+    zeta_hat = 0.3 * omega**p / omega  # gamma = 0.3 omega^p
     assert loglog_exponent(omega, zeta_hat * omega) == pytest.approx(p, abs=1e-12)
 
 
@@ -76,9 +85,11 @@ def test_against_scipy_on_random_data():
     t, b = trusted, bone[trusted]
     assert s.n_trusted == t.sum()
     assert s.median_rel_err == pytest.approx(
-        np.median(np.abs(zeta_hat[t] - zeta_b[b]) / zeta_b[b]), rel=1e-12)
+        np.median(np.abs(zeta_hat[t] - zeta_b[b]) / zeta_b[b]), rel=1e-12
+    )
     assert s.log_corr == pytest.approx(
-        scipy.stats.pearsonr(np.log(zeta_hat[t]), np.log(zeta_b[b]))[0], abs=1e-12)
+        scipy.stats.pearsonr(np.log(zeta_hat[t]), np.log(zeta_b[b]))[0], abs=1e-12
+    )
     lr = scipy.stats.linregress(np.log(omega_hat[t]), np.log(zeta_hat[t] * omega_hat[t]))
     assert s.gamma_exponent == pytest.approx(lr.slope, abs=1e-12)
     lr = scipy.stats.linregress(np.log(omega_b[b]), np.log(zeta_b[b] * omega_b[b]))
@@ -90,8 +101,9 @@ def test_undefined_scores_are_nan():
     zb, ob = np.array([0.05, 0.1, 0.2]), np.array([2.0, 4.0, 6.0])
     none = damping_scores([0, 1, 2], [False] * 3, [0.1] * 3, [2.0, 4.0, 6.0], zb, ob)
     assert none.n_trusted == 0
-    assert np.isnan([none.median_rel_err, none.log_corr, none.gamma_exponent,
-                     none.gamma_exponent_true]).all()
+    assert np.isnan(
+        [none.median_rel_err, none.log_corr, none.gamma_exponent, none.gamma_exponent_true]
+    ).all()
     two = damping_scores([0, 1, 2], [True, True, False], [0.1, 0.2, 0.3], [2.0, 4.0, 6.0], zb, ob)
     assert two.n_trusted == 2 < MIN_CORR_PARTS
     assert np.isnan(two.log_corr) and np.isfinite(two.median_rel_err)
@@ -153,7 +165,10 @@ def test_null_is_scored_like_the_model_against_the_same_matching():
     for i, z in enumerate(null.zeta):
         s = damping_scores(bone, trusted, z, omega_hat, zeta_b, omega_b)
         assert (null.median_rel_err[i], null.log_corr[i], null.gamma_exponent[i]) == (
-            s.median_rel_err, s.log_corr, s.gamma_exponent)
+            s.median_rel_err,
+            s.log_corr,
+            s.gamma_exponent,
+        )
     back = DampingNull.from_dict(json.loads(json.dumps(null.to_dict())))
     np.testing.assert_array_equal(back.zeta, null.zeta)
     assert back.median_log_corr == null.median_log_corr and back.seed == 5
@@ -170,8 +185,9 @@ def test_null_has_no_ranking_and_a_ratio_exponent_and_a_recovering_model_beats_i
     assert abs(null.log_corr.mean()) < 0.04
     assert abs(null.gamma_exponent.mean() - 1.0) < 0.1
     rng = np.random.default_rng(9)
-    good = damping_scores(bone, trusted, zeta_b * np.exp(0.1 * rng.standard_normal(B)), omega_b,
-                          zeta_b, omega_b)
+    good = damping_scores(
+        bone, trusted, zeta_b * np.exp(0.1 * rng.standard_normal(B)), omega_b, zeta_b, omega_b
+    )
     assert good.log_corr > np.quantile(null.log_corr, 0.99)
     assert good.median_rel_err < np.quantile(null.median_rel_err, 0.01)
 

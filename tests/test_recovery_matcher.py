@@ -1,4 +1,5 @@
 """Matcher and damping summary on constructed trajectories with known answers (scipy oracle)."""
+
 import numpy as np
 import pytest
 from scipy import stats
@@ -27,7 +28,9 @@ def test_copies_with_noise_and_sign_flips_match_exactly(bones):
     rng = np.random.default_rng(1)
     perm = np.array([3, 0, 4, 4, 1, 2])
     sign = np.array([1, -1, 1, -1, -1, 1])
-    parts = sign[:, None] * 2.5 * theta[perm] + 0.05 * theta.std() * rng.standard_normal((6, theta.shape[1]))
+    parts = sign[:, None] * 2.5 * theta[perm] + 0.05 * theta.std() * rng.standard_normal(
+        (6, theta.shape[1])
+    )
     omega_hat = omega[perm] * np.array([1.1, 0.95, 1.0, 1.02, 0.8, 1.3])
     m = match_parts(parts, theta, omega_hat, omega)
     np.testing.assert_array_equal(m.bone, perm)
@@ -42,8 +45,14 @@ def test_copies_with_noise_and_sign_flips_match_exactly(bones):
 def test_constant_and_unrelated_parts_untrusted_never_nan(bones):
     omega, theta = bones
     rng = np.random.default_rng(2)
-    parts = np.stack([np.full(theta.shape[1], 0.3), np.zeros(theta.shape[1]),
-                      rng.standard_normal(theta.shape[1]), theta[2]])
+    parts = np.stack(
+        [
+            np.full(theta.shape[1], 0.3),
+            np.zeros(theta.shape[1]),
+            rng.standard_normal(theta.shape[1]),
+            theta[2],
+        ]
+    )
     m = match_parts(parts, theta, np.full(4, 3.0), omega)
     assert np.all(np.isfinite(m.corr)) and np.all(np.isfinite(m.rel_err))
     assert m.corr[0] == 0 and m.corr[1] == 0
@@ -92,11 +101,18 @@ def test_damping_constant_ratio_and_constant_rate():
 def test_restricted_scores_only_parts_on_visible_bones():
     from physgs.recovery.matcher import MatchResult, restricted
 
-    m = MatchResult(bone=np.array([0, 1, 2, 2]), corr=np.array([0.9, 0.9, 0.5, 0.95]),
-                    trusted=np.array([True, True, False, True]),
-                    omega_hat=np.ones(4), omega_true=np.ones(4),
-                    rel_err=np.array([0.01, 0.20, 0.50, 0.03]), n_trusted=3, n_parts=4,
-                    median_rel_err=0.03, loglog_r2=float("nan"))
+    m = MatchResult(
+        bone=np.array([0, 1, 2, 2]),
+        corr=np.array([0.9, 0.9, 0.5, 0.95]),
+        trusted=np.array([True, True, False, True]),
+        omega_hat=np.ones(4),
+        omega_true=np.ones(4),
+        rel_err=np.array([0.01, 0.20, 0.50, 0.03]),
+        n_trusted=3,
+        n_parts=4,
+        median_rel_err=0.03,
+        loglog_r2=float("nan"),
+    )
     # bone 1 invisible: the trusted parts on bones 0 and 2 remain (errors 0.01 and 0.03)
     n, med = restricted(m, np.array([True, False, True]))
     assert n == 2 and med == pytest.approx(0.02)

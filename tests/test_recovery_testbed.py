@@ -1,4 +1,5 @@
 """Recovery on a real testbed tree (physics only, no frames): known answers."""
+
 from types import SimpleNamespace
 
 import numpy as np
@@ -20,8 +21,13 @@ def sparse():
     cfg = physgs.config.load("config/trees.yaml", "default")
     sim = simulate_tree(cfg["testbed"], cfg["presets"]["sparse"], seed=cfg["seed"], tree="sparse")
     tr = sim.truth
-    obs = SimpleNamespace(wind=sim.wind, lead_in_frames=int(tr.lead_in_frames),
-                          n_train=int(cfg["testbed"]["n_train"]), fps=int(tr.fps), vbar=tr.vbar)
+    obs = SimpleNamespace(
+        wind=sim.wind,
+        lead_in_frames=int(tr.lead_in_frames),
+        n_train=int(cfg["testbed"]["n_train"]),
+        fps=int(tr.fps),
+        vbar=tr.vbar,
+    )
     return tr, obs
 
 
@@ -32,10 +38,12 @@ def test_parts_that_are_bones_are_recovered_exactly(sparse):
     wind = torch.as_tensor(obs.wind[0], dtype=torch.float64)
     # any vbar error is a constant force offset: it shifts theta by a constant and leaves the
     # correlation unchanged, so the record's mean stands in for the nominal speed here
-    theta = integrate(om, torch.full_like(om, 0.08), torch.ones_like(om), wind, float(wind.mean()),
-                      1 / obs.fps, 2).numpy()
-    rec = score_recovery(theta, tr.omega[pick], np.full(5, 0.08), tr,
-                         obs.lead_in_frames, obs.n_train)
+    theta = integrate(
+        om, torch.full_like(om, 0.08), torch.ones_like(om), wind, float(wind.mean()), 1 / obs.fps, 2
+    ).numpy()
+    rec = score_recovery(
+        theta, tr.omega[pick], np.full(5, 0.08), tr, obs.lead_in_frames, obs.n_train
+    )
     m = rec.match
     # integrated from rest over a 1.5 tau_max lead-in, the slowest bones keep a trace of their
     # start transient (exp(-1.5) at omega_min), so the match is near, not exactly, perfect
@@ -58,10 +66,21 @@ def test_null_on_sparse_tree_is_seeded_and_bounded_by_the_grid(sparse):
     # rebuilt here with the same solver and matcher)
     om = draw_null_omegas(tr.omega, 32, 8, 0)[0]
     w = torch.as_tensor(obs.wind[0], dtype=torch.float64)
-    th = integrate(torch.as_tensor(om), torch.full((32,), 0.1, dtype=torch.float64),
-                   torch.ones(32, dtype=torch.float64), w, float(obs.vbar[0]), 1 / obs.fps, 2).numpy()
-    m = match_parts(training_window(th, obs.lead_in_frames, obs.n_train),
-                    bone_window(tr, obs.lead_in_frames, obs.n_train), om, tr.omega)
+    th = integrate(
+        torch.as_tensor(om),
+        torch.full((32,), 0.1, dtype=torch.float64),
+        torch.ones(32, dtype=torch.float64),
+        w,
+        float(obs.vbar[0]),
+        1 / obs.fps,
+        2,
+    ).numpy()
+    m = match_parts(
+        training_window(th, obs.lead_in_frames, obs.n_train),
+        bone_window(tr, obs.lead_in_frames, obs.n_train),
+        om,
+        tr.omega,
+    )
     assert m.median_rel_err == a.median_rel_err[0]
     assert np.all(m.rel_err >= nearest_bone_gap(om, tr.omega) - 1e-12)
     # over trusted parts only, the median error can sit below the median gap (trust favours parts

@@ -1,4 +1,5 @@
 """Rasterizer numerics: closed forms, gradcheck, occlusion, an independent dense oracle, extremes."""
+
 import numpy as np
 import pytest
 import torch
@@ -20,10 +21,18 @@ def axis_camera(w=24, h=20, f=30.0, near=0.01):
 def gaussians(means, scales, opac, colors, quats=None):
     means = torch.tensor(means, dtype=F64)
     n = means.shape[0]
-    quats = torch.tensor([[1.0, 0, 0, 0]] * n, dtype=F64) if quats is None else torch.tensor(
-        quats, dtype=F64)
-    return [means, quats, torch.tensor(scales, dtype=F64), torch.tensor(opac, dtype=F64),
-            torch.tensor(colors, dtype=F64)]
+    quats = (
+        torch.tensor([[1.0, 0, 0, 0]] * n, dtype=F64)
+        if quats is None
+        else torch.tensor(quats, dtype=F64)
+    )
+    return [
+        means,
+        quats,
+        torch.tensor(scales, dtype=F64),
+        torch.tensor(opac, dtype=F64),
+        torch.tensor(colors, dtype=F64),
+    ]
 
 
 @pytest.mark.parametrize("backend", BACKENDS)
@@ -64,8 +73,11 @@ def test_nearer_gaussian_occludes_farther(backend):
     r2 = (xx - cam.cx) ** 2 + (yy - cam.cy) ** 2
     var = (cam.fx * 0.3 / 2.0) ** 2 + 0.3
     a = np.minimum(0.99, o * np.exp(-0.5 * r2 / var))  # both project identically
-    expect = (a[..., None] * red + (1 - a[..., None]) * a[..., None] * green
-              + ((1 - a) ** 2)[..., None] * bg)
+    expect = (
+        a[..., None] * red
+        + (1 - a[..., None]) * a[..., None] * green
+        + ((1 - a) ** 2)[..., None] * bg
+    )
     i, j = cam.height // 2, cam.width // 2
     np.testing.assert_allclose(imgs[0][i, j], expect[i, j], atol=1e-12)
     assert imgs[0][i, j, 0] > 0.9 and imgs[0][i, j, 1] < 0.06
@@ -74,8 +86,9 @@ def test_nearer_gaussian_occludes_farther(backend):
 def dense_oracle(means, quats, scales, opac, colors, cam, bg):
     """Independent float64 numpy renderer: every Gaussian at every pixel, no tiles, scipy's
     quaternion convention (x, y, z, w), plain loops over depth order."""
-    means, quats, scales, opac, colors, bg = (np.asarray(x, np.float64) for x in
-                                              (means, quats, scales, opac, colors, bg))
+    means, quats, scales, opac, colors, bg = (
+        np.asarray(x, np.float64) for x in (means, quats, scales, opac, colors, bg)
+    )
     Rw = rotation_wxyz(quats).as_matrix()
     cov3 = Rw @ (scales[:, :, None] ** 2 * np.transpose(Rw, (0, 2, 1)))
     pc = means @ cam.R.T + cam.t
@@ -114,7 +127,8 @@ def dense_oracle(means, quats, scales, opac, colors, cam, bg):
 def test_matches_independent_dense_oracle(backend):
     # Odd image size (partial tiles), opaque-ish Gaussians (transmittance cut-off reached).
     means, quats, scales, opac, colors, cam, bg = random_scene(
-        120, 37, 29, seed=3, dtype=F64, opacity_range=(0.3, 0.97))
+        120, 37, 29, seed=3, dtype=F64, opacity_range=(0.3, 0.97)
+    )
     out = rasterization(means, quats, scales, opac, colors, cam, bg, backend=backend)
     rgb, alpha, dep = dense_oracle(means, quats, scales, opac, colors, cam, bg)
     assert alpha.max() > 0.999  # the T < 1e-4 stop is exercised
@@ -129,9 +143,17 @@ def test_gradcheck_tiny_scene(backend):
     # 1/255 skip, the 0.99 clamp or the transmittance stop, so the image is smooth in the inputs.
     cam = look_at([0.3, -3.0, 0.2], [0, 0, 0], fov_deg=25, width=6, height=5)
     rng = np.random.default_rng(0)
-    g = [torch.tensor(x, dtype=F64, requires_grad=True) for x in (
-        rng.uniform(-0.2, 0.2, (3, 3)), rng.normal(size=(3, 4)), rng.uniform(0.3, 0.6, (3, 3)),
-        rng.uniform(0.3, 0.6, 3), rng.uniform(0, 1, (3, 3)), [0.2, 0.4, 0.7])]
+    g = [
+        torch.tensor(x, dtype=F64, requires_grad=True)
+        for x in (
+            rng.uniform(-0.2, 0.2, (3, 3)),
+            rng.normal(size=(3, 4)),
+            rng.uniform(0.3, 0.6, (3, 3)),
+            rng.uniform(0.3, 0.6, 3),
+            rng.uniform(0, 1, (3, 3)),
+            [0.2, 0.4, 0.7],
+        )
+    ]
 
     def f(m, q, s, o, c, bg):
         out = rasterization(m, q, s, o, c, cam, bg, backend=backend)
@@ -140,8 +162,9 @@ def test_gradcheck_tiny_scene(backend):
     rgb, alpha, _ = f(*g)
     assert alpha.min() > 0.03 and alpha.max() > 0.3  # not empty; every pixel far above 1/255
     # Full Jacobians for the hand-written fast backward; random projections suffice for autograd.
-    assert torch.autograd.gradcheck(f, g, eps=1e-6, atol=1e-7, rtol=1e-5,
-                                    fast_mode=backend == "reference")
+    assert torch.autograd.gradcheck(
+        f, g, eps=1e-6, atol=1e-7, rtol=1e-5, fast_mode=backend == "reference"
+    )
 
 
 EXTREMES = {
@@ -191,7 +214,9 @@ def test_transparent_and_empty_scenes_show_background(backend):
     for opac in ([0.0, 1e-3], None):  # all below 1/255; then no Gaussians at all
         if opac is None:
             g = [torch.zeros((0, k), dtype=F64) for k in (3, 4, 3)] + [
-                torch.zeros(0, dtype=F64), torch.zeros((0, 3), dtype=F64)]
+                torch.zeros(0, dtype=F64),
+                torch.zeros((0, 3), dtype=F64),
+            ]
         else:
             g = gaussians([[0, 0, 2.0], [0.1, 0, 3.0]], [[0.3] * 3] * 2, opac, [[1.0, 0, 0]] * 2)
         for x in g:

@@ -7,6 +7,7 @@ oracle here takes those limits from the camera's field-of-view *angle* (not from
 0.5 W / fx), builds J Sigma J^T + 0.3 I in float64 numpy with scipy's rotations, and splats one
 Gaussian. An earlier version clamped at 1.6 tan(fov / 2); the clamped cases below fail under it.
 """
+
 import numpy as np
 import pytest
 import torch
@@ -26,8 +27,14 @@ BG = np.array([0.1, 0.2, 0.6])
 def centred_camera(fov_deg, width, height):
     """At the origin looking down +z (R = I, t = 0), vertical fov ``fov_deg``, square pixels,
     principal point at the image centre."""
-    cam = look_at([0.0, 0.0, 0.0], [0.0, 0.0, 1.0], up=(0.0, -1.0, 0.0), fov_deg=fov_deg,
-                  width=width, height=height)
+    cam = look_at(
+        [0.0, 0.0, 0.0],
+        [0.0, 0.0, 1.0],
+        up=(0.0, -1.0, 0.0),
+        fov_deg=fov_deg,
+        width=width,
+        height=height,
+    )
     assert np.allclose(cam.R, np.eye(3)) and np.allclose(cam.t, 0.0)
     return cam
 
@@ -67,17 +74,49 @@ def oracle(cam, mean, quat, scale, opacity, lim):
 # name: (fov_deg, width, height, (x/z, y/z), z, scale, quat (w, x, y, z), clamped by 1.3 tan?)
 CASES = {
     # the issue's range: x/z in (0.65, 0.8) for tan(fov / 2) = 0.5
-    "right": (FOV_TAN_HALF_0P5, 32, 32, (0.72, 0.1), 3.0, (0.15, 0.2, 0.8),
-              (0.95, 0.1, -0.2, 0.15), True),
-    "left": (FOV_TAN_HALF_0P5, 32, 32, (-0.78, -0.05), 2.5, (0.12, 0.15, 0.7),
-             (0.9, -0.1, 0.3, 0.05), True),
-    "corner": (FOV_TAN_HALF_0P5, 32, 32, (0.7, -0.7), 3.0, (0.3, 0.35, 0.9),
-               (0.8, 0.2, 0.1, -0.3), True),
+    "right": (
+        FOV_TAN_HALF_0P5,
+        32,
+        32,
+        (0.72, 0.1),
+        3.0,
+        (0.15, 0.2, 0.8),
+        (0.95, 0.1, -0.2, 0.15),
+        True,
+    ),
+    "left": (
+        FOV_TAN_HALF_0P5,
+        32,
+        32,
+        (-0.78, -0.05),
+        2.5,
+        (0.12, 0.15, 0.7),
+        (0.9, -0.1, 0.3, 0.05),
+        True,
+    ),
+    "corner": (
+        FOV_TAN_HALF_0P5,
+        32,
+        32,
+        (0.7, -0.7),
+        3.0,
+        (0.3, 0.35, 0.9),
+        (0.8, 0.2, 0.1, -0.3),
+        True,
+    ),
     # wide image, 60 degree vertical fov: only y clamped (lim_y = 0.75, lim_x = 1.25)
     "below": (60.0, 40, 24, (0.3, 0.84), 2.0, (0.15, 0.1, 0.6), (0.9, 0.3, 0.0, 0.2), True),
     # just off-screen but inside 1.3 tan(fov / 2): no clamp, old and new agree
-    "inside": (FOV_TAN_HALF_0P5, 32, 32, (0.6, 0.2), 3.0, (0.15, 0.2, 0.8),
-               (0.95, 0.1, -0.2, 0.15), False),
+    "inside": (
+        FOV_TAN_HALF_0P5,
+        32,
+        32,
+        (0.6, 0.2),
+        3.0,
+        (0.15, 0.2, 0.8),
+        (0.95, 0.1, -0.2, 0.15),
+        False,
+    ),
 }
 
 
@@ -86,8 +125,10 @@ def case_inputs(name, opacity=0.9):
     cam = centred_camera(fov, W, H)
     mean = np.array([u * z, v * z, z])
     quat = np.asarray(quat) / np.linalg.norm(quat)
-    tensors = [torch.tensor(np.asarray(a, dtype=np.float64)[None], dtype=F64)
-               for a in (mean, quat, scale, opacity, COLOR)]
+    tensors = [
+        torch.tensor(np.asarray(a, dtype=np.float64)[None], dtype=F64)
+        for a in (mean, quat, scale, opacity, COLOR)
+    ]
     return cam, mean, quat, np.asarray(scale), tensors, limits_from_fov(fov, W, H), clamped
 
 
@@ -102,10 +143,24 @@ def test_projected_covariance_matches_fov_oracle(name):
     np.testing.assert_allclose(proj.cov2d[0].numpy(), want, rtol=1e-12, atol=1e-12)
     # fast backend (numba kernel)
     n = 1
-    m2, con, dep, cov2d, valid = (np.empty((n, 2)), np.empty((n, 3)), np.empty(n),
-                                  np.empty((n, 3)), np.empty(n, np.bool_))
-    kernels.project_forward(*(np.ascontiguousarray(x.numpy()) for x in g[:3]),
-                            *camera_arrays(cam), cam.near, 0.3, m2, con, dep, cov2d, valid)
+    m2, con, dep, cov2d, valid = (
+        np.empty((n, 2)),
+        np.empty((n, 3)),
+        np.empty(n),
+        np.empty((n, 3)),
+        np.empty(n, np.bool_),
+    )
+    kernels.project_forward(
+        *(np.ascontiguousarray(x.numpy()) for x in g[:3]),
+        *camera_arrays(cam),
+        cam.near,
+        0.3,
+        m2,
+        con,
+        dep,
+        cov2d,
+        valid,
+    )
     assert valid[0]
     np.testing.assert_allclose(cov2d[0], want, rtol=1e-12, atol=1e-12)
     # the case tests what it says: the clamp changes the covariance (or, inside, does not)
@@ -134,8 +189,10 @@ def test_alpha_and_rgb_match_fov_oracle(name, backend):
 def test_fast_gradients_match_reference_on_clamped_gaussian(name):
     cam, *_, g, _, _ = case_inputs(name)
     gen = torch.Generator().manual_seed(0)
-    w = [torch.rand(s, generator=gen, dtype=F64) for s in
-         ((cam.height, cam.width, 3), (cam.height, cam.width), (cam.height, cam.width))]
+    w = [
+        torch.rand(s, generator=gen, dtype=F64)
+        for s in ((cam.height, cam.width, 3), (cam.height, cam.width), (cam.height, cam.width))
+    ]
     grads = {}
     for backend in ("reference", "fast"):
         params = [x.clone().requires_grad_(True) for x in g]
@@ -144,11 +201,15 @@ def test_fast_gradients_match_reference_on_clamped_gaussian(name):
         loss = (out.rgb * w[0]).sum() + (out.alpha * w[1]).sum() + (out.depth * w[2]).sum()
         loss.backward()
         grads[backend] = [p.grad.numpy() for p in params] + [bg.grad.numpy()]
-    for label, a, b in zip(["means", "quats", "scales", "opacities", "colors", "background"],
-                           grads["reference"], grads["fast"]):
+    for label, a, b in zip(
+        ["means", "quats", "scales", "opacities", "colors", "background"],
+        grads["reference"],
+        grads["fast"],
+    ):
         assert np.isfinite(a).all() and np.abs(a).max() > 0, label
-        np.testing.assert_allclose(b, a, rtol=0, atol=1e-10 * max(1.0, np.abs(a).max()),
-                                   err_msg=label)
+        np.testing.assert_allclose(
+            b, a, rtol=0, atol=1e-10 * max(1.0, np.abs(a).max()), err_msg=label
+        )
 
 
 def test_fast_gradcheck_through_the_clamp():
@@ -157,9 +218,17 @@ def test_fast_gradcheck_through_the_clamp():
     # the inputs and finite differences check the clamped branch of the hand-written backward.
     cam = centred_camera(FOV_TAN_HALF_0P5, 8, 8)
     z = 3.0
-    g = [torch.tensor(x, dtype=F64, requires_grad=True) for x in (
-        [[0.72 * z, -0.7 * z, z]], [[0.9, 0.2, -0.1, 0.3]], [[2.2, 2.5, 3.0]], [0.5],
-        [[0.2, 0.7, 0.4]], BG)]
+    g = [
+        torch.tensor(x, dtype=F64, requires_grad=True)
+        for x in (
+            [[0.72 * z, -0.7 * z, z]],
+            [[0.9, 0.2, -0.1, 0.3]],
+            [[2.2, 2.5, 3.0]],
+            [0.5],
+            [[0.2, 0.7, 0.4]],
+            BG,
+        )
+    ]
 
     def f(m, q, s, o, c, bg):
         out = rasterization(m, q, s, o, c, cam, bg, backend="fast")
@@ -181,6 +250,7 @@ def test_gsplat_matches_fov_oracle(name):
     pytest.importorskip("gsplat")
     cam, mean, quat, scale, g, lim, _ = case_inputs(name, opacity=0.3)
     _, alpha, _ = oracle(cam, mean, quat, scale, 0.3, lim)
-    out = rasterization(*(x.float().cuda() for x in g), cam, torch.tensor(BG).float().cuda(),
-                        backend="gsplat")
+    out = rasterization(
+        *(x.float().cuda() for x in g), cam, torch.tensor(BG).float().cuda(), backend="gsplat"
+    )
     np.testing.assert_allclose(out.alpha.cpu().double().numpy(), alpha, rtol=0, atol=2e-3)

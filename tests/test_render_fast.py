@@ -1,4 +1,5 @@
 """Fast numba path against the PyTorch reference; determinism; gsplat dispatch (GPU only)."""
+
 import numpy as np
 import pytest
 import torch
@@ -10,13 +11,16 @@ from physgs.render.scenes import random_scene
 def render_with_grads(backend, scene, dtype, seed=0):
     """Outputs and gradients of a random weighted sum of rgb, alpha and depth."""
     means, quats, scales, opac, colors, cam, bg = scene
-    params = [x.detach().to(dtype).requires_grad_(True)
-              for x in (means, quats, scales, opac, colors, bg)]
+    params = [
+        x.detach().to(dtype).requires_grad_(True) for x in (means, quats, scales, opac, colors, bg)
+    ]
     out = rasterization(*params[:5], cam, params[5], backend=backend)
     g = torch.Generator().manual_seed(seed)
     H, W = cam.height, cam.width
-    w = [torch.rand(s, generator=g, dtype=torch.float64).to(dtype)
-         for s in ((H, W, 3), (H, W), (H, W))]
+    w = [
+        torch.rand(s, generator=g, dtype=torch.float64).to(dtype)
+        for s in ((H, W, 3), (H, W), (H, W))
+    ]
     loss = (out.rgb * w[0]).sum() + (out.alpha * w[1]).sum() + (out.depth * w[2]).sum()
     loss.backward()
     return [out.rgb, out.alpha, out.depth] + [p.grad for p in params]
@@ -37,8 +41,9 @@ def test_fast_matches_reference_float64(scene):
     assert ref[1].max() > 0.999 and ref[1].min() < 0.01  # dense and empty regions both present
     for name, a, b in zip(NAMES, ref, fast):
         scale = max(1.0, a.abs().max().item())
-        np.testing.assert_allclose(b.detach().numpy(), a.detach().numpy(), rtol=0,
-                                   atol=1e-10 * scale, err_msg=name)
+        np.testing.assert_allclose(
+            b.detach().numpy(), a.detach().numpy(), rtol=0, atol=1e-10 * scale, err_msg=name
+        )
 
 
 def test_float32_paths_close_to_float64_reference(scene):
@@ -51,11 +56,13 @@ def test_float32_paths_close_to_float64_reference(scene):
     for name, a, b, c in zip(NAMES, ref, fast, ref32):
         assert b.dtype == torch.float32 and c.dtype == torch.float32, name
         scale = max(1.0, a.abs().max().item())
-        np.testing.assert_allclose(b.detach().double().numpy(), a.detach().numpy(), rtol=0,
-                                   atol=1e-5 * scale, err_msg=name)
+        np.testing.assert_allclose(
+            b.detach().double().numpy(), a.detach().numpy(), rtol=0, atol=1e-5 * scale, err_msg=name
+        )
         # the float32 reference itself accumulates in float32: looser, but still close
-        np.testing.assert_allclose(c.detach().double().numpy(), a.detach().numpy(), rtol=0,
-                                   atol=1e-4 * scale, err_msg=name)
+        np.testing.assert_allclose(
+            c.detach().double().numpy(), a.detach().numpy(), rtol=0, atol=1e-4 * scale, err_msg=name
+        )
 
 
 def test_fast_is_deterministic():

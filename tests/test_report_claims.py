@@ -1,4 +1,5 @@
 """The claims ledger: verdicts from seed intervals, and claims measured from table CSVs."""
+
 import numpy as np
 import pandas as pd
 import pytest
@@ -17,11 +18,14 @@ def test_interval_is_students_t_on_the_mean():
     assert (lo, hi) == (pytest.approx(3 - half, abs=1e-3), pytest.approx(3 + half, abs=1e-3))
 
 
-@pytest.mark.parametrize("values, want", [
-    ([1.0, 1.2, 0.9], "holds"),          # interval above 0
-    ([-1.0, -1.2, -0.9], "fails"),       # interval below 0
-    ([1.0, -0.8, 0.5], "undecided"),     # interval straddles 0
-])
+@pytest.mark.parametrize(
+    "values, want",
+    [
+        ([1.0, 1.2, 0.9], "holds"),  # interval above 0
+        ([-1.0, -1.2, -0.9], "fails"),  # interval below 0
+        ([1.0, -0.8, 0.5], "undecided"),  # interval straddles 0
+    ],
+)
 def test_verdict_from_the_interval(values, want):
     assert C.verdict(CLAIM, values) == want
 
@@ -39,8 +43,14 @@ def _tables(seeds=(0,)):
     for s in seeds:
         for t in ("sparse", "medium"):
             for m in models:  # the wind-blind MLP at 30% of the ceiling's gain, the rest at 60%
-                fit.append({"seed": s, "tree": t, "model": m,
-                            "ceiling_frac": 0.3 if m == "mlp" else 0.6 + 0.01 * s})
+                fit.append(
+                    {
+                        "seed": s,
+                        "tree": t,
+                        "model": m,
+                        "ceiling_frac": 0.3 if m == "mlp" else 0.6 + 0.01 * s,
+                    }
+                )
         for m in models:
             r = {"seed": s, "model": C.LABELS[m]}
             for t in ("sparse", "medium"):
@@ -50,18 +60,47 @@ def _tables(seeds=(0,)):
             psnr.append(r)
         for t in ("sparse", "medium"):
             for c in (0.84, 0.71):
-                transfer.append({"seed": s, "split": "beyond", "tree": t, "condition": c,
-                                 "static": 20.0, "mlp": 19.0, "mlp_wind": 19.5, "d3dgs": 18.0,
-                                 "d3dgs_wind": 19.2, "ours": 21.0})
-            margin.append({"seed": s, "tree": t, "margin_v0": -1.0, "margin_0.84v0": 0.0,
-                           "margin_0.71v0": 1.0 + 0.1 * s})
-            null.append({"seed": s, "tree": t, "config": "joint32",
-                         "trained_median_rel_err_pct": 2.0, "null_median_rel_err_pct":
-                         5.0 if t == "sparse" else 2.1})
+                transfer.append(
+                    {
+                        "seed": s,
+                        "split": "beyond",
+                        "tree": t,
+                        "condition": c,
+                        "static": 20.0,
+                        "mlp": 19.0,
+                        "mlp_wind": 19.5,
+                        "d3dgs": 18.0,
+                        "d3dgs_wind": 19.2,
+                        "ours": 21.0,
+                    }
+                )
+            margin.append(
+                {
+                    "seed": s,
+                    "tree": t,
+                    "margin_v0": -1.0,
+                    "margin_0.84v0": 0.0,
+                    "margin_0.71v0": 1.0 + 0.1 * s,
+                }
+            )
+            null.append(
+                {
+                    "seed": s,
+                    "tree": t,
+                    "config": "joint32",
+                    "trained_median_rel_err_pct": 2.0,
+                    "null_median_rel_err_pct": 5.0 if t == "sparse" else 2.1,
+                }
+            )
             testbed.append({"tree": t, "nearest_bone_gap_pct": 5.45 if t == "sparse" else 0.24})
-    return {"tab_psnr": pd.DataFrame(psnr), "tab_transfer": pd.DataFrame(transfer),
-            "tab_margin": pd.DataFrame(margin), "tab_null": pd.DataFrame(null),
-            "tab_testbed": pd.DataFrame(testbed), "tab_fit": pd.DataFrame(fit)}
+    return {
+        "tab_psnr": pd.DataFrame(psnr),
+        "tab_transfer": pd.DataFrame(transfer),
+        "tab_margin": pd.DataFrame(margin),
+        "tab_null": pd.DataFrame(null),
+        "tab_testbed": pd.DataFrame(testbed),
+        "tab_fit": pd.DataFrame(fit),
+    }
 
 
 def test_claims_measured_from_the_tables():
@@ -84,8 +123,17 @@ def test_claims_measured_from_the_tables():
     assert v.loc["fits_window/medium/mlp", "verdict"] == "fails"
     assert v.loc["fits_window/medium/d3dgs_wind", "measured"] == pytest.approx(0.61)
     assert v.loc["fits_window/sparse/ours", "verdict"] == "holds"
-    assert (v["seeds"].drop(["nearest_bone_gap/sparse", "nearest_bone_gap/medium",
-                             "damping_not_recovered/sparse", "decay_rate_flat/sparse"]) == 3).all()
+    assert (
+        v["seeds"].drop(
+            [
+                "nearest_bone_gap/sparse",
+                "nearest_bone_gap/medium",
+                "damping_not_recovered/sparse",
+                "decay_rate_flat/sparse",
+            ]
+        )
+        == 3
+    ).all()
     md = C.ledger_markdown(df, {"profile": "default"})
     assert "| **holds** |" in md and "profile=default" in md
 

@@ -1,4 +1,5 @@
 """Seed statistics (physgs.report.seeds) against scipy: intervals, decisions, the best."""
+
 import numpy as np
 import pytest
 from scipy import stats
@@ -22,9 +23,16 @@ def test_one_seed_gives_no_interval_and_decides_nothing():
     assert S.difference([2.0], ".2f") == "$+2.00$" + S.UNDECIDED
 
 
-@pytest.mark.parametrize("values, want", [([1.0, 1.1, 0.9], True), ([-1.0, -1.1, -0.9], True),
-                                          ([1.0, -0.8, 0.5], False), ([0.0, 0.0], False),
-                                          ([np.nan, 1.0], False)])
+@pytest.mark.parametrize(
+    "values, want",
+    [
+        ([1.0, 1.1, 0.9], True),
+        ([-1.0, -1.1, -0.9], True),
+        ([1.0, -0.8, 0.5], False),
+        ([0.0, 0.0], False),
+        ([np.nan, 1.0], False),
+    ],
+)
 def test_decided_when_the_interval_excludes_zero(values, want):
     assert S.decided(values) is want
 

@@ -1,4 +1,5 @@
 """Tables: known best in bold, .tex and .csv agree, bad input stops."""
+
 import re
 
 import numpy as np
@@ -44,7 +45,9 @@ def tex_rows(tex):
             continue
         nums, bold = [], []
         for c in line.split("&"):
-            plain = re.sub(r"\\textbf\{(.*)\}", r"\1", c.strip()).replace("$", "").replace("\\%", "")
+            plain = (
+                re.sub(r"\\textbf\{(.*)\}", r"\1", c.strip()).replace("$", "").replace("\\%", "")
+            )
             plain = plain.replace("^{\\dagger}", "")  # the undecided mark
             for part in plain.split("\\pm"):
                 m = re.fullmatch(r"([-+]?\d+(?:\.\d+)?)(?:/\d+)?", part.strip())
@@ -62,8 +65,9 @@ def per_seed(n_seeds, noise=0.0):
     for s in range(n_seeds):
         S = summaries()
         shift = rng.normal(0, 1.0)  # a seed-wide offset every model shares (pairing cancels it)
-        out[s] = {k: {kk: v + shift + noise * rng.normal() for kk, v in d.items()}
-                  for k, d in S.items()}
+        out[s] = {
+            k: {kk: v + shift + noise * rng.normal() for kk, v in d.items()} for k, d in S.items()
+        }
     return out
 
 
@@ -114,8 +118,10 @@ def test_paired_differences_use_scipy_t_interval():
     data = per_seed(5, noise=0.3)
     tab = T.tab_margin(data, TREES, BONES, COND)
     d = tab.df[tab.df.tree == "medium"]["margin_0.84v0"].to_numpy()
-    exp = [data[s][("medium", "ours")]["train_c1"] - data[s][("medium", "mlp_wind")]["train_c1"]
-           for s in range(5)]
+    exp = [
+        data[s][("medium", "ours")]["train_c1"] - data[s][("medium", "mlp_wind")]["train_c1"]
+        for s in range(5)
+    ]
     np.testing.assert_allclose(d, exp)
     lo, hi = stats.t.interval(0.95, len(d) - 1, loc=d.mean(), scale=stats.sem(d))
     cell = f"${d.mean():+.2f}$ [{lo:.2f}, {hi:.2f}]"
@@ -149,8 +155,9 @@ def test_tab_transfer_rows_and_decided_bold():
     first = tab.df[tab.df.seed == 0]
     rows = tex_rows(tab.tex)
     for (nums, bold), (i, r) in zip(rows, first.iterrows()):
-        vals = tab.df[(tab.df.split == r.split) & (tab.df.tree == r.tree)
-                      & (tab.df.condition == r.condition)][list(T.MODELS)].to_numpy(float)
+        vals = tab.df[
+            (tab.df.split == r.split) & (tab.df.tree == r.tree) & (tab.df.condition == r.condition)
+        ][list(T.MODELS)].to_numpy(float)
         np.testing.assert_allclose(nums[::2], np.round(vals.mean(0), 2))  # mean, then sd
         top = np.sort(vals.mean(0))
         if top[-1] - top[-2] > 0.1:  # a gap ten times the noise: decided
@@ -162,8 +169,14 @@ def test_tab_transfer_rows_and_decided_bold():
 def test_tab_margin_values():
     S = per_seed(1)
     tab = T.tab_margin(S, TREES, BONES, COND)
-    assert list(tab.df.columns) == ["seed", "tree", "bones", "margin_v0", "margin_0.84v0",
-                                    "margin_0.71v0"]
+    assert list(tab.df.columns) == [
+        "seed",
+        "tree",
+        "bones",
+        "margin_v0",
+        "margin_0.84v0",
+        "margin_0.71v0",
+    ]
     exp = S[0][("medium", "ours")]["train_c1"] - S[0][("medium", "mlp_wind")]["train_c1"]
     assert tab.df.loc[1, "margin_0.84v0"] == pytest.approx(exp)
     assert f"${exp:+.2f}$" + T.seedstats.UNDECIDED in tab.tex
@@ -177,28 +190,54 @@ def test_results_not_keyed_by_seed_are_refused():
 def record(n_trusted, med):
     K = 4
     trusted = np.arange(K) < n_trusted
-    m = MatchResult(np.zeros(K, int), np.ones(K), trusted, np.ones(K), np.ones(K), np.zeros(K),
-                    n_trusted, K, med, 0.9)
+    m = MatchResult(
+        np.zeros(K, int),
+        np.ones(K),
+        trusted,
+        np.ones(K),
+        np.ones(K),
+        np.zeros(K),
+        n_trusted,
+        K,
+        med,
+        0.9,
+    )
     return RecoveryRecord(m, damping_summary(np.array([1.0, 2, 3, 4]), np.full(4, 0.1), 0.08))
 
 
 def null(med):
-    return NullResult(np.array([4, 3, 4]), np.array([med, med, np.nan]), np.array([0.99, 0.98, np.nan]),
-                      np.ones((3, 4)), 4, 0.004, 0)
+    return NullResult(
+        np.array([4, 3, 4]),
+        np.array([med, med, np.nan]),
+        np.array([0.99, 0.98, np.nan]),
+        np.ones((3, 4)),
+        4,
+        0.004,
+        0,
+    )
 
 
 def test_tab_null_per_seed_difference_and_nan_cells(tmp_path):
     cfg = {"single": "single ($K{=}32$)"}
-    rec = {s: {("sparse", "single"): record(3, 0.018 + 0.001 * s),
-               ("medium", "single"): record(0, float("nan"))} for s in range(3)}
-    nl = {s: {("sparse", "single"): null(0.0456 + 0.002 * s), ("medium", "single"): null(0.0177)}
-          for s in range(3)}
+    rec = {
+        s: {
+            ("sparse", "single"): record(3, 0.018 + 0.001 * s),
+            ("medium", "single"): record(0, float("nan")),
+        }
+        for s in range(3)
+    }
+    nl = {
+        s: {("sparse", "single"): null(0.0456 + 0.002 * s), ("medium", "single"): null(0.0177)}
+        for s in range(3)
+    }
     tab = T.tab_null(rec, nl, TREES, BONES, configs=cfg)
     sp = tab.df[tab.df.tree == "sparse"]
     np.testing.assert_allclose(sp.trained_median_rel_err_pct, [1.8, 1.9, 2.0])
     np.testing.assert_allclose(sp.null_median_rel_err_pct, [4.56, 4.76, 4.96])
     np.testing.assert_allclose(sp.trained_minus_null_pp, [-2.76, -2.86, -2.96])
-    assert (sp.null_parts_trusted == 4).all() and sp.nearest_bone_gap_pct.iloc[0] == pytest.approx(0.4)
+    assert (sp.null_parts_trusted == 4).all() and sp.nearest_bone_gap_pct.iloc[0] == pytest.approx(
+        0.4
+    )
     # trained beats the null on every seed by ~2.9 points with sd 0.1: decided, bold
     assert r"\textbf{$-2.86$" in tab.tex
     assert "1.90 $\\pm$ 0.10\\%" in tab.tex
@@ -213,7 +252,9 @@ def test_tab_null_per_seed_difference_and_nan_cells(tmp_path):
 def test_tab_null_refuses_a_null_with_another_k():
     cfg = {"single": "single ($K{=}32$)"}
     rec = {0: {("sparse", "single"): record(3, 0.018)}}
-    other = NullResult(np.array([4]), np.array([0.04]), np.array([0.9]), np.ones((1, 8)), 8, 0.004, 0)
+    other = NullResult(
+        np.array([4]), np.array([0.04]), np.array([0.9]), np.ones((1, 8)), 8, 0.004, 0
+    )
     with pytest.raises(ValueError, match="K=8"):
         T.tab_null(rec, {0: {("sparse", "single"): other}}, ["sparse"], BONES, configs=cfg)
 
@@ -244,8 +285,13 @@ def test_tab_fit_fraction_of_the_ceiling():
     rows = {}
     for t in TREES:
         for m, fit in zip((*models, "truth_motion"), (20.0, 22.0, 26.0, 30.0)):
-            rows[(t, m)] = {"fit": fit, "heldout": fit - 0.5, "view": 21.0, "time": 21.5,
-                            "train_s": 12.0}
+            rows[(t, m)] = {
+                "fit": fit,
+                "heldout": fit - 0.5,
+                "view": 21.0,
+                "time": 21.5,
+                "train_s": 12.0,
+            }
     tab = T.tab_fit({0: rows}, TREES, BONES, models, "truth_motion")
     frac = dict(zip(tab.df.model[tab.df.tree == "sparse"], tab.df.ceiling_frac))
     # (model - static) / (ceiling - static): 0, 2/10, 6/10, 1
@@ -261,9 +307,16 @@ def test_fit_row_splits_trained_and_held_out_frames(tmp_path):
     cam = np.full((3, n_train + n_tail), 5.0)
     cam[0, :n_train] = 10.0
     cam[0, 9:n_train:10] = 20.0  # frames 9, 19, 29: the held-out ones (every 10th)
-    ev = EvalResult(camera_psnr=cam, centroid_err=np.zeros_like(cam), view_psnr=np.full((2, 3), 7.0),
-                    conditions=np.array(COND), heldout_azimuths_deg=np.array([-5.0, 5.0]),
-                    heldout_frame_idx=np.array([0, 10, 20]), n_train=n_train, n_tail=n_tail)
+    ev = EvalResult(
+        camera_psnr=cam,
+        centroid_err=np.zeros_like(cam),
+        view_psnr=np.full((2, 3), 7.0),
+        conditions=np.array(COND),
+        heldout_azimuths_deg=np.array([-5.0, 5.0]),
+        heldout_frame_idx=np.array([0, 10, 20]),
+        n_train=n_train,
+        n_tail=n_tail,
+    )
     ev.save(tmp_path / "e.npz")
     pd.DataFrame({"seconds": [1.0, 2.0, 42.5]}).to_csv(tmp_path / "l.csv", index=False)
     r = fit_row(tmp_path / "e.npz", tmp_path / "l.csv", n_train, 10)

@@ -1,4 +1,5 @@
 """Model only what the scene requires: image swing, freezing, and K chosen from the data."""
+
 import copy
 import math
 from types import SimpleNamespace
@@ -38,6 +39,7 @@ def _cfg(K=4, iterations=16, warmup=4):
 
 # -- image swing --------------------------------------------------------------------------------
 
+
 def test_probe_swing_matches_an_independent_projection(data):
     model = build_model("ours", data, _cfg(K=4)["models"])
     with torch.no_grad():
@@ -75,6 +77,7 @@ def test_swing_under_theta_is_zero_for_a_silent_model_and_grows_with_gain(data):
 
 # -- freezing ----------------------------------------------------------------------------------
 
+
 def test_frozen_parts_have_zero_theta_and_their_parameters_never_move(data, tmp_path):
     cfg = _cfg(K=4, iterations=14, warmup=2)
     model = build_model("ours", data, cfg["models"])
@@ -86,13 +89,18 @@ def test_frozen_parts_have_zero_theta_and_their_parameters_never_move(data, tmp_
                 m.gain_raw.fill_(0.05)
                 m.gain_raw[0] = 1e-6
             out = freeze_invisible(m, data, 1e-3, optimizer=opt)  # part 0 swings ~1e-5 px
-            snap.update({n: getattr(m, n).detach().clone() for n in
-                         ("omega_raw", "zeta_raw", "gain_raw", "axis_raw", "pivot")})
+            snap.update(
+                {
+                    n: getattr(m, n).detach().clone()
+                    for n in ("omega_raw", "zeta_raw", "gain_raw", "axis_raw", "pivot")
+                }
+            )
             return out
         return None
 
-    res = train_model(model, data, cfg["train"], conditions=[0], seed=0, progress=False,
-                      on_iteration=hook)
+    res = train_model(
+        model, data, cfg["train"], conditions=[0], seed=0, progress=False, on_iteration=hook
+    )
     m = res.model
     assert res.stats["frozen_parts"] == int(m.frozen.sum()) >= 1 and bool(m.frozen[0])
     fz = m.frozen
@@ -104,8 +112,17 @@ def test_frozen_parts_have_zero_theta_and_their_parameters_never_move(data, tmp_
     assert torch.all(theta[fz] == 0) and torch.all(theta[~fz].abs().amax(1) > 0)
     # the mask travels in the checkpoint
     from physgs.models import save_checkpoint
-    save_checkpoint(tmp_path / "o.pt", m, name="ours", config="single", seed=0,
-                    models_cfg=cfg["models"], train_cfg=cfg["train"], stats=res.stats)
+
+    save_checkpoint(
+        tmp_path / "o.pt",
+        m,
+        name="ours",
+        config="single",
+        seed=0,
+        models_cfg=cfg["models"],
+        train_cfg=cfg["train"],
+        stats=res.stats,
+    )
     assert torch.equal(load_checkpoint(tmp_path / "o.pt").frozen, fz)
 
 
@@ -117,10 +134,17 @@ def test_frozen_parts_count_as_untrusted_in_recovery(data):
     model.freeze_parts(np.array([True, False, False, False]))
     w = np.asarray(data.wind[0], dtype=np.float64)
     from physgs.models.oscillator import integrate
+
     om = model.omega.detach().double()
-    bones = integrate(om, torch.full((4,), 0.1, dtype=torch.float64),
-                      torch.ones(4, dtype=torch.float64), w, float(w.mean()), 1 / data.fps,
-                      2).numpy()
+    bones = integrate(
+        om,
+        torch.full((4,), 0.1, dtype=torch.float64),
+        torch.ones(4, dtype=torch.float64),
+        w,
+        float(w.mean()),
+        1 / data.fps,
+        2,
+    ).numpy()
     truth = SimpleNamespace(omega=om.numpy(), zeta=np.full(4, 0.1), theta=bones.T[None])
     rec = recover_model(model, data, truth)
     assert rec.n_frozen == 1 and not rec.match.trusted[0] and rec.match.corr[0] == 0.0
@@ -142,14 +166,20 @@ def test_freeze_schedule_is_checked():
 def test_run_training_freezes_and_reports(data, tmp_path):
     cfg = _cfg(K=4, iterations=12, warmup=2)
     cfg["models"]["ours"].update(freeze_below_px=1e6, freeze_at=0.5)  # everything is "invisible"
-    res = train_and_save(data, job_spec(cfg, "ours", "single"), progress=False,
-                         checkpoint_path=tmp_path / "o.pt", loss_path=tmp_path / "o.csv")
+    res = train_and_save(
+        data,
+        job_spec(cfg, "ours", "single"),
+        progress=False,
+        checkpoint_path=tmp_path / "o.pt",
+        loss_path=tmp_path / "o.csv",
+    )
     assert res.stats["frozen_parts"] == 4 and res.stats["frozen_at"] == 6
     assert len(res.stats["part_swing_px"]) == 4
     assert load_checkpoint(tmp_path / "o.pt").checkpoint_info["stats"]["frozen_parts"] == 4
 
 
 # -- K from the data ---------------------------------------------------------------------------
+
 
 def test_split_and_choices():
     tr, held = heldout_split(20, 5)
@@ -158,16 +188,23 @@ def test_split_and_choices():
         heldout_split(20, 1)
     assert choose_heldout([8, 16, 32, 64], [20.0, 21.0, 21.08, 20.5], 0.1) == 16  # tie -> smaller
     assert choose_heldout([8, 16, 32, 64], [20.0, 21.0, 21.5, 20.5], 0.1) == 32
-    assert bic(0.01, 1000, 4) == pytest.approx(1000 * math.log(0.01) + PARAMS_PER_PART * 4
-                                               * math.log(1000))
+    assert bic(0.01, 1000, 4) == pytest.approx(
+        1000 * math.log(0.01) + PARAMS_PER_PART * 4 * math.log(1000)
+    )
     assert choose_bic([8, 16, 32], [5.0, 3.0, 3.0]) == 16
 
 
 def test_select_k_then_train_auto(data, tmp_path):
     cfg = _cfg(iterations=14, warmup=4)
-    cfg["models"]["kselect"] = {"candidates": [4, 1], "method": "heldout", "every": 5,
-                                "iterations": 14, "warmup": 4, "tie_db": 0.0,
-                                "conditions": "train"}
+    cfg["models"]["kselect"] = {
+        "candidates": [4, 1],
+        "method": "heldout",
+        "every": 5,
+        "iterations": 14,
+        "warmup": 4,
+        "tie_db": 0.0,
+        "conditions": "train",
+    }
     cfg["models"]["ours"].update(freeze_below_px=0.0, freeze_at=0.5)
     job = job_spec(cfg, "ours", "single")
     sel = select_k(data, job, cfg["models"]["kselect"])
@@ -178,8 +215,13 @@ def test_select_k_then_train_auto(data, tmp_path):
     save_selection(tmp_path / "k.json", sel)
     back = load_selection(tmp_path / "k.json")
     assert back == sel
-    train_and_save(data, auto_job(job, back, "train"), progress=False,
-                   checkpoint_path=tmp_path / "a.pt", loss_path=tmp_path / "a.csv")
+    train_and_save(
+        data,
+        auto_job(job, back, "train"),
+        progress=False,
+        checkpoint_path=tmp_path / "a.pt",
+        loss_path=tmp_path / "a.csv",
+    )
     model = load_checkpoint(tmp_path / "a.pt")
     assert model.K == sel.chosen_k and model.checkpoint_info["config"] == "auto"
     bad = copy.deepcopy(cfg)
@@ -193,10 +235,21 @@ def test_select_k_then_train_auto(data, tmp_path):
 def test_tab_kselect_rows_and_undefined_entries():
     from physgs.report.build import needs
     from physgs.report.kselect import tab_kselect
-    rows = {("sparse", "single"): dict(K=32, time_psnr=25.0, median_rel_err=0.05, trusted=10,
-                                       frozen=3, k_heldout=16, k_bic=64),
-            ("sparse", "auto"): dict(K=16, time_psnr=25.5, median_rel_err=float("nan"), trusted=0,
-                                     frozen=16, k_heldout=16, k_bic=64)}
+
+    rows = {
+        ("sparse", "single"): dict(
+            K=32, time_psnr=25.0, median_rel_err=0.05, trusted=10, frozen=3, k_heldout=16, k_bic=64
+        ),
+        ("sparse", "auto"): dict(
+            K=16,
+            time_psnr=25.5,
+            median_rel_err=float("nan"),
+            trusted=0,
+            frozen=16,
+            k_heldout=16,
+            k_bic=64,
+        ),
+    }
     t = tab_kselect({0: rows}, ["sparse"], {"sparse": 22}, "heldout")
     assert t.df["K"].tolist() == [32, 16] and t.df["median_rel_err_pct"].iloc[0] == 5.0
     assert "10/32" in t.tex and "0/16" in t.tex and "--" in t.tex  # NaN median shown as --

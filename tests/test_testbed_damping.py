@@ -4,6 +4,7 @@ inside the training window, free decays against the closed form; the faithful va
 Physics only (simulate_tree, no rendering), on the quick profile's sparse tree with a 10 s
 training window (240 frames at 24 fps) holding the gust (2-3 s) and a 5 s calm (3-8 s).
 """
+
 import copy
 
 import numpy as np
@@ -61,8 +62,9 @@ def test_faithful_variant_is_the_default_code_path():
         assert np.array_equal(a[k], b[k]) and np.asarray(a[k]).dtype == np.asarray(b[k]).dtype, k
     tr = sim.truth
     np.testing.assert_array_equal(tr.zeta, np.full(len(tr.omega), tb["zeta"]))
-    assert tr.lead_in_frames == physics.lead_in_frames(tr.omega.min(), tb["zeta"],
-                                                       tb["lead_in_tau"], FPS)
+    assert tr.lead_in_frames == physics.lead_in_frames(
+        tr.omega.min(), tb["zeta"], tb["lead_in_tau"], FPS
+    )
     # the damping block is not read by the faithful variant
     odd = copy.deepcopy(tb)
     odd["damping"]["zeta_range"] = [0.5, 0.9]
@@ -75,16 +77,28 @@ def test_the_zeta_stream_changes_nothing_else_in_the_tree(damped):
     """Same seed: geometry, frequencies, mesh and Gaussian order equal the faithful tree's."""
     f = _sim(_tb("faithful")).truth
     d = damped.truth
-    for k in ("omega", "bone_head", "bone_tail", "bone_parent", "rest_vertices", "faces",
-              "vertex_bone", "vertex_colors", "gaussian_vertex", "omega_clamped", "tip_vertices"):
+    for k in (
+        "omega",
+        "bone_head",
+        "bone_tail",
+        "bone_parent",
+        "rest_vertices",
+        "faces",
+        "vertex_bone",
+        "vertex_colors",
+        "gaussian_vertex",
+        "omega_clamped",
+        "tip_vertices",
+    ):
         np.testing.assert_array_equal(getattr(f, k), getattr(d, k), err_msg=k)
     # the wind before the gust is the same realisation, bit for bit (the lead-ins differ)
     L_f, L_d = f.lead_in_frames, d.lead_in_frames
     m = min(L_f, L_d)
     j_gust = int(round((START_S - CFG["testbed"]["damping"]["transient"]["gust_s"]) * FPS))
     sf = _sim(_tb("faithful"))
-    np.testing.assert_array_equal(sf.wind[:, L_f - m:L_f + j_gust + 1],
-                                  damped.wind[:, L_d - m:L_d + j_gust + 1])
+    np.testing.assert_array_equal(
+        sf.wind[:, L_f - m : L_f + j_gust + 1], damped.wind[:, L_d - m : L_d + j_gust + 1]
+    )
     assert not np.array_equal(sf.wind[:, L_f + j_gust + 1], damped.wind[:, L_d + j_gust + 1])
 
 
@@ -109,8 +123,9 @@ def test_zeta_draw_is_log_uniform_against_its_quantiles():
     """draw_zeta alone: 20000 draws, the empirical CDF of log zeta against the uniform's."""
     z = variant.draw_zeta([0.03, 0.2], 20000, np.random.SeedSequence(4))
     u = np.log(z / 0.03) / np.log(0.2 / 0.03)
-    np.testing.assert_allclose(np.quantile(u, [0.1, 0.25, 0.5, 0.75, 0.9]),
-                               [0.1, 0.25, 0.5, 0.75, 0.9], atol=0.015)
+    np.testing.assert_allclose(
+        np.quantile(u, [0.1, 0.25, 0.5, 0.75, 0.9]), [0.1, 0.25, 0.5, 0.75, 0.9], atol=0.015
+    )
     with pytest.raises(ValueError, match="zeta_range"):
         variant.draw_zeta([0.2, 0.03], 3, np.random.SeedSequence(0))
 
@@ -120,8 +135,9 @@ def test_lead_in_uses_the_slowest_decay_rate(damped):
     rate = (tr.zeta * tr.omega).min()
     assert tr.lead_in_frames == int(np.ceil(CFG["testbed"]["lead_in_tau"] / rate * FPS))
     # slower than omega_min at the median zeta would give
-    assert tr.lead_in_frames > physics.lead_in_frames(tr.omega.min(), np.median(tr.zeta),
-                                                      CFG["testbed"]["lead_in_tau"], FPS)
+    assert tr.lead_in_frames > physics.lead_in_frames(
+        tr.omega.min(), np.median(tr.zeta), CFG["testbed"]["lead_in_tau"], FPS
+    )
 
 
 def test_truth_file_keeps_zeta_per_bone(damped, tmp_path):
@@ -140,13 +156,13 @@ def test_calm_window_has_no_forcing_and_the_wind_is_shared_by_every_condition(da
     assert (j0, j1) == (START_S * FPS, (START_S + CALM_S) * FPS + 1)
     assert j1 <= N_TRAIN  # inside the recorded training window
     v0 = CFG["testbed"]["wind"]["v0"]
-    np.testing.assert_array_equal(damped.wind[0, L + j0:L + j1], v0)  # exactly the mean speed
+    np.testing.assert_array_equal(damped.wind[0, L + j0 : L + j1], v0)  # exactly the mean speed
     u = physics.drag_forcing(damped.wind.astype(np.float64), tr.vbar)  # [C, L+F]
-    assert np.abs(u[:, L + j0:L + j1]).max() < 1e-6 * np.abs(u).max()
+    assert np.abs(u[:, L + j0 : L + j1]).max() < 1e-6 * np.abs(u).max()
     # turbulence before the gust and after the ramp back, and a gust above the mean
-    assert np.std(u[0, L:L + j0 - FPS]) > 0.1 * np.abs(u).max()
-    assert np.std(u[0, L + j1 + FPS:L + N_TRAIN]) > 0.1 * np.abs(u).max()
-    gust = damped.wind[0, L + j0 - FPS:L + j0]
+    assert np.std(u[0, L : L + j0 - FPS]) > 0.1 * np.abs(u).max()
+    assert np.std(u[0, L + j1 + FPS : L + N_TRAIN]) > 0.1 * np.abs(u).max()
+    gust = damped.wind[0, L + j0 - FPS : L + j0]
     assert gust.max() > v0 * 1.2
     # the observed wind is one series, each condition a rescaling of it
     for c, k in enumerate(damped.conditions):
@@ -156,7 +172,7 @@ def test_calm_window_has_no_forcing_and_the_wind_is_shared_by_every_condition(da
 def _through(two, omega, zeta, h):
     """(A, B) [B] of the free response e^{-zeta w t} (A cos w_d t + B sin w_d t) through two
     consecutive samples two [2, B] (t = 0 and h); its amplitude at t = 0 is hypot(A, B)."""
-    g, wd = zeta * omega, omega * np.sqrt(1 - zeta ** 2)
+    g, wd = zeta * omega, omega * np.sqrt(1 - zeta**2)
     return two[0], (two[1] * np.exp(g * h) - two[0] * np.cos(wd * h)) / np.sin(wd * h)
 
 
@@ -165,7 +181,7 @@ def _free_decay(theta, omega, zeta, h):
     t = k h, k < T. Independent of the testbed's simulator. Returns (prediction [T, B],
     amplitude hypot(A, B) [B] at sample 0)."""
     A, B = _through(theta[:2], omega, zeta, h)
-    g, wd = zeta * omega, omega * np.sqrt(1 - zeta ** 2)
+    g, wd = zeta * omega, omega * np.sqrt(1 - zeta**2)
     t = np.arange(len(theta))[:, None] * h
     return np.exp(-g * t) * (A * np.cos(wd * t) + B * np.sin(wd * t)), np.hypot(A, B)
 
@@ -173,12 +189,12 @@ def _free_decay(theta, omega, zeta, h):
 def test_every_bone_decays_freely_through_the_calm(damped):
     tr, L = damped.truth, damped.truth.lead_in_frames
     j0, j1 = variant.calm_frames(variant.transient_of(_tb()), FPS)
-    calm = tr.theta[0, L + j0:L + j1]  # [T, B], the training wind
+    calm = tr.theta[0, L + j0 : L + j1]  # [T, B], the training wind
     pred, amp = _free_decay(calm, tr.omega, tr.zeta, 1.0 / FPS)
     np.testing.assert_allclose(calm, pred, rtol=0, atol=FREE_DECAY_RTOL * amp.max())
     assert np.all(np.abs(calm - pred).max(0) <= FREE_DECAY_RTOL * amp)
     # the decay starts from a visible swing: a deliberate transient, not a residue
-    rms = np.sqrt(np.mean(tr.theta[0, L:L + N_TRAIN] ** 2, axis=0))
+    rms = np.sqrt(np.mean(tr.theta[0, L : L + N_TRAIN] ** 2, axis=0))
     assert (amp >= MIN_CALM_START_AMPLITUDE * rms).all(), (amp / rms).min()
     # and it really is a decay at each bone's own rate: the envelope shrinks by exp(-zeta w T)
     T = (j1 - j0 - 2) / FPS  # from the calm's first sample to its last but one
@@ -186,7 +202,7 @@ def test_every_bone_decays_freely_through_the_calm(damped):
     np.testing.assert_allclose(env / amp, np.exp(-tr.zeta * tr.omega * T), rtol=1e-6)
     # control: the faithful variant's wind over the same frames forces the bones
     f = _sim(_tb("faithful")).truth
-    fc = f.theta[0, f.lead_in_frames + j0:f.lead_in_frames + j1]
+    fc = f.theta[0, f.lead_in_frames + j0 : f.lead_in_frames + j1]
     fp, famp = _free_decay(fc, f.omega, f.zeta, 1.0 / FPS)
     assert np.abs(fc - fp).max() > 100 * FREE_DECAY_RTOL * famp.max()
 
@@ -212,16 +228,16 @@ def test_the_record_before_the_gust_does_not_depend_on_the_transient(damped):
     a, L = damped, damped.truth.lead_in_frames
     assert b.truth.lead_in_frames == L
     j = int(round((START_S - CFG["testbed"]["damping"]["transient"]["gust_s"]) * FPS))
-    np.testing.assert_array_equal(a.wind[:, :L + j + 1], b.wind[:, :L + j + 1])
+    np.testing.assert_array_equal(a.wind[:, : L + j + 1], b.wind[:, : L + j + 1])
     unit_a, unit_b = a.truth.theta / a.truth.g0, b.truth.theta / b.truth.g0
-    np.testing.assert_allclose(unit_a[:, :L + j + 1], unit_b[:, :L + j + 1], rtol=1e-12, atol=0)
+    np.testing.assert_allclose(unit_a[:, : L + j + 1], unit_b[:, : L + j + 1], rtol=1e-12, atol=0)
     assert not np.allclose(unit_a[:, L + j + FPS], unit_b[:, L + j + FPS], rtol=1e-3)
 
 
 def test_rms_swing_calibration_is_unchanged(damped):
     tr, L = damped.truth, damped.truth.lead_in_frames
-    world = kinematics.cumulative_angle(tr.bone_parent, tr.theta[0, L:L + N_TRAIN])
-    rms_deg = np.degrees(np.sqrt(np.mean(world ** 2)))
+    world = kinematics.cumulative_angle(tr.bone_parent, tr.theta[0, L : L + N_TRAIN])
+    rms_deg = np.degrees(np.sqrt(np.mean(world**2)))
     assert rms_deg == pytest.approx(CFG["testbed"]["rms_swing_deg"], rel=1e-9)
 
 

@@ -1,5 +1,6 @@
 """Dataset: a tiny end-to-end build, the interface fields, load errors, no partial outputs,
 Gaussians stored in a permuted order, framing."""
+
 import shutil
 import subprocess
 import sys
@@ -38,7 +39,9 @@ def test_roundtrip_matches_interface(tiny):
     # order: Gaussian i is mesh vertex gaussian_vertex[i]
     posed = kinematics.pose_vertices(t, t.theta[0, L])
     np.testing.assert_allclose(o.canonical_xyz, posed[t.gaussian_vertex], atol=1e-6)
-    np.testing.assert_allclose(o.canonical_xyz, kinematics.pose_gaussians(t, t.theta[0, L]), atol=1e-6)
+    np.testing.assert_allclose(
+        o.canonical_xyz, kinematics.pose_gaussians(t, t.theta[0, L]), atol=1e-6
+    )
     np.testing.assert_allclose(o.canonical_xyz[t.vertex_gaussian], posed, atol=1e-6)
     assert not np.array_equal(t.gaussian_vertex, np.arange(len(posed)))
     # the observed file holds no permutation and no bone label
@@ -50,7 +53,9 @@ def test_roundtrip_matches_interface(tiny):
     # the tree is in every frame, and never touches the image border (framing with margin)
     assert o.masks.reshape(C * F, -1).any(axis=1).all()
     for m in (o.masks, o.heldout_masks):
-        assert not (m[..., 0, :].any() or m[..., -1, :].any() or m[..., :, 0].any() or m[..., :, -1].any())
+        assert not (
+            m[..., 0, :].any() or m[..., -1, :].any() or m[..., :, 0].any() or m[..., :, -1].any()
+        )
     # held-out azimuths really are different viewpoints on the same orbit
     c0 = o.train_camera.center
     for a, cam in zip(o.heldout_azimuths_deg, o.heldout_cameras):
@@ -140,8 +145,11 @@ def test_framing_shifts_the_camera_height_for_a_held_out_view():
 
 def test_framing_error_names_the_key_and_the_fix():
     flat = _box(6.0, 0.2, 1.0)  # wide and low: it leaves the image sideways at 0.9 height fill
-    with pytest.raises(scene.FramingError, match=r"testbed\.fill_height = 0\.9.*training camera.*lower "
-                       r"testbed\.fill_height.*at most 0\.\d+ fits"):
+    with pytest.raises(
+        scene.FramingError,
+        match=r"testbed\.fill_height = 0\.9.*training camera.*lower "
+        r"testbed\.fill_height.*at most 0\.\d+ fits",
+    ):
         scene.frame_cameras(flat, [0.0], fov_deg=40, resolution=128, fill_height=0.9)
     deep = _box(0.5, 6.0, 3.0)  # deep along the training axis: side views see it wide
     with pytest.raises(scene.FramingError, match=r"held-out view at azimuth [+-]60 deg"):
@@ -180,8 +188,12 @@ def _workdir(tmp_path, edit):
     cfg = yaml.safe_load((tmp_path / "config/trees.yaml").read_text())
     edit(cfg)
     (tmp_path / "config/trees.yaml").write_text(yaml.safe_dump(cfg))
-    return subprocess.run([sys.executable, "-m", "snakemake", "--cores", "1", "testbed",
-                           "--config", "profile=quick"], cwd=tmp_path, capture_output=True, text=True)
+    return subprocess.run(
+        [sys.executable, "-m", "snakemake", "--cores", "1", "testbed", "--config", "profile=quick"],
+        cwd=tmp_path,
+        capture_output=True,
+        text=True,
+    )
 
 
 def test_schema_violation_stops_the_workflow(tmp_path):
@@ -195,6 +207,7 @@ def test_unreachable_bone_count_stops_with_cause_and_leaves_nothing(tmp_path):
     def edit(c):
         c["trees"] = ["sparse"]
         c["presets"]["sparse"]["levels"][0]["curve_res"] = 5
+
     r = _workdir(tmp_path, edit)
     out = r.stderr + r.stdout
     assert r.returncode != 0

@@ -1,4 +1,5 @@
 """Ground-truth oscillators against independent oracles; lead-in; wind spectrum; conditions."""
+
 import copy
 
 import numpy as np
@@ -19,7 +20,7 @@ def test_simulate_matches_lsim_with_linear_interpolated_forcing():
     fps, T = 24, 400
     omega = 2 * np.pi * np.array([0.35, 0.8, 1.5])
     zeta = np.array([0.08, 0.08, 0.2])
-    u = rng.normal(size=(T, 3)) * omega ** 2 * 0.01  # ~0.01 rad quasi-static scale
+    u = rng.normal(size=(T, 3)) * omega**2 * 0.01  # ~0.01 rad quasi-static scale
     th = physics.simulate(omega, zeta, u, 1.0 / fps)
     assert np.abs(th).max() > 1e-3
     for b in range(3):
@@ -50,16 +51,17 @@ def sparse_sims():
 def test_doubling_lead_in_leaves_recorded_window_unchanged(sparse_sims):
     a, b = sparse_sims[1.5].truth, sparse_sims[3.0].truth
     assert b.lead_in_frames >= 2 * a.lead_in_frames - 1
-    wa, wb = a.theta[:, a.lead_in_frames:], b.theta[:, b.lead_in_frames:]
+    wa, wb = a.theta[:, a.lead_in_frames :], b.theta[:, b.lead_in_frames :]
     assert np.abs(wa - wb).max() < 1e-6
     # the same wind realisation extends backwards
-    np.testing.assert_array_equal(sparse_sims[1.5].wind[:, a.lead_in_frames:],
-                                  sparse_sims[3.0].wind[:, b.lead_in_frames:])
+    np.testing.assert_array_equal(
+        sparse_sims[1.5].wind[:, a.lead_in_frames :], sparse_sims[3.0].wind[:, b.lead_in_frames :]
+    )
     # control: started from rest instead of the steady state, a start transient is there
     tr = a
     u = sparse_sims[1.5].wind.astype(np.float64) ** 2 - tr.vbar[:, None] ** 2
     rest = physics.simulate(tr.omega, tr.zeta, u[:, :, None] * tr.gain, 1.0 / tr.fps)
-    assert np.abs(rest[:, tr.lead_in_frames:] - wa).max() > 1e-4
+    assert np.abs(rest[:, tr.lead_in_frames :] - wa).max() > 1e-4
 
 
 def test_periodic_steady_state_equals_long_run_from_rest():
@@ -68,10 +70,10 @@ def test_periodic_steady_state_equals_long_run_from_rest():
     omega, zeta = 2 * np.pi * np.array([0.35, 1.2]), np.array([0.08, 0.08])
     one = rng.normal(size=(P, 2))
     u = np.concatenate([np.tile(one, (12, 1)), one[:1]])  # 12 periods (120 s), periodic
-    x0 = physics.periodic_steady_state(omega, zeta, u[:P + 1], dt)
-    ss = physics.simulate(omega, zeta, u[:P + 1], dt, x0=x0)
+    x0 = physics.periodic_steady_state(omega, zeta, u[: P + 1], dt)
+    ss = physics.simulate(omega, zeta, u[: P + 1], dt, x0=x0)
     long = physics.simulate(omega, zeta, u, dt)  # transient decays by exp(-0.176 * 110) ~ 4e-9
-    np.testing.assert_allclose(long[-P - 1:], ss, atol=1e-9 * np.abs(ss).max())
+    np.testing.assert_allclose(long[-P - 1 :], ss, atol=1e-9 * np.abs(ss).max())
 
 
 def test_lead_in_is_one_and_a_half_tau_max(sparse_sims):
@@ -93,7 +95,7 @@ def test_conditions_are_exact_rescalings(sparse_sims):
     h = 1.0 / tr.fps
     u = s.wind.astype(np.float64) ** 2 - tr.vbar[:, None] ** 2
     D = tr.theta - physics.simulate(tr.omega, tr.zeta, u[:, :, None] * tr.gain, h)
-    wd = tr.omega * np.sqrt(1 - tr.zeta ** 2)
+    wd = tr.omega * np.sqrt(1 - tr.zeta**2)
     a1 = 2 * np.exp(-tr.zeta * tr.omega * h) * np.cos(wd * h)
     a2 = np.exp(-2 * tr.zeta * tr.omega * h)
     resid = D[:, 2:] - a1 * D[:, 1:-1] + a2 * D[:, :-2]
@@ -103,8 +105,14 @@ def test_conditions_are_exact_rescalings(sparse_sims):
 
 def test_wind_spectrum_flat_inside_band_and_zero_outside():
     w = TB["wind"]
-    wf = make_wind(v0=w["v0"], turbulence_intensity=w["turbulence_intensity"], f_lo_hz=w["f_lo_hz"],
-                   f_hi_hz=w["f_hi_hz"], seed_seq=np.random.SeedSequence(7), period_s=60.0)
+    wf = make_wind(
+        v0=w["v0"],
+        turbulence_intensity=w["turbulence_intensity"],
+        f_lo_hz=w["f_lo_hz"],
+        f_hi_hz=w["f_hi_hz"],
+        seed_seq=np.random.SeedSequence(7),
+        period_s=60.0,
+    )
     fs, n = 32.0, 32 * 60  # exactly one period: every component falls on an FFT bin
     v = wf.speed(np.arange(n) / fs)
     assert abs(v.mean() - w["v0"]) < 1e-9

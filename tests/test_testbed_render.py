@@ -1,4 +1,5 @@
 """Mesh renderer against analytic cases; determinism."""
+
 import numpy as np
 import trimesh
 
@@ -14,7 +15,7 @@ def test_sphere_silhouette_radius_within_one_pixel():
     fc = np.full((len(sphere.faces), 3), 0.5)
     _, alpha = raycast.render_mesh(sphere.vertices, sphere.faces, fc, rays, [1, 1, 1])
     r_px = np.sqrt(alpha.sum() / np.pi)
-    exact = cam.fx * rho / np.sqrt(D ** 2 - rho ** 2)  # tangent cone of a sphere
+    exact = cam.fx * rho / np.sqrt(D**2 - rho**2)  # tangent cone of a sphere
     assert abs(r_px - exact) < 1.0, (r_px, exact)
     ys, xs = np.nonzero(alpha > 0.5)
     assert abs(xs.mean() + 0.5 - cam.cx) < 0.5 and abs(ys.mean() + 0.5 - cam.cy) < 0.5
@@ -26,8 +27,9 @@ def test_lambert_plus_ambient_shading_of_a_flat_quad():
     f = np.array([[0, 1, 2], [0, 2, 3]])
     col = np.array([0.8, 0.4, 0.2])
     cam = look_at([0.0, -3.0, 0.0], [0.0, 0.0, 0.0], fov_deg=40.0, width=8, height=8)
-    rgb, alpha = raycast.render_mesh(v, f, np.stack([col, col]), raycast.RayBundle(cam, 2), [1, 1, 1],
-                                     ambient=0.3)
+    rgb, alpha = raycast.render_mesh(
+        v, f, np.stack([col, col]), raycast.RayBundle(cam, 2), [1, 1, 1], ambient=0.3
+    )
     expect = col * (0.3 + 0.7 * abs(raycast.LIGHT_DIR[1]))
     np.testing.assert_allclose(rgb, np.broadcast_to(expect, rgb.shape), atol=1e-6)
     assert (alpha == 1).all()

@@ -1,5 +1,6 @@
 """Testbed statistics: the order leak, distinct frequencies, the nearest-bone gap and the visible
 motion against hand-computable cases; the stored Gaussian order carries no bone label."""
+
 from types import SimpleNamespace
 
 import numpy as np
@@ -108,10 +109,16 @@ def _toy(theta_window):
     tail = np.array([[0, 0, 1], [Lb, 0, 1], [Lb + 0.1, 0, 1.0]])
     rest = np.array([[0.0, 0, 0.5], [0, 0, 1], [Lb / 2, 0, 1], [Lb, 0, 1]])
     th = np.asarray(theta_window, float)
-    truth = SimpleNamespace(bone_head=head, bone_tail=tail, bone_parent=np.array([-1, 0, 1]),
-                            swing_axis=np.array([0.0, 1.0, 0.0]), rest_vertices=rest,
-                            vertex_bone=np.array([0, 0, 1, 1]), lead_in_frames=2,
-                            theta=np.concatenate([np.zeros((1, 2, 3)), th[None]], axis=1))
+    truth = SimpleNamespace(
+        bone_head=head,
+        bone_tail=tail,
+        bone_parent=np.array([-1, 0, 1]),
+        swing_axis=np.array([0.0, 1.0, 0.0]),
+        rest_vertices=rest,
+        vertex_bone=np.array([0, 0, 1, 1]),
+        lead_in_frames=2,
+        theta=np.concatenate([np.zeros((1, 2, 3)), th[None]], axis=1),
+    )
     return truth, Lb
 
 
@@ -131,7 +138,9 @@ def test_visible_motion_of_a_horizontal_bone_by_hand():
     assert vis[2] == 0.0  # no vertex: nothing to see
     # the familiar small-angle form: theta in [-a, a] moves the tip by about fx 2 L a / Z
     a = 0.01
-    vis_a = stats.visible_motion_px(_toy(np.stack([0 * t, a * np.sin(t), 0 * t], 1))[0], cam, len(t))
+    vis_a = stats.visible_motion_px(
+        _toy(np.stack([0 * t, a * np.sin(t), 0 * t], 1))[0], cam, len(t)
+    )
     assert vis_a[1] == pytest.approx(cam.fx * 2 * Lb * np.sin(a * np.sin(t).max()) / Z, rel=1e-9)
     assert vis_a[1] == pytest.approx(cam.fx * 2 * Lb * a / Z, rel=1e-3)
 
@@ -193,6 +202,7 @@ def test_displacement_energy_below_splits_two_tones_by_their_amplitudes():
     """Oracle: two sinusoids on exact rFFT bins (1 Hz, amplitude 1; 3 Hz, amplitude 2) carry
     energies in the ratio 1 : 4, so a cutoff between them keeps 1/5 of the energy."""
     from physgs.testbed.stats import displacement_energy_below
+
     fps, T = 24.0, 240
     t = np.arange(T) / fps
     x = np.zeros((T, 2, 3))
@@ -210,9 +220,11 @@ def test_time_band_top_matches_the_encodings_fastest_sine():
     import torch
     from physgs.models.encoding import fourier
     from physgs.testbed.stats import time_band_top_hz
+
     n, fps, bands = 300, 24.0, 4
     t = torch.linspace(0, 1, 20001)[:, None].double()
     top = fourier(t, bands)[:, 1 + 2 * (bands - 1)]  # [x, (sin, cos) per band]: the last sine
     crossings = int((np.diff(np.sign(top.numpy()[1:-1])) != 0).sum())  # 2 per cycle
     assert time_band_top_hz(bands, n, fps) == pytest.approx(
-        (crossings + 1) / 2 / ((n - 1) / fps), rel=1e-9)
+        (crossings + 1) / 2 / ((n - 1) / fps), rel=1e-9
+    )

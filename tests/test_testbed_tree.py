@@ -1,4 +1,5 @@
 """Testbed geometry: exact bone counts, skinning, frequency band, forward kinematics."""
+
 import copy
 
 import numpy as np
@@ -19,7 +20,11 @@ def sims():
 
 
 def test_exact_bone_counts(sims):
-    assert {t: s.truth.omega.size for t, s in sims.items()} == {"sparse": 22, "medium": 224, "dense": 562}
+    assert {t: s.truth.omega.size for t, s in sims.items()} == {
+        "sparse": 22,
+        "medium": 224,
+        "dense": 562,
+    }
 
 
 def test_every_vertex_skinned_and_deep_geometry_to_an_ancestor(sims):
@@ -48,12 +53,12 @@ def test_omega_band_law_and_zeta(sims):
         assert tr.omega.min() >= lo * (1 - 1e-12) and tr.omega.max() <= hi * (1 + 1e-12)
         assert tr.omega_clamped.sum() <= 0.02 * tr.omega.size
         free = ~tr.omega_clamped
-        q = tr.bone_radius / tr.bone_length ** 2
+        q = tr.bone_radius / tr.bone_length**2
         np.testing.assert_allclose(tr.omega[free] / q[free], tr.omega_c, rtol=1e-12)
         # band mostly used: spread of at least 3.5x of the 4.29x band
         assert tr.omega.max() / tr.omega.min() > 3.5
         np.testing.assert_array_equal(tr.zeta, TB["zeta"])
-        np.testing.assert_allclose(tr.gain, tr.g0 * tr.omega ** 2, rtol=1e-12)
+        np.testing.assert_allclose(tr.gain, tr.g0 * tr.omega**2, rtol=1e-12)
 
 
 def test_bad_bone_count_names_cause():
@@ -101,7 +106,9 @@ def test_clone_variation_is_seeded_and_touches_only_the_clones():
     np.testing.assert_array_equal(a.radius, exact.radius)
 
 
-@pytest.mark.parametrize("key,value", [("length_v", 1.0), ("length_v", -0.1), ("curve_v_deg", -1.0)])
+@pytest.mark.parametrize(
+    "key,value", [("length_v", 1.0), ("length_v", -0.1), ("curve_v_deg", -1.0)]
+)
 def test_bad_clone_variation_names_the_key(key, value):
     p = copy.deepcopy(CFG["presets"]["sparse"])
     p["split"][key] = value
@@ -121,9 +128,18 @@ def test_fk_two_bone_chain_against_hand_computation():
     np.testing.assert_allclose(H[1], p1, atol=1e-15)
     np.testing.assert_allclose(T[1], p1 + np.array([0, -np.sin(a + b), np.cos(a + b)]), atol=1e-15)
     # a vertex halfway along bone 1
-    V = kinematics.pose_points(np.array([[0, 0, 1.5]]), np.array([1]), head, tail, parent,
-                               np.array([1.0, 0, 0]), np.array([a, b]))
-    np.testing.assert_allclose(V[0], p1 + 0.5 * np.array([0, -np.sin(a + b), np.cos(a + b)]), atol=1e-15)
+    V = kinematics.pose_points(
+        np.array([[0, 0, 1.5]]),
+        np.array([1]),
+        head,
+        tail,
+        parent,
+        np.array([1.0, 0, 0]),
+        np.array([a, b]),
+    )
+    np.testing.assert_allclose(
+        V[0], p1 + 0.5 * np.array([0, -np.sin(a + b), np.cos(a + b)]), atol=1e-15
+    )
 
 
 def test_swing_axis_horizontal_and_perpendicular_to_wind():

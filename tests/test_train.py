@@ -28,8 +28,16 @@ def _eval_loss(model, data):
         tot = 0.0
         for j in range(0, data.n_train, 4):
             s = model.gaussians_at(j, torch.tensor(data.wind[0]))
-            out = rasterization(s.means, s.quats, s.scales, s.opacities, s.colors,
-                                data.train_camera, data.background, return_depth=False)
+            out = rasterization(
+                s.means,
+                s.quats,
+                s.scales,
+                s.opacities,
+                s.colors,
+                data.train_camera,
+                data.background,
+                return_depth=False,
+            )
             tgt = torch.from_numpy(data.frames[0, j]).float() / 255
             tot += float(photometric_loss(out.rgb, tgt)[0])
     return tot
@@ -43,14 +51,17 @@ def test_short_training_lowers_the_loss(name, data):
     res = train_model(model, data, cfg["train"], conditions=[0], seed=0, progress=False)
     after = _eval_loss(res.model, data)
     assert after < 0.9 * before, (name, before, after)
-    assert len(res.log) == 24 and res.log[0]["phase"] == "warmup" and res.log[-1]["phase"] == "deform"
+    assert (
+        len(res.log) == 24 and res.log[0]["phase"] == "warmup" and res.log[-1]["phase"] == "deform"
+    )
 
 
 def test_train_and_save_writes_checkpoint_and_log(tmp_path, data):
     cfg = _cfg(iterations=6, warmup=2)
     ck, lg = tmp_path / "ours_joint32.pt", tmp_path / "ours_joint32.loss.csv"
-    train_and_save(data, job_spec(cfg, "ours", "joint32"), checkpoint_path=ck, loss_path=lg,
-                   progress=False)
+    train_and_save(
+        data, job_spec(cfg, "ours", "joint32"), checkpoint_path=ck, loss_path=lg, progress=False
+    )
     m = load_checkpoint(ck)
     st = m.checkpoint_info["stats"]
     assert st["iterations"] == 6 and st["conditions"] == [0, 1, 2]
@@ -63,14 +74,23 @@ def test_divergence_stops_with_a_named_error_and_no_checkpoint(tmp_path, data):
     cfg = _cfg(iterations=5, warmup=1)
     cfg["train"]["lr"] = {k: 1e30 for k in cfg["train"]["lr"]}
     # the first (warm-up) update sends the canonical set to 1e30: named at once
-    with pytest.raises(TrainingError, match=r"model 'mlp_single'.*update of iteration 0.*"
-                                            r"likely setting: train\.lr\.\w+ \(now 1e\+30\)"):
-        train_and_save(data, job_spec(cfg, "mlp", "single"), checkpoint_path=tmp_path / "m.pt",
-                       loss_path=tmp_path / "m.csv", progress=False)
+    with pytest.raises(
+        TrainingError,
+        match=r"model 'mlp_single'.*update of iteration 0.*"
+        r"likely setting: train\.lr\.\w+ \(now 1e\+30\)",
+    ):
+        train_and_save(
+            data,
+            job_spec(cfg, "mlp", "single"),
+            checkpoint_path=tmp_path / "m.pt",
+            loss_path=tmp_path / "m.csv",
+            progress=False,
+        )
     assert list(tmp_path.iterdir()) == []
 
 
 # -- reproducibility ---------------------------------------------------------------------------
+
 
 def _draws(seed):
     seed_everything(seed)
@@ -104,8 +124,14 @@ def test_same_seed_same_checkpoint_weights(data):
         torch.randn(junk)  # a different history of the global generator
         seed_everything(seed)
         m = build_model(name, data, _cfg()["models"], seed=seed)
-        res = train_model(m, data, _cfg(iterations=8, warmup=2)["train"], conditions=[0],
-                          seed=seed, progress=False)
+        res = train_model(
+            m,
+            data,
+            _cfg(iterations=8, warmup=2)["train"],
+            conditions=[0],
+            seed=seed,
+            progress=False,
+        )
         return {k: v.clone() for k, v in res.model.state_dict().items()}, res.log
 
     for name in ("mlp", "ours"):
@@ -129,19 +155,22 @@ def test_ssim_against_direct_float64_formula():
     a = rng.random((9, 8, 1))
     b = np.clip(a + 0.1 * rng.standard_normal(a.shape), 0, 1)
     x = np.arange(11) - 5.0
-    g = np.exp(-x**2 / (2 * 1.5**2))
+    g = np.exp(-(x**2) / (2 * 1.5**2))
     g /= g.sum()
     w = np.outer(g, g)
     pa, pb = (np.pad(z[..., 0], 5) for z in (a, b))
     vals = []
     for i in range(9):
         for j in range(8):
-            A, B = pa[i:i + 11, j:j + 11], pb[i:i + 11, j:j + 11]
+            A, B = pa[i : i + 11, j : j + 11], pb[i : i + 11, j : j + 11]
             ma, mb = (w * A).sum(), (w * B).sum()
             va, vb = (w * A * A).sum() - ma**2, (w * B * B).sum() - mb**2
             cov = (w * A * B).sum() - ma * mb
-            vals.append((2 * ma * mb + 1e-4) * (2 * cov + 9e-4)
-                        / ((ma**2 + mb**2 + 1e-4) * (va + vb + 9e-4)))
+            vals.append(
+                (2 * ma * mb + 1e-4)
+                * (2 * cov + 9e-4)
+                / ((ma**2 + mb**2 + 1e-4) * (va + vb + 9e-4))
+            )
     got = ssim(torch.tensor(a), torch.tensor(b))
     assert float(got) == pytest.approx(np.mean(vals), abs=1e-10)
     assert float(ssim(torch.tensor(a), torch.tensor(a))) == pytest.approx(1.0, abs=1e-12)

@@ -1,5 +1,6 @@
 """Divergence during training: the guard on synthetic arrays, and the loop on the tiny swaying
 scene (a diverged run stops with the model, the iteration and the likely setting named)."""
+
 import numpy as np
 import pytest
 import torch
@@ -12,8 +13,13 @@ from oracles import quick_train_cfg
 
 # -- the guard on synthetic arrays ---------------------------------------------------------------
 
-GROUPS = {"canonical.means": "means", "canonical.opacity_logits": "opacities",
-          "field.w": "deform", "gain_raw": "physics", "pivot": "pivot"}
+GROUPS = {
+    "canonical.means": "means",
+    "canonical.opacity_logits": "opacities",
+    "field.w": "deform",
+    "gain_raw": "physics",
+    "pivot": "pivot",
+}
 
 
 def _box(n=400, seed=0):
@@ -22,9 +28,13 @@ def _box(n=400, seed=0):
 
 def _guard(xyz=None, warmup=20, params=None):
     xyz = _box() if xyz is None else xyz
-    params = params or {"canonical.means": xyz, "canonical.opacity_logits": np.full(5, -2.2),
-                        "field.w": np.full(4, 0.1), "gain_raw": np.zeros(3),
-                        "pivot": np.ones((3, 3))}
+    params = params or {
+        "canonical.means": xyz,
+        "canonical.opacity_logits": np.full(5, -2.2),
+        "field.w": np.full(4, 0.1),
+        "gain_raw": np.zeros(3),
+        "pivot": np.ones((3, 3)),
+    }
     return DivergenceGuard.build(xyz, params, GROUPS, warmup)
 
 
@@ -121,8 +131,13 @@ def test_loss_level_without_a_warmup_is_the_first_window():
 
 def test_parameter_checks_name_the_parameter_and_its_group():
     g = _guard()
-    ok = {"canonical.means": _box(), "canonical.opacity_logits": np.full(5, -90.0),
-          "field.w": np.full(4, 50.0), "gain_raw": np.full(3, 0.3), "pivot": np.ones((3, 3))}
+    ok = {
+        "canonical.means": _box(),
+        "canonical.opacity_logits": np.full(5, -90.0),
+        "field.w": np.full(4, 50.0),
+        "gain_raw": np.full(3, 0.3),
+        "pivot": np.ones((3, 3)),
+    }
     assert g.check_params(ok) is None
     d = g.check_params({**ok, "field.w": np.array([0.1, np.nan])})
     assert "parameter 'field.w' (group deform) is non-finite" in d.what and d.groups == ("deform",)
@@ -138,8 +153,13 @@ def test_parameter_checks_name_the_parameter_and_its_group():
 
 def test_suspects_are_ordered_by_growth_and_unmoved_groups_dropped():
     g = _guard()
-    base = {"canonical.means": _box(), "canonical.opacity_logits": np.full(5, -2.2),
-            "field.w": np.full(4, 0.1), "gain_raw": np.zeros(3), "pivot": np.ones((3, 3))}
+    base = {
+        "canonical.means": _box(),
+        "canonical.opacity_logits": np.full(5, -2.2),
+        "field.w": np.full(4, 0.1),
+        "gain_raw": np.zeros(3),
+        "pivot": np.ones((3, 3)),
+    }
     g.check_params({**base, "pivot": np.full(3, 300.0)})
     xyz = _box()
     d = g.check_means(xyz + 1e3)
@@ -157,6 +177,7 @@ def test_guard_rejects_bad_inputs():
 
 # -- the training loop on the tiny swaying scene -------------------------------------------------
 
+
 @pytest.fixture(scope="module")
 def data(swaying):
     return swaying
@@ -172,8 +193,9 @@ def _train(name, data, cfg, **kw):
     return train_model(model, data, cfg["train"], conditions=[0], seed=0, progress=False, **kw)
 
 
-@pytest.mark.parametrize("name, key", [("mlp", "deform"), ("d3dgs_wind", "deform"),
-                                       ("ours", "physics")])
+@pytest.mark.parametrize(
+    "name, key", [("mlp", "deform"), ("d3dgs_wind", "deform"), ("ours", "physics")]
+)
 def test_a_huge_deformation_rate_stops_at_its_first_update(name, key, data):
     cfg = _cfg(**{key: 1e6})
     with pytest.raises(TrainingError) as e:

@@ -1,4 +1,5 @@
 """Snakemake wiring of the training rule (dry runs only)."""
+
 import re
 import subprocess
 import sys
@@ -11,16 +12,36 @@ ROOT = Path(__file__).resolve().parents[1]
 
 def _dry_run(*targets, profile="quick"):
     return subprocess.run(
-        [sys.executable, "-m", "snakemake", "-n", "--cores", "2", "--config", f"profile={profile}",
-         "--", *targets], cwd=ROOT, capture_output=True, text=True, timeout=300)
+        [
+            sys.executable,
+            "-m",
+            "snakemake",
+            "-n",
+            "--cores",
+            "2",
+            "--config",
+            f"profile={profile}",
+            "--",
+            *targets,
+        ],
+        cwd=ROOT,
+        capture_output=True,
+        text=True,
+        timeout=300,
+    )
 
 
 @pytest.fixture(scope="module")
 def plan():
     """One dry run of every training job and the true-motion ceiling (each dry run costs
     seconds of DAG building, so both tests read this one)."""
-    r = _dry_run("train_all", *[f"results/models/{t}/seed0/truth_motion_single.pt"
-                                for t in ("sparse", "medium", "dense")])
+    r = _dry_run(
+        "train_all",
+        *[
+            f"results/models/{t}/seed0/truth_motion_single.pt"
+            for t in ("sparse", "medium", "dense")
+        ],
+    )
     assert r.returncode == 0, r.stderr[-2000:] + r.stdout[-2000:]
     return r.stdout
 
@@ -38,8 +59,11 @@ def test_only_the_reference_rule_reads_the_truth(plan):
         assert "truth.npz" in inputs and "truth_motion_single.pt" in b
     text = (ROOT / "workflow" / "rules" / "train.smk").read_text()
     rules = re.split(r"\nrule ", text)
-    readers = [b.split(":", 1)[0] for b in rules[1:]
-               if re.search(r"TRUTH|truth_input", b.split("output:", 1)[0])]
+    readers = [
+        b.split(":", 1)[0]
+        for b in rules[1:]
+        if re.search(r"TRUTH|truth_input", b.split("output:", 1)[0])
+    ]
     assert readers == ["train_reference"], readers
 
 
@@ -52,8 +76,10 @@ def test_train_jobs_read_only_the_observed_dataset(plan):
         assert "truth" not in inputs and "truth_motion" not in b
         assert "mem_mb=" in b and "runtime=" in b and "benchmark:" in b and "log:" in b
     # threads are declared (a 1-thread job prints no threads line in the plan)
-    assert re.search(r"rule train:(?:\n    .*)*\n    threads: \d", (ROOT / "workflow" / "rules" /
-                                                                "train.smk").read_text())
+    assert re.search(
+        r"rule train:(?:\n    .*)*\n    threads: \d",
+        (ROOT / "workflow" / "rules" / "train.smk").read_text(),
+    )
 
 
 def test_tab_damping_plans_ours_on_both_testbeds_of_each_tree():
@@ -67,8 +93,13 @@ def test_tab_damping_plans_ours_on_both_testbeds_of_each_tree():
     r = _dry_run("results/tables/tab_damping.tex", profile="default")
     assert r.returncode == 0, r.stderr[-2000:] + r.stdout[-2000:]
     trained = set(re.findall(r"results/models/(\w+)/seed(\d+)/(\w+?)_(\w+)\.pt", r.stdout))
-    want = {(tb, str(s), "ours", c) for t in db["trees"] for tb in (t, f"{t}_damping")
-            for s in cfg["seeds"] for c in db["configs"]}
+    want = {
+        (tb, str(s), "ours", c)
+        for t in db["trees"]
+        for tb in (t, f"{t}_damping")
+        for s in cfg["seeds"]
+        for c in db["configs"]
+    }
     assert trained == want
     built = [b for b in _blocks(r.stdout, "testbed_dataset") if "_damping/observed" in b]
     assert len(built) == len(db["trees"])

@@ -5,6 +5,7 @@ Gaussian order, three exactly rescaled wind conditions, and frames rendered from
 Oracles: ``kinematics.pose_gaussians`` for the means; scipy's Rotation about the swing axis by the
 cumulative-angle difference (``kinematics.cumulative_angle``) for the orientations.
 """
+
 from __future__ import annotations
 
 import copy
@@ -38,21 +39,43 @@ FPS, N_TRAIN, N_TAIL, LEAD_IN, RES = 24, 8, 2, 6, 24
 F = N_TRAIN + N_TAIL
 COND = np.array([1.0, 0.84, 0.71])
 CANON = {"opacity": 0.1, "color": 0.5, "knn": 3, "scale_factor": 1.0}
-LR = {"means": 1.6e-4, "quats": 1e-3, "scales": 5e-3, "opacities": 5e-2, "colors": 1e-2,
-      "deform": 8e-4, "physics": 5e-2, "pivot": 1.6e-4}
+LR = {
+    "means": 1.6e-4,
+    "quats": 1e-3,
+    "scales": 5e-3,
+    "opacities": 5e-2,
+    "colors": 1e-2,
+    "deform": 8e-4,
+    "physics": 5e-2,
+    "pivot": 1.6e-4,
+}
 
 
 def _train_cfg(iterations=30, warmup=10):
-    return {"iterations": iterations, "warmup": warmup, "ssim_weight": 0.2, "lr": dict(LR),
-            "lr_final_ratio": 0.01, "backend": "fast"}
+    return {
+        "iterations": iterations,
+        "warmup": warmup,
+        "ssim_weight": 0.2,
+        "lr": dict(LR),
+        "lr_final_ratio": 0.01,
+        "backend": "fast",
+    }
 
 
 def _cfg():
     """The slice of a resolved config that job_spec reads."""
-    return {"seed": 0, "train": _train_cfg(),
-            "models": {"canonical": dict(CANON), "mlp": {"pos_bands": 2},
-                       "configs": {"single": {"conditions": "train", "K": 4},
-                                   "joint32": {"conditions": "all", "K": 4}}}}
+    return {
+        "seed": 0,
+        "train": _train_cfg(),
+        "models": {
+            "canonical": dict(CANON),
+            "mlp": {"pos_bands": 2},
+            "configs": {
+                "single": {"conditions": "train", "K": 4},
+                "joint32": {"conditions": "all", "K": 4},
+            },
+        },
+    }
 
 
 def make_pair(seed: int = 0):
@@ -72,9 +95,18 @@ def make_pair(seed: int = 0):
     theta = COND[:, None, None] * unit[None]  # [C, L+F, B]; nonzero at frame 0
     gv = rng.permutation(B * per)
     truth = SimpleNamespace(
-        theta=theta, bone_head=head, bone_tail=tail, bone_parent=parent,
-        swing_axis=kinematics.swing_axis(40.0), vertex_bone=vb, rest_vertices=rest,
-        gaussian_vertex=gv, vertex_gaussian=np.argsort(gv), lead_in_frames=LEAD_IN, fps=FPS)
+        theta=theta,
+        bone_head=head,
+        bone_tail=tail,
+        bone_parent=parent,
+        swing_axis=kinematics.swing_axis(40.0),
+        vertex_bone=vb,
+        rest_vertices=rest,
+        gaussian_vertex=gv,
+        vertex_gaussian=np.argsort(gv),
+        lead_in_frames=LEAD_IN,
+        fps=FPS,
+    )
     canonical = kinematics.pose_gaussians(truth, theta[0, LEAD_IN]).astype(np.float32)
     wind = (COND[:, None] * (6.0 + 1.5 * rng.standard_normal(LEAD_IN + F))).astype(np.float32)
     cam = look_at((0.0, -5.0, 1.0), (0.0, 0.0, 1.0), fov_deg=40, width=RES, height=RES)
@@ -87,13 +119,31 @@ def make_pair(seed: int = 0):
     for c in range(3):
         posed = kinematics.pose_gaussians(truth, theta[c, LEAD_IN:])  # [F, N, 3]
         for j in range(F):
-            out = rasterization(torch.tensor(posed[j], dtype=torch.float32), q, sc, op, col, cam,
-                                [1.0, 1.0, 1.0], backend="fast", return_depth=False)
+            out = rasterization(
+                torch.tensor(posed[j], dtype=torch.float32),
+                q,
+                sc,
+                op,
+                col,
+                cam,
+                [1.0, 1.0, 1.0],
+                backend="fast",
+                return_depth=False,
+            )
             frames[c, j] = np.round(out.rgb.numpy() * 255).astype(np.uint8)
     observed = SimpleNamespace(
-        fps=FPS, n_train=N_TRAIN, n_tail=N_TAIL, lead_in_frames=LEAD_IN, conditions=COND,
-        vbar=6.0 * COND, wind=wind, frames=frames, train_camera=cam, background=np.ones(3),
-        canonical_xyz=canonical)
+        fps=FPS,
+        n_train=N_TRAIN,
+        n_tail=N_TAIL,
+        lead_in_frames=LEAD_IN,
+        conditions=COND,
+        vbar=6.0 * COND,
+        wind=wind,
+        frames=frames,
+        train_camera=cam,
+        background=np.ones(3),
+        canonical_xyz=canonical,
+    )
     return observed, truth
 
 
@@ -109,15 +159,22 @@ def trained(pair, tmp_path_factory):
     d = tmp_path_factory.mktemp("ref")
     ck, lg = d / "truth_motion_single.pt", d / "truth_motion_single.loss.csv"
     before = build_model("truth_motion", observed, {"canonical": CANON}, truth=truth)
-    res = train_and_save(observed, job_spec(_cfg(), "truth_motion", "single"),
-                         checkpoint_path=ck, loss_path=lg, progress=False, truth=truth)
+    res = train_and_save(
+        observed,
+        job_spec(_cfg(), "truth_motion", "single"),
+        checkpoint_path=ck,
+        loss_path=lg,
+        progress=False,
+        truth=truth,
+    )
     return SimpleNamespace(before=before, result=res, checkpoint=ck, loss=lg)
 
 
 def _model(pair):
     observed, truth = pair
-    return build_model("truth_motion", observed, model_settings(_cfg()["models"], "truth_motion"),
-                       truth=truth)
+    return build_model(
+        "truth_motion", observed, model_settings(_cfg()["models"], "truth_motion"), truth=truth
+    )
 
 
 def _winds(observed):
@@ -145,11 +202,16 @@ def test_means_follow_the_true_motion(pair):
             for j in range(F):
                 got = model.gaussians_at(j, winds[c]).means
                 assert got.dtype == torch.float32
-                np.testing.assert_allclose(got.numpy(), want[j], atol=1e-5, rtol=0,
-                                           err_msg=f"condition {c}, frame {j}")
+                np.testing.assert_allclose(
+                    got.numpy(), want[j], atol=1e-5, rtol=0, err_msg=f"condition {c}, frame {j}"
+                )
     # the motion is real: the tree moves by centimetres between frames and conditions
-    assert np.abs(kinematics.pose_gaussians(truth, truth.theta[2, LEAD_IN + 5])
-                  - observed.canonical_xyz).max() > 0.02
+    assert (
+        np.abs(
+            kinematics.pose_gaussians(truth, truth.theta[2, LEAD_IN + 5]) - observed.canonical_xyz
+        ).max()
+        > 0.02
+    )
 
 
 def test_orientations_rotate_with_the_bone_chain(pair):
@@ -170,8 +232,9 @@ def test_orientations_rotate_with_the_bone_chain(pair):
             q = model.gaussians_at(j, winds[c]).quats.numpy()
         change = rotation_wxyz(q) * R0.inv()
         want = Rotation.from_rotvec(axis[None] * _dphi(truth, c, j)[:, None]).apply(v)
-        np.testing.assert_allclose(change.apply(v), want, atol=1e-5, rtol=0,
-                                   err_msg=f"condition {c}, frame {j}")
+        np.testing.assert_allclose(
+            change.apply(v), want, atol=1e-5, rtol=0, err_msg=f"condition {c}, frame {j}"
+        )
     assert np.abs(_dphi(truth, 2, 9)).max() > 0.05  # the check is not vacuous
 
 
@@ -205,9 +268,17 @@ def test_training_lowers_the_loss_and_changes_only_appearance(pair, trained):
             tot = 0.0
             for j in range(N_TRAIN):
                 s = m.gaussians_at(j, torch.tensor(observed.wind[0]))
-                out = rasterization(s.means, s.quats, s.scales, s.opacities, s.colors,
-                                    observed.train_camera, observed.background,
-                                    backend="fast", return_depth=False)
+                out = rasterization(
+                    s.means,
+                    s.quats,
+                    s.scales,
+                    s.opacities,
+                    s.colors,
+                    observed.train_camera,
+                    observed.background,
+                    backend="fast",
+                    return_depth=False,
+                )
                 tgt = torch.from_numpy(observed.frames[0, j]).float() / 255
                 tot += float(photometric_loss(out.rgb, tgt)[0])
         return tot
@@ -275,9 +346,11 @@ def test_a_wind_of_no_recorded_condition_raises(pair):
         model.gaussians_at(2, w[1:])
     # float64 copies of a recorded wind still identify it
     g = model.gaussians_at(2, torch.tensor(observed.wind[2], dtype=torch.float64))
-    np.testing.assert_allclose(g.means.detach().numpy(),
-                               kinematics.pose_gaussians(truth, truth.theta[2, LEAD_IN + 2]),
-                               atol=1e-5)
+    np.testing.assert_allclose(
+        g.means.detach().numpy(),
+        kinematics.pose_gaussians(truth, truth.theta[2, LEAD_IN + 2]),
+        atol=1e-5,
+    )
     assert model.use_wind  # it reads the condition: evaluation must not share frames across them
 
 

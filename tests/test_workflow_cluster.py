@@ -4,6 +4,7 @@ would. Starting from the quick DAG's testbed (built by the session fixture), tra
 plus the null control run through the plugin: every kind of job that reads a dataset and writes a
 checkpoint or scores, within the suite's time budget (the full DAG runs locally in
 test_workflow_e2e.py)."""
+
 from __future__ import annotations
 
 import shutil
@@ -31,10 +32,24 @@ def test_quick_dag_through_cluster_generic_executor(tmp_path, quick_dag):
     submit.write_text(SUBMIT)
     submit.chmod(submit.stat().st_mode | stat.S_IEXEC)
     proc = snakemake(
-        wd, "--executor", "cluster-generic", "--cluster-generic-submit-cmd", str(submit),
-        "--jobs", "2", "--latency-wait", "30", "--seconds-between-status-checks", "1",
-        "--default-resources", "mem_mb=2000", "runtime=20",
-        "--config", "profile=quick", 'trees=["sparse"]', "--",
+        wd,
+        "--executor",
+        "cluster-generic",
+        "--cluster-generic-submit-cmd",
+        str(submit),
+        "--jobs",
+        "2",
+        "--latency-wait",
+        "30",
+        "--seconds-between-status-checks",
+        "1",
+        "--default-resources",
+        "mem_mb=2000",
+        "runtime=20",
+        "--config",
+        "profile=quick",
+        'trees=["sparse"]',
+        "--",
         "results/recovery/sparse/seed0/ours_single.json",
         "results/recovery/sparse/seed0/null_K32.json",
         timeout=900,

@@ -5,6 +5,7 @@ on the sparse tree alone so the suite stays within its time budget; the tests th
 produced as a reviewer would: every table's rows and columns, finite numbers, .tex agreeing with
 .csv, and every figure present.
 """
+
 from __future__ import annotations
 
 import re
@@ -23,8 +24,14 @@ QUICK = pconfig.resolve(yaml.safe_load((ROOT / "config" / "trees.yaml").read_tex
 TREES = ["sparse"]
 # the quick profile builds no damping testbed (its 2.5 s window cannot hold a calm): no tab_damping
 BUILT = [n for n in TABLES if n != "tab_damping" or QUICK["damping_benchmark"]["trees"]]
-MODELS = ["Static pose", "Deformation MLP", "Deformation MLP + wind", "Deformable-3DGS",
-          "Deformable-3DGS + wind", "Ours"]
+MODELS = [
+    "Static pose",
+    "Deformation MLP",
+    "Deformation MLP + wind",
+    "Deformable-3DGS",
+    "Deformable-3DGS + wind",
+    "Ours",
+]
 
 
 @pytest.fixture
@@ -57,13 +64,17 @@ def test_every_output_exists(run):
 def test_tab_psnr_rows_columns_and_finite(run):
     df = _csv(run, "tab_psnr")
     # the models, the reference, then the two paired differences; one seed
-    assert list(df["model"]) == [*MODELS, "True motion (ceiling)", "Ours - Static pose",
-                                 "Ours - best learned field"]
+    assert list(df["model"]) == [
+        *MODELS,
+        "True motion (ceiling)",
+        "Ours - Static pose",
+        "Ours - best learned field",
+    ]
     assert list(df["reference"]) == [False] * len(MODELS) + [True, False, False]
     assert list(df["difference"]) == [False] * (len(MODELS) + 1) + [True, True]
     assert set(df["seed"]) == set(QUICK["seeds"])
     cols = [f"{t}_{s}" for t in TREES for s in ("view", "time")]
-    assert list(df.columns[2:2 + len(cols)]) == cols
+    assert list(df.columns[2 : 2 + len(cols)]) == cols
     vals = df.loc[~df["difference"], cols].to_numpy(float)
     assert np.isfinite(vals).all() and (vals > 5).all() and (vals < 60).all()
     diff = df.loc[df["difference"], cols].to_numpy(float)
@@ -87,9 +98,13 @@ def test_tab_transfer_rows_columns_and_finite(run):
 def test_tab_margin_is_ours_minus_mlp_wind(run):
     df = _csv(run, "tab_margin")
     assert list(df["tree"]) == TREES
-    assert [c for c in df.columns if c.startswith("margin_")] == ["margin_v0", "margin_0.84v0",
-                                                                 "margin_0.71v0"]
+    assert [c for c in df.columns if c.startswith("margin_")] == [
+        "margin_v0",
+        "margin_0.84v0",
+        "margin_0.71v0",
+    ]
     from physgs.evaluate.splits import load_eval
+
     for _, row in df.iterrows():
         ev = run / "results" / "eval" / row["tree"] / f"seed{row['seed']}"
         ours = load_eval(ev / "ours_single.npz").summary()
@@ -137,8 +152,9 @@ def test_tab_null_plan_trains_ours_only():
 
     with tempfile.TemporaryDirectory() as d:
         wd = workflow_copy(Path(d))
-        out = snakemake(wd, "-n", "--cores", "2", "results/tables/tab_null.tex",
-                        "--config", "profile=quick").stdout
+        out = snakemake(
+            wd, "-n", "--cores", "2", "results/tables/tab_null.tex", "--config", "profile=quick"
+        ).stdout
     trained = re.findall(r"results/models/\w+/seed\d+/(\w+?)_(single|joint32|joint96)\.pt", out)
     assert trained, "the plan trains nothing"
     assert {m for m, _ in trained} == {"ours"}
@@ -150,8 +166,15 @@ def test_snakemake_report_collects_tables_and_figures(run, tmp_path):
     html = tmp_path / "report.html"
     snakemake(run, "--report", str(html), "--config", "profile=quick", 'trees=["sparse"]')
     text = html.read_text(errors="replace")
-    for name in ("1. Testbed", "2. Results", "3. Tables", "4. Speed-accuracy trade",
-                 "testbed_sparse", *BUILT, *FIGURES):
+    for name in (
+        "1. Testbed",
+        "2. Results",
+        "3. Tables",
+        "4. Speed-accuracy trade",
+        "testbed_sparse",
+        *BUILT,
+        *FIGURES,
+    ):
         assert name in text, f"the report lacks {name}"
 
 
@@ -161,8 +184,11 @@ def test_every_table_csv_carries_the_provenance_stamp(run):
         assert set(df["profile"]) == {"quick"}, name
         assert df["config_hash"].str.fullmatch(r"[0-9a-f]{12}").all(), name
         assert df["physgs_version"].notna().all(), name
-        assert (run / "results" / "tables" / f"{name}.tex").read_text().startswith(
-            "% profile=quick, config_hash="), name
+        assert (
+            (run / "results" / "tables" / f"{name}.tex")
+            .read_text()
+            .startswith("% profile=quick, config_hash=")
+        ), name
 
 
 def test_claims_ledger_has_a_computed_verdict_per_claim(run):
@@ -210,8 +236,16 @@ def test_a_second_seed_pairs_with_the_first(run, tmp_path):
     # as done and nothing is planned)
     shutil.copytree(run / ".snakemake" / "metadata", wd / ".snakemake" / "metadata")
     one = _csv(run, "tab_margin")
-    out = snakemake(wd, "--cores", "2", "results/tables/tab_margin.tex", "--config",
-                    "profile=quick", 'trees=["sparse"]', "seeds=[0,1]")
+    out = snakemake(
+        wd,
+        "--cores",
+        "2",
+        "results/tables/tab_margin.tex",
+        "--config",
+        "profile=quick",
+        'trees=["sparse"]',
+        "seeds=[0,1]",
+    )
     out = out.stdout + out.stderr
     trained = set(re.findall(r"results/models/\w+/(seed\d+)/\w+\.pt", out))
     assert trained == {"seed1"}, trained

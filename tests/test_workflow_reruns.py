@@ -1,5 +1,6 @@
 """Targeted reruns: on a finished quick DAG, a config edit plans only the jobs that read the
 edited key (each rule's params are its narrow settings), and profiles name only real rules."""
+
 from __future__ import annotations
 
 import re
@@ -29,8 +30,18 @@ EDITS = {
 
 def _dry_run(wd: Path, override: Path) -> str:
     """The dry-run plan of `all` with the config file ``override`` merged into the config."""
-    return snakemake(wd, "-n", "--nolock", "--cores", "2", "all", "--configfile",
-                     "config/trees.yaml", str(override), *QUICK).stdout
+    return snakemake(
+        wd,
+        "-n",
+        "--nolock",
+        "--cores",
+        "2",
+        "all",
+        "--configfile",
+        "config/trees.yaml",
+        str(override),
+        *QUICK,
+    ).stdout
 
 
 @pytest.fixture(scope="module")
@@ -59,8 +70,6 @@ def _counts(out: str) -> dict[str, int]:
 def _checkpoints(out: str) -> set[str]:
     """The checkpoints a dry-run's output (re)trains, as '<model>_<config>'."""
     return set(re.findall(r"results/models/\w+/seed\d+/(\w+?)\.pt", out))
-
-
 
 
 def test_an_unchanged_config_plans_nothing(plans):

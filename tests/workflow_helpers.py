@@ -1,4 +1,5 @@
 """Run the Snakemake workflow in a scratch copy of the repository's workflow files."""
+
 from __future__ import annotations
 
 import os
@@ -18,8 +19,9 @@ def workflow_copy(dest: Path) -> Path:
     if not (dest / "profiles").exists():  # where Snakemake looks for profiles/default
         (dest / "profiles").symlink_to(os.readlink(ROOT / "profiles"))
     for d in ("workflow", "config"):
-        shutil.copytree(ROOT / d, dest / d, dirs_exist_ok=True,
-                        ignore=shutil.ignore_patterns("__pycache__"))
+        shutil.copytree(
+            ROOT / d, dest / d, dirs_exist_ok=True, ignore=shutil.ignore_patterns("__pycache__")
+        )
     return dest
 
 
@@ -27,7 +29,9 @@ def snakemake(workdir: Path, *args: str, timeout: int = 600) -> subprocess.Compl
     """``snakemake`` in ``workdir``; raises with the tail of the log if it fails."""
     env = dict(os.environ, PYTHONUNBUFFERED="1")
     cmd = [sys.executable, "-m", "snakemake", *args]
-    proc = subprocess.run(cmd, cwd=workdir, env=env, capture_output=True, text=True, timeout=timeout)
+    proc = subprocess.run(
+        cmd, cwd=workdir, env=env, capture_output=True, text=True, timeout=timeout
+    )
     if proc.returncode != 0:
         tail = (proc.stdout + proc.stderr)[-6000:]
         raise AssertionError(f"{' '.join(cmd)} failed ({proc.returncode}):\n{tail}")

@@ -1,5 +1,6 @@
 """Atomic file writes: write to a temporary sibling, then rename, so a crash never leaves a
 partial output that a later step would take as good."""
+
 from __future__ import annotations
 
 import json

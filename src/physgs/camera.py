@@ -5,6 +5,7 @@ the tree stands at the origin. A camera maps a world point X to camera coordinat
 ``R @ X + t`` and to pixels ``(fx * x / z + cx, fy * y / z + cy)``, pixel centres at
 integer + 0.5 (pixel (0, 0) covers [0, 1) x [0, 1)).
 """
+
 from __future__ import annotations
 
 from dataclasses import dataclass
@@ -89,8 +90,9 @@ class Camera:
         return Camera(v[:3, :3].copy(), v[:3, 3].copy(), fx, fy, cx, cy, w, h, float(d["near"]))
 
 
-def look_at(eye, target, up=(0.0, 0.0, 1.0), *, fov_deg: float, width: int, height: int,
-            near: float = 0.01) -> Camera:
+def look_at(
+    eye, target, up=(0.0, 0.0, 1.0), *, fov_deg: float, width: int, height: int, near: float = 0.01
+) -> Camera:
     """Camera at ``eye`` looking at ``target`` with vertical field of view ``fov_deg`` (degrees)."""
     eye, target, up = (np.asarray(a, dtype=np.float64) for a in (eye, target, up))
     z = target - eye
@@ -106,8 +108,16 @@ def look_at(eye, target, up=(0.0, 0.0, 1.0), *, fov_deg: float, width: int, heig
     return Camera(R, t, f, f, width / 2, height / 2, width, height, near)
 
 
-def orbit_camera(azimuth_deg: float, *, radius: float, height: float, target, fov_deg: float,
-                 width: int, height_px: int) -> Camera:
+def orbit_camera(
+    azimuth_deg: float,
+    *,
+    radius: float,
+    height: float,
+    target,
+    fov_deg: float,
+    width: int,
+    height_px: int,
+) -> Camera:
     """Camera on a circle about the world z axis; azimuth 0 sits on the -y axis looking toward +y.
 
     azimuth_deg: degrees, counter-clockwise seen from above. radius, height: world units.

@@ -12,6 +12,7 @@ resolved config, and runs the cross-key checks of :mod:`physgs.config_checks`. E
 :class:`ConfigError` that names the full key path (``profiles/quick/trian``), the nearest valid key
 where one exists, and the fix.
 """
+
 from __future__ import annotations
 
 import copy
@@ -65,8 +66,9 @@ def partial_schema(node, defs: dict | None = None):
         if isinstance(ref, str) and ref.startswith("#/$defs/"):
             merged = {**defs[ref.split("/")[-1]], **{k: v for k, v in node.items() if k != "$ref"}}
             return partial_schema(merged, defs)
-        return {k: partial_schema(v, defs) for k, v in node.items()
-                if k not in ("required", "$defs")}
+        return {
+            k: partial_schema(v, defs) for k, v in node.items() if k not in ("required", "$defs")
+        }
     if isinstance(node, list):
         return [partial_schema(v, defs) for v in node]
     return node
@@ -119,7 +121,8 @@ def _nested_paths(node: dict, root: dict, prefix: tuple = (), depth: int = 0) ->
 def _declared(key: str, node: dict) -> bool:
     """Whether an object schema node declares ``key`` (properties or patternProperties)."""
     return key in node.get("properties", {}) or any(
-        re.search(pat, key) for pat in node.get("patternProperties", {}))
+        re.search(pat, key) for pat in node.get("patternProperties", {})
+    )
 
 
 def _fmt(path) -> str:
@@ -132,8 +135,9 @@ def _nest(path, value):
     return value
 
 
-def _unknown_key(where: tuple, key: str, node: dict, instance: dict, raw: dict | None,
-                 source: str) -> str:
+def _unknown_key(
+    where: tuple, key: str, node: dict, instance: dict, raw: dict | None, source: str
+) -> str:
     """Message for an unknown ``key`` in the object at ``where`` whose schema is ``node``."""
     root = _schema()
     node = _deref(node, root)
@@ -142,8 +146,11 @@ def _unknown_key(where: tuple, key: str, node: dict, instance: dict, raw: dict |
     siblings = [p[0] for p in _nested_paths(node, root) if len(p) == 1 and p[0] != "<name>"]
     # a key that lives deeper (`iterations` -> train/iterations), else a misspelt sibling, else a
     # misspelt deeper key
-    nested = [p for p in _nested_paths(node, root)
-              if len(p) > 1 and not (not where and p[0] == "profiles")]
+    nested = [
+        p
+        for p in _nested_paths(node, root)
+        if len(p) > 1 and not (not where and p[0] == "profiles")
+    ]
     hits = [p for p in nested if p[-1] == key]
     if not hits:
         close = difflib.get_close_matches(key, siblings, n=1, cutoff=0.6)
@@ -163,11 +170,14 @@ def _unknown_key(where: tuple, key: str, node: dict, instance: dict, raw: dict |
     if not where and raw is not None:  # the raw config's top level is where --config lands
         profile = raw.get("profile", "default")
         value = instance.get(key)
-        override = yaml.safe_dump(_nest(("profiles", profile) + hits[0], value),
-                                  default_flow_style=True, width=1000).strip()
-        msg += (f" --config KEY=VALUE sets top-level keys only (profile, seed, ...); set "
-                f"'{_fmt(('profiles', profile) + hits[0])}' in {source}, or pass "
-                f"--configfile FILE with FILE holding {override}")
+        override = yaml.safe_dump(
+            _nest(("profiles", profile) + hits[0], value), default_flow_style=True, width=1000
+        ).strip()
+        msg += (
+            f" --config KEY=VALUE sets top-level keys only (profile, seed, ...); set "
+            f"'{_fmt(('profiles', profile) + hits[0])}' in {source}, or pass "
+            f"--configfile FILE with FILE holding {override}"
+        )
     return msg
 
 
@@ -181,7 +191,7 @@ def _origin(path: tuple, raw: dict | None, profile: str | None) -> str:
             return ""
         node = node[k]
         if not isinstance(node, dict):  # a leaf (or a whole list) the profile replaces
-            return f" (set by '{_fmt(('profiles', profile) + tuple(path[:i + 1]))}')"
+            return f" (set by '{_fmt(('profiles', profile) + tuple(path[: i + 1]))}')"
     return f" (set by '{_fmt(('profiles', profile) + tuple(path))}')"
 
 
@@ -195,8 +205,11 @@ def _problems(cfg: dict, *, raw: dict | None, profile: str | None, source: str) 
         if e.validator == "additionalProperties" and e.validator_value is False:
             for key in e.instance:
                 if not _declared(key, e.schema):
-                    lines.append(_unknown_key(where, key, e.schema, e.instance,
-                                              raw if raw is cfg else None, source))
+                    lines.append(
+                        _unknown_key(
+                            where, key, e.schema, e.instance, raw if raw is cfg else None, source
+                        )
+                    )
         elif e.validator == "required":
             for key in e.validator_value:
                 if isinstance(e.instance, dict) and key not in e.instance:
@@ -223,18 +236,24 @@ def validate(cfg: dict, *, raw: dict | None = None, source: str = DEFAULT_SOURCE
     ``raw``: the raw config ``cfg`` was resolved from, to say which values a profile set.
     """
     if not isinstance(cfg, dict):
-        raise ConfigError(f"{source} must hold a mapping of settings, got {type(cfg).__name__}. "
-                          f"Fix {source}.")
+        raise ConfigError(
+            f"{source} must hold a mapping of settings, got {type(cfg).__name__}. Fix {source}."
+        )
     profile = cfg.get("profile") if raw is not None else None
-    _raise(_problems(cfg, raw=raw if raw is not None else cfg, profile=profile, source=source),
-           source, profile)
+    _raise(
+        _problems(cfg, raw=raw if raw is not None else cfg, profile=profile, source=source),
+        source,
+        profile,
+    )
 
 
 def check(cfg: dict, *, raw: dict | None = None, source: str = DEFAULT_SOURCE) -> None:
     """Run the cross-key checks (:data:`physgs.config_checks.CHECKS`) on a resolved config."""
     profile = cfg.get("profile")
-    lines = [f"config key '{_fmt(path)}'{_origin(path, raw, profile)}: {msg}"
-             for path, msg in config_checks.problems(cfg)]
+    lines = [
+        f"config key '{_fmt(path)}'{_origin(path, raw, profile)}: {msg}"
+        for path, msg in config_checks.problems(cfg)
+    ]
     _raise(lines, source, profile)
 
 
@@ -273,8 +292,13 @@ def _from_command_line(value):
     return value
 
 
-def load_workflow_config(config: dict, profile: str | None = None, *,
-                         source: str = DEFAULT_SOURCE, command_line: dict | None = None) -> dict:
+def load_workflow_config(
+    config: dict,
+    profile: str | None = None,
+    *,
+    source: str = DEFAULT_SOURCE,
+    command_line: dict | None = None,
+) -> dict:
     """The one way in: validate a raw config, resolve its profile, validate and check the result.
 
     config: the raw config (what Snakemake's ``config`` holds: ``config/trees.yaml`` plus any
@@ -285,8 +309,11 @@ def load_workflow_config(config: dict, profile: str | None = None, *,
     seeds=[0,1,2]`` means those seeds under any profile. Returns the resolved config; raises
     ConfigError before anything runs.
     """
-    cl = {k: _from_command_line(v) for k, v in dict(command_line or {}).items()
-          if k != "profile" and not isinstance(v, dict)}
+    cl = {
+        k: _from_command_line(v)
+        for k, v in dict(command_line or {}).items()
+        if k != "profile" and not isinstance(v, dict)
+    }
     if profile is not None and isinstance(config, dict):
         config = {**config, "profile": profile}
     if cl and isinstance(config, dict):

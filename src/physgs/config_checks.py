@@ -7,6 +7,7 @@ pairs into one ``ConfigError``. They run when the Snakefile loads, so a bad conf
 with nothing written, instead of in the first job that needs the value. To add a check, write a
 function here and append it to :data:`CHECKS`.
 """
+
 from __future__ import annotations
 
 import math
@@ -21,39 +22,48 @@ def trees_have_settings(cfg: dict) -> Iterator[Problem]:
     vertices, presets = cfg["testbed"]["vertices"], cfg["presets"]
     for t in cfg["trees"]:
         if t not in vertices:
-            yield (("testbed", "vertices", t),
-                   f"tree '{t}' is listed in trees but has no target vertex count; add "
-                   f"testbed/vertices/{t} (e.g. {t}: 2000) or drop '{t}' from trees")
+            yield (
+                ("testbed", "vertices", t),
+                f"tree '{t}' is listed in trees but has no target vertex count; add "
+                f"testbed/vertices/{t} (e.g. {t}: 2000) or drop '{t}' from trees",
+            )
         if t not in presets:
-            yield (("presets", t),
-                   f"tree '{t}' is listed in trees but has no Weber-Penn preset; add presets/{t} "
-                   f"or drop '{t}' from trees")
+            yield (
+                ("presets", t),
+                f"tree '{t}' is listed in trees but has no Weber-Penn preset; add presets/{t} "
+                f"or drop '{t}' from trees",
+            )
 
 
 def conditions_have_unseen_wind(cfg: dict) -> Iterator[Problem]:
     """conditions[0] is the training wind (1.0) and at least one unseen condition follows."""
     cond = cfg["testbed"]["conditions"]
     if not math.isclose(float(cond[0]), 1.0, rel_tol=0, abs_tol=1e-12):
-        yield (("testbed", "conditions", 0),
-               f"the first condition is the training wind and must be 1.0, got {cond[0]}; put 1.0 "
-               "first (the multipliers scale the training mean speed testbed/wind/v0)")
+        yield (
+            ("testbed", "conditions", 0),
+            f"the first condition is the training wind and must be 1.0, got {cond[0]}; put 1.0 "
+            "first (the multipliers scale the training mean speed testbed/wind/v0)",
+        )
     if len(cond) < 2:
-        yield (("testbed", "conditions"),
-               f"{cond} has no unseen wind condition, which the transfer table (tab_transfer) and "
-               "the joint configurations need; add at least one multiplier after 1.0, e.g. "
-               "[1.0, 0.84, 0.71]")
+        yield (
+            ("testbed", "conditions"),
+            f"{cond} has no unseen wind condition, which the transfer table (tab_transfer) and "
+            "the joint configurations need; add at least one multiplier after 1.0, e.g. "
+            "[1.0, 0.84, 0.71]",
+        )
 
 
 def band_ordered(cfg: dict) -> Iterator[Problem]:
     """testbed/band_hz and the wind band are (low, high)."""
     lo, hi = cfg["testbed"]["band_hz"]
     if not lo < hi:
-        yield (("testbed", "band_hz"),
-               f"[{lo}, {hi}] Hz must be [low, high] with low < high")
+        yield (("testbed", "band_hz"), f"[{lo}, {hi}] Hz must be [low, high] with low < high")
     w = cfg["testbed"]["wind"]
     if not w["f_lo_hz"] < w["f_hi_hz"]:
-        yield (("testbed", "wind", "f_lo_hz"),
-               f"{w['f_lo_hz']} Hz must be below testbed/wind/f_hi_hz = {w['f_hi_hz']} Hz")
+        yield (
+            ("testbed", "wind", "f_lo_hz"),
+            f"{w['f_lo_hz']} Hz must be below testbed/wind/f_hi_hz = {w['f_hi_hz']} Hz",
+        )
 
 
 def lead_in_fits_wind_period(cfg: dict) -> Iterator[Problem]:
@@ -74,9 +84,11 @@ def lead_in_fits_wind_period(cfg: dict) -> Iterator[Problem]:
     fps, tau = int(tb["fps"]), float(tb["lead_in_tau"])
     period = wind.PERIOD_S * fps
     if abs(period - round(period)) > 1e-9:
-        yield (("testbed", "fps"),
-               f"{fps} fps does not divide the {wind.PERIOD_S:g} s wind period into whole frames; "
-               "use an integer number of frames per second that does")
+        yield (
+            ("testbed", "fps"),
+            f"{fps} fps does not divide the {wind.PERIOD_S:g} s wind period into whole frames; "
+            "use an integer number of frames per second that does",
+        )
         return
     damping = _damping_built(cfg) and "damping" in tb
     # the damping variant's slowest decay is at the lowest zeta it can draw
@@ -91,20 +103,23 @@ def lead_in_fits_wind_period(cfg: dict) -> Iterator[Problem]:
     if L + F >= P:
         tau_max = 1.0 / (zeta * omega_min)
         room = max(P - F - 1, 0)
-        yield (("testbed", "lead_in_tau"),
-               f"{tau:g} gives a lead-in of {L / fps:.1f} s ({tau:g} x tau_max, tau_max = "
-               f"1/(zeta*2pi*band_hz[0]) = {tau_max:.2f} s), so the record ({L / fps:.1f} s + "
-               f"{F / fps:.1f} s of n_train + n_tail) is not shorter than the {wind.PERIOD_S:g} s "
-               f"wind period; lower testbed/lead_in_tau to at most "
-               f"{room / (tau_max * fps):.3g}, or raise {raise_zeta} or testbed/band_hz[0], or "
-               "lower n_train/n_tail")
+        yield (
+            ("testbed", "lead_in_tau"),
+            f"{tau:g} gives a lead-in of {L / fps:.1f} s ({tau:g} x tau_max, tau_max = "
+            f"1/(zeta*2pi*band_hz[0]) = {tau_max:.2f} s), so the record ({L / fps:.1f} s + "
+            f"{F / fps:.1f} s of n_train + n_tail) is not shorter than the {wind.PERIOD_S:g} s "
+            f"wind period; lower testbed/lead_in_tau to at most "
+            f"{room / (tau_max * fps):.3g}, or raise {raise_zeta} or testbed/band_hz[0], or "
+            "lower n_train/n_tail",
+        )
 
 
 def _damping_built(cfg: dict) -> bool:
     """Whether any damping-variant testbed is built: every tree (testbed/variant: damping) or
     the damping benchmark's <tree>_damping copies (damping_benchmark/trees)."""
-    return (cfg["testbed"].get("variant", "faithful") == "damping"
-            or bool(cfg.get("damping_benchmark", {}).get("trees")))
+    return cfg["testbed"].get("variant", "faithful") == "damping" or bool(
+        cfg.get("damping_benchmark", {}).get("trees")
+    )
 
 
 def damping_benchmark_is_runnable(cfg: dict) -> Iterator[Problem]:
@@ -112,18 +127,24 @@ def damping_benchmark_is_runnable(cfg: dict) -> Iterator[Problem]:
     its configurations are ours' configurations."""
     db = cfg.get("damping_benchmark") or {}
     if db.get("trees") and "damping" not in cfg["testbed"]:
-        yield (("damping_benchmark", "trees"),
-               f"{db['trees']} are built as damping testbeds, which read testbed/damping "
-               "(zeta_range, transient); add that block or set damping_benchmark/trees: []")
+        yield (
+            ("damping_benchmark", "trees"),
+            f"{db['trees']} are built as damping testbeds, which read testbed/damping "
+            "(zeta_range, transient); add that block or set damping_benchmark/trees: []",
+        )
     for t in db.get("trees", []):
         if t not in cfg["trees"]:
-            yield (("damping_benchmark", "trees"),
-                   f"'{t}' is not in trees {cfg['trees']}: tab_damping compares each damping "
-                   "testbed with the same tree's faithful one; add it to trees or drop it here")
+            yield (
+                ("damping_benchmark", "trees"),
+                f"'{t}' is not in trees {cfg['trees']}: tab_damping compares each damping "
+                "testbed with the same tree's faithful one; add it to trees or drop it here",
+            )
     for c in db.get("configs", []):
         if c not in cfg["models"]["configs"]:
-            yield (("damping_benchmark", "configs"),
-                   f"'{c}' is not one of models/configs {sorted(cfg['models']['configs'])}")
+            yield (
+                ("damping_benchmark", "configs"),
+                f"'{c}' is not one of models/configs {sorted(cfg['models']['configs'])}",
+            )
 
 
 #: The calm must last at least this many periods of the slowest band frequency (band_hz[0]) to
@@ -139,13 +160,17 @@ def damping_range_valid(cfg: dict) -> Iterator[Problem]:
         return
     lo, hi = (float(z) for z in tb["damping"]["zeta_range"])
     if not (0 < lo <= 1 and 0 < hi <= 1):
-        yield (("testbed", "damping", "zeta_range"),
-               f"[{lo:g}, {hi:g}] must lie in (0, 1] (damping ratios of under-damped bones); "
-               "choose e.g. [0.03, 0.2]")
+        yield (
+            ("testbed", "damping", "zeta_range"),
+            f"[{lo:g}, {hi:g}] must lie in (0, 1] (damping ratios of under-damped bones); "
+            "choose e.g. [0.03, 0.2]",
+        )
     elif not lo < hi:
-        yield (("testbed", "damping", "zeta_range"),
-               f"[{lo:g}, {hi:g}] must be [low, high] with low < high; swap them, or for one zeta "
-               "on every bone use variant: faithful with testbed/zeta")
+        yield (
+            ("testbed", "damping", "zeta_range"),
+            f"[{lo:g}, {hi:g}] must be [low, high] with low < high; swap them, or for one zeta "
+            "on every bone use variant: faithful with testbed/zeta",
+        )
 
 
 def damping_transient_fits(cfg: dict) -> Iterator[Problem]:
@@ -160,10 +185,12 @@ def damping_transient_fits(cfg: dict) -> Iterator[Problem]:
     window = int(tb["n_train"]) / int(tb["fps"])
     key = ("testbed", "damping", "transient")
     if start - gust < 0:
-        yield (key + ("start_s",),
-               f"{start:g} s puts the gust (gust_s = {gust:g} s before the calm) at "
-               f"{start - gust:g} s, before recorded frame 0; raise start_s to at least "
-               f"{gust:g} or shorten gust_s")
+        yield (
+            key + ("start_s",),
+            f"{start:g} s puts the gust (gust_s = {gust:g} s before the calm) at "
+            f"{start - gust:g} s, before recorded frame 0; raise start_s to at least "
+            f"{gust:g} or shorten gust_s",
+        )
     lo_hz = float(tb["band_hz"][0])
     shortest = MIN_CALM_PERIODS / lo_hz if lo_hz > 0 else 0.0
     if start - gust >= 0 and start + calm > window + 1e-9:
@@ -174,17 +201,24 @@ def damping_transient_fits(cfg: dict) -> Iterator[Problem]:
             fixes.append(f"lower calm_s to at most {window - start:g}")
         n_min = math.ceil((start + calm) * int(tb["fps"]) - 1e-9)
         fixes.append(f"raise testbed/n_train to at least {n_min}")
-        yield (key + ("calm_s",),
-               f"the calm [{start:g}, {start + calm:g}] s ends after the training window "
-               f"(n_train / fps = {window:g} s), so the free decay is not all recorded; "
-               + ", or ".join(fixes))
+        yield (
+            key + ("calm_s",),
+            f"the calm [{start:g}, {start + calm:g}] s ends after the training window "
+            f"(n_train / fps = {window:g} s), so the free decay is not all recorded; "
+            + ", or ".join(fixes),
+        )
     if calm < shortest:
-        yield (key + ("calm_s",),
-               f"{calm:g} s of calm is shorter than one period of the slowest band frequency "
-               f"(1 / band_hz[0] = {shortest:.2f} s), too short to show the slow bones decay; "
-               f"raise calm_s to at least {shortest:.2f}"
-               + (f" (and testbed/n_train to fit it: the window is {window:g} s)"
-                  if shortest + gust > window else ""))
+        yield (
+            key + ("calm_s",),
+            f"{calm:g} s of calm is shorter than one period of the slowest band frequency "
+            f"(1 / band_hz[0] = {shortest:.2f} s), too short to show the slow bones decay; "
+            f"raise calm_s to at least {shortest:.2f}"
+            + (
+                f" (and testbed/n_train to fit it: the window is {window:g} s)"
+                if shortest + gust > window
+                else ""
+            ),
+        )
 
 
 def warmup_below_iterations(cfg: dict) -> Iterator[Problem]:
@@ -195,17 +229,21 @@ def warmup_below_iterations(cfg: dict) -> Iterator[Problem]:
             node = node[k]
         it, warm = int(node["iterations"]), int(node["warmup"])
         if not 0 <= warm < it:
-            yield (section + ("warmup",),
-                   f"{warm} must lie in [0, {key}/iterations = {it}); lower {key}/warmup or raise "
-                   f"{key}/iterations")
+            yield (
+                section + ("warmup",),
+                f"{warm} must lie in [0, {key}/iterations = {it}); lower {key}/warmup or raise "
+                f"{key}/iterations",
+            )
 
 
 def holdout_leaves_training_frames(cfg: dict) -> Iterator[Problem]:
     """Held-out training frames (train.holdout_every) leave most of the window to train on."""
     every, n = int(cfg["train"]["holdout_every"]), int(cfg["testbed"]["n_train"])
     if every != 0 and not 2 <= every <= n:
-        yield (("train", "holdout_every"),
-               f"{every} must be 0 (no held-out frames) or lie in [2, testbed/n_train = {n}]")
+        yield (
+            ("train", "holdout_every"),
+            f"{every} must be 0 (no held-out frames) or lie in [2, testbed/n_train = {n}]",
+        )
 
 
 def freeze_inside_deformation_phase(cfg: dict) -> Iterator[Problem]:
@@ -224,10 +262,12 @@ def freeze_inside_deformation_phase(cfg: dict) -> Iterator[Problem]:
             continue  # warmup_below_iterations reports it
         frz = int(round(at * it))
         if not warm < frz < it:
-            yield (("models", "ours", "freeze_at"),
-                   f"{at:g} freezes at iteration {frz} of {key}/iterations = {it}, outside its "
-                   f"deformation phase ({warm}, {it}); choose freeze_at in ({warm / it:.3g}, 1) "
-                   "or set models/ours/freeze_below_px: 0 to turn freezing off")
+            yield (
+                ("models", "ours", "freeze_at"),
+                f"{at:g} freezes at iteration {frz} of {key}/iterations = {it}, outside its "
+                f"deformation phase ({warm}, {it}); choose freeze_at in ({warm / it:.3g}, 1) "
+                "or set models/ours/freeze_below_px: 0 to turn freezing off",
+            )
 
 
 def ours_bounds_ordered(cfg: dict) -> Iterator[Problem]:
@@ -237,24 +277,32 @@ def ours_bounds_ordered(cfg: dict) -> Iterator[Problem]:
         lo, hi = (float(v) for v in o[pair])
         x = float(o[init])
         if not lo < hi:
-            yield (("models", "ours", pair),
-                   f"[{lo:g}, {hi:g}] must be [low, high] with low < high; swap them")
+            yield (
+                ("models", "ours", pair),
+                f"[{lo:g}, {hi:g}] must be [low, high] with low < high; swap them",
+            )
         elif not lo < x < hi:
-            yield (("models", "ours", init),
-                   f"{x:g} lies outside models/ours/{pair} = [{lo:g}, {hi:g}]; choose a value "
-                   "strictly inside the bounds")
+            yield (
+                ("models", "ours", init),
+                f"{x:g} lies outside models/ours/{pair} = [{lo:g}, {hi:g}]; choose a value "
+                "strictly inside the bounds",
+            )
 
 
 def configs_have_single(cfg: dict) -> Iterator[Problem]:
     """models/configs holds `single` (every model trains in it) and not the reserved `auto`."""
     configs = cfg["models"]["configs"]
     if "single" not in configs:
-        yield (("models", "configs", "single"),
-               "missing: every model is trained in configuration 'single'; add "
-               "single: {conditions: train, K: 32} under models/configs")
+        yield (
+            ("models", "configs", "single"),
+            "missing: every model is trained in configuration 'single'; add "
+            "single: {conditions: train, K: 32} under models/configs",
+        )
     if "auto" in configs:
-        yield (("models", "configs", "auto"),
-               "is reserved for ours with K chosen from the data (models/kselect); rename it")
+        yield (
+            ("models", "configs", "auto"),
+            "is reserved for ours with K chosen from the data (models/kselect); rename it",
+        )
 
 
 def k_within_gaussians(cfg: dict) -> Iterator[Problem]:
@@ -272,28 +320,36 @@ def k_within_gaussians(cfg: dict) -> Iterator[Problem]:
     fix = f"the {smallest} Gaussians of tree '{tmin}' (testbed/vertices/{tmin})"
     for name, c in cfg["models"]["configs"].items():
         if int(c["K"]) > smallest:
-            yield (("models", "configs", name, "K"),
-                   f"K = {c['K']} parts exceeds {fix}; lower K or raise the vertex count")
+            yield (
+                ("models", "configs", name, "K"),
+                f"K = {c['K']} parts exceeds {fix}; lower K or raise the vertex count",
+            )
     for i, k in enumerate(cfg["models"]["kselect"]["candidates"]):
         if int(k) > smallest:
-            yield (("models", "kselect", "candidates", i),
-                   f"K = {k} exceeds {fix}; drop it from the candidates or raise the vertex count")
+            yield (
+                ("models", "kselect", "candidates", i),
+                f"K = {k} exceeds {fix}; drop it from the candidates or raise the vertex count",
+            )
     sa = cfg["speed_accuracy"]
     tree = sa["tree"]
     if tree in vertices:
         n = int(vertices[tree])
         for i, k in enumerate(sa["knobs"].get("K", [])):
             if int(k) > n:
-                yield (("speed_accuracy", "knobs", "K", i),
-                       f"K = {k} exceeds the {n} Gaussians of the sweep tree '{tree}' "
-                       f"(testbed/vertices/{tree}); lower it")
+                yield (
+                    ("speed_accuracy", "knobs", "K", i),
+                    f"K = {k} exceeds the {n} Gaussians of the sweep tree '{tree}' "
+                    f"(testbed/vertices/{tree}); lower it",
+                )
     single = cfg["models"]["configs"].get("single")
     if single is not None:
         for i, n in enumerate(sa["knobs"].get("vertices", [])):
             if int(n) < int(single["K"]):
-                yield (("speed_accuracy", "knobs", "vertices", i),
-                       f"{n} Gaussians is fewer than models/configs/single/K = {single['K']} "
-                       "parts, which the sweep trains at every vertex count; raise it")
+                yield (
+                    ("speed_accuracy", "knobs", "vertices", i),
+                    f"{n} Gaussians is fewer than models/configs/single/K = {single['K']} "
+                    "parts, which the sweep trains at every vertex count; raise it",
+                )
 
 
 def presets_reach_bone_counts(cfg: dict) -> Iterator[Problem]:
@@ -315,8 +371,10 @@ def sweep_tree_is_listed(cfg: dict) -> Iterator[Problem]:
     """The speed-accuracy sweep runs on a tree the pipeline builds."""
     tree = cfg["speed_accuracy"]["tree"]
     if tree not in cfg["trees"]:
-        yield (("speed_accuracy", "tree"),
-               f"'{tree}' is not in trees {cfg['trees']}; choose one of them or add it to trees")
+        yield (
+            ("speed_accuracy", "tree"),
+            f"'{tree}' is not in trees {cfg['trees']}; choose one of them or add it to trees",
+        )
 
 
 def fit_curve_is_runnable(cfg: dict) -> Iterator[Problem]:
@@ -324,14 +382,17 @@ def fit_curve_is_runnable(cfg: dict) -> Iterator[Problem]:
     own job) and its budgets give at least three points with the profile's."""
     fc = cfg["speed_accuracy"]["fit_curve"]
     if fc["tree"] not in cfg["trees"]:
-        yield (("speed_accuracy", "fit_curve", "tree"),
-               f"'{fc['tree']}' is not in trees {cfg['trees']}; choose one of them or add it to "
-               "trees")
+        yield (
+            ("speed_accuracy", "fit_curve", "tree"),
+            f"'{fc['tree']}' is not in trees {cfg['trees']}; choose one of them or add it to trees",
+        )
     own = int(cfg["train"]["iterations"])
     if len({*map(int, fc["iterations"]), own}) < 3:
-        yield (("speed_accuracy", "fit_curve", "iterations"),
-               f"{fc['iterations']} and the profile's own budget (train/iterations = {own}) make "
-               "fewer than three budgets; list at least two others")
+        yield (
+            ("speed_accuracy", "fit_curve", "iterations"),
+            f"{fc['iterations']} and the profile's own budget (train/iterations = {own}) make "
+            "fewer than three budgets; list at least two others",
+        )
 
 
 #: Every cross-key check, in the order their problems are reported.

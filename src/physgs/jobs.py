@@ -1,5 +1,6 @@
 """The prologue every workflow script shares: thread counts from the rule, output to the job's
 log, and any traceback into that log before the job fails."""
+
 from __future__ import annotations
 
 import contextlib
@@ -21,8 +22,11 @@ def job(sm):
 
     torch.set_num_threads(threads)
     numba.set_num_threads(min(threads, numba.config.NUMBA_NUM_THREADS))
-    with open(sm.log[0], "w") as log, contextlib.redirect_stderr(log), \
-            contextlib.redirect_stdout(log):
+    with (
+        open(sm.log[0], "w") as log,
+        contextlib.redirect_stderr(log),
+        contextlib.redirect_stdout(log),
+    ):
         try:
             yield log
         except BaseException:

@@ -1,5 +1,6 @@
 """Which settings made a result: a stamp (profile, resolved-config hash, package version)
 written into every table's CSV and the report, so copied results say where they came from."""
+
 from __future__ import annotations
 
 import hashlib

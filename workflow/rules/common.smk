@@ -50,9 +50,17 @@ FIT_POINT = "results/fit_curve/{tree}/seed{seed}/{model}_it{iterations}.json"
 TABLE = "results/tables/{name}.{ext}"
 FIGURE = "results/figures/{name}.{ext}"
 #: need kind (physgs.report.build.needs) -> path template
-NEED_PATHS = {"eval": EVAL, "traj": TRAJ, "panels": PANELS, "loss": LOSS, "recovery": RECOVERY,
-              "null": NULL, "kselect": KSELECT, "stats": STATS,
-              "table": TABLE.replace("{ext}", "csv")}
+NEED_PATHS = {
+    "eval": EVAL,
+    "traj": TRAJ,
+    "panels": PANELS,
+    "loss": LOSS,
+    "recovery": RECOVERY,
+    "null": NULL,
+    "kselect": KSELECT,
+    "stats": STATS,
+    "table": TABLE.replace("{ext}", "csv"),
+}
 SA_TREE = CFG["speed_accuracy"]["tree"]
 SWEEP_POINTS = _sweep.sweep_points(CFG)
 FC = CFG["speed_accuracy"]["fit_curve"]
@@ -76,11 +84,16 @@ def testbed_files(tree, seed):
     """{observed, truth, stats} paths of the instance training seed ``seed`` reads: the tree's
     one instance, or with testbed_seeds the instance built with testbed seed ``seed``."""
     if TESTBED_SEEDS:
-        return {"observed": SEEDED_OBSERVED.format(tree=tree, seed=seed),
-                "truth": SEEDED_TRUTH.format(tree=tree, seed=seed),
-                "stats": SEEDED_STATS.format(tree=tree, seed=seed)}
-    return {"observed": OBSERVED.format(tree=tree), "truth": TRUTH.format(tree=tree),
-            "stats": STATS.format(tree=tree)}
+        return {
+            "observed": SEEDED_OBSERVED.format(tree=tree, seed=seed),
+            "truth": SEEDED_TRUTH.format(tree=tree, seed=seed),
+            "stats": SEEDED_STATS.format(tree=tree, seed=seed),
+        }
+    return {
+        "observed": OBSERVED.format(tree=tree),
+        "truth": TRUTH.format(tree=tree),
+        "stats": STATS.format(tree=tree),
+    }
 
 
 def observed_input(wildcards):
@@ -101,7 +114,8 @@ def train_input(wildcards):
         raise ValueError(
             f"model '{wildcards.model}' is not trained in configuration '{wildcards.config}'; "
             f"valid: {_models.configs_for(wildcards.model, CONFIGS)} (joint configurations "
-            "are ours only)")
+            "are ours only)"
+        )
     return observed_input(wildcards)
 
 
@@ -127,8 +141,12 @@ def train_params(wildcards):
 
 
 def kselect_params(wildcards):
-    return _canonical({"job": _job_spec(CFG, "ours", _models.BASE_CONFIG, seed=int(wildcards.seed)),
-                       "kselect": CFG["models"]["kselect"]})
+    return _canonical(
+        {
+            "job": _job_spec(CFG, "ours", _models.BASE_CONFIG, seed=int(wildcards.seed)),
+            "kselect": CFG["models"]["kselect"],
+        }
+    )
 
 
 def null_params(wildcards):
@@ -140,8 +158,9 @@ def report_params(wildcards):
 
 
 def sweep_params(wildcards):
-    return _sweep.point_settings(CFG, wildcards.point, seed=int(wildcards.seed),
-                                 testbed_seeds=TESTBED_SEEDS)
+    return _sweep.point_settings(
+        CFG, wildcards.point, seed=int(wildcards.seed), testbed_seeds=TESTBED_SEEDS
+    )
 
 
 def sweep_inputs(wildcards):
@@ -154,21 +173,31 @@ def sweep_collect_inputs(wildcards):
     """Every sweep point of every seed, and the untrained null of the sweep tree at the
     profile's K per seed (the chance level the recovery panel draws)."""
     k = int(CONFIGS[_models.BASE_CONFIG]["K"])
-    return {"points": expand(SWEEP_POINT, seed=SEEDS, point=SWEEP_POINTS),
-            "nulls": expand(NULL, tree=SA_TREE, seed=SEEDS, K=k)}
+    return {
+        "points": expand(SWEEP_POINT, seed=SEEDS, point=SWEEP_POINTS),
+        "nulls": expand(NULL, tree=SA_TREE, seed=SEEDS, K=k),
+    }
 
 
 def fit_point_params(wildcards):
-    return _fit_curve.point_job(CFG, wildcards.model, int(wildcards.iterations),
-                                seed=int(wildcards.seed))
+    return _fit_curve.point_job(
+        CFG, wildcards.model, int(wildcards.iterations), seed=int(wildcards.seed)
+    )
 
 
 def fit_curve_inputs(wildcards):
     """The extra-budget points of every seed, and the pipeline's own evaluation and loss log of
     each model and seed at the profile's budget (keys eval_{model}_{seed}, loss_{model}_{seed})."""
     tree, cfg = FC["tree"], _models.BASE_CONFIG
-    out = {"points": expand(FIT_POINT, tree=tree, seed=SEEDS, model=FC["models"],
-                            iterations=_fit_curve.extra_budgets(CFG))}
+    out = {
+        "points": expand(
+            FIT_POINT,
+            tree=tree,
+            seed=SEEDS,
+            model=FC["models"],
+            iterations=_fit_curve.extra_budgets(CFG),
+        )
+    }
     for s in SEEDS:
         for m in FC_PROFILE_MODELS:
             out[f"eval_{m}_{s}"] = EVAL.format(tree=tree, seed=s, model=m, config=cfg)
@@ -185,8 +214,14 @@ def testbed_params(wildcards):
     if variant == _variant.DAMPING:
         tb["variant"] = _variant.DAMPING
     seed = int(getattr(wildcards, "seed", CFG["seed"]))  # a seeded instance (testbed_seeds)
-    return _canonical({"testbed": _variant.effective_settings(tb), "preset": CFG["presets"][t],
-                       "seed": seed, "tree": t})
+    return _canonical(
+        {
+            "testbed": _variant.effective_settings(tb),
+            "preset": CFG["presets"][t],
+            "seed": seed,
+            "tree": t,
+        }
+    )
 
 
 def recovery_damping_params(wildcards):
@@ -195,5 +230,7 @@ def recovery_damping_params(wildcards):
     t, _ = _variant.parse_id(wildcards.tree)
     if t not in DAMPING["trees"] or wildcards.config not in DAMPING["configs"]:
         return None
-    return {"zeta_range": [float(z) for z in CFG["testbed"]["damping"]["zeta_range"]],
-            "seed": int(wildcards.seed)}
+    return {
+        "zeta_range": [float(z) for z in CFG["testbed"]["damping"]["zeta_range"]],
+        "seed": int(wildcards.seed),
+    }

@@ -11,17 +11,17 @@ rule evaluate:
         scores=EVAL,
         traj=TRAJ,
         panels=PANELS,
-    params:
-        backend=CFG["train"]["backend"],
-    conda:
-        "../envs/physgs.yaml"
     log:
         "logs/evaluate/{tree}/seed{seed}/{model}_{config}.log",
     benchmark:
         "results/benchmarks/evaluate/{tree}/seed{seed}/{model}_{config}.tsv"
+    conda:
+        "../envs/physgs.yaml"
     threads: 1
     resources:
         mem_mb=3000,
         runtime=30,
+    params:
+        backend=CFG["train"]["backend"],
     script:
         "../scripts/evaluate.py"

@@ -8,21 +8,22 @@ rule kselect:
         observed=observed_input,
     output:
         selection=KSELECT,
-    params:
-        settings=kselect_params,
-    conda:
-        "../envs/physgs.yaml"
     log:
         "logs/kselect/{tree}/seed{seed}.log",
     benchmark:
         "results/benchmarks/kselect/{tree}/seed{seed}.tsv"
+    conda:
+        "../envs/physgs.yaml"
     threads: 2
     resources:
         mem_mb=4000,
         # minutes; about 1 s per iteration per candidate, generous for a cluster
-        runtime=10 + len(CFG["models"]["kselect"]["candidates"])
+        runtime=10
+        + len(CFG["models"]["kselect"]["candidates"])
         * CFG["models"]["kselect"]["iterations"]
         // 60,
+    params:
+        settings=kselect_params,
     script:
         "../scripts/kselect.py"
 
@@ -34,18 +35,18 @@ rule train_auto:
     output:
         ckpt=CKPT.replace("{model}_{config}", "ours_auto"),
         loss=LOSS.replace("{model}_{config}", "ours_auto"),
-    params:
-        job=lambda wc: _job_spec(CFG, "ours", _models.BASE_CONFIG, seed=int(wc.seed)),
-        conditions=CFG["models"]["kselect"]["conditions"],
-    conda:
-        "../envs/physgs.yaml"
     log:
         "logs/train/{tree}/seed{seed}/ours_auto.log",
     benchmark:
         "results/benchmarks/train/{tree}/seed{seed}/ours_auto.tsv"
+    conda:
+        "../envs/physgs.yaml"
     threads: 1
     resources:
         mem_mb=4000,
         runtime=10 + CFG["train"]["iterations"] // 60,
+    params:
+        job=lambda wc: _job_spec(CFG, "ours", _models.BASE_CONFIG, seed=int(wc.seed)),
+        conditions=CFG["models"]["kselect"]["conditions"],
     script:
         "../scripts/train_auto.py"

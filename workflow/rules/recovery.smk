@@ -11,16 +11,16 @@ rule recovery:
         stats=stats_input,
     output:
         record=RECOVERY,
-    params:
-        damping=recovery_damping_params,
-    conda:
-        "../envs/physgs.yaml"
     log:
         "logs/recovery/{tree}/seed{seed}/ours_{config}.log",
+    conda:
+        "../envs/physgs.yaml"
     threads: 1
     resources:
         mem_mb=2000,
         runtime=10,
+    params:
+        damping=recovery_damping_params,
     script:
         "../scripts/recovery.py"
 
@@ -32,15 +32,15 @@ rule null_control:
         stats=stats_input,
     output:
         record=NULL,
-    params:
-        null=null_params,
-    conda:
-        "../envs/physgs.yaml"
     log:
         "logs/recovery/{tree}/seed{seed}/null_K{K}.log",
+    conda:
+        "../envs/physgs.yaml"
     threads: 1
     resources:
         mem_mb=2000,
         runtime=10,
+    params:
+        null=null_params,
     script:
         "../scripts/null_control.py"

@@ -9,17 +9,17 @@ rule table:
     output:
         tex=TABLE.replace("{ext}", "tex"),
         csv=report(TABLE.replace("{ext}", "csv"), category="3. Tables", labels={"table": "{name}"}),
-    params:
-        settings=report_params,
-        stamp=STAMP,
-    conda:
-        "../envs/physgs.yaml"
     log:
         "logs/report/{name}.log",
+    conda:
+        "../envs/physgs.yaml"
     threads: 1
     resources:
         mem_mb=1000,
         runtime=5,
+    params:
+        settings=report_params,
+        stamp=STAMP,
     script:
         "../scripts/report_table.py"
 
@@ -29,26 +29,34 @@ rule figure:
         unpack(report_inputs),
     output:
         pdf=FIGURE.replace("{ext}", "pdf"),
-        png=report(FIGURE.replace("{ext}", "png"), category="2. Results",
-                   labels={"figure": "{name}"}),
-    params:
-        settings=report_params,
-    conda:
-        "../envs/physgs.yaml"
+        png=report(
+            FIGURE.replace("{ext}", "png"), category="2. Results", labels={"figure": "{name}"}
+        ),
     log:
         "logs/report/{name}.log",
+    conda:
+        "../envs/physgs.yaml"
     threads: 1
     resources:
         mem_mb=1500,
         runtime=5,
+    params:
+        settings=report_params,
     script:
         "../scripts/report_figure.py"
 
 
 rule report:
     input:
-        expand(TABLE, ext=("tex", "csv"), name=[n for n in _build.TABLES if n != "tab_kselect"
-                                                and (n != "tab_damping" or DAMPING["trees"])]),
+        expand(
+            TABLE,
+            ext=("tex", "csv"),
+            name=[
+                n
+                for n in _build.TABLES
+                if n != "tab_kselect" and (n != "tab_damping" or DAMPING["trees"])
+            ],
+        ),
         expand(FIGURE, name=_build.FIGURES, ext=("pdf", "png")),
 
 
@@ -60,16 +68,16 @@ rule claims:
     output:
         md=report("results/claims.md", category="5. Claims"),
         csv="results/claims.csv",
-    params:
-        trees=TREES,
-        stamp=STAMP,
-    conda:
-        "../envs/physgs.yaml"
     log:
         "logs/report/claims.log",
+    conda:
+        "../envs/physgs.yaml"
     threads: 1
     resources:
         mem_mb=1000,
         runtime=5,
+    params:
+        trees=TREES,
+        stamp=STAMP,
     script:
         "../scripts/claims.py"

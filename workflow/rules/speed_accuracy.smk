@@ -7,18 +7,18 @@ rule speed_accuracy_point:
         unpack(sweep_inputs),
     output:
         record=SWEEP_POINT,
-    params:
-        point=sweep_params,
-    conda:
-        "../envs/physgs.yaml"
     log:
         "logs/speed_accuracy/seed{seed}/{point}.log",
     benchmark:
         "results/benchmarks/speed_accuracy/seed{seed}/{point}.tsv"
+    conda:
+        "../envs/physgs.yaml"
     threads: 1  # two points run side by side on 2 cores (better throughput than 2 threads each)
     resources:
         mem_mb=4000,
         runtime=10 + CFG["train"]["iterations"] // 30,
+    params:
+        point=sweep_params,
     script:
         "../scripts/speed_accuracy_point.py"
 
@@ -30,10 +30,10 @@ rule speed_accuracy:
         csv=report("results/tables/speed_accuracy.csv", category="4. Speed-accuracy trade"),
         pdf="results/figures/fig_speed_accuracy.pdf",
         png=report("results/figures/fig_speed_accuracy.png", category="4. Speed-accuracy trade"),
-    conda:
-        "../envs/physgs.yaml"
     log:
         "logs/speed_accuracy/collect.log",
+    conda:
+        "../envs/physgs.yaml"
     threads: 1
     resources:
         mem_mb=1000,
@@ -49,18 +49,18 @@ rule fit_curve_point:
         observed=observed_input,
     output:
         record=FIT_POINT,
-    params:
-        job=fit_point_params,
-    conda:
-        "../envs/physgs.yaml"
     log:
         "logs/fit_curve/{tree}/seed{seed}/{model}_it{iterations}.log",
     benchmark:
         "results/benchmarks/fit_curve/{tree}/seed{seed}/{model}_it{iterations}.tsv"
+    conda:
+        "../envs/physgs.yaml"
     threads: 1
     resources:
         mem_mb=4000,
         runtime=lambda wc: 10 + int(wc.iterations) // 30,
+    params:
+        job=fit_point_params,
     script:
         "../scripts/fit_curve_point.py"
 
@@ -72,6 +72,14 @@ rule fit_curve:
         csv=report("results/tables/fit_curve.csv", category="4. Speed-accuracy trade"),
         pdf="results/figures/fig_fit_curve.pdf",
         png=report("results/figures/fig_fit_curve.png", category="4. Speed-accuracy trade"),
+    log:
+        "logs/fit_curve/collect.log",
+    conda:
+        "../envs/physgs.yaml"
+    threads: 1
+    resources:
+        mem_mb=1000,
+        runtime=5,
     params:
         tree=FC["tree"],
         models=FC_PROFILE_MODELS,
@@ -79,13 +87,5 @@ rule fit_curve:
         iterations=CFG["train"]["iterations"],
         n_train=CFG["testbed"]["n_train"],
         holdout_every=CFG["train"]["holdout_every"],
-    conda:
-        "../envs/physgs.yaml"
-    log:
-        "logs/fit_curve/collect.log",
-    threads: 1
-    resources:
-        mem_mb=1000,
-        runtime=5,
     script:
         "../scripts/fit_curve.py"

@@ -6,18 +6,18 @@ rule testbed_dataset:
     output:
         observed=OBSERVED,
         truth=TRUTH,
-    params:
-        settings=testbed_params,
-    conda:
-        "../envs/physgs.yaml"
     log:
         "logs/testbed/{tree}.log",
     benchmark:
         "results/benchmarks/testbed/{tree}.tsv"
+    conda:
+        "../envs/physgs.yaml"
     threads: 1
     resources:
         mem_mb=3000,
         runtime=20,
+    params:
+        settings=testbed_params,
     script:
         "../scripts/testbed_dataset.py"
 
@@ -28,12 +28,12 @@ rule testbed_stats:
         truth=TRUTH,
     output:
         stats=STATS,
-    conda:
-        "../envs/physgs.yaml"
     log:
         "logs/testbed/stats_{tree}.log",
     benchmark:
         "results/benchmarks/testbed/stats_{tree}.tsv"
+    conda:
+        "../envs/physgs.yaml"
     threads: 1
     resources:
         mem_mb=3000,
@@ -76,10 +76,10 @@ rule testbed_figure:
             category="1. Testbed",
             labels={"tree": "{tree}"},
         ),
-    conda:
-        "../envs/physgs.yaml"
     log:
         "logs/testbed/figure_{tree}.log",
+    conda:
+        "../envs/physgs.yaml"
     threads: 1
     resources:
         mem_mb=1500,

@@ -10,22 +10,22 @@ rule train:
     output:
         ckpt=CKPT,
         loss=LOSS,
-    wildcard_constraints:
-        model="|".join(_models.MODEL_NAMES),  # methods; the reference has its own rule
-        config="|".join(CONFIGS),  # ours_auto has its own rule (kselect.smk)
-    params:
-        job=train_params,
-    conda:
-        "../envs/physgs.yaml"
     log:
         "logs/train/{tree}/seed{seed}/{model}_{config}.log",
     benchmark:
         "results/benchmarks/train/{tree}/seed{seed}/{model}_{config}.tsv"
+    wildcard_constraints:
+        model="|".join(_models.MODEL_NAMES),  # methods; the reference has its own rule
+        config="|".join(CONFIGS),  # ours_auto has its own rule (kselect.smk)
+    conda:
+        "../envs/physgs.yaml"
     threads: 1  # two 1-thread jobs side by side beat one 2-thread job on 2 cores (benchmarks/training.py)
     resources:
         mem_mb=4000,
         # minutes; generous (about 1 s per iteration) so a cluster never kills a default job
         runtime=10 + CFG["train"]["iterations"] // 60,
+    params:
+        job=train_params,
     script:
         "../scripts/train.py"
 
@@ -39,25 +39,29 @@ rule train_reference:
     output:
         ckpt=CKPT.replace("{config}", _models.BASE_CONFIG),
         loss=LOSS.replace("{config}", _models.BASE_CONFIG),
-    wildcard_constraints:
-        model="|".join(_models.REFERENCE_NAMES),
-    params:
-        job=lambda wc: _job_spec(CFG, wc.model, _models.BASE_CONFIG, seed=int(wc.seed)),
-    conda:
-        "../envs/physgs.yaml"
     log:
         "logs/train/{tree}/seed{seed}/{model}_single.log",
     benchmark:
         "results/benchmarks/train/{tree}/seed{seed}/{model}_single.tsv"
+    wildcard_constraints:
+        model="|".join(_models.REFERENCE_NAMES),
+    conda:
+        "../envs/physgs.yaml"
     threads: 1
     resources:
         mem_mb=4000,
         runtime=10 + CFG["train"]["iterations"] // 60,
+    params:
+        job=lambda wc: _job_spec(CFG, wc.model, _models.BASE_CONFIG, seed=int(wc.seed)),
     script:
         "../scripts/train_reference.py"
 
 
 rule train_all:
     input:
-        [CKPT.format(tree=t, seed=s, model=m, config=c)
-         for t in TREES for s in SEEDS for m, c in TRAIN_JOBS],
+        [
+            CKPT.format(tree=t, seed=s, model=m, config=c)
+            for t in TREES
+            for s in SEEDS
+            for m, c in TRAIN_JOBS
+        ],

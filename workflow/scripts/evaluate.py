@@ -1,4 +1,5 @@
 """Snakemake script of rule `evaluate`: score one checkpoint on every split."""
+
 from physgs.evaluate.run import evaluate_checkpoint
 from physgs.jobs import job
 from physgs.models.registry import load_checkpoint
@@ -7,7 +8,13 @@ from physgs.testbed.dataset import load_observed, load_truth
 sm = snakemake  # noqa: F821 (injected by Snakemake)
 with job(sm) as log:
     summary = evaluate_checkpoint(
-        load_checkpoint(sm.input.ckpt), load_observed(sm.input.observed), load_truth(sm.input.truth),
-        eval_path=sm.output.scores, traj_path=sm.output.traj, panels_path=sm.output.panels,
-        backend=sm.params.backend, progress=lambda msg: print(msg, file=log, flush=True))
+        load_checkpoint(sm.input.ckpt),
+        load_observed(sm.input.observed),
+        load_truth(sm.input.truth),
+        eval_path=sm.output.scores,
+        traj_path=sm.output.traj,
+        panels_path=sm.output.panels,
+        backend=sm.params.backend,
+        progress=lambda msg: print(msg, file=log, flush=True),
+    )
     print({k: round(v, 3) for k, v in summary.items()}, file=log)

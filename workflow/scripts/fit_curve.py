@@ -1,4 +1,5 @@
 """Snakemake script of rule `fit_curve`: the fit curve's CSV and fig_fit_curve."""
+
 import json
 
 from physgs.atomic import atomic_path
@@ -11,8 +12,15 @@ sm = snakemake  # noqa: F821 (injected by Snakemake)
 p = sm.params
 with job(sm) as log:
     points = [json.load(open(f)) for f in sm.input.points]
-    own = {s: {m: fit_row(sm.input[f"eval_{m}_{s}"], sm.input[f"loss_{m}_{s}"], p.n_train,
-                          p.holdout_every) for m in p.models} for s in p.seeds}
+    own = {
+        s: {
+            m: fit_row(
+                sm.input[f"eval_{m}_{s}"], sm.input[f"loss_{m}_{s}"], p.n_train, p.holdout_every
+            )
+            for m in p.models
+        }
+        for s in p.seeds
+    }
     df = collect(points, own, p.iterations, p.tree)
     df["of_ceiling"] = ceiling_fraction(df)
     with atomic_path(sm.output.csv) as tmp:

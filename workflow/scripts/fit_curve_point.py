@@ -1,4 +1,5 @@
 """Snakemake script of rule `fit_curve_point`: one model trained and scored at one budget."""
+
 from physgs.atomic import write_json
 from physgs.experiments.fit_curve import run_point
 from physgs.jobs import job

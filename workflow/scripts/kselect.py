@@ -1,4 +1,5 @@
 """Snakemake script of rule `kselect`: choose ours' K for one tree from its training frames."""
+
 from physgs.experiments.kselect import save_selection, select_k
 from physgs.jobs import job
 from physgs.testbed.dataset import load_observed

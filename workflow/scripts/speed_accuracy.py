@@ -1,4 +1,5 @@
 """Snakemake script of rule `speed_accuracy`: the sweep's CSV and fig_speed_accuracy."""
+
 import json
 
 from physgs.atomic import atomic_path

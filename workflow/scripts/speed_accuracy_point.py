@@ -1,4 +1,5 @@
 """Snakemake script of rule `speed_accuracy_point`: train and score ours at one sweep point."""
+
 from physgs.atomic import write_json
 from physgs.experiments.sweep import run_point
 from physgs.jobs import job

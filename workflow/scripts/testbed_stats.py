@@ -1,5 +1,6 @@
 """Snakemake script of rule `testbed_stats`: one tree's statistics (frequencies, gaps, swing,
 visible motion per bone, framing, order leak) as JSON."""
+
 from physgs.jobs import job
 from physgs.testbed.dataset import load_observed, load_truth
 from physgs.testbed.stats import save_stats, testbed_stats

@@ -7,11 +7,15 @@ from a model via the shared interfaces); safe writes live in ``physgs.atomic``.
 The names load on first use (lazy_loader): the report jobs read evaluation records with
 ``splits.load_eval`` and should not pay torch's start-up for it.
 """
+
 import lazy_loader
 
-__getattr__, __dir__, __all__ = lazy_loader.attach(__name__, submod_attrs={
-    "metrics": ["psnr", "silhouette_centroid", "centroid_error"],
-    "splits": ["EvalResult", "evaluate", "load_eval"],
-    "trajectories": ["Trajectories", "tip_trajectories", "load_trajectories"],
-    "adapter": ["model_render_fn", "model_means_fn"],
-})
+__getattr__, __dir__, __all__ = lazy_loader.attach(
+    __name__,
+    submod_attrs={
+        "metrics": ["psnr", "silhouette_centroid", "centroid_error"],
+        "splits": ["EvalResult", "evaluate", "load_eval"],
+        "trajectories": ["Trajectories", "tip_trajectories", "load_trajectories"],
+        "adapter": ["model_render_fn", "model_means_fn"],
+    },
+)

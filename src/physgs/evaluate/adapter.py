@@ -1,5 +1,6 @@
 """Callbacks that let the evaluation score any model through the shared interfaces only
 (``model.gaussians_at`` and ``physgs.render.rasterization``), never a model class."""
+
 from __future__ import annotations
 
 import numpy as np
@@ -26,10 +27,21 @@ def model_render_fn(model, observed, *, backend: str = "auto"):
             if last.get("key") != key:
                 last["key"], last["g"] = key, model.gaussians_at(int(frame_idx), winds[condition])
             g = last["g"]
-            out = rasterization(g.means, g.quats, g.scales, g.opacities, g.colors, camera, bg,
-                                backend=backend, return_depth=False)
-        return (out.rgb.clamp(0, 1).cpu().numpy().astype(np.float64),
-                out.alpha.cpu().numpy().astype(np.float64))
+            out = rasterization(
+                g.means,
+                g.quats,
+                g.scales,
+                g.opacities,
+                g.colors,
+                camera,
+                bg,
+                backend=backend,
+                return_depth=False,
+            )
+        return (
+            out.rgb.clamp(0, 1).cpu().numpy().astype(np.float64),
+            out.alpha.cpu().numpy().astype(np.float64),
+        )
 
     return render_fn
 

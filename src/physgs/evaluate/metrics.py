@@ -1,4 +1,5 @@
 """Image metrics: PSNR per frame and silhouette centroids (pixels)."""
+
 from __future__ import annotations
 
 import numpy as np
@@ -15,8 +16,10 @@ def to_float_image(img: np.ndarray) -> np.ndarray:
     if not np.all(np.isfinite(out)):
         raise ValueError("image contains NaN/inf; the renderer produced invalid pixels")
     if out.min() < -1e-6 or out.max() > 1 + 1e-6:
-        raise ValueError(f"float image outside [0, 1] (min {out.min():.4g}, max {out.max():.4g}); "
-                         "clip or rescale the render before scoring")
+        raise ValueError(
+            f"float image outside [0, 1] (min {out.min():.4g}, max {out.max():.4g}); "
+            "clip or rescale the render before scoring"
+        )
     return np.clip(out, 0.0, 1.0)
 
 
@@ -46,8 +49,10 @@ def silhouette_centroid(weight: np.ndarray) -> np.ndarray:
         raise ValueError(f"silhouette must be [H, W], got shape {w.shape}")
     total = w.sum()
     if not total > 0:
-        raise ValueError("empty silhouette: nothing covers the image, so its centroid is undefined; "
-                         "check the render (all Gaussians transparent or off-screen?)")
+        raise ValueError(
+            "empty silhouette: nothing covers the image, so its centroid is undefined; "
+            "check the render (all Gaussians transparent or off-screen?)"
+        )
     ys, xs = np.indices(w.shape, dtype=np.float64)
     return np.array([(w * (xs + 0.5)).sum() / total, (w * (ys + 0.5)).sum() / total])
 

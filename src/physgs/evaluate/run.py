@@ -3,6 +3,7 @@
 This is what the Snakemake rule `evaluate` calls; it only joins the pieces of
 ``physgs.evaluate`` (scores through the render callback, never through a model class).
 """
+
 from __future__ import annotations
 
 import numpy as np
@@ -49,8 +50,9 @@ def render_panels(render_fn, observed) -> dict[str, np.ndarray]:
     return out
 
 
-def training_camera_scores(model, observed, frames, *, condition: int = 0,
-                           backend: str = "auto") -> tuple[np.ndarray, np.ndarray]:
+def training_camera_scores(
+    model, observed, frames, *, condition: int = 0, backend: str = "auto"
+) -> tuple[np.ndarray, np.ndarray]:
     """(MSE [M], PSNR dB [M]) of ``model`` at the training camera, per recorded frame in
     ``frames`` [M] of ``condition``, through the same render callback as the evaluation."""
     render_fn = model_render_fn(model, observed, backend=backend)
@@ -63,8 +65,17 @@ def training_camera_scores(model, observed, frames, *, condition: int = 0,
     return np.asarray(mse), np.asarray(score)
 
 
-def evaluate_checkpoint(model, observed, truth, *, eval_path, traj_path, panels_path,
-                        backend: str = "auto", progress=None) -> dict[str, float]:
+def evaluate_checkpoint(
+    model,
+    observed,
+    truth,
+    *,
+    eval_path,
+    traj_path,
+    panels_path,
+    backend: str = "auto",
+    progress=None,
+) -> dict[str, float]:
     """Score ``model`` on every split and write three files atomically.
 
     eval_path: ``EvalResult`` npz (per-frame PSNR in dB, centroid errors in pixels);
@@ -78,8 +89,10 @@ def evaluate_checkpoint(model, observed, truth, *, eval_path, traj_path, panels_
     summary = res.summary()
     bad = [k for k, v in summary.items() if not np.isfinite(v)]
     if bad:
-        raise FloatingPointError(f"evaluation produced non-finite scores for {bad}; "
-                                 "the checkpoint is likely corrupt: delete it and retrain")
+        raise FloatingPointError(
+            f"evaluation produced non-finite scores for {bad}; "
+            "the checkpoint is likely corrupt: delete it and retrain"
+        )
     res.save(eval_path)
     traj.save(traj_path)
     save_npz(panels_path, **panels)

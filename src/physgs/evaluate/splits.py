@@ -5,6 +5,7 @@ The evaluation never sees a model class: it calls a render callback
 where ``frame_idx`` is the 0-based recorded frame (t = frame_idx / fps seconds) and
 ``condition`` indexes ``observed.conditions`` (0 = training wind).
 """
+
 from __future__ import annotations
 
 from dataclasses import dataclass, fields
@@ -45,7 +46,7 @@ class EvalResult:
     @property
     def time_psnr(self) -> np.ndarray:
         """[n_tail] the time split: tail frames, training camera and wind."""
-        return self.camera_psnr[0, self.n_train:]
+        return self.camera_psnr[0, self.n_train :]
 
     @property
     def train_timestamps_psnr(self) -> np.ndarray:
@@ -55,7 +56,7 @@ class EvalResult:
     @property
     def beyond_window_psnr(self) -> np.ndarray:
         """[C, n_tail] training camera, frames 301-350 of each condition."""
-        return self.camera_psnr[:, self.n_train:]
+        return self.camera_psnr[:, self.n_train :]
 
     # --- split means (what the tables show) ---------------------------------------------
     def summary(self) -> dict[str, float]:
@@ -79,7 +80,9 @@ def load_eval(path) -> EvalResult:
         with np.load(path) as z:
             d = {k: z[k] for k in z.files}
     except (OSError, ValueError) as e:
-        raise ValueError(f"cannot read evaluation file {path}: {e}; delete it and re-run its rule") from e
+        raise ValueError(
+            f"cannot read evaluation file {path}: {e}; delete it and re-run its rule"
+        ) from e
     missing = {f.name for f in fields(EvalResult)} - set(d)
     if missing:
         raise ValueError(f"evaluation file {path} lacks {sorted(missing)}; re-run its rule")
@@ -91,12 +94,16 @@ def _render(render_fn: RenderFn, frame: int, cond: int, camera, shape: tuple[int
     rgb, alpha = render_fn(int(frame), int(cond), camera)
     rgb, alpha = np.asarray(rgb), np.asarray(alpha, dtype=np.float64)
     if rgb.shape != (*shape, 3) or alpha.shape != shape:
-        raise ValueError(f"render_fn returned rgb {rgb.shape}, alpha {alpha.shape} for frame {frame}, "
-                         f"condition {cond}; expected {(*shape, 3)} and {shape} (the camera's size)")
+        raise ValueError(
+            f"render_fn returned rgb {rgb.shape}, alpha {alpha.shape} for frame {frame}, "
+            f"condition {cond}; expected {(*shape, 3)} and {shape} (the camera's size)"
+        )
     return to_float_image(rgb), alpha
 
 
-def evaluate(render_fn: RenderFn, observed, *, progress: Callable[[str], None] | None = None) -> EvalResult:
+def evaluate(
+    render_fn: RenderFn, observed, *, progress: Callable[[str], None] | None = None
+) -> EvalResult:
     """Score a model through its render callback on every split of SPEC section 4.
 
     observed: a ``physgs.testbed.dataset.Observed``. Renders C x F frames at the training camera
@@ -106,8 +113,10 @@ def evaluate(render_fn: RenderFn, observed, *, progress: Callable[[str], None] |
     frames = observed.frames  # [C, F, H, W, 3] uint8
     C, F, H, W, _ = frames.shape
     if F != observed.n_train + observed.n_tail:
-        raise ValueError(f"observed has {F} frames but n_train + n_tail = "
-                         f"{observed.n_train + observed.n_tail}; the dataset is inconsistent")
+        raise ValueError(
+            f"observed has {F} frames but n_train + n_tail = "
+            f"{observed.n_train + observed.n_tail}; the dataset is inconsistent"
+        )
     cam_psnr = np.empty((C, F))
     cen = np.empty((C, F))
     # frame-major order, so a render_fn that caches its last deformed frame deforms each once
@@ -126,7 +135,13 @@ def evaluate(render_fn: RenderFn, observed, *, progress: Callable[[str], None] |
         for a, cam in enumerate(observed.heldout_cameras):
             rgb, _ = _render(render_fn, j, 0, cam, observed.heldout_frames.shape[2:4])
             view[a, m] = psnr(rgb, observed.heldout_frames[a, m])
-    return EvalResult(cam_psnr, cen, view, np.asarray(observed.conditions, dtype=np.float64),
-                      np.asarray(observed.heldout_azimuths_deg, dtype=np.float64),
-                      np.asarray(observed.heldout_frame_idx, dtype=np.int64),
-                      int(observed.n_train), int(observed.n_tail))
+    return EvalResult(
+        cam_psnr,
+        cen,
+        view,
+        np.asarray(observed.conditions, dtype=np.float64),
+        np.asarray(observed.heldout_azimuths_deg, dtype=np.float64),
+        np.asarray(observed.heldout_frame_idx, dtype=np.int64),
+        int(observed.n_train),
+        int(observed.n_tail),
+    )

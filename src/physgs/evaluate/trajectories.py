@@ -1,4 +1,5 @@
 """Branch-tip trajectories in pixels at the training camera, through the window and the tail."""
+
 from __future__ import annotations
 
 from dataclasses import dataclass, fields
@@ -42,8 +43,14 @@ def load_trajectories(path) -> Trajectories:
     return Trajectories(**d)
 
 
-def gt_tip_positions(truth, tips: np.ndarray, condition: int, lead_in_frames: int, n_frames: int,
-                     pose_fn: Callable | None = None) -> np.ndarray:
+def gt_tip_positions(
+    truth,
+    tips: np.ndarray,
+    condition: int,
+    lead_in_frames: int,
+    n_frames: int,
+    pose_fn: Callable | None = None,
+) -> np.ndarray:
     """Ground-truth world positions [P, F, 3] of vertices ``tips`` at recorded frames 0..F-1.
 
     Recorded frame j uses bone angles ``truth.theta[condition, lead_in_frames + j]`` (rad) posed
@@ -55,16 +62,25 @@ def gt_tip_positions(truth, tips: np.ndarray, condition: int, lead_in_frames: in
         from physgs.testbed.kinematics import pose_vertices as pose_fn
     theta = np.asarray(truth.theta)[condition]  # [L+F, B]
     if lead_in_frames + n_frames > theta.shape[0]:
-        raise ValueError(f"truth has {theta.shape[0]} samples, fewer than lead-in {lead_in_frames} "
-                         f"+ {n_frames} frames; dataset and truth files disagree")
+        raise ValueError(
+            f"truth has {theta.shape[0]} samples, fewer than lead-in {lead_in_frames} "
+            f"+ {n_frames} frames; dataset and truth files disagree"
+        )
     out = np.empty((len(tips), n_frames, 3))
     for j in range(n_frames):
         out[:, j] = np.asarray(pose_fn(truth, theta[lead_in_frames + j]))[tips]
     return out
 
 
-def tip_trajectories(means_fn: MeansFn, truth, observed, *, condition: int = 0,
-                     tips: np.ndarray | None = None, pose_fn: Callable | None = None) -> Trajectories:
+def tip_trajectories(
+    means_fn: MeansFn,
+    truth,
+    observed,
+    *,
+    condition: int = 0,
+    tips: np.ndarray | None = None,
+    pose_fn: Callable | None = None,
+) -> Trajectories:
     """Ground-truth and predicted branch-tip paths in pixels at the training camera.
 
     means_fn(frame_idx, condition) -> [N, 3] numpy Gaussian means of the model, in Gaussian order
@@ -77,9 +93,16 @@ def tip_trajectories(means_fn: MeansFn, truth, observed, *, condition: int = 0,
     F = int(observed.n_train + observed.n_tail)
     cam = observed.train_camera
     gt = gt_tip_positions(truth, tips, condition, int(observed.lead_in_frames), F, pose_fn)
-    pred = np.stack([np.asarray(means_fn(j, condition))[gauss] for j in range(F)], axis=1)  # [P, F, 3]
+    pred = np.stack(
+        [np.asarray(means_fn(j, condition))[gauss] for j in range(F)], axis=1
+    )  # [P, F, 3]
     P = len(tips)
     gt_px, _ = cam.project(gt.reshape(-1, 3))
     pred_px, _ = cam.project(pred.reshape(-1, 3).astype(np.float64))
-    return Trajectories(gt_px.reshape(P, F, 2), pred_px.reshape(P, F, 2), tips, int(condition),
-                        int(observed.n_train))
+    return Trajectories(
+        gt_px.reshape(P, F, 2),
+        pred_px.reshape(P, F, 2),
+        tips,
+        int(condition),
+        int(observed.n_train),
+    )

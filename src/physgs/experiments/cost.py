@@ -9,6 +9,7 @@ job-seconds one seed costs, what is shared by all seeds (the testbeds), and what
 benchmark adds. Light jobs without a benchmark (tables, figures, recovery) are not counted: the
 measured wall time of the run says how much they and the scheduling add.
 """
+
 from __future__ import annotations
 
 import csv
@@ -25,6 +26,7 @@ _SEED = re.compile(r"(?:^|_)seed(\d+)$")
 class JobCost:
     """One benchmarked job: ``stage`` (train, evaluate, ...), ``seed`` (None = shared by every
     seed), ``damping`` (part of the damping benchmark), wall seconds, and its path."""
+
     stage: str
     seed: int | None
     damping: bool
@@ -58,13 +60,21 @@ def read_costs(benchmark_dir) -> list[JobCost]:
         with f.open() as fh:
             rows = list(csv.DictReader(fh, delimiter="\t"))
         if not rows or "s" not in rows[-1]:
-            raise ValueError(f"{f}: not a Snakemake benchmark file (needs a header with `s` and a row)")
+            raise ValueError(
+                f"{f}: not a Snakemake benchmark file (needs a header with `s` and a row)"
+            )
         row = rows[-1]  # one row per run (benchmark repeats would add rows: the last counts)
         rel = f.relative_to(root)
         parts = rel.with_suffix("").parts
-        jobs.append(JobCost(stage=parts[0], seed=_seed_of(parts[1:]),
-                            damping=any(_is_damping(p) for p in parts[1:]),
-                            wall_s=float(row["s"]), path=str(rel)))
+        jobs.append(
+            JobCost(
+                stage=parts[0],
+                seed=_seed_of(parts[1:]),
+                damping=any(_is_damping(p) for p in parts[1:]),
+                wall_s=float(row["s"]),
+                path=str(rel),
+            )
+        )
     if not jobs:
         raise FileNotFoundError(f"{root}: no benchmark files (*.tsv)")
     return jobs
@@ -92,9 +102,14 @@ def summarise(jobs: list[JobCost]) -> dict:
             damping += j.wall_s
             if j.seed is not None:
                 damping_per_seed[j.seed] = damping_per_seed.get(j.seed, 0.0) + j.wall_s
-    return {"by_stage": by_stage, "per_seed": dict(sorted(per_seed.items())), "shared_s": shared,
-            "damping_s": damping, "damping_per_seed": dict(sorted(damping_per_seed.items())),
-            "total_s": shared + sum(per_seed.values())}
+    return {
+        "by_stage": by_stage,
+        "per_seed": dict(sorted(per_seed.items())),
+        "shared_s": shared,
+        "damping_s": damping,
+        "damping_per_seed": dict(sorted(damping_per_seed.items())),
+        "total_s": shared + sum(per_seed.values()),
+    }
 
 
 def extra_seed_wall_s(summary: dict, *, run_wall_s: float) -> float:

@@ -7,6 +7,7 @@ the every-``holdout_every``-th frames held out of training (interpolation), and 
 time split). The profile's own budget is not retrained: its point is the pipeline's own job,
 read from that job's evaluation and loss log, so the curve passes through the tables' numbers.
 """
+
 from __future__ import annotations
 
 import time
@@ -20,8 +21,7 @@ from physgs.experiments.recipe import fit, heldout_split, job_spec
 from physgs.experiments.sweep import with_knob
 from physgs.models.registry import BASE_CONFIG
 
-COLUMNS = ("seed", "model", "iterations", "is_profile", "fit", "heldout", "time", "train_s",
-           "tree")
+COLUMNS = ("seed", "model", "iterations", "is_profile", "fit", "heldout", "time", "train_s", "tree")
 
 
 def budgets(cfg: dict) -> list[int]:
@@ -51,26 +51,42 @@ def run_point(job: Mapping, observed, *, progress: bool = False) -> dict:
     from physgs.evaluate.run import training_camera_scores  # torch: only when training
 
     t0 = time.perf_counter()
-    res = fit(observed, dict(job), progress=progress,
-              name=f"{job['model']}_{job['config']}[{job['train']['iterations']} it]")
+    res = fit(
+        observed,
+        dict(job),
+        progress=progress,
+        name=f"{job['model']}_{job['config']}[{job['train']['iterations']} it]",
+    )
     train_s = time.perf_counter() - t0
     n = int(observed.n_train)
     every = int(job["train"].get("holdout_every", 0))
     trained, held = heldout_split(n, every) if every else (np.arange(n), np.arange(0))
     backend = job["train"]["backend"]
     _, p_fit = training_camera_scores(res.model, observed, trained, backend=backend)
-    _, p_held = (training_camera_scores(res.model, observed, held, backend=backend)
-                 if held.size else (None, np.array([np.nan])))
+    _, p_held = (
+        training_camera_scores(res.model, observed, held, backend=backend)
+        if held.size
+        else (None, np.array([np.nan]))
+    )
     tail = np.arange(n, n + int(observed.n_tail))
     _, p_time = training_camera_scores(res.model, observed, tail, backend=backend)
-    return {"model": job["model"], "seed": int(job["seed"]),
-            "iterations": int(job["train"]["iterations"]),
-            "fit": float(np.mean(p_fit)), "heldout": float(np.mean(p_held)),
-            "time": float(np.mean(p_time)), "train_s": float(train_s)}
+    return {
+        "model": job["model"],
+        "seed": int(job["seed"]),
+        "iterations": int(job["train"]["iterations"]),
+        "fit": float(np.mean(p_fit)),
+        "heldout": float(np.mean(p_held)),
+        "time": float(np.mean(p_time)),
+        "train_s": float(train_s),
+    }
 
 
-def collect(points: Sequence[dict], profile_rows: Mapping[int, Mapping[str, dict]],
-            profile_iterations: int, tree: str) -> pd.DataFrame:
+def collect(
+    points: Sequence[dict],
+    profile_rows: Mapping[int, Mapping[str, dict]],
+    profile_iterations: int,
+    tree: str,
+) -> pd.DataFrame:
     """One row per (seed, model, budget), sorted.
 
     points: ``run_point`` records (each names its seed); profile_rows: seed -> model -> the
@@ -78,22 +94,37 @@ def collect(points: Sequence[dict], profile_rows: Mapping[int, Mapping[str, dict
     train_s), references included.
     """
     keep = ("model", "iterations", "fit", "heldout", "time", "train_s")
-    rows = [{"seed": int(p["seed"]), **{k: p[k] for k in keep}, "is_profile": False,
-             "tree": tree} for p in points]
+    rows = [
+        {"seed": int(p["seed"]), **{k: p[k] for k in keep}, "is_profile": False, "tree": tree}
+        for p in points
+    ]
     for seed, by_model in profile_rows.items():
         for m, r in by_model.items():
-            rows.append({"seed": int(seed), "model": m, "iterations": int(profile_iterations),
-                         "fit": r["fit"], "heldout": r["heldout"], "time": r["time"],
-                         "train_s": r["train_s"], "is_profile": True, "tree": tree})
+            rows.append(
+                {
+                    "seed": int(seed),
+                    "model": m,
+                    "iterations": int(profile_iterations),
+                    "fit": r["fit"],
+                    "heldout": r["heldout"],
+                    "time": r["time"],
+                    "train_s": r["train_s"],
+                    "is_profile": True,
+                    "tree": tree,
+                }
+            )
     df = pd.DataFrame(rows, columns=list(COLUMNS))
     if df.duplicated(["seed", "model", "iterations"]).any():
-        raise ValueError(f"fit curve: budget {profile_iterations} given twice for a model and "
-                         "seed; the profile's budget comes from the pipeline, not from a point")
+        raise ValueError(
+            f"fit curve: budget {profile_iterations} given twice for a model and "
+            "seed; the profile's budget comes from the pipeline, not from a point"
+        )
     return df.sort_values(["model", "iterations", "seed"], kind="stable").reset_index(drop=True)
 
 
-def ceiling_fraction(df: pd.DataFrame, static: str = "static",
-                     ceiling: str = "truth_motion") -> pd.Series:
+def ceiling_fraction(
+    df: pd.DataFrame, static: str = "static", ceiling: str = "truth_motion"
+) -> pd.Series:
     """(fit - static) / (ceiling - static) per row, against the same seed's profile-budget static
     and ceiling rows (the fraction of the achievable in-window gain); NaN without them."""
     prof = df[df["is_profile"]].set_index(["seed", "model"])["fit"]

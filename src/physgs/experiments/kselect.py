@@ -16,6 +16,7 @@ the evaluation's render callback.
   n overstates the evidence and BIC leans to large K; held-out frames are the default.
 Both choices are recorded whichever ``method`` picks the K used.
 """
+
 from __future__ import annotations
 
 import json
@@ -94,18 +95,22 @@ def load_selection(path) -> KSelection:
         with open(path) as fh:
             return KSelection.from_dict(json.load(fh))
     except (OSError, json.JSONDecodeError, KeyError, TypeError) as e:
-        raise ValueError(f"cannot read the K selection {path} ({e}); delete it and re-run the "
-                         "kselect rule") from None
+        raise ValueError(
+            f"cannot read the K selection {path} ({e}); delete it and re-run the kselect rule"
+        ) from None
 
 
 def _check_cfg(ks: dict, n_gaussians: int) -> list[int]:
     cands = sorted({int(k) for k in ks["candidates"]})
     if not cands or cands[0] < 1:
-        raise ValueError(f"models.kselect.candidates must be positive integers, got "
-                         f"{ks['candidates']}")
+        raise ValueError(
+            f"models.kselect.candidates must be positive integers, got {ks['candidates']}"
+        )
     if cands[-1] > n_gaussians:
-        raise ValueError(f"models.kselect.candidates: K = {cands[-1]} exceeds the {n_gaussians} "
-                         "Gaussians of this tree; drop it from the candidates")
+        raise ValueError(
+            f"models.kselect.candidates: K = {cands[-1]} exceeds the {n_gaussians} "
+            "Gaussians of this tree; drop it from the candidates"
+        )
     if ks["method"] not in METHODS:
         raise ValueError(f"models.kselect.method must be one of {METHODS}, got {ks['method']!r}")
     return cands
@@ -143,9 +148,17 @@ def select_k(observed, job: Job | dict, kselect: dict, *, progress: bool = False
         rows["wall_s"].append(time.perf_counter() - t0)
     k_h = choose_heldout(cands, rows["heldout_psnr"], float(ks["tie_db"]))
     k_b = choose_bic(cands, rows["bic"])
-    return KSelection(candidates=cands, method=ks["method"], every=int(ks["every"]),
-                      iterations=int(ks["iterations"]), n_pixels=n_pix, k_heldout=k_h, k_bic=k_b,
-                      chosen_k=k_h if ks["method"] == "heldout" else k_b, **rows)
+    return KSelection(
+        candidates=cands,
+        method=ks["method"],
+        every=int(ks["every"]),
+        iterations=int(ks["iterations"]),
+        n_pixels=n_pix,
+        k_heldout=k_h,
+        k_bic=k_b,
+        chosen_k=k_h if ks["method"] == "heldout" else k_b,
+        **rows,
+    )
 
 
 def auto_job(job: Job | dict, sel: KSelection, conditions: str) -> dict:

@@ -3,6 +3,7 @@ included), in that order, for every model and every caller.
 
 The workflow imports ``job_spec`` and ``canonical`` to plan jobs; the training machinery (torch)
 loads inside ``fit`` and ``train_and_save``, so a dry run does not pay its start-up."""
+
 from __future__ import annotations
 
 from dataclasses import asdict, dataclass, field
@@ -75,28 +76,44 @@ def job_spec(cfg: dict, model: str, config: str, seed: int | None = None) -> dic
     """
     configs = cfg["models"]["configs"]
     if config not in configs_for(model, configs):
-        raise ValueError(f"model {model!r} is not trained in configuration {config!r}; valid: "
-                         f"{configs_for(model, configs)} (joint configurations are ours only)")
+        raise ValueError(
+            f"model {model!r} is not trained in configuration {config!r}; valid: "
+            f"{configs_for(model, configs)} (joint configurations are ours only)"
+        )
     spec = configs[config]
-    return Job(model=model, config=config, conditions=spec["conditions"],
-               seed=int(cfg["seed"] if seed is None else seed),
-               settings=model_settings(cfg["models"], model), train=cfg["train"],
-               K=int(spec["K"]) if model == "ours" else None).to_dict()
+    return Job(
+        model=model,
+        config=config,
+        conditions=spec["conditions"],
+        seed=int(cfg["seed"] if seed is None else seed),
+        settings=model_settings(cfg["models"], model),
+        train=cfg["train"],
+        K=int(spec["K"]) if model == "ours" else None,
+    ).to_dict()
 
 
 def heldout_split(n_train: int, every: int) -> tuple[np.ndarray, np.ndarray]:
     """(training frames, held-out frames): indices in [0, n_train), every ``every``-th held out
     (frames every-1, 2 every-1, ...), so frame 0 and the window's start stay in training."""
     if not 2 <= every <= n_train:
-        raise ValueError(f"every (train.holdout_every, models.kselect.every) must lie in "
-                         f"[2, n_train = {n_train}], got {every}")
+        raise ValueError(
+            f"every (train.holdout_every, models.kselect.every) must lie in "
+            f"[2, n_train = {n_train}], got {every}"
+        )
     idx = np.arange(n_train)
     held = (idx % every) == every - 1
     return idx[~held], idx[held]
 
 
-def fit(observed, job: Job | dict, *, truth=None, frame_pool=None, progress: bool = True,
-        name: str | None = None) -> TrainResult:
+def fit(
+    observed,
+    job: Job | dict,
+    *,
+    truth=None,
+    frame_pool=None,
+    progress: bool = True,
+    name: str | None = None,
+) -> TrainResult:
     """Seed, build and train one model on ``observed`` (a testbed ``Observed``).
 
     Every random source is seeded from ``job.seed`` before the model is built, so the same job
@@ -114,21 +131,38 @@ def fit(observed, job: Job | dict, *, truth=None, frame_pool=None, progress: boo
     job = Job.from_dict(job) if isinstance(job, dict) else job
     spec_of(job.model)  # unknown ids raise, naming the valid ones
     if truth is not None and not is_reference(job.model):
-        raise ValueError(f"model {job.model!r} is a method: its training may not read the ground "
-                         "truth (truth.npz); only references (truth_motion) do")
+        raise ValueError(
+            f"model {job.model!r} is a method: its training may not read the ground "
+            "truth (truth.npz); only references (truth_motion) do"
+        )
     _check_precision(job)
     seed_everything(job.seed)
     # a reference without a truth raises here, saying it needs truth.npz
-    model = build_model(job.model, observed, job.settings, config=job.config, K=job.K,
-                        seed=job.seed, truth=truth if is_reference(job.model) else None)
+    model = build_model(
+        job.model,
+        observed,
+        job.settings,
+        config=job.config,
+        K=job.K,
+        seed=job.seed,
+        truth=truth if is_reference(job.model) else None,
+    )
     conds = condition_indices(job.conditions, len(observed.conditions))
     every = int(job.train.get("holdout_every", 0))
     if frame_pool is None and every:
         frame_pool = heldout_split(int(observed.n_train), every)[0]
     hook = freeze_callback(observed, job.settings, job.train) if job.model == "ours" else None
-    result = train_model(model, observed, job.train, conditions=conds, seed=job.seed,
-                         name=name or job.name, progress=progress, frame_pool=frame_pool,
-                         on_iteration=hook)
+    result = train_model(
+        model,
+        observed,
+        job.train,
+        conditions=conds,
+        seed=job.seed,
+        name=name or job.name,
+        progress=progress,
+        frame_pool=frame_pool,
+        on_iteration=hook,
+    )
     if job.model == "ours":
         result.stats["frozen_parts"] = int(result.model.frozen.sum())
     return result
@@ -144,7 +178,9 @@ def check_precision_supported(settings: dict, families: tuple[str, ...] = ("mlp"
     settings ``settings`` and this CPU has no native bf16 (autocast would emulate it, ~48x
     slower than float32: a default run would take days), naming the key and the way out. torch
     is imported only when some family asks for bf16, so planning a float32 run stays light."""
-    asked = [f for f in families if (settings.get(f) or {}).get("precision", "float32") == "bfloat16"]
+    asked = [
+        f for f in families if (settings.get(f) or {}).get("precision", "float32") == "bfloat16"
+    ]
     if not asked:
         return
     from physgs.models.fields import native_bf16
@@ -158,11 +194,13 @@ def check_precision_supported(settings: dict, families: tuple[str, ...] = ("mlp"
             f"{torch.backends.cpu.get_cpu_capability()}) has no native bf16 matmuls: autocast "
             "would emulate them, ~48x slower than float32. Run with `--configfile "
             "config/float32.yaml` (or set precision: float32 in config/trees.yaml), or on a CPU "
-            "with AVX-512 BF16 or AMX")
+            "with AVX-512 BF16 or AMX"
+        )
 
 
-def train_and_save(observed, job: Job | dict, *, checkpoint_path, loss_path,
-                   progress: bool = True, truth=None) -> TrainResult:
+def train_and_save(
+    observed, job: Job | dict, *, checkpoint_path, loss_path, progress: bool = True, truth=None
+) -> TrainResult:
     """``fit``, then write the loss log and the checkpoint (each atomically, the checkpoint
     last). Nothing is written if training fails. truth: as in ``fit`` (references only); the
     checkpoint of a reference carries its motion, so it reloads without truth.npz."""
@@ -171,7 +209,14 @@ def train_and_save(observed, job: Job | dict, *, checkpoint_path, loss_path,
     job = Job.from_dict(job) if isinstance(job, dict) else job
     result = fit(observed, job, truth=truth, progress=progress)
     write_loss_log(loss_path, result.log)
-    save_checkpoint(checkpoint_path, result.model, name=job.model, config=job.config,
-                    seed=job.seed, models_cfg=job.settings, train_cfg=job.train,
-                    stats=result.stats)
+    save_checkpoint(
+        checkpoint_path,
+        result.model,
+        name=job.model,
+        config=job.config,
+        seed=job.seed,
+        models_cfg=job.settings,
+        train_cfg=job.train,
+        stats=result.stats,
+    )
     return result

@@ -7,6 +7,7 @@ frames at the training camera and wind) and the frequency-recovery error (median
 over trusted parts). Points whose knob changes the testbed (resolution, vertices) rebuild the
 tree's dataset at that setting in a scratch folder; the rest reuse the pipeline's dataset.
 """
+
 from __future__ import annotations
 
 import copy
@@ -79,13 +80,15 @@ def parse_point(name: str) -> tuple[str | None, int | None]:
         return None, None
     knob, _, value = name.rpartition("-")
     if knob not in KNOBS or not value.isdigit():
-        raise ValueError(f"bad sweep point '{name}': expected '{BASE}' or '<knob>-<int>' with knob "
-                         f"in {KNOBS}")
+        raise ValueError(
+            f"bad sweep point '{name}': expected '{BASE}' or '<knob>-<int>' with knob in {KNOBS}"
+        )
     return knob, int(value)
 
 
-def point_settings(cfg: dict, name: str, seed: int | None = None,
-                   testbed_seeds: bool = False) -> dict:
+def point_settings(
+    cfg: dict, name: str, seed: int | None = None, testbed_seeds: bool = False
+) -> dict:
     """What sweep point ``name`` reads, as a sorted plain dict (the workflow's params): its knob
     values, ours' training job at those values (``recipe.job_spec``, the tables' recipe, with
     training seed ``seed``, default ``cfg['seed']``) and, for a knob that changes the testbed,
@@ -94,13 +97,20 @@ def point_settings(cfg: dict, name: str, seed: int | None = None,
     tree = cfg["speed_accuracy"]["tree"]
     knob, value = parse_point(name)
     pcfg = cfg if knob is None else with_knob(cfg, tree, knob, value)
-    out = {"point": name, "knob": knob or BASE, "tree": tree,
-           "values": {k: int(knob_value(pcfg, tree, k)) for k in KNOBS},
-           "job": job_spec(pcfg, "ours", BASE_CONFIG, seed=seed)}
+    out = {
+        "point": name,
+        "knob": knob or BASE,
+        "tree": tree,
+        "values": {k: int(knob_value(pcfg, tree, k)) for k in KNOBS},
+        "job": job_spec(pcfg, "ours", BASE_CONFIG, seed=seed),
+    }
     if knob in TESTBED_KNOBS:
         tb_seed = int(seed) if testbed_seeds and seed is not None else int(pcfg["seed"])
-        out["testbed"] = {"testbed": effective_settings(pcfg["testbed"]),
-                          "preset": pcfg["presets"][tree], "seed": tb_seed}
+        out["testbed"] = {
+            "testbed": effective_settings(pcfg["testbed"]),
+            "preset": pcfg["presets"][tree],
+            "seed": tb_seed,
+        }
     return canonical(out)
 
 
@@ -117,14 +127,20 @@ def run_point(point: dict, observed_path, truth_path, *, progress: bool = False)
     from physgs.testbed.dataset import build_dataset, load_observed, load_truth, save_dataset
 
     name, tree = point["point"], point["tree"]
-    rec = {"point": name, "knob": point["knob"], "tree": tree, "seed": int(point["job"]["seed"]),
-           **point["values"]}
+    rec = {
+        "point": name,
+        "knob": point["knob"],
+        "tree": tree,
+        "seed": int(point["job"]["seed"]),
+        **point["values"],
+    }
     with tempfile.TemporaryDirectory(prefix="physgs-sweep-") as tmp:
         t0 = time.perf_counter()
         if "testbed" in point:
             tb = point["testbed"]
-            obs, tru = build_dataset(tb["testbed"], tb["preset"], seed=int(tb["seed"]), tree=tree,
-                                     progress=progress)
+            obs, tru = build_dataset(
+                tb["testbed"], tb["preset"], seed=int(tb["seed"]), tree=tree, progress=progress
+            )
             observed_path, truth_path = Path(tmp) / "observed.npz", Path(tmp) / "truth.npz"
             save_dataset(obs, tru, observed_path, truth_path)
         rec["testbed_s"] = time.perf_counter() - t0 if "testbed" in point else 0.0
@@ -134,8 +150,9 @@ def run_point(point: dict, observed_path, truth_path, *, progress: bool = False)
         rec["train_s"] = time.perf_counter() - t0
         t0 = time.perf_counter()
         tail = np.arange(observed.n_train, observed.n_train + observed.n_tail)
-        _, p_time = training_camera_scores(res.model, observed, tail,
-                                           backend=point["job"]["train"]["backend"])
+        _, p_time = training_camera_scores(
+            res.model, observed, tail, backend=point["job"]["train"]["backend"]
+        )
         rec["psnr_time"] = float(np.mean(p_time))
         r = recover_model(res.model, observed, truth)
         rec["eval_s"] = time.perf_counter() - t0
@@ -160,15 +177,39 @@ def collect(records: Sequence[dict]) -> pd.DataFrame:
         recs = by_seed[seed]
         base = [r for r in recs if r["point"] == BASE]
         if len(base) != 1:
-            raise ValueError(f"speed-accuracy records of seed {seed} need exactly one 'base' "
-                             f"point, got {len(base)}")
+            raise ValueError(
+                f"speed-accuracy records of seed {seed} need exactly one 'base' "
+                f"point, got {len(base)}"
+            )
         for knob in KNOBS:
             for r in [*base, *[r for r in recs if r["knob"] == knob]]:
-                rows.append({**r, "seed": seed, "knob": knob, "value": r[knob],
-                             "is_base": r["point"] == BASE})
+                rows.append(
+                    {
+                        **r,
+                        "seed": seed,
+                        "knob": knob,
+                        "value": r[knob],
+                        "is_base": r["point"] == BASE,
+                    }
+                )
     df = pd.DataFrame(rows).sort_values(["knob", "value", "seed"], kind="stable")
-    cols = ["seed", "knob", "value", "is_base", "wall_s", "train_s", "testbed_s", "eval_s",
-            "psnr_time", "rel_err", "trusted", "parts", "frozen", "tree", *KNOBS]
+    cols = [
+        "seed",
+        "knob",
+        "value",
+        "is_base",
+        "wall_s",
+        "train_s",
+        "testbed_s",
+        "eval_s",
+        "psnr_time",
+        "rel_err",
+        "trusted",
+        "parts",
+        "frozen",
+        "tree",
+        *KNOBS,
+    ]
     return df[cols].reset_index(drop=True)
 
 
@@ -181,5 +222,10 @@ def null_level(nulls: Sequence) -> dict:
     if not v.size:
         return {"median": np.nan, "low": np.nan, "high": np.nan, "draws": 0}
     lo, med, hi = np.percentile(v, [2.5, 50, 97.5])
-    return {"median": float(med), "low": float(lo), "high": float(hi), "draws": int(v.size),
-            "K": int(nulls[0].n_parts)}
+    return {
+        "median": float(med),
+        "low": float(lo),
+        "high": float(hi),
+        "draws": int(v.size),
+        "K": int(nulls[0].n_parts),
+    }

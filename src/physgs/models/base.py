@@ -1,4 +1,5 @@
 """What every model shares: the context read off the observed dataset, and the canonical set."""
+
 from __future__ import annotations
 
 from dataclasses import dataclass
@@ -37,9 +38,12 @@ class ModelContext:
         """Checkpoint-safe form (tensors and Python scalars only)."""
         return {
             "canonical_xyz": torch.tensor(np.asarray(self.canonical_xyz, dtype=np.float32)),
-            "fps": int(self.fps), "n_train": int(self.n_train),
-            "lead_in_frames": int(self.lead_in_frames), "wind_mean": float(self.wind_mean),
-            "wind_std": float(self.wind_std), "wind_force_std": float(self.wind_force_std),
+            "fps": int(self.fps),
+            "n_train": int(self.n_train),
+            "lead_in_frames": int(self.lead_in_frames),
+            "wind_mean": float(self.wind_mean),
+            "wind_std": float(self.wind_std),
+            "wind_force_std": float(self.wind_force_std),
             "view_dir": torch.tensor(np.asarray(self.view_dir, dtype=np.float64)),
             "vbar_ratio": float(self.vbar_ratio),
         }
@@ -47,9 +51,14 @@ class ModelContext:
     @staticmethod
     def from_dict(d: dict) -> "ModelContext":
         return ModelContext(
-            np.asarray(d["canonical_xyz"], dtype=np.float32), int(d["fps"]), int(d["n_train"]),
-            int(d["lead_in_frames"]), float(d["wind_mean"]), float(d["wind_std"]),
-            float(d["wind_force_std"]), np.asarray(d["view_dir"], dtype=np.float64),
+            np.asarray(d["canonical_xyz"], dtype=np.float32),
+            int(d["fps"]),
+            int(d["n_train"]),
+            int(d["lead_in_frames"]),
+            float(d["wind_mean"]),
+            float(d["wind_std"]),
+            float(d["wind_force_std"]),
+            np.asarray(d["view_dir"], dtype=np.float64),
             float(d.get("vbar_ratio", 1.0)),
         )
 
@@ -65,9 +74,14 @@ def context_from_observed(obs) -> ModelContext:
         )
     fwd = np.asarray(obs.train_camera.R, dtype=np.float64)[2]  # camera +z in world
     return ModelContext(
-        canonical_xyz=np.asarray(obs.canonical_xyz, dtype=np.float32), fps=int(obs.fps),
-        n_train=int(obs.n_train), lead_in_frames=int(obs.lead_in_frames), wind_mean=float(w.mean()),
-        wind_std=std, wind_force_std=float((w**2 - w.mean() ** 2).std()), view_dir=fwd,
+        canonical_xyz=np.asarray(obs.canonical_xyz, dtype=np.float32),
+        fps=int(obs.fps),
+        n_train=int(obs.n_train),
+        lead_in_frames=int(obs.lead_in_frames),
+        wind_mean=float(w.mean()),
+        wind_std=std,
+        wind_force_std=float((w**2 - w.mean() ** 2).std()),
+        view_dir=fwd,
         vbar_ratio=float(np.asarray(obs.vbar)[0] / w.mean()) if hasattr(obs, "vbar") else 1.0,
     )
 
@@ -100,8 +114,10 @@ class BaseModel(nn.Module):
 
     def _check(self, frame_idx: int, wind: torch.Tensor) -> None:
         if wind.ndim != 1:
-            raise ValueError(f"{self.name}: wind must be one condition's series [L+F], got shape "
-                             f"{tuple(wind.shape)}")
+            raise ValueError(
+                f"{self.name}: wind must be one condition's series [L+F], got shape "
+                f"{tuple(wind.shape)}"
+            )
         if not 0 <= frame_idx < wind.shape[0] - self.lead_in:
             raise ValueError(
                 f"{self.name}: frame {frame_idx} outside the recording (0 .. "

@@ -1,4 +1,5 @@
 """Fourier (NeRF-style) positional encoding."""
+
 from __future__ import annotations
 
 import math

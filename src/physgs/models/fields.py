@@ -10,6 +10,7 @@ weights, their gradients and Adam stay float32; the inputs and the heads stay fl
 offsets keep float32 resolution). On a CPU with native bf16 dot products (AVX-512 BF16 / AMX) the
 Deformable-3DGS field's forward + backward runs ~2.4x faster (``benchmarks/field_precision.py``).
 """
+
 from __future__ import annotations
 
 import numpy as np
@@ -28,7 +29,9 @@ PRECISIONS = ("float32", "bfloat16")  # models.<mlp|d3dgs>.precision
 def native_bf16() -> bool:
     """Whether this CPU runs bf16 matmuls natively (oneDNN's own probe: AVX-512 BF16 or AMX
     class hardware). Without it autocast emulates them, ~48x slower than float32."""
-    return bool(torch.backends.mkldnn.is_available() and torch.ops.mkldnn._is_mkldnn_bf16_supported())
+    return bool(
+        torch.backends.mkldnn.is_available() and torch.ops.mkldnn._is_mkldnn_bf16_supported()
+    )
 
 
 class DeformationField(nn.Module):
@@ -38,8 +41,15 @@ class DeformationField(nn.Module):
     the activations after hidden layer ``skip`` (0-based), as in Deformable-3DGS.
     """
 
-    def __init__(self, in_dim: int, depth: int, width: int, skip: int | None,
-                 heads: tuple[str, ...], precision: str = "float32"):
+    def __init__(
+        self,
+        in_dim: int,
+        depth: int,
+        width: int,
+        skip: int | None,
+        heads: tuple[str, ...],
+        precision: str = "float32",
+    ):
         super().__init__()
         if precision not in PRECISIONS:
             raise ValueError(f"field precision {precision!r}: use one of {PRECISIONS}")
@@ -49,8 +59,9 @@ class DeformationField(nn.Module):
         self.skip = skip
         layers = []
         for i in range(depth):
-            d_in = in_dim if i == 0 else width + (in_dim if skip is not None and i == skip + 1
-                                                  else 0)
+            d_in = (
+                in_dim if i == 0 else width + (in_dim if skip is not None and i == skip + 1 else 0)
+            )
             layers.append(nn.Linear(d_in, width))
         self.layers = nn.ModuleList(layers)
         self.heads = nn.ModuleDict({h: nn.Linear(width, HEAD_DIMS[h]) for h in heads})
@@ -60,8 +71,9 @@ class DeformationField(nn.Module):
 
     def forward(self, x: torch.Tensor) -> dict[str, torch.Tensor]:  # x [N, in_dim] float32
         h = x
-        with torch.autocast(x.device.type, dtype=torch.bfloat16,
-                            enabled=self.precision == "bfloat16"):
+        with torch.autocast(
+            x.device.type, dtype=torch.bfloat16, enabled=self.precision == "bfloat16"
+        ):
             for i, layer in enumerate(self.layers):
                 h = torch.relu(layer(h))
                 if self.skip is not None and i == self.skip:
@@ -77,10 +89,23 @@ class FieldModel(BaseModel):
     and scale (added to the log-scale) offsets.
     """
 
-    def __init__(self, ctx: ModelContext, canonical_cfg: dict, *, arch: str, pos_bands: int,
-                 time_bands: int, depth: int, width: int, skip: int | None, wind: bool,
-                 window_seconds: float | None, window_values: int | None, name: str,
-                 precision: str = "float32"):
+    def __init__(
+        self,
+        ctx: ModelContext,
+        canonical_cfg: dict,
+        *,
+        arch: str,
+        pos_bands: int,
+        time_bands: int,
+        depth: int,
+        width: int,
+        skip: int | None,
+        wind: bool,
+        window_seconds: float | None,
+        window_values: int | None,
+        name: str,
+        precision: str = "float32",
+    ):
         super().__init__(ctx, canonical_cfg)
         if arch not in ("mlp", "d3dgs"):
             raise ValueError(f"unknown field architecture {arch!r}; use 'mlp' or 'd3dgs'")
@@ -112,8 +137,15 @@ class FieldModel(BaseModel):
         t = torch.tensor([self.t_norm(frame_idx)], dtype=xn.dtype)
         parts = [fourier(xn, self.pos_bands), fourier(t, self.time_bands).expand(n, -1)]
         if self.use_wind:
-            w = wind_window(wind, frame_idx, self.lead_in, self.wind_mean, self.wind_std,
-                            self.window_values, self.window_step)  # [48]
+            w = wind_window(
+                wind,
+                frame_idx,
+                self.lead_in,
+                self.wind_mean,
+                self.wind_std,
+                self.window_values,
+                self.window_step,
+            )  # [48]
             parts.append(w.to(xn.dtype).expand(n, -1))
         return torch.cat(parts, dim=-1)
 
@@ -125,8 +157,13 @@ class FieldModel(BaseModel):
         if "dq" in out:
             quats = quats + out["dq"]
             log_s = log_s + out["ds"]
-        return GaussianState(means, quats, torch.exp(log_s), torch.sigmoid(c.opacity_logits),
-                             torch.sigmoid(c.color_logits))
+        return GaussianState(
+            means,
+            quats,
+            torch.exp(log_s),
+            torch.sigmoid(c.opacity_logits),
+            torch.sigmoid(c.color_logits),
+        )
 
     def deformation_param_groups(self, lr: dict) -> list[dict]:
         return [{"name": "deform", "params": list(self.field.parameters()), "lr": lr["deform"]}]

@@ -3,6 +3,7 @@
 Quaternions are (w, x, y, z) and act on column vectors; they need not be unit (the rasterizer
 normalises), but the helpers here that build rotations return unit quaternions.
 """
+
 from __future__ import annotations
 
 from dataclasses import dataclass
@@ -35,12 +36,15 @@ def quat_multiply(a: torch.Tensor, b: torch.Tensor) -> torch.Tensor:
     """Hamilton product a * b of quaternions [..., 4] (w, x, y, z); rotation b first, then a."""
     aw, ax, ay, az = a.unbind(-1)
     bw, bx, by, bz = b.unbind(-1)
-    return torch.stack([
-        aw * bw - ax * bx - ay * by - az * bz,
-        aw * bx + ax * bw + ay * bz - az * by,
-        aw * by - ax * bz + ay * bw + az * bx,
-        aw * bz + ax * by - ay * bx + az * bw,
-    ], dim=-1)
+    return torch.stack(
+        [
+            aw * bw - ax * bx - ay * by - az * bz,
+            aw * bx + ax * bw + ay * bz - az * by,
+            aw * by - ax * bz + ay * bw + az * bx,
+            aw * bz + ax * by - ay * bx + az * bw,
+        ],
+        dim=-1,
+    )
 
 
 def axis_angle_quat(axis: torch.Tensor, angle: torch.Tensor) -> torch.Tensor:
@@ -64,11 +68,18 @@ def rodrigues_minus_identity(axis: torch.Tensor, angle: torch.Tensor) -> torch.T
 
 def rodrigues(axis: torch.Tensor, angle: torch.Tensor) -> torch.Tensor:
     """Rotation matrices [..., 3, 3] by ``angle`` [...] rad about unit ``axis`` [..., 3]."""
-    return torch.eye(3, dtype=axis.dtype, device=axis.device) + rodrigues_minus_identity(axis, angle)
+    return torch.eye(3, dtype=axis.dtype, device=axis.device) + rodrigues_minus_identity(
+        axis, angle
+    )
 
 
-def rotate_about_pivot(means: torch.Tensor, quats: torch.Tensor, axis: torch.Tensor,
-                       angle: torch.Tensor, pivot: torch.Tensor) -> tuple[torch.Tensor, torch.Tensor]:
+def rotate_about_pivot(
+    means: torch.Tensor,
+    quats: torch.Tensor,
+    axis: torch.Tensor,
+    angle: torch.Tensor,
+    pivot: torch.Tensor,
+) -> tuple[torch.Tensor, torch.Tensor]:
     """Rigidly rotate Gaussians: positions about ``pivot`` and orientations alike.
 
     means [N, 3]; quats [N, 4]; axis [N, 3] unit; angle [N] rad; pivot [N, 3] (per Gaussian,
@@ -113,12 +124,21 @@ class CanonicalGaussians(nn.Module):
     Parameters are stored unactivated (log-scale, opacity and colour logits).
     """
 
-    def __init__(self, xyz: np.ndarray, *, opacity: float = 0.1, color: float = 0.5,
-                 knn: int = 3, scale_factor: float = 1.0):
+    def __init__(
+        self,
+        xyz: np.ndarray,
+        *,
+        opacity: float = 0.1,
+        color: float = 0.5,
+        knn: int = 3,
+        scale_factor: float = 1.0,
+    ):
         super().__init__()
         if not (0 < opacity < 1 and 0 < color < 1):
-            raise ValueError(f"canonical opacity and color must lie in (0, 1); got {opacity}, "
-                             f"{color} (config models.canonical)")
+            raise ValueError(
+                f"canonical opacity and color must lie in (0, 1); got {opacity}, "
+                f"{color} (config models.canonical)"
+            )
         xyz = np.asarray(xyz, dtype=np.float64)
         s = nearest_neighbour_scale(xyz, knn) * scale_factor  # [N]
         n = xyz.shape[0]
@@ -126,8 +146,9 @@ class CanonicalGaussians(nn.Module):
         q = torch.zeros(n, 4)
         q[:, 0] = 1.0
         self.quats = nn.Parameter(q)
-        self.log_scales = nn.Parameter(torch.tensor(np.log(s), dtype=torch.float32)[:, None]
-                                       .repeat(1, 3))
+        self.log_scales = nn.Parameter(
+            torch.tensor(np.log(s), dtype=torch.float32)[:, None].repeat(1, 3)
+        )
         self.opacity_logits = nn.Parameter(torch.full((n,), _logit(opacity)))
         self.color_logits = nn.Parameter(torch.full((n, 3), _logit(color)))
 
@@ -137,5 +158,10 @@ class CanonicalGaussians(nn.Module):
 
     def state(self) -> GaussianState:
         """Activated canonical Gaussians."""
-        return GaussianState(self.means, self.quats, torch.exp(self.log_scales),
-                             torch.sigmoid(self.opacity_logits), torch.sigmoid(self.color_logits))
+        return GaussianState(
+            self.means,
+            self.quats,
+            torch.exp(self.log_scales),
+            torch.sigmoid(self.opacity_logits),
+            torch.sigmoid(self.color_logits),
+        )

@@ -13,6 +13,7 @@ Two paths compute the same numbers:
   to rounding. Wrapped in a torch.autograd.Function.
 - ``backend="reference"``: plain torch operations, differentiated by autograd (slow; for tests).
 """
+
 from __future__ import annotations
 
 import math
@@ -70,10 +71,14 @@ def _rhs(th, w, tho, wo, thz, wz, thg, wg, om, ze, g, u):
     c = 2.0 * ze * om
     o2 = om * om
     return (
-        w, g * u - c * w - o2 * th,
-        wo, -c * wo - o2 * tho - 2.0 * ze * w - 2.0 * om * th,
-        wz, -c * wz - o2 * thz - 2.0 * om * w,
-        wg, -c * wg - o2 * thg + u,
+        w,
+        g * u - c * w - o2 * th,
+        wo,
+        -c * wo - o2 * tho - 2.0 * ze * w - 2.0 * om * th,
+        wz,
+        -c * wz - o2 * thz - 2.0 * om * w,
+        wg,
+        -c * wg - o2 * thg + u,
     )
 
 
@@ -100,26 +105,50 @@ def _rk4_sens_kernel(omega, zeta, gain, u, dt, substeps, theta_out, sens_out):
                 ub = u0 + du * ((s + 0.5) / substeps)
                 uc = u0 + du * ((s + 1.0) / substeps)
                 k1 = _rhs(y[0], y[1], y[2], y[3], y[4], y[5], y[6], y[7], om, ze, g, ua)
-                y2 = (y[0] + 0.5 * h * k1[0], y[1] + 0.5 * h * k1[1], y[2] + 0.5 * h * k1[2],
-                      y[3] + 0.5 * h * k1[3], y[4] + 0.5 * h * k1[4], y[5] + 0.5 * h * k1[5],
-                      y[6] + 0.5 * h * k1[6], y[7] + 0.5 * h * k1[7])
+                y2 = (
+                    y[0] + 0.5 * h * k1[0],
+                    y[1] + 0.5 * h * k1[1],
+                    y[2] + 0.5 * h * k1[2],
+                    y[3] + 0.5 * h * k1[3],
+                    y[4] + 0.5 * h * k1[4],
+                    y[5] + 0.5 * h * k1[5],
+                    y[6] + 0.5 * h * k1[6],
+                    y[7] + 0.5 * h * k1[7],
+                )
                 k2 = _rhs(y2[0], y2[1], y2[2], y2[3], y2[4], y2[5], y2[6], y2[7], om, ze, g, ub)
-                y3 = (y[0] + 0.5 * h * k2[0], y[1] + 0.5 * h * k2[1], y[2] + 0.5 * h * k2[2],
-                      y[3] + 0.5 * h * k2[3], y[4] + 0.5 * h * k2[4], y[5] + 0.5 * h * k2[5],
-                      y[6] + 0.5 * h * k2[6], y[7] + 0.5 * h * k2[7])
+                y3 = (
+                    y[0] + 0.5 * h * k2[0],
+                    y[1] + 0.5 * h * k2[1],
+                    y[2] + 0.5 * h * k2[2],
+                    y[3] + 0.5 * h * k2[3],
+                    y[4] + 0.5 * h * k2[4],
+                    y[5] + 0.5 * h * k2[5],
+                    y[6] + 0.5 * h * k2[6],
+                    y[7] + 0.5 * h * k2[7],
+                )
                 k3 = _rhs(y3[0], y3[1], y3[2], y3[3], y3[4], y3[5], y3[6], y3[7], om, ze, g, ub)
-                y4 = (y[0] + h * k3[0], y[1] + h * k3[1], y[2] + h * k3[2], y[3] + h * k3[3],
-                      y[4] + h * k3[4], y[5] + h * k3[5], y[6] + h * k3[6], y[7] + h * k3[7])
+                y4 = (
+                    y[0] + h * k3[0],
+                    y[1] + h * k3[1],
+                    y[2] + h * k3[2],
+                    y[3] + h * k3[3],
+                    y[4] + h * k3[4],
+                    y[5] + h * k3[5],
+                    y[6] + h * k3[6],
+                    y[7] + h * k3[7],
+                )
                 k4 = _rhs(y4[0], y4[1], y4[2], y4[3], y4[4], y4[5], y4[6], y4[7], om, ze, g, uc)
                 f = h / 6.0
-                y = (y[0] + f * (k1[0] + 2.0 * k2[0] + 2.0 * k3[0] + k4[0]),
-                     y[1] + f * (k1[1] + 2.0 * k2[1] + 2.0 * k3[1] + k4[1]),
-                     y[2] + f * (k1[2] + 2.0 * k2[2] + 2.0 * k3[2] + k4[2]),
-                     y[3] + f * (k1[3] + 2.0 * k2[3] + 2.0 * k3[3] + k4[3]),
-                     y[4] + f * (k1[4] + 2.0 * k2[4] + 2.0 * k3[4] + k4[4]),
-                     y[5] + f * (k1[5] + 2.0 * k2[5] + 2.0 * k3[5] + k4[5]),
-                     y[6] + f * (k1[6] + 2.0 * k2[6] + 2.0 * k3[6] + k4[6]),
-                     y[7] + f * (k1[7] + 2.0 * k2[7] + 2.0 * k3[7] + k4[7]))
+                y = (
+                    y[0] + f * (k1[0] + 2.0 * k2[0] + 2.0 * k3[0] + k4[0]),
+                    y[1] + f * (k1[1] + 2.0 * k2[1] + 2.0 * k3[1] + k4[1]),
+                    y[2] + f * (k1[2] + 2.0 * k2[2] + 2.0 * k3[2] + k4[2]),
+                    y[3] + f * (k1[3] + 2.0 * k2[3] + 2.0 * k3[3] + k4[3]),
+                    y[4] + f * (k1[4] + 2.0 * k2[4] + 2.0 * k3[4] + k4[4]),
+                    y[5] + f * (k1[5] + 2.0 * k2[5] + 2.0 * k3[5] + k4[5]),
+                    y[6] + f * (k1[6] + 2.0 * k2[6] + 2.0 * k3[6] + k4[6]),
+                    y[7] + f * (k1[7] + 2.0 * k2[7] + 2.0 * k3[7] + k4[7]),
+                )
             theta_out[k, j + 1] = y[0]
             sens_out[0, k, j + 1] = y[2]
             sens_out[1, k, j + 1] = y[4]
@@ -174,9 +203,18 @@ def _reference(omega, zeta, gain, u, dt, substeps):
     return torch.stack(out, dim=1)
 
 
-def integrate(omega: torch.Tensor, zeta: torch.Tensor, gain: torch.Tensor, wind, vbar: float,
-              dt: float, substeps: int, *, guard: float = STABILITY_GUARD,
-              backend: str = "fast") -> torch.Tensor:
+def integrate(
+    omega: torch.Tensor,
+    zeta: torch.Tensor,
+    gain: torch.Tensor,
+    wind,
+    vbar: float,
+    dt: float,
+    substeps: int,
+    *,
+    guard: float = STABILITY_GUARD,
+    backend: str = "fast",
+) -> torch.Tensor:
     """Swing angles of K wind-driven damped oscillators, from rest at wind sample 0.
 
     omega [K] rad/s (> 0), zeta [K] (dimensionless), gain [K] (rad / m^2), torch tensors;
@@ -207,13 +245,19 @@ def integrate(omega: torch.Tensor, zeta: torch.Tensor, gain: torch.Tensor, wind,
         return omega.new_zeros((0, w.shape[0]))
     om_min, ze_min = float(omega.detach().min()), float(zeta.detach().min())
     if not om_min > 0:
-        raise ValueError(f"integrate: omega must be > 0 rad/s; got min {om_min}"
-                         + (" (NaN: a parameter upstream is NaN)" if math.isnan(om_min) else ""))
+        raise ValueError(
+            f"integrate: omega must be > 0 rad/s; got min {om_min}"
+            + (" (NaN: a parameter upstream is NaN)" if math.isnan(om_min) else "")
+        )
     if not ze_min >= 0:
-        raise ValueError(f"integrate: zeta must be >= 0; got min {ze_min}"
-                         + (" (NaN: a parameter upstream is NaN)" if math.isnan(ze_min) else ""))
+        raise ValueError(
+            f"integrate: zeta must be >= 0; got min {ze_min}"
+            + (" (NaN: a parameter upstream is NaN)" if math.isnan(ze_min) else "")
+        )
     # Guard the fastest eigenvalue, not omega alone: an over-damped part's stiff pole is faster.
-    rates = fastest_rate(omega.detach().cpu().double().numpy(), zeta.detach().cpu().double().numpy())
+    rates = fastest_rate(
+        omega.detach().cpu().double().numpy(), zeta.detach().cpu().double().numpy()
+    )
     i = int(np.argmax(rates))
     rate, om_i, ze_i = float(rates[i]), float(omega.detach()[i]), float(zeta.detach()[i])
     h = dt / substeps

@@ -16,6 +16,7 @@ Parameterisation (all bounded or normalised so one Adam rate suits every tree):
   motion the camera sees best) and is learned;
 - pivot (world units), initialised at the part's member nearest the base of the tree.
 """
+
 from __future__ import annotations
 
 import math
@@ -49,20 +50,35 @@ class OscillatorPrior(BaseModel):
 
     name = "ours"
 
-    def __init__(self, ctx: ModelContext, canonical_cfg: dict, *, K: int, omega_hz: list,
-                 zeta: list, omega_init_hz: float, zeta_init: float, substeps: int,
-                 rk4_guard: float = STABILITY_GUARD, kmeans_n_init: int = 4, seed: int = 0,
-                 labels: np.ndarray | None = None):
+    def __init__(
+        self,
+        ctx: ModelContext,
+        canonical_cfg: dict,
+        *,
+        K: int,
+        omega_hz: list,
+        zeta: list,
+        omega_init_hz: float,
+        zeta_init: float,
+        substeps: int,
+        rk4_guard: float = STABILITY_GUARD,
+        kmeans_n_init: int = 4,
+        seed: int = 0,
+        labels: np.ndarray | None = None,
+    ):
         super().__init__(ctx, canonical_cfg)
         lo, hi = (2 * math.pi * float(f) for f in omega_hz)
         zlo, zhi = (float(z) for z in zeta)
         w0 = 2 * math.pi * float(omega_init_hz)
         if not (0 < lo < w0 < hi):
-            raise ValueError(f"models.ours needs 0 < omega_hz[0] < omega_init_hz < omega_hz[1]; "
-                             f"got {omega_hz}, {omega_init_hz}")
+            raise ValueError(
+                f"models.ours needs 0 < omega_hz[0] < omega_init_hz < omega_hz[1]; "
+                f"got {omega_hz}, {omega_init_hz}"
+            )
         if not (0 < zlo < zeta_init < zhi):
-            raise ValueError(f"models.ours needs 0 < zeta[0] < zeta_init < zeta[1]; got {zeta}, "
-                             f"{zeta_init}")
+            raise ValueError(
+                f"models.ours needs 0 < zeta[0] < zeta_init < zeta[1]; got {zeta}, {zeta_init}"
+            )
         self.omega_lo, self.omega_hi, self.zeta_lo, self.zeta_hi = lo, hi, zlo, zhi
         self.dt = 1.0 / ctx.fps
         self.vbar_ratio = float(ctx.vbar_ratio)
@@ -76,8 +92,9 @@ class OscillatorPrior(BaseModel):
             raise ValueError(f"part labels must be [N] in [0, K={K}); got shape {labels.shape}")
         self.K = K
         self.register_buffer("part_labels", torch.tensor(labels))
-        self.omega_raw = nn.Parameter(torch.full(
-            (K,), _logit((math.log(w0) - math.log(lo)) / (math.log(hi) - math.log(lo)))))
+        self.omega_raw = nn.Parameter(
+            torch.full((K,), _logit((math.log(w0) - math.log(lo)) / (math.log(hi) - math.log(lo))))
+        )
         self.zeta_raw = nn.Parameter(torch.full((K,), _logit((zeta_init - zlo) / (zhi - zlo))))
         self.gain_raw = nn.Parameter(torch.zeros(K))
         self.register_buffer("gain_scale", torch.tensor(w0**2 / ctx.wind_force_std))
@@ -140,8 +157,9 @@ class OscillatorPrior(BaseModel):
         if wind.ndim != 1:
             raise ValueError(f"part_theta: wind must be [L+F], got shape {tuple(wind.shape)}")
         vbar = self.vbar_ratio * float(wind.mean())
-        theta = integrate(self.omega, self.zeta, self.gain, wind, vbar, self.dt,
-                          self.substeps, guard=self.guard)  # [K, L+F]
+        theta = integrate(
+            self.omega, self.zeta, self.gain, wind, vbar, self.dt, self.substeps, guard=self.guard
+        )  # [K, L+F]
         if not bool(self.frozen.any()):
             return theta
         # where(), not a product: frozen rows get exactly zero gradient, so with their Adam
@@ -152,14 +170,23 @@ class OscillatorPrior(BaseModel):
         theta = self.part_theta(wind)[:, self.lead_in + frame_idx]  # [K]
         lab = self.part_labels
         c = self.canonical
-        means, quats = rotate_about_pivot(c.means, c.quats, self.axis[lab], theta[lab],
-                                          self.pivot[lab])
-        return GaussianState(means, quats, torch.exp(c.log_scales),
-                             torch.sigmoid(c.opacity_logits), torch.sigmoid(c.color_logits))
+        means, quats = rotate_about_pivot(
+            c.means, c.quats, self.axis[lab], theta[lab], self.pivot[lab]
+        )
+        return GaussianState(
+            means,
+            quats,
+            torch.exp(c.log_scales),
+            torch.sigmoid(c.opacity_logits),
+            torch.sigmoid(c.color_logits),
+        )
 
     def deformation_param_groups(self, lr: dict) -> list[dict]:
         return [
-            {"name": "physics", "params": [self.omega_raw, self.zeta_raw, self.gain_raw,
-                                           self.axis_raw], "lr": lr["physics"]},
+            {
+                "name": "physics",
+                "params": [self.omega_raw, self.zeta_raw, self.gain_raw, self.axis_raw],
+                "lr": lr["physics"],
+            },
             {"name": "pivot", "params": [self.pivot], "lr": lr["pivot"] * self.extent},
         ]

@@ -1,4 +1,5 @@
 """Rigid parts of the oscillator prior: k-means on canonical positions."""
+
 from __future__ import annotations
 
 import warnings

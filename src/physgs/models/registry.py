@@ -13,6 +13,7 @@ statistics), the state dict and the training statistics.
 The ids and labels import nothing heavy: the workflow reads them to plan jobs. The model classes
 and torch load inside the functions that build, save or read a model.
 """
+
 from __future__ import annotations
 
 from dataclasses import dataclass
@@ -26,6 +27,7 @@ from physgs.atomic import atomic_path
 
 if TYPE_CHECKING:
     from physgs.models.base import BaseModel
+
 
 @dataclass(frozen=True)
 class ModelSpec:
@@ -71,8 +73,9 @@ def spec_of(model: str) -> ModelSpec:
     """The ModelSpec of a method or reference id (ValueError naming the valid ids)."""
     spec = MODELS.get(model) or REFERENCES.get(model)
     if spec is None:
-        raise ValueError(f"unknown model {model!r}; choose one of {MODEL_NAMES} or a reference "
-                         f"{REFERENCE_NAMES}")
+        raise ValueError(
+            f"unknown model {model!r}; choose one of {MODEL_NAMES} or a reference {REFERENCE_NAMES}"
+        )
     return spec
 
 
@@ -118,8 +121,17 @@ def model_settings(models_cfg: dict, model: str) -> dict:
     return out
 
 
-def build_model(name: str, observed, cfg: dict, *, config: str = BASE_CONFIG, K: int | None = None,
-                seed: int = 0, labels: np.ndarray | None = None, truth=None) -> BaseModel:
+def build_model(
+    name: str,
+    observed,
+    cfg: dict,
+    *,
+    config: str = BASE_CONFIG,
+    K: int | None = None,
+    seed: int = 0,
+    labels: np.ndarray | None = None,
+    truth=None,
+) -> BaseModel:
     """A freshly initialised model.
 
     name: one of MODEL_NAMES or REFERENCE_NAMES; observed: a testbed ``Observed`` or a
@@ -138,22 +150,30 @@ def build_model(name: str, observed, cfg: dict, *, config: str = BASE_CONFIG, K:
 
     spec_of(name)
     if name != "ours" and config != BASE_CONFIG:
-        raise ValueError(f"model {name!r} is not trained in configuration {config!r}; valid: "
-                         f"('{BASE_CONFIG}',) (joint configurations are ours only)")
+        raise ValueError(
+            f"model {name!r} is not trained in configuration {config!r}; valid: "
+            f"('{BASE_CONFIG}',) (joint configurations are ours only)"
+        )
     if truth is not None and not is_reference(name):
-        raise ValueError(f"model {name!r} is a method: it may not read the ground truth "
-                         f"(truth.npz); only the references {REFERENCE_NAMES} do")
+        raise ValueError(
+            f"model {name!r} is a method: it may not read the ground truth "
+            f"(truth.npz); only the references {REFERENCE_NAMES} do"
+        )
     ctx = observed if isinstance(observed, ModelContext) else context_from_observed(observed)
     canon = dict(cfg["canonical"])
     if is_reference(name):
         if truth is None:
-            raise ValueError(f"the reference {name!r} moves the Gaussians by the ground truth: it "
-                             "needs the dataset's truth.npz (pass truth=load_truth(<tree>/"
-                             "truth.npz)); the dataset has no truth file or none was given")
+            raise ValueError(
+                f"the reference {name!r} moves the Gaussians by the ground truth: it "
+                "needs the dataset's truth.npz (pass truth=load_truth(<tree>/"
+                "truth.npz)); the dataset has no truth file or none was given"
+            )
         if not isinstance(truth, TrueMotion):
             if isinstance(observed, ModelContext):
-                raise ValueError(f"building {name!r} from truth.npz needs the Observed dataset "
-                                 "(its per-condition winds), not a ModelContext")
+                raise ValueError(
+                    f"building {name!r} from truth.npz needs the Observed dataset "
+                    "(its per-condition winds), not a ModelContext"
+                )
             truth = TrueMotion.from_truth(truth, observed)
         return TruthMotionModel(ctx, canon, truth)
     family = MODELS[name].family
@@ -162,27 +182,57 @@ def build_model(name: str, observed, cfg: dict, *, config: str = BASE_CONFIG, K:
     if family in FIELDS:
         a = cfg[family]
         ww = cfg["wind_window"] if MODELS[name].wind else {"seconds": None, "values": None}
-        return FieldModel(ctx, canon, arch=family, pos_bands=a["pos_bands"],
-                          time_bands=a["time_bands"], depth=a["depth"], width=a["width"],
-                          skip=a.get("skip"), wind=MODELS[name].wind,
-                          window_seconds=ww["seconds"], window_values=ww["values"], name=name,
-                          precision=a.get("precision", "float32"))
+        return FieldModel(
+            ctx,
+            canon,
+            arch=family,
+            pos_bands=a["pos_bands"],
+            time_bands=a["time_bands"],
+            depth=a["depth"],
+            width=a["width"],
+            skip=a.get("skip"),
+            wind=MODELS[name].wind,
+            window_seconds=ww["seconds"],
+            window_values=ww["values"],
+            name=name,
+            precision=a.get("precision", "float32"),
+        )
     if K is None:
         spec = cfg.get("configs", {}).get(config)
         if spec is None:
-            raise ValueError(f"ours has no configuration {config!r} and no K was given; valid: "
-                             f"{sorted(cfg.get('configs', {}))}")
+            raise ValueError(
+                f"ours has no configuration {config!r} and no K was given; valid: "
+                f"{sorted(cfg.get('configs', {}))}"
+            )
         K = spec["K"]
     o = cfg["ours"]
-    return OscillatorPrior(ctx, canon, K=int(K), omega_hz=o["omega_hz"],
-                           zeta=o["zeta"], omega_init_hz=o["omega_init_hz"],
-                           zeta_init=o["zeta_init"], substeps=o["substeps"],
-                           rk4_guard=o["rk4_guard"], kmeans_n_init=o["kmeans_n_init"], seed=seed,
-                           labels=labels)
+    return OscillatorPrior(
+        ctx,
+        canon,
+        K=int(K),
+        omega_hz=o["omega_hz"],
+        zeta=o["zeta"],
+        omega_init_hz=o["omega_init_hz"],
+        zeta_init=o["zeta_init"],
+        substeps=o["substeps"],
+        rk4_guard=o["rk4_guard"],
+        kmeans_n_init=o["kmeans_n_init"],
+        seed=seed,
+        labels=labels,
+    )
 
 
-def save_checkpoint(path, model: BaseModel, *, name: str, config: str, seed: int,
-                    models_cfg: dict, train_cfg: dict, stats: dict) -> None:
+def save_checkpoint(
+    path,
+    model: BaseModel,
+    *,
+    name: str,
+    config: str,
+    seed: int,
+    models_cfg: dict,
+    train_cfg: dict,
+    stats: dict,
+) -> None:
     """Write the checkpoint atomically (temporary file in the same folder, then rename).
 
     models_cfg: the settings the model was built from (``model_settings`` or the whole
@@ -193,9 +243,16 @@ def save_checkpoint(path, model: BaseModel, *, name: str, config: str, seed: int
     path = Path(path)
     path.parent.mkdir(parents=True, exist_ok=True)
     blob = {
-        "format": FORMAT, "model": name, "config": config, "seed": int(seed),
-        "K": int(model.K) if hasattr(model, "K") else None, "models_cfg": models_cfg, "train_cfg": train_cfg, "context": model.ctx.to_dict(),
-        "state_dict": model.state_dict(), "stats": stats,
+        "format": FORMAT,
+        "model": name,
+        "config": config,
+        "seed": int(seed),
+        "K": int(model.K) if hasattr(model, "K") else None,
+        "models_cfg": models_cfg,
+        "train_cfg": train_cfg,
+        "context": model.ctx.to_dict(),
+        "state_dict": model.state_dict(),
+        "stats": stats,
     }
     with atomic_path(path) as tmp:
         torch.save(blob, tmp)
@@ -208,12 +265,14 @@ def read_checkpoint(path) -> dict:
     path = Path(path)
     if not path.is_file():
         raise FileNotFoundError(
-            f"no checkpoint at {path}; train it first (snakemake --cores 2 {path})")
+            f"no checkpoint at {path}; train it first (snakemake --cores 2 {path})"
+        )
     try:
         blob = torch.load(path, map_location="cpu", weights_only=True)
     except Exception as e:  # noqa: BLE001 - any unpickling failure means a corrupt file
-        raise ValueError(f"checkpoint {path} is corrupt or not a physgs checkpoint ({e}); delete "
-                         "it and retrain") from None
+        raise ValueError(
+            f"checkpoint {path} is corrupt or not a physgs checkpoint ({e}); delete it and retrain"
+        ) from None
     if not isinstance(blob, dict) or blob.get("format") != FORMAT:
         raise ValueError(f"{path} is not a {FORMAT} checkpoint; delete it and retrain")
     return blob
@@ -232,11 +291,19 @@ def load_checkpoint(path) -> BaseModel:
     labels = sd["part_labels"].numpy() if "part_labels" in sd else None
     # a reference's motion is in its own buffers: no truth.npz needed to reload it
     motion = TrueMotion.from_state_dict(sd) if is_reference(blob["model"]) else None
-    model = build_model(blob["model"], ModelContext.from_dict(blob["context"]), blob["models_cfg"],
-                        config=blob["config"], K=blob["K"], seed=blob["seed"], labels=labels,
-                        truth=motion)
+    model = build_model(
+        blob["model"],
+        ModelContext.from_dict(blob["context"]),
+        blob["models_cfg"],
+        config=blob["config"],
+        K=blob["K"],
+        seed=blob["seed"],
+        labels=labels,
+        truth=motion,
+    )
     model.load_state_dict(sd, strict=True)
     model.eval()
-    model.checkpoint_info = {k: blob[k] for k in ("model", "config", "seed", "stats",
-                                                  "models_cfg", "train_cfg")}
+    model.checkpoint_info = {
+        k: blob[k] for k in ("model", "config", "seed", "stats", "models_cfg", "train_cfg")
+    }
     return model

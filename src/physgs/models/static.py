@@ -1,4 +1,5 @@
 """Static pose: the canonical set alone, the floor every model must clear."""
+
 from __future__ import annotations
 
 import torch

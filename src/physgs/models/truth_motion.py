@@ -25,6 +25,7 @@ index; the model finds the condition by matching that wind against the per-condi
 stores (the recorded ones only: a wind that matches none raises ``ValueError``). What it needs is
 stored as buffers (``TrueMotion``), so a checkpoint reloads without ``truth.npz``.
 """
+
 from __future__ import annotations
 
 from dataclasses import dataclass
@@ -81,29 +82,39 @@ class TrueMotion:
         gv = np.asarray(truth.gaussian_vertex, dtype=np.int64)
         problems = []
         if theta.ndim != 3 or theta.shape[:2] != wind.shape:
-            problems.append(f"theta has shape {theta.shape}, the observed wind {wind.shape} "
-                            "(expected [C, L+F, B] with the same C and L+F)")
+            problems.append(
+                f"theta has shape {theta.shape}, the observed wind {wind.shape} "
+                "(expected [C, L+F, B] with the same C and L+F)"
+            )
         if int(getattr(truth, "lead_in_frames", L)) != L:
             problems.append(f"lead-in {truth.lead_in_frames} frames, observed {L}")
         if gv.shape != (xyz.shape[0],):
-            problems.append(f"{gv.shape[0]} Gaussians in gaussian_vertex, {xyz.shape[0]} in "
-                            "canonical_xyz")
+            problems.append(
+                f"{gv.shape[0]} Gaussians in gaussian_vertex, {xyz.shape[0]} in canonical_xyz"
+            )
         if not problems:
             posed = kinematics.pose_gaussians(truth, theta[0, L])  # [N, 3] canonical pose
             err = float(np.abs(posed - xyz).max())
             if not err <= CANONICAL_TOL_M:
-                problems.append(f"canonical_xyz lies up to {err:.3g} m from the truth's pose at "
-                                "frame 0 of the training condition")
+                problems.append(
+                    f"canonical_xyz lies up to {err:.3g} m from the truth's pose at "
+                    "frame 0 of the training condition"
+                )
         if problems:
-            raise ValueError("truth_motion: truth.npz does not belong to this observed.npz ("
-                             + "; ".join(problems) + "); build both with the same testbed rule")
+            raise ValueError(
+                "truth_motion: truth.npz does not belong to this observed.npz ("
+                + "; ".join(problems)
+                + "); build both with the same testbed rule"
+            )
         axis = np.asarray(truth.swing_axis, dtype=np.float64)
         return TrueMotion(
             theta=np.ascontiguousarray(theta[:, L:]),
             bone_head=np.asarray(truth.bone_head, dtype=np.float64),
             bone_parent=np.asarray(truth.bone_parent, dtype=np.int64),
             swing_axis=axis / np.linalg.norm(axis),
-            gaussian_bone=np.asarray(truth.vertex_bone, dtype=np.int64)[gv], winds=wind)
+            gaussian_bone=np.asarray(truth.vertex_bone, dtype=np.int64)[gv],
+            winds=wind,
+        )
 
     @staticmethod
     def from_state_dict(sd: dict, prefix: str = "") -> "TrueMotion":
@@ -130,13 +141,20 @@ class TruthMotionModel(BaseModel):
         gb = torch.as_tensor(np.asarray(m.gaussian_bone, dtype=np.int64))
         parent = np.asarray(m.bone_parent, dtype=np.int64)
         head = np.asarray(m.bone_head, dtype=np.float64)
-        if (winds.shape != (C, self.lead_in + F) or gb.shape != (N,) or head.shape != (B, 3)
-                or parent.shape != (B,) or int(gb.min()) < 0 or int(gb.max()) >= B):
+        if (
+            winds.shape != (C, self.lead_in + F)
+            or gb.shape != (N,)
+            or head.shape != (B, 3)
+            or parent.shape != (B,)
+            or int(gb.min()) < 0
+            or int(gb.max()) >= B
+        ):
             raise ValueError(
                 f"truth_motion: inconsistent motion (theta {tuple(theta.shape)} [C, F, B], winds "
                 f"{tuple(winds.shape)} [C, L+F] with L = {self.lead_in}, gaussian_bone "
                 f"{tuple(gb.shape)} [N = {N}] in [0, B), bone_head {head.shape}, bone_parent "
-                f"{parent.shape})")
+                f"{parent.shape})"
+            )
         self.register_buffer("theta", theta)
         self.register_buffer("bone_head", torch.as_tensor(head))
         self.register_buffer("bone_parent", torch.as_tensor(parent))
@@ -159,15 +177,18 @@ class TruthMotionModel(BaseModel):
         """The recorded condition whose observed wind [L+F] this is (ValueError if none)."""
         w = torch.as_tensor(wind, dtype=torch.float32, device=self.winds.device)
         if w.shape != self.winds.shape[1:]:
-            raise ValueError(f"truth_motion: wind has {tuple(w.shape)} columns, the recorded "
-                             f"conditions {self.winds.shape[1]}; it replays only those")
+            raise ValueError(
+                f"truth_motion: wind has {tuple(w.shape)} columns, the recorded "
+                f"conditions {self.winds.shape[1]}; it replays only those"
+            )
         gap = (self.winds - w).abs().amax(dim=1)  # [C] m/s
         c = int(torch.argmin(gap))
         if not float(gap[c]) <= WIND_MATCH_TOL:
             raise ValueError(
                 f"truth_motion: the wind matches none of the {self.n_conditions} recorded "
                 f"conditions (nearest: condition {c}, max |difference| {float(gap[c]):.3g} m/s "
-                f"> {WIND_MATCH_TOL:g}); the true motion is known for the recorded winds only")
+                f"> {WIND_MATCH_TOL:g}); the true motion is known for the recorded winds only"
+            )
         return c
 
     def bone_motion(self, frame_idx: int, condition: int) -> tuple[torch.Tensor, torch.Tensor]:
@@ -186,6 +207,10 @@ class TruthMotionModel(BaseModel):
         # x' = H(j) + R (x - H(0)) = x + dHead + (R - I)(x - H(0)): exactly x when nothing moves
         means = x + shift + (rodrigues_minus_identity(axis, angle) @ (x - pivot)[..., None])[..., 0]
         quats = quat_multiply(axis_angle_quat(axis, angle), cn.quats.double())
-        return GaussianState(means.to(cn.means.dtype), quats.to(cn.quats.dtype),
-                             torch.exp(cn.log_scales), torch.sigmoid(cn.opacity_logits),
-                             torch.sigmoid(cn.color_logits))
+        return GaussianState(
+            means.to(cn.means.dtype),
+            quats.to(cn.quats.dtype),
+            torch.exp(cn.log_scales),
+            torch.sigmoid(cn.opacity_logits),
+            torch.sigmoid(cn.color_logits),
+        )

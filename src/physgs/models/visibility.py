@@ -15,6 +15,7 @@ the gains have grown. ``probe_rad`` instead rotates every part by a fixed angle:
 geometric check (a part whose members sit near its pivot or move along the viewing ray is
 invisible whatever its gain), usable on an untrained model whose theta is still zero.
 """
+
 from __future__ import annotations
 
 import numpy as np
@@ -26,8 +27,9 @@ from physgs.models.gaussians import rotate_about_pivot
 PART_PARAMS = ("omega_raw", "zeta_raw", "gain_raw", "axis_raw", "pivot")
 
 
-def part_image_swing(model, observed, *, condition: int = 0, frames=None,
-                     probe_rad: float | None = None) -> np.ndarray:
+def part_image_swing(
+    model, observed, *, condition: int = 0, frames=None, probe_rad: float | None = None
+) -> np.ndarray:
     """[K] largest image displacement (pixels, training camera) of each part's Gaussians.
 
     model: an oscillator prior (``part_theta``, ``part_labels`` [N], ``axis`` [K, 3],
@@ -66,8 +68,9 @@ def part_image_swing(model, observed, *, condition: int = 0, frames=None,
     return swing
 
 
-def freeze_invisible(model, observed, threshold_px: float, *, optimizer=None,
-                     probe_rad: float | None = None) -> dict:
+def freeze_invisible(
+    model, observed, threshold_px: float, *, optimizer=None, probe_rad: float | None = None
+) -> dict:
     """Freeze every part whose image swing is below ``threshold_px`` pixels.
 
     Also clears the Adam first moments of the frozen rows in ``optimizer`` (if given): their
@@ -106,7 +109,8 @@ def freeze_schedule(models_cfg: dict, train_cfg: dict) -> int | None:
         raise ValueError(
             f"models.ours.freeze_at = {at} puts freezing at iteration {it}, outside the "
             f"deformation phase ({warmup}, {iterations}); choose freeze_at in "
-            f"({warmup / iterations:.3g}, 1) or set freeze_below_px: 0 to turn freezing off")
+            f"({warmup / iterations:.3g}, 1) or set freeze_below_px: 0 to turn freezing off"
+        )
     return it
 
 
@@ -120,7 +124,10 @@ def freeze_callback(observed, models_cfg: dict, train_cfg: dict):
     def on_iteration(it, model, optimizer):
         if it != at:
             return None
-        return {"frozen_at": it, "freeze_below_px": thr,
-                **freeze_invisible(model, observed, thr, optimizer=optimizer)}
+        return {
+            "frozen_at": it,
+            "freeze_below_px": thr,
+            **freeze_invisible(model, observed, thr, optimizer=optimizer),
+        }
 
     return on_iteration

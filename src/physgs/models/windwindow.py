@@ -3,6 +3,7 @@
 Wind series are indexed by column: column ``lead_in + j`` holds recorded frame j (0-based), so a
 window near the start of the recording reads back into the lead-in.
 """
+
 from __future__ import annotations
 
 import numpy as np
@@ -39,8 +40,15 @@ def window_columns(frame_idx: int, lead_in: int, n_values: int, step: int) -> np
     return cols
 
 
-def wind_window(wind: torch.Tensor, frame_idx: int, lead_in: int, mean: float, std: float,
-                n_values: int, step: int) -> torch.Tensor:
+def wind_window(
+    wind: torch.Tensor,
+    frame_idx: int,
+    lead_in: int,
+    mean: float,
+    std: float,
+    n_values: int,
+    step: int,
+) -> torch.Tensor:
     """Standardised raw-speed history [n_values] ending at frame ``frame_idx``.
 
     wind [L+F] m/s of one condition; mean, std: m/s, the TRAINING condition's statistics (so a

@@ -4,6 +4,7 @@ Ground truth is a constant damping ratio, i.e. gamma = zeta * omega (slope zeta,
 exponent 1). A model that fits a frequency-independent decay *rate* instead shows slope ~ 0
 and log-log exponent ~ 0 (the paper's finding).
 """
+
 from __future__ import annotations
 
 from dataclasses import asdict, dataclass
@@ -30,17 +31,27 @@ class DampingResult:
     zeta_true: float
 
     def to_dict(self) -> dict:
-        return {k: (v.tolist() if isinstance(v, np.ndarray) else v) for k, v in asdict(self).items()}
+        return {
+            k: (v.tolist() if isinstance(v, np.ndarray) else v) for k, v in asdict(self).items()
+        }
 
     @staticmethod
     def from_dict(d: dict) -> "DampingResult":
-        return DampingResult(np.asarray(d["zeta"]), np.asarray(d["omega"]), np.asarray(d["gamma"]),
-                             float(d["median_zeta"]), float(d["slope"]), float(d["intercept"]),
-                             float(d["loglog_exponent"]), float(d["zeta_true"]))
+        return DampingResult(
+            np.asarray(d["zeta"]),
+            np.asarray(d["omega"]),
+            np.asarray(d["gamma"]),
+            float(d["median_zeta"]),
+            float(d["slope"]),
+            float(d["intercept"]),
+            float(d["loglog_exponent"]),
+            float(d["zeta_true"]),
+        )
 
 
-def damping_summary(omega_hat: np.ndarray, zeta_hat: np.ndarray, zeta_true: float,
-                    mask: np.ndarray | None = None) -> DampingResult:
+def damping_summary(
+    omega_hat: np.ndarray, zeta_hat: np.ndarray, zeta_true: float, mask: np.ndarray | None = None
+) -> DampingResult:
     """Summarise recovered damping over the parts selected by ``mask`` [K] (default: all).
 
     omega_hat [K] rad/s, zeta_hat [K] dimensionless, zeta_true the testbed's constant ratio.
@@ -62,5 +73,13 @@ def damping_summary(omega_hat: np.ndarray, zeta_hat: np.ndarray, zeta_true: floa
         expo = np.polyfit(np.log(omega), np.log(gamma), 1)[0]
     else:
         slope = intercept = expo = float("nan")
-    return DampingResult(zeta, omega, gamma, float(np.median(zeta)), float(slope), float(intercept),
-                         float(expo), float(zeta_true))
+    return DampingResult(
+        zeta,
+        omega,
+        gamma,
+        float(np.median(zeta)),
+        float(slope),
+        float(intercept),
+        float(expo),
+        float(zeta_true),
+    )

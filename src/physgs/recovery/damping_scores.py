@@ -17,6 +17,7 @@ The untrained null replaces zeta_hat by log-uniform draws from the testbed's zet
 scores them the same way against the same matching (same bones, same trusted parts, same
 omega_hat): a model that does not beat it has not recovered damping.
 """
+
 from __future__ import annotations
 
 import zlib
@@ -58,8 +59,13 @@ class DampingScores:
 
     @staticmethod
     def from_dict(d: dict) -> "DampingScores":
-        return DampingScores(int(d["n_trusted"]), *(float(d[k]) for k in (
-            "median_rel_err", "log_corr", "gamma_exponent", "gamma_exponent_true")))
+        return DampingScores(
+            int(d["n_trusted"]),
+            *(
+                float(d[k])
+                for k in ("median_rel_err", "log_corr", "gamma_exponent", "gamma_exponent_true")
+            ),
+        )
 
 
 def _positive(name: str, x) -> np.ndarray:
@@ -90,9 +96,14 @@ def log_correlation(zeta_hat: np.ndarray, zeta_true: np.ndarray) -> float:
     return float(pearson_matrix(x[None], y[None])[0, 0])
 
 
-def damping_scores(bone: np.ndarray, trusted: np.ndarray, zeta_hat: np.ndarray,
-                   omega_hat: np.ndarray, zeta_bones: np.ndarray,
-                   omega_bones: np.ndarray) -> DampingScores:
+def damping_scores(
+    bone: np.ndarray,
+    trusted: np.ndarray,
+    zeta_hat: np.ndarray,
+    omega_hat: np.ndarray,
+    zeta_bones: np.ndarray,
+    omega_bones: np.ndarray,
+) -> DampingScores:
     """Score zeta_hat over the trusted parts of a matching.
 
     bone [K] int: the bone each part is matched to; trusted [K] bool (``MatchResult.bone`` and
@@ -106,24 +117,31 @@ def damping_scores(bone: np.ndarray, trusted: np.ndarray, zeta_hat: np.ndarray,
     omega_bones = _positive("omega_bones", omega_bones)
     K, B = len(bone), len(zeta_bones)
     if trusted.shape != (K,) or zeta_hat.shape != (K,) or omega_hat.shape != (K,):
-        raise ValueError(f"bone {bone.shape}, trusted {trusted.shape}, zeta_hat {zeta_hat.shape} "
-                         f"and omega_hat {omega_hat.shape} must all be [K]")
+        raise ValueError(
+            f"bone {bone.shape}, trusted {trusted.shape}, zeta_hat {zeta_hat.shape} "
+            f"and omega_hat {omega_hat.shape} must all be [K]"
+        )
     if omega_bones.shape != (B,) or np.any((bone < 0) | (bone >= B)):
-        raise ValueError(f"zeta_bones {zeta_bones.shape} / omega_bones {omega_bones.shape} do not "
-                         f"cover the matched bone indices (0..{bone.max() if K else -1})")
+        raise ValueError(
+            f"zeta_bones {zeta_bones.shape} / omega_bones {omega_bones.shape} do not "
+            f"cover the matched bone indices (0..{bone.max() if K else -1})"
+        )
     b = bone[trusted]
     zh, oh, zt, ot = zeta_hat[trusted], omega_hat[trusted], zeta_bones[b], omega_bones[b]
     n = int(trusted.sum())
     med = float(np.median(np.abs(zh - zt) / zt)) if n else float("nan")
-    return DampingScores(n, med, log_correlation(zh, zt), loglog_exponent(oh, zh * oh),
-                         loglog_exponent(ot, zt * ot))
+    return DampingScores(
+        n, med, log_correlation(zh, zt), loglog_exponent(oh, zh * oh), loglog_exponent(ot, zt * ot)
+    )
 
 
-def score_match(match, zeta_hat: np.ndarray, zeta_bones: np.ndarray,
-                omega_bones: np.ndarray) -> DampingScores:
+def score_match(
+    match, zeta_hat: np.ndarray, zeta_bones: np.ndarray, omega_bones: np.ndarray
+) -> DampingScores:
     """``damping_scores`` of a ``MatchResult`` (its bones, trusted parts and omega_hat)."""
-    return damping_scores(match.bone, match.trusted, zeta_hat, match.omega_hat, zeta_bones,
-                          omega_bones)
+    return damping_scores(
+        match.bone, match.trusted, zeta_hat, match.omega_hat, zeta_bones, omega_bones
+    )
 
 
 # --------------------------------------------------------------------------------------------
@@ -171,23 +189,43 @@ class DampingNull:
         return self._median(self.gamma_exponent)
 
     def to_dict(self) -> dict:
-        return {k: (v.tolist() if isinstance(v, np.ndarray) else v) for k, v in asdict(self).items()}
+        return {
+            k: (v.tolist() if isinstance(v, np.ndarray) else v) for k, v in asdict(self).items()
+        }
 
     @staticmethod
     def from_dict(d: dict) -> "DampingNull":
-        return DampingNull(*(np.asarray(d[k], float) for k in
-                             ("median_rel_err", "log_corr", "gamma_exponent", "zeta")),
-                           int(d["n_trusted"]), int(d["seed"]))
+        return DampingNull(
+            *(
+                np.asarray(d[k], float)
+                for k in ("median_rel_err", "log_corr", "gamma_exponent", "zeta")
+            ),
+            int(d["n_trusted"]),
+            int(d["seed"]),
+        )
 
 
-def damping_null(bone: np.ndarray, trusted: np.ndarray, omega_hat: np.ndarray,
-                 zeta_bones: np.ndarray, omega_bones: np.ndarray, zeta_range, *, seed: int,
-                 n_draws: int = N_DRAWS) -> DampingNull:
+def damping_null(
+    bone: np.ndarray,
+    trusted: np.ndarray,
+    omega_hat: np.ndarray,
+    zeta_bones: np.ndarray,
+    omega_bones: np.ndarray,
+    zeta_range,
+    *,
+    seed: int,
+    n_draws: int = N_DRAWS,
+) -> DampingNull:
     """Score n_draws log-uniform zeta draws (``draw_null_zetas``) exactly as ``damping_scores``
     scores zeta_hat: same matching (bone [K], trusted [K]), same omega_hat [K] rad/s, same truth
     (zeta_bones [B], omega_bones [B] rad/s). Seeded: same seed, same draws."""
     draws = draw_null_zetas(zeta_range, len(np.asarray(bone)), n_draws, seed)
     s = [damping_scores(bone, trusted, z, omega_hat, zeta_bones, omega_bones) for z in draws]
-    return DampingNull(np.array([x.median_rel_err for x in s]), np.array([x.log_corr for x in s]),
-                       np.array([x.gamma_exponent for x in s]), draws,
-                       int(np.asarray(trusted, bool).sum()), int(seed))
+    return DampingNull(
+        np.array([x.median_rel_err for x in s]),
+        np.array([x.log_corr for x in s]),
+        np.array([x.gamma_exponent for x in s]),
+        draws,
+        int(np.asarray(trusted, bool).sum()),
+        int(seed),
+    )

@@ -3,6 +3,7 @@
 Both a part and a bone solve the same oscillator under the same forcing, so a part that
 recovered its bone reproduces the bone's theta(t); the match reads omega off that bone.
 """
+
 from __future__ import annotations
 
 from dataclasses import asdict, dataclass
@@ -16,9 +17,11 @@ def training_window(theta: np.ndarray, lead_in_frames: int, n_train: int) -> np.
     """Columns of recorded frames 0..n_train-1 from a series [..., L+F] that starts at the lead-in."""
     theta = np.asarray(theta)
     if theta.shape[-1] < lead_in_frames + n_train:
-        raise ValueError(f"series has {theta.shape[-1]} samples, fewer than lead-in {lead_in_frames}"
-                         f" + {n_train} training frames")
-    return theta[..., lead_in_frames: lead_in_frames + n_train]
+        raise ValueError(
+            f"series has {theta.shape[-1]} samples, fewer than lead-in {lead_in_frames}"
+            f" + {n_train} training frames"
+        )
+    return theta[..., lead_in_frames : lead_in_frames + n_train]
 
 
 def pearson_matrix(a: np.ndarray, b: np.ndarray) -> np.ndarray:
@@ -76,17 +79,32 @@ class MatchResult:
     loglog_r2: float
 
     def to_dict(self) -> dict:
-        return {k: (v.tolist() if isinstance(v, np.ndarray) else v) for k, v in asdict(self).items()}
+        return {
+            k: (v.tolist() if isinstance(v, np.ndarray) else v) for k, v in asdict(self).items()
+        }
 
     @staticmethod
     def from_dict(d: dict) -> "MatchResult":
-        arr = {k: np.asarray(d[k]) for k in ("bone", "corr", "trusted", "omega_hat", "omega_true", "rel_err")}
-        return MatchResult(**arr, n_trusted=int(d["n_trusted"]), n_parts=int(d["n_parts"]),
-                           median_rel_err=float(d["median_rel_err"]), loglog_r2=float(d["loglog_r2"]))
+        arr = {
+            k: np.asarray(d[k])
+            for k in ("bone", "corr", "trusted", "omega_hat", "omega_true", "rel_err")
+        }
+        return MatchResult(
+            **arr,
+            n_trusted=int(d["n_trusted"]),
+            n_parts=int(d["n_parts"]),
+            median_rel_err=float(d["median_rel_err"]),
+            loglog_r2=float(d["loglog_r2"]),
+        )
 
 
-def match_parts(part_theta: np.ndarray, bone_theta: np.ndarray, omega_hat: np.ndarray,
-                omega_bones: np.ndarray, threshold: float = TRUST_THRESHOLD) -> MatchResult:
+def match_parts(
+    part_theta: np.ndarray,
+    bone_theta: np.ndarray,
+    omega_hat: np.ndarray,
+    omega_bones: np.ndarray,
+    threshold: float = TRUST_THRESHOLD,
+) -> MatchResult:
     """Match each part to the bone whose trajectory it correlates with best (by |corr|).
 
     part_theta [K, T], bone_theta [B, T]: angles (rad) over the same samples (the training
@@ -96,8 +114,10 @@ def match_parts(part_theta: np.ndarray, bone_theta: np.ndarray, omega_hat: np.nd
     omega_bones = np.asarray(omega_bones, dtype=np.float64)
     K, B = len(part_theta), len(bone_theta)
     if omega_hat.shape != (K,) or omega_bones.shape != (B,):
-        raise ValueError(f"omega_hat {omega_hat.shape} / omega_bones {omega_bones.shape} do not match "
-                         f"{K} parts / {B} bones")
+        raise ValueError(
+            f"omega_hat {omega_hat.shape} / omega_bones {omega_bones.shape} do not match "
+            f"{K} parts / {B} bones"
+        )
     if np.any(omega_hat <= 0) or np.any(omega_bones <= 0):
         raise ValueError("natural frequencies must be positive (rad/s)")
     absc = np.abs(pearson_matrix(part_theta, bone_theta))  # [K, B]

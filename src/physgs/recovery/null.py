@@ -5,6 +5,7 @@ integrate with the model's own solver under the same observed wind, and push the
 through the same matcher. If the null scores like the trained model, the metric cannot tell
 whether recovery happened (dense skeletons tile the frequency axis too finely).
 """
+
 from __future__ import annotations
 
 from dataclasses import asdict, dataclass
@@ -73,22 +74,46 @@ class NullResult:
         return float(np.median(v)) if v.size else float("nan")
 
     def to_dict(self) -> dict:
-        return {k: (v.tolist() if isinstance(v, np.ndarray) else v) for k, v in asdict(self).items()}
+        return {
+            k: (v.tolist() if isinstance(v, np.ndarray) else v) for k, v in asdict(self).items()
+        }
 
     @staticmethod
     def from_dict(d: dict) -> "NullResult":
-        opt = {k: (np.asarray(d[k], float) if d.get(k) is not None else None)
-               for k in ("n_trusted_visible", "median_rel_err_visible")}
-        return NullResult(np.asarray(d["n_trusted"]), np.asarray(d["median_rel_err"], float),
-                          np.asarray(d["loglog_r2"], float), np.asarray(d["omega"], float),
-                          int(d["n_parts"]), float(d["nearest_bone_gap"]), int(d["seed"]), **opt)
+        opt = {
+            k: (np.asarray(d[k], float) if d.get(k) is not None else None)
+            for k in ("n_trusted_visible", "median_rel_err_visible")
+        }
+        return NullResult(
+            np.asarray(d["n_trusted"]),
+            np.asarray(d["median_rel_err"], float),
+            np.asarray(d["loglog_r2"], float),
+            np.asarray(d["omega"], float),
+            int(d["n_parts"]),
+            float(d["nearest_bone_gap"]),
+            int(d["seed"]),
+            **opt,
+        )
 
 
-def null_control(omega_bones: np.ndarray, bone_theta: np.ndarray, wind: np.ndarray, *, n_parts: int,
-                 zeta_init: float, vbar: float, dt: float, substeps: int, lead_in_frames: int,
-                 n_train: int, seed: int, n_draws: int = N_DRAWS, gain: float = 1.0,
-                 threshold: float = TRUST_THRESHOLD,
-                 bone_visible: np.ndarray | None = None) -> NullResult:
+def null_control(
+    omega_bones: np.ndarray,
+    bone_theta: np.ndarray,
+    wind: np.ndarray,
+    *,
+    n_parts: int,
+    zeta_init: float,
+    vbar: float,
+    dt: float,
+    substeps: int,
+    lead_in_frames: int,
+    n_train: int,
+    seed: int,
+    n_draws: int = N_DRAWS,
+    gain: float = 1.0,
+    threshold: float = TRUST_THRESHOLD,
+    bone_visible: np.ndarray | None = None,
+) -> NullResult:
     """Run the untrained null through ``physgs.models.oscillator.integrate`` and the matcher.
 
     omega_bones [B] rad/s; bone_theta [B, n_train] rad, the bones' angles over the training
@@ -107,9 +132,15 @@ def null_control(omega_bones: np.ndarray, bone_theta: np.ndarray, wind: np.ndarr
     n_tr, med, r2, vis = [], [], [], []
     for om in draws:
         with torch.no_grad():
-            theta = integrate(torch.as_tensor(om), torch.full((n_parts,), float(zeta_init), dtype=torch.float64),
-                              torch.full((n_parts,), float(gain), dtype=torch.float64), w, float(vbar),
-                              float(dt), int(substeps))  # [K, L+F]
+            theta = integrate(
+                torch.as_tensor(om),
+                torch.full((n_parts,), float(zeta_init), dtype=torch.float64),
+                torch.full((n_parts,), float(gain), dtype=torch.float64),
+                w,
+                float(vbar),
+                float(dt),
+                int(substeps),
+            )  # [K, L+F]
         part = training_window(theta.detach().cpu().numpy(), lead_in_frames, n_train)
         m = match_parts(part, bone_theta, om, omega_bones, threshold)
         n_tr.append(m.n_trusted)
@@ -119,5 +150,14 @@ def null_control(omega_bones: np.ndarray, bone_theta: np.ndarray, wind: np.ndarr
             vis.append(restricted(m, bone_visible))
     gap = float(np.median(nearest_bone_gap(draws, omega_bones)))
     v_n, v_med = (np.asarray(x, float) for x in zip(*vis)) if vis else (None, None)
-    return NullResult(np.asarray(n_tr), np.asarray(med), np.asarray(r2), draws, int(n_parts), gap,
-                      int(seed), v_n, v_med)
+    return NullResult(
+        np.asarray(n_tr),
+        np.asarray(med),
+        np.asarray(r2),
+        draws,
+        int(n_parts),
+        gap,
+        int(seed),
+        v_n,
+        v_med,
+    )

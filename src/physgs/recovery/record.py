@@ -1,4 +1,5 @@
 """Score one trained model's recovery against the truth file, and store results as JSON."""
+
 from __future__ import annotations
 
 import dataclasses
@@ -46,8 +47,14 @@ def bone_window(truth, lead_in_frames: int, n_train: int) -> np.ndarray:
     return training_window(theta.T, lead_in_frames, n_train)
 
 
-def score_recovery(part_theta: np.ndarray, omega_hat: np.ndarray, zeta_hat: np.ndarray, truth,
-                   lead_in_frames: int, n_train: int) -> RecoveryRecord:
+def score_recovery(
+    part_theta: np.ndarray,
+    omega_hat: np.ndarray,
+    zeta_hat: np.ndarray,
+    truth,
+    lead_in_frames: int,
+    n_train: int,
+) -> RecoveryRecord:
     """Match parts to bones and summarise damping.
 
     part_theta [K, L+F]: the model's part angles (rad) under the training wind, lead-in first
@@ -61,26 +68,33 @@ def score_recovery(part_theta: np.ndarray, omega_hat: np.ndarray, zeta_hat: np.n
 
 
 def save_recovery(path, rec: RecoveryRecord) -> None:
-    write_json(path, {"match": rec.match.to_dict(), "damping": rec.damping.to_dict(),
-                      "n_frozen": int(rec.n_frozen),
-                      "n_trusted_visible": int(rec.n_trusted_visible),
-                      "median_rel_err_visible": rec.median_rel_err_visible,
-                      "damping_scores": (rec.damping_scores.to_dict()
-                                         if rec.damping_scores is not None else None),
-                      "damping_null": (rec.damping_null.to_dict()
-                                       if rec.damping_null is not None else None)})
+    write_json(
+        path,
+        {
+            "match": rec.match.to_dict(),
+            "damping": rec.damping.to_dict(),
+            "n_frozen": int(rec.n_frozen),
+            "n_trusted_visible": int(rec.n_trusted_visible),
+            "median_rel_err_visible": rec.median_rel_err_visible,
+            "damping_scores": (
+                rec.damping_scores.to_dict() if rec.damping_scores is not None else None
+            ),
+            "damping_null": (rec.damping_null.to_dict() if rec.damping_null is not None else None),
+        },
+    )
 
 
 def load_recovery(path) -> RecoveryRecord:
     d = _read(path)
-    return RecoveryRecord(MatchResult.from_dict(d["match"]), DampingResult.from_dict(d["damping"]),
-                          int(d.get("n_frozen", 0)),  # records from before freezing: none frozen
-                          int(d.get("n_trusted_visible", -1)),
-                          float(d.get("median_rel_err_visible", float("nan"))),
-                          DampingScores.from_dict(d["damping_scores"])
-                          if d.get("damping_scores") else None,
-                          DampingNull.from_dict(d["damping_null"])
-                          if d.get("damping_null") else None)
+    return RecoveryRecord(
+        MatchResult.from_dict(d["match"]),
+        DampingResult.from_dict(d["damping"]),
+        int(d.get("n_frozen", 0)),  # records from before freezing: none frozen
+        int(d.get("n_trusted_visible", -1)),
+        float(d.get("median_rel_err_visible", float("nan"))),
+        DampingScores.from_dict(d["damping_scores"]) if d.get("damping_scores") else None,
+        DampingNull.from_dict(d["damping_null"]) if d.get("damping_null") else None,
+    )
 
 
 def save_null(path, res: NullResult) -> None:
@@ -96,11 +110,22 @@ def _read(path) -> dict:
         with open(path) as fh:
             return json.load(fh)
     except (OSError, json.JSONDecodeError) as e:
-        raise ValueError(f"cannot read recovery file {path}: {e}; delete it and re-run its rule") from e
+        raise ValueError(
+            f"cannot read recovery file {path}: {e}; delete it and re-run its rule"
+        ) from e
 
 
-def run_null(truth, observed, *, n_parts: int, zeta_init: float, substeps: int, seed: int,
-             n_draws: int | None = None, bone_visible: np.ndarray | None = None) -> NullResult:
+def run_null(
+    truth,
+    observed,
+    *,
+    n_parts: int,
+    zeta_init: float,
+    substeps: int,
+    seed: int,
+    n_draws: int | None = None,
+    bone_visible: np.ndarray | None = None,
+) -> NullResult:
     """The null control for one tree and one K, wired exactly like the trained model.
 
     Uses the training condition's observed wind (lead-in first), dt = 1 / fps, and the
@@ -111,9 +136,18 @@ def run_null(truth, observed, *, n_parts: int, zeta_init: float, substeps: int, 
 
     wind = np.asarray(observed.wind[0], dtype=np.float64)  # [L+F]
     L, n_train = int(observed.lead_in_frames), int(observed.n_train)
-    return null_control(truth.omega, bone_window(truth, L, n_train), wind, n_parts=n_parts,
-                        zeta_init=zeta_init, vbar=float(np.asarray(observed.vbar)[0]),
-                        dt=1.0 / observed.fps,
-                        substeps=substeps, lead_in_frames=L, n_train=n_train, seed=seed,
-                        n_draws=N_DRAWS if n_draws is None else n_draws,
-                        bone_visible=bone_visible)
+    return null_control(
+        truth.omega,
+        bone_window(truth, L, n_train),
+        wind,
+        n_parts=n_parts,
+        zeta_init=zeta_init,
+        vbar=float(np.asarray(observed.vbar)[0]),
+        dt=1.0 / observed.fps,
+        substeps=substeps,
+        lead_in_frames=L,
+        n_train=n_train,
+        seed=seed,
+        n_draws=N_DRAWS if n_draws is None else n_draws,
+        bone_visible=bone_visible,
+    )

@@ -2,6 +2,7 @@
 
 The workflow imports ``null_settings`` to plan jobs; the solver and torch load inside the
 functions that run it, so a dry run does not pay torch's start-up."""
+
 from __future__ import annotations
 
 import dataclasses
@@ -14,8 +15,9 @@ if TYPE_CHECKING:
     from physgs.recovery.record import RecoveryRecord
 
 
-def recover_model(model, observed, truth, bone_visible=None, damping: dict | None = None
-                  ) -> RecoveryRecord:
+def recover_model(
+    model, observed, truth, bone_visible=None, damping: dict | None = None
+) -> RecoveryRecord:
     """Match the trained parts to bones (training wind, training window) and summarise damping.
 
     model: a trained ``ours`` model (``part_theta``, ``omega`` rad/s, ``zeta``); bone_visible
@@ -35,8 +37,9 @@ def recover_model(model, observed, truth, bone_visible=None, damping: dict | Non
         theta = model.part_theta(wind).cpu().numpy()  # [K, L+F]
         omega = model.omega.detach().cpu().numpy().astype(np.float64)
         zeta = model.zeta.detach().cpu().numpy().astype(np.float64)
-    rec = score_recovery(theta, omega, zeta, truth, int(observed.lead_in_frames),
-                         int(observed.n_train))
+    rec = score_recovery(
+        theta, omega, zeta, truth, int(observed.lead_in_frames), int(observed.n_train)
+    )
     if bone_visible is not None:
         rec = rec.with_visibility(bone_visible)
     if damping is not None:
@@ -45,9 +48,18 @@ def recover_model(model, observed, truth, bone_visible=None, damping: dict | Non
         zb, ob = np.asarray(truth.zeta, np.float64), np.asarray(truth.omega, np.float64)
         m = rec.match
         rec = dataclasses.replace(
-            rec, damping_scores=score_match(m, zeta, zb, ob),
-            damping_null=damping_null(m.bone, m.trusted, m.omega_hat, zb, ob,
-                                      damping["zeta_range"], seed=int(damping["seed"])))
+            rec,
+            damping_scores=score_match(m, zeta, zb, ob),
+            damping_null=damping_null(
+                m.bone,
+                m.trusted,
+                m.omega_hat,
+                zb,
+                ob,
+                damping["zeta_range"],
+                seed=int(damping["seed"]),
+            ),
+        )
     frozen = getattr(model, "frozen", None)
     if frozen is None or not bool(frozen.any()):
         return rec
@@ -63,10 +75,15 @@ def null_settings(cfg: dict, K: int, seed: int | None = None) -> dict:
     seed draws its own null, paired with that seed's model; default ``cfg['seed']``). Keyed by K,
     not by configuration, so configurations sharing a K share one null."""
     o = cfg["models"]["ours"]
-    return {"K": int(K), "omega_hz": [float(x) for x in o["omega_hz"]],
-            "zeta": [float(x) for x in o["zeta"]], "zeta_init": float(o["zeta_init"]),
-            "substeps": int(o["substeps"]), "rk4_guard": float(o["rk4_guard"]),
-            "seed": int(cfg["seed"] if seed is None else seed)}
+    return {
+        "K": int(K),
+        "omega_hz": [float(x) for x in o["omega_hz"]],
+        "zeta": [float(x) for x in o["zeta"]],
+        "zeta_init": float(o["zeta_init"]),
+        "substeps": int(o["substeps"]),
+        "rk4_guard": float(o["rk4_guard"]),
+        "seed": int(cfg["seed"] if seed is None else seed),
+    }
 
 
 def null_control(observed, truth, settings: dict, bone_visible=None) -> NullResult:
@@ -78,8 +95,19 @@ def null_control(observed, truth, settings: dict, bone_visible=None) -> NullResu
     from physgs.recovery.record import run_null
 
     dt = 1.0 / observed.fps
-    substeps = prior_substeps(settings["omega_hz"], settings["zeta"], settings["substeps"], dt,
-                              float(settings.get("rk4_guard", STABILITY_GUARD)))
-    return run_null(truth, observed, n_parts=int(settings["K"]),
-                    zeta_init=float(settings["zeta_init"]), substeps=substeps,
-                    seed=int(settings["seed"]), bone_visible=bone_visible)
+    substeps = prior_substeps(
+        settings["omega_hz"],
+        settings["zeta"],
+        settings["substeps"],
+        dt,
+        float(settings.get("rk4_guard", STABILITY_GUARD)),
+    )
+    return run_null(
+        truth,
+        observed,
+        n_parts=int(settings["K"]),
+        zeta_init=float(settings["zeta_init"]),
+        substeps=substeps,
+        seed=int(settings["seed"]),
+        bone_visible=bone_visible,
+    )

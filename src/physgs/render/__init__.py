@@ -4,6 +4,7 @@ One entry point, :func:`rasterization`, in the spirit of gsplat's: Gaussians + c
 background -> RGB, accumulated alpha and expected depth, differentiable w.r.t. means, quats,
 scales, opacities and colours.
 """
+
 from __future__ import annotations
 
 from dataclasses import dataclass
@@ -40,36 +41,55 @@ def _all(torch_pred, np_pred, x: torch.Tensor) -> bool:
 
 def _check_inputs(means, quats, scales, opacities, colors, camera, background):
     n = means.shape[0] if means.ndim == 2 else -1
-    shapes = {"means": (means, (n, 3)), "quats": (quats, (n, 4)), "scales": (scales, (n, 3)),
-              "opacities": (opacities, (n,)), "colors": (colors, (n, colors.shape[-1]))}
+    shapes = {
+        "means": (means, (n, 3)),
+        "quats": (quats, (n, 4)),
+        "scales": (scales, (n, 3)),
+        "opacities": (opacities, (n,)),
+        "colors": (colors, (n, colors.shape[-1])),
+    }
     for name, (x, shape) in shapes.items():
         if not isinstance(x, torch.Tensor):
             raise TypeError(f"rasterization: {name} must be a torch.Tensor, got {type(x).__name__}")
         if tuple(x.shape) != shape or n < 0:
-            raise ValueError(f"rasterization: {name} has shape {tuple(x.shape)}, expected "
-                             f"{shape} (N = {n} from means [N, 3]); reshape the input")
+            raise ValueError(
+                f"rasterization: {name} has shape {tuple(x.shape)}, expected "
+                f"{shape} (N = {n} from means [N, 3]); reshape the input"
+            )
         if x.dtype != means.dtype or x.device != means.device:
-            raise ValueError(f"rasterization: {name} is {x.dtype} on {x.device} but means is "
-                             f"{means.dtype} on {means.device}; cast all inputs alike")
+            raise ValueError(
+                f"rasterization: {name} is {x.dtype} on {x.device} but means is "
+                f"{means.dtype} on {means.device}; cast all inputs alike"
+            )
         if not _all(torch.isfinite, np.isfinite, x):
-            raise ValueError(f"rasterization: {name} contains NaN or inf; fix the upstream model "
-                             "(e.g. a diverged training step)")
+            raise ValueError(
+                f"rasterization: {name} contains NaN or inf; fix the upstream model "
+                "(e.g. a diverged training step)"
+            )
     if means.dtype not in (torch.float32, torch.float64):
         raise ValueError(f"rasterization: dtype {means.dtype} unsupported; use float32 or float64")
     if not _all(lambda v: v >= 0, lambda v: v >= 0, scales):
-        raise ValueError("rasterization: scales must be >= 0 (already activated, e.g. exp of the "
-                         "log-scale parameter)")
+        raise ValueError(
+            "rasterization: scales must be >= 0 (already activated, e.g. exp of the "
+            "log-scale parameter)"
+        )
     if not _all(lambda v: (v >= 0) & (v <= 1), lambda v: (v >= 0) & (v <= 1), opacities):
-        raise ValueError("rasterization: opacities must lie in [0, 1] (already activated, e.g. "
-                         "sigmoid of the logit parameter)")
+        raise ValueError(
+            "rasterization: opacities must lie in [0, 1] (already activated, e.g. "
+            "sigmoid of the logit parameter)"
+        )
     if not isinstance(camera, Camera):
         raise TypeError(f"rasterization: camera must be physgs.camera.Camera, got {type(camera)}")
     if camera.width <= 0 or camera.height <= 0:
-        raise ValueError(f"rasterization: image size {camera.width}x{camera.height} is empty; "
-                         "give the camera a positive width and height")
+        raise ValueError(
+            f"rasterization: image size {camera.width}x{camera.height} is empty; "
+            "give the camera a positive width and height"
+        )
     if background.shape != (colors.shape[-1],):
-        raise ValueError(f"rasterization: background has shape {tuple(background.shape)}, "
-                         f"expected ({colors.shape[-1]},) to match colors")
+        raise ValueError(
+            f"rasterization: background has shape {tuple(background.shape)}, "
+            f"expected ({colors.shape[-1]},) to match colors"
+        )
 
 
 def _gsplat_available(device: torch.device) -> bool:
@@ -82,9 +102,18 @@ def _gsplat_available(device: torch.device) -> bool:
     return True
 
 
-def rasterization(means: torch.Tensor, quats: torch.Tensor, scales: torch.Tensor,
-                  opacities: torch.Tensor, colors: torch.Tensor, camera: Camera, background,
-                  *, backend: str = "auto", return_depth: bool = True) -> RenderOutput:
+def rasterization(
+    means: torch.Tensor,
+    quats: torch.Tensor,
+    scales: torch.Tensor,
+    opacities: torch.Tensor,
+    colors: torch.Tensor,
+    camera: Camera,
+    background,
+    *,
+    backend: str = "auto",
+    return_depth: bool = True,
+) -> RenderOutput:
     """Render N 3D Gaussians into ``camera``.
 
     means [N, 3] world units; quats [N, 4] (w, x, y, z), need not be unit; scales [N, 3] world
@@ -98,28 +127,45 @@ def rasterization(means: torch.Tensor, quats: torch.Tensor, scales: torch.Tensor
     """
     if backend not in BACKENDS:
         raise ValueError(f"rasterization: unknown backend {backend!r}; choose one of {BACKENDS}")
-    background = torch.as_tensor(np.asarray(background) if not isinstance(background, torch.Tensor)
-                                 else background, dtype=means.dtype, device=means.device)
+    background = torch.as_tensor(
+        np.asarray(background) if not isinstance(background, torch.Tensor) else background,
+        dtype=means.dtype,
+        device=means.device,
+    )
     _check_inputs(means, quats, scales, opacities, colors, camera, background)
     if backend == "auto":
         backend = "gsplat" if _gsplat_available(means.device) else "fast"
     if backend == "gsplat":
         if not _gsplat_available(means.device):
-            raise RuntimeError("rasterization: backend 'gsplat' needs CUDA tensors and the gsplat "
-                               "package; use backend='fast' on the CPU or `pip install gsplat`")
+            raise RuntimeError(
+                "rasterization: backend 'gsplat' needs CUDA tensors and the gsplat "
+                "package; use backend='fast' on the CPU or `pip install gsplat`"
+            )
         from physgs.render.gsplat_backend import rasterize_gsplat
 
-        rgb, alpha, depth = rasterize_gsplat(means, quats, scales, opacities, colors, camera,
-                                             background, return_depth)
+        rgb, alpha, depth = rasterize_gsplat(
+            means, quats, scales, opacities, colors, camera, background, return_depth
+        )
         return RenderOutput(rgb, alpha, depth)
     if backend == "fast":
-        rgb, alpha, depth = rasterize_fast(means, quats, scales, opacities, colors, camera,
-                                           background, return_depth)
+        rgb, alpha, depth = rasterize_fast(
+            means, quats, scales, opacities, colors, camera, background, return_depth
+        )
         return RenderOutput(rgb, alpha, depth)
     proj = project_gaussians(means, quats, scales, camera)
-    rgb, alpha, depth = composite_reference(proj.means2d, proj.conics, opacities, colors,
-                                            proj.depths, proj.valid, proj.cov2d, background,
-                                            camera.width, camera.height, return_depth)
+    rgb, alpha, depth = composite_reference(
+        proj.means2d,
+        proj.conics,
+        opacities,
+        colors,
+        proj.depths,
+        proj.valid,
+        proj.cov2d,
+        background,
+        camera.width,
+        camera.height,
+        return_depth,
+    )
     return RenderOutput(rgb, alpha, depth)
 
 

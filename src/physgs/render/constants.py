@@ -10,6 +10,7 @@ fast-vs-reference tests catch a stale cache.
 Not here: the near plane, which is per camera (``Camera.near``, default 0.01 world units, as
 gsplat's ``near_plane``), and the pixel-centre convention (centres at integer + 0.5).
 """
+
 from __future__ import annotations
 
 # --- projection ----------------------------------------------------------------------------

@@ -5,6 +5,7 @@ Everything between the input tensors and the output images runs in numba or vect
 no Python loop over Gaussians and no small torch ops (whose OpenMP barriers cost more than the
 arithmetic on a busy 2-core machine).
 """
+
 from __future__ import annotations
 
 import numpy as np
@@ -33,15 +34,20 @@ def camera_arrays(camera: Camera):
     :func:`physgs.render.project.fov_clamp_limits` (the reference path uses the same)."""
     intr = np.array([camera.fx, camera.fy, camera.cx, camera.cy], dtype=np.float64)
     lims = np.array(fov_clamp_limits(camera), dtype=np.float64)
-    return (np.ascontiguousarray(camera.R, dtype=np.float64),
-            np.ascontiguousarray(camera.t, dtype=np.float64), intr, lims)
+    return (
+        np.ascontiguousarray(camera.R, dtype=np.float64),
+        np.ascontiguousarray(camera.t, dtype=np.float64),
+        intr,
+        lims,
+    )
 
 
 class _FastRasterize(torch.autograd.Function):
     @staticmethod
     def forward(ctx, means, quats, scales, opacities, colors, background, camera):
-        m, q, s, o, col, bg = (_np(x) for x in (means, quats, scales, opacities, colors,
-                                               background))
+        m, q, s, o, col, bg = (
+            _np(x) for x in (means, quats, scales, opacities, colors, background)
+        )
         n, D = col.shape
         W, H = camera.width, camera.height
         cam = camera_arrays(camera)
@@ -56,8 +62,9 @@ class _FastRasterize(torch.autograd.Function):
         order = np.argsort(np.where(touches, dep, np.inf), kind="stable")[: int(touches.sum())]
         tiles_x = (W + TILE - 1) // TILE
         tiles_y = (H + TILE - 1) // TILE
-        tile_start, pair_gid = kernels.bin_tiles(boxes, order.astype(np.int64), TILE, tiles_x,
-                                                 tiles_y)
+        tile_start, pair_gid = kernels.bin_tiles(
+            boxes, order.astype(np.int64), TILE, tiles_x, tiles_y
+        )
         rgb = np.empty((H, W, D))
         alpha = np.empty((H, W))
         depth = np.empty((H, W))
@@ -93,22 +100,42 @@ class _FastRasterize(torch.autograd.Function):
         v_means = np.empty((n, 3))
         v_quats = np.empty((n, 4))
         v_scales = np.empty((n, 3))
-        kernels.project_backward(m, q, s, *cam, near, EPS2D, valid,
-                                 np.ascontiguousarray(G[:, 0:2]), np.ascontiguousarray(G[:, 2:5]),
-                                 np.ascontiguousarray(G[:, 6]), v_means, v_quats, v_scales)
+        kernels.project_backward(
+            m,
+            q,
+            s,
+            *cam,
+            near,
+            EPS2D,
+            valid,
+            np.ascontiguousarray(G[:, 0:2]),
+            np.ascontiguousarray(G[:, 2:5]),
+            np.ascontiguousarray(G[:, 6]),
+            v_means,
+            v_quats,
+            v_scales,
+        )
         g_bg = np.einsum("hwd,hw->d", g_rgb, t_final)
-        out = (v_means, v_quats, v_scales, G[:, 5], G[:, kernels.N_GRAD:], g_bg)
+        out = (v_means, v_quats, v_scales, G[:, 5], G[:, kernels.N_GRAD :], g_bg)
         return tuple(_to_torch(x, ctx.like) for x in out) + (None,)
 
 
-def rasterize_fast(means: torch.Tensor, quats: torch.Tensor, scales: torch.Tensor,
-                   opacities: torch.Tensor, colors: torch.Tensor, camera: Camera,
-                   background: torch.Tensor, return_depth: bool = True):
+def rasterize_fast(
+    means: torch.Tensor,
+    quats: torch.Tensor,
+    scales: torch.Tensor,
+    opacities: torch.Tensor,
+    colors: torch.Tensor,
+    camera: Camera,
+    background: torch.Tensor,
+    return_depth: bool = True,
+):
     """Fast CPU backend of :func:`physgs.render.rasterization` (same shapes and units).
 
     Returns (rgb [H, W, D], alpha [H, W], depth [H, W] or None). Tensors on another device are
     copied to the CPU and back. Arithmetic is float64 inside the kernels for any input dtype.
     """
-    rgb, alpha, depth = _FastRasterize.apply(means, quats, scales, opacities, colors, background,
-                                             camera)
+    rgb, alpha, depth = _FastRasterize.apply(
+        means, quats, scales, opacities, colors, background, camera
+    )
     return rgb, alpha, (depth if return_depth else None)

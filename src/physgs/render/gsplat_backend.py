@@ -6,6 +6,7 @@ unnormalised expected depth sum z a T from render_mode "RGB+D", background compo
 gsplat bounds each Gaussian by 3 sigma where the CPU paths use the exact 1/255 footprint, so faint
 far tails can differ slightly.
 """
+
 from __future__ import annotations
 
 import torch
@@ -14,9 +15,16 @@ from physgs.camera import Camera
 from physgs.render.constants import EPS2D
 
 
-def rasterize_gsplat(means: torch.Tensor, quats: torch.Tensor, scales: torch.Tensor,
-                     opacities: torch.Tensor, colors: torch.Tensor, camera: Camera,
-                     background: torch.Tensor, return_depth: bool = True):
+def rasterize_gsplat(
+    means: torch.Tensor,
+    quats: torch.Tensor,
+    scales: torch.Tensor,
+    opacities: torch.Tensor,
+    colors: torch.Tensor,
+    camera: Camera,
+    background: torch.Tensor,
+    return_depth: bool = True,
+):
     """gsplat backend of :func:`physgs.render.rasterization` (same shapes and units).
 
     Returns (rgb [H, W, D], alpha [H, W], depth [H, W] or None) on the CUDA device.
@@ -32,9 +40,22 @@ def rasterize_gsplat(means: torch.Tensor, quats: torch.Tensor, scales: torch.Ten
     # with 0 itself.
     mode = "RGB+D" if return_depth else "RGB"
     img, alpha, _ = gsplat.rasterization(
-        m, q, s, o, c, viewmat, K, camera.width, camera.height, near_plane=camera.near,
-        eps2d=EPS2D, backgrounds=bg[None], render_mode=mode, packed=False,
-        rasterize_mode="classic")
+        m,
+        q,
+        s,
+        o,
+        c,
+        viewmat,
+        K,
+        camera.width,
+        camera.height,
+        near_plane=camera.near,
+        eps2d=EPS2D,
+        backgrounds=bg[None],
+        render_mode=mode,
+        packed=False,
+        rasterize_mode="classic",
+    )
     img = img[0].to(dt)
     alpha = alpha[0, ..., 0].to(dt)
     D = colors.shape[1]

@@ -11,6 +11,7 @@ no reverse traversal: the light behind Gaussian i is (total - prefix up to i).
 Determinism: every tile writes only its own pixels and its own rows of the per-(tile, Gaussian)
 gradient buffer; a sequential loop then sums those rows per Gaussian in a fixed order. No atomics.
 """
+
 from __future__ import annotations
 
 import math
@@ -19,8 +20,15 @@ import numba as nb
 import numpy as np
 
 # Module globals: numba freezes them into the compiled (and cached) kernels.
-from physgs.render.constants import (ALPHA_MAX, ALPHA_MIN, FOOTPRINT_SLACK, INV_ALPHA_MIN,
-                                     QUAT_NORM_EPS, ROW_SPAN_TOL, T_MIN)
+from physgs.render.constants import (
+    ALPHA_MAX,
+    ALPHA_MIN,
+    FOOTPRINT_SLACK,
+    INV_ALPHA_MIN,
+    QUAT_NORM_EPS,
+    ROW_SPAN_TOL,
+    T_MIN,
+)
 
 N_GRAD = 7  # per-pair gradient columns before colours: mx, my, conic a, b, c, opacity, depth
 
@@ -79,9 +87,28 @@ def _row_span(ca, cb, cc, thr, mx, dy, lo, hi):  # pragma: no cover - compiled
 
 
 @nb.njit(parallel=True, cache=True)
-def forward(means2d, conics, opac, colors, depths, bg, boxes, tile_start, pair_gid, tile,
-            tiles_x, width, height, out_rgb, out_alpha, out_depth, acc_c, acc_d, t_final,
-            n_contrib):  # pragma: no cover - compiled
+def forward(
+    means2d,
+    conics,
+    opac,
+    colors,
+    depths,
+    bg,
+    boxes,
+    tile_start,
+    pair_gid,
+    tile,
+    tiles_x,
+    width,
+    height,
+    out_rgb,
+    out_alpha,
+    out_depth,
+    acc_c,
+    acc_d,
+    t_final,
+    n_contrib,
+):  # pragma: no cover - compiled
     """Composite front to back. Inputs: means2d [N, 2] px, conics [N, 3], opac [N],
     colors [N, D], depths [N], bg [D], boxes [N, 4], tile lists from bin_tiles.
     Writes out_rgb [H, W, D], out_alpha [H, W], out_depth [H, W] (input dtype) and float64 totals
@@ -153,9 +180,28 @@ def forward(means2d, conics, opac, colors, depths, bg, boxes, tile_start, pair_g
 
 
 @nb.njit(parallel=True, cache=True)
-def backward(means2d, conics, opac, colors, depths, bg, boxes, tile_start, pair_gid, tile,
-             tiles_x, width, height, acc_c, acc_d, t_final, g_rgb, g_alpha, g_depth,
-             pair_grad):  # pragma: no cover - compiled
+def backward(
+    means2d,
+    conics,
+    opac,
+    colors,
+    depths,
+    bg,
+    boxes,
+    tile_start,
+    pair_gid,
+    tile,
+    tiles_x,
+    width,
+    height,
+    acc_c,
+    acc_d,
+    t_final,
+    g_rgb,
+    g_alpha,
+    g_depth,
+    pair_grad,
+):  # pragma: no cover - compiled
     """Explicit backward of :func:`forward`. g_rgb [H, W, D], g_alpha [H, W], g_depth [H, W] are
     upstream gradients (float64). Writes pair_grad [P, 7 + D] per (tile, Gaussian) pair:
     d/d(mx, my, conic a, b, c, opacity, depth, colours). Front-to-back pass: the light behind
@@ -304,8 +350,9 @@ def _mm(A, B, out, ta, tb):  # pragma: no cover - compiled
 
 
 @nb.njit(cache=True)
-def project_forward(means, quats, scales, Rc, tc, intr, lims, near, eps2d, means2d, conics,
-                    depths, cov2d, valid):  # pragma: no cover - compiled
+def project_forward(
+    means, quats, scales, Rc, tc, intr, lims, near, eps2d, means2d, conics, depths, cov2d, valid
+):  # pragma: no cover - compiled
     """Fused EWA projection, same maths as :func:`physgs.render.project.project_gaussians`.
 
     means [N, 3], quats [N, 4] wxyz, scales [N, 3] world units; Rc [3, 3], tc [3] world->camera;
@@ -328,11 +375,11 @@ def project_forward(means, quats, scales, Rc, tc, intr, lims, near, eps2d, means
         c = 0.0
         det = 0.0
         if ok:
-            qn = math.sqrt(quats[i, 0] ** 2 + quats[i, 1] ** 2 + quats[i, 2] ** 2
-                           + quats[i, 3] ** 2)
+            qn = math.sqrt(
+                quats[i, 0] ** 2 + quats[i, 1] ** 2 + quats[i, 2] ** 2 + quats[i, 3] ** 2
+            )
             qn = max(qn, QUAT_NORM_EPS)
-            _quat_rotmat(quats[i, 0] / qn, quats[i, 1] / qn, quats[i, 2] / qn,
-                         quats[i, 3] / qn, Rq)
+            _quat_rotmat(quats[i, 0] / qn, quats[i, 1] / qn, quats[i, 2] / qn, quats[i, 3] / qn, Rq)
             _mm(Rc, Rq, M, False, False)
             for col in range(3):
                 for row in range(3):
@@ -375,8 +422,24 @@ def project_forward(means, quats, scales, Rc, tc, intr, lims, near, eps2d, means
 
 
 @nb.njit(cache=True)
-def project_backward(means, quats, scales, Rc, tc, intr, lims, near, eps2d, valid, v_means2d,
-                     v_conics, v_depths, v_means, v_quats, v_scales):  # pragma: no cover
+def project_backward(
+    means,
+    quats,
+    scales,
+    Rc,
+    tc,
+    intr,
+    lims,
+    near,
+    eps2d,
+    valid,
+    v_means2d,
+    v_conics,
+    v_depths,
+    v_means,
+    v_quats,
+    v_scales,
+):  # pragma: no cover
     """Explicit backward of :func:`project_forward`: upstream v_means2d [N, 2], v_conics [N, 3],
     v_depths [N] -> v_means [N, 3], v_quats [N, 4], v_scales [N, 3] (written; zero if culled).
     Each Gaussian is independent (no accumulation across Gaussians)."""
@@ -411,8 +474,10 @@ def project_backward(means, quats, scales, Rc, tc, intr, lims, near, eps2d, vali
         x = Rc[0, 0] * means[i, 0] + Rc[0, 1] * means[i, 1] + Rc[0, 2] * means[i, 2] + tc[0]
         y = Rc[1, 0] * means[i, 0] + Rc[1, 1] * means[i, 1] + Rc[1, 2] * means[i, 2] + tc[1]
         z = Rc[2, 0] * means[i, 0] + Rc[2, 1] * means[i, 1] + Rc[2, 2] * means[i, 2] + tc[2]
-        qn = max(math.sqrt(quats[i, 0] ** 2 + quats[i, 1] ** 2 + quats[i, 2] ** 2
-                           + quats[i, 3] ** 2), QUAT_NORM_EPS)
+        qn = max(
+            math.sqrt(quats[i, 0] ** 2 + quats[i, 1] ** 2 + quats[i, 2] ** 2 + quats[i, 3] ** 2),
+            QUAT_NORM_EPS,
+        )
         qw, qx, qy, qz = quats[i, 0] / qn, quats[i, 1] / qn, quats[i, 2] / qn, quats[i, 3] / qn
         _quat_rotmat(qw, qx, qy, qz, Rq)
         _mm(Rc, Rq, RR, False, False)
@@ -465,14 +530,44 @@ def project_backward(means, quats, scales, Rc, tc, intr, lims, near, eps2d, vali
             v_scales[i, col] = acc
         _mm(Rc, VRR, VRq, True, False)
         # rotation matrix -> unit quaternion
-        gw = 2 * (-qz * VRq[0, 1] + qy * VRq[0, 2] + qz * VRq[1, 0] - qx * VRq[1, 2]
-                  - qy * VRq[2, 0] + qx * VRq[2, 1])
-        gx = 2 * (qy * VRq[0, 1] + qz * VRq[0, 2] + qy * VRq[1, 0] - 2 * qx * VRq[1, 1]
-                  - qw * VRq[1, 2] + qz * VRq[2, 0] + qw * VRq[2, 1] - 2 * qx * VRq[2, 2])
-        gy = 2 * (-2 * qy * VRq[0, 0] + qx * VRq[0, 1] + qw * VRq[0, 2] + qx * VRq[1, 0]
-                  + qz * VRq[1, 2] - qw * VRq[2, 0] + qz * VRq[2, 1] - 2 * qy * VRq[2, 2])
-        gz = 2 * (-2 * qz * VRq[0, 0] - qw * VRq[0, 1] + qx * VRq[0, 2] + qw * VRq[1, 0]
-                  - 2 * qz * VRq[1, 1] + qy * VRq[1, 2] + qx * VRq[2, 0] + qy * VRq[2, 1])
+        gw = 2 * (
+            -qz * VRq[0, 1]
+            + qy * VRq[0, 2]
+            + qz * VRq[1, 0]
+            - qx * VRq[1, 2]
+            - qy * VRq[2, 0]
+            + qx * VRq[2, 1]
+        )
+        gx = 2 * (
+            qy * VRq[0, 1]
+            + qz * VRq[0, 2]
+            + qy * VRq[1, 0]
+            - 2 * qx * VRq[1, 1]
+            - qw * VRq[1, 2]
+            + qz * VRq[2, 0]
+            + qw * VRq[2, 1]
+            - 2 * qx * VRq[2, 2]
+        )
+        gy = 2 * (
+            -2 * qy * VRq[0, 0]
+            + qx * VRq[0, 1]
+            + qw * VRq[0, 2]
+            + qx * VRq[1, 0]
+            + qz * VRq[1, 2]
+            - qw * VRq[2, 0]
+            + qz * VRq[2, 1]
+            - 2 * qy * VRq[2, 2]
+        )
+        gz = 2 * (
+            -2 * qz * VRq[0, 0]
+            - qw * VRq[0, 1]
+            + qx * VRq[0, 2]
+            + qw * VRq[1, 0]
+            - 2 * qz * VRq[1, 1]
+            + qy * VRq[1, 2]
+            + qx * VRq[2, 0]
+            + qy * VRq[2, 1]
+        )
         # normalisation q / |q|
         dot = qw * gw + qx * gx + qy * gy + qz * gz
         v_quats[i, 0] = (gw - qw * dot) / qn
@@ -487,8 +582,12 @@ def project_backward(means, quats, scales, Rc, tc, intr, lims, near, eps2d, vali
         z2 = z * z
         v_tx = VJ02 * (-fx / z2)
         v_ty = VJ12 * (-fy / z2)
-        vz = (VJ00 * (-fx / z2) + VJ11 * (-fy / z2)
-              + VJ02 * (2 * fx * tx / (z2 * z)) + VJ12 * (2 * fy * ty / (z2 * z)))
+        vz = (
+            VJ00 * (-fx / z2)
+            + VJ11 * (-fy / z2)
+            + VJ02 * (2 * fx * tx / (z2 * z))
+            + VJ12 * (2 * fy * ty / (z2 * z))
+        )
         vx = 0.0
         vy = 0.0
         if cl_x:

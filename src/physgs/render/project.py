@@ -8,6 +8,7 @@ the 2D covariance, conic = its inverse. Culled Gaussians (behind the near plane,
 mask and finite zero outputs, never NaN: every division uses a clamped denominator, so gradients
 stay finite too. Thresholds live in :mod:`physgs.render.constants`.
 """
+
 from __future__ import annotations
 
 from dataclasses import dataclass
@@ -16,8 +17,13 @@ import numpy as np
 import torch
 
 from physgs.camera import Camera
-from physgs.render.constants import (BOX_SLACK_PX, EPS2D, FOV_CLAMP_MARGIN, INV_ALPHA_MIN,
-                                     QUAT_NORM_EPS)
+from physgs.render.constants import (
+    BOX_SLACK_PX,
+    EPS2D,
+    FOV_CLAMP_MARGIN,
+    INV_ALPHA_MIN,
+    QUAT_NORM_EPS,
+)
 
 
 @dataclass(frozen=True)
@@ -48,9 +54,15 @@ def quat_to_rotmat(quats: torch.Tensor) -> torch.Tensor:
     w, x, y, z = q.unbind(-1)
     return torch.stack(
         [
-            1 - 2 * (y * y + z * z), 2 * (x * y - w * z), 2 * (x * z + w * y),
-            2 * (x * y + w * z), 1 - 2 * (x * x + z * z), 2 * (y * z - w * x),
-            2 * (x * z - w * y), 2 * (y * z + w * x), 1 - 2 * (x * x + y * y),
+            1 - 2 * (y * y + z * z),
+            2 * (x * y - w * z),
+            2 * (x * z + w * y),
+            2 * (x * y + w * z),
+            1 - 2 * (x * x + z * z),
+            2 * (y * z - w * x),
+            2 * (x * z - w * y),
+            2 * (y * z + w * x),
+            1 - 2 * (x * x + y * y),
         ],
         dim=-1,
     ).reshape(q.shape[:-1] + (3, 3))
@@ -65,8 +77,12 @@ def fov_clamp_limits(camera: Camera) -> tuple[float, float, float, float]:
     W, H = camera.width, camera.height
     tan_fovx = 0.5 * W / fx
     tan_fovy = 0.5 * H / fy
-    return (cx / fx + FOV_CLAMP_MARGIN * tan_fovx, (W - cx) / fx + FOV_CLAMP_MARGIN * tan_fovx,
-            cy / fy + FOV_CLAMP_MARGIN * tan_fovy, (H - cy) / fy + FOV_CLAMP_MARGIN * tan_fovy)
+    return (
+        cx / fx + FOV_CLAMP_MARGIN * tan_fovx,
+        (W - cx) / fx + FOV_CLAMP_MARGIN * tan_fovx,
+        cy / fy + FOV_CLAMP_MARGIN * tan_fovy,
+        (H - cy) / fy + FOV_CLAMP_MARGIN * tan_fovy,
+    )
 
 
 def camera_tensors(camera: Camera, like: torch.Tensor) -> tuple[torch.Tensor, torch.Tensor]:
@@ -76,8 +92,13 @@ def camera_tensors(camera: Camera, like: torch.Tensor) -> tuple[torch.Tensor, to
     return R, t
 
 
-def project_gaussians(means: torch.Tensor, quats: torch.Tensor, scales: torch.Tensor,
-                      camera: Camera, eps2d: float = EPS2D) -> Projected:
+def project_gaussians(
+    means: torch.Tensor,
+    quats: torch.Tensor,
+    scales: torch.Tensor,
+    camera: Camera,
+    eps2d: float = EPS2D,
+) -> Projected:
     """Project Gaussians (means [N, 3] world units, quats [N, 4] wxyz, scales [N, 3] world units).
 
     Returns a :class:`Projected`; differentiable w.r.t. means, quats and scales.
@@ -120,8 +141,14 @@ def project_gaussians(means: torch.Tensor, quats: torch.Tensor, scales: torch.Te
     return Projected(means2d, conics, depths, cov2d, valid)
 
 
-def pixel_bounds(means2d: np.ndarray, cov2d: np.ndarray, opacities: np.ndarray, valid: np.ndarray,
-                 width: int, height: int) -> np.ndarray:
+def pixel_bounds(
+    means2d: np.ndarray,
+    cov2d: np.ndarray,
+    opacities: np.ndarray,
+    valid: np.ndarray,
+    width: int,
+    height: int,
+) -> np.ndarray:
     """Conservative pixel boxes outside which a Gaussian's alpha is below ALPHA_MIN.
 
     alpha >= 1/255 needs d^T conic d <= 2 ln(255 o); that ellipse's bounding box has half-widths
@@ -148,8 +175,15 @@ def pixel_bounds(means2d: np.ndarray, cov2d: np.ndarray, opacities: np.ndarray, 
     x1 = np.ceil(np.clip(m[:, 0] + rx - 0.5, lo, width - lo)) + s
     y0 = np.floor(np.clip(m[:, 1] - ry - 0.5, lo, height - lo)) - s
     y1 = np.ceil(np.clip(m[:, 1] + ry - 0.5, lo, height - lo)) + s
-    box = np.stack([np.maximum(x0, 0), np.minimum(x1, width - 1),
-                    np.maximum(y0, 0), np.minimum(y1, height - 1)], axis=1).astype(np.int64)
+    box = np.stack(
+        [
+            np.maximum(x0, 0),
+            np.minimum(x1, width - 1),
+            np.maximum(y0, 0),
+            np.minimum(y1, height - 1),
+        ],
+        axis=1,
+    ).astype(np.int64)
     bad = ~np.isfinite(rx) | ~np.isfinite(ry)  # NaN extents cannot be bounded: cover the image
     box[bad] = [0, width - 1, 0, height - 1]
     out[keep] = box

@@ -4,6 +4,7 @@ Simple on purpose (tests and fallback): for each 16x16 tile, every Gaussian whos
 pixel box touches the tile is evaluated at every pixel of the tile as a dense [P, n] matrix, sorted
 front to back by depth, and composited with cumulative products. Python loops run over tiles only.
 """
+
 from __future__ import annotations
 
 import numpy as np
@@ -13,10 +14,19 @@ from physgs.render.constants import ALPHA_MAX, ALPHA_MIN, T_MIN, TILE
 from physgs.render.project import pixel_bounds
 
 
-def composite_reference(means2d: torch.Tensor, conics: torch.Tensor, opacities: torch.Tensor,
-                        colors: torch.Tensor, depths: torch.Tensor, valid: torch.Tensor,
-                        cov2d: torch.Tensor, background: torch.Tensor, width: int, height: int,
-                        return_depth: bool = True):
+def composite_reference(
+    means2d: torch.Tensor,
+    conics: torch.Tensor,
+    opacities: torch.Tensor,
+    colors: torch.Tensor,
+    depths: torch.Tensor,
+    valid: torch.Tensor,
+    cov2d: torch.Tensor,
+    background: torch.Tensor,
+    width: int,
+    height: int,
+    return_depth: bool = True,
+):
     """Alpha-composite projected Gaussians front to back.
 
     means2d [N, 2] px, conics [N, 3] 1/px^2, opacities [N], colors [N, D], depths [N] world units,
@@ -25,8 +35,14 @@ def composite_reference(means2d: torch.Tensor, conics: torch.Tensor, opacities: 
     conics, opacities, colors, depths and background.
     """
     D = colors.shape[1]
-    boxes = pixel_bounds(means2d.detach().cpu().numpy(), cov2d.cpu().numpy(),
-                         opacities.detach().cpu().numpy(), valid.cpu().numpy(), width, height)
+    boxes = pixel_bounds(
+        means2d.detach().cpu().numpy(),
+        cov2d.cpu().numpy(),
+        opacities.detach().cpu().numpy(),
+        valid.cpu().numpy(),
+        width,
+        height,
+    )
     touches = boxes[:, 0] <= boxes[:, 1]
     dep = depths.detach().cpu().numpy()
     order = np.argsort(np.where(touches, dep, np.inf), kind="stable")[: int(touches.sum())]
@@ -37,14 +53,18 @@ def composite_reference(means2d: torch.Tensor, conics: torch.Tensor, opacities: 
             ty1, tx1 = min(ty0 + TILE, height) - 1, min(tx0 + TILE, width) - 1
             hit = (b[:, 0] <= tx1) & (b[:, 1] >= tx0) & (b[:, 2] <= ty1) & (b[:, 3] >= ty0)
             idx = torch.as_tensor(order[hit], device=means2d.device)  # depth-sorted candidates
-            yy, xx = torch.meshgrid(torch.arange(ty0, ty1 + 1), torch.arange(tx0, tx1 + 1),
-                                    indexing="ij")
+            yy, xx = torch.meshgrid(
+                torch.arange(ty0, ty1 + 1), torch.arange(tx0, tx1 + 1), indexing="ij"
+            )
             pix_parts.append((yy * width + xx).reshape(-1))
             px = torch.stack([xx, yy], -1).reshape(-1, 2).to(means2d) + 0.5  # [P, 2] centres
             d = px[:, None, :] - means2d[idx][None, :, :]  # [P, n, 2]
             cn = conics[idx]
-            sigma = (cn[:, 0] * d[..., 0] ** 2 + 2 * cn[:, 1] * d[..., 0] * d[..., 1]
-                     + cn[:, 2] * d[..., 1] ** 2)  # [P, n]
+            sigma = (
+                cn[:, 0] * d[..., 0] ** 2
+                + 2 * cn[:, 1] * d[..., 0] * d[..., 1]
+                + cn[:, 2] * d[..., 1] ** 2
+            )  # [P, n]
             alpha = torch.clamp(opacities[idx] * torch.exp(-0.5 * sigma), max=ALPHA_MAX)
             alpha = torch.where(alpha >= ALPHA_MIN, alpha, torch.zeros_like(alpha))
             # Stop before the Gaussian that would take transmittance below T_MIN (and after it).
@@ -60,12 +80,21 @@ def composite_reference(means2d: torch.Tensor, conics: torch.Tensor, opacities: 
                 d_parts.append(w @ depths[idx])
     pix = torch.cat(pix_parts).to(means2d.device)
     n_pix = height * width
-    rgb = torch.zeros(n_pix, D, dtype=colors.dtype, device=colors.device).index_copy(
-        0, pix, torch.cat(rgb_parts)).reshape(height, width, D)
-    alpha = torch.zeros(n_pix, dtype=colors.dtype, device=colors.device).index_copy(
-        0, pix, torch.cat(a_parts)).reshape(height, width)
+    rgb = (
+        torch.zeros(n_pix, D, dtype=colors.dtype, device=colors.device)
+        .index_copy(0, pix, torch.cat(rgb_parts))
+        .reshape(height, width, D)
+    )
+    alpha = (
+        torch.zeros(n_pix, dtype=colors.dtype, device=colors.device)
+        .index_copy(0, pix, torch.cat(a_parts))
+        .reshape(height, width)
+    )
     depth = None
     if return_depth:
-        depth = torch.zeros(n_pix, dtype=colors.dtype, device=colors.device).index_copy(
-            0, pix, torch.cat(d_parts)).reshape(height, width)
+        depth = (
+            torch.zeros(n_pix, dtype=colors.dtype, device=colors.device)
+            .index_copy(0, pix, torch.cat(d_parts))
+            .reshape(height, width)
+        )
     return rgb, alpha, depth

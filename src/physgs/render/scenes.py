@@ -1,4 +1,5 @@
 """Synthetic Gaussian scenes for tests and benchmarks (no testbed needed)."""
+
 from __future__ import annotations
 
 import numpy as np
@@ -7,8 +8,9 @@ import torch
 from physgs.camera import Camera, look_at
 
 
-def random_scene(n: int, width: int, height: int, seed: int, dtype=torch.float32,
-                 opacity_range=(0.1, 0.9)):
+def random_scene(
+    n: int, width: int, height: int, seed: int, dtype=torch.float32, opacity_range=(0.1, 0.9)
+):
     """A canopy-like blob: n Gaussians uniform in a unit ball (world units), seen from 3.5 units.
 
     Scales follow the mean nearest-neighbour spacing (0.6 x (4/3 pi / n)^(1/3), times a random
@@ -25,8 +27,7 @@ def random_scene(n: int, width: int, height: int, seed: int, dtype=torch.float32
     quats = rng.normal(size=(n, 4))
     opac = rng.uniform(*opacity_range, size=n)
     colors = rng.uniform(0, 1, size=(n, 3))
-    cam: Camera = look_at([0.0, -3.5, 0.3], [0.0, 0.0, 0.0], fov_deg=40, width=width,
-                          height=height)
+    cam: Camera = look_at([0.0, -3.5, 0.3], [0.0, 0.0, 0.0], fov_deg=40, width=width, height=height)
     bg = np.array([0.9, 0.95, 1.0])
     t = [torch.as_tensor(x, dtype=dtype) for x in (means, quats, scales, opac, colors)]
     return (*t, cam, torch.as_tensor(bg, dtype=dtype))

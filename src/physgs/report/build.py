@@ -8,6 +8,7 @@ maps each tuple to a path (``workflow/rules/common.smk``) and hands the builders
 ``key(need) -> path``; the builders read only those paths. ``settings_for`` gives the narrow
 settings an output reads, so editing one table's format rebuilds that table only.
 """
+
 from __future__ import annotations
 
 from typing import TYPE_CHECKING, Mapping, Sequence
@@ -27,17 +28,29 @@ from physgs.testbed.stats import load_stats
 if TYPE_CHECKING:
     from physgs.report.tables import Table
 
-TABLES = ("tab_testbed", "tab_psnr", "tab_null", "tab_transfer", "tab_margin", "tab_kselect",
-          "tab_fit", "tab_damping")
+TABLES = (
+    "tab_testbed",
+    "tab_psnr",
+    "tab_null",
+    "tab_transfer",
+    "tab_margin",
+    "tab_kselect",
+    "tab_fit",
+    "tab_damping",
+)
 FIGURES = ("fig_temporal", "fig_teaser", "fig_results", "fig_damping")
 #: The fields of each need tuple after its kind (what a workflow path template is formatted with).
-NEED_FIELDS = {"eval": ("tree", "model", "config", "seed"),
-               "traj": ("tree", "model", "config", "seed"),
-               "panels": ("tree", "model", "config", "seed"),
-               "loss": ("tree", "model", "config", "seed"),
-               "recovery": ("tree", "config", "seed"),
-               "null": ("tree", "K", "seed"), "kselect": ("tree", "seed"), "stats": ("tree",),
-               "table": ("name",)}
+NEED_FIELDS = {
+    "eval": ("tree", "model", "config", "seed"),
+    "traj": ("tree", "model", "config", "seed"),
+    "panels": ("tree", "model", "config", "seed"),
+    "loss": ("tree", "model", "config", "seed"),
+    "recovery": ("tree", "config", "seed"),
+    "null": ("tree", "K", "seed"),
+    "kselect": ("tree", "seed"),
+    "stats": ("tree",),
+    "table": ("name",),
+}
 #: Figures that show one training seed (qualitative: images, trajectories, a damping scatter);
 #: they show the first seed listed.
 ONE_SEED_FIGURES = ("fig_teaser", "fig_results", "fig_damping")
@@ -46,9 +59,12 @@ CLAIMS_TABLES = ("tab_psnr", "tab_transfer", "tab_margin", "tab_null", "tab_test
 CLAIMS_CONFIG = "joint32"
 #: Models (trained in the base configuration) whose evaluation an output reads.
 NEEDS_MODELS = {
-    "tab_psnr": (*MODEL_NAMES, *REFERENCE_NAMES), "tab_transfer": MODEL_NAMES,
-    "tab_margin": ("mlp_wind", "ours"), "fig_temporal": (*MODEL_NAMES, *REFERENCE_NAMES),
-    "fig_teaser": MODEL_NAMES, "fig_results": MODEL_NAMES,
+    "tab_psnr": (*MODEL_NAMES, *REFERENCE_NAMES),
+    "tab_transfer": MODEL_NAMES,
+    "tab_margin": ("mlp_wind", "ours"),
+    "fig_temporal": (*MODEL_NAMES, *REFERENCE_NAMES),
+    "fig_teaser": MODEL_NAMES,
+    "fig_results": MODEL_NAMES,
     "tab_fit": (*MODEL_NAMES, *REFERENCE_NAMES),
 }
 KSELECT_ROWS = tuple(c for c, _ in kselect.ROWS)  # fixed K (single), chosen K (auto)
@@ -59,28 +75,35 @@ def key(need: tuple) -> str:
     return "/".join(str(p) for p in need)
 
 
-def damping_needs(trees: Sequence[str], configs: Sequence[str],
-                  seeds: Sequence[int]) -> list[tuple]:
+def damping_needs(
+    trees: Sequence[str], configs: Sequence[str], seeds: Sequence[int]
+) -> list[tuple]:
     """What tab_damping reads: ours' recovery on each benchmark tree's faithful and damping
     testbeds (``physgs.testbed.variant.damping_id``), per configuration and seed."""
     from physgs.testbed.variant import damping_id
 
-    return [("recovery", tb, c, int(s)) for t in trees for tb in (t, damping_id(t))
-            for c in configs for s in seeds]
+    return [
+        ("recovery", tb, c, int(s))
+        for t in trees
+        for tb in (t, damping_id(t))
+        for c in configs
+        for s in seeds
+    ]
 
 
-def claims_needs(trees: Sequence[str], configs: Mapping[str, dict],
-                 seeds: Sequence[int]) -> list[tuple]:
+def claims_needs(
+    trees: Sequence[str], configs: Mapping[str, dict], seeds: Sequence[int]
+) -> list[tuple]:
     """What the claims ledger reads: the tables' CSVs and ours' recovery (damping) of every seed
     in the joint K=32 configuration (the paper's), or the base configuration when the config
     has none."""
     c = CLAIMS_CONFIG if CLAIMS_CONFIG in configs else BASE_CONFIG
-    return ([("table", n) for n in CLAIMS_TABLES]
-            + [("recovery", t, c, int(s)) for t in trees for s in seeds])
+    return [("table", n) for n in CLAIMS_TABLES] + [
+        ("recovery", t, c, int(s)) for t in trees for s in seeds
+    ]
 
 
-def make_claims(inputs: Mapping[str, str], trees: Sequence[str], md_path, csv_path,
-                stamp=None):
+def make_claims(inputs: Mapping[str, str], trees: Sequence[str], md_path, csv_path, stamp=None):
     """Build the claims ledger (``physgs.report.claims``) from the files in ``inputs`` (need
     key -> path, ``claims_needs``) and write results/claims.md and .csv; returns the ledger."""
     from physgs.atomic import atomic_path, write_text
@@ -92,8 +115,12 @@ def make_claims(inputs: Mapping[str, str], trees: Sequence[str], md_path, csv_pa
         if k.startswith("recovery/"):
             d = load_recovery(p).damping
             damping.setdefault(k.split("/")[1], []).append(
-                {"median_zeta": d.median_zeta, "zeta_true": d.zeta_true,
-                 "loglog_exponent": d.loglog_exponent})
+                {
+                    "median_zeta": d.median_zeta,
+                    "zeta_true": d.zeta_true,
+                    "loglog_exponent": d.loglog_exponent,
+                }
+            )
     df = claims.ledger(claims.measure(tabs, damping, trees))
     sd = stamp.to_dict() if stamp is not None else None
     write_text(md_path, claims.ledger_markdown(df, sd))
@@ -102,8 +129,9 @@ def make_claims(inputs: Mapping[str, str], trees: Sequence[str], md_path, csv_pa
     return df
 
 
-def needs(name: str, trees: Sequence[str], configs: Mapping[str, dict],
-          seeds: Sequence[int]) -> list[tuple]:
+def needs(
+    name: str, trees: Sequence[str], configs: Mapping[str, dict], seeds: Sequence[int]
+) -> list[tuple]:
     """Every result an output reads, as need tuples (see the module docstring).
 
     configs: the config's ``models.configs`` (name -> {conditions, K}); the null control is
@@ -129,13 +157,17 @@ def needs(name: str, trees: Sequence[str], configs: Mapping[str, dict],
         if name in ("tab_null", "fig_damping"):
             out += [("recovery", t, c, s) for t in trees for c in configs]
         if name == "tab_null":
-            out += list(dict.fromkeys(("null", t, int(configs[c]["K"]), s)
-                                      for t in trees for c in configs))
+            out += list(
+                dict.fromkeys(("null", t, int(configs[c]["K"]), s) for t in trees for c in configs)
+            )
         if name == "tab_kselect":
             for t in trees:
                 out.append(("kselect", t, s))
-                out += [x for c in KSELECT_ROWS
-                        for x in (("eval", t, "ours", c, s), ("recovery", t, c, s))]
+                out += [
+                    x
+                    for c in KSELECT_ROWS
+                    for x in (("eval", t, "ours", c, s), ("recovery", t, c, s))
+                ]
     if name == "tab_testbed":
         out += [("stats", t) for t in trees]
     return out
@@ -146,8 +178,10 @@ def settings_for(name: str, cfg: dict) -> dict:
     trees = list(cfg["damping_benchmark"]["trees"] if name == "tab_damping" else cfg["trees"])
     out = {"trees": trees, "bones": {t: int(cfg["presets"][t]["bones"]) for t in trees}}
     if name == "tab_damping":
-        out["configs"] = {c: config_label(c, cfg["models"]["configs"][c])
-                          for c in cfg["damping_benchmark"]["configs"]}
+        out["configs"] = {
+            c: config_label(c, cfg["models"]["configs"][c])
+            for c in cfg["damping_benchmark"]["configs"]
+        }
     if name not in ("tab_testbed", *ONE_SEED_FIGURES):
         out["seeds"] = [int(x) for x in cfg["seeds"]]
     elif name in ONE_SEED_FIGURES:
@@ -155,8 +189,10 @@ def settings_for(name: str, cfg: dict) -> dict:
     if name in TABLES:
         out["digits"] = int(cfg["report"][name]["digits"])
     if name in ("tab_null", "fig_damping"):
-        out["configs"] = {c: {"K": int(v["K"]), "conditions": v["conditions"]}
-                          for c, v in cfg["models"]["configs"].items()}
+        out["configs"] = {
+            c: {"K": int(v["K"]), "conditions": v["conditions"]}
+            for c, v in cfg["models"]["configs"].items()
+        }
     if name in ("tab_transfer", "tab_margin", "fig_teaser", "fig_results"):
         out["conditions"] = [float(c) for c in cfg["testbed"]["conditions"]]
     if name in ("fig_temporal", "tab_fit"):
@@ -174,16 +210,25 @@ def _reader(inputs: Mapping[str, str]):
     def path(*need) -> str:
         k = key(need)
         if k not in inputs:
-            raise KeyError(f"no input file for {k!r}; the rule must declare report needs "
-                           f"(physgs.report.build.needs)")
+            raise KeyError(
+                f"no input file for {k!r}; the rule must declare report needs "
+                f"(physgs.report.build.needs)"
+            )
         return inputs[k]
+
     return path
 
 
 def _summaries(path, trees, models, seeds):
     """{seed: {(tree, model): summary}} of the models trained ``single``."""
-    return {s: {(t, m): load_eval(path("eval", t, m, BASE_CONFIG, s)).summary()
-                for t in trees for m in models} for s in seeds}
+    return {
+        s: {
+            (t, m): load_eval(path("eval", t, m, BASE_CONFIG, s)).summary()
+            for t in trees
+            for m in models
+        }
+        for s in seeds
+    }
 
 
 def fit_row(eval_path, loss_path, n_train: int, holdout_every: int) -> dict:
@@ -197,13 +242,18 @@ def fit_row(eval_path, loss_path, n_train: int, holdout_every: int) -> dict:
         trained, held = np.arange(n_train), np.arange(0)
     s = ev.summary()
     secs = pd.read_csv(loss_path)["seconds"]
-    return {"fit": float(cam[trained].mean()),
-            "heldout": float(cam[held].mean()) if held.size else float("nan"),
-            "view": s["view"], "time": s["time"], "train_s": float(secs.iloc[-1])}
+    return {
+        "fit": float(cam[trained].mean()),
+        "heldout": float(cam[held].mean()) if held.size else float("nan"),
+        "view": s["view"],
+        "time": s["time"],
+        "train_s": float(secs.iloc[-1]),
+    }
 
 
-def make_table(name: str, inputs: Mapping[str, str], settings: dict, tex_path, csv_path,
-               stamp=None) -> Table:
+def make_table(
+    name: str, inputs: Mapping[str, str], settings: dict, tex_path, csv_path, stamp=None
+) -> Table:
     """Build table ``name`` from the files in ``inputs`` (need key -> path) and write its .tex
     and .csv. settings: ``settings_for(name, cfg)``; stamp: a ``physgs.provenance.Stamp``
     written into every CSV row (profile, config hash, package version)."""
@@ -213,30 +263,70 @@ def make_table(name: str, inputs: Mapping[str, str], settings: dict, tex_path, c
     trees, bones, d = settings["trees"], settings["bones"], settings.get("digits", 2)
     seeds = [int(x) for x in settings.get("seeds", ())]
     if name == "tab_testbed":
-        table = tables.tab_testbed({t: load_stats(path("stats", t)) for t in trees}, trees,
-                                   digits=d)
+        table = tables.tab_testbed(
+            {t: load_stats(path("stats", t)) for t in trees}, trees, digits=d
+        )
     elif name == "tab_psnr":
-        table = tables.tab_psnr(_summaries(path, trees, (*MODEL_NAMES, *REFERENCE_NAMES), seeds),
-                                trees, bones, digits=d, references=REFERENCE_NAMES)
+        table = tables.tab_psnr(
+            _summaries(path, trees, (*MODEL_NAMES, *REFERENCE_NAMES), seeds),
+            trees,
+            bones,
+            digits=d,
+            references=REFERENCE_NAMES,
+        )
     elif name == "tab_fit":
-        rows = {s: {(t, m): fit_row(path("eval", t, m, BASE_CONFIG, s),
-                                    path("loss", t, m, BASE_CONFIG, s),
-                                    int(settings["n_train"]), int(settings["holdout_every"]))
-                    for t in trees for m in NEEDS_MODELS[name]} for s in seeds}
-        table = tables.tab_fit(rows, trees, bones, MODEL_NAMES, REFERENCE_NAMES[0], digits=d,
-                               holdout_every=int(settings["holdout_every"]))
+        rows = {
+            s: {
+                (t, m): fit_row(
+                    path("eval", t, m, BASE_CONFIG, s),
+                    path("loss", t, m, BASE_CONFIG, s),
+                    int(settings["n_train"]),
+                    int(settings["holdout_every"]),
+                )
+                for t in trees
+                for m in NEEDS_MODELS[name]
+            }
+            for s in seeds
+        }
+        table = tables.tab_fit(
+            rows,
+            trees,
+            bones,
+            MODEL_NAMES,
+            REFERENCE_NAMES[0],
+            digits=d,
+            holdout_every=int(settings["holdout_every"]),
+        )
     elif name == "tab_transfer":
-        table = tables.tab_transfer(_summaries(path, trees, MODEL_NAMES, seeds), trees, bones,
-                                    settings["conditions"], digits=d)
+        table = tables.tab_transfer(
+            _summaries(path, trees, MODEL_NAMES, seeds),
+            trees,
+            bones,
+            settings["conditions"],
+            digits=d,
+        )
     elif name == "tab_margin":
-        table = tables.tab_margin(_summaries(path, trees, ("mlp_wind", "ours"), seeds), trees,
-                                  bones, settings["conditions"], digits=d)
+        table = tables.tab_margin(
+            _summaries(path, trees, ("mlp_wind", "ours"), seeds),
+            trees,
+            bones,
+            settings["conditions"],
+            digits=d,
+        )
     elif name == "tab_null":
         configs = settings["configs"]
-        rec = {s: {(t, c): load_recovery(path("recovery", t, c, s)) for t in trees for c in configs}
-               for s in seeds}
-        null = {s: {(t, c): load_null(path("null", t, int(configs[c]["K"]), s))
-                    for t in trees for c in configs} for s in seeds}
+        rec = {
+            s: {(t, c): load_recovery(path("recovery", t, c, s)) for t in trees for c in configs}
+            for s in seeds
+        }
+        null = {
+            s: {
+                (t, c): load_null(path("null", t, int(configs[c]["K"]), s))
+                for t in trees
+                for c in configs
+            }
+            for s in seeds
+        }
         labels = {c: config_label(c, v) for c, v in configs.items()}
         table = tables.tab_null(rec, null, trees, bones, labels, digits=d)
     elif name == "tab_damping":
@@ -244,8 +334,15 @@ def make_table(name: str, inputs: Mapping[str, str], settings: dict, tex_path, c
         from physgs.testbed.variant import DAMPING, FAITHFUL, damping_id
 
         ids = {FAITHFUL: lambda t: t, DAMPING: damping_id}
-        rows = {s: {(t, v, c): load_recovery(path("recovery", ids[v](t), c, s))
-                    for t in trees for v in ids for c in settings["configs"]} for s in seeds}
+        rows = {
+            s: {
+                (t, v, c): load_recovery(path("recovery", ids[v](t), c, s))
+                for t in trees
+                for v in ids
+                for c in settings["configs"]
+            }
+            for s in seeds
+        }
         table = tab_damping(rows, trees, bones, settings["configs"], digits=d)
     elif name == "tab_kselect":
         rows = {}
@@ -256,10 +353,15 @@ def make_table(name: str, inputs: Mapping[str, str], settings: dict, tex_path, c
                 for c in KSELECT_ROWS:
                     ev = load_eval(path("eval", t, "ours", c, s)).summary()
                     rec = load_recovery(path("recovery", t, c, s))
-                    rows[s][(t, c)] = {"K": rec.match.n_parts, "time_psnr": ev["time"],
-                                       "median_rel_err": rec.match.median_rel_err,
-                                       "trusted": rec.match.n_trusted, "frozen": rec.n_frozen,
-                                       "k_heldout": sel.k_heldout, "k_bic": sel.k_bic}
+                    rows[s][(t, c)] = {
+                        "K": rec.match.n_parts,
+                        "time_psnr": ev["time"],
+                        "median_rel_err": rec.match.median_rel_err,
+                        "trusted": rec.match.n_trusted,
+                        "frozen": rec.n_frozen,
+                        "k_heldout": sel.k_heldout,
+                        "k_bic": sel.k_bic,
+                    }
         table = kselect.tab_kselect(rows, trees, bones, settings["method"], digits=d)
     else:
         raise ValueError(f"unknown table '{name}'; choose one of {TABLES}")
@@ -272,8 +374,9 @@ def _teaser_tree(trees: Sequence[str]) -> str:
     return "medium" if "medium" in trees else trees[-1]
 
 
-def make_figure(name: str, inputs: Mapping[str, str], settings: dict,
-                outputs: Sequence[str]) -> None:
+def make_figure(
+    name: str, inputs: Mapping[str, str], settings: dict, outputs: Sequence[str]
+) -> None:
     """Build figure ``name`` from the files in ``inputs`` (need key -> path), written to every
     path in ``outputs``. settings: ``settings_for(name, cfg)``."""
     from physgs.report import figures  # matplotlib: not for the workflow's planning imports
@@ -283,9 +386,13 @@ def make_figure(name: str, inputs: Mapping[str, str], settings: dict,
     seeds = [int(x) for x in settings["seeds"]]
     s0 = seeds[0]  # what the one-seed figures show
     if name == "fig_temporal":
-        curves = {(t, m): np.stack([load_eval(path("eval", t, m, BASE_CONFIG, s)).temporal_psnr
-                                    for s in seeds])
-                  for t in trees for m in NEEDS_MODELS[name]}
+        curves = {
+            (t, m): np.stack(
+                [load_eval(path("eval", t, m, BASE_CONFIG, s)).temporal_psnr for s in seeds]
+            )
+            for t in trees
+            for m in NEEDS_MODELS[name]
+        }
         figures.fig_temporal(curves, trees, int(settings["n_train"]), outputs)
     elif name == "fig_teaser":
         t = _teaser_tree(trees)
@@ -294,8 +401,9 @@ def make_figure(name: str, inputs: Mapping[str, str], settings: dict,
         shown = ("ours", base)
         traj = {m: load_trajectories(path("traj", t, m, BASE_CONFIG, s0)) for m in shown}
         cen = {m: evals[m].centroid_err for m in shown}
-        figures.fig_teaser(traj, cen, settings["conditions"], outputs,
-                           title=f"{t} tree, training seed {s0}")
+        figures.fig_teaser(
+            traj, cen, settings["conditions"], outputs, title=f"{t} tree, training seed {s0}"
+        )
     elif name == "fig_results":
         rows, images = [], {}
         for t in trees:
@@ -305,12 +413,18 @@ def make_figure(name: str, inputs: Mapping[str, str], settings: dict,
                 rows.append(row)
                 images[(row, "gt")] = (panels["ours"][f"{split}_gt"], None)
                 for m in MODEL_NAMES:
-                    images[(row, m)] = (panels[m][f"{split}_pred"], float(panels[m][f"{split}_psnr"]))
+                    images[(row, m)] = (
+                        panels[m][f"{split}_pred"],
+                        float(panels[m][f"{split}_psnr"]),
+                    )
         figures.fig_results(rows, ["gt", *MODEL_NAMES], images, outputs)
     elif name == "fig_damping":
         configs = list(settings["configs"])
-        damping = {(t, c): load_recovery(path("recovery", t, c, s0)).damping
-                   for t in trees for c in configs}
+        damping = {
+            (t, c): load_recovery(path("recovery", t, c, s0)).damping
+            for t in trees
+            for c in configs
+        }
         figures.fig_damping(damping, trees, configs, float(settings["zeta"]), outputs)
     else:
         raise ValueError(f"unknown figure '{name}'; choose one of {FIGURES}")

@@ -11,6 +11,7 @@ falls on). A claim about the fixed testbed (the nearest-bone gap) needs none.
 The tables give one value per seed: a table whose CSV has a ``seed`` column contributes one
 value per seed, one without it (today's single-seed pipeline) contributes one value.
 """
+
 from __future__ import annotations
 
 from dataclasses import dataclass
@@ -22,20 +23,51 @@ from physgs.report import paper
 from physgs.report.seeds import interval
 
 LEARNED = ("mlp", "mlp_wind", "d3dgs", "d3dgs_wind")
-LABELS = {"static": "Static pose", "mlp": "Deformation MLP", "mlp_wind": "Deformation MLP + wind",
-          "d3dgs": "Deformable-3DGS", "d3dgs_wind": "Deformable-3DGS + wind", "ours": "Ours"}
+LABELS = {
+    "static": "Static pose",
+    "mlp": "Deformation MLP",
+    "mlp_wind": "Deformation MLP + wind",
+    "d3dgs": "Deformable-3DGS",
+    "d3dgs_wind": "Deformable-3DGS + wind",
+    "ours": "Ours",
+}
 #: The paper's own figures for each tree (tables 1-4 and section 4).
 PAPER_PSNR = {  # tab:psnr, (view, time)
-    "sparse": {"static": (24.99, 25.16), "mlp": (25.45, 25.02), "mlp_wind": (26.39, 24.75),
-               "d3dgs": (26.01, 24.25), "d3dgs_wind": (25.49, 24.53), "ours": (25.24, 25.42)},
-    "medium": {"static": (25.35, 24.70), "mlp": (27.88, 23.07), "mlp_wind": (27.93, 23.53),
-               "d3dgs": (27.66, 23.07), "d3dgs_wind": (27.75, 23.56), "ours": (26.37, 27.50)},
-    "dense": {"static": (25.08, 24.09), "mlp": (26.59, 23.19), "mlp_wind": (26.44, 23.67),
-              "d3dgs": (26.58, 22.65), "d3dgs_wind": (26.49, 23.31), "ours": (25.66, 26.14)},
+    "sparse": {
+        "static": (24.99, 25.16),
+        "mlp": (25.45, 25.02),
+        "mlp_wind": (26.39, 24.75),
+        "d3dgs": (26.01, 24.25),
+        "d3dgs_wind": (25.49, 24.53),
+        "ours": (25.24, 25.42),
+    },
+    "medium": {
+        "static": (25.35, 24.70),
+        "mlp": (27.88, 23.07),
+        "mlp_wind": (27.93, 23.53),
+        "d3dgs": (27.66, 23.07),
+        "d3dgs_wind": (27.75, 23.56),
+        "ours": (26.37, 27.50),
+    },
+    "dense": {
+        "static": (25.08, 24.09),
+        "mlp": (26.59, 23.19),
+        "mlp_wind": (26.44, 23.67),
+        "d3dgs": (26.58, 22.65),
+        "d3dgs_wind": (26.49, 23.31),
+        "ours": (25.66, 26.14),
+    },
 }
-PAPER_NULL = {"sparse": (1.80, 4.56), "medium": (1.60, 1.77), "dense": (2.40, 1.56)}  # trained, null %
-PAPER_MARGIN = {"sparse": (-1.42, -1.21, -0.61), "medium": (-0.60, 0.46, 1.67),
-                "dense": (-0.03, -0.11, 0.75)}
+PAPER_NULL = {
+    "sparse": (1.80, 4.56),
+    "medium": (1.60, 1.77),
+    "dense": (2.40, 1.56),
+}  # trained, null %
+PAPER_MARGIN = {
+    "sparse": (-1.42, -1.21, -0.61),
+    "medium": (-0.60, 0.46, 1.67),
+    "dense": (-0.03, -0.11, 0.75),
+}
 PAPER_ZETA = {"sparse": "0.095-0.102", "medium": "0.125-0.142", "dense": "0.125-0.142"}
 DAMPING_OFF = 0.10  # |median zeta_hat - zeta| / zeta above this: damping not recovered
 RATE_EXPONENT = 0.5  # gamma ~ omega^p with p below this: the decay rate is nearly omega-free
@@ -85,8 +117,11 @@ def _psnr(df, tree, model, split):
     return float(df.loc[df["model"] == LABELS[model], f"{tree}_{split}"].iloc[0])
 
 
-def measure(tables: Mapping[str, pd.DataFrame], damping: Mapping[str, Mapping[str, float]],
-            trees: Sequence[str]) -> list[tuple[Claim, list[float]]]:
+def measure(
+    tables: Mapping[str, pd.DataFrame],
+    damping: Mapping[str, Mapping[str, float]],
+    trees: Sequence[str],
+) -> list[tuple[Claim, list[float]]]:
     """Every claim with its per-seed values, from the tables' CSVs (tab_psnr, tab_transfer,
     tab_margin, tab_null, tab_testbed and, when given, tab_fit) and ours' damping summaries (tree -> median_zeta,
     loglog_exponent, zeta_true, for the joint K=32 configuration)."""
@@ -99,112 +134,233 @@ def measure(tables: Mapping[str, pd.DataFrame], damping: Mapping[str, Mapping[st
         pp = PAPER_PSNR.get(t, {})
         if pp:
             base_time = max(pp[m][1] - pp["static"][1] for m in LEARNED)
-        add(Claim(f"baselines_below_static_beyond/{t}",
-                  f"{t}: every learned baseline is below the static pose beyond the window",
-                  f"best baseline - static = {base_time:+.2f} dB" if pp else "--",
-                  "tab_psnr, time column: max over learned fields of (model - static)",
-                  0.0, "<", "dB"), "tab_psnr",
-            lambda d, t=t: max(_psnr(d, t, m, "time") for m in LEARNED) - _psnr(d, t, "static", "time"))
-        add(Claim(f"ours_above_static_beyond/{t}",
-                  f"{t}: ours is above the static pose beyond the window",
-                  f"{pp['ours'][1] - pp['static'][1]:+.2f} dB" if pp else "--",
-                  "tab_psnr, time column: ours - static", 0.0, ">", "dB"), "tab_psnr",
-            lambda d, t=t: _psnr(d, t, "ours", "time") - _psnr(d, t, "static", "time"))
-        add(Claim(f"ours_behind_on_views/{t}",
-                  f"{t}: ours is behind the best learned field on held-out views",
-                  f"{pp['ours'][0] - max(pp[m][0] for m in LEARNED):+.2f} dB" if pp else "--",
-                  "tab_psnr, view column: ours - max over learned fields", 0.0, "<", "dB"),
+        add(
+            Claim(
+                f"baselines_below_static_beyond/{t}",
+                f"{t}: every learned baseline is below the static pose beyond the window",
+                f"best baseline - static = {base_time:+.2f} dB" if pp else "--",
+                "tab_psnr, time column: max over learned fields of (model - static)",
+                0.0,
+                "<",
+                "dB",
+            ),
             "tab_psnr",
-            lambda d, t=t: _psnr(d, t, "ours", "view") - max(_psnr(d, t, m, "view") for m in LEARNED))
+            lambda d, t=t: (
+                max(_psnr(d, t, m, "time") for m in LEARNED) - _psnr(d, t, "static", "time")
+            ),
+        )
+        add(
+            Claim(
+                f"ours_above_static_beyond/{t}",
+                f"{t}: ours is above the static pose beyond the window",
+                f"{pp['ours'][1] - pp['static'][1]:+.2f} dB" if pp else "--",
+                "tab_psnr, time column: ours - static",
+                0.0,
+                ">",
+                "dB",
+            ),
+            "tab_psnr",
+            lambda d, t=t: _psnr(d, t, "ours", "time") - _psnr(d, t, "static", "time"),
+        )
+        add(
+            Claim(
+                f"ours_behind_on_views/{t}",
+                f"{t}: ours is behind the best learned field on held-out views",
+                f"{pp['ours'][0] - max(pp[m][0] for m in LEARNED):+.2f} dB" if pp else "--",
+                "tab_psnr, view column: ours - max over learned fields",
+                0.0,
+                "<",
+                "dB",
+            ),
+            "tab_psnr",
+            lambda d, t=t: (
+                _psnr(d, t, "ours", "view") - max(_psnr(d, t, m, "view") for m in LEARNED)
+            ),
+        )
 
     for t in trees:
         tr, nl = PAPER_NULL.get(t, (np.nan, np.nan))
         sel = lambda d, t=t: d[(d["tree"] == t) & (d["config"] == "joint32")]  # noqa: E731
         if t == "sparse":
-            add(Claim("null_loses/sparse", "sparse: joint training beats the untrained null",
-                      f"null / trained = {nl / tr:.2f}", "tab_null, joint32: null / trained "
-                      "median rel. error", 1.0, ">", "ratio"), "tab_null",
-                lambda d: float(sel(d)["null_median_rel_err_pct"].iloc[0]
-                                / sel(d)["trained_median_rel_err_pct"].iloc[0]))
-            add(Claim("null_factor/sparse", "sparse: ... by the paper's factor of 2.5",
-                      f"null / trained = {nl / tr:.2f}", "tab_null, joint32: null / trained",
-                      2.5, ">", "ratio"), "tab_null",
-                lambda d: float(sel(d)["null_median_rel_err_pct"].iloc[0]
-                                / sel(d)["trained_median_rel_err_pct"].iloc[0]))
+            add(
+                Claim(
+                    "null_loses/sparse",
+                    "sparse: joint training beats the untrained null",
+                    f"null / trained = {nl / tr:.2f}",
+                    "tab_null, joint32: null / trained median rel. error",
+                    1.0,
+                    ">",
+                    "ratio",
+                ),
+                "tab_null",
+                lambda d: float(
+                    sel(d)["null_median_rel_err_pct"].iloc[0]
+                    / sel(d)["trained_median_rel_err_pct"].iloc[0]
+                ),
+            )
+            add(
+                Claim(
+                    "null_factor/sparse",
+                    "sparse: ... by the paper's factor of 2.5",
+                    f"null / trained = {nl / tr:.2f}",
+                    "tab_null, joint32: null / trained",
+                    2.5,
+                    ">",
+                    "ratio",
+                ),
+                "tab_null",
+                lambda d: float(
+                    sel(d)["null_median_rel_err_pct"].iloc[0]
+                    / sel(d)["trained_median_rel_err_pct"].iloc[0]
+                ),
+            )
         else:
-            add(Claim(f"null_matches/{t}",
-                      f"{t}: the untrained null matches the trained model (it is not beaten by "
-                      f"{NULL_MATCH_PP} points or more)",
-                      f"trained - null = {tr - nl:+.2f} points",
-                      "tab_null, joint32: trained - null median rel. error (points)",
-                      -NULL_MATCH_PP, ">", "points"), "tab_null",
-                lambda d: float(sel(d)["trained_median_rel_err_pct"].iloc[0]
-                                - sel(d)["null_median_rel_err_pct"].iloc[0]))
+            add(
+                Claim(
+                    f"null_matches/{t}",
+                    f"{t}: the untrained null matches the trained model (it is not beaten by "
+                    f"{NULL_MATCH_PP} points or more)",
+                    f"trained - null = {tr - nl:+.2f} points",
+                    "tab_null, joint32: trained - null median rel. error (points)",
+                    -NULL_MATCH_PP,
+                    ">",
+                    "points",
+                ),
+                "tab_null",
+                lambda d: float(
+                    sel(d)["trained_median_rel_err_pct"].iloc[0]
+                    - sel(d)["null_median_rel_err_pct"].iloc[0]
+                ),
+            )
         gap = paper.NEAREST_BONE_GAP_PCT.get(t)
         if gap is not None:
-            add(Claim(f"nearest_bone_gap/{t}",
-                      f"{t}: the median nearest-bone gap is the paper's (within "
-                      f"{GAP_RTOL:.0%} of it)", f"{gap:.2f}%",
-                      "tab_testbed: |gap - paper| / paper", GAP_RTOL, "<", "fraction",
-                      needs_variance=False), "tab_testbed",
-                lambda d, t=t, g=gap: abs(float(d.loc[d["tree"] == t, "nearest_bone_gap_pct"]
-                                                .iloc[0]) - g) / g)
+            add(
+                Claim(
+                    f"nearest_bone_gap/{t}",
+                    f"{t}: the median nearest-bone gap is the paper's (within "
+                    f"{GAP_RTOL:.0%} of it)",
+                    f"{gap:.2f}%",
+                    "tab_testbed: |gap - paper| / paper",
+                    GAP_RTOL,
+                    "<",
+                    "fraction",
+                    needs_variance=False,
+                ),
+                "tab_testbed",
+                lambda d, t=t, g=gap: (
+                    abs(float(d.loc[d["tree"] == t, "nearest_bone_gap_pct"].iloc[0]) - g) / g
+                ),
+            )
 
     for t in trees:
         dmp = damping.get(t)
         if dmp is None:
             continue
-        out.append((Claim(f"damping_not_recovered/{t}",
-                          f"{t}: damping is not recovered (median zeta_hat off the truth by more "
-                          f"than {DAMPING_OFF:.0%})", f"median zeta_hat {PAPER_ZETA.get(t)} vs 0.08",
-                          "recovery (joint32): |median zeta_hat - zeta| / zeta",
-                          DAMPING_OFF, ">", "fraction"),
-                    [abs(v["median_zeta"] - v["zeta_true"]) / v["zeta_true"] for v in dmp]))
-        out.append((Claim(f"decay_rate_flat/{t}",
-                          f"{t}: the fitted decay rate gamma = zeta*omega is nearly "
-                          f"frequency-independent (gamma ~ omega^p, p < {RATE_EXPONENT})",
-                          "nearly frequency-independent", "recovery (joint32): exponent p",
-                          RATE_EXPONENT, "<", "exponent"),
-                    [v["loglog_exponent"] for v in dmp]))
+        out.append(
+            (
+                Claim(
+                    f"damping_not_recovered/{t}",
+                    f"{t}: damping is not recovered (median zeta_hat off the truth by more "
+                    f"than {DAMPING_OFF:.0%})",
+                    f"median zeta_hat {PAPER_ZETA.get(t)} vs 0.08",
+                    "recovery (joint32): |median zeta_hat - zeta| / zeta",
+                    DAMPING_OFF,
+                    ">",
+                    "fraction",
+                ),
+                [abs(v["median_zeta"] - v["zeta_true"]) / v["zeta_true"] for v in dmp],
+            )
+        )
+        out.append(
+            (
+                Claim(
+                    f"decay_rate_flat/{t}",
+                    f"{t}: the fitted decay rate gamma = zeta*omega is nearly "
+                    f"frequency-independent (gamma ~ omega^p, p < {RATE_EXPONENT})",
+                    "nearly frequency-independent",
+                    "recovery (joint32): exponent p",
+                    RATE_EXPONENT,
+                    "<",
+                    "exponent",
+                ),
+                [v["loglog_exponent"] for v in dmp],
+            )
+        )
 
     if "tab_fit" in tables:  # the premise of every comparison: the fields fit their window
         for t in trees:
             for m in (*LEARNED, "ours"):
-                add(Claim(f"fits_window/{t}/{m}",
-                          f"{t}: {LABELS[m]} fits its training window (reaches {FIT_BAR:.0%} of "
-                          "the true-motion ceiling's in-window gain over static)",
-                          "the fields 'fit the training window well'",
-                          "tab_fit: (fit - static) / (ceiling - static) on the trained frames",
-                          FIT_BAR, ">", "fraction"), "tab_fit",
-                    lambda d, t=t, m=m: float(d.loc[(d["tree"] == t) & (d["model"] == m),
-                                                    "ceiling_frac"].iloc[0]))
+                add(
+                    Claim(
+                        f"fits_window/{t}/{m}",
+                        f"{t}: {LABELS[m]} fits its training window (reaches {FIT_BAR:.0%} of "
+                        "the true-motion ceiling's in-window gain over static)",
+                        "the fields 'fit the training window well'",
+                        "tab_fit: (fit - static) / (ceiling - static) on the trained frames",
+                        FIT_BAR,
+                        ">",
+                        "fraction",
+                    ),
+                    "tab_fit",
+                    lambda d, t=t, m=m: float(
+                        d.loc[(d["tree"] == t) & (d["model"] == m), "ceiling_frac"].iloc[0]
+                    ),
+                )
 
     tr = tables["tab_transfer"]
     beyond = tr[tr["split"] == "beyond"] if "split" in tr.columns else tr
     for (t, c), _ in beyond.groupby(["tree", "condition"], sort=False):
-        cell = lambda d, t=t, c=c: d[(d["split"] == "beyond") & (d["tree"] == t)  # noqa: E731
-                                     & np.isclose(d["condition"], c)].iloc[0]
-        add(Claim(f"transfer_ours_ahead/{t}/{c:.2f}",
-                  f"{t}, {c:.2f} v0, beyond the window: ours ahead of the best baseline",
-                  "ahead in every cell, by 0.38-4.68 dB", "tab_transfer (beyond): ours - max "
-                  "learned", 0.0, ">", "dB"), "tab_transfer",
-            lambda d, cell=cell: float(cell(d)["ours"] - max(cell(d)[m] for m in LEARNED)))
-        add(Claim(f"transfer_baselines_below_static/{t}/{c:.2f}",
-                  f"{t}, {c:.2f} v0, beyond the window: every learned baseline below static",
-                  "below static in all 24 cells, by 0.10-2.79 dB",
-                  "tab_transfer (beyond): max learned - static", 0.0, "<", "dB"), "tab_transfer",
-            lambda d, cell=cell: float(max(cell(d)[m] for m in LEARNED) - cell(d)["static"]))
+        cell = lambda d, t=t, c=c: d[
+            (d["split"] == "beyond")
+            & (d["tree"] == t)  # noqa: E731
+            & np.isclose(d["condition"], c)
+        ].iloc[0]
+        add(
+            Claim(
+                f"transfer_ours_ahead/{t}/{c:.2f}",
+                f"{t}, {c:.2f} v0, beyond the window: ours ahead of the best baseline",
+                "ahead in every cell, by 0.38-4.68 dB",
+                "tab_transfer (beyond): ours - max learned",
+                0.0,
+                ">",
+                "dB",
+            ),
+            "tab_transfer",
+            lambda d, cell=cell: float(cell(d)["ours"] - max(cell(d)[m] for m in LEARNED)),
+        )
+        add(
+            Claim(
+                f"transfer_baselines_below_static/{t}/{c:.2f}",
+                f"{t}, {c:.2f} v0, beyond the window: every learned baseline below static",
+                "below static in all 24 cells, by 0.10-2.79 dB",
+                "tab_transfer (beyond): max learned - static",
+                0.0,
+                "<",
+                "dB",
+            ),
+            "tab_transfer",
+            lambda d, cell=cell: float(max(cell(d)[m] for m in LEARNED) - cell(d)["static"]),
+        )
 
     mg = tables["tab_margin"]
     cols = [c for c in mg.columns if c.startswith("margin_")]
     for t in trees:
         p = PAPER_MARGIN.get(t)
-        add(Claim(f"margin_grows/{t}",
-                  f"{t}: the margin against MLP + wind grows as the wind departs from training",
-                  f"{p[-1] - p[0]:+.2f} dB" if p else "--",
-                  f"tab_margin: {cols[-1]} - {cols[0]}", 0.0, ">", "dB"), "tab_margin",
-            lambda d, t=t: float(d.loc[d["tree"] == t, cols[-1]].iloc[0]
-                                 - d.loc[d["tree"] == t, cols[0]].iloc[0]))
+        add(
+            Claim(
+                f"margin_grows/{t}",
+                f"{t}: the margin against MLP + wind grows as the wind departs from training",
+                f"{p[-1] - p[0]:+.2f} dB" if p else "--",
+                f"tab_margin: {cols[-1]} - {cols[0]}",
+                0.0,
+                ">",
+                "dB",
+            ),
+            "tab_margin",
+            lambda d, t=t: float(
+                d.loc[d["tree"] == t, cols[-1]].iloc[0] - d.loc[d["tree"] == t, cols[0]].iloc[0]
+            ),
+        )
     return out
 
 
@@ -214,31 +370,51 @@ def ledger(measured: Sequence[tuple[Claim, list[float]]]) -> pd.DataFrame:
     rows = []
     for c, values in measured:
         m, sd, lo, hi = interval(values)
-        rows.append({"id": c.id, "claim": c.text, "paper": c.paper, "measured": m, "sd": sd,
-                     "ci_low": lo, "ci_high": hi, "seeds": int(np.isfinite(values).sum()),
-                     "unit": c.unit, "threshold": f"{c.side} {c.threshold:g}",
-                     "verdict": verdict(c, values), "source": c.source})
+        rows.append(
+            {
+                "id": c.id,
+                "claim": c.text,
+                "paper": c.paper,
+                "measured": m,
+                "sd": sd,
+                "ci_low": lo,
+                "ci_high": hi,
+                "seeds": int(np.isfinite(values).sum()),
+                "unit": c.unit,
+                "threshold": f"{c.side} {c.threshold:g}",
+                "verdict": verdict(c, values),
+                "source": c.source,
+            }
+        )
     return pd.DataFrame(rows)
 
 
 def ledger_markdown(df: pd.DataFrame, stamp: Mapping[str, str] | None = None) -> str:
     """The ledger as a Markdown page (results/claims.md)."""
     counts = df["verdict"].str.split(":").str[0].value_counts().to_dict()
-    lines = ["# Claims ledger", "",
-             "Each claim of the paper, measured by this pipeline; verdicts are computed by "
-             "`physgs.report.claims` (holds / fails when the seed interval lies on one side of "
-             "the threshold, undecided when it straddles it or when one seed gives no interval).",
-             ""]
+    lines = [
+        "# Claims ledger",
+        "",
+        "Each claim of the paper, measured by this pipeline; verdicts are computed by "
+        "`physgs.report.claims` (holds / fails when the seed interval lies on one side of "
+        "the threshold, undecided when it straddles it or when one seed gives no interval).",
+        "",
+    ]
     if stamp:
         lines += ["Made by: " + ", ".join(f"{k}={v}" for k, v in stamp.items()), ""]
-    lines += ["Verdicts: " + ", ".join(f"{k} {v}" for k, v in sorted(counts.items())), "",
-              "| claim | paper | measured | threshold | verdict | from |", "|---|---|---|---|---|---|"]
+    lines += [
+        "Verdicts: " + ", ".join(f"{k} {v}" for k, v in sorted(counts.items())),
+        "",
+        "| claim | paper | measured | threshold | verdict | from |",
+        "|---|---|---|---|---|---|",
+    ]
     for _, r in df.iterrows():
         meas = "--" if not np.isfinite(r.measured) else f"{r.measured:+.3g} {r.unit}"
         if np.isfinite(r.ci_low):
             meas += f" [{r.ci_low:+.3g}, {r.ci_high:+.3g}], {r.seeds} seeds"
         elif np.isfinite(r.measured):
             meas += f", {r.seeds} seed"
-        lines.append(f"| {r.claim} | {r.paper} | {meas} | {r.threshold} | **{r.verdict}** | "
-                     f"{r.source} |")
+        lines.append(
+            f"| {r.claim} | {r.paper} | {meas} | {r.threshold} | **{r.verdict}** | {r.source} |"
+        )
     return "\n".join(lines) + "\n"

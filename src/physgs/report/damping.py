@@ -10,6 +10,7 @@ ratio gives the truth's p, 1 for a constant zeta), each beside the untrained nul
 log-uniformly from the damping range, scored on the same matching; medians over its draws).
 Built from the recovery records (``physgs.recovery.record``, ``damping_scores``/``damping_null``).
 """
+
 from __future__ import annotations
 
 from typing import Mapping, Sequence
@@ -22,13 +23,26 @@ from physgs.report.tables import Table, _by_seed, _check, _seeds, _wrap, tree_la
 from physgs.testbed.variant import DAMPING, FAITHFUL
 
 VARIANTS = (FAITHFUL, DAMPING)
-COLUMNS = ("trusted", "rel_err_pct", "null_rel_err_pct", "trained_minus_null_pp", "log_corr",
-           "null_log_corr", "gamma_exponent", "null_gamma_exponent", "gamma_exponent_true")
+COLUMNS = (
+    "trusted",
+    "rel_err_pct",
+    "null_rel_err_pct",
+    "trained_minus_null_pp",
+    "log_corr",
+    "null_log_corr",
+    "gamma_exponent",
+    "null_gamma_exponent",
+    "gamma_exponent_true",
+)
 
 
-def tab_damping(per_seed: Mapping[int, Mapping[tuple[str, str, str], object]],
-                trees: Sequence[str], bones: Mapping[str, int], configs: Mapping[str, str],
-                digits: int = 2) -> Table:
+def tab_damping(
+    per_seed: Mapping[int, Mapping[tuple[str, str, str], object]],
+    trees: Sequence[str],
+    bones: Mapping[str, int],
+    configs: Mapping[str, str],
+    digits: int = 2,
+) -> Table:
     """per_seed[seed][(tree, variant, config)]: ``RecoveryRecord`` with damping scores and null;
     variant 'faithful' or 'damping'; configs: name -> LaTeX label, in row order. One CSV row per
     seed, tree, variant and configuration; the .tex gives mean +- sd over seeds and the paired
@@ -42,54 +56,87 @@ def tab_damping(per_seed: Mapping[int, Mapping[tuple[str, str, str], object]],
             rec = per_seed[s][(t, v, c)]
             sc, nl = rec.damping_scores, rec.damping_null
             if sc is None or nl is None:
-                raise ValueError(f"tab_damping: the recovery of {t}/{v}/{c} (seed {s}) has no "
-                                 "damping scores; re-run its recovery rule with damping params")
-            rows.append({"seed": s, "tree": t, "bones": bones[t], "testbed": v, "config": c,
-                         "trusted": sc.n_trusted, "rel_err_pct": 100 * sc.median_rel_err,
-                         "null_rel_err_pct": 100 * nl.median_median_rel_err,
-                         "trained_minus_null_pp": 100 * (sc.median_rel_err
-                                                         - nl.median_median_rel_err),
-                         "log_corr": sc.log_corr, "null_log_corr": nl.median_log_corr,
-                         "gamma_exponent": sc.gamma_exponent,
-                         "null_gamma_exponent": nl.median_gamma_exponent,
-                         "gamma_exponent_true": sc.gamma_exponent_true})
+                raise ValueError(
+                    f"tab_damping: the recovery of {t}/{v}/{c} (seed {s}) has no "
+                    "damping scores; re-run its recovery rule with damping params"
+                )
+            rows.append(
+                {
+                    "seed": s,
+                    "tree": t,
+                    "bones": bones[t],
+                    "testbed": v,
+                    "config": c,
+                    "trusted": sc.n_trusted,
+                    "rel_err_pct": 100 * sc.median_rel_err,
+                    "null_rel_err_pct": 100 * nl.median_median_rel_err,
+                    "trained_minus_null_pp": 100 * (sc.median_rel_err - nl.median_median_rel_err),
+                    "log_corr": sc.log_corr,
+                    "null_log_corr": nl.median_log_corr,
+                    "gamma_exponent": sc.gamma_exponent,
+                    "null_gamma_exponent": nl.median_gamma_exponent,
+                    "gamma_exponent_true": sc.gamma_exponent_true,
+                }
+            )
     df = pd.DataFrame(rows)
     V = {c: _by_seed(df, c, len(seeds)) for c in COLUMNS}
     fmt, pct = f".{int(digits)}f", lambda x: x if x == "--" else x + r"\%"
-    lines = ["  \\begin{tabular}{lllccccccc}", "    \\toprule",
-             r"    & & & & \multicolumn{3}{c}{Med.\ rel.\ err.\ of $\hat\zeta$} & "
-             r"\multicolumn{2}{c}{corr($\log\hat\zeta$, $\log\zeta$)} & $\hat\gamma\propto\hat\omega^p$ \\",
-             r"    \cmidrule(lr){5-7}\cmidrule(lr){8-9}",
-             r"    Tree & Testbed & Config & Trusted & Trained & Null & Trained $-$ null & Trained "
-             r"& Null & $p$ (truth) \\", "    \\midrule"]
+    lines = [
+        "  \\begin{tabular}{lllccccccc}",
+        "    \\toprule",
+        r"    & & & & \multicolumn{3}{c}{Med.\ rel.\ err.\ of $\hat\zeta$} & "
+        r"\multicolumn{2}{c}{corr($\log\hat\zeta$, $\log\zeta$)} & $\hat\gamma\propto\hat\omega^p$ \\",
+        r"    \cmidrule(lr){5-7}\cmidrule(lr){8-9}",
+        r"    Tree & Testbed & Config & Trusted & Trained & Null & Trained $-$ null & Trained "
+        r"& Null & $p$ (truth) \\",
+        "    \\midrule",
+    ]
     for i in range(len(keys)):
         t, v, c = keys[i]
-        head = (rf"\multirow{{{2 * len(configs)}}}{{*}}{{{tree_label(t, bones[t])}}}"
-                if i % (2 * len(configs)) == 0 else "")
+        head = (
+            rf"\multirow{{{2 * len(configs)}}}{{*}}{{{tree_label(t, bones[t])}}}"
+            if i % (2 * len(configs)) == 0
+            else ""
+        )
         p = seedstats.pm(V["gamma_exponent"][:, i], ".2f")
         p_true = np.nanmean(V["gamma_exponent_true"][:, i])
-        lines.append("    " + " & ".join([
-            head, v if i % len(configs) == 0 else "", configs[c],
-            seedstats.pm(V["trusted"][:, i], ".1f"),  # a mean count: one decimal
-            pct(seedstats.pm(V["rel_err_pct"][:, i], ".0f")),
-            pct(seedstats.pm(V["null_rel_err_pct"][:, i], ".0f")),
-            seedstats.difference(V["trained_minus_null_pp"][:, i], ".0f"),
-            seedstats.pm(V["log_corr"][:, i], fmt), seedstats.pm(V["null_log_corr"][:, i], fmt),
-            f"{p} ({p_true:.2f})" if np.isfinite(p_true) else p]) + r" \\")
+        lines.append(
+            "    "
+            + " & ".join(
+                [
+                    head,
+                    v if i % len(configs) == 0 else "",
+                    configs[c],
+                    seedstats.pm(V["trusted"][:, i], ".1f"),  # a mean count: one decimal
+                    pct(seedstats.pm(V["rel_err_pct"][:, i], ".0f")),
+                    pct(seedstats.pm(V["null_rel_err_pct"][:, i], ".0f")),
+                    seedstats.difference(V["trained_minus_null_pp"][:, i], ".0f"),
+                    seedstats.pm(V["log_corr"][:, i], fmt),
+                    seedstats.pm(V["null_log_corr"][:, i], fmt),
+                    f"{p} ({p_true:.2f})" if np.isfinite(p_true) else p,
+                ]
+            )
+            + r" \\"
+        )
         if (i + 1) % (2 * len(configs)) == 0 and i + 1 < len(keys):
             lines.append("    \\midrule")
     lines += ["    \\bottomrule", "  \\end{tabular}", ""]
-    cap = (r"Damping recovery on the faithful testbed ($\zeta$ fixed on every bone, no deliberate "
-           r"transient) and on its damping variant ($\zeta$ per bone, log-uniform, and a gust "
-           r"dropping to calm inside the window). Over trusted parts: median relative error of "
-           r"$\hat\zeta$ against the matched bone's $\zeta$ (\%), beside the untrained null "
-           r"($\zeta$ drawn log-uniformly from the same range, scored on the same matching; "
-           r"medians over its draws) and the paired difference (percentage points; negative: "
-           r"the model beats chance); the correlation of $\log\hat\zeta$ with $\log\zeta$; the "
-           r"exponent $p$ of the fitted decay rate $\hat\gamma=\hat\zeta\hat\omega\propto"
-           r"\hat\omega^p$ ($p\approx0$: a frequency-independent rate fitted in place of a "
-           r"ratio), the truth's own $p$ on the matched bones in brackets."
-           + (rf" Mean $\pm$ sd over {len(seeds)} training seeds; differences bold when their 95\% "
-              r"interval excludes 0, $^{\dagger}$ when not." if len(seeds) > 1 else
-              r" One training seed: no interval, nothing decided."))
+    cap = (
+        r"Damping recovery on the faithful testbed ($\zeta$ fixed on every bone, no deliberate "
+        r"transient) and on its damping variant ($\zeta$ per bone, log-uniform, and a gust "
+        r"dropping to calm inside the window). Over trusted parts: median relative error of "
+        r"$\hat\zeta$ against the matched bone's $\zeta$ (\%), beside the untrained null "
+        r"($\zeta$ drawn log-uniformly from the same range, scored on the same matching; "
+        r"medians over its draws) and the paired difference (percentage points; negative: "
+        r"the model beats chance); the correlation of $\log\hat\zeta$ with $\log\zeta$; the "
+        r"exponent $p$ of the fitted decay rate $\hat\gamma=\hat\zeta\hat\omega\propto"
+        r"\hat\omega^p$ ($p\approx0$: a frequency-independent rate fitted in place of a "
+        r"ratio), the truth's own $p$ on the matched bones in brackets."
+        + (
+            rf" Mean $\pm$ sd over {len(seeds)} training seeds; differences bold when their 95\% "
+            r"interval excludes 0, $^{\dagger}$ when not."
+            if len(seeds) > 1
+            else r" One training seed: no interval, nothing decided."
+        )
+    )
     return Table("tab_damping", df, _wrap("\n".join(lines), cap, "tab:damping"))

@@ -5,6 +5,7 @@ Each ``fig_*`` takes collected results as arrays and a list of output paths; the
 path picks its format (.pdf, .png), each written atomically. Matplotlib's Agg backend is used
 so nothing needs a display.
 """
+
 from __future__ import annotations
 
 from pathlib import Path
@@ -24,8 +25,15 @@ from physgs.models.registry import REFERENCE_NAMES  # noqa: E402
 from physgs.models.registry import label  # noqa: E402
 from physgs.report.tables import condition_label  # noqa: E402
 
-COLORS = {"static": "0.55", "mlp": "tab:orange", "mlp_wind": "tab:red", "d3dgs": "tab:purple",
-          "d3dgs_wind": "tab:brown", "ours": "tab:blue", "gt": "k"}
+COLORS = {
+    "static": "0.55",
+    "mlp": "tab:orange",
+    "mlp_wind": "tab:red",
+    "d3dgs": "tab:purple",
+    "d3dgs_wind": "tab:brown",
+    "ours": "tab:blue",
+    "gt": "k",
+}
 GOOD, BAD = "#1a9850", "#f46d43"  # green where ours is best, orange where a baseline beats it
 WINDOW, TAIL = "0.6", "tab:blue"
 
@@ -43,8 +51,11 @@ def save_figure(fig, outputs: Sequence[str | Path], dpi: int = 200) -> None:
         plt.close(fig)
 
 
-def best_baseline(summaries: Mapping[str, Mapping[str, float]], key: str = "time",
-                  exclude: Sequence[str] = ("static", "ours")) -> str:
+def best_baseline(
+    summaries: Mapping[str, Mapping[str, float]],
+    key: str = "time",
+    exclude: Sequence[str] = ("static", "ours"),
+) -> str:
     """The learned baseline with the highest ``summary[key]`` (dB) among summaries[model]."""
     cands = {m: s[key] for m, s in summaries.items() if m not in exclude}
     if not cands:
@@ -59,8 +70,13 @@ def representative_frame(psnr_ours: np.ndarray, psnr_base: np.ndarray) -> int:
 
 
 # --------------------------------------------------------------------------------------------
-def fig_temporal(curves: Mapping[tuple[str, str], np.ndarray], trees: Sequence[str], n_train: int,
-                 outputs: Sequence[str | Path], models: Sequence[str] = MODELS) -> None:
+def fig_temporal(
+    curves: Mapping[tuple[str, str], np.ndarray],
+    trees: Sequence[str],
+    n_train: int,
+    outputs: Sequence[str | Path],
+    models: Sequence[str] = MODELS,
+) -> None:
     """Per-frame PSNR (dB) at the training camera and wind, one panel per tree.
 
     curves[(tree, model)]: [S, F] PSNR over recorded frames 1..F, one row per training seed
@@ -69,7 +85,9 @@ def fig_temporal(curves: Mapping[tuple[str, str], np.ndarray], trees: Sequence[s
     and the tail shaded. A reference present in ``curves`` (the true-motion ceiling) is drawn as
     a thin black dotted line.
     """
-    fig, axes = plt.subplots(1, len(trees), figsize=(4.2 * len(trees), 3.2), squeeze=False, sharey=False)
+    fig, axes = plt.subplots(
+        1, len(trees), figsize=(4.2 * len(trees), 3.2), squeeze=False, sharey=False
+    )
     n_seeds = 1
     for ax, t in zip(axes[0], trees):
         for m in models:
@@ -78,8 +96,14 @@ def fig_temporal(curves: Mapping[tuple[str, str], np.ndarray], trees: Sequence[s
             Y = np.atleast_2d(np.asarray(curves[(t, m)], dtype=np.float64))  # [S, F]
             n_seeds, y = len(Y), Y.mean(0)
             x = np.arange(1, len(y) + 1)
-            ax.plot(x, y, color=COLORS.get(m), lw=1.6 if m == "ours" else 1.0,
-                    ls="--" if m == "static" else "-", label=label(m))
+            ax.plot(
+                x,
+                y,
+                color=COLORS.get(m),
+                lw=1.6 if m == "ours" else 1.0,
+                ls="--" if m == "static" else "-",
+                label=label(m),
+            )
             if len(Y) > 1:  # the seeds' spread
                 ax.fill_between(x, Y.min(0), Y.max(0), color=COLORS.get(m), alpha=0.2, lw=0)
         for m in REFERENCE_NAMES:
@@ -94,16 +118,24 @@ def fig_temporal(curves: Mapping[tuple[str, str], np.ndarray], trees: Sequence[s
     axes[0, 0].set_ylabel("PSNR (dB)")
     axes[0, -1].legend(fontsize=7, loc="lower left")
     if n_seeds > 1:
-        fig.suptitle(f"mean over {n_seeds} training seeds; bands: lowest to highest seed",
-                     fontsize=8)
+        fig.suptitle(
+            f"mean over {n_seeds} training seeds; bands: lowest to highest seed", fontsize=8
+        )
     fig.tight_layout()
     save_figure(fig, outputs)
 
 
 # --------------------------------------------------------------------------------------------
-def fig_teaser(trajectories: Mapping[str, object], centroid_err: Mapping[str, np.ndarray],
-               conditions: Sequence[float], outputs: Sequence[str | Path], *, tip: int | None = None,
-               unseen: int = -1, title: str = "") -> None:
+def fig_teaser(
+    trajectories: Mapping[str, object],
+    centroid_err: Mapping[str, np.ndarray],
+    conditions: Sequence[float],
+    outputs: Sequence[str | Path],
+    *,
+    tip: int | None = None,
+    unseen: int = -1,
+    title: str = "",
+) -> None:
     """Branch-tip paths through the window (grey) and tail (blue), and canopy-centroid error.
 
     trajectories[model]: ``Trajectories`` at the training wind (e.g. ours and the best
@@ -116,19 +148,20 @@ def fig_teaser(trajectories: Mapping[str, object], centroid_err: Mapping[str, np
     n_train = first.n_train
     if tip is None:
         tip = int(np.argmax(np.ptp(first.gt_px, axis=1).sum(-1)))
-    panels = [("Ground truth", first.gt_px[tip])] + [(label(m), trajectories[m].pred_px[tip])
-                                                     for m in models]
+    panels = [("Ground truth", first.gt_px[tip])] + [
+        (label(m), trajectories[m].pred_px[tip]) for m in models
+    ]
     fig = plt.figure(figsize=(3.0 * len(panels), 5.6))
     gs = fig.add_gridspec(2, 2 * len(panels))
     gt = first.gt_px[tip]
     pad = 0.15 * max(np.ptp(gt[:, 0]), np.ptp(gt[:, 1]), 1.0)
     lims = [gt[:, 0].min() - pad, gt[:, 0].max() + pad, gt[:, 1].max() + pad, gt[:, 1].min() - pad]
     for i, (name, p) in enumerate(panels):
-        ax = fig.add_subplot(gs[0, 2 * i: 2 * i + 2])
+        ax = fig.add_subplot(gs[0, 2 * i : 2 * i + 2])
         if i:
             ax.plot(gt[:, 0], gt[:, 1], color="k", lw=0.5, ls=":", label="ground truth")
         ax.plot(p[:n_train, 0], p[:n_train, 1], color=WINDOW, lw=0.9, label="training window")
-        ax.plot(p[n_train - 1:, 0], p[n_train - 1:, 1], color=TAIL, lw=1.4, label="tail")
+        ax.plot(p[n_train - 1 :, 0], p[n_train - 1 :, 1], color=TAIL, lw=1.4, label="tail")
         ax.set_xlim(lims[0], lims[1])
         ax.set_ylim(lims[2], lims[3])  # image y points down
         ax.set_aspect("equal", adjustable="box")
@@ -140,12 +173,22 @@ def fig_teaser(trajectories: Mapping[str, object], centroid_err: Mapping[str, np
             ax.legend(fontsize=6)
     unseen = unseen % len(conditions)
     half = len(panels)
-    for j, (c, lab) in enumerate([(0, "training wind"), (unseen, f"unseen wind {condition_label(conditions[unseen], tex=False)}")]):
-        ax = fig.add_subplot(gs[1, j * half:(j + 1) * half])
+    for j, (c, lab) in enumerate(
+        [
+            (0, "training wind"),
+            (unseen, f"unseen wind {condition_label(conditions[unseen], tex=False)}"),
+        ]
+    ):
+        ax = fig.add_subplot(gs[1, j * half : (j + 1) * half])
         for m in models:
             e = np.asarray(centroid_err[m])[c]
-            ax.plot(np.arange(1, len(e) + 1), e, color=COLORS.get(m), lw=1.0,
-                    label=f"{label(m)} (mean {e.mean():.1f} px)")
+            ax.plot(
+                np.arange(1, len(e) + 1),
+                e,
+                color=COLORS.get(m),
+                lw=1.0,
+                label=f"{label(m)} (mean {e.mean():.1f} px)",
+            )
         ax.axvline(n_train + 0.5, color="k", lw=0.8, ls=":")
         ax.set_title(f"canopy-centroid error, {lab}", fontsize=9)
         ax.set_xlabel("frame")
@@ -158,17 +201,22 @@ def fig_teaser(trajectories: Mapping[str, object], centroid_err: Mapping[str, np
 
 
 # --------------------------------------------------------------------------------------------
-def fig_results(rows: Sequence[str], columns: Sequence[str],
-                images: Mapping[tuple[str, str], tuple[np.ndarray, float | None]],
-                outputs: Sequence[str | Path], ours: str = "ours") -> None:
+def fig_results(
+    rows: Sequence[str],
+    columns: Sequence[str],
+    images: Mapping[tuple[str, str], tuple[np.ndarray, float | None]],
+    outputs: Sequence[str | Path],
+    ours: str = "ours",
+) -> None:
     """Qualitative grid: one row per (tree, split) label, one column per model (or 'gt').
 
     images[(row, column)] = (rgb [H, W, 3] in [0, 1] or uint8, PSNR in dB or None for the
     ground truth). PSNR is printed on each panel, green on ours where it is best in its row
     and orange on a baseline that beats ours.
     """
-    fig, axes = plt.subplots(len(rows), len(columns), figsize=(1.7 * len(columns), 1.8 * len(rows)),
-                             squeeze=False)
+    fig, axes = plt.subplots(
+        len(rows), len(columns), figsize=(1.7 * len(columns), 1.8 * len(rows)), squeeze=False
+    )
     for i, r in enumerate(rows):
         scores = {c: images[(r, c)][1] for c in columns if images[(r, c)][1] is not None}
         ours_score = scores.get(ours)
@@ -187,8 +235,15 @@ def fig_results(rows: Sequence[str], columns: Sequence[str],
                         color = GOOD
                     elif c != ours and score > ours_score:
                         color = BAD
-                ax.text(0.03, 0.03, f"{score:.2f}", transform=ax.transAxes, fontsize=7, color=color,
-                        bbox=dict(facecolor="white", alpha=0.75, lw=0, pad=1))
+                ax.text(
+                    0.03,
+                    0.03,
+                    f"{score:.2f}",
+                    transform=ax.transAxes,
+                    fontsize=7,
+                    color=color,
+                    bbox=dict(facecolor="white", alpha=0.75, lw=0, pad=1),
+                )
             if i == 0:
                 ax.set_title("Ground truth" if c == "gt" else label(c), fontsize=7)
             if j == 0:
@@ -198,8 +253,13 @@ def fig_results(rows: Sequence[str], columns: Sequence[str],
 
 
 # --------------------------------------------------------------------------------------------
-def fig_damping(damping: Mapping[tuple[str, str], object], trees: Sequence[str], configs: Sequence[str],
-                zeta_true: float, outputs: Sequence[str | Path]) -> None:
+def fig_damping(
+    damping: Mapping[tuple[str, str], object],
+    trees: Sequence[str],
+    configs: Sequence[str],
+    zeta_true: float,
+    outputs: Sequence[str | Path],
+) -> None:
     """Left: zeta_hat per part for each tree and config against the true ratio (line).
     Right: decay rate gamma_hat = zeta_hat * omega_hat (1/s) against omega_hat (rad/s), log-log,
     with the ground-truth line gamma = zeta_true * omega.
@@ -220,8 +280,15 @@ def fig_damping(damping: Mapping[tuple[str, str], object], trees: Sequence[str],
             a0.plot([pos - 0.3, pos + 0.3], [d.median_zeta] * 2, color="k", lw=1.5)
             labels.append(f"{t} {c}")
             pos += 1
-            a1.scatter(d.omega, d.gamma, s=8, color=tree_colors[t], marker=markers[c], alpha=0.6,
-                       label=f"{t}, {c} (median $\\hat\\zeta$ {d.median_zeta:.3f})")
+            a1.scatter(
+                d.omega,
+                d.gamma,
+                s=8,
+                color=tree_colors[t],
+                marker=markers[c],
+                alpha=0.6,
+                label=f"{t}, {c} (median $\\hat\\zeta$ {d.median_zeta:.3f})",
+            )
             allw.append(d.omega)
     a0.axhline(zeta_true, color="k", ls="--", lw=0.8, label=f"truth $\\zeta$ = {zeta_true}")
     a0.set_xticks(range(pos))
@@ -257,8 +324,9 @@ def _seed_mean(df: pd.DataFrame, by: list[str], cols: Sequence[str]) -> pd.DataF
     return pd.concat([out, sd, rest], axis=1).reset_index()
 
 
-def fig_speed_accuracy(df: pd.DataFrame, outputs: Sequence[str | Path],
-                       null: Mapping[str, float] | None = None) -> None:
+def fig_speed_accuracy(
+    df: pd.DataFrame, outputs: Sequence[str | Path], null: Mapping[str, float] | None = None
+) -> None:
     """Two panels against wall time (s): PSNR on the time split (dB) and recovery error (%).
 
     df: ``experiments.sweep.collect`` (one row per seed, knob and value). One line per knob
@@ -267,19 +335,37 @@ def fig_speed_accuracy(df: pd.DataFrame, outputs: Sequence[str | Path],
     95% of its draws are drawn on the recovery panel, so a point inside the band reads as chance.
     """
     n_seeds = df["seed"].nunique()
-    m = _seed_mean(df.assign(rel_pct=100 * df["rel_err"]), ["knob", "value"],
-                   ("wall_s", "psnr_time", "rel_pct"))
+    m = _seed_mean(
+        df.assign(rel_pct=100 * df["rel_err"]),
+        ["knob", "value"],
+        ("wall_s", "psnr_time", "rel_pct"),
+    )
     fig, axes = plt.subplots(1, 2, figsize=(10, 4))
     colors = {k: f"C{i}" for i, k in enumerate(sorted(m["knob"].unique()))}
     for knob, g in m.groupby("knob", sort=False):
         g = g.sort_values("value")
         for ax, col in ((axes[0], "psnr_time"), (axes[1], "rel_pct")):
-            ax.errorbar(g["wall_s"], g[col], yerr=g[f"{col}_sd"] if n_seeds > 1 else None,
-                        xerr=g["wall_s_sd"] if n_seeds > 1 else None, fmt="-o", ms=3.5,
-                        capsize=2, lw=1.0, color=colors[knob], label=knob)
+            ax.errorbar(
+                g["wall_s"],
+                g[col],
+                yerr=g[f"{col}_sd"] if n_seeds > 1 else None,
+                xerr=g["wall_s_sd"] if n_seeds > 1 else None,
+                fmt="-o",
+                ms=3.5,
+                capsize=2,
+                lw=1.0,
+                color=colors[knob],
+                label=knob,
+            )
             for _, r in g.iterrows():
-                ax.annotate(str(int(r["value"])), (r["wall_s"], r[col]), fontsize=6,
-                            xytext=(3, 3), textcoords="offset points", color=colors[knob])
+                ax.annotate(
+                    str(int(r["value"])),
+                    (r["wall_s"], r[col]),
+                    fontsize=6,
+                    xytext=(3, 3),
+                    textcoords="offset points",
+                    color=colors[knob],
+                )
     base = m[m["is_base"]].iloc[0]
     for ax, col in ((axes[0], "psnr_time"), (axes[1], "rel_pct")):
         ax.plot([base["wall_s"]], [base[col]], "k*", ms=11, label="profile setting")
@@ -287,17 +373,29 @@ def fig_speed_accuracy(df: pd.DataFrame, outputs: Sequence[str | Path],
         ax.set_xlabel("wall time per point (s, log)")
         ax.grid(alpha=0.3)
     if null is not None and np.isfinite(null.get("median", np.nan)):
-        axes[1].axhline(100 * null["median"], color="0.3", ls="--", lw=1.0,
-                        label=f"untrained null, K={null.get('K', '?')} (median)")
-        axes[1].axhspan(100 * null["low"], 100 * null["high"], color="0.6", alpha=0.25, lw=0,
-                        label=f"null: central 95% of {null['draws']} draws")
+        axes[1].axhline(
+            100 * null["median"],
+            color="0.3",
+            ls="--",
+            lw=1.0,
+            label=f"untrained null, K={null.get('K', '?')} (median)",
+        )
+        axes[1].axhspan(
+            100 * null["low"],
+            100 * null["high"],
+            color="0.6",
+            alpha=0.25,
+            lw=0,
+            label=f"null: central 95% of {null['draws']} draws",
+        )
         axes[1].legend(fontsize=7)
     axes[0].set_ylabel("PSNR, time split (dB)")
     axes[1].set_ylabel("median rel. error of omega, trusted parts (%)")
     axes[0].legend(fontsize=7)
     seeds = f"; mean +- sd over {n_seeds} training seeds" if n_seeds > 1 else "; one seed"
-    fig.suptitle(f"Speed-accuracy trade, ours on the {df['tree'].iloc[0]} tree (one knob at a "
-                 f"time{seeds})")
+    fig.suptitle(
+        f"Speed-accuracy trade, ours on the {df['tree'].iloc[0]} tree (one knob at a time{seeds})"
+    )
     fig.tight_layout()
     save_figure(fig, outputs)
 
@@ -311,9 +409,11 @@ def fig_fit_curve(df: pd.DataFrame, outputs: Sequence[str | Path]) -> None:
     static pose and the true-motion ceiling at the profile's budget are horizontal lines; the
     profile's budget is starred.
     """
-    panels = (("iterations", "fit", "training iterations (log)", "PSNR, trained frames (dB)"),
-              ("iterations", "time", "training iterations (log)", "PSNR, time split (dB)"),
-              ("train_s", "fit", "training wall time (s, log)", "PSNR, trained frames (dB)"))
+    panels = (
+        ("iterations", "fit", "training iterations (log)", "PSNR, trained frames (dB)"),
+        ("iterations", "time", "training iterations (log)", "PSNR, time split (dB)"),
+        ("train_s", "fit", "training wall time (s, log)", "PSNR, trained frames (dB)"),
+    )
     n_seeds = df["seed"].nunique()
     df = _seed_mean(df, ["model", "iterations"], ("fit", "time", "train_s"))
     fig, axes = plt.subplots(1, len(panels), figsize=(13, 3.8))
@@ -326,10 +426,18 @@ def fig_fit_curve(df: pd.DataFrame, outputs: Sequence[str | Path]) -> None:
                 continue
             g = g.sort_values("iterations")
             bars = n_seeds > 1
-            ax.errorbar(g[x], g[y], yerr=g[f"{y}_sd"] if bars else None,
-                        xerr=g[f"{x}_sd"] if bars and x != "iterations" else None, fmt="-o",
-                        ms=3.5, capsize=2, color=COLORS.get(m),
-                        lw=1.6 if m == "ours" else 1.0, label=label(m))
+            ax.errorbar(
+                g[x],
+                g[y],
+                yerr=g[f"{y}_sd"] if bars else None,
+                xerr=g[f"{x}_sd"] if bars and x != "iterations" else None,
+                fmt="-o",
+                ms=3.5,
+                capsize=2,
+                color=COLORS.get(m),
+                lw=1.6 if m == "ours" else 1.0,
+                label=label(m),
+            )
             p = g[g["is_profile"]]
             ax.plot(p[x], p[y], "*", ms=10, color=COLORS.get(m))
         for m, (c, ls) in refs.items():

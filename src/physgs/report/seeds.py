@@ -6,6 +6,7 @@ seeds. A difference between two models is taken per seed first (the two share th
 initialisation stream, k-means and frame draws) and then summarised (Student's t on the mean of
 the paired differences). With one seed there is no interval, so nothing is decided.
 """
+
 from __future__ import annotations
 
 from typing import Sequence
@@ -47,8 +48,9 @@ def paired(a: Sequence[float], b: Sequence[float]) -> np.ndarray:
     """Per-seed differences a - b [S] (a, b [S] in the same seed order)."""
     a, b = np.asarray(a, dtype=np.float64), np.asarray(b, dtype=np.float64)
     if a.shape != b.shape:
-        raise ValueError(f"paired differences need one value per seed on both sides, got "
-                         f"{a.shape} and {b.shape}")
+        raise ValueError(
+            f"paired differences need one value per seed on both sides, got {a.shape} and {b.shape}"
+        )
     return a - b
 
 

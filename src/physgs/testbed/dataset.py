@@ -18,6 +18,7 @@ Gaussian ``vertex_gaussian[v]``. Everything indexed by mesh vertex (``vertex_bon
 ``rest_vertices``, ``tip_vertices``, ``kinematics.pose_vertices``) stays in mesh order;
 ``kinematics.pose_gaussians`` poses in Gaussian order.
 """
+
 from __future__ import annotations
 
 import os
@@ -139,9 +140,13 @@ def simulate_tree(tb: dict, preset: dict, *, seed: int, tree: str) -> TreeSim:
     """
     skel = weberpenn.generate(preset, seed=seed, name=tree)
     leaves = preset.get("leaves") or {}
-    mesh = build_mesh(skel, target_vertices=int(tb["vertices"][tree]),
-                      leaf_fraction=float(leaves.get("fraction", 0.0)),
-                      leaf_scale=float(leaves.get("scale", 0.1)), seed_seq=_seed(seed, tree, "mesh"))
+    mesh = build_mesh(
+        skel,
+        target_vertices=int(tb["vertices"][tree]),
+        leaf_fraction=float(leaves.get("fraction", 0.0)),
+        leaf_scale=float(leaves.get("scale", 0.1)),
+        seed_seq=_seed(seed, tree, "mesh"),
+    )
     omega, c, clamped = physics.calibrate_omega(skel.radius, skel.length, tb["band_hz"])
     B = skel.n_bones
     # per-bone zeta (damping variant) from its own seeded stream: it changes nothing else
@@ -151,65 +156,99 @@ def simulate_tree(tb: dict, preset: dict, *, seed: int, tree: str) -> TreeSim:
     L = variant.lead_in_frames(omega, zeta, float(tb["lead_in_tau"]), fps)
 
     w = tb["wind"]
-    wf = windmod.make_wind(v0=w["v0"], turbulence_intensity=w["turbulence_intensity"],
-                           f_lo_hz=w["f_lo_hz"], f_hi_hz=w["f_hi_hz"], seed_seq=_seed(seed, "wind"))
+    wf = windmod.make_wind(
+        v0=w["v0"],
+        turbulence_intensity=w["turbulence_intensity"],
+        f_lo_hz=w["f_lo_hz"],
+        f_hi_hz=w["f_hi_hz"],
+        seed_seq=_seed(seed, "wind"),
+    )
     P = int(round(windmod.PERIOD_S * fps))  # the wind repeats every P frames
     if L + F >= P or abs(P - windmod.PERIOD_S * fps) > 1e-9:
-        raise windmod.WindError(f"record of {(L + F) / fps:.1f} s must be shorter than the "
-                                f"{windmod.PERIOD_S:.0f} s wind period, which must be a whole number "
-                                "of frames; lower testbed.lead_in_tau or n_train/n_tail, or use an "
-                                "integer fps")
+        raise windmod.WindError(
+            f"record of {(L + F) / fps:.1f} s must be shorter than the "
+            f"{windmod.PERIOD_S:.0f} s wind period, which must be a whole number "
+            "of frames; lower testbed.lead_in_tau or n_train/n_tail, or use an "
+            "integer fps"
+        )
     t = np.arange(-L, -L + P + 1) / fps  # one full period from the record start
     v_period = wf.speed(t)
-    v = v_period[:L + F]
+    v = v_period[: L + F]
     if v_period.min() <= 0:
-        raise windmod.WindError(f"wind speed reaches {v.min():.2f} m/s <= 0; lower "
-                                "testbed.wind.turbulence_intensity in config/trees.yaml")
+        raise windmod.WindError(
+            f"wind speed reaches {v.min():.2f} m/s <= 0; lower "
+            "testbed.wind.turbulence_intensity in config/trees.yaml"
+        )
     transient = variant.transient_of(tb)
     if transient is not None:
         # the recorded wind (what models observe) carries the gust and the calm; the start
         # state below stays the periodic steady state of the unmodified wind, which is the
         # exact state at the record start because the transient begins inside the window
         if transient.start_s - transient.gust_s < 0:
-            raise windmod.WindError("testbed.damping.transient starts before recorded frame 0; "
-                                    "raise start_s to at least gust_s in config/trees.yaml")
-        v = variant.shape_wind(v, t[:L + F], float(w["v0"]), transient)
+            raise windmod.WindError(
+                "testbed.damping.transient starts before recorded frame 0; "
+                "raise start_s to at least gust_s in config/trees.yaml"
+            )
+        v = variant.shape_wind(v, t[: L + F], float(w["v0"]), transient)
     cond = np.asarray(tb["conditions"], dtype=np.float64)
     wind32 = (cond[:, None] * v[None, :]).astype(np.float32)  # [C, L+F]
     vbar = cond * float(w["v0"])
     u = physics.drag_forcing(wind32.astype(np.float64), vbar)  # [C, T], the wind models observe
     # the same float32 rounding over one whole period, to start at the periodic steady state
     vp32 = (cond[:, None] * v_period[None, :]).astype(np.float32).astype(np.float64)
-    up = physics.drag_forcing(vp32, vbar)[:, :, None] * omega ** 2  # [C, P+1, B]
+    up = physics.drag_forcing(vp32, vbar)[:, :, None] * omega**2  # [C, P+1, B]
     x0 = physics.periodic_steady_state(omega, zeta, up, 1.0 / fps)
-    unit = physics.simulate(omega, zeta, u[:, :, None] * omega[None, None, :] ** 2, 1.0 / fps, x0=x0)
+    unit = physics.simulate(
+        omega, zeta, u[:, :, None] * omega[None, None, :] ** 2, 1.0 / fps, x0=x0
+    )
     # "RMS swing" = RMS over bones and training frames of each bone's world angle (its own theta
     # plus its ancestors'), what a viewer sees; per-bone theta is smaller on deep chains.
-    world = kinematics.cumulative_angle(skel.parent, unit[0, L:L + int(tb["n_train"])])
-    rms = np.sqrt(np.mean(world ** 2))
+    world = kinematics.cumulative_angle(skel.parent, unit[0, L : L + int(tb["n_train"])])
+    rms = np.sqrt(np.mean(world**2))
     g0 = np.deg2rad(float(tb["rms_swing_deg"])) / rms
     theta = g0 * unit  # linear system: scaling the gain scales the response
 
     axis = kinematics.swing_axis(float(w["direction_deg"]))
     arm_levels = int(preset["armature_levels"])
-    tip_cands = np.array([mesh.stem_tip_vertex[i] for i, s in enumerate(skel.stems)
-                          if s.level == arm_levels - 1])
+    tip_cands = np.array(
+        [mesh.stem_tip_vertex[i] for i, s in enumerate(skel.stems) if s.level == arm_levels - 1]
+    )
     az = np.arctan2(mesh.vertices[tip_cands, 1], mesh.vertices[tip_cands, 0])
     order = tip_cands[np.argsort(az)]
     P = min(6, len(order))
     tips = order[np.linspace(0, len(order) - 1, P).round().astype(int)] if P else order
     # observed Gaussian order: its own seeded stream, so it changes nothing else in the tree
     gaussian_vertex = np.random.default_rng(_seed(seed, tree, "gaussian_order")).permutation(
-        len(mesh.vertices))
+        len(mesh.vertices)
+    )
     vertex_gaussian = np.argsort(gaussian_vertex)
 
-    truth = Truth(omega=omega, zeta=zeta, gain=g0 * omega ** 2, theta=theta,
-                  bone_head=skel.head, bone_tail=skel.tail, bone_parent=skel.parent,
-                  bone_level=skel.level, bone_radius=skel.radius, bone_length=skel.length,
-                  swing_axis=axis, vertex_bone=mesh.vertex_bone, rest_vertices=mesh.vertices,
-                  faces=mesh.faces, vertex_colors=mesh.vertex_colors, tip_vertices=tips,
-                  omega_clamped=clamped, omega_c=c, g0=float(g0), fps=fps, lead_in_frames=L, vbar=vbar,
-                  gaussian_vertex=gaussian_vertex, vertex_gaussian=vertex_gaussian)
+    truth = Truth(
+        omega=omega,
+        zeta=zeta,
+        gain=g0 * omega**2,
+        theta=theta,
+        bone_head=skel.head,
+        bone_tail=skel.tail,
+        bone_parent=skel.parent,
+        bone_level=skel.level,
+        bone_radius=skel.radius,
+        bone_length=skel.length,
+        swing_axis=axis,
+        vertex_bone=mesh.vertex_bone,
+        rest_vertices=mesh.vertices,
+        faces=mesh.faces,
+        vertex_colors=mesh.vertex_colors,
+        tip_vertices=tips,
+        omega_clamped=clamped,
+        omega_c=c,
+        g0=float(g0),
+        fps=fps,
+        lead_in_frames=L,
+        vbar=vbar,
+        gaussian_vertex=gaussian_vertex,
+        vertex_gaussian=vertex_gaussian,
+    )
     return TreeSim(skel, mesh, truth, wind32, cond)
 
 
@@ -222,8 +261,9 @@ def swept_points(truth: Truth, chunk: int = 25) -> np.ndarray:
     every condition (lead-in excluded): the tree's swept extent, as the framing needs it."""
     L = truth.lead_in_frames
     th = truth.theta[:, L:].reshape(-1, truth.theta.shape[-1])
-    return scene.convex_hull_points(kinematics.pose_vertices(truth, th[i:i + chunk])
-                                    for i in range(0, len(th), chunk))
+    return scene.convex_hull_points(
+        kinematics.pose_vertices(truth, th[i : i + chunk]) for i in range(0, len(th), chunk)
+    )
 
 
 def build_dataset(tb: dict, preset: dict, *, seed: int, tree: str, progress: bool = True):
@@ -234,12 +274,19 @@ def build_dataset(tb: dict, preset: dict, *, seed: int, tree: str, progress: boo
     n_train, n_tail = int(tb["n_train"]), int(tb["n_tail"])
     F = n_train + n_tail
     if "fill_height" not in tb:
-        raise scene.FramingError("config key testbed.fill_height is missing (fraction of the training "
-                                 "image height the swept tree spans, e.g. 0.9); add it to "
-                                 "config/trees.yaml")
+        raise scene.FramingError(
+            "config key testbed.fill_height is missing (fraction of the training "
+            "image height the swept tree spans, e.g. 0.9); add it to "
+            "config/trees.yaml"
+        )
     az = np.asarray(tb["heldout_azimuths_deg"], dtype=np.float64)
-    cams = scene.frame_cameras(swept_points(tr), [0.0, *az], fov_deg=float(tb["fov_deg"]),
-                               resolution=int(tb["resolution"]), fill_height=float(tb["fill_height"]))
+    cams = scene.frame_cameras(
+        swept_points(tr),
+        [0.0, *az],
+        fov_deg=float(tb["fov_deg"]),
+        resolution=int(tb["resolution"]),
+        fill_height=float(tb["fill_height"]),
+    )
     train_cam, held_cams = cams[0], cams[1:]
     # imported here: Embree and trimesh cost ~1 s of start-up, and most jobs only load datasets
     from physgs.testbed import raycast
@@ -258,7 +305,7 @@ def build_dataset(tb: dict, preset: dict, *, seed: int, tree: str, progress: boo
     chunk = 25  # pose several frames per call (vectorised FK), render one by one
     for c in range(C):
         for j0 in range(0, F, chunk):
-            Vs = kinematics.pose_vertices(tr, tr.theta[c, L + j0:L + min(F, j0 + chunk)])
+            Vs = kinematics.pose_vertices(tr, tr.theta[c, L + j0 : L + min(F, j0 + chunk)])
             for k, V in enumerate(Vs):
                 rgb, alpha = raycast.render_mesh(V, tr.faces, face_colors, rays, bg)
                 frames[c, j0 + k], masks[c, j0 + k] = raycast.to_uint8(rgb), alpha >= 0.5
@@ -273,14 +320,29 @@ def build_dataset(tb: dict, preset: dict, *, seed: int, tree: str, progress: boo
     bar.close()
 
     canonical = kinematics.pose_gaussians(tr, tr.theta[0, L]).astype(np.float32)
-    observed = dict(format_version=FORMAT_VERSION, fps=fps, n_train=n_train, n_tail=n_tail,
-                    lead_in_frames=L, conditions=sim.conditions, vbar=tr.vbar, wind=sim.wind,
-                    frames=frames, masks=masks, heldout_azimuths_deg=az, heldout_frame_idx=held_idx,
-                    heldout_frames=hframes, heldout_masks=hmasks, background=bg,
-                    canonical_xyz=canonical,
-                    **{f"train_camera_{k}": v for k, v in train_cam.to_dict().items()},
-                    **{f"heldout_camera_{k}": np.stack([cm.to_dict()[k] for cm in held_cams])
-                       for k in ("viewmat", "intrinsics", "size", "near")})
+    observed = dict(
+        format_version=FORMAT_VERSION,
+        fps=fps,
+        n_train=n_train,
+        n_tail=n_tail,
+        lead_in_frames=L,
+        conditions=sim.conditions,
+        vbar=tr.vbar,
+        wind=sim.wind,
+        frames=frames,
+        masks=masks,
+        heldout_azimuths_deg=az,
+        heldout_frame_idx=held_idx,
+        heldout_frames=hframes,
+        heldout_masks=hmasks,
+        background=bg,
+        canonical_xyz=canonical,
+        **{f"train_camera_{k}": v for k, v in train_cam.to_dict().items()},
+        **{
+            f"heldout_camera_{k}": np.stack([cm.to_dict()[k] for cm in held_cams])
+            for k in ("viewmat", "intrinsics", "size", "near")
+        },
+    )
     truth = {k: getattr(tr, k) for k in Truth.__dataclass_fields__}
     truth["format_version"] = FORMAT_VERSION
     return observed, truth
@@ -311,22 +373,30 @@ def save_dataset(observed: dict, truth: dict, observed_path, truth_path) -> None
 def _open(path: Path | str, required: tuple[str, ...]) -> dict:
     path = Path(path)
     if not path.is_file():
-        raise DatasetError(f"dataset file {path} does not exist; build it with "
-                           "`snakemake --cores 2 testbed` (or the matching results/testbed target)")
+        raise DatasetError(
+            f"dataset file {path} does not exist; build it with "
+            "`snakemake --cores 2 testbed` (or the matching results/testbed target)"
+        )
     try:
         with np.load(path, allow_pickle=False) as z:
             missing = [k for k in required if k not in z.files]
             if missing:
-                raise DatasetError(f"dataset file {path} lacks {missing}: it is from another "
-                                   f"version or incomplete; {REBUILD}")
+                raise DatasetError(
+                    f"dataset file {path} lacks {missing}: it is from another "
+                    f"version or incomplete; {REBUILD}"
+                )
             d = {k: z[k] for k in z.files}
     except DatasetError:
         raise
     except (zipfile.BadZipFile, ValueError, OSError, EOFError, KeyError) as e:
-        raise DatasetError(f"dataset file {path} is corrupt ({type(e).__name__}: {e}); {REBUILD}") from None
+        raise DatasetError(
+            f"dataset file {path} is corrupt ({type(e).__name__}: {e}); {REBUILD}"
+        ) from None
     if int(d.get("format_version", -1)) != FORMAT_VERSION:
-        raise DatasetError(f"dataset file {path} has format_version {d.get('format_version')}, "
-                           f"expected {FORMAT_VERSION}; {REBUILD}")
+        raise DatasetError(
+            f"dataset file {path} has format_version {d.get('format_version')}, "
+            f"expected {FORMAT_VERSION}; {REBUILD}"
+        )
     return d
 
 
@@ -335,11 +405,31 @@ def _check(path, ok: bool, what: str):
         raise DatasetError(f"dataset file {path} is inconsistent: {what}; {REBUILD}")
 
 
-OBSERVED_KEYS = ("fps", "n_train", "n_tail", "lead_in_frames", "conditions", "vbar", "wind", "frames",
-                 "masks", "train_camera_viewmat", "train_camera_intrinsics", "train_camera_size",
-                 "train_camera_near", "heldout_azimuths_deg", "heldout_camera_viewmat",
-                 "heldout_camera_intrinsics", "heldout_camera_size", "heldout_camera_near",
-                 "heldout_frame_idx", "heldout_frames", "heldout_masks", "background", "canonical_xyz")
+OBSERVED_KEYS = (
+    "fps",
+    "n_train",
+    "n_tail",
+    "lead_in_frames",
+    "conditions",
+    "vbar",
+    "wind",
+    "frames",
+    "masks",
+    "train_camera_viewmat",
+    "train_camera_intrinsics",
+    "train_camera_size",
+    "train_camera_near",
+    "heldout_azimuths_deg",
+    "heldout_camera_viewmat",
+    "heldout_camera_intrinsics",
+    "heldout_camera_size",
+    "heldout_camera_near",
+    "heldout_frame_idx",
+    "heldout_frames",
+    "heldout_masks",
+    "background",
+    "canonical_xyz",
+)
 
 
 def load_observed(path: Path | str) -> Observed:
@@ -348,26 +438,61 @@ def load_observed(path: Path | str) -> Observed:
     C, F = len(d["conditions"]), int(d["n_train"]) + int(d["n_tail"])
     L = int(d["lead_in_frames"])
     _check(path, d["wind"].shape == (C, L + F), f"wind shape {d['wind'].shape} != ({C}, {L + F})")
-    _check(path, d["frames"].shape[:2] == (C, F) and d["frames"].dtype == np.uint8,
-           f"frames shape {d['frames'].shape} / dtype {d['frames'].dtype}")
+    _check(
+        path,
+        d["frames"].shape[:2] == (C, F) and d["frames"].dtype == np.uint8,
+        f"frames shape {d['frames'].shape} / dtype {d['frames'].dtype}",
+    )
     _check(path, d["masks"].shape == d["frames"].shape[:4], "masks do not match frames")
     A = len(d["heldout_azimuths_deg"])
-    _check(path, d["heldout_camera_viewmat"].shape == (A, 4, 4), "held-out cameras do not match azimuths")
-    _check(path, d["heldout_frames"].shape[:2] == (A, len(d["heldout_frame_idx"])),
-           "held-out frames do not match azimuths x frame indices")
-    _check(path, d["canonical_xyz"].ndim == 2 and d["canonical_xyz"].shape[1] == 3, "canonical_xyz not [N, 3]")
-    _check(path, bool(np.isfinite(d["wind"]).all() and np.isfinite(d["canonical_xyz"]).all()),
-           "non-finite wind or canonical_xyz")
-    cam = Camera.from_dict({k: d[f"train_camera_{k}"] for k in ("viewmat", "intrinsics", "size", "near")})
-    held = [Camera.from_dict({k: d[f"heldout_camera_{k}"][a] for k in ("viewmat", "intrinsics", "size", "near")})
-            for a in range(A)]
-    return Observed(fps=int(d["fps"]), n_train=int(d["n_train"]), n_tail=int(d["n_tail"]),
-                    lead_in_frames=L, conditions=d["conditions"], vbar=d["vbar"], wind=d["wind"],
-                    frames=d["frames"], masks=d["masks"], train_camera=cam,
-                    heldout_azimuths_deg=d["heldout_azimuths_deg"], heldout_cameras=held,
-                    heldout_frame_idx=d["heldout_frame_idx"], heldout_frames=d["heldout_frames"],
-                    heldout_masks=d["heldout_masks"], background=d["background"],
-                    canonical_xyz=d["canonical_xyz"])
+    _check(
+        path,
+        d["heldout_camera_viewmat"].shape == (A, 4, 4),
+        "held-out cameras do not match azimuths",
+    )
+    _check(
+        path,
+        d["heldout_frames"].shape[:2] == (A, len(d["heldout_frame_idx"])),
+        "held-out frames do not match azimuths x frame indices",
+    )
+    _check(
+        path,
+        d["canonical_xyz"].ndim == 2 and d["canonical_xyz"].shape[1] == 3,
+        "canonical_xyz not [N, 3]",
+    )
+    _check(
+        path,
+        bool(np.isfinite(d["wind"]).all() and np.isfinite(d["canonical_xyz"]).all()),
+        "non-finite wind or canonical_xyz",
+    )
+    cam = Camera.from_dict(
+        {k: d[f"train_camera_{k}"] for k in ("viewmat", "intrinsics", "size", "near")}
+    )
+    held = [
+        Camera.from_dict(
+            {k: d[f"heldout_camera_{k}"][a] for k in ("viewmat", "intrinsics", "size", "near")}
+        )
+        for a in range(A)
+    ]
+    return Observed(
+        fps=int(d["fps"]),
+        n_train=int(d["n_train"]),
+        n_tail=int(d["n_tail"]),
+        lead_in_frames=L,
+        conditions=d["conditions"],
+        vbar=d["vbar"],
+        wind=d["wind"],
+        frames=d["frames"],
+        masks=d["masks"],
+        train_camera=cam,
+        heldout_azimuths_deg=d["heldout_azimuths_deg"],
+        heldout_cameras=held,
+        heldout_frame_idx=d["heldout_frame_idx"],
+        heldout_frames=d["heldout_frames"],
+        heldout_masks=d["heldout_masks"],
+        background=d["background"],
+        canonical_xyz=d["canonical_xyz"],
+    )
 
 
 def load_truth(path: Path | str) -> Truth:
@@ -375,14 +500,31 @@ def load_truth(path: Path | str) -> Truth:
     keys = tuple(Truth.__dataclass_fields__)
     d = _open(path, keys)
     B = len(d["omega"])
-    _check(path, d["theta"].ndim == 3 and d["theta"].shape[2] == B, f"theta shape {d['theta'].shape}")
-    _check(path, d["bone_head"].shape == (B, 3) and len(d["bone_parent"]) == B, "bone arrays disagree")
-    _check(path, len(d["vertex_bone"]) == len(d["rest_vertices"]), "vertex_bone does not match rest_vertices")
-    _check(path, bool((d["vertex_bone"] >= 0).all() and (d["vertex_bone"] < B).all()), "vertex_bone out of range")
+    _check(
+        path, d["theta"].ndim == 3 and d["theta"].shape[2] == B, f"theta shape {d['theta'].shape}"
+    )
+    _check(
+        path, d["bone_head"].shape == (B, 3) and len(d["bone_parent"]) == B, "bone arrays disagree"
+    )
+    _check(
+        path,
+        len(d["vertex_bone"]) == len(d["rest_vertices"]),
+        "vertex_bone does not match rest_vertices",
+    )
+    _check(
+        path,
+        bool((d["vertex_bone"] >= 0).all() and (d["vertex_bone"] < B).all()),
+        "vertex_bone out of range",
+    )
     N = len(d["rest_vertices"])
     gv, vg = d["gaussian_vertex"], d["vertex_gaussian"]
-    _check(path, gv.shape == (N,) and vg.shape == (N,) and np.array_equal(np.sort(gv), np.arange(N))
-           and np.array_equal(gv[vg], np.arange(N)),
-           "gaussian_vertex is not a permutation of the vertices with inverse vertex_gaussian")
+    _check(
+        path,
+        gv.shape == (N,)
+        and vg.shape == (N,)
+        and np.array_equal(np.sort(gv), np.arange(N))
+        and np.array_equal(gv[vg], np.arange(N)),
+        "gaussian_vertex is not a permutation of the vertices with inverse vertex_gaussian",
+    )
     scalars = {"omega_c": float, "g0": float, "fps": int, "lead_in_frames": int}
     return Truth(**{k: scalars[k](d[k]) if k in scalars else d[k] for k in keys})

@@ -1,5 +1,6 @@
 """The testbed figure: skeleton coloured by natural frequency, the frequency histogram, and a few
 ground-truth frames (training camera, three conditions, and held-out views)."""
+
 from __future__ import annotations
 
 from pathlib import Path
@@ -15,8 +16,9 @@ from physgs.atomic import atomic_path  # noqa: E402
 from physgs.testbed.dataset import Observed, Truth  # noqa: E402
 
 
-def testbed_figure(obs: Observed, truth: Truth, tree: str, path: Path | str,
-                   stats: dict | None = None) -> Path:
+def testbed_figure(
+    obs: Observed, truth: Truth, tree: str, path: Path | str, stats: dict | None = None
+) -> Path:
     """Write the figure to ``path`` (PNG, via a temporary file) and return the path.
 
     stats: ``physgs.testbed.stats.testbed_stats`` of the tree; when given, the skeleton is
@@ -42,17 +44,25 @@ def testbed_figure(obs: Observed, truth: Truth, tree: str, path: Path | str,
     fig.colorbar(lc, ax=ax, label="natural frequency (Hz)", shrink=0.8)
 
     ax = fig.add_subplot(gs[0, 2:4])
-    ax.hist(f_hz, bins=np.linspace(0.3, 1.55, 26), color="tab:green", edgecolor="k",
-            label="all bones")
+    ax.hist(
+        f_hz, bins=np.linspace(0.3, 1.55, 26), color="tab:green", edgecolor="k", label="all bones"
+    )
     if stats is not None:
-        ax.hist(f_hz[np.asarray(stats["visible"], bool)], bins=np.linspace(0.3, 1.55, 26),
-                color="tab:orange", edgecolor="k", alpha=0.8,
-                label=f"own motion >= {stats['visible_threshold_px']:g} px")
+        ax.hist(
+            f_hz[np.asarray(stats["visible"], bool)],
+            bins=np.linspace(0.3, 1.55, 26),
+            color="tab:orange",
+            edgecolor="k",
+            alpha=0.8,
+            label=f"own motion >= {stats['visible_threshold_px']:g} px",
+        )
         ax.legend(fontsize=7)
     ax.set_xlabel("natural frequency f = omega / 2 pi (Hz)")
     ax.set_ylabel("bones")
-    ax.set_title(f"min {f_hz.min():.2f}, median {np.median(f_hz):.2f}, max {f_hz.max():.2f} Hz"
-                 f"; clamped {int(truth.omega_clamped.sum())}")
+    ax.set_title(
+        f"min {f_hz.min():.2f}, median {np.median(f_hz):.2f}, max {f_hz.max():.2f} Hz"
+        f"; clamped {int(truth.omega_clamped.sum())}"
+    )
 
     ax = fig.add_subplot(gs[0, 4:6])
     L = truth.lead_in_frames
@@ -68,10 +78,12 @@ def testbed_figure(obs: Observed, truth: Truth, tree: str, path: Path | str,
     ax.legend(fontsize=7)
     ax.set_title("ground-truth bone angles, training wind")
 
-    panels = [(obs.frames[0, 0], "train cam, frame 0"),
-              (obs.frames[0, obs.n_train - 1], f"frame {obs.n_train - 1}"),
-              (obs.frames[-1, obs.n_train - 1], f"frame {obs.n_train - 1}, {obs.conditions[-1]:.2f} v0"),
-              (obs.frames[0, -1], f"tail frame {obs.n_train + obs.n_tail - 1}")]
+    panels = [
+        (obs.frames[0, 0], "train cam, frame 0"),
+        (obs.frames[0, obs.n_train - 1], f"frame {obs.n_train - 1}"),
+        (obs.frames[-1, obs.n_train - 1], f"frame {obs.n_train - 1}, {obs.conditions[-1]:.2f} v0"),
+        (obs.frames[0, -1], f"tail frame {obs.n_train + obs.n_tail - 1}"),
+    ]
     for k in (0, len(obs.heldout_cameras) - 1):
         panels.append((obs.heldout_frames[k, 0], f"azimuth {obs.heldout_azimuths_deg[k]:+.0f} deg"))
     for i, (img, title) in enumerate(panels[:6]):
@@ -86,7 +98,10 @@ def testbed_figure(obs: Observed, truth: Truth, tree: str, path: Path | str,
             f"median own-motion visibility {stats['visible_px_median']:.2f} px, "
             f"{100 * stats['visible_below_px_fraction']:.0f}% of bones under "
             f"{stats['visible_threshold_px']:g} px; tree spans {100 * stats['height_fill']:.0f}% "
-            "of the image height", fontsize=9, y=0.995)
+            "of the image height",
+            fontsize=9,
+            y=0.995,
+        )
     fig.tight_layout()
     path = Path(path)
     try:

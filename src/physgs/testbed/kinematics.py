@@ -4,6 +4,7 @@ swing axis through its own head; a child moves rigidly with its parent.
 All rotations share one world axis, so a bone's world rotation is a rotation by the sum of the
 angles along its chain; its head is carried by the parent's transform.
 """
+
 from __future__ import annotations
 
 import numpy as np
@@ -56,8 +57,9 @@ def cumulative_angle(parent: np.ndarray, theta: np.ndarray) -> np.ndarray:
     return Theta
 
 
-def pose_bones(head: np.ndarray, tail: np.ndarray, parent: np.ndarray, axis: np.ndarray,
-               theta: np.ndarray):
+def pose_bones(
+    head: np.ndarray, tail: np.ndarray, parent: np.ndarray, axis: np.ndarray, theta: np.ndarray
+):
     """Posed bones for angles theta [..., B] (rad).
 
     Returns (Theta [..., B] cumulative angle, heads [..., B, 3], tails [..., B, 3]) in metres.
@@ -78,8 +80,15 @@ def pose_bones(head: np.ndarray, tail: np.ndarray, parent: np.ndarray, axis: np.
     return Theta, H, T
 
 
-def pose_points(points: np.ndarray, point_bone: np.ndarray, head: np.ndarray, tail: np.ndarray,
-                parent: np.ndarray, axis: np.ndarray, theta: np.ndarray) -> np.ndarray:
+def pose_points(
+    points: np.ndarray,
+    point_bone: np.ndarray,
+    head: np.ndarray,
+    tail: np.ndarray,
+    parent: np.ndarray,
+    axis: np.ndarray,
+    theta: np.ndarray,
+) -> np.ndarray:
     """Rigidly skinned points [N, 3] (rest pose, m) posed by theta [..., B] -> [..., N, 3]."""
     Theta, H, _ = pose_bones(head, tail, parent, axis, theta)
     return H[..., point_bone, :] + rotate(points - head[point_bone], axis, Theta[..., point_bone])
@@ -90,8 +99,15 @@ def pose_vertices(truth, theta_b: np.ndarray) -> np.ndarray:
 
     ``truth`` is a :class:`physgs.testbed.dataset.Truth` (or anything with its bone fields).
     """
-    return pose_points(truth.rest_vertices, truth.vertex_bone, truth.bone_head, truth.bone_tail,
-                       truth.bone_parent, truth.swing_axis, theta_b)
+    return pose_points(
+        truth.rest_vertices,
+        truth.vertex_bone,
+        truth.bone_head,
+        truth.bone_tail,
+        truth.bone_parent,
+        truth.swing_axis,
+        theta_b,
+    )
 
 
 def pose_gaussians(truth, theta_b: np.ndarray) -> np.ndarray:

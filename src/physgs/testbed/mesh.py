@@ -4,6 +4,7 @@ every vertex bound to exactly one bone (rigid skinning, no blending).
 Geometry on levels below the armature is skinned to the nearest ancestor bone (the bone of the
 parent stem where it attaches), so no generated vertex is left unskinned.
 """
+
 from __future__ import annotations
 
 from dataclasses import dataclass
@@ -37,8 +38,9 @@ class TreeMesh:
     def to_trimesh(self) -> "trimesh.Trimesh":  # noqa: F821
         import trimesh  # here: ~1 s of start-up that jobs reading a dataset never need
 
-        return trimesh.Trimesh(self.vertices, self.faces, vertex_colors=self.vertex_colors,
-                               process=False)
+        return trimesh.Trimesh(
+            self.vertices, self.faces, vertex_colors=self.vertex_colors, process=False
+        )
 
 
 def tube_vertex_count(stems: tuple[Stem, ...], sides: int, rings_per_segment: int) -> int:
@@ -63,7 +65,8 @@ def choose_resolution(stems, target_tube: int) -> tuple[int, int]:
         raise MeshBudgetError(
             f"vertex target too small: the tubes alone need at least {need} vertices "
             f"(3 sides, 1 ring per segment) for {len(stems)} stems; raise testbed.vertices for "
-            "this tree (or lower the leaf fraction) in config/trees.yaml")
+            "this tree (or lower the leaf fraction) in config/trees.yaml"
+        )
     return best[1], best[2]
 
 
@@ -87,8 +90,14 @@ def _frames(points: np.ndarray, n_rings: int, rings_per_segment: int):
     return centres, dirs, normals, s
 
 
-def build_mesh(skeleton: Skeleton, *, target_vertices: int, leaf_fraction: float, leaf_scale: float,
-               seed_seq: np.random.SeedSequence) -> TreeMesh:
+def build_mesh(
+    skeleton: Skeleton,
+    *,
+    target_vertices: int,
+    leaf_fraction: float,
+    leaf_scale: float,
+    seed_seq: np.random.SeedSequence,
+) -> TreeMesh:
     """Mesh a skeleton near ``target_vertices`` vertices.
 
     leaf_fraction: share of the vertex budget given to leaf quads (0 = no leaves) on the deepest
@@ -109,8 +118,10 @@ def build_mesh(skeleton: Skeleton, *, target_vertices: int, leaf_fraction: float
         b = np.cross(d, nrm)
         r = st.radius_at(np.arange(n_rings) / (n_rings - 1))
         r = np.maximum(r, 0.03 * st.radius)  # keep a thin tip ring instead of a degenerate one
-        ring = c[:, None, :] + r[:, None, None] * (np.cos(ang)[None, :, None] * nrm[:, None, :]
-                                                   + np.sin(ang)[None, :, None] * b[:, None, :])
+        ring = c[:, None, :] + r[:, None, None] * (
+            np.cos(ang)[None, :, None] * nrm[:, None, :]
+            + np.sin(ang)[None, :, None] * b[:, None, :]
+        )
         verts.append(ring.reshape(-1, 3))
         vbone.append(np.repeat(st.segment_bone[seg_idx], sides))
         # side quads between consecutive rings
@@ -168,5 +179,13 @@ def build_mesh(skeleton: Skeleton, *, target_vertices: int, leaf_fraction: float
     vb = np.concatenate(vbone).astype(np.int64)
     if (vb < 0).any():
         raise AssertionError("unskinned vertex: a stem has no ancestor bone")  # programming error
-    return TreeMesh(V, np.concatenate(faces).astype(np.int64), vb, np.concatenate(colors),
-                    np.array(tips, dtype=np.int64), sides, rps, n_leaves)
+    return TreeMesh(
+        V,
+        np.concatenate(faces).astype(np.int64),
+        vb,
+        np.concatenate(colors),
+        np.array(tips, dtype=np.int64),
+        sides,
+        rps,
+        n_leaves,
+    )

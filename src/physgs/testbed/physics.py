@@ -6,12 +6,15 @@ The system is linear time-invariant, so each frame step is exact: x_{k+1} = Phi 
 G1 (u_{k+1} - u_k) / h with Phi, G0, G1 from one augmented matrix exponential (Van Loan).
 The wind is periodic, so the start state can be the exact periodic steady state (no transient).
 """
+
 from __future__ import annotations
 
 import numpy as np
 
 
-def calibrate_omega(radius: np.ndarray, length: np.ndarray, band_hz) -> tuple[np.ndarray, float, np.ndarray]:
+def calibrate_omega(
+    radius: np.ndarray, length: np.ndarray, band_hz
+) -> tuple[np.ndarray, float, np.ndarray]:
     """omega_b = c r_b / L_b^2 (rad/s), one c per tree, centred (geometric mean) on the band.
 
     radius, length [B] (m); band_hz (lo, hi) in Hz. Returns (omega [B] rad/s clamped into the band,
@@ -33,7 +36,7 @@ def foh_matrices(omega: np.ndarray, zeta: np.ndarray, dt: float):
     B = len(omega)
     M = np.zeros((B, 4, 4))
     M[:, 0, 1] = 1.0
-    M[:, 1, 0] = -omega ** 2
+    M[:, 1, 0] = -(omega**2)
     M[:, 1, 1] = -2 * zeta * omega
     M[:, 1, 2] = 1.0  # input u
     M[:, 2, 3] = 1.0  # du/dt (constant over a step)
@@ -43,8 +46,9 @@ def foh_matrices(omega: np.ndarray, zeta: np.ndarray, dt: float):
     return E[:, :2, :2], E[:, :2, 2], E[:, :2, 3]
 
 
-def simulate(omega: np.ndarray, zeta: np.ndarray, u: np.ndarray, dt: float,
-             x0: np.ndarray | None = None) -> np.ndarray:
+def simulate(
+    omega: np.ndarray, zeta: np.ndarray, u: np.ndarray, dt: float, x0: np.ndarray | None = None
+) -> np.ndarray:
     """Exact response of each oscillator to its forcing.
 
     omega [B] rad/s, zeta [B], u [..., T, B] forcing (rad/s^2) at samples t_k = k dt (dt seconds),
@@ -66,8 +70,9 @@ def simulate(omega: np.ndarray, zeta: np.ndarray, u: np.ndarray, dt: float,
     return out
 
 
-def periodic_steady_state(omega: np.ndarray, zeta: np.ndarray, u_period: np.ndarray,
-                          dt: float) -> np.ndarray:
+def periodic_steady_state(
+    omega: np.ndarray, zeta: np.ndarray, u_period: np.ndarray, dt: float
+) -> np.ndarray:
     """State (theta, theta') [..., B, 2] at sample 0 of the periodic steady state.
 
     u_period [..., P+1, B]: one full period of the forcing (sample P equals sample 0). From rest the
@@ -75,8 +80,9 @@ def periodic_steady_state(omega: np.ndarray, zeta: np.ndarray, u_period: np.ndar
     started there carries no start transient at all (the infinite-past response).
     """
     P = u_period.shape[-2] - 1
-    Phi, _, _ = foh_matrices(np.asarray(omega, float),
-                             np.broadcast_to(np.asarray(zeta, float), np.shape(omega)), dt)
+    Phi, _, _ = foh_matrices(
+        np.asarray(omega, float), np.broadcast_to(np.asarray(zeta, float), np.shape(omega)), dt
+    )
     r = _final_state(omega, zeta, u_period, dt)  # one period from rest
     PhiP = np.linalg.matrix_power(Phi, P)  # [B, 2, 2]
     A = np.eye(2) - PhiP
@@ -86,8 +92,9 @@ def periodic_steady_state(omega: np.ndarray, zeta: np.ndarray, u_period: np.ndar
 
 def _final_state(omega, zeta, u, dt) -> np.ndarray:
     """(theta, theta') [..., B, 2] after the last sample of u [..., T, B], from rest."""
-    Phi, G0, G1 = foh_matrices(np.asarray(omega, float),
-                               np.broadcast_to(np.asarray(zeta, float), np.shape(omega)), dt)
+    Phi, G0, G1 = foh_matrices(
+        np.asarray(omega, float), np.broadcast_to(np.asarray(zeta, float), np.shape(omega)), dt
+    )
     x = np.zeros(u.shape[:-2] + (u.shape[-1], 2))
     for k in range(u.shape[-2] - 1):
         uk, du = u[..., k, :], (u[..., k + 1, :] - u[..., k, :]) / dt
@@ -97,7 +104,7 @@ def _final_state(omega, zeta, u, dt) -> np.ndarray:
 
 def drag_forcing(wind: np.ndarray, vbar: np.ndarray) -> np.ndarray:
     """Unit-gain drag forcing v^2 - vbar^2 (m^2/s^2): wind [C, T] m/s, vbar [C] m/s -> [C, T]."""
-    return wind ** 2 - np.asarray(vbar)[:, None] ** 2
+    return wind**2 - np.asarray(vbar)[:, None] ** 2
 
 
 def lead_in_frames(omega_min: float, zeta: float, lead_in_tau: float, fps: int) -> int:

@@ -1,5 +1,6 @@
 """Mesh renderer for ground-truth frames: trimesh + Embree ray casting, Lambertian + ambient
 shading with per-face colours, constant background, s x s supersampling, silhouette coverage."""
+
 from __future__ import annotations
 
 import numpy as np
@@ -21,8 +22,16 @@ class RayBundle:
         self.dirs = d.reshape(-1, 3)
 
 
-def render_mesh(vertices: np.ndarray, faces: np.ndarray, face_colors: np.ndarray, rays: RayBundle,
-                background, *, ambient: float = 0.35, light_dir: np.ndarray = LIGHT_DIR):
+def render_mesh(
+    vertices: np.ndarray,
+    faces: np.ndarray,
+    face_colors: np.ndarray,
+    rays: RayBundle,
+    background,
+    *,
+    ambient: float = 0.35,
+    light_dir: np.ndarray = LIGHT_DIR,
+):
     """Render a triangle mesh.
 
     vertices [N, 3] (m), faces [M, 3], face_colors [M, 3] in [0, 1], background [3].

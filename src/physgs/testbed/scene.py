@@ -10,6 +10,7 @@ Every camera, training and held-out, must see the whole swept extent at least ``
 inside its border, or :class:`FramingError` names ``testbed.fill_height`` and the largest value
 that fits.
 """
+
 from __future__ import annotations
 
 import numpy as np
@@ -48,8 +49,9 @@ def _rotate_z(points: np.ndarray, centre_xy: np.ndarray, deg: float) -> np.ndarr
     return np.stack([c * x + s * y + centre_xy[0], -s * x + c * y + centre_xy[1], points[:, 2]], 1)
 
 
-def orbit_cameras(centre_xy, distance: float, height: float, azimuths_deg, *, fov_deg: float,
-                  resolution: int) -> list[Camera]:
+def orbit_cameras(
+    centre_xy, distance: float, height: float, azimuths_deg, *, fov_deg: float, resolution: int
+) -> list[Camera]:
     """Square cameras at ``distance`` (m) from the vertical line through centre_xy [2] (m), at
     ``height`` (m), looking horizontally at it. Azimuth 0 sits on -y looking along +y; azimuths in
     degrees, counter-clockwise seen from above."""
@@ -58,8 +60,9 @@ def orbit_cameras(centre_xy, distance: float, height: float, azimuths_deg, *, fo
     for a in azimuths_deg:
         ar = np.deg2rad(float(a))
         eye = np.array([c[0] + distance * np.sin(ar), c[1] - distance * np.cos(ar), height])
-        cams.append(look_at(eye, [c[0], c[1], height], fov_deg=fov_deg, width=resolution,
-                            height=resolution))
+        cams.append(
+            look_at(eye, [c[0], c[1], height], fov_deg=fov_deg, width=resolution, height=resolution)
+        )
     return cams
 
 
@@ -67,8 +70,14 @@ def _violation(cam: Camera, points: np.ndarray, margin_px: float):
     """None if every point is in front of ``cam`` and inside its image with margin_px to spare;
     else (u, v, depth) of the worst point."""
     uv, z = cam.project(points)
-    over = np.maximum.reduce([margin_px - uv[:, 0], uv[:, 0] - (cam.width - margin_px),
-                              margin_px - uv[:, 1], uv[:, 1] - (cam.height - margin_px)])
+    over = np.maximum.reduce(
+        [
+            margin_px - uv[:, 0],
+            uv[:, 0] - (cam.width - margin_px),
+            margin_px - uv[:, 1],
+            uv[:, 1] - (cam.height - margin_px),
+        ]
+    )
     over = np.where(z > cam.near, over, np.inf)
     i = int(np.argmax(over))
     return None if over[i] <= 1e-6 else (float(uv[i, 0]), float(uv[i, 1]), float(z[i]))  # round-off
@@ -82,8 +91,15 @@ def _bisect(f, lo: float, hi: float, n: int = 60) -> float:
     return 0.5 * (lo + hi)
 
 
-def frame_cameras(points: np.ndarray, azimuths_deg, *, fov_deg: float, resolution: int,
-                  fill_height: float, margin_px: float = 0.5) -> list[Camera]:
+def frame_cameras(
+    points: np.ndarray,
+    azimuths_deg,
+    *,
+    fov_deg: float,
+    resolution: int,
+    fill_height: float,
+    margin_px: float = 0.5,
+) -> list[Camera]:
     """Orbit cameras (one per azimuth, degrees; the first is the training camera, which is framed).
 
     points [K, 3] (m): the swept extent, every posed vertex over the whole recording (or the
@@ -97,8 +113,10 @@ def frame_cameras(points: np.ndarray, azimuths_deg, *, fov_deg: float, resolutio
     pts = np.asarray(points, dtype=np.float64).reshape(-1, 3)
     az = [float(a) for a in azimuths_deg]
     if not 0.0 < fill_height < 1.0:
-        raise FramingError(f"testbed.fill_height = {fill_height} must lie in (0, 1) (fraction of the "
-                           "training image height the swept tree spans); fix config/trees.yaml")
+        raise FramingError(
+            f"testbed.fill_height = {fill_height} must lie in (0, 1) (fraction of the "
+            "training image height the swept tree spans); fix config/trees.yaml"
+        )
     centre = 0.5 * (pts[:, :2].min(axis=0) + pts[:, :2].max(axis=0))
     tan = np.tan(np.deg2rad(fov_deg) / 2)
     # each camera's view of the points as the azimuth-0 camera's: y = depth offset, z = height
@@ -115,8 +133,11 @@ def frame_cameras(points: np.ndarray, azimuths_deg, *, fov_deg: float, resolutio
 
     def height(D):  # centred in the training view, clamped into the feasible range
         depth = D + dy0
-        hc = _bisect(lambda h: np.max((z - h) / depth) - np.max((h - z) / depth),
-                     float(z.min()) - span, float(z.max()) + span)
+        hc = _bisect(
+            lambda h: np.max((z - h) / depth) - np.max((h - z) / depth),
+            float(z.min()) - span,
+            float(z.max()) + span,
+        )
         lo, hi = h_range(D)
         return min(max(hc, lo), hi) if lo <= hi else hc
 
@@ -154,4 +175,5 @@ def frame_cameras(points: np.ndarray, azimuths_deg, *, fov_deg: float, resolutio
         f"testbed.fill_height = {fill_height}: the tree's swept extent (every frame, every "
         f"condition) leaves {which} (a vertex reaches pixel ({u:.1f}, {v:.1f}) at depth {zz:.2f} m "
         f"of a {resolution}x{resolution} image, {margin_px:g} px margin required); lower "
-        f"testbed.fill_height in config/trees.yaml (at most {lo:.3f} fits every view)")
+        f"testbed.fill_height in config/trees.yaml (at most {lo:.3f} fits every view)"
+    )

@@ -28,6 +28,7 @@ condition 0, unless said otherwise):
 - order leak: ``neighbour_bone_share`` of the bone labels in stored Gaussian order, beside its
   expectation under a uniformly random order, ``expected_neighbour_share``.
 """
+
 from __future__ import annotations
 
 import numpy as np
@@ -84,7 +85,7 @@ def median_nearest_bone_gap(omega, n_grid: int = 200_001) -> float:
     ob = np.unique(om)
     gaps = np.empty_like(grid)
     for i in range(0, grid.size, 20_000):  # [chunk, B] at a time
-        gaps[i:i + 20_000] = nearest_bone_gap(grid[i:i + 20_000], ob)
+        gaps[i : i + 20_000] = nearest_bone_gap(grid[i : i + 20_000], ob)
     return float(np.median(gaps))
 
 
@@ -94,10 +95,12 @@ def median_nearest_bone_gap(omega, n_grid: int = 200_001) -> float:
 
 def _window(truth, n_train: int, condition: int = 0) -> np.ndarray:
     L = int(truth.lead_in_frames)
-    th = np.asarray(truth.theta)[condition, L:L + int(n_train)]
+    th = np.asarray(truth.theta)[condition, L : L + int(n_train)]
     if th.shape[0] != int(n_train):
-        raise ValueError(f"truth has {np.asarray(truth.theta).shape[1]} samples, fewer than lead-in "
-                         f"{L} + {n_train} training frames")
+        raise ValueError(
+            f"truth has {np.asarray(truth.theta).shape[1]} samples, fewer than lead-in "
+            f"{L} + {n_train} training frames"
+        )
     return th  # [n_train, B]
 
 
@@ -162,7 +165,7 @@ def swept_image_extent(truth, camera, *, chunk: int = 25) -> tuple[np.ndarray, n
     th = np.asarray(truth.theta)[:, L:].reshape(-1, np.asarray(truth.theta).shape[-1])
     lo, hi = np.full(2, np.inf), np.full(2, -np.inf)
     for i in range(0, len(th), chunk):
-        V = kinematics.pose_vertices(truth, th[i:i + chunk])
+        V = kinematics.pose_vertices(truth, th[i : i + chunk])
         uv, _ = camera.project(V.reshape(-1, 3))
         lo, hi = np.minimum(lo, uv.min(axis=0)), np.maximum(hi, uv.max(axis=0))
     return lo, hi
@@ -232,7 +235,9 @@ def testbed_stats(observed, truth, *, visible_threshold_px: float = 1.0) -> dict
     return dict(
         bones=int(omega.size),
         distinct_frequencies=distinct_count(omega),
-        f_min_hz=float(f.min()), f_median_hz=float(np.median(f)), f_max_hz=float(f.max()),
+        f_min_hz=float(f.min()),
+        f_median_hz=float(np.median(f)),
+        f_max_hz=float(f.max()),
         f_span=float(f.max() / f.min()),
         clamped=int(np.asarray(truth.omega_clamped).sum()),
         nearest_bone_gap=median_nearest_bone_gap(omega),
@@ -246,7 +251,9 @@ def testbed_stats(observed, truth, *, visible_threshold_px: float = 1.0) -> dict
         order_share=neighbour_bone_share(stored),
         order_share_random=expected_neighbour_share(vb),
         mesh_order_share=neighbour_bone_share(vb),
-        swing_deg=swing, visible_px=vis, visible=vis >= visible_threshold_px,
+        swing_deg=swing,
+        visible_px=vis,
+        visible=vis >= visible_threshold_px,
     )
 
 
@@ -254,7 +261,9 @@ def save_stats(path, stats: dict) -> None:
     """Write ``testbed_stats`` as JSON (arrays as lists), atomically."""
     from physgs.atomic import write_json
 
-    write_json(path, {k: (v.tolist() if isinstance(v, np.ndarray) else v) for k, v in stats.items()})
+    write_json(
+        path, {k: (v.tolist() if isinstance(v, np.ndarray) else v) for k, v in stats.items()}
+    )
 
 
 def load_stats(path) -> dict:
@@ -265,6 +274,7 @@ def load_stats(path) -> dict:
         with open(path) as fh:
             d = json.load(fh)
     except (OSError, json.JSONDecodeError) as e:
-        raise ValueError(f"cannot read testbed statistics {path}: {e}; delete it and re-run "
-                         "its rule") from e
+        raise ValueError(
+            f"cannot read testbed statistics {path}: {e}; delete it and re-run its rule"
+        ) from e
     return {k: (np.asarray(v) if isinstance(v, list) else v) for k, v in d.items()}

@@ -10,6 +10,7 @@ every bone decays freely with envelope exp(-zeta_b omega_b t)), and the turbulen
 Times are seconds with t = 0 at recorded frame 0 (frame j at t = j / fps), as in
 ``physgs.testbed.dataset``. Everything here is a pure function of the config and arrays.
 """
+
 from __future__ import annotations
 
 import math
@@ -63,8 +64,10 @@ def draw_zeta(zeta_range, n_bones: int, seed_seq: np.random.SeedSequence) -> np.
     """[n_bones] damping ratios, log-uniform on [lo, hi] = zeta_range, 0 < lo <= hi <= 1, seeded."""
     lo, hi = (float(z) for z in zeta_range)
     if not 0 < lo <= hi <= 1:
-        raise ValueError(f"zeta_range {list(zeta_range)} must satisfy 0 < lo <= hi <= 1; fix "
-                         "testbed.damping.zeta_range in config/trees.yaml")
+        raise ValueError(
+            f"zeta_range {list(zeta_range)} must satisfy 0 < lo <= hi <= 1; fix "
+            "testbed.damping.zeta_range in config/trees.yaml"
+        )
     u = np.random.default_rng(seed_seq).uniform(size=n_bones)
     return np.exp(math.log(lo) + u * (math.log(hi) - math.log(lo)))
 
@@ -109,8 +112,13 @@ def transient_of(tb: dict) -> Transient | None:
     if variant_of(tb) == FAITHFUL:
         return None
     t = tb["damping"]["transient"]
-    return Transient(float(t["start_s"]), float(t["calm_s"]), float(t["gust_s"]),
-                     float(t["gust_gain"]), float(t["ramp_s"]))
+    return Transient(
+        float(t["start_s"]),
+        float(t["calm_s"]),
+        float(t["gust_s"]),
+        float(t["gust_gain"]),
+        float(t["ramp_s"]),
+    )
 
 
 def _rise(x: np.ndarray) -> np.ndarray:

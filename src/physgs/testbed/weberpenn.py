@@ -19,6 +19,7 @@ on a longer clone still grow with it). Neither can change a bone count: a clone 
 ceil(curve_res / bone_step) bones whatever its length or bend, and length_v < 1 keeps every
 clone's length positive.
 """
+
 from __future__ import annotations
 
 import math
@@ -32,8 +33,16 @@ class PresetError(ValueError):
     """A tree preset that cannot be built as declared; the message names the cause and the fix."""
 
 
-SHAPES = ("conical", "spherical", "hemispherical", "cylindrical", "tapered_cylindrical", "flame",
-          "inverse_conical", "tend_flame")
+SHAPES = (
+    "conical",
+    "spherical",
+    "hemispherical",
+    "cylindrical",
+    "tapered_cylindrical",
+    "flame",
+    "inverse_conical",
+    "tend_flame",
+)
 
 
 def shape_ratio(shape: str, r: float) -> float:
@@ -144,8 +153,10 @@ def _apportion(total: int, weights: np.ndarray) -> np.ndarray:
     if total == 0:
         return np.zeros(len(weights), dtype=int)
     if weights.sum() <= 0:
-        raise PresetError("no parent stem has room for children (all weights zero); "
-                          "lower base_size or add a parent level")
+        raise PresetError(
+            "no parent stem has room for children (all weights zero); "
+            "lower base_size or add a parent level"
+        )
     share = total * weights / weights.sum()
     n = np.floor(share).astype(int)
     rest = total - n.sum()
@@ -172,8 +183,10 @@ def generate(preset: dict, *, seed: int, name: str) -> Skeleton:
     levels = preset["levels"]
     n_arm = int(preset["armature_levels"])
     if not 1 <= n_arm <= len(levels):
-        raise PresetError(f"preset '{name}': armature_levels={n_arm} must be between 1 and the "
-                          f"number of levels ({len(levels)}); fix presets.{name} in config/trees.yaml")
+        raise PresetError(
+            f"preset '{name}': armature_levels={n_arm} must be between 1 and the "
+            f"number of levels ({len(levels)}); fix presets.{name} in config/trees.yaml"
+        )
     scale = float(preset["scale"])
     base_size = float(preset["base_size"])
     ratio, ratio_power, taper = (float(preset[k]) for k in ("ratio", "ratio_power", "taper"))
@@ -207,8 +220,15 @@ def generate(preset: dict, *, seed: int, name: str) -> Skeleton:
     lv0 = levels[0]
     L0 = float(lv0["length"]) * scale
     r0 = L0 * ratio
-    trunk_pts = _polyline([0, 0, 0], [0, 0, 1], L0, int(lv0["curve_res"]), float(lv0.get("curve_deg", 0)),
-                          float(lv0.get("curve_v_deg", 0)), rng)
+    trunk_pts = _polyline(
+        [0, 0, 0],
+        [0, 0, 1],
+        L0,
+        int(lv0["curve_res"]),
+        float(lv0.get("curve_deg", 0)),
+        float(lv0.get("curve_v_deg", 0)),
+        rng,
+    )
     add_stem(trunk_pts, r0, 0, -1, -1, taper)
 
     # Split clones at the trunk's end (still level 0): a fork.
@@ -217,12 +237,16 @@ def generate(preset: dict, *, seed: int, name: str) -> Skeleton:
     length_v = float(split.get("length_v", 0.0))
     clone_curve_v = float(split.get("curve_v_deg", lv0.get("curve_v_deg", 0)))
     if not 0.0 <= length_v < 1.0:
-        raise PresetError(f"preset '{name}': split.length_v = {length_v} must lie in [0, 1) (a clone's "
-                          "length is scaled by 1 + U(-length_v, length_v), which must stay positive); "
-                          f"fix presets.{name}.split.length_v in config/trees.yaml")
+        raise PresetError(
+            f"preset '{name}': split.length_v = {length_v} must lie in [0, 1) (a clone's "
+            "length is scaled by 1 + U(-length_v, length_v), which must stay positive); "
+            f"fix presets.{name}.split.length_v in config/trees.yaml"
+        )
     if clone_curve_v < 0:
-        raise PresetError(f"preset '{name}': split.curve_v_deg = {clone_curve_v} must be >= 0; "
-                          f"fix presets.{name}.split.curve_v_deg in config/trees.yaml")
+        raise PresetError(
+            f"preset '{name}': split.curve_v_deg = {clone_curve_v} must be >= 0; "
+            f"fix presets.{name}.split.curve_v_deg in config/trees.yaml"
+        )
     if n_clones:
         # per-clone length variation from its own stream: every other draw is as without it
         crng = np.random.default_rng(np.random.SeedSequence([int(seed), _stable_id(name), 2]))
@@ -237,21 +261,40 @@ def generate(preset: dict, *, seed: int, name: str) -> Skeleton:
             Lc = float(split["length"]) * L0 * clone_scale[i]
             # the same draws from the tree stream as without variation (curve_res normals per
             # clone), scaled by the clone's curve_v_deg
-            pts = _polyline(trunk_pts[-1], d, Lc, int(split["curve_res"]), float(lv0.get("curve_deg", 0)),
-                            clone_curve_v, rng)
-            add_stem(pts, r0 * (1 - taper) * float(split.get("radius", 0.8)), 0, 0, tip_bone,
-                     float(split.get("taper", taper)))
+            pts = _polyline(
+                trunk_pts[-1],
+                d,
+                Lc,
+                int(split["curve_res"]),
+                float(lv0.get("curve_deg", 0)),
+                clone_curve_v,
+                rng,
+            )
+            add_stem(
+                pts,
+                r0 * (1 - taper) * float(split.get("radius", 0.8)),
+                0,
+                0,
+                tip_bone,
+                float(split.get("taper", taper)),
+            )
 
     # Child levels.
     for n in range(1, len(levels)):
         lv = levels[n]
         parent_ids = [i for i, s in enumerate(stems) if s.level == n - 1]
-        starts = np.array([base_size if (n == 1 and stems[i].parent == -1) else float(lv.get("start", 0.1))
-                           for i in parent_ids])
+        starts = np.array(
+            [
+                base_size if (n == 1 and stems[i].parent == -1) else float(lv.get("start", 0.1))
+                for i in parent_ids
+            ]
+        )
         weights = np.array([stems[i].length for i in parent_ids]) * (1 - starts)
         if "stems" not in lv:
-            raise PresetError(f"preset '{name}': level {n} has no 'stems' (total child stems at that "
-                              f"level); add it to presets.{name}.levels[{n}] in config/trees.yaml")
+            raise PresetError(
+                f"preset '{name}': level {n} has no 'stems' (total child stems at that "
+                f"level); add it to presets.{name}.levels[{n}] in config/trees.yaml"
+            )
         counts = _apportion(int(lv["stems"]), weights)
         for pid, start, cnt in zip(parent_ids, starts, counts):
             ps = stems[pid]
@@ -263,31 +306,55 @@ def generate(preset: dict, *, seed: int, name: str) -> Skeleton:
             end = float(lv.get("end", 1.0))  # children occupy [start, end] of the parent
             for i in range(cnt):
                 z = start + (end - start) * (i + 0.5) / cnt
-                z = float(np.clip(z + rng.uniform(-0.25, 0.25) * (end - start) / cnt, start, min(end, 0.999)))
+                z = float(
+                    np.clip(
+                        z + rng.uniform(-0.25, 0.25) * (end - start) / cnt, start, min(end, 0.999)
+                    )
+                )
                 s = int(np.clip(np.searchsorted(cum, z, side="right") - 1, 0, len(seg) - 1))
                 frac = (z - cum[s]) / (cum[s + 1] - cum[s])
                 pos = ps.points[s] + frac * seg[s]
                 d_par = _unit(seg[s])
                 if n == 1:
-                    L = L0 * float(lv["length"]) * shape_ratio(shape, (1 - z) / max(1 - start, 1e-9)) \
-                        if ps.parent == -1 else p_len * float(lv["length"]) * shape_ratio(shape, 1 - z)
+                    L = (
+                        L0
+                        * float(lv["length"])
+                        * shape_ratio(shape, (1 - z) / max(1 - start, 1e-9))
+                        if ps.parent == -1
+                        else p_len * float(lv["length"]) * shape_ratio(shape, 1 - z)
+                    )
                 else:
                     L = float(lv["length"]) * (p_len - 0.6 * z * p_len)
                 L *= 1 + rng.uniform(-1, 1) * float(lv.get("length_v", 0.0))
                 if L <= 1e-6:
-                    raise PresetError(f"preset '{name}': a level-{n} stem gets zero length "
-                                      f"(shape '{shape}' at position {z:.2f}); use another shape "
-                                      "or raise length")
-                rot = phi0 + i * math.radians(float(lv["rotate_deg"])) + \
-                    math.radians(rng.normal(0, float(lv.get("rotate_v_deg", 0))))
+                    raise PresetError(
+                        f"preset '{name}': a level-{n} stem gets zero length "
+                        f"(shape '{shape}' at position {z:.2f}); use another shape "
+                        "or raise length"
+                    )
+                rot = (
+                    phi0
+                    + i * math.radians(float(lv["rotate_deg"]))
+                    + math.radians(rng.normal(0, float(lv.get("rotate_v_deg", 0))))
+                )
                 u = _rot(_perp(d_par), d_par, rot)
-                down = math.radians(float(lv["down_angle_deg"]) + rng.normal(0, float(lv.get("down_angle_v_deg", 0))))
+                down = math.radians(
+                    float(lv["down_angle_deg"])
+                    + rng.normal(0, float(lv.get("down_angle_v_deg", 0)))
+                )
                 d = _unit(math.cos(down) * d_par + math.sin(down) * u)
                 r_par_here = float(ps.radius_at(z))
                 rp = float(lv.get("ratio_power", ratio_power))
                 r = min(ps.radius * (L / p_len) ** rp, r_par_here)
-                pts = _polyline(pos, d, L, int(lv["curve_res"]), float(lv.get("curve_deg", 0)),
-                                float(lv.get("curve_v_deg", 0)), rng)
+                pts = _polyline(
+                    pos,
+                    d,
+                    L,
+                    int(lv["curve_res"]),
+                    float(lv.get("curve_deg", 0)),
+                    float(lv.get("curve_v_deg", 0)),
+                    rng,
+                )
                 add_stem(pts, r, n, pid, int(ps.segment_bone[s]), taper)
 
     B = len(heads)
@@ -296,11 +363,21 @@ def generate(preset: dict, *, seed: int, name: str) -> Skeleton:
         per_level = []
         for n in range(n_arm):
             cnt = sum(1 for s in stems if s.level == n)
-            per_level.append(f"level {n}: {cnt} stems -> {sum(1 for lv_ in blevel if lv_ == n)} bones")
+            per_level.append(
+                f"level {n}: {cnt} stems -> {sum(1 for lv_ in blevel if lv_ == n)} bones"
+            )
         raise PresetError(
             f"preset '{name}' yields {B} animated bones but declares bones: {want} "
             f"({'; '.join(per_level)}). Bones = sum over the {n_arm} armature level(s) of stems x "
             f"ceil(curve_res / bone_step); fix presets.{name} (stems, curve_res, bone_step, split, "
-            "armature_levels) in config/trees.yaml")
-    return Skeleton(np.array(heads), np.array(tails), np.array(radii), np.array(lengths),
-                    np.array(parents, dtype=int), np.array(blevel, dtype=int), tuple(stems))
+            "armature_levels) in config/trees.yaml"
+        )
+    return Skeleton(
+        np.array(heads),
+        np.array(tails),
+        np.array(radii),
+        np.array(lengths),
+        np.array(parents, dtype=int),
+        np.array(blevel, dtype=int),
+        tuple(stems),
+    )

@@ -4,6 +4,7 @@ The speed is a sum of equal-amplitude cosines on a frequency grid of spacing df 
 phases, so it is defined at every time t (seconds; t = 0 at recorded frame 1) and a longer
 lead-in extends the same realisation backwards without changing the recorded window.
 """
+
 from __future__ import annotations
 
 from dataclasses import dataclass
@@ -33,20 +34,29 @@ class WindField:
         K = len(self.freqs)
         s = np.zeros_like(t)
         for k0 in range(0, K, 256):  # chunked to bound memory at [T, 256]
-            f, ph = self.freqs[k0:k0 + 256], self.phases[k0:k0 + 256]
+            f, ph = self.freqs[k0 : k0 + 256], self.phases[k0 : k0 + 256]
             s += np.cos(2 * np.pi * t[:, None] * f[None, :] + ph[None, :]).sum(1)
         return self.v0 * (1.0 + self.ti * np.sqrt(2.0 / K) * s)
 
 
-def make_wind(*, v0: float, turbulence_intensity: float, f_lo_hz: float, f_hi_hz: float,
-              seed_seq: np.random.SeedSequence, period_s: float = PERIOD_S) -> WindField:
+def make_wind(
+    *,
+    v0: float,
+    turbulence_intensity: float,
+    f_lo_hz: float,
+    f_hi_hz: float,
+    seed_seq: np.random.SeedSequence,
+    period_s: float = PERIOD_S,
+) -> WindField:
     """A flat-spectrum realisation on the grid f = k / period_s inside [f_lo_hz, f_hi_hz].
 
     period_s (s) must exceed the whole record (lead-in included) so the record never repeats.
     """
     if not 0 < f_lo_hz < f_hi_hz:
-        raise WindError(f"wind band [{f_lo_hz}, {f_hi_hz}] Hz is empty; set 0 < f_lo_hz < f_hi_hz "
-                        "in testbed.wind of config/trees.yaml")
+        raise WindError(
+            f"wind band [{f_lo_hz}, {f_hi_hz}] Hz is empty; set 0 < f_lo_hz < f_hi_hz "
+            "in testbed.wind of config/trees.yaml"
+        )
     k = np.arange(np.ceil(f_lo_hz * period_s - 1e-9), np.floor(f_hi_hz * period_s + 1e-9) + 1)
     freqs = k / period_s
     phases = np.random.default_rng(seed_seq).uniform(0, 2 * np.pi, len(freqs))

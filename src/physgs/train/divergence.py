@@ -19,6 +19,7 @@ Three checks, each cheap next to a render:
 Parameter groups are named as in ``BaseModel.param_groups``, which are the keys of the config's
 ``train.lr``; a Divergence lists the groups most likely responsible, most likely first.
 """
+
 from __future__ import annotations
 
 from collections import deque
@@ -99,14 +100,17 @@ class DivergenceGuard:
     _growth: dict[str, float] = field(default_factory=dict, repr=False)
 
     @classmethod
-    def build(cls, canonical_xyz, params: Mapping[str, object], group: Mapping[str, str],
-              warmup: int) -> "DivergenceGuard":
+    def build(
+        cls, canonical_xyz, params: Mapping[str, object], group: Mapping[str, str], warmup: int
+    ) -> "DivergenceGuard":
         """Guard from the canonical positions [N, 3] (world units), the initial parameters
         (name -> array, or its largest |value|), each parameter's group, and the warm-up length."""
         xyz = np.asarray(canonical_xyz, dtype=np.float64)
         if xyz.ndim != 2 or xyz.shape[1] != 3 or xyz.shape[0] == 0 or not np.isfinite(xyz).all():
-            raise ValueError(f"DivergenceGuard: canonical positions must be finite [N, 3], N > 0; "
-                             f"got shape {xyz.shape}")
+            raise ValueError(
+                f"DivergenceGuard: canonical positions must be finite [N, 3], N > 0; "
+                f"got shape {xyz.shape}"
+            )
         missing = sorted(set(params) - set(group))
         if missing:
             raise ValueError(f"DivergenceGuard: parameters {missing} belong to no parameter group")
@@ -163,14 +167,17 @@ class DivergenceGuard:
         if worst is None or worst_ratio <= PARAM_GROWTH:
             return None
         g = self.group[worst]
-        over = tuple(sorted((k for k in growth if growth[k] > PARAM_GROWTH),
-                            key=lambda k: -growth[k]))  # every group over the limit, g first
+        over = tuple(
+            sorted((k for k in growth if growth[k] > PARAM_GROWTH), key=lambda k: -growth[k])
+        )  # every group over the limit, g first
         also = "".join(f"; group {k} too ({growth[k]:.3g}x)" for k in over if k != g)
         value = worst_ratio * self.scale[worst]
         return Divergence(
             f"parameter '{worst}' (group {g}) reached |value| {value:.3g}, "
             f"{worst_ratio:.3g}x its initial scale {self.scale[worst]:.3g} (limit "
-            f"{PARAM_GROWTH:g}x){also}", over)
+            f"{PARAM_GROWTH:g}x){also}",
+            over,
+        )
 
     def check_means(self, means) -> Divergence | None:
         """Gaussian positions [N, 3] (world units) about to be rendered."""
@@ -178,8 +185,10 @@ class DivergenceGuard:
         lo, hi = x.min(0), x.max(0)
         if not (np.isfinite(lo).all() and np.isfinite(hi).all()):
             bad = int((~np.isfinite(x).all(1)).sum())
-            return Divergence(f"{bad} of the {x.shape[0]} Gaussian means are NaN or inf",
-                              self.suspects(("means", *self.deformation_groups())))
+            return Divergence(
+                f"{bad} of the {x.shape[0]} Gaussian means are NaN or inf",
+                self.suspects(("means", *self.deformation_groups())),
+            )
         r = BOUNDS_FACTOR * self.extent
         # the farthest corner of the means' own box bounds every distance: usually one test
         corner = np.maximum(np.abs(lo - self.center), np.abs(hi - self.center))
@@ -192,7 +201,9 @@ class DivergenceGuard:
         return Divergence(
             f"{frac:.0%} of the {x.shape[0]} Gaussians are more than {BOUNDS_FACTOR:g}x the scene "
             f"extent ({self.extent:.3g}) from its centre (median {np.median(d):.3g}x, farthest "
-            f"{d.max():.3g}x)", self.suspects(("means", *self.deformation_groups())))
+            f"{d.max():.3g}x)",
+            self.suspects(("means", *self.deformation_groups())),
+        )
 
     def check_loss(self, it: int, loss: float) -> Divergence | None:
         """The loss of iteration ``it`` (0-based, called once per iteration in order)."""
@@ -218,7 +229,9 @@ class DivergenceGuard:
         return Divergence(
             f"the loss (median {med:.3g} over the last {LOSS_WINDOW} iterations) is "
             f"{med / max(self._level, 1e-12):.3g}x its warm-up level {self._level:.3g} (limit "
-            f"{LOSS_RATIO:g}x)", self.deformation_suspects())
+            f"{LOSS_RATIO:g}x)",
+            self.deformation_suspects(),
+        )
 
 
 def _abs_max(v) -> float:

@@ -1,4 +1,5 @@
 """One training loop for every model: Adam, L1 + D-SSIM, shared static warm-up and schedule."""
+
 from __future__ import annotations
 
 import csv
@@ -24,9 +25,15 @@ class TrainingError(RuntimeError):
     """Training cannot go on (the loss turned NaN or inf, the fit diverged, or the model's
     forward pass failed); no checkpoint is written."""
 
+
 #: Canonical-set field of a GaussianState -> the parameter group (train.lr key) that trains it.
-_STATE_GROUP = {"means": "means", "quats": "quats", "scales": "scales", "opacities": "opacities",
-                "colors": "colors"}
+_STATE_GROUP = {
+    "means": "means",
+    "quats": "quats",
+    "scales": "scales",
+    "opacities": "opacities",
+    "colors": "colors",
+}
 
 
 @dataclass
@@ -47,9 +54,18 @@ def condition_indices(spec: str, n_conditions: int) -> list[int]:
     raise ValueError(f"unknown conditions {spec!r} in models.configs; use 'train' or 'all'")
 
 
-def train_model(model: BaseModel, observed, train_cfg: dict, *, conditions: list[int], seed: int,
-                name: str | None = None, progress: bool = True, frame_pool=None,
-                on_iteration=None) -> TrainResult:
+def train_model(
+    model: BaseModel,
+    observed,
+    train_cfg: dict,
+    *,
+    conditions: list[int],
+    seed: int,
+    name: str | None = None,
+    progress: bool = True,
+    frame_pool=None,
+    on_iteration=None,
+) -> TrainResult:
     """Fit ``model`` to the training-camera frames of ``observed``.
 
     Each iteration draws (seeded) one condition from ``conditions`` and one recorded frame
@@ -74,8 +90,10 @@ def train_model(model: BaseModel, observed, train_cfg: dict, *, conditions: list
     if frame_pool is not None:
         frame_pool = np.asarray(frame_pool, dtype=np.int64)
         if frame_pool.size == 0 or frame_pool.min() < 0 or frame_pool.max() >= observed.n_train:
-            raise ValueError(f"frame_pool must hold training-frame indices in [0, "
-                             f"{observed.n_train}); got {frame_pool.size} frames")
+            raise ValueError(
+                f"frame_pool must hold training-frame indices in [0, "
+                f"{observed.n_train}); got {frame_pool.size} frames"
+            )
     extra: dict = {}
     rng = np.random.default_rng(seed)
     torch.manual_seed(seed)
@@ -86,12 +104,15 @@ def train_model(model: BaseModel, observed, train_cfg: dict, *, conditions: list
     lr_cfg = train_cfg["lr"]
     group_of = {id(p): g["name"] for g in groups for p in g["params"]}
     named = [(n, p) for n, p in model.named_parameters() if id(p) in group_of]
-    guard = DivergenceGuard.build(model.ctx.canonical_xyz, _abs_maxes(named),
-                                  {n: group_of[id(p)] for n, p in named}, warmup)
+    guard = DivergenceGuard.build(
+        model.ctx.canonical_xyz, _abs_maxes(named), {n: group_of[id(p)] for n, p in named}, warmup
+    )
 
     def diverged(it: int, d: Divergence, when: str = "at") -> TrainingError:
-        return TrainingError(f"model '{name}': training diverged {when} iteration {it}: {d.what}; "
-                             f"{_likely(d.groups, lr_cfg)}; no checkpoint written")
+        return TrainingError(
+            f"model '{name}': training diverged {when} iteration {it}: {d.what}; "
+            f"{_likely(d.groups, lr_cfg)}; no checkpoint written"
+        )
 
     winds = torch.as_tensor(np.asarray(observed.wind), dtype=torch.float32)  # [C, L+F]
     bg = torch.as_tensor(np.asarray(observed.background), dtype=torch.float32)
@@ -107,20 +128,26 @@ def train_model(model: BaseModel, observed, train_cfg: dict, *, conditions: list
         if on_iteration is not None:
             extra.update(on_iteration(it, model, opt) or {})
         c = int(conditions[rng.integers(len(conditions))])
-        j = int(rng.integers(observed.n_train) if frame_pool is None
-                else frame_pool[rng.integers(frame_pool.size)])
+        j = int(
+            rng.integers(observed.n_train)
+            if frame_pool is None
+            else frame_pool[rng.integers(frame_pool.size)]
+        )
         target = torch.from_numpy(np.array(observed.frames[c, j])).float() / 255.0  # [H, W, 3]
         warm = it < warmup
         # the groups that shape this iteration's Gaussians, most grown first
-        shaping = (guard.suspects(_STATE_GROUP.values()) if warm
-                   else guard.deformation_suspects())
+        shaping = guard.suspects(_STATE_GROUP.values()) if warm else guard.deformation_suspects()
         try:
             s = model.canonical_state() if warm else model.gaussians_at(j, winds[c])
         except Exception as e:  # e.g. integrate: omega ... got min nan
             grown = max(guard.growth().values(), default=1.0)
-            note = ("" if grown > SUSPECT_GROWN else f" (no parameter has grown past "
-                    f"{grown:.2g}x its initial scale: if the rate is not the cause, the error "
-                    "itself is)")
+            note = (
+                ""
+                if grown > SUSPECT_GROWN
+                else f" (no parameter has grown past "
+                f"{grown:.2g}x its initial scale: if the rate is not the cause, the error "
+                "itself is)"
+            )
             raise TrainingError(
                 f"model '{name}': its {'canonical state' if warm else 'deformation'} failed at "
                 f"iteration {it} (condition {c}, frame {j}) with {type(e).__name__}: {e}; "
@@ -128,20 +155,41 @@ def train_model(model: BaseModel, observed, train_cfg: dict, *, conditions: list
             ) from e
         bad = [k for k in _STATE_GROUP if not _finite(getattr(s, k))]
         if bad:
-            raise diverged(it, Divergence(
-                f"Gaussian {', '.join(bad)} became NaN or inf",
-                guard.suspects([_STATE_GROUP[k] for k in bad] if warm
-                               else [*shaping, *(_STATE_GROUP[k] for k in bad)])))
+            raise diverged(
+                it,
+                Divergence(
+                    f"Gaussian {', '.join(bad)} became NaN or inf",
+                    guard.suspects(
+                        [_STATE_GROUP[k] for k in bad]
+                        if warm
+                        else [*shaping, *(_STATE_GROUP[k] for k in bad)]
+                    ),
+                ),
+            )
         d = guard.check_means(s.means.detach().cpu().numpy())
         if d is not None:
             raise diverged(it, d)
-        out = rasterization(s.means, s.quats, s.scales, s.opacities, s.colors, cam, bg,
-                            backend=backend, return_depth=False)
+        out = rasterization(
+            s.means,
+            s.quats,
+            s.scales,
+            s.opacities,
+            s.colors,
+            cam,
+            bg,
+            backend=backend,
+            return_depth=False,
+        )
         loss, l1, dssim = photometric_loss(out.rgb, target, w_ssim)
         if not math.isfinite(loss.item()):
-            raise diverged(it, Divergence(
-                f"the loss became {float(loss)} (condition {c}, frame {j}; if no setting below "
-                "explains it, check the dataset for corrupt frames)", shaping))
+            raise diverged(
+                it,
+                Divergence(
+                    f"the loss became {float(loss)} (condition {c}, frame {j}; if no setting below "
+                    "explains it, check the dataset for corrupt frames)",
+                    shaping,
+                ),
+            )
         d = guard.check_loss(it, loss.item())
         if d is not None:
             raise diverged(it, d)
@@ -153,20 +201,36 @@ def train_model(model: BaseModel, observed, train_cfg: dict, *, conditions: list
         d = guard.check_params(_abs_maxes(named))
         if d is not None:
             raise diverged(it, d, "in the update of")
-        log.append({"iteration": it, "phase": "warmup" if warm else "deform", "condition": c,
-                    "frame": j, "loss": loss.item(), "l1": l1.item(), "dssim": dssim.item(),
-                    "seconds": time.perf_counter() - t0})
+        log.append(
+            {
+                "iteration": it,
+                "phase": "warmup" if warm else "deform",
+                "condition": c,
+                "frame": j,
+                "loss": loss.item(),
+                "l1": l1.item(),
+                "dssim": dssim.item(),
+                "seconds": time.perf_counter() - t0,
+            }
+        )
         if it % 10 == 0:
             bar.set_postfix(loss=f"{loss.item():.4f}")
     wall = time.perf_counter() - t0
     model.eval()
-    tail = [r["loss"] for r in log[-max(1, iterations // 10):]]
+    tail = [r["loss"] for r in log[-max(1, iterations // 10) :]]
     stats = {
-        "iterations": iterations, "warmup": warmup, "wall_s": wall,
-        "s_per_iter": wall / iterations, "final_loss": float(np.mean(tail)),
-        "conditions": list(conditions), "seed": int(seed), "backend": backend,
-        "n_gaussians": int(model.canonical.n), "wind_mean": float(model.ctx.wind_mean),
-        "wind_std": float(model.ctx.wind_std), "torch_threads": torch.get_num_threads(),
+        "iterations": iterations,
+        "warmup": warmup,
+        "wall_s": wall,
+        "s_per_iter": wall / iterations,
+        "final_loss": float(np.mean(tail)),
+        "conditions": list(conditions),
+        "seed": int(seed),
+        "backend": backend,
+        "n_gaussians": int(model.canonical.n),
+        "wind_mean": float(model.ctx.wind_mean),
+        "wind_std": float(model.ctx.wind_std),
+        "torch_threads": torch.get_num_threads(),
         **extra,
     }
     return TrainResult(model, stats, log)
@@ -175,8 +239,11 @@ def train_model(model: BaseModel, observed, train_cfg: dict, *, conditions: list
 def _finite(x: torch.Tensor) -> bool:
     # numpy on the CPU: a small torch op can cost milliseconds of OpenMP barrier on a busy machine
     x = x.detach()
-    return bool(np.isfinite(x.numpy()).all()) if x.device.type == "cpu" else bool(
-        torch.isfinite(x).all())
+    return (
+        bool(np.isfinite(x.numpy()).all())
+        if x.device.type == "cpu"
+        else bool(torch.isfinite(x).all())
+    )
 
 
 def _abs_maxes(named) -> dict[str, float]:
@@ -198,8 +265,11 @@ def _likely(groups, lr_cfg: dict) -> str:
     for parameter groups (= train.lr keys), most likely first."""
     if not groups:
         return "likely setting: the learning rates in train.lr; lower them"
-    parts = [f"train.lr.{g}" + (f" (now {lr_cfg[g]:g})" if isinstance(lr_cfg.get(g), (int, float))
-                                else "") for g in groups]
+    parts = [
+        f"train.lr.{g}"
+        + (f" (now {lr_cfg[g]:g})" if isinstance(lr_cfg.get(g), (int, float)) else "")
+        for g in groups
+    ]
     return "likely setting: " + " or ".join(parts) + "; lower it"
 
 

@@ -1,4 +1,5 @@
 """Photometric loss of 3DGS: (1 - w) L1 + w (1 - SSIM)."""
+
 from __future__ import annotations
 
 import torch
@@ -16,8 +17,9 @@ def ssim(a: torch.Tensor, b: torch.Tensor, window: int = 11, sigma: float = 1.5)
     """Mean SSIM of images a, b [H, W, C] in [0, 1] (Gaussian 11x11 window, sigma 1.5, zero
     padding: the 3DGS implementation)."""
     if a.shape != b.shape or a.ndim != 3:
-        raise ValueError(f"ssim: images must share shape [H, W, C]; got {tuple(a.shape)}, "
-                         f"{tuple(b.shape)}")
+        raise ValueError(
+            f"ssim: images must share shape [H, W, C]; got {tuple(a.shape)}, {tuple(b.shape)}"
+        )
     c = a.shape[-1]
     x = a.permute(2, 0, 1)[None]  # [1, C, H, W]
     y = b.permute(2, 0, 1)[None]

@@ -1,4 +1,5 @@
 """Learning-rate schedule shared by every model."""
+
 from __future__ import annotations
 
 #: Parameter groups whose rate decays exponentially (as 3DGS's position and Deformable-3DGS's

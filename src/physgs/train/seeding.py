@@ -9,6 +9,7 @@ This pins only what reads global state. Library code should still take explicit 
 generators (``np.random.default_rng(seed)``, scikit-learn's ``random_state``): k-means and the
 training loop's frame draws do, so they do not depend on what ran before them in the process.
 """
+
 from __future__ import annotations
 
 import random
