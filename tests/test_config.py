@@ -315,6 +315,37 @@ def _set(path, value, profile=None):
             "default",
             "speed_accuracy/fit_curve/iterations",
         ),
+        # a field's time scale: positive, at most half the frame rate (24 fps: 12 Hz), every id
+        (_set(("models", "mlp", "time_top_hz", "mlp"), 0), "default", "models/mlp/time_top_hz/mlp"),
+        (
+            _set(("models", "d3dgs", "time_top_hz", "d3dgs_wind"), -1.5),
+            "default",
+            "models/d3dgs/time_top_hz/d3dgs_wind",
+        ),
+        (
+            _set(("models", "mlp", "time_top_hz", "mlp_wind"), 12.5),
+            "default",
+            "models/mlp/time_top_hz/mlp_wind",
+        ),
+        (_set(("models", "mlp", "time_top_hz", "mlp_wind"), 12.0), "default", None),
+        (
+            _set(("models", "mlp", "time_top_hz", "mlp"), "seconds"),
+            "quick",
+            "models/mlp/time_top_hz/mlp",
+        ),
+        (
+            lambda c: c["models"]["mlp"]["time_top_hz"].pop("mlp"),
+            "default",
+            "models/mlp/time_top_hz/mlp",
+        ),
+        (
+            _set(("models", "mlp", "time_top_hz", "d3dgs"), 1.0),
+            "default",
+            "models/mlp/time_top_hz/d3dgs",
+        ),
+        # the studies' seeds come from seeds
+        (_set(("speed_accuracy", "seeds"), [0, 7]), "default", "speed_accuracy/seeds"),
+        (_set(("speed_accuracy", "seeds"), "all"), "default", None),
     ],
 )
 def test_cross_key_problem_is_refused_naming_the_key(edit, profile, key):
@@ -519,3 +550,15 @@ def test_the_damping_lead_in_uses_the_lowest_zeta_of_the_range():
     raw["testbed"]["zeta"] = 0.005  # unused by the damping variant
     _damping()(raw)
     pconfig.load_workflow_config(raw, "default")
+
+
+@pytest.mark.parametrize(
+    "value, seeds, expected",
+    [("first", [3, 1, 2], [3]), ("all", [0, 1, 2], [0, 1, 2]), ([2, 0], [0, 1, 2], [2, 0])],
+)
+def test_study_seeds_resolve_first_all_or_a_list(value, seeds, expected):
+    raw = _base()
+    raw.update(seeds=seeds)
+    raw["speed_accuracy"]["seeds"] = value
+    cfg = pconfig.load_workflow_config(raw, "default")
+    assert pconfig.study_seeds(cfg) == expected

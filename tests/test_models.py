@@ -190,3 +190,25 @@ def test_ours_drives_each_condition_with_its_nominal_mean_speed():
                 backend="reference",
             )
             torch.testing.assert_close(got.double(), want, rtol=1e-5, atol=1e-7)
+
+
+@pytest.mark.parametrize(
+    "name, top_hz", [("mlp", 1.5), ("mlp_wind", 0.75), ("d3dgs", 3.0), ("d3dgs_wind", "window")]
+)
+def test_field_time_encoding_puts_its_top_band_at_the_named_frequency(name, top_hz):
+    """The top time band's sine is sin(2 pi f t) in seconds (t = frame / fps), whatever the
+    window; "window" keeps Deformable-3DGS's t_norm = frame / (n_train - 1): f = 2^(L-2) / T."""
+    ctx, w = _ctx()
+    cfg = quick_models_cfg()
+    family = "mlp" if name.startswith("mlp") else "d3dgs"
+    cfg[family]["time_top_hz"][name] = top_hz
+    bands = int(cfg[family]["time_bands"])
+    model = build_model(name, ctx, cfg)
+    wind = torch.tensor(w, dtype=torch.float32)
+    n_pos = 3 * (1 + 2 * int(cfg[family]["pos_bands"]))
+    col = n_pos + 1 + 2 * (bands - 1)  # [t, sin0, cos0, sin1, cos1, ...]: the top band's sine
+    frames = np.arange(0, 300, 7)
+    got = np.array([float(model.features(int(f), wind)[0, col]) for f in frames])
+    window_s = (ctx.n_train - 1) / ctx.fps
+    f_hz = 2.0 ** (bands - 2) / window_s if top_hz == "window" else top_hz
+    np.testing.assert_allclose(got, np.sin(2 * np.pi * f_hz * frames / FPS), atol=2e-5)

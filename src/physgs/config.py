@@ -331,3 +331,16 @@ def load(path: Path | str, profile: str | None = None) -> dict:
     with open(path) as f:
         cfg = yaml.safe_load(f)
     return load_workflow_config(cfg, profile, source=str(path))
+
+
+def study_seeds(cfg: dict) -> list[int]:
+    """The training seeds the studies of the trade (speed-accuracy sweep, fit curve) run at:
+    ``speed_accuracy.seeds`` of a resolved config ('first' = the first of ``seeds``, 'all' =
+    every one, or a list from ``seeds``, which the config checks enforce)."""
+    seeds = [int(s) for s in cfg["seeds"]]
+    v = cfg["speed_accuracy"]["seeds"]
+    if v == "first":
+        return seeds[:1]
+    if v == "all":
+        return seeds
+    return [int(s) for s in v]

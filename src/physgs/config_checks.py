@@ -221,6 +221,61 @@ def damping_transient_fits(cfg: dict) -> Iterator[Problem]:
         )
 
 
+def field_time_scales_valid(cfg: dict) -> Iterator[Problem]:
+    """Each learned field names its time encoding's top band: a positive frequency (Hz) no higher
+    than half the frame rate (a band above Nyquist aliases between frames), or "window"
+    (physgs.models.timescale), for exactly the model ids of its architecture."""
+    from physgs.models.registry import MODELS
+    from physgs.models.timescale import WINDOW_TIME
+
+    nyquist = 0.5 * float(cfg["testbed"]["fps"])
+    for family in ("mlp", "d3dgs"):
+        tops = cfg["models"][family]["time_top_hz"]
+        ids = [m for m, spec in MODELS.items() if spec.family == family]
+        for m in ids:
+            if m not in tops:
+                yield (
+                    ("models", family, "time_top_hz", m),
+                    f"the field {m!r} names no time scale; add models/{family}/time_top_hz/{m}: "
+                    f"a top-band frequency in Hz, or {WINDOW_TIME!r} for Deformable-3DGS's "
+                    "window-normalised time",
+                )
+        for m, v in tops.items():
+            key = ("models", family, "time_top_hz", m)
+            if m not in ids:
+                yield (key, f"{m!r} is not a {family} field; the {family} fields are {ids}")
+            elif v == WINDOW_TIME:
+                continue
+            elif isinstance(v, str) or isinstance(v, bool) or not v > 0:
+                yield (
+                    key,
+                    f"{v!r} is not a time scale: give a positive top-band frequency in Hz "
+                    f"or {WINDOW_TIME!r}",
+                )
+            elif v > nyquist:
+                yield (
+                    key,
+                    f"a top time band at {v} Hz lies above half the frame rate "
+                    f"(testbed/fps = {cfg['testbed']['fps']}: {nyquist:g} Hz), where it "
+                    "aliases between frames; choose at most "
+                    f"{nyquist:g} Hz",
+                )
+
+
+def study_seeds_in_seeds(cfg: dict) -> Iterator[Problem]:
+    """The studies' seeds (speed_accuracy/seeds) are training seeds of the run."""
+    v = cfg["speed_accuracy"]["seeds"]
+    if isinstance(v, list):
+        extra = [s for s in v if int(s) not in {int(x) for x in cfg["seeds"]}]
+        if extra:
+            yield (
+                ("speed_accuracy", "seeds"),
+                f"{v} names seed(s) {extra} that are not in seeds {cfg['seeds']}: the studies "
+                "reuse the tables' own jobs of their seeds; name seeds from seeds, or 'first' "
+                "or 'all'",
+            )
+
+
 def warmup_below_iterations(cfg: dict) -> Iterator[Problem]:
     """The static warm-up ends before training does (train and the K-selection runs)."""
     for section, key in ((("train",), "train"), (("models", "kselect"), "models/kselect")):
@@ -411,6 +466,8 @@ CHECKS: list[Check] = [
     k_within_gaussians,
     sweep_tree_is_listed,
     fit_curve_is_runnable,
+    field_time_scales_valid,
+    study_seeds_in_seeds,
     damping_benchmark_is_runnable,
     presets_reach_bone_counts,
 ]

@@ -2,6 +2,7 @@
 # owns the file layout; the library receives the files (and only the settings) a job reads.
 import os
 
+import physgs.config as _config
 import physgs.experiments.fit_curve as _fit_curve
 import physgs.experiments.kselect as _kselect
 import physgs.experiments.sweep as _sweep
@@ -23,6 +24,7 @@ DAMPING = CFG["damping_benchmark"]
 DAMPING_TREES = [_variant.damping_id(t) for t in DAMPING["trees"]]
 TESTBEDS = [*TREES, *DAMPING_TREES]  # every testbed id a rule may see as {tree}
 SEEDS = [int(s) for s in CFG["seeds"]]  # training seeds; the testbed's is CFG["seed"]
+STUDY_SEEDS = _config.study_seeds(CFG)  # the sweep's and the fit curve's seeds (a subset)
 TESTBED_SEEDS = bool(CFG["testbed_seeds"])
 CONFIGS = dict(CFG["models"]["configs"])  # name -> {conditions, K}
 TRAIN_JOBS = _models.training_jobs(CONFIGS)
@@ -174,8 +176,8 @@ def sweep_collect_inputs(wildcards):
     profile's K per seed (the chance level the recovery panel draws)."""
     k = int(CONFIGS[_models.BASE_CONFIG]["K"])
     return {
-        "points": expand(SWEEP_POINT, seed=SEEDS, point=SWEEP_POINTS),
-        "nulls": expand(NULL, tree=SA_TREE, seed=SEEDS, K=k),
+        "points": expand(SWEEP_POINT, seed=STUDY_SEEDS, point=SWEEP_POINTS),
+        "nulls": expand(NULL, tree=SA_TREE, seed=STUDY_SEEDS, K=k),
     }
 
 
@@ -193,12 +195,12 @@ def fit_curve_inputs(wildcards):
         "points": expand(
             FIT_POINT,
             tree=tree,
-            seed=SEEDS,
+            seed=STUDY_SEEDS,
             model=FC["models"],
             iterations=_fit_curve.extra_budgets(CFG),
         )
     }
-    for s in SEEDS:
+    for s in STUDY_SEEDS:
         for m in FC_PROFILE_MODELS:
             out[f"eval_{m}_{s}"] = EVAL.format(tree=tree, seed=s, model=m, config=cfg)
             out[f"loss_{m}_{s}"] = LOSS.format(tree=tree, seed=s, model=m, config=cfg)

@@ -83,7 +83,7 @@ rule fit_curve:
     params:
         tree=FC["tree"],
         models=FC_PROFILE_MODELS,
-        seeds=SEEDS,
+        seeds=STUDY_SEEDS,
         iterations=CFG["train"]["iterations"],
         n_train=CFG["testbed"]["n_train"],
         holdout_every=CFG["train"]["holdout_every"],

@@ -1,8 +1,12 @@
 """Learned deformation fields: Deformation MLP and Deformable-3DGS, each with or without wind.
 
 Input per Gaussian: Fourier features of its canonical position (normalised to about [-1, 1] by
-the canonical bounding box, detached as in Deformable-3DGS) and of t_norm, plus, for the + wind
+the canonical bounding box, detached as in Deformable-3DGS) and of time, plus, for the + wind
 variants, the standardised 48-value wind history (shared by all Gaussians of a frame).
+Time enters the encoding as ``time_scale * t_norm`` (t_norm 0..1 over the training window):
+``time_top_hz`` puts the top time band at a frequency in Hz (the paper fixes the band counts, not
+the unit of time), or ``"window"`` keeps Deformable-3DGS's window-normalised time, whose 4 bands
+top out at 0.32 Hz over a 12.5 s window, below every bone's natural frequency.
 Output heads start at zero, so at initialisation every field returns the canonical pose.
 
 ``precision: bfloat16`` runs the hidden layers' matmuls under CPU/CUDA autocast in bfloat16 (the
@@ -19,6 +23,7 @@ from torch import nn
 
 from physgs.models.base import BaseModel, ModelContext
 from physgs.models.encoding import fourier, fourier_dim
+from physgs.models.timescale import WINDOW_TIME, time_scale_for
 from physgs.models.gaussians import GaussianState
 from physgs.models.windwindow import wind_window, window_step
 
@@ -105,6 +110,7 @@ class FieldModel(BaseModel):
         window_values: int | None,
         name: str,
         precision: str = "float32",
+        time_top_hz: float | str = WINDOW_TIME,
     ):
         super().__init__(ctx, canonical_cfg)
         if arch not in ("mlp", "d3dgs"):
@@ -112,6 +118,9 @@ class FieldModel(BaseModel):
         self.name = name
         self.arch = arch
         self.pos_bands, self.time_bands = pos_bands, time_bands
+        # t_norm runs 0..1 over frames 0..n_train-1, i.e. over (n_train - 1) / fps seconds
+        self.time_top_hz = time_top_hz
+        self.time_scale = time_scale_for(time_top_hz, time_bands, (ctx.n_train - 1) / ctx.fps)
         self.use_wind = wind
         if wind and (window_seconds is None or window_values is None):
             raise ValueError(f"{name}: a wind-conditioned field needs models.wind_window")
@@ -134,7 +143,7 @@ class FieldModel(BaseModel):
         """Field input [N, in_dim] at recorded frame ``frame_idx``."""
         xn = (self.canonical.means.detach() - self.xyz_center) / self.xyz_half  # [N, 3]
         n = xn.shape[0]
-        t = torch.tensor([self.t_norm(frame_idx)], dtype=xn.dtype)
+        t = torch.tensor([self.time_scale * self.t_norm(frame_idx)], dtype=xn.dtype)
         parts = [fourier(xn, self.pos_bands), fourier(t, self.time_bands).expand(n, -1)]
         if self.use_wind:
             w = wind_window(

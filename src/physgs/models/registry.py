@@ -196,6 +196,7 @@ def build_model(
             window_values=ww["values"],
             name=name,
             precision=a.get("precision", "float32"),
+            time_top_hz=a["time_top_hz"][name],
         )
     if K is None:
         spec = cfg.get("configs", {}).get(config)
