@@ -208,3 +208,44 @@ def test_fig_fit_curve_labels_wall_time_in_plain_seconds(monkeypatch):
     assert len([t for t in major if t]) >= 3
     assert all(float(t) > 0 for t in major if t)
     assert not any(minor)
+
+
+def test_window_series_is_the_field_with_only_its_time_encoding_changed(cfg):
+    """A field whose config names a top band in Hz gets an @window point at the profile's
+    budget: the same job with time_top_hz set to the window convention; window fields get none."""
+    cfg["models"]["mlp"]["time_top_hz"] = {"mlp": 1.5, "mlp_wind": "window"}
+    cfg["speed_accuracy"]["fit_curve"]["models"] = ["mlp", "mlp_wind", "ours"]
+    assert fc.window_models(cfg) == ["mlp"]
+    own = int(cfg["train"]["iterations"])
+    j = fc.point_job(cfg, "mlp", own, window_time=True)
+    ref = job_spec(cfg, "mlp", "single")
+    assert ref["settings"]["mlp"]["time_top_hz"]["mlp"] == 1.5
+    assert j["settings"]["mlp"]["time_top_hz"]["mlp"] == "window"
+    j["settings"]["mlp"]["time_top_hz"]["mlp"] = 1.5
+    assert j == ref
+    assert cfg["models"]["mlp"]["time_top_hz"]["mlp"] == 1.5  # the config is not edited
+    with pytest.raises(ValueError, match="fields"):
+        fc.point_job(cfg, "ours", own, window_time=True)
+
+
+def test_fig_fit_curve_draws_the_window_series(tmp_path):
+    from physgs.report.figures import fig_fit_curve
+
+    pts = [
+        {
+            "model": m,
+            "seed": 0,
+            "iterations": it,
+            "fit": 20.0,
+            "heldout": 19.0,
+            "time": 18.0,
+            "train_s": it / 10,
+        }
+        for m, it in (("mlp", 500), ("mlp@window", 1500))
+    ]
+    own = {0: {m: _row(20.0) for m in ("static", "mlp", "truth_motion")}}
+    df = fc.collect(pts, own, 1500, "medium")
+    assert set(df["model"]) == {"static", "mlp", "mlp@window", "truth_motion"}
+    outs = [tmp_path / "f.png"]
+    fig_fit_curve(df, outs)
+    assert outs[0].stat().st_size > 1000

@@ -49,6 +49,8 @@ NULL = "results/recovery/{tree}/seed{seed}/null_K{K}.json"
 KSELECT = "results/kselect/{tree}/seed{seed}.json"
 SWEEP_POINT = "results/speed_accuracy/seed{seed}/{point}.json"
 FIT_POINT = "results/fit_curve/{tree}/seed{seed}/{model}_it{iterations}.json"
+# a field trained with the window-normalised time encoding (the fit curve's diagnostic series)
+FIT_WINDOW_POINT = "results/fit_curve/{tree}/seed{seed}/{model}_it{iterations}_windowtime.json"
 TABLE = "results/tables/{name}.{ext}"
 FIGURE = "results/figures/{name}.{ext}"
 #: need kind (physgs.report.build.needs) -> path template
@@ -187,6 +189,12 @@ def fit_point_params(wildcards):
     )
 
 
+def fit_window_params(wildcards):
+    return _fit_curve.point_job(
+        CFG, wildcards.model, int(wildcards.iterations), seed=int(wildcards.seed), window_time=True
+    )
+
+
 def fit_curve_inputs(wildcards):
     """The extra-budget points of every seed, and the pipeline's own evaluation and loss log of
     each model and seed at the profile's budget (keys eval_{model}_{seed}, loss_{model}_{seed})."""
@@ -198,6 +206,13 @@ def fit_curve_inputs(wildcards):
             seed=STUDY_SEEDS,
             model=FC["models"],
             iterations=_fit_curve.extra_budgets(CFG),
+        )
+        + expand(
+            FIT_WINDOW_POINT,
+            tree=tree,
+            seed=STUDY_SEEDS,
+            model=_fit_curve.window_models(CFG),
+            iterations=CFG["train"]["iterations"],
         )
     }
     for s in STUDY_SEEDS:

@@ -61,8 +61,23 @@ rule fit_curve_point:
         runtime=lambda wc: 10 + int(wc.iterations) // 30,
     params:
         job=fit_point_params,
+        series=lambda wc: wc.model,
     script:
         "../scripts/fit_curve_point.py"
+
+
+# the diagnostic series: a field with Deformable-3DGS's window-normalised time, at the profile's
+# budget, beside the time encoding the config chose
+use rule fit_curve_point as fit_curve_window_point with:
+    output:
+        record=FIT_WINDOW_POINT,
+    log:
+        "logs/fit_curve/{tree}/seed{seed}/{model}_it{iterations}_windowtime.log",
+    benchmark:
+        "results/benchmarks/fit_curve/{tree}/seed{seed}/{model}_it{iterations}_windowtime.tsv"
+    params:
+        job=fit_window_params,
+        series=lambda wc: wc.model + _fit_curve.WINDOW_SERIES,
 
 
 rule fit_curve:

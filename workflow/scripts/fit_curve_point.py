@@ -7,6 +7,8 @@ from physgs.testbed.dataset import load_observed
 
 sm = snakemake  # noqa: F821 (injected by Snakemake)
 with job(sm) as log:
-    rec = run_point(sm.params.job, load_observed(sm.input.observed), progress=True)
+    rec = run_point(
+        sm.params.job, load_observed(sm.input.observed), progress=True, series=sm.params.series
+    )
     write_json(sm.output.record, rec)
     print(rec, file=log)

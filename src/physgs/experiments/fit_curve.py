@@ -6,6 +6,10 @@ the tables' recipe, and scored at the training camera and wind: on the trained f
 the every-``holdout_every``-th frames held out of training (interpolation), and on the tail (the
 time split). The profile's own budget is not retrained: its point is the pipeline's own job,
 read from that job's evaluation and loss log, so the curve passes through the tables' numbers.
+
+Diagnostic series: each listed field whose time encoding is not Deformable-3DGS's window-
+normalised time (``models.<family>.time_top_hz``) is also trained at the profile's budget with
+that convention, as the series ``<model>@window``, so a reader sees both.
 """
 
 from __future__ import annotations
@@ -19,7 +23,11 @@ import pandas as pd
 from physgs.evaluate.metrics import ceiling_fraction as _fraction
 from physgs.experiments.recipe import fit, heldout_split, job_spec
 from physgs.experiments.sweep import with_knob
-from physgs.models.registry import BASE_CONFIG
+from physgs.models.registry import BASE_CONFIG, FIELDS, MODELS
+from physgs.models.timescale import WINDOW_TIME
+
+#: suffix of a fit-curve series trained with the window-normalised time encoding
+WINDOW_SERIES = "@" + WINDOW_TIME
 
 COLUMNS = ("seed", "model", "iterations", "is_profile", "fit", "heldout", "time", "train_s", "tree")
 
@@ -35,15 +43,41 @@ def extra_budgets(cfg: dict) -> list[int]:
     return [b for b in budgets(cfg) if b != int(cfg["train"]["iterations"])]
 
 
-def point_job(cfg: dict, model: str, iterations: int, seed: int | None = None) -> dict:
+def window_models(cfg: dict) -> list[str]:
+    """The fit curve's fields whose chosen time encoding is not the window convention: each gets
+    a ``<model>@window`` diagnostic point at the profile's budget."""
+    out = []
+    for m in cfg["speed_accuracy"]["fit_curve"]["models"]:
+        family = MODELS[m].family
+        if family in FIELDS and cfg["models"][family]["time_top_hz"][m] != WINDOW_TIME:
+            out.append(m)
+    return out
+
+
+def point_job(
+    cfg: dict, model: str, iterations: int, seed: int | None = None, window_time: bool = False
+) -> dict:
     """The training job (``recipe.job_spec``) of ``model`` at ``iterations`` with training seed
-    ``seed`` (default ``cfg['seed']``), as a sorted dict."""
+    ``seed`` (default ``cfg['seed']``), as a sorted dict; ``window_time``: a field with the
+    window-normalised time encoding instead of its chosen one (the diagnostic series)."""
     tree = cfg["speed_accuracy"]["fit_curve"]["tree"]
-    return job_spec(with_knob(cfg, tree, "iterations", iterations), model, BASE_CONFIG, seed=seed)
+    pcfg = with_knob(cfg, tree, "iterations", iterations)
+    if window_time:
+        family = MODELS[model].family
+        if family not in FIELDS:
+            raise ValueError(f"{model!r} has no time encoding; the window series is for fields")
+        pcfg["models"][family]["time_top_hz"] = {
+            **pcfg["models"][family]["time_top_hz"],
+            model: WINDOW_TIME,
+        }
+    return job_spec(pcfg, model, BASE_CONFIG, seed=seed)
 
 
-def run_point(job: Mapping, observed, *, progress: bool = False) -> dict:
+def run_point(job: Mapping, observed, *, progress: bool = False, series: str | None = None) -> dict:
     """Train ``job`` on ``observed`` and score it; a flat record (dB, seconds).
+
+    series: the record's ``model`` (default the job's model id; ``<model>@window`` for the
+    window-time diagnostic).
 
     fit / heldout: mean PSNR over the trained / held-out training-window frames; time: over the
     tail frames; all at the training camera and wind. train_s: wall time of the training.
@@ -71,7 +105,7 @@ def run_point(job: Mapping, observed, *, progress: bool = False) -> dict:
     tail = np.arange(n, n + int(observed.n_tail))
     _, p_time = training_camera_scores(res.model, observed, tail, backend=backend)
     return {
-        "model": job["model"],
+        "model": series if series is not None else job["model"],
         "seed": int(job["seed"]),
         "iterations": int(job["train"]["iterations"]),
         "fit": float(np.mean(p_fit)),

@@ -407,7 +407,8 @@ def fig_fit_curve(df: pd.DataFrame, outputs: Sequence[str | Path]) -> None:
     iterations, and the fit against training wall time (s). df: ``experiments.fit_curve.collect``
     (one row per seed, model and budget): points are means over seeds, error bars the sd. The
     static pose and the true-motion ceiling at the profile's budget are horizontal lines; the
-    profile's budget is starred.
+    profile's budget is starred. A ``<field>@window`` series (the field with Deformable-3DGS's
+    window-normalised time) is drawn as open diamonds in its field's colour.
     """
     panels = (
         ("iterations", "fit", "training iterations (log)", "PSNR, trained frames (dB)"),
@@ -426,17 +427,19 @@ def fig_fit_curve(df: pd.DataFrame, outputs: Sequence[str | Path]) -> None:
                 continue
             g = g.sort_values("iterations")
             bars = n_seeds > 1
+            base, _, variant = m.partition("@")  # <field>@window: the diagnostic series
             ax.errorbar(
                 g[x],
                 g[y],
                 yerr=g[f"{y}_sd"] if bars else None,
                 xerr=g[f"{x}_sd"] if bars and x != "iterations" else None,
-                fmt="-o",
-                ms=3.5,
+                fmt="-o" if not variant else "D",
+                mfc=None if not variant else "none",
+                ms=3.5 if not variant else 6,
                 capsize=2,
-                color=COLORS.get(m),
+                color=COLORS.get(base),
                 lw=1.6 if m == "ours" else 1.0,
-                label=label(m),
+                label=label(base) + (f" ({variant} time)" if variant else ""),
             )
             p = g[g["is_profile"]]
             ax.plot(p[x], p[y], "*", ms=10, color=COLORS.get(m))
