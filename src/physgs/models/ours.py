@@ -28,6 +28,7 @@ from torch import nn
 from physgs.models.base import BaseModel, ModelContext
 from physgs.models.gaussians import GaussianState, rotate_about_pivot
 from physgs.models.oscillator import STABILITY_GUARD, fastest_rate, integrate, required_substeps
+from physgs.models.oscillator_params import OscillatorBounds, condition_vbar
 from physgs.models.parts import kmeans_parts
 
 
@@ -39,10 +40,6 @@ def prior_substeps(omega_hz, zeta, substeps: int, dt: float, guard: float = STAB
     hi = 2 * math.pi * float(omega_hz[1])
     rate = float(fastest_rate(hi, float(zeta[1])))
     return max(int(substeps), required_substeps(rate, dt, guard))
-
-
-def _logit(p: float) -> float:
-    return math.log(p / (1.0 - p))
 
 
 class OscillatorPrior(BaseModel):
@@ -67,19 +64,15 @@ class OscillatorPrior(BaseModel):
         labels: np.ndarray | None = None,
     ):
         super().__init__(ctx, canonical_cfg)
-        lo, hi = (2 * math.pi * float(f) for f in omega_hz)
-        zlo, zhi = (float(z) for z in zeta)
-        w0 = 2 * math.pi * float(omega_init_hz)
-        if not (0 < lo < w0 < hi):
-            raise ValueError(
-                f"models.ours needs 0 < omega_hz[0] < omega_init_hz < omega_hz[1]; "
-                f"got {omega_hz}, {omega_init_hz}"
-            )
-        if not (0 < zlo < zeta_init < zhi):
-            raise ValueError(
-                f"models.ours needs 0 < zeta[0] < zeta_init < zeta[1]; got {zeta}, {zeta_init}"
-            )
-        self.omega_lo, self.omega_hi, self.zeta_lo, self.zeta_hi = lo, hi, zlo, zhi
+        # the parameterisation the 2D-track control shares (physgs.models.oscillator_params)
+        self.bounds = b = OscillatorBounds.from_config(omega_hz, zeta, omega_init_hz, zeta_init)
+        w0 = b.omega_init
+        self.omega_lo, self.omega_hi, self.zeta_lo, self.zeta_hi = (
+            b.omega_lo,
+            b.omega_hi,
+            b.zeta_lo,
+            b.zeta_hi,
+        )
         self.dt = 1.0 / ctx.fps
         self.vbar_ratio = float(ctx.vbar_ratio)
         self.guard = float(rk4_guard)
@@ -92,10 +85,8 @@ class OscillatorPrior(BaseModel):
             raise ValueError(f"part labels must be [N] in [0, K={K}); got shape {labels.shape}")
         self.K = K
         self.register_buffer("part_labels", torch.tensor(labels))
-        self.omega_raw = nn.Parameter(
-            torch.full((K,), _logit((math.log(w0) - math.log(lo)) / (math.log(hi) - math.log(lo))))
-        )
-        self.zeta_raw = nn.Parameter(torch.full((K,), _logit((zeta_init - zlo) / (zhi - zlo))))
+        self.omega_raw = nn.Parameter(torch.full((K,), b.omega_raw_init()))
+        self.zeta_raw = nn.Parameter(torch.full((K,), b.zeta_raw_init()))
         self.gain_raw = nn.Parameter(torch.zeros(K))
         self.register_buffer("gain_scale", torch.tensor(w0**2 / ctx.wind_force_std))
         axis = np.asarray(ctx.view_dir, dtype=np.float64).copy()
@@ -129,13 +120,12 @@ class OscillatorPrior(BaseModel):
     @property
     def omega(self) -> torch.Tensor:
         """[K] natural frequencies, rad/s."""
-        lo, hi = math.log(self.omega_lo), math.log(self.omega_hi)
-        return torch.exp(lo + (hi - lo) * torch.sigmoid(self.omega_raw))
+        return self.bounds.omega(self.omega_raw)
 
     @property
     def zeta(self) -> torch.Tensor:
         """[K] damping ratios (dimensionless)."""
-        return self.zeta_lo + (self.zeta_hi - self.zeta_lo) * torch.sigmoid(self.zeta_raw)
+        return self.bounds.zeta(self.zeta_raw)
 
     @property
     def gain(self) -> torch.Tensor:
@@ -156,7 +146,7 @@ class OscillatorPrior(BaseModel):
         wind = torch.as_tensor(wind, dtype=torch.float64)
         if wind.ndim != 1:
             raise ValueError(f"part_theta: wind must be [L+F], got shape {tuple(wind.shape)}")
-        vbar = self.vbar_ratio * float(wind.mean())
+        vbar = condition_vbar(self.vbar_ratio, wind)
         theta = integrate(
             self.omega, self.zeta, self.gain, wind, vbar, self.dt, self.substeps, guard=self.guard
         )  # [K, L+F]
