@@ -1,12 +1,23 @@
 """Rasterizer speed: fast (numba) vs reference (PyTorch autograd) side by side.
 
-Prints median forward and forward+backward milliseconds (and the fastest fast-path
-forward+backward, the best estimate on a shared machine) and peak extra memory (MiB, resident
-set growth during the timed calls, measured in a fresh subprocess per cell) for N in
-{2k, 10k, 30k} Gaussians at 128x128 and 256x256 on the canopy-like random scene of
-physgs.render.scenes. Usage:
+Two kinds of scene:
 
-    python benchmarks/rasterizer.py [--reps 7] [--ref-reps 2] [--sizes 2000,10000,30000]
+* blob: the canopy-like random blob of :func:`physgs.render.scenes.random_scene`, for N in
+  ``--sizes`` Gaussians at each of ``--res`` pixels (square); it covers most of the image.
+* tree: each testbed tree's initial canonical Gaussians from its training camera
+  (:func:`physgs.render.scenes.tree_scene`), read from ``--datasets`` folders
+  (results/testbed/<tree>, each holding observed.npz; a folder without one is skipped with a
+  message). Trees cover 1.6-20 % of the pixels, so they time the sparse case.
+
+Per cell: median forward (no autograd) and forward+backward milliseconds, the fastest fast-path
+forward+backward in wall and in CPU seconds of the process (the best estimates on a shared
+machine; CPU time is the steadier when other processes compete for the cores), and peak extra memory (MiB, resident
+set growth during the timed calls), each cell in a fresh subprocess. Usage:
+
+    NUMBA_NUM_THREADS=1 python benchmarks/rasterizer.py [--reps 15] [--ref-reps 2]
+        [--sizes 2000,10000,30000] [--res 128,256]
+        [--datasets results/testbed/sparse results/testbed/medium results/testbed/dense]
+        [--no-reference]
 """
 
 from __future__ import annotations
@@ -18,6 +29,9 @@ import statistics
 import subprocess
 import sys
 import time
+from pathlib import Path
+
+TREES = ("sparse", "medium", "dense")
 
 
 def rss_mib() -> float:
@@ -25,7 +39,22 @@ def rss_mib() -> float:
         return int(f.read().split()[1]) * resource.getpagesize() / 2**20
 
 
-def one(backend: str, n: int, res: int, reps: int) -> dict:
+def load_scene(spec: str):
+    """'blob:N:RES' -> random_scene(N, RES, RES, seed=0); 'tree:DIR' -> tree_scene(DIR) at the
+    default profile's models.canonical settings."""
+    from physgs.render.scenes import random_scene, tree_scene
+
+    kind, _, rest = spec.partition(":")
+    if kind == "blob":
+        n, res = (int(v) for v in rest.split(":"))
+        return random_scene(n, res, res, seed=0)
+    import physgs.config
+
+    cfg = physgs.config.load("config/trees.yaml", "default")
+    return tree_scene(rest, cfg["models"]["canonical"])
+
+
+def one(backend: str, spec: str, reps: int) -> dict:
     """Time one cell in this process (called in a subprocess)."""
     import torch
 
@@ -34,63 +63,87 @@ def one(backend: str, n: int, res: int, reps: int) -> dict:
 
     warm = random_scene(200, 32, 32, seed=1)  # loads the numba cache, warms torch
     rasterization(*warm[:5], warm[5], warm[6], backend=backend)
-    means, quats, scales, opac, colors, cam, bg = random_scene(n, res, res, seed=0)
+    means, quats, scales, opac, colors, cam, bg = load_scene(spec)
     params = [x.requires_grad_(True) for x in (means, quats, scales, opac, colors)]
     base = rss_mib()
-    fwd, fb = [], []
+    fwd, fb, fb_cpu = [], [], []
     for _ in range(reps):
         t0 = time.perf_counter()
         with torch.no_grad():
             rasterization(*params, cam, bg, backend=backend)
         fwd.append(time.perf_counter() - t0)
-        t0 = time.perf_counter()
+        t0, c0 = time.perf_counter(), time.process_time()
         out = rasterization(*params, cam, bg, backend=backend)
         (out.rgb.sum() + out.alpha.sum() + out.depth.sum()).backward()
         fb.append(time.perf_counter() - t0)
+        fb_cpu.append(time.process_time() - c0)
         for p in params:
             p.grad = None
     peak = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024 - base
     return {
+        "n": int(means.shape[0]),
+        "res": f"{cam.width}x{cam.height}",
         "fwd_ms": 1e3 * statistics.median(fwd),
         "fb_ms": 1e3 * statistics.median(fb),
         "fb_min_ms": 1e3 * min(fb),
+        "fb_cpu_min_ms": 1e3 * min(fb_cpu),
         "peak_mib": max(peak, 0.0),
-        "alpha_mean": float(out.alpha.mean()),
+        "cover": float((out.alpha > 1.0 / 255.0).float().mean()),
     }
+
+
+def run_cell(backend: str, spec: str, reps: int) -> dict:
+    cmd = [sys.executable, __file__, "--one", backend, spec, str(reps)]
+    out = subprocess.run(cmd, capture_output=True, text=True, check=True)
+    return json.loads(out.stdout.strip().splitlines()[-1])
 
 
 def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--reps", type=int, default=15, help="timed calls per fast cell")
     ap.add_argument("--ref-reps", type=int, default=2, help="timed calls per reference cell")
-    ap.add_argument("--sizes", default="2000,10000,30000")
-    ap.add_argument("--res", default="128,256")
+    ap.add_argument("--sizes", default="2000,10000,30000", help="blob sizes (empty: none)")
+    ap.add_argument("--res", default="128,256", help="blob resolutions, px")
     ap.add_argument(
-        "--one", nargs=4, metavar=("BACKEND", "N", "RES", "REPS"), help=argparse.SUPPRESS
+        "--datasets",
+        nargs="*",
+        default=[f"results/testbed/{t}" for t in TREES],
+        help="testbed folders (each with observed.npz) whose canonical sets are tree scenes",
     )
+    ap.add_argument("--no-reference", action="store_true", help="time the fast path only")
+    ap.add_argument("--one", nargs=3, metavar=("BACKEND", "SCENE", "REPS"), help=argparse.SUPPRESS)
     a = ap.parse_args()
     if a.one:
-        print(json.dumps(one(a.one[0], int(a.one[1]), int(a.one[2]), int(a.one[3]))))
+        print(json.dumps(one(a.one[0], a.one[1], int(a.one[2]))))
         return
+    specs = []
+    for res in (int(r) for r in a.res.split(",") if r):
+        specs += [(f"blob:{n}:{res}", "blob") for n in (int(s) for s in a.sizes.split(",") if s)]
+    for d in a.datasets:
+        if not (Path(d) / "observed.npz").is_file():
+            print(f"skipping tree {d}: no {Path(d) / 'observed.npz'} (generate the testbed first)")
+            continue
+        specs.append((f"tree:{d}", Path(d).name))
     print(
-        f"{'N':>6} {'res':>4} | {'fast fwd':>9} {'fast f+b':>9} {'(min)':>7} {'MiB':>6} | "
-        f"{'ref fwd':>9} {'ref f+b':>9} {'MiB':>6} | {'speed-up f+b':>12}"
+        f"{'scene':<8} {'N':>6} {'res':>7} {'cover':>6} | {'fast fwd':>9} {'fast f+b':>9} "
+        f"{'(min)':>7} {'cpu min':>7} {'MiB':>6} | {'ref fwd':>9} {'ref f+b':>9} {'MiB':>6} | "
+        f"{'speed-up f+b':>12}"
     )
-    for res in (int(r) for r in a.res.split(",")):
-        for n in (int(s) for s in a.sizes.split(",")):
-            row = {}
-            for backend, reps in (("fast", a.reps), ("reference", a.ref_reps)):
-                cmd = [sys.executable, __file__, "--one", backend, str(n), str(res), str(reps)]
-                out = subprocess.run(cmd, capture_output=True, text=True, check=True)
-                row[backend] = json.loads(out.stdout.strip().splitlines()[-1])
-            f, r = row["fast"], row["reference"]
-            print(
-                f"{n:>6} {res:>4} | {f['fwd_ms']:>9.1f} {f['fb_ms']:>9.1f} "
-                f"{f['fb_min_ms']:>7.1f} {f['peak_mib']:>6.0f} | "
-                f"{r['fwd_ms']:>9.1f} {r['fb_ms']:>9.1f} {r['peak_mib']:>6.0f} | "
-                f"{r['fb_ms'] / f['fb_ms']:>11.1f}x",
-                flush=True,
+    for spec, name in specs:
+        f = run_cell("fast", spec, a.reps)
+        line = (
+            f"{name:<8} {f['n']:>6} {f['res']:>7} {100 * f['cover']:>5.1f}% | "
+            f"{f['fwd_ms']:>9.1f} {f['fb_ms']:>9.1f} {f['fb_min_ms']:>7.1f} "
+            f"{f['fb_cpu_min_ms']:>7.1f} "
+            f"{f['peak_mib']:>6.0f} |"
+        )
+        if not a.no_reference:
+            r = run_cell("reference", spec, a.ref_reps)
+            line += (
+                f" {r['fwd_ms']:>9.1f} {r['fb_ms']:>9.1f} {r['peak_mib']:>6.0f} | "
+                f"{r['fb_ms'] / f['fb_ms']:>11.1f}x"
             )
+        print(line, flush=True)
 
 
 if __name__ == "__main__":

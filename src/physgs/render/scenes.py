@@ -1,6 +1,9 @@
-"""Synthetic Gaussian scenes for tests and benchmarks (no testbed needed)."""
+"""Gaussian scenes for tests and benchmarks: a synthetic blob (no testbed needed) and a testbed
+tree's initial canonical set seen from its training camera."""
 
 from __future__ import annotations
+
+from pathlib import Path
 
 import numpy as np
 import torch
@@ -31,3 +34,27 @@ def random_scene(
     bg = np.array([0.9, 0.95, 1.0])
     t = [torch.as_tensor(x, dtype=dtype) for x in (means, quats, scales, opac, colors)]
     return (*t, cam, torch.as_tensor(bg, dtype=dtype))
+
+
+def tree_scene(dataset_dir, canonical_cfg: dict | None = None, dtype=torch.float32):
+    """A testbed tree's canonical Gaussians at initialisation, seen from its training camera.
+
+    dataset_dir: a testbed folder holding ``observed.npz`` (results/testbed/<tree>);
+    canonical_cfg: ``models.canonical`` of the config (opacity, color, knn, scale_factor; the
+    class defaults when None). Built exactly as every model builds its canonical set
+    (:class:`physgs.models.gaussians.CanonicalGaussians` on ``Observed.canonical_xyz``), so the
+    scene is what the first training iteration renders. Returns the tuple of
+    :func:`random_scene`: (means [N, 3], quats [N, 4], scales [N, 3], opacities [N], colors [N, 3],
+    camera, background [3]) as tensors of ``dtype``, the image the camera's size (pixels).
+    """
+    from physgs.models.gaussians import CanonicalGaussians
+    from physgs.testbed.dataset import load_observed
+
+    obs = load_observed(Path(dataset_dir) / "observed.npz")
+    with torch.no_grad():
+        st = CanonicalGaussians(obs.canonical_xyz, **(canonical_cfg or {})).state()
+        t = [
+            x.detach().to(dtype).clone()
+            for x in (st.means, st.quats, st.scales, st.opacities, st.colors)
+        ]
+    return (*t, obs.train_camera, torch.as_tensor(np.asarray(obs.background), dtype=dtype))
