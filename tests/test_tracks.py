@@ -1,0 +1,143 @@
+"""The 2D-track control (physgs.tracks): the tracker on a synthetic video with a known motion, the
+oscillator fit on tracks simulated by an independent solver (scipy's solve_ivp), and its errors."""
+
+from __future__ import annotations
+
+import functools
+import math
+
+import numpy as np
+import pytest
+from scipy.integrate import solve_ivp
+
+from physgs.models.oscillator_params import OscillatorBounds
+from physgs.tracks.fit import FitSettings, Oscillators, fit_tracks, part_theta, predict_tracks
+from physgs.tracks.track import Tracks, TrackSettings, track_video
+
+cv2 = pytest.importorskip("cv2")
+
+
+def _blob_video(shift_px: np.ndarray, size: int = 64, seed: int = 0) -> np.ndarray:
+    """[T, size, size, 3] uint8: a textured disc on white, translated by shift_px [T, 2] (x, y)."""
+    rng = np.random.default_rng(seed)
+    tex = cv2.GaussianBlur(rng.uniform(0, 200, (size, size)).astype(np.float32), (0, 0), 1.2)
+    yy, xx = np.mgrid[:size, :size]
+    disc = ((xx - size / 2) ** 2 + (yy - size / 2) ** 2) < (size / 4) ** 2
+    img = np.where(disc, tex, 255.0).astype(np.float32)
+    out = []
+    for dx, dy in shift_px:
+        m = np.float32([[1, 0, dx], [0, 1, dy]])
+        f = cv2.warpAffine(img, m, (size, size), flags=cv2.INTER_CUBIC, borderValue=255.0)
+        out.append(np.repeat(np.clip(f, 0, 255).round().astype(np.uint8)[..., None], 3, -1))
+    return np.stack(out)
+
+
+def test_tracker_follows_a_known_sinusoid():
+    T = 60
+    t = np.arange(T)
+    shift = np.stack([2.5 * np.sin(2 * np.pi * t / 20), 1.5 * np.sin(2 * np.pi * t / 13 + 1)], 1)
+    frames = _blob_video(shift)
+    trk = track_video(frames, [1.0, 1.0, 1.0], TrackSettings())
+    s0 = trk.start == 0
+    assert s0.sum() >= 10, "too few seeds on a textured disc"
+    kept = trk.valid[s0, -1]
+    assert kept.mean() > 0.8
+    disp = trk.xy[s0][kept] - trk.xy[s0][kept][:, :1]  # [p, T, 2] displacement since frame 0
+    err = np.linalg.norm(disp - (shift - shift[0])[None], axis=-1)
+    assert np.median(err) < 0.1 and np.percentile(err, 90) < 0.25
+    # seeds lie on the disc, none on the white background
+    first = trk.first_xy()
+    r = np.linalg.norm(first - 32.0 - shift[trk.start], axis=1)
+    assert np.all(r < 16 + 2)
+
+
+def test_tracker_drops_a_track_whose_patch_disappears():
+    T = 30
+    frames = _blob_video(np.zeros((T, 2)))
+    frames[15:] = 255  # the object vanishes: every track must end, none may stay valid on white
+    trk = track_video(frames, [1.0, 1.0, 1.0], TrackSettings(reseed_every=5))
+    assert trk.n_tracks > 0
+    assert not trk.valid[:, 15:].any()
+    assert trk.valid[trk.start == 0, 14].all()
+
+
+def _simulate(omega, zeta, wind, vbar, dt, gain):
+    """theta [T] from rest at sample 0: scipy's adaptive solver with v^2 interpolated linearly."""
+    ts = np.arange(len(wind)) * dt
+    us = wind**2 - vbar**2
+
+    def rhs(t, y):
+        return [
+            y[1],
+            gain * np.interp(t, ts, us) - 2 * zeta * omega * y[1] - omega**2 * y[0],
+        ]
+
+    sol = solve_ivp(rhs, (0, ts[-1]), [0.0, 0.0], t_eval=ts, rtol=1e-9, atol=1e-12, max_step=dt)
+    return sol.y[0]
+
+
+@functools.cache
+def _synthetic(seed=0, n_per_part=6, T=240, L=120, fps=24):
+    """Tracks of two parts whose true oscillators are known, plus the Oscillators that fit them."""
+    rng = np.random.default_rng(seed)
+    n = L + T + 20
+    f = np.fft.rfftfreq(n, 1 / fps)
+    spec = rng.normal(size=f.size) + 1j * rng.normal(size=f.size)
+    spec[(f < 0.1) | (f > 4.0)] = 0
+    wind = 6.0 + np.fft.irfft(spec, n)  # broadband around 6 m/s
+    wind = (6.0 + 1.5 * (wind - 6.0) / (wind - 6.0).std()).astype(np.float64)
+    truth = [(2 * np.pi * 0.45, 0.06), (2 * np.pi * 1.2, 0.12)]  # (omega rad/s, zeta)
+    vbar = float(wind.mean())
+    th = [_simulate(om, ze, wind, vbar, 1 / fps, om**2 / 300.0) for om, ze in truth]
+    centres = [np.array([20.0, 80.0]), np.array([90.0, 30.0])]
+    xy, valid, clean = [], [], []
+    for p, c in enumerate(centres):
+        for _ in range(n_per_part):
+            x0 = c + rng.normal(0, 3, 2)
+            d = rng.normal(0, 1, 2)
+            d = 2.0 * d / np.linalg.norm(d) / np.abs(th[p][L : L + T]).max()  # ~2 px swing
+            clean.append(x0 + d * th[p][L:, None])  # [T + 20, 2] noiseless, window then tail
+            xy.append(clean[-1][:T] + rng.normal(0, 0.05, (T, 2)))
+            valid.append(np.ones(T, bool))
+    tracks = Tracks(np.stack(xy), np.stack(valid), np.zeros(len(xy), np.int64))
+    bounds = OscillatorBounds.from_config([0.1, 3.0], [0.01, 0.5], 0.7, 0.1)
+    w = wind[: L + T]
+    gain = bounds.omega_init**2 / (w**2 - w.mean() ** 2).std()
+    osc = Oscillators(bounds, 2, fps, L, 1.0, float(gain))
+    return tracks, wind[None], osc, truth, np.stack(clean)
+
+
+def test_fit_recovers_omega_and_zeta_of_solve_ivp_tracks():
+    tracks, wind, osc, truth, clean = _synthetic()
+    fit = fit_tracks([tracks], [0], wind, osc, FitSettings(K=2, iterations=250, seed=0))
+    assert fit.estimated.all() and fit.n_tracks.tolist() == [6, 6]
+    # part 0 is the lower one in the image (larger y): the first centre, the slow oscillator
+    for p, (om, ze) in enumerate(truth):
+        assert fit.omega[p] == pytest.approx(om, rel=0.02), (p, fit.omega / 2 / math.pi)
+        assert fit.zeta[p] == pytest.approx(ze, abs=0.02), (p, fit.zeta)
+    assert fit.rms_px < 0.1  # the noise is 0.05 px per coordinate
+    # extrapolation into the 20 frames after the window, which the fit never saw
+    T = tracks.xy.shape[1]
+    pred = predict_tracks(fit, osc, 0, wind[0], np.arange(T, T + 20))  # [P, 20, 2]
+    assert np.median(np.linalg.norm(pred - clean[:, T:], axis=-1)) < 0.1
+
+
+def test_parts_without_enough_tracks_give_no_estimate():
+    tracks, wind, osc, _, _ = _synthetic(n_per_part=6)
+    # cut part 1 to two tracks: below MIN_TRACKS_PER_PART, so no estimate, and theta row 0
+    keep = np.r_[np.arange(6), 6, 7]
+    few = Tracks(tracks.xy[keep], tracks.valid[keep], tracks.start[keep])
+    fit = fit_tracks([few], [0], wind, osc, FitSettings(K=2, iterations=5))
+    assert fit.estimated.tolist() == [True, False]
+    assert np.all(part_theta(fit, osc, wind[0])[1] == 0)
+    assert np.isnan(fit.d[0][6:]).all() and np.isfinite(fit.d[0][:6]).all()
+
+
+def test_short_tracks_are_not_fitted_and_k_above_track_count_names_the_key():
+    tracks, wind, osc, _, _ = _synthetic(n_per_part=2)
+    with pytest.raises(ValueError, match=r"models\.configs K = 5 .* 4 tracks"):
+        fit_tracks([tracks], [0], wind, osc, FitSettings(K=5, iterations=1))
+    short = Tracks(tracks.xy, tracks.valid.copy(), tracks.start)
+    short.valid[:, 10:] = False  # 10 frames each: shorter than MIN_TRACK_FRAMES
+    with pytest.raises(ValueError, match="exceeds the 0 tracks"):
+        fit_tracks([short], [0], wind, osc, FitSettings(K=1, iterations=1))
