@@ -62,7 +62,7 @@ def main() -> None:
                 + fourier_dim(1, a["time_bands"])
                 + (m["wind_window"]["values"] if wind else 0)
             )
-            for tree, n in cfg["testbed"]["vertices"].items():
+            for n in cfg["testbed"]["vertices"].values():
                 torch.manual_seed(0)
                 f32 = DeformationField(in_dim, a["depth"], a["width"], a.get("skip"), heads)
                 for h in f32.heads.values():

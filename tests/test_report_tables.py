@@ -133,7 +133,7 @@ def test_pairing_decides_what_unpaired_seeds_cannot():
     """A large seed-wide offset shared by both models hides a constant 0.5 dB margin from any
     unpaired comparison; per-seed pairing recovers it exactly."""
     base = per_seed(4, noise=0.0)
-    for s, S in base.items():
+    for S in base.values():
         for c in range(3):
             S[("sparse", "ours")][f"train_c{c}"] = S[("sparse", "mlp_wind")][f"train_c{c}"] + 0.5
     from scipy import stats
@@ -154,7 +154,7 @@ def test_tab_transfer_rows_and_decided_bold():
     assert list(tab.df.columns) == ["seed", "split", "tree", "bones", "condition", *T.MODELS]
     first = tab.df[tab.df.seed == 0]
     rows = tex_rows(tab.tex)
-    for (nums, bold), (i, r) in zip(rows, first.iterrows()):
+    for (nums, bold), (_, r) in zip(rows, first.iterrows()):
         vals = tab.df[
             (tab.df.split == r.split) & (tab.df.tree == r.tree) & (tab.df.condition == r.condition)
         ][list(T.MODELS)].to_numpy(float)

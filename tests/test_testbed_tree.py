@@ -28,7 +28,7 @@ def test_exact_bone_counts(sims):
 
 
 def test_every_vertex_skinned_and_deep_geometry_to_an_ancestor(sims):
-    for t, s in sims.items():
+    for s in sims.values():
         vb = s.mesh.vertex_bone
         assert vb.shape == (len(s.mesh.vertices),)
         assert vb.min() >= 0 and vb.max() < s.truth.omega.size
@@ -48,7 +48,7 @@ def test_every_vertex_skinned_and_deep_geometry_to_an_ancestor(sims):
 
 def test_omega_band_law_and_zeta(sims):
     lo, hi = 2 * np.pi * np.array(TB["band_hz"])
-    for t, s in sims.items():
+    for s in sims.values():
         tr = s.truth
         assert tr.omega.min() >= lo * (1 - 1e-12) and tr.omega.max() <= hi * (1 + 1e-12)
         assert tr.omega_clamped.sum() <= 0.02 * tr.omega.size

@@ -193,7 +193,7 @@ def measure(
                     "ratio",
                 ),
                 "tab_null",
-                lambda d: float(
+                lambda d, sel=sel: float(
                     sel(d)["null_median_rel_err_pct"].iloc[0]
                     / sel(d)["trained_median_rel_err_pct"].iloc[0]
                 ),
@@ -209,7 +209,7 @@ def measure(
                     "ratio",
                 ),
                 "tab_null",
-                lambda d: float(
+                lambda d, sel=sel: float(
                     sel(d)["null_median_rel_err_pct"].iloc[0]
                     / sel(d)["trained_median_rel_err_pct"].iloc[0]
                 ),
@@ -227,7 +227,7 @@ def measure(
                     "points",
                 ),
                 "tab_null",
-                lambda d: float(
+                lambda d, sel=sel: float(
                     sel(d)["trained_median_rel_err_pct"].iloc[0]
                     - sel(d)["null_median_rel_err_pct"].iloc[0]
                 ),
@@ -310,11 +310,11 @@ def measure(
     tr = tables["tab_transfer"]
     beyond = tr[tr["split"] == "beyond"] if "split" in tr.columns else tr
     for (t, c), _ in beyond.groupby(["tree", "condition"], sort=False):
-        cell = lambda d, t=t, c=c: d[
-            (d["split"] == "beyond")
-            & (d["tree"] == t)  # noqa: E731
-            & np.isclose(d["condition"], c)
-        ].iloc[0]
+
+        def cell(d, t=t, c=c):
+            row = (d["split"] == "beyond") & (d["tree"] == t) & np.isclose(d["condition"], c)
+            return d[row].iloc[0]
+
         add(
             Claim(
                 f"transfer_ours_ahead/{t}/{c:.2f}",
