@@ -257,3 +257,18 @@ def test_a_second_seed_pairs_with_the_first(run, tmp_path):
     lo, hi = stats.t.interval(0.95, 1, loc=d.mean(), scale=stats.sem(d))
     tex = (wd / "results" / "tables" / "tab_margin.tex").read_text()
     assert f"${d.mean():+.2f}$ [{lo:.2f}, {hi:.2f}]" in tex
+
+
+def test_summary_is_printed_from_the_run(run):
+    """results/summary.md (part of `all`): the run's stamp, the ledger's counts, tab_fit's trees
+    and the benchmarked stages, read back from the run's own files."""
+    text = (run / "results" / "summary.md").read_text()
+    ledger = pd.read_csv(run / "results" / "claims.csv", dtype={"config_hash": str})
+    stamp = ledger[["profile", "config_hash", "physgs_version"]].iloc[0]
+    assert f"profile=quick, config_hash={stamp.config_hash}," in text
+    kinds = ledger["verdict"].str.split(":").str[0]
+    for v in ("holds", "fails", "undecided"):
+        assert f"**{v}** {int((kinds == v).sum())}" in text
+    assert "| model | sparse |" in text and "Warning" not in text
+    for stage in ("testbed", "train", "evaluate"):
+        assert f"| {stage} | " in text

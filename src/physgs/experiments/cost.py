@@ -25,13 +25,16 @@ _SEED = re.compile(r"(?:^|_)seed(\d+)$")
 @dataclass(frozen=True)
 class JobCost:
     """One benchmarked job: ``stage`` (train, evaluate, ...), ``seed`` (None = shared by every
-    seed), ``damping`` (part of the damping benchmark), wall seconds, and its path."""
+    seed), ``damping`` (part of the damping benchmark), wall seconds, its path, and when it ended
+    (``end``: the benchmark file's modification time, seconds since the epoch; Snakemake writes
+    it as the job finishes, so the job ran from ``end - wall_s`` to ``end``)."""
 
     stage: str
     seed: int | None
     damping: bool
     wall_s: float
     path: str
+    end: float = float("nan")
 
 
 def _seed_of(parts: tuple[str, ...]) -> int | None:
@@ -73,6 +76,7 @@ def read_costs(benchmark_dir) -> list[JobCost]:
                 damping=any(_is_damping(p) for p in parts[1:]),
                 wall_s=float(row["s"]),
                 path=str(rel),
+                end=f.stat().st_mtime,
             )
         )
     if not jobs:
@@ -123,3 +127,23 @@ def extra_seed_wall_s(summary: dict, *, run_wall_s: float) -> float:
         raise ValueError(f"run_wall_s = {run_wall_s}: the run's measured wall time must be > 0")
     mean_seed = sum(summary["per_seed"].values()) / len(summary["per_seed"])
     return mean_seed * run_wall_s / summary["total_s"]
+
+
+def wall_spans(jobs: list[JobCost]) -> dict:
+    """Elapsed wall seconds from the first job's start to the last job's end, for the whole run
+    and per stage (stages overlap: jobs of different stages run side by side).
+
+    Returns {"run_s": s, "by_stage": {stage: s}}. Read from the benchmark files' times, so a run
+    resumed after a pause counts the pause, and a stage rerun later spans both runs."""
+    if not jobs:
+        raise ValueError("no jobs: nothing to span")
+    if any(j.end != j.end for j in jobs):  # NaN: a JobCost built without its end time
+        raise ValueError("a job has no end time (read the jobs with read_costs)")
+
+    def span(js):
+        return max(j.end for j in js) - min(j.end - j.wall_s for j in js)
+
+    stages: dict[str, list[JobCost]] = {}
+    for j in jobs:
+        stages.setdefault(j.stage, []).append(j)
+    return {"run_s": span(jobs), "by_stage": {k: span(v) for k, v in sorted(stages.items())}}

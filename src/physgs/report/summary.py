@@ -1,0 +1,159 @@
+"""results/summary.md: what one finished run says, printed from the run's own files.
+
+The profile and config stamp the run was made with, the claims ledger's verdict counts and each
+verdict (``results/claims.csv``), ``tab_fit``'s fraction of the true-motion ceiling's gain per
+tree and model (``results/tables/tab_fit.csv``), and what the run cost: wall time and
+job-minutes by stage from Snakemake's benchmark files (``physgs.experiments.cost``). Nothing here
+is typed by hand, so the summary cannot go stale against the run it describes.
+
+Pure: takes paths (and the stamp), returns Markdown; the workflow writes it.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Mapping
+from pathlib import Path
+
+import numpy as np
+import pandas as pd
+
+from physgs.experiments.cost import read_costs, summarise, wall_spans
+from physgs.report.claims import FIT_BAR, LABELS
+from physgs.report.seeds import interval
+
+VERDICTS = ("holds", "fails", "undecided")
+
+
+def _stamp_line(stamp: Mapping[str, str]) -> str:
+    return ", ".join(f"{k}={v}" for k, v in stamp.items())
+
+
+def _stale(stamp: Mapping[str, str], df: pd.DataFrame, name: str) -> list[str]:
+    """A warning when a file was made under another config than the run's stamp."""
+    if "config_hash" not in df.columns or "config_hash" not in stamp:
+        return []
+    found = sorted({str(h) for h in df["config_hash"].dropna()})
+    if found and found != [str(stamp["config_hash"])]:
+        return [
+            f"> **Warning**: {name} was made under config_hash {', '.join(found)}, not this "
+            f"run's {stamp['config_hash']}: rerun `snakemake` for the target first.",
+            "",
+        ]
+    return []
+
+
+def claims_section(claims: pd.DataFrame) -> list[str]:
+    """Verdict counts and one line per claim (verdict, measured value with its interval)."""
+    kind = claims["verdict"].astype(str).str.split(":").str[0]
+    bad = sorted(set(kind) - set(VERDICTS))
+    if bad:
+        raise ValueError(f"claims: unknown verdicts {bad} (expected one of {VERDICTS})")
+    counts = kind.value_counts()
+    lines = [
+        "## Claims ledger",
+        "",
+        f"{len(claims)} claims: "
+        + ", ".join(f"**{v}** {int(counts.get(v, 0))}" for v in VERDICTS)
+        + ". The claims, the paper's figures and the cells each verdict comes from: "
+        "[claims.md](claims.md).",
+        "",
+        "| claim | measured [95% interval] | threshold | verdict |",
+        "|---|---|---|---|",
+    ]
+    for _, r in claims.iterrows():
+        meas = "--" if not np.isfinite(r["measured"]) else f"{r['measured']:+.3g} {r['unit']}"
+        if np.isfinite(r["ci_low"]):
+            meas += f" [{r['ci_low']:+.3g}, {r['ci_high']:+.3g}]"
+        lines.append(f"| `{r['id']}` | {meas} | {r['threshold']} | {r['verdict']} |")
+    return lines + [""]
+
+
+def fit_section(tab_fit: pd.DataFrame) -> list[str]:
+    """Fraction of the ceiling's in-window gain per model (rows) and tree (columns), in percent:
+    the mean over seeds, with its 95% interval when there are two seeds or more."""
+    trees = list(dict.fromkeys(tab_fit["tree"]))
+    models = list(dict.fromkeys(tab_fit.loc[~tab_fit["reference"].astype(bool), "model"]))
+    seeds = sorted(tab_fit["seed"].unique())
+    lines = [
+        "## Fit to the training window (`tab_fit`)",
+        "",
+        "Each model's share of the gain from the static pose to the true-motion ceiling on its "
+        f"trained frames, % (the bar an opponent must clear: {FIT_BAR:.0%}); "
+        + (
+            f"mean over {len(seeds)} seeds [95% interval]."
+            if len(seeds) > 1
+            else "one seed, no interval."
+        )
+        + " The table with every PSNR: `results/tables/tab_fit.tex`.",
+        "",
+        "| model | " + " | ".join(trees) + " |",
+        "|---|" + "---|" * len(trees),
+    ]
+    for m in models:
+        cells = []
+        for t in trees:
+            v = tab_fit.loc[(tab_fit["tree"] == t) & (tab_fit["model"] == m), "ceiling_frac"]
+            mean, _, lo, hi = interval(100 * v.to_numpy(float))
+            cell = "--" if not np.isfinite(mean) else f"{mean:.0f}%"
+            if np.isfinite(lo):
+                cell += f" [{lo:.0f}, {hi:.0f}]"
+            cells.append(cell)
+        lines.append(f"| {LABELS.get(m, m)} | " + " | ".join(cells) + " |")
+    return lines + [""]
+
+
+def cost_section(benchmark_dir) -> list[str]:
+    """Wall time of the run and of each stage (first job start to last job end) and
+    job-minutes by stage, shared and per seed, from the benchmark files."""
+    jobs = read_costs(benchmark_dir)
+    s, spans = summarise(jobs), wall_spans(jobs)
+    seeds = list(s["per_seed"])
+    cols = ["shared", *seeds]
+    head = ["shared" if c == "shared" else f"seed {c}" for c in cols]
+    lines = [
+        "## What the run cost",
+        "",
+        f"Wall time **{spans['run_s'] / 60:.1f} min** from the first benchmarked job's start to "
+        f"the last one's end ({len(jobs)} jobs, {s['total_s'] / 60:.1f} job-minutes; a run "
+        "resumed after a pause counts the pause). Tables, figures and recovery are light jobs "
+        "without a benchmark file. Per stage: wall minutes of its span (stages overlap) and "
+        "job-minutes, shared by every seed or per training seed "
+        "(`python benchmarks/pipeline_cost.py` prints the same, and one more seed's cost).",
+        "",
+        "| stage | wall min | " + " | ".join(f"job-min {h}" for h in head) + " |",
+        "|---|---|" + "---|" * len(cols),
+    ]
+    for stage, row in sorted(s["by_stage"].items()):
+        cells = [f"{row[c] / 60:.1f}" if c in row else "" for c in cols]
+        lines.append(
+            f"| {stage} | {spans['by_stage'][stage] / 60:.1f} | " + " | ".join(cells) + " |"
+        )
+    totals = [f"{s['shared_s'] / 60:.1f}", *(f"{s['per_seed'][k] / 60:.1f}" for k in seeds)]
+    lines.append(f"| **all** | {spans['run_s'] / 60:.1f} | " + " | ".join(totals) + " |")
+    return lines + [""]
+
+
+def run_summary(stamp: Mapping[str, str], claims_csv, tab_fit_csv, benchmark_dir) -> str:
+    """results/summary.md of a finished run, from its claims ledger, its ``tab_fit`` and its
+    benchmark folder. Raises FileNotFoundError naming a missing file or folder."""
+    for p in (claims_csv, tab_fit_csv):
+        if not Path(p).is_file():
+            raise FileNotFoundError(f"{p}: missing (run `snakemake --cores 2 all` first)")
+    claims = pd.read_csv(claims_csv, dtype={"config_hash": str})
+    tab_fit = pd.read_csv(tab_fit_csv, dtype={"config_hash": str})
+    seeds = sorted(int(x) for x in tab_fit["seed"].unique())
+    trees = list(dict.fromkeys(tab_fit["tree"]))
+    lines = [
+        "# Run summary",
+        "",
+        f"Made by: {_stamp_line(stamp)}; training seeds {', '.join(map(str, seeds))}; "
+        f"trees {', '.join(trees)}. Printed from this run's files (`results/claims.csv`, "
+        "`results/tables/tab_fit.csv`, `results/benchmarks/`) by `physgs.report.summary`.",
+        "",
+        *_stale(stamp, claims, "results/claims.csv"),
+        *_stale(stamp, tab_fit, "results/tables/tab_fit.csv"),
+        *claims_section(claims),
+        *fit_section(tab_fit),
+        *cost_section(benchmark_dir),
+    ]
+    return "\n".join(lines)
