@@ -14,6 +14,7 @@ import numpy as np
 from physgs.models.registry import (
     build_model,
     configs_for,
+    is_prior,
     is_reference,
     model_settings,
     save_checkpoint,
@@ -88,7 +89,7 @@ def job_spec(cfg: dict, model: str, config: str, seed: int | None = None) -> dic
         seed=int(cfg["seed"] if seed is None else seed),
         settings=model_settings(cfg["models"], model),
         train=cfg["train"],
-        K=int(spec["K"]) if model == "ours" else None,
+        K=int(spec["K"]) if is_prior(model) else None,
     ).to_dict()
 
 
@@ -151,7 +152,7 @@ def fit(
     every = int(job.train.get("holdout_every", 0))
     if frame_pool is None and every:
         frame_pool = heldout_split(int(observed.n_train), every)[0]
-    hook = freeze_callback(observed, job.settings, job.train) if job.model == "ours" else None
+    hook = freeze_callback(observed, job.settings, job.train) if is_prior(job.model) else None
     result = train_model(
         model,
         observed,
@@ -163,7 +164,7 @@ def fit(
         frame_pool=frame_pool,
         on_iteration=hook,
     )
-    if job.model == "ours":
+    if is_prior(job.model):
         result.stats["frozen_parts"] = int(result.model.frozen.sum())
     return result
 

@@ -15,6 +15,15 @@ Parameterisation (all bounded or normalised so one Adam rate suits every tree):
   horizontal part of the training camera's viewing direction (a swing in the image plane, the
   motion the camera sees best) and is learned;
 - pivot (world units), initialised at the part's member nearest the base of the tree.
+
+Two options (registry ids ``ours_topo`` and ``ours_chain``; ``ours`` is the paper's):
+- ``segmentation="topology"``: parts cut along the tree (``physgs.models.topology``) instead of
+  k-means; each part has a parent (``part_parent`` [K], root -1, parents numbered first) and
+  its pivot starts at the joint with that parent.
+- ``chain=True`` (topology parts only): each part keeps its own oscillator, but its rigid
+  transform is composed with its ancestors' (``physgs.models.chain``): a branch is carried by
+  its parent. ``part_theta`` stays each part's OWN angle theta_p(t), the quantity the
+  oscillator models and recovery compares with each bone's own angle.
 """
 
 from __future__ import annotations
@@ -26,10 +35,12 @@ import torch
 from torch import nn
 
 from physgs.models.base import BaseModel, ModelContext
+from physgs.models.chain import chain_deform, depth_levels
 from physgs.models.gaussians import GaussianState, rotate_about_pivot
 from physgs.models.oscillator import STABILITY_GUARD, fastest_rate, integrate, required_substeps
 from physgs.models.oscillator_params import OscillatorBounds, condition_vbar
 from physgs.models.parts import kmeans_parts
+from physgs.models.topology import KNN, topology_parts
 
 
 def prior_substeps(omega_hz, zeta, substeps: int, dt: float, guard: float = STABILITY_GUARD) -> int:
@@ -62,6 +73,10 @@ class OscillatorPrior(BaseModel):
         kmeans_n_init: int = 4,
         seed: int = 0,
         labels: np.ndarray | None = None,
+        segmentation: str = "kmeans",
+        knn: int = KNN,
+        chain: bool = False,
+        parent: np.ndarray | None = None,
     ):
         super().__init__(ctx, canonical_cfg)
         # the parameterisation the 2D-track control shares (physgs.models.oscillator_params)
@@ -78,13 +93,29 @@ class OscillatorPrior(BaseModel):
         self.guard = float(rk4_guard)
         self.substeps = prior_substeps(omega_hz, zeta, substeps, self.dt, self.guard)
         xyz = np.asarray(ctx.canonical_xyz, dtype=np.float64)
+        if segmentation not in ("kmeans", "topology"):
+            raise ValueError(f"segmentation must be 'kmeans' or 'topology', got {segmentation!r}")
+        if chain and segmentation != "topology":
+            raise ValueError("a chained prior needs topology parts (a parent per part)")
+        topo_pivots = None
+        if segmentation == "topology" and (labels is None or parent is None):
+            tp = topology_parts(xyz, K, knn)  # deterministic: no seed
+            labels, parent, topo_pivots = tp.labels, tp.parent, tp.pivots
         if labels is None:
             labels = kmeans_parts(xyz, K, seed, kmeans_n_init)
         labels = np.asarray(labels, dtype=np.int64)
         if labels.shape != (xyz.shape[0],) or labels.min() < 0 or labels.max() >= K:
             raise ValueError(f"part labels must be [N] in [0, K={K}); got shape {labels.shape}")
         self.K = K
+        self.segmentation, self.chain = segmentation, bool(chain)
         self.register_buffer("part_labels", torch.tensor(labels))
+        self.levels = None  # [(parts, parents)] per depth, for the chained transform
+        if segmentation == "topology":
+            parent = np.asarray(parent, dtype=np.int64)
+            if parent.shape != (K,):
+                raise ValueError(f"part parents must be [K = {K}], got shape {parent.shape}")
+            self.levels = depth_levels(parent)  # refuses a cycle or unnumbered parents
+            self.register_buffer("part_parent", torch.tensor(parent))
         self.omega_raw = nn.Parameter(torch.full((K,), b.omega_raw_init()))
         self.zeta_raw = nn.Parameter(torch.full((K,), b.zeta_raw_init()))
         self.gain_raw = nn.Parameter(torch.zeros(K))
@@ -100,6 +131,8 @@ class OscillatorPrior(BaseModel):
         for p in range(K):
             members = xyz[labels == p]
             pivots[p] = members[np.argmin(np.linalg.norm(members - base, axis=1))]
+        if topo_pivots is not None:  # the joint with the parent (loading overwrites it anyway)
+            pivots = topo_pivots
         self.pivot = nn.Parameter(torch.tensor(pivots, dtype=torch.float32))
         # Parts whose motion never reaches the image (physgs.models.visibility): theta = 0 and
         # their physics parameters take no further updates. Saved in checkpoints.
@@ -160,9 +193,14 @@ class OscillatorPrior(BaseModel):
         theta = self.part_theta(wind)[:, self.lead_in + frame_idx]  # [K]
         lab = self.part_labels
         c = self.canonical
-        means, quats = rotate_about_pivot(
-            c.means, c.quats, self.axis[lab], theta[lab], self.pivot[lab]
-        )
+        if self.chain:
+            means, quats = chain_deform(
+                c.means, c.quats, lab, self.axis, theta, self.pivot, self.levels
+            )
+        else:
+            means, quats = rotate_about_pivot(
+                c.means, c.quats, self.axis[lab], theta[lab], self.pivot[lab]
+            )
         return GaussianState(
             means,
             quats,

@@ -37,6 +37,8 @@ class ModelSpec:
     short: str  # column head under a family heading (tab_transfer)
     family: str  # config section of its architecture ("static", "mlp", "d3dgs", "ours")
     wind: bool  # reads the observed wind
+    parts: str = "kmeans"  # oscillator priors: how parts are cut ("kmeans" or "topology")
+    chain: bool = False  # oscillator priors: each part's transform composed with its parent's
 
 
 #: The one source of model ids and labels; order = row order of every table.
@@ -49,6 +51,18 @@ MODELS: dict[str, ModelSpec] = {
     "ours": ModelSpec("Ours", "Ours", "ours", True),
 }
 MODEL_NAMES = tuple(MODELS)
+#: Variants of the oscillator prior (issue 28): topology-aware parts (physgs.models.topology),
+#: independent or chained (physgs.models.chain). Ids of their own, not options of ``ours``, so
+#: one run can train all three side by side under one recipe (``job_spec``/``fit`` treat every
+#: model of family "ours" alike) and a table can compare them. Kept out of MODELS until the
+#: workflow trains them and tab_parts reads them: every table and the job plan iterate MODELS.
+PRIOR_VARIANTS: dict[str, ModelSpec] = {
+    "ours_topo": ModelSpec("Ours, topology parts", "topology", "ours", True, parts="topology"),
+    "ours_chain": ModelSpec(
+        "Ours, chained topology parts", "chained", "ours", True, parts="topology", chain=True
+    ),
+}
+PRIOR_VARIANT_NAMES = tuple(PRIOR_VARIANTS)
 #: Reference models: not methods (no recovery, null or method result depends on them), so kept
 #: out of MODELS / MODEL_NAMES. truth_motion moves the canonical Gaussians by the ground-truth
 #: skinning (physgs.models.truth_motion): the ceiling; the only model that reads truth.npz.
@@ -70,18 +84,25 @@ def is_reference(model: str) -> bool:
 
 
 def spec_of(model: str) -> ModelSpec:
-    """The ModelSpec of a method or reference id (ValueError naming the valid ids)."""
-    spec = MODELS.get(model) or REFERENCES.get(model)
+    """The ModelSpec of a method, prior variant or reference id (ValueError naming the ids)."""
+    spec = MODELS.get(model) or PRIOR_VARIANTS.get(model) or REFERENCES.get(model)
     if spec is None:
         raise ValueError(
-            f"unknown model {model!r}; choose one of {MODEL_NAMES} or a reference {REFERENCE_NAMES}"
+            f"unknown model {model!r}; choose one of {MODEL_NAMES}, a prior variant "
+            f"{PRIOR_VARIANT_NAMES} or a reference {REFERENCE_NAMES}"
         )
     return spec
 
 
+def is_prior(model: str) -> bool:
+    """Whether ``model`` is an oscillator prior (``ours`` or one of PRIOR_VARIANTS): trained in
+    every configuration, with K parts, part freezing and recovery."""
+    return spec_of(model).family == "ours"
+
+
 def label(model: str) -> str:
     """Table/legend label of a model id (method or reference)."""
-    spec = MODELS.get(model) or REFERENCES.get(model)
+    spec = MODELS.get(model) or PRIOR_VARIANTS.get(model) or REFERENCES.get(model)
     return spec.label if spec is not None else model
 
 
@@ -92,13 +113,12 @@ def config_label(name: str, spec: dict, tex: bool = True) -> str:
 
 
 def configs_for(model: str, configs) -> tuple[str, ...]:
-    """Configurations a model is trained in: every model (references too) `single`, ours every
-    configuration.
+    """Configurations a model is trained in: every model (references too) `single`, ours (and
+    its variants) every configuration.
 
     configs: the names of the config's ``models.configs`` (the one source of configurations).
     """
-    spec_of(model)
-    return tuple(configs) if model == "ours" else (BASE_CONFIG,)
+    return tuple(configs) if is_prior(model) else (BASE_CONFIG,)
 
 
 def training_jobs(configs) -> list[tuple[str, str]]:
@@ -116,6 +136,8 @@ def model_settings(models_cfg: dict, model: str) -> dict:
         return out
     if spec.family != "static":
         out[spec.family] = models_cfg[spec.family]
+    if spec.parts == "topology":
+        out["topology"] = models_cfg["topology"]
     if spec.wind and spec.family in FIELDS:
         out["wind_window"] = models_cfg["wind_window"]
     return out
@@ -130,6 +152,7 @@ def build_model(
     K: int | None = None,
     seed: int = 0,
     labels: np.ndarray | None = None,
+    parent: np.ndarray | None = None,
     truth=None,
 ) -> BaseModel:
     """A freshly initialised model.
@@ -138,7 +161,7 @@ def build_model(
     ModelContext; cfg: the ``models`` config section, or ``model_settings`` of it; config:
     training configuration name; K: number of parts of ours (default:
     ``cfg['configs'][config]['K']``); seed: k-means seed (ours); labels: precomputed part labels
-    [N] (used when loading); truth: references only, and required by them: the dataset's
+    [N] and parent: precomputed part parents [K] (topology variants; used when loading); truth: references only, and required by them: the dataset's
     ``Truth`` (``load_truth`` of truth.npz; ``observed`` must then be the ``Observed``), or the
     ``TrueMotion`` a checkpoint stores. A method given a truth raises (methods never read it).
     """
@@ -148,8 +171,7 @@ def build_model(
     from physgs.models.static import StaticModel
     from physgs.models.truth_motion import TrueMotion, TruthMotionModel
 
-    spec_of(name)
-    if name != "ours" and config != BASE_CONFIG:
+    if not is_prior(name) and config != BASE_CONFIG:
         raise ValueError(
             f"model {name!r} is not trained in configuration {config!r}; valid: "
             f"('{BASE_CONFIG}',) (joint configurations are ours only)"
@@ -176,7 +198,7 @@ def build_model(
                 )
             truth = TrueMotion.from_truth(truth, observed)
         return TruthMotionModel(ctx, canon, truth)
-    family = MODELS[name].family
+    family = spec_of(name).family
     if family == "static":
         return StaticModel(ctx, canon)
     if family in FIELDS:
@@ -207,6 +229,10 @@ def build_model(
             )
         K = spec["K"]
     o = cfg["ours"]
+    spec = spec_of(name)
+    topo = {}
+    if spec.parts == "topology":
+        topo = dict(segmentation="topology", knn=int(cfg["topology"]["knn"]), parent=parent)
     return OscillatorPrior(
         ctx,
         canon,
@@ -220,6 +246,8 @@ def build_model(
         kmeans_n_init=o["kmeans_n_init"],
         seed=seed,
         labels=labels,
+        chain=spec.chain,
+        **topo,
     )
 
 
@@ -290,6 +318,7 @@ def load_checkpoint(path) -> BaseModel:
     blob = read_checkpoint(path)
     sd = blob["state_dict"]
     labels = sd["part_labels"].numpy() if "part_labels" in sd else None
+    parent = sd["part_parent"].numpy() if "part_parent" in sd else None
     # a reference's motion is in its own buffers: no truth.npz needed to reload it
     motion = TrueMotion.from_state_dict(sd) if is_reference(blob["model"]) else None
     model = build_model(
@@ -300,6 +329,7 @@ def load_checkpoint(path) -> BaseModel:
         K=blob["K"],
         seed=blob["seed"],
         labels=labels,
+        parent=parent,
         truth=motion,
     )
     model.load_state_dict(sd, strict=True)

@@ -9,6 +9,11 @@ only adds parameters the data cannot pin down. Freezing such a part sets theta_p
 updates of its physics parameters; recovery then counts it as untrusted (a constant trajectory
 correlates with nothing).
 
+In a chained prior (``model.chain``) a part's own rotation also carries its descendants, so
+its swing counts their Gaussians too (a trunk part barely moves its own members but moves the
+whole tree); there it is evaluated at the frames of the part's largest and smallest theta
+(a rigid rotation displaces every point monotonically in |theta|).
+
 By default the swing uses the model's current theta (what its motion actually does in the
 image), so freezing happens part-way through training (config ``models.ours.freeze_at``) once
 the gains have grown. ``probe_rad`` instead rotates every part by a fixed angle: a purely
@@ -56,6 +61,8 @@ def part_image_swing(
             idx = np.arange(observed.n_train) if frames is None else np.asarray(frames)
             angles = theta[:, int(observed.lead_in_frames) + idx].T  # [M, K]
     uv0, _ = cam.project(means0.numpy())  # [N, 2] pixels
+    if getattr(model, "chain", False):
+        return _chain_swing(model, means0, uv0, cam, angles)
     swing = np.zeros(K)
     q0 = torch.tensor([[1.0, 0.0, 0.0, 0.0]], dtype=torch.float64).expand(means0.shape[0], 4)
     for a in angles:  # [K] rad at one frame
@@ -65,6 +72,36 @@ def part_image_swing(
         uv, _ = cam.project(m.numpy())
         d = np.linalg.norm(uv - uv0, axis=1)  # [N] pixels
         np.maximum.at(swing, lab, d)
+    return swing
+
+
+def _chain_swing(model, means0, uv0, cam, angles) -> np.ndarray:
+    """[K] pixels: each part rotated alone by its theta, its Gaussians and its descendants'."""
+    parent = model.part_parent.cpu().numpy()
+    lab = model.part_labels.cpu().numpy()
+    K = int(model.K)
+    sub = np.eye(K, dtype=bool)  # sub[p, q]: q is p or a descendant of p
+    for q in range(K - 1, 0, -1):  # parents are numbered first: children before their parents
+        sub[parent[q]] |= sub[q]
+    swing = np.zeros(K)
+    q0 = torch.tensor([[1.0, 0.0, 0.0, 0.0]], dtype=torch.float64)
+    with torch.no_grad():
+        axis, pivot = model.axis.double(), model.pivot.double()  # [K, 3]
+    for p in range(K):
+        idx = np.nonzero(sub[p][lab])[0]
+        for a in {float(angles[:, p].max()), float(angles[:, p].min())}:
+            if a == 0.0:
+                continue
+            n = len(idx)
+            m, _ = rotate_about_pivot(
+                means0[idx],
+                q0.expand(n, 4),
+                axis[p].expand(n, 3),
+                torch.full((n,), a, dtype=torch.float64),
+                pivot[p].expand(n, 3),
+            )
+            uv, _ = cam.project(m.numpy())
+            swing[p] = max(swing[p], float(np.linalg.norm(uv - uv0[idx], axis=1).max()))
     return swing
 
 

@@ -1,0 +1,81 @@
+"""Forward kinematics of chained rigid parts: each part rotates about its own pivot and rides on
+its parent (the testbed's own skinning, ``physgs.testbed.kinematics``, with one axis per part).
+
+Part p's map of canonical space is T_p = T_parent(p) o Rot_p, Rot_p(x) = c_p + R_p (x - c_p)
+the rotation by theta_p about axis a_p through its canonical pivot c_p (a_p and c_p are given
+in the canonical frame; the ancestors carry them). So a Gaussian of part p moves by the product
+of the rotations of p and of every ancestor, each about its own pivot as carried by the
+ancestors. Written as displacements, so that zero angles give exactly zero motion:
+
+    T_p(x) = x + u_p + E_p (x - c_p),   E_p = Rw_p - I,   u_p = T_parent(c_p) - c_p,
+    E_p = E_q + G_p + E_q G_p,   u_p = u_q + E_q (c_p - c_q),   q = parent(p), G_p = R_p - I,
+
+with E = G and u = 0 at the root. Parts must be numbered parents first (parent[p] < p), as
+``physgs.models.topology`` numbers them; one vectorised step per tree depth.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+import torch
+
+from physgs.models.gaussians import axis_angle_quat, quat_multiply, rodrigues_minus_identity
+
+
+def depth_levels(parent) -> list[tuple[np.ndarray, np.ndarray]]:
+    """[(parts [M] int64, their parents [M] int64)] per depth 1, 2, ... for parent [K] (root -1,
+    parent[p] < p); raises ValueError on any other parent array (so no cycle is accepted)."""
+    from physgs.models.topology import part_depth
+
+    parent = np.asarray(parent, dtype=np.int64)
+    depth = part_depth(parent)
+    out = []
+    for d in range(1, int(depth.max()) + 1 if len(depth) else 1):
+        idx = np.nonzero(depth == d)[0]
+        out.append((idx, parent[idx]))
+    return out
+
+
+def chain_transforms(
+    axis: torch.Tensor, theta: torch.Tensor, pivot: torch.Tensor, levels
+) -> tuple[torch.Tensor, torch.Tensor, torch.Tensor]:
+    """World transforms of chained parts at one instant.
+
+    axis [K, 3] unit swing axes; theta [K] own angles (rad); pivot [K, 3] canonical pivots;
+    levels: ``depth_levels(parent)``. Returns (E [K, 3, 3] = world rotation - I, u [K, 3]
+    displacement of each part's pivot by its ancestors, q [K, 4] world rotation quaternions
+    (w, x, y, z)). Differentiable in axis, theta and pivot.
+    """
+    G = rodrigues_minus_identity(axis, theta)  # [K, 3, 3] own rotation - I
+    qo = axis_angle_quat(axis, theta)  # [K, 4] own rotation
+    E, u, q = G, torch.zeros_like(pivot), qo
+    for idx_np, par_np in levels:
+        idx = torch.as_tensor(idx_np, device=axis.device)
+        par = torch.as_tensor(par_np, device=axis.device)
+        Eq, Gp = E[par], G[idx]  # [M, 3, 3]
+        # out-of-place index_copy: autograd sees every level's write
+        E = E.index_copy(0, idx, Eq + Gp + Eq @ Gp)
+        u = u.index_copy(0, idx, u[par] + (Eq @ (pivot[idx] - pivot[par])[..., None])[..., 0])
+        q = q.index_copy(0, idx, quat_multiply(q[par], qo[idx]))
+    return E, u, q
+
+
+def chain_deform(
+    means: torch.Tensor,
+    quats: torch.Tensor,
+    labels: torch.Tensor,
+    axis: torch.Tensor,
+    theta: torch.Tensor,
+    pivot: torch.Tensor,
+    levels,
+) -> tuple[torch.Tensor, torch.Tensor]:
+    """Move Gaussians by their parts' chained transforms.
+
+    means [N, 3]; quats [N, 4] (w, x, y, z); labels [N] part of each Gaussian; axis [K, 3];
+    theta [K] rad; pivot [K, 3]; levels: ``depth_levels(parent)``. Returns (means [N, 3],
+    quats [N, 4]); exactly the input at theta = 0.
+    """
+    E, u, q = chain_transforms(axis, theta, pivot, levels)
+    rel = (means - pivot[labels])[..., None]  # [N, 3, 1]
+    new_means = means + u[labels] + (E[labels] @ rel)[..., 0]
+    return new_means, quat_multiply(q[labels], quats)
