@@ -221,3 +221,35 @@ def test_chain_needs_topology_parts():
     kw = {k: o[k] for k in ("omega_hz", "zeta", "omega_init_hz", "zeta_init", "substeps")}
     with pytest.raises(ValueError, match="topology parts"):
         OscillatorPrior(ctx, quick_models_cfg()["canonical"], K=3, chain=True, **kw)
+
+
+def test_chained_swing_counts_the_descendants(swaying):
+    # a chained part's own rotation carries its descendants: its image swing is theirs too
+    from physgs.models.visibility import part_image_swing
+
+    cfg = quick_models_cfg()
+    model = build_model("ours_chain", swaying, cfg, K=4)
+    swing = part_image_swing(model, swaying, probe_rad=0.05)
+    xyz = swaying.canonical_xyz.astype(np.float64)
+    lab = model.part_labels.numpy()
+    parent = model.part_parent.numpy()
+    uv0, _ = swaying.train_camera.project(xyz)
+
+    def ancestors_or_self(q):
+        out = set()
+        while q >= 0:
+            out.add(q)
+            q = int(parent[q])
+        return out
+
+    for p in range(4):
+        moved = np.array([p in ancestors_or_self(int(q)) for q in lab])  # p or below
+        ax = model.axis[p].detach().double().numpy()
+        c = model.pivot[p].detach().double().numpy()
+        best = 0.0
+        for a in (0.05, -0.05):
+            R = Rotation.from_rotvec(a * ax).as_matrix()
+            uv, _ = swaying.train_camera.project((xyz[moved] - c) @ R.T + c)
+            best = max(best, np.linalg.norm(uv - uv0[moved], axis=1).max())
+        assert swing[p] == pytest.approx(best, rel=1e-6)
+        assert moved.sum() >= (lab == p).sum()
