@@ -43,7 +43,7 @@ def tab_damping(
     configs: Mapping[str, str],
     digits: int = 2,
 ) -> Table:
-    """per_seed[seed][(tree, variant, config)]: ``RecoveryRecord`` with damping scores and null;
+    """``per_seed[seed][(tree, variant, config)]``: ``RecoveryRecord`` with damping scores and null;
     variant 'faithful' or 'damping'; configs: name -> LaTeX label, in row order. One CSV row per
     seed, tree, variant and configuration; the .tex gives mean +- sd over seeds and the paired
     trained - null difference with its 95% interval."""

@@ -24,7 +24,7 @@ def tab_kselect(
     method: str,
     digits: int = 2,
 ) -> Table:
-    """per_seed[seed][(tree, config)]: K, time_psnr (dB), median_rel_err (fraction), trusted,
+    """``per_seed[seed][(tree, config)]``: K, time_psnr (dB), median_rel_err (fraction), trusted,
     frozen, k_heldout, k_bic. One LaTeX row per tree and configuration: K as chosen by each seed
     (slash-separated when the seeds disagree), the rest mean +- sd over seeds."""
     seeds = _seeds(per_seed, "tab_kselect")

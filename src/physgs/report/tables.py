@@ -149,7 +149,7 @@ def tab_psnr(
 ) -> Table:
     """PSNR (dB) on the view and time splits, one row per model, two columns per tree.
 
-    per_seed[seed][(tree, model)]: ``EvalResult.summary()`` of the model trained ``single`` with
+    ``per_seed[seed][(tree, model)]``: ``EvalResult.summary()`` of the model trained ``single`` with
     that training seed. Below the models: references (the true-motion ceiling; never bold) and
     two paired differences, ours - static and ours - the best learned field (per seed, the
     learned field with the highest PSNR in that column). The best method per column is bold when
@@ -260,7 +260,7 @@ def tab_fit(
 ) -> Table:
     """How much of the achievable fit each model reaches, per tree and model.
 
-    per_seed[seed][(tree, model)]: fit (dB: mean PSNR over the trained training-window frames at
+    ``per_seed[seed][(tree, model)]``: fit (dB: mean PSNR over the trained training-window frames at
     the training camera and wind), heldout (dB: the same over the held-out training-window
     frames), view, time (dB: the evaluation splits), train_s (seconds of training).
     ceiling_frac is (model - static) / (reference - static) on ``fit``, per seed against that
@@ -355,8 +355,8 @@ def tab_null(
 ) -> Table:
     """Frequency recovery of the trained model against the untrained null, per tree and config.
 
-    recovery[seed][(tree, config)]: ``RecoveryRecord`` of that seed's model; null[seed][(tree,
-    config)]: ``NullResult`` drawn with that seed and the model's K; configs: configuration name
+    ``recovery[seed][(tree, config)]``: ``RecoveryRecord`` of that seed's model;
+    ``null[seed][(tree, config)]``: ``NullResult`` drawn with that seed and the model's K; configs: configuration name
     -> its LaTeX label (``registry.config_label``), in row order. Columns: parts trusted, median
     relative error (%), log-log R^2 for trained and null (null entries are medians over draws),
     trained - null (percentage points, paired per seed: negative means the trained model beats
@@ -476,7 +476,7 @@ def tab_transfer(
 ) -> Table:
     """Zero-shot transfer PSNR (dB) on the unseen conditions (index >= 1), all models ``single``.
 
-    per_seed[seed][(tree, model)]: ``EvalResult.summary()``. Rows: split (training timestamps /
+    ``per_seed[seed][(tree, model)]``: ``EvalResult.summary()``. Rows: split (training timestamps /
     beyond the window) x tree x unseen condition; columns: models. The best per row is bold when
     its paired difference to the runner-up is decided.
     """
