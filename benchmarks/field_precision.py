@@ -8,7 +8,7 @@ inputs (best of ``--reps``, after two untimed calls) at ``precision: float32`` a
 ``bfloat16`` (the weights are identical; heads randomised so the outputs are not zero), and
 prints the speed-up and the bf16 outputs' error relative to float32 (max |diff| / max |out|).
 Whether bf16 changes a *trained* model beyond seed noise is measured with
-``benchmarks/fit_recipe.py --set models.d3dgs.precision=bfloat16`` (README).
+``benchmarks/fit_recipe.py --set models.d3dgs.precision=bfloat16`` (docs/models.md).
 """
 
 from __future__ import annotations

@@ -111,7 +111,7 @@ def test_every_rule_a_profile_names_exists(tmp_path):
 
 def test_a_bare_snakemake_call_uses_the_default_profile(tmp_path):
     """`snakemake <target>` with no --cores works: profiles/default (-> workflow/profiles) sets
-    them, as the README says."""
+    them, as docs/reliability.md says."""
     from workflow_helpers import workflow_copy
 
     wd = workflow_copy(tmp_path)
