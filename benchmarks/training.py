@@ -1,11 +1,15 @@
-"""Training cost: seconds per iteration of every model on every tree, and RK4 cost.
+"""Training cost: seconds per iteration of every model on every tree, by part, and RK4 cost.
 
     python benchmarks/training.py [--profile default] [--iters 8] [--threads 1]
+        [--configfile config/float32.yaml] [--trees medium] [--models static,ours]
 
 For each tree the testbed's own geometry and cameras are generated (no frame rendering: the
 per-iteration cost does not depend on the target image's content), every model is built at the
 profile's settings and timed over ``--iters`` deformation iterations of the real training loop
-(after one untimed iteration that compiles kernels). Prints a table of s/iter, then the total
+(after one untimed iteration that compiles kernels). Prints a table of s/iter, then, per tree and
+model, where the CPU time of one iteration goes (:class:`Parts`: rasterizer forward and backward,
+the field (deformation forward + its backward), loss forward + backward, optimiser, divergence
+guard, the rest of the loop), then the total
 wall time the profile's training jobs imply (3 trees x 5 baselines `single` + ours
 single/joint32/joint96; the static warm-up iterations are charged at the static model's rate),
 and the RK4 forward+backward cost for K = 96 over the whole recording (lead-in + 350 frames).
@@ -14,19 +18,27 @@ and the RK4 forward+backward cost for K = 96 over the whole recording (lead-in +
 from __future__ import annotations
 
 import argparse
+import contextlib
 import time
+from collections import defaultdict
 from types import SimpleNamespace
 
 import numba
 import numpy as np
 import torch
+import yaml
 
 import physgs.config
+import physgs.render.fast
+import physgs.train.loop
 from physgs.models import build_model, training_jobs
 from physgs.models.oscillator import integrate
 from physgs.testbed import scene
 from physgs.testbed.dataset import simulate_tree, swept_points
 from physgs.train import train_model
+from physgs.train.divergence import DivergenceGuard
+
+PARTS = ("raster_fwd", "raster_bwd", "field", "loss", "optimiser", "guard", "other")
 
 
 def tree_dataset(cfg: dict, tree: str) -> SimpleNamespace:
@@ -60,21 +72,120 @@ def tree_dataset(cfg: dict, tree: str) -> SimpleNamespace:
     )
 
 
-def time_model(data, cfg: dict, model: str, config: str, iters: int) -> tuple[float, float]:
-    """(CPU seconds, wall seconds) per deformation iteration of the training loop, each the best
-    of three runs. CPU time (all threads of this process) is what a dedicated core would spend;
+class Parts:
+    """CPU seconds (this process, all threads) spent in each part of the real training loop,
+    accumulated by wrapping the names ``physgs.train.loop`` calls; nothing in the loop changes.
+
+    raster_fwd: ``rasterization`` (input checks, projection, compositing); raster_bwd: the fast
+    path's explicit backward; loss: ``photometric_loss`` plus the backward from the loss down to
+    the rendered image; field: the model's deformation (``gaussians_at`` / ``canonical_state``)
+    plus the rest of ``loss.backward()`` (the field's and the activations' backward); optimiser:
+    Adam's ``zero_grad`` and ``step``; guard: the divergence guard's checks and the finiteness
+    tests; other: the rest of the loop (target frame, learning-rate schedule, log).
+    """
+
+    def __init__(self):
+        self.sec = defaultdict(float)
+        self._bwd_mark = None  # CPU time at which the loss's backward reached the image
+
+    @contextlib.contextmanager
+    def timed(self, part: str):
+        c0 = time.process_time()
+        try:
+            yield
+        finally:
+            self.sec[part] += time.process_time() - c0
+
+    def wrap(self, part: str, fn):
+        def wrapped(*a, **k):
+            with self.timed(part):
+                return fn(*a, **k)
+
+        return wrapped
+
+    @contextlib.contextmanager
+    def patched(self, model):
+        loop, fast = physgs.train.loop, physgs.render.fast._FastRasterize
+        saved = []
+
+        def patch(obj, name, value):
+            saved.append((obj, name, obj.__dict__.get(name, _MISSING)))
+            setattr(obj, name, value)
+
+        raster = loop.rasterization
+
+        def rasterization(*a, **k):
+            with self.timed("raster_fwd"):
+                out = raster(*a, **k)
+            if out.rgb.requires_grad:  # the loss's backward reaches the image here
+                out.rgb.register_hook(self._reached_image)
+            return out
+
+        backward = torch.Tensor.backward
+
+        def tensor_backward(t, *a, **k):
+            c0 = time.process_time()
+            self._bwd_mark = None
+            r0 = self.sec["raster_bwd"]
+            backward(t, *a, **k)
+            c1 = time.process_time()
+            mark = c0 if self._bwd_mark is None else self._bwd_mark
+            self.sec["loss"] += mark - c0
+            self.sec["field"] += (c1 - mark) - (self.sec["raster_bwd"] - r0)
+            return None
+
+        patch(loop, "rasterization", rasterization)
+        patch(loop, "photometric_loss", self.wrap("loss", loop.photometric_loss))
+        patch(loop, "_abs_maxes", self.wrap("guard", loop._abs_maxes))
+        patch(loop, "_finite", self.wrap("guard", loop._finite))
+        for name in ("check_means", "check_loss", "check_params", "suspects"):
+            patch(DivergenceGuard, name, self.wrap("guard", getattr(DivergenceGuard, name)))
+        patch(fast, "backward", staticmethod(self.wrap("raster_bwd", fast.backward)))
+        patch(torch.Tensor, "backward", tensor_backward)
+        patch(torch.optim.Adam, "step", self.wrap("optimiser", torch.optim.Adam.step))
+        patch(torch.optim.Adam, "zero_grad", self.wrap("optimiser", torch.optim.Adam.zero_grad))
+        patch(model, "gaussians_at", self.wrap("field", model.gaussians_at))
+        patch(model, "canonical_state", self.wrap("field", model.canonical_state))
+        try:
+            yield self
+        finally:
+            for obj, name, old in reversed(saved):
+                if old is _MISSING:
+                    delattr(obj, name)
+                else:
+                    setattr(obj, name, old)
+
+    def _reached_image(self, grad):
+        self._bwd_mark = time.process_time()
+        return grad
+
+
+_MISSING = object()
+
+
+def time_model(
+    data, cfg: dict, model: str, config: str, iters: int
+) -> tuple[float, float, dict[str, float]]:
+    """(CPU seconds, wall seconds, CPU seconds by part of :data:`PARTS`) per deformation
+    iteration of the training loop: totals the best of three runs, parts from the run with the
+    least CPU time. CPU time (all threads of this process) is what a dedicated core would spend;
     on a shared machine it is far steadier than wall time."""
     tcfg = dict(cfg["train"], iterations=iters, warmup=0)
     conds = [0] if config == "single" else [0, 1, 2]
     m = build_model(model, data, cfg["models"], config=config, seed=cfg["seed"])
     train_model(m, data, dict(tcfg, iterations=1), conditions=conds, seed=0, progress=False)
-    cpu, wall = [], []
+    cpu, wall, parts = [], [], []
     for s in range(3):
-        c0, t0 = time.process_time(), time.perf_counter()
-        train_model(m, data, tcfg, conditions=conds, seed=s, progress=False)
-        cpu.append((time.process_time() - c0) / iters)
-        wall.append((time.perf_counter() - t0) / iters)
-    return float(np.min(cpu)), float(np.min(wall))
+        with Parts().patched(m) as p:
+            c0, t0 = time.process_time(), time.perf_counter()
+            train_model(m, data, tcfg, conditions=conds, seed=s, progress=False)
+            cpu.append((time.process_time() - c0) / iters)
+            wall.append((time.perf_counter() - t0) / iters)
+        by_part = {k: p.sec[k] / iters for k in PARTS if k != "other"}
+        by_part["other"] = cpu[-1] - sum(by_part.values())
+        parts.append(by_part)
+    best = int(np.argmin(cpu))
+    return cpu[best], float(np.min(wall)), parts[best]
 
 
 def rk4_cost(T: int, K: int = 96, reps: int = 20) -> tuple[float, float]:
@@ -104,28 +215,54 @@ def main() -> None:
     ap.add_argument("--iters", type=int, default=8, help="timed iterations per model")
     ap.add_argument("--threads", type=int, default=1, help="torch and numba threads")
     ap.add_argument("--trees", nargs="*", default=None)
+    ap.add_argument("--models", default=None, help="comma-separated model ids (default: all)")
+    ap.add_argument(
+        "--configfile",
+        action="append",
+        default=[],
+        help="YAML overlay merged into config/trees.yaml before the profile resolves (as "
+        "Snakemake's --configfile; config/float32.yaml on a CPU without native bf16)",
+    )
     args = ap.parse_args()
     torch.set_num_threads(args.threads)
     numba.set_num_threads(args.threads)
-    cfg = physgs.config.load("config/trees.yaml", args.profile)
+    with open("config/trees.yaml") as f:
+        raw = yaml.safe_load(f)
+    for overlay in args.configfile:
+        with open(overlay) as f:
+            raw = physgs.config.deep_merge(raw, yaml.safe_load(f))
+    cfg = physgs.config.load_workflow_config(raw, args.profile, source="config/trees.yaml")
     trees = args.trees or cfg["trees"]
     it_total, warm = cfg["train"]["iterations"], cfg["train"]["warmup"]
     jobs = training_jobs(cfg["models"]["configs"])
+    if args.models:
+        jobs = [j for j in jobs if j[0] in args.models.split(",")]
     print(
         f"profile {args.profile}: {cfg['testbed']['resolution']} px, {it_total} iterations "
         f"({warm} warm-up), {args.threads} thread(s) per job; CPU s/iter (wall s/iter)"
     )
     print(f"{'tree':<7} {'N':>6} " + " ".join(f"{m + '_' + c:>17}" for m, c in jobs))
     cpu_total = 0.0
+    breakdown = {}
     for tree in trees:
         data = tree_dataset(cfg, tree)
         t = {job: time_model(data, cfg, *job, args.iters) for job in jobs}
-        static = t[("static", "single")][0]
+        breakdown[tree] = t
+        static = t.get(("static", "single"), (0.0,))[0]
         cpu_total += sum(warm * static + (it_total - warm) * v[0] for v in t.values())
         print(
             f"{tree:<7} {data.canonical_xyz.shape[0]:>6} "
-            + " ".join(f"{t[j][0]:>8.3f} ({t[j][1]:>6.3f})" for j in jobs)
+            + " ".join(f"{t[j][0]:>8.3f} ({t[j][1]:>6.3f})" for j in jobs),
+            flush=True,
         )
+    print("\nCPU ms per iteration by part (the run with the least CPU time of three)")
+    print(f"{'tree':<7} {'model':<18} {'total':>7} " + " ".join(f"{p:>10}" for p in PARTS))
+    for tree, t in breakdown.items():
+        for (model, config), (cpu, _, parts) in t.items():
+            print(
+                f"{tree:<7} {model + '_' + config:<18} {1e3 * cpu:>7.1f} "
+                + " ".join(f"{1e3 * parts[p]:>10.1f}" for p in PARTS)
+            )
     print(
         f"implied training CPU time, {len(jobs)} jobs x {len(trees)} trees: "
         f"{cpu_total / 60:.1f} CPU-min -> about {cpu_total / 120:.1f} min wall on 2 idle cores "
