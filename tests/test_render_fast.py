@@ -46,6 +46,33 @@ def test_fast_matches_reference_float64(scene):
         )
 
 
+@pytest.mark.parametrize(
+    "n, spacing, label",
+    [
+        (600, 0.15, "pixel-sized"),  # tree-like: footprints of one to three rows (row trimming)
+        (60, 4.0, "tile-wide"),  # spans as wide as a tile (exp stepped across 16 pixels)
+    ],
+)
+def test_fast_matches_reference_across_footprint_sizes(n, spacing, label):
+    # The fast kernels trim each footprint to the rows its 1/255 contour reaches and step
+    # exp(-sigma / 2) along a row by multiplication; both must stay within 1e-12 of the float64
+    # reference (scaled by the largest value of each output), from sub-pixel to tile-wide spans.
+    means, quats, scales, opac, colors, cam, bg = random_scene(
+        n, 48, 40, seed=3, dtype=torch.float64, opacity_range=(0.05, 0.95)
+    )
+    scales = scales * spacing * torch.linspace(0.3, 3.0, n, dtype=torch.float64)[:, None] ** 0.5
+    scales[:, 0] *= 3.0  # elongated, rotated ellipses: row spans far from their box
+    scene = (means, quats, scales, opac, colors, cam, bg)
+    ref = render_with_grads("reference", scene, torch.float64)
+    fast = render_with_grads("fast", scene, torch.float64)
+    assert ref[1].max() > 0.5, label  # something is drawn
+    for name, a, b in zip(NAMES, ref, fast):
+        scale = max(1.0, a.abs().max().item())
+        np.testing.assert_allclose(
+            b.detach().numpy(), a.detach().numpy(), rtol=0, atol=1e-12 * scale, err_msg=name
+        )
+
+
 def test_float32_paths_close_to_float64_reference(scene):
     # float32 inputs go through float64 kernels: the fast path's only error is the final cast.
     scene32 = [x.float() if isinstance(x, torch.Tensor) else x for x in scene]

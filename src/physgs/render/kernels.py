@@ -72,34 +72,52 @@ def _footprint(o):  # pragma: no cover - compiled
 
 
 @nb.njit(cache=True, inline="always")
-def _row_span(ca, cb, cc, thr, mx, dy, lo, hi):  # pragma: no cover - compiled
+def _row_span(ca, cb, det, ica, thr, mx, dy, lo, hi):  # pragma: no cover - compiled
     """Pixel columns [x0, x1] of one row (offset dy px from the mean) where
-    ca dx^2 + 2 cb dx dy + cc dy^2 <= thr, clipped to [lo, hi]; x0 > x1 when empty."""
-    disc = ca * thr - (ca * cc - cb * cb) * dy * dy
+    ca dx^2 + 2 cb dx dy + cc dy^2 <= thr, clipped to [lo, hi]; x0 > x1 when empty.
+    det = ca cc - cb^2 and ica = 1 / ca are per-Gaussian (hoisted out of the row loop); the
+    span's rounding is absorbed by ROW_SPAN_TOL and the exact alpha test."""
+    disc = ca * thr - det * dy * dy
     if thr < 0.0 or disc < 0.0 or ca <= 0.0:
         return lo, lo - 1
     r = math.sqrt(disc)
-    c0 = mx - 0.5 + (-cb * dy - r) / ca
-    c1 = mx - 0.5 + (-cb * dy + r) / ca
+    c0 = mx - 0.5 + (-cb * dy - r) * ica
+    c1 = mx - 0.5 + (-cb * dy + r) * ica
     if not (c1 >= lo and c0 <= hi):  # also catches NaN
         return lo, lo - 1
     return max(lo, int(math.ceil(c0 - ROW_SPAN_TOL))), min(hi, int(math.floor(c1 + ROW_SPAN_TOL)))
 
 
 @nb.njit(cache=True, inline="always")
-def _row_gauss(ca, cb, cc, mx, dy, x0):  # pragma: no cover - compiled
-    """exp(-sigma / 2) at the first pixel x0 of a row (offset dy px from the mean) and the two
-    factors that step it one pixel right: (G, r, q) with G(x + 1) = G(x) r, r(x + 1) = r(x) q.
+def _rows(ca, det, thr, my, lo, hi):  # pragma: no cover - compiled
+    """Pixel rows [y0, y1] (clipped to [lo, hi]) that can hold a pixel of the contour
+    ca dx^2 + 2 cb dx dy + cc dy^2 <= thr: |dy| <= sqrt(thr ca / det) (where :func:`_row_span`'s
+    discriminant is >= 0), widened by ROW_SPAN_TOL px. Tighter than the axis-aligned pixel box,
+    which adds a pixel of slack on each side: for the trees' pixel-sized Gaussians it skips about
+    half the rows the box holds. Rows it keeps that have no pixel get an empty span."""
+    if thr < 0.0 or ca <= 0.0 or det <= 0.0:
+        return lo, lo - 1
+    e = math.sqrt(thr * ca / det) + ROW_SPAN_TOL
+    if not (e < 1e18):  # NaN or huge: every row of the tile
+        return lo, hi
+    return max(lo, int(math.ceil(my - 0.5 - e))), min(hi, int(math.floor(my - 0.5 + e)))
+
+
+@nb.njit(cache=True, inline="always")
+def _row_gauss(ca, cb, cc, mx, dy, x0, step):  # pragma: no cover - compiled
+    """exp(-sigma / 2) at the first pixel x0 of a row (offset dy px from the mean) and the factor
+    r that steps it one pixel right: G(x + 1) = G(x) r, r(x + 1) = r(x) exp(-ca).
 
     sigma(dx) = ca dx^2 + 2 cb dx dy + cc dy^2 is quadratic in dx, so the ratio of neighbouring
-    values is exp(-ca (dx + 1/2) - cb dy), itself a geometric sequence of ratio exp(-ca): three
-    exps per row instead of one per pixel. Within a span (at most one tile wide, inside the 1/255
-    contour) the product drifts by a few ulps per pixel, ~1e-14 relative, far below the 1e-12 the
-    fast path keeps to the reference. forward and backward step identically, so their alpha
-    tests agree bit for bit."""
+    values is exp(-ca (dx + 1/2) - cb dy), itself a geometric sequence of ratio exp(-ca)
+    (computed once per Gaussian): two exps per row instead of one per pixel. Within a span (at
+    most one tile wide, inside the 1/255 contour) the product drifts by a few ulps per pixel,
+    ~1e-14 relative, far below the 1e-12 the fast path keeps to the reference. forward and
+    backward step identically, so their alpha tests agree bit for bit."""
     dx = x0 + 0.5 - mx
     sigma = ca * dx * dx + 2.0 * cb * dx * dy + cc * dy * dy
-    return math.exp(-0.5 * sigma), math.exp(-ca * (dx + 0.5) - cb * dy), math.exp(-ca)
+    # a one-pixel span never steps: skip its second exp
+    return math.exp(-0.5 * sigma), math.exp(-ca * (dx + 0.5) - cb * dy) if step else 0.0
 
 
 @nb.njit(parallel=True, cache=True)
@@ -143,6 +161,7 @@ def forward(
         cacc = np.zeros((npix, D))
         dacc = np.zeros(npix)
         cnt = np.zeros(npix, np.int64)
+        col_g = np.empty(D)
         n_done = 0
         for k in range(tile_start[t], tile_start[t + 1]):
             if n_done == npix:
@@ -154,34 +173,41 @@ def forward(
             cb = conics[g, 1]
             cc = conics[g, 2]
             o = opac[g]
+            z = depths[g]
+            for c in range(D):  # a local copy: the compiler cannot hoist loads past cacc stores
+                col_g[c] = colors[g, c]
             thr = _footprint(o)
-            y0 = max(boxes[g, 2], ty0)
-            y1 = min(boxes[g, 3], ty0 + th - 1)
+            det = ca * cc - cb * cb
+            ica = 1.0 / ca if ca > 0.0 else 0.0
+            q = math.exp(-ca)
+            y0, y1 = _rows(ca, det, thr, my, max(boxes[g, 2], ty0), min(boxes[g, 3], ty0 + th - 1))
             for py in range(y0, y1 + 1):
                 dy = py + 0.5 - my
-                x0, x1 = _row_span(ca, cb, cc, thr, mx, dy, tx0, tx0 + tw - 1)
+                x0, x1 = _row_span(ca, cb, det, ica, thr, mx, dy, tx0, tx0 + tw - 1)
                 if x0 > x1:
                     continue
-                Gn, r, q = _row_gauss(ca, cb, cc, mx, dy, x0)
+                Gn, r = _row_gauss(ca, cb, cc, mx, dy, x0, x1 > x0)
+                base = (py - ty0) * tw - tx0  # pixel px of this row is tile-local base + px
                 for px in range(x0, x1 + 1):
                     G = Gn
                     Gn *= r
                     r *= q
-                    p = (py - ty0) * tw + (px - tx0)
+                    p = base + px
                     if done[p]:
                         continue
                     a = min(ALPHA_MAX, o * G)
                     if a < ALPHA_MIN:
                         continue
-                    nt = T[p] * (1.0 - a)
+                    Tp = T[p]
+                    nt = Tp * (1.0 - a)
                     if nt < T_MIN:
                         done[p] = True
                         n_done += 1
                         continue
-                    w = a * T[p]
+                    w = a * Tp
                     for c in range(D):
-                        cacc[p, c] += w * colors[g, c]
-                    dacc[p] += w * depths[g]
+                        cacc[p, c] += w * col_g[c]
+                    dacc[p] += w * z
                     cnt[p] += 1
                     T[p] = nt
         for ly in range(th):
@@ -237,24 +263,28 @@ def backward(
         npix = th * tw
         T = np.ones(npix)
         done = np.zeros(npix, np.bool_)
-        # tile-local copies: behind_c (colour still to come, background included), behind_d,
-        # upstream grads, and g_alpha * T_final (d alpha_out / d a_i = T_final / (1 - a_i))
-        behind_c = np.empty((npix, D))
+        # tile-local per-pixel state. The gradient of the loss w.r.t. Gaussian i's alpha at a
+        # pixel is T_i u_i - S_i / (1 - a_i), u_i = sum_c g_c c_i + g_z z_i (its colour and depth
+        # seen through the upstream gradients) and S_i = sum_c g_c behind_c + g_z behind_z -
+        # g_alpha T_final, behind = what lies behind i (later Gaussians plus background, from the
+        # forward totals minus the prefix up to i). One scalar S per pixel carries all channels.
         up_c = np.empty((npix, D))
-        behind_d = np.empty(npix)
         up_d = np.empty(npix)
-        up_a = np.empty(npix)
+        S = np.empty(npix)
         for ly in range(th):
             for lx in range(tw):
                 p = ly * tw + lx
                 tf = t_final[ty0 + ly, tx0 + lx]
+                acc = -g_alpha[ty0 + ly, tx0 + lx] * tf
                 for c in range(D):
-                    behind_c[p, c] = acc_c[ty0 + ly, tx0 + lx, c] + tf * bg[c]
-                    up_c[p, c] = g_rgb[ty0 + ly, tx0 + lx, c]
-                behind_d[p] = acc_d[ty0 + ly, tx0 + lx]
-                up_d[p] = g_depth[ty0 + ly, tx0 + lx]
-                up_a[p] = g_alpha[ty0 + ly, tx0 + lx] * tf
+                    gc = g_rgb[ty0 + ly, tx0 + lx, c]
+                    up_c[p, c] = gc
+                    acc += gc * (acc_c[ty0 + ly, tx0 + lx, c] + tf * bg[c])
+                gz = g_depth[ty0 + ly, tx0 + lx]
+                up_d[p] = gz
+                S[p] = acc + gz * acc_d[ty0 + ly, tx0 + lx]
         g_col = np.empty(D)
+        col_g = np.empty(D)
         n_done = 0
         for k in range(tile_start[t], tile_start[t + 1]):
             if n_done == npix:
@@ -267,7 +297,13 @@ def backward(
             cc = conics[g, 2]
             o = opac[g]
             z = depths[g]
+            for c in range(D):
+                col_g[c] = colors[g, c]
+                g_col[c] = 0.0
             thr = _footprint(o)
+            det = ca * cc - cb * cb
+            ica = 1.0 / ca if ca > 0.0 else 0.0
+            q = math.exp(-ca)
             g_mx = 0.0
             g_my = 0.0
             g_a = 0.0
@@ -275,23 +311,21 @@ def backward(
             g_c = 0.0
             g_o = 0.0
             g_z = 0.0
-            g_col[:] = 0.0
-            y0 = max(boxes[g, 2], ty0)
-            y1 = min(boxes[g, 3], ty0 + th - 1)
+            y0, y1 = _rows(ca, det, thr, my, max(boxes[g, 2], ty0), min(boxes[g, 3], ty0 + th - 1))
             for py in range(y0, y1 + 1):
                 dy = py + 0.5 - my
-                x0, x1 = _row_span(ca, cb, cc, thr, mx, dy, tx0, tx0 + tw - 1)
+                x0, x1 = _row_span(ca, cb, det, ica, thr, mx, dy, tx0, tx0 + tw - 1)
                 if x0 > x1:
                     continue
-                Gn, r, q = _row_gauss(ca, cb, cc, mx, dy, x0)
+                Gn, r = _row_gauss(ca, cb, cc, mx, dy, x0, x1 > x0)
+                base = (py - ty0) * tw - tx0
                 for px in range(x0, x1 + 1):
                     G = Gn
                     Gn *= r
                     r *= q
-                    p = (py - ty0) * tw + (px - tx0)
+                    p = base + px
                     if done[p]:
                         continue
-                    dx = px + 0.5 - mx
                     raw = o * G
                     a = min(ALPHA_MAX, raw)
                     if a < ALPHA_MIN:
@@ -303,20 +337,20 @@ def backward(
                         n_done += 1
                         continue
                     w = a * Tp
-                    inv = 1.0 / (1.0 - a)
-                    dlda = up_a[p] * inv
+                    u = up_d[p] * z
                     for c in range(D):
-                        col = colors[g, c]
-                        behind_c[p, c] -= w * col
-                        dlda += up_c[p, c] * (col * Tp - behind_c[p, c] * inv)
-                        g_col[c] += up_c[p, c] * w
-                    behind_d[p] -= w * z
-                    dlda += up_d[p] * (z * Tp - behind_d[p] * inv)
+                        gc = up_c[p, c]
+                        u += gc * col_g[c]
+                        g_col[c] += gc * w
                     g_z += up_d[p] * w
+                    Sp = S[p] - w * u
+                    S[p] = Sp
                     T[p] = nt
                     if raw <= ALPHA_MAX:  # the clamp passes no gradient above 0.99
+                        dlda = Tp * u - Sp / (1.0 - a)
                         g_o += dlda * G
                         ds = -0.5 * a * dlda  # dL/dsigma
+                        dx = px + 0.5 - mx
                         g_a += ds * dx * dx
                         g_b += ds * 2.0 * dx * dy
                         g_c += ds * dy * dy
