@@ -92,6 +92,27 @@ def test_float32_paths_close_to_float64_reference(scene):
         )
 
 
+@pytest.mark.parametrize("mode", ["no_grad", "inference_mode", "no input requires grad"])
+def test_forward_only_path_renders_the_same_and_keeps_no_graph(scene, mode):
+    # Evaluation renders without autograd: the fast path then skips the autograd Function (no
+    # node, no saved state) and must give the very same images as the differentiable call.
+    means, quats, scales, opac, colors, cam, bg = scene
+    params = [x.detach().requires_grad_(True) for x in (means, quats, scales, opac, colors)]
+    ref = rasterization(*params, cam, bg, backend="fast")
+    assert ref.rgb.grad_fn is not None
+    if mode == "no_grad":
+        with torch.no_grad():
+            out = rasterization(*params, cam, bg, backend="fast")
+    elif mode == "inference_mode":
+        with torch.inference_mode():
+            out = rasterization(*params, cam, bg, backend="fast")
+    else:
+        out = rasterization(*(p.detach() for p in params), cam, bg, backend="fast")
+    for a, b in zip((ref.rgb, ref.alpha, ref.depth), (out.rgb, out.alpha, out.depth)):
+        assert b.grad_fn is None and not b.requires_grad
+        assert torch.equal(a.detach(), b)
+
+
 def test_fast_is_deterministic():
     scene = random_scene(3000, 64, 64, seed=11, dtype=torch.float32)
     first = render_with_grads("fast", scene, torch.float32)

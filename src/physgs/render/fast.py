@@ -42,41 +42,44 @@ def camera_arrays(camera: Camera):
     )
 
 
+def _forward(means, quats, scales, opacities, colors, background, camera):
+    """Project, bin and composite: ((rgb [H, W, D], alpha [H, W], depth [H, W]) float64 numpy,
+    state) where state holds what the backward needs (float64 inputs, projection, tile lists,
+    per-pixel totals); a forward-only caller drops it."""
+    m, q, s, o, col, bg = (_np(x) for x in (means, quats, scales, opacities, colors, background))
+    n, D = col.shape
+    W, H = camera.width, camera.height
+    cam = camera_arrays(camera)
+    m2 = np.empty((n, 2))
+    con = np.empty((n, 3))
+    dep = np.empty(n)
+    cov = np.empty((n, 3))
+    valid = np.empty(n, np.bool_)
+    kernels.project_forward(m, q, s, *cam, camera.near, EPS2D, m2, con, dep, cov, valid)
+    boxes = pixel_bounds(m2, cov, o, valid, W, H)
+    touches = boxes[:, 0] <= boxes[:, 1]
+    order = np.argsort(np.where(touches, dep, np.inf), kind="stable")[: int(touches.sum())]
+    tiles_x = (W + TILE - 1) // TILE
+    tiles_y = (H + TILE - 1) // TILE
+    tile_start, pair_gid = kernels.bin_tiles(boxes, order.astype(np.int64), TILE, tiles_x, tiles_y)
+    rgb = np.empty((H, W, D))
+    alpha = np.empty((H, W))
+    depth = np.empty((H, W))
+    acc_c = np.empty((H, W, D))
+    acc_d = np.empty((H, W))
+    t_final = np.empty((H, W))
+    n_contrib = np.empty((H, W), np.int64)
+    comp = (m2, con, o, col, dep, bg, boxes, tile_start, pair_gid, TILE, tiles_x, W, H)
+    kernels.forward(*comp, rgb, alpha, depth, acc_c, acc_d, t_final, n_contrib)
+    return (rgb, alpha, depth), (m, q, s, cam, camera.near, valid, comp, acc_c, acc_d, t_final)
+
+
 class _FastRasterize(torch.autograd.Function):
     @staticmethod
     def forward(ctx, means, quats, scales, opacities, colors, background, camera):
-        m, q, s, o, col, bg = (
-            _np(x) for x in (means, quats, scales, opacities, colors, background)
-        )
-        n, D = col.shape
-        W, H = camera.width, camera.height
-        cam = camera_arrays(camera)
-        m2 = np.empty((n, 2))
-        con = np.empty((n, 3))
-        dep = np.empty(n)
-        cov = np.empty((n, 3))
-        valid = np.empty(n, np.bool_)
-        kernels.project_forward(m, q, s, *cam, camera.near, EPS2D, m2, con, dep, cov, valid)
-        boxes = pixel_bounds(m2, cov, o, valid, W, H)
-        touches = boxes[:, 0] <= boxes[:, 1]
-        order = np.argsort(np.where(touches, dep, np.inf), kind="stable")[: int(touches.sum())]
-        tiles_x = (W + TILE - 1) // TILE
-        tiles_y = (H + TILE - 1) // TILE
-        tile_start, pair_gid = kernels.bin_tiles(
-            boxes, order.astype(np.int64), TILE, tiles_x, tiles_y
-        )
-        rgb = np.empty((H, W, D))
-        alpha = np.empty((H, W))
-        depth = np.empty((H, W))
-        acc_c = np.empty((H, W, D))
-        acc_d = np.empty((H, W))
-        t_final = np.empty((H, W))
-        n_contrib = np.empty((H, W), np.int64)
-        comp = (m2, con, o, col, dep, bg, boxes, tile_start, pair_gid, TILE, tiles_x, W, H)
-        kernels.forward(*comp, rgb, alpha, depth, acc_c, acc_d, t_final, n_contrib)
-        ctx.saved = (m, q, s, cam, camera.near, valid, comp, acc_c, acc_d, t_final)
+        images, ctx.saved = _forward(means, quats, scales, opacities, colors, background, camera)
         ctx.like = torch.empty(0, dtype=means.dtype, device=means.device)
-        return tuple(_to_torch(x, means) for x in (rgb, alpha, depth))
+        return tuple(_to_torch(x, means) for x in images)
 
     @staticmethod
     def backward(ctx, g_rgb, g_alpha, g_depth):
@@ -134,8 +137,13 @@ def rasterize_fast(
 
     Returns (rgb [H, W, D], alpha [H, W], depth [H, W] or None). Tensors on another device are
     copied to the CPU and back. Arithmetic is float64 inside the kernels for any input dtype.
+    Forward only (no autograd node, no state kept for a backward) when autograd is off
+    (torch.no_grad, inference_mode) or no input requires a gradient, as in evaluation.
     """
-    rgb, alpha, depth = _FastRasterize.apply(
-        means, quats, scales, opacities, colors, background, camera
-    )
+    inputs = (means, quats, scales, opacities, colors, background)
+    if torch.is_grad_enabled() and any(x.requires_grad for x in inputs):
+        rgb, alpha, depth = _FastRasterize.apply(*inputs, camera)
+    else:
+        images, _ = _forward(*inputs, camera)
+        rgb, alpha, depth = (_to_torch(x, means) for x in images)
     return rgb, alpha, (depth if return_depth else None)
