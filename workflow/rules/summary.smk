@@ -7,7 +7,7 @@
 rule summary:
     input:
         claims="results/claims.csv",
-        tab_fit=expand(TABLE, name="tab_fit", ext="csv"),
+        tab_fit=TABLE.format(name="tab_fit", ext="csv"),
         run=RUN,
     output:
         report("results/summary.md", category="0. Summary"),
