@@ -22,7 +22,6 @@ import time
 from pathlib import Path
 
 import numpy as np
-import yaml
 
 import physgs.config
 from physgs.evaluate.run import training_camera_scores
@@ -30,15 +29,6 @@ from physgs.experiments import fit, job_spec
 from physgs.experiments.recipe import heldout_split
 from physgs.models.registry import is_reference
 from physgs.testbed.dataset import load_observed, load_truth
-
-
-def _set(cfg: dict, assignment: str) -> None:
-    key, _, value = assignment.partition("=")
-    node = cfg
-    *path, last = key.split(".")
-    for k in path:
-        node = node[k]
-    node[last] = yaml.safe_load(value)
 
 
 def main(argv: list[str] | None = None) -> None:
@@ -59,8 +49,8 @@ def main(argv: list[str] | None = None) -> None:
         for a in args.candidate:
             recipe_candidates.apply(a)
     cfg = physgs.config.load("config/trees.yaml", args.profile)
-    for a in args.set:
-        _set(cfg, a)
+    # the same schema and cross-key checks as the config: a bad --set stops here, key named
+    cfg = physgs.config.apply_overrides(cfg, args.set)
     obs = load_observed(args.dataset / "observed.npz")
     truth = load_truth(args.dataset / "truth.npz")
     n = int(obs.n_train)

@@ -333,6 +333,43 @@ def load(path: Path | str, profile: str | None = None) -> dict:
     return load_workflow_config(cfg, profile, source=str(path))
 
 
+_NUMBER_LIKE = re.compile(r"[+-]?(\d+\.?\d*|\.\d+)([eE][+-]?\d+)?")
+
+
+def apply_overrides(cfg: dict, assignments: list[str]) -> dict:
+    """A resolved config with ``KEY.PATH=VALUE`` overrides (a script's ``--set``) applied, then
+    validated against the schema and the cross-key checks exactly as the config is: an unknown key
+    or a value of the wrong type is refused with the key and the ``--set`` named, before any work.
+
+    VALUE is read as YAML, as the config file is (so ``1e6`` is the string '1e6', which a number
+    key refuses; the message says to write ``1.0e+6``)."""
+    out = copy.deepcopy(cfg)
+    for a in assignments:
+        key, eq, value = a.partition("=")
+        if not eq or not key.strip():
+            raise ConfigError(f"--set {a!r}: expected KEY.PATH=VALUE (e.g. train.iterations=300)")
+        *path, last = key.strip().split(".")
+        node = out
+        for i, k in enumerate(path):
+            if not isinstance(node.get(k), dict):
+                where = "/".join(path[: i + 1])
+                raise ConfigError(f"--set {a!r}: config key '{where}' is not a section")
+            node = node[k]
+        node[last] = yaml.safe_load(value)
+    source = "the --set overrides " + " ".join(assignments)
+    try:
+        validate(out, source=source)
+        check(out, source=source)
+    except ConfigError as err:
+        hints = [
+            f" ('{v}' is read as a string, as in YAML 1.1; write a number as 1.0e+6)"
+            for v in (a.partition("=")[2].strip() for a in assignments)
+            if _NUMBER_LIKE.fullmatch(v) and isinstance(yaml.safe_load(v), str)
+        ]
+        raise ConfigError(f"{err}{hints[0] if hints else ''}") from None
+    return out
+
+
 def study_seeds(cfg: dict) -> list[int]:
     """The training seeds the studies of the trade (speed-accuracy sweep, fit curve) run at:
     ``speed_accuracy.seeds`` of a resolved config ('first' = the first of ``seeds``, 'all' =
