@@ -52,3 +52,12 @@ rule all:
     input:
         RUN,
         rules.summary.output,
+
+
+# On SLURM, a request that no node of its partition can meet would wait PENDING for ever: every
+# job's threads, memory and run time are checked against `sinfo` before the first submission.
+onstart:
+    if workflow.executor_plugin is not None and workflow.executor_plugin.name == "slurm":
+        import physgs.cluster
+
+        physgs.cluster.check_jobs(workflow.dag.needrun_jobs())
