@@ -442,7 +442,9 @@ def test_snakefile_refuses_a_bad_override_in_seconds_and_writes_nothing(tmp_path
     assert r.returncode != 0
     assert "ConfigError" in out and "models/kselect/warmup" in out, out
     assert "profiles/quick/models/kselect/warmup" in out
-    assert wall < 20, f"took {wall:.1f} s"
+    # no job ran: a refused plan costs the config load, not a training (minutes); generous for a
+    # loaded shared machine (22 s measured under a load of ~4 on 2 cores)
+    assert wall < 60, f"took {wall:.1f} s"
     assert not (tmp_path / "results").exists()
 
 
