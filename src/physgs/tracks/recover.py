@@ -19,6 +19,7 @@ class TracksRecovery:
 
     record: RecoveryRecord
     no_estimate: np.ndarray
+    median_zeta: float  # over the parts with an estimate (a part without one keeps zeta_init)
 
     @property
     def n_no_estimate(self) -> int:
@@ -31,7 +32,7 @@ class TracksRecovery:
             "n_trusted": int(m.n_trusted),
             "median_rel_err": float(m.median_rel_err),
             "loglog_r2": float(m.loglog_r2),
-            "median_zeta": float(self.record.damping.median_zeta),
+            "median_zeta": self.median_zeta,
             "n_no_estimate": self.n_no_estimate,
             "no_estimate": self.no_estimate.tolist(),
         }
@@ -45,4 +46,6 @@ def recover_tracks(fit: TrackFit, osc: Oscillators, observed, truth) -> TracksRe
     )
     if np.any(rec.match.trusted & ~fit.estimated):  # theta = 0 correlates with nothing
         raise RuntimeError("a part with no estimate was matched as trusted; its theta is not 0")
-    return TracksRecovery(rec, np.flatnonzero(~fit.estimated))
+    zeta = np.asarray(fit.zeta, np.float64)[fit.estimated]
+    med = float(np.median(zeta)) if zeta.size else float("nan")
+    return TracksRecovery(rec, np.flatnonzero(~fit.estimated), med)
