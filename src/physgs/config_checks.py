@@ -147,6 +147,29 @@ def damping_benchmark_is_runnable(cfg: dict) -> Iterator[Problem]:
             )
 
 
+def parts_study_is_runnable(cfg: dict) -> Iterator[Problem]:
+    """The parts study's configurations are ours' configurations, and, where the damping
+    benchmark builds testbeds, among its configurations too (tab_parts sets each variant's damping
+    error beside ours' on the same configuration)."""
+    ps = cfg.get("parts_study") or {}
+    if not ps.get("models"):
+        return
+    db = cfg.get("damping_benchmark") or {}
+    for c in ps.get("configs", []):
+        if c not in cfg["models"]["configs"]:
+            yield (
+                ("parts_study", "configs"),
+                f"'{c}' is not one of models/configs {sorted(cfg['models']['configs'])}",
+            )
+        elif db.get("trees") and c not in db.get("configs", []):
+            yield (
+                ("parts_study", "configs"),
+                f"'{c}' is not one of damping_benchmark/configs {db.get('configs')}: tab_parts "
+                "compares each variant's damping error with ours' in the same configuration; "
+                "add it there or drop it here",
+            )
+
+
 #: The calm must last at least this many periods of the slowest band frequency (band_hz[0]) to
 #: show a free decay: over less, the slowest bones do not complete one oscillation.
 MIN_CALM_PERIODS = 1.0
@@ -469,6 +492,7 @@ CHECKS: list[Check] = [
     field_time_scales_valid,
     study_seeds_in_seeds,
     damping_benchmark_is_runnable,
+    parts_study_is_runnable,
     presets_reach_bone_counts,
 ]
 

@@ -28,6 +28,12 @@ STUDY_SEEDS = _config.study_seeds(CFG)  # the sweep's and the fit curve's seeds 
 TESTBED_SEEDS = bool(CFG["testbed_seeds"])
 CONFIGS = dict(CFG["models"]["configs"])  # name -> {conditions, K}
 TRAIN_JOBS = _models.training_jobs(CONFIGS)
+# the parts study (tab_parts, fig_parts): ours' variants with parts cut along the tree, on every
+# tree and on the damping benchmark's testbeds of those trees
+PARTS = CFG["parts_study"]
+PARTS_MODELS = list(PARTS["models"])
+PARTS_CONFIGS = {c: CONFIGS[c] for c in PARTS["configs"]} if PARTS_MODELS else {}
+PRIORS = ["ours", *PARTS_MODELS]  # every oscillator prior the run trains
 STAMP = _provenance.stamp(CFG)  # not a rerun trigger (see physgs.provenance.Stamp)
 
 # ---- file layout ------------------------------------------------------------------------------
@@ -44,7 +50,8 @@ LOSS = "results/models/{tree}/seed{seed}/{model}_{config}.loss.csv"
 EVAL = "results/eval/{tree}/seed{seed}/{model}_{config}.npz"
 TRAJ = "results/eval/{tree}/seed{seed}/{model}_{config}.traj.npz"
 PANELS = "results/eval/{tree}/seed{seed}/{model}_{config}.panels.npz"
-RECOVERY = "results/recovery/{tree}/seed{seed}/ours_{config}.json"
+RECOVERY = "results/recovery/{tree}/seed{seed}/{model}_{config}.json"  # any oscillator prior
+PARTS_RECORD = "results/parts/{tree}/seed{seed}.npz"  # the priors' segmentations and purity
 NULL = "results/recovery/{tree}/seed{seed}/null_K{K}.json"
 KSELECT = "results/kselect/{tree}/seed{seed}.json"
 SWEEP_POINT = "results/speed_accuracy/seed{seed}/{point}.json"
@@ -59,7 +66,9 @@ NEED_PATHS = {
     "traj": TRAJ,
     "panels": PANELS,
     "loss": LOSS,
-    "recovery": RECOVERY,
+    "recovery": RECOVERY.replace("{model}", "ours"),
+    "prior_recovery": RECOVERY,
+    "parts": PARTS_RECORD,
     "null": NULL,
     "kselect": KSELECT,
     "stats": STATS,
@@ -74,7 +83,7 @@ FC_PROFILE_MODELS = ["static", *FC["models"], *_models.REFERENCE_NAMES]
 
 wildcard_constraints:
     tree="|".join(TESTBEDS),
-    model="|".join([*_models.MODEL_NAMES, *_models.REFERENCE_NAMES]),
+    model="|".join([*_models.MODEL_NAMES, *_models.PRIOR_VARIANT_NAMES, *_models.REFERENCE_NAMES]),
     config="|".join([*CONFIGS, _models.AUTO_CONFIG]),
     K=r"\d+",
     point="|".join(SWEEP_POINTS),
@@ -136,6 +145,17 @@ def report_inputs(wildcards):
     """need key -> path of every file table or figure ``name`` reads."""
     if wildcards.name == "tab_damping":
         return need_paths(_build.damping_needs(DAMPING["trees"], DAMPING["configs"], SEEDS))
+    if wildcards.name in _build.PARTS_OUTPUTS:
+        return need_paths(
+            _build.parts_needs(
+                wildcards.name,
+                TREES,
+                [t for t in DAMPING["trees"] if t in TREES],
+                PARTS_MODELS,
+                PARTS_CONFIGS,
+                SEEDS,
+            )
+        )
     return need_paths(_build.needs(wildcards.name, TREES, CONFIGS, SEEDS))
 
 
@@ -239,6 +259,29 @@ def testbed_params(wildcards):
             "tree": t,
         }
     )
+
+
+def parts_inputs(wildcards):
+    """The truth and each prior's checkpoint in the base configuration (keys: the model ids)."""
+    out = {"truth": truth_input(wildcards)}
+    for m in PRIORS:
+        out[m] = CKPT.format(
+            tree=wildcards.tree, seed=wildcards.seed, model=m, config=_models.BASE_CONFIG
+        )
+    return out
+
+
+def parts_jobs():
+    """Checkpoints of the parts study's variants: every tree and damping testbed, seed and
+    configuration of the study (what `all` trains beyond the methods)."""
+    trees = [*TREES, *[_variant.damping_id(t) for t in DAMPING["trees"] if t in TREES]]
+    return [
+        CKPT.format(tree=t, seed=s, model=m, config=c)
+        for t in trees
+        for s in SEEDS
+        for m in PARTS_MODELS
+        for c in PARTS_CONFIGS
+    ]
 
 
 def recovery_damping_params(wildcards):

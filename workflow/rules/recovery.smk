@@ -1,18 +1,21 @@
-# Recovery (SPEC section 4): match ours' parts to bones by trajectory, against an untrained null.
+# Recovery (SPEC section 4): match an oscillator prior's parts to bones by trajectory (ours and the
+# parts study's variants), against an untrained null.
 # The null control is keyed by K and seed: configurations sharing a K share one null, and each
 # training seed draws its own (paired with that seed's trained model in tab_null).
 
 
 rule recovery:
     input:
-        ckpt=CKPT.replace("{model}", "ours"),
+        ckpt=CKPT,
         observed=observed_input,
         truth=truth_input,
         stats=stats_input,
     output:
         record=RECOVERY,
     log:
-        "logs/recovery/{tree}/seed{seed}/ours_{config}.log",
+        "logs/recovery/{tree}/seed{seed}/{model}_{config}.log",
+    wildcard_constraints:
+        model="|".join(["ours", *_models.PRIOR_VARIANT_NAMES]),
     conda:
         "../envs/physgs.yaml"
     threads: 1
@@ -44,3 +47,24 @@ rule null_control:
         null=null_params,
     script:
         "../scripts/null_control.py"
+
+
+# The parts study's check of the segmentations against the bones (reads truth.npz): each prior's
+# parts in the base configuration, their purity, pivots and parent links (tab_parts, fig_parts).
+rule parts_segmentation:
+    input:
+        unpack(parts_inputs),
+    output:
+        record=PARTS_RECORD,
+    log:
+        "logs/parts/{tree}/seed{seed}.log",
+    conda:
+        "../envs/physgs.yaml"
+    threads: 1
+    resources:
+        mem_mb=2000,
+        runtime=10,
+    params:
+        models=PRIORS,
+    script:
+        "../scripts/parts_segmentation.py"

@@ -54,17 +54,28 @@ rule report:
             name=[
                 n
                 for n in _build.TABLES
-                if n != "tab_kselect" and (n != "tab_damping" or DAMPING["trees"])
+                if n != "tab_kselect"
+                and (n != "tab_damping" or DAMPING["trees"])
+                and (n not in _build.PARTS_OUTPUTS or PARTS_MODELS)
             ],
         ),
-        expand(FIGURE, name=_build.FIGURES, ext=("pdf", "png")),
+        expand(
+            FIGURE,
+            name=[f for f in _build.FIGURES if f not in _build.PARTS_OUTPUTS or PARTS_MODELS],
+            ext=("pdf", "png"),
+        ),
+        parts_jobs(),
 
 
 # The claims ledger: every quantitative claim of the paper with its measured value, seed
 # interval and a verdict computed by code (physgs.report.claims).
 rule claims:
     input:
-        unpack(lambda wc: need_paths(_build.claims_needs(TREES, CONFIGS, SEEDS))),
+        unpack(
+            lambda wc: need_paths(
+                _build.claims_needs(TREES, CONFIGS, SEEDS, parts=bool(PARTS_MODELS))
+            )
+        ),
     output:
         md=report("results/claims.md", category="5. Claims"),
         csv="results/claims.csv",

@@ -15,7 +15,8 @@ rule train:
     benchmark:
         "results/benchmarks/train/{tree}/seed{seed}/{model}_{config}.tsv"
     wildcard_constraints:
-        model="|".join(_models.MODEL_NAMES),  # methods; the reference has its own rule
+        # methods and the parts study's prior variants; the reference has its own rule
+        model="|".join([*_models.MODEL_NAMES, *_models.PRIOR_VARIANT_NAMES]),
         config="|".join(CONFIGS),  # ours_auto has its own rule (kselect.smk)
     conda:
         "../envs/physgs.yaml"

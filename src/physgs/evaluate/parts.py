@@ -44,3 +44,49 @@ def part_purity(labels: np.ndarray, bone: np.ndarray) -> Purity:
         raise ValueError(f"part labels must cover [0, K = {K}) with no empty part")
     top = counts.max(1)
     return Purity(top / size, counts.argmax(1), size, float(top.sum() / labels.size))
+
+
+def segmentation_record(models, bone: np.ndarray) -> dict[str, np.ndarray]:
+    """Arrays of one tree's parts record: each trained prior's segmentation and its purity.
+
+    models: {model id: trained oscillator prior} (their ``part_labels`` [N], ``pivot`` [K, 3]
+    world units, ``part_parent`` [K] for topology parts, all on the same canonical Gaussians);
+    bone [N]: each Gaussian's bone (``gaussian_bone``). Keys: ``models`` [M] ids, ``xyz`` [N, 3]
+    canonical positions, ``bone`` [N], and per model ``<id>/labels`` [N], ``<id>/parent`` [K]
+    (-1 where a part has no parent: every part of k-means), ``<id>/pivots`` [K, 3],
+    ``<id>/purity`` [K], ``<id>/majority_bone`` [K], ``<id>/size`` [K], ``<id>/overall`` [].
+    """
+    bone = np.asarray(bone, dtype=np.int64)
+    out: dict[str, np.ndarray] = {"models": np.asarray(list(models), dtype=str), "bone": bone}
+    for name, m in models.items():
+        labels = m.part_labels.cpu().numpy().astype(np.int64)
+        if labels.shape != bone.shape:
+            raise ValueError(f"{name}: {labels.shape[0]} part labels for {bone.shape[0]} Gaussians")
+        K = int(m.K)
+        parent = getattr(m, "part_parent", None)
+        pur = part_purity(labels, bone)
+        out.setdefault("xyz", np.asarray(m.ctx.canonical_xyz, dtype=np.float64))
+        out[f"{name}/labels"] = labels
+        out[f"{name}/parent"] = (
+            np.full(K, -1, np.int64) if parent is None else parent.cpu().numpy().astype(np.int64)
+        )
+        out[f"{name}/pivots"] = m.pivot.detach().cpu().numpy().astype(np.float64)
+        out[f"{name}/purity"] = pur.per_part
+        out[f"{name}/majority_bone"] = pur.majority_bone
+        out[f"{name}/size"] = pur.size
+        out[f"{name}/overall"] = np.float64(pur.overall)
+    return out
+
+
+def save_segmentations(path, record: dict[str, np.ndarray]) -> None:
+    """Write a ``segmentation_record`` atomically as .npz."""
+    from physgs.atomic import atomic_path
+
+    with atomic_path(path) as tmp, open(tmp, "wb") as f:
+        np.savez_compressed(f, **record)
+
+
+def load_segmentations(path) -> dict[str, np.ndarray]:
+    """The arrays of a parts record written by ``save_segmentations``."""
+    with np.load(path, allow_pickle=False) as z:
+        return {k: z[k] for k in z.files}

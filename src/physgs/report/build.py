@@ -37,15 +37,18 @@ TABLES = (
     "tab_kselect",
     "tab_fit",
     "tab_damping",
+    "tab_parts",
 )
-FIGURES = ("fig_temporal", "fig_teaser", "fig_results", "fig_damping")
+FIGURES = ("fig_temporal", "fig_teaser", "fig_results", "fig_damping", "fig_parts")
 #: The fields of each need tuple after its kind (what a workflow path template is formatted with).
 NEED_FIELDS = {
     "eval": ("tree", "model", "config", "seed"),
     "traj": ("tree", "model", "config", "seed"),
     "panels": ("tree", "model", "config", "seed"),
     "loss": ("tree", "model", "config", "seed"),
-    "recovery": ("tree", "config", "seed"),
+    "recovery": ("tree", "config", "seed"),  # ours'
+    "prior_recovery": ("tree", "model", "config", "seed"),  # any oscillator prior's
+    "parts": ("tree", "seed"),  # the priors' segmentations (physgs.evaluate.parts)
     "null": ("tree", "K", "seed"),
     "kselect": ("tree", "seed"),
     "stats": ("tree",),
@@ -53,7 +56,9 @@ NEED_FIELDS = {
 }
 #: Figures that show one training seed (qualitative: images, trajectories, a damping scatter);
 #: they show the first seed listed.
-ONE_SEED_FIGURES = ("fig_teaser", "fig_results", "fig_damping")
+ONE_SEED_FIGURES = ("fig_teaser", "fig_results", "fig_damping", "fig_parts")
+#: Outputs of the parts study (``parts_needs``), built only when it trains a variant.
+PARTS_OUTPUTS = ("tab_parts", "fig_parts")
 #: Tables the claims ledger reads (their CSVs), and the configuration whose damping it reads.
 CLAIMS_TABLES = ("tab_psnr", "tab_transfer", "tab_margin", "tab_null", "tab_testbed", "tab_fit")
 CLAIMS_CONFIG = "joint32"
@@ -67,7 +72,10 @@ NEEDS_MODELS = {
     "fig_results": MODEL_NAMES,
     "tab_fit": (*MODEL_NAMES, *REFERENCE_NAMES),
 }
-KSELECT_ROWS = tuple(c for c, _ in kselect.ROWS)  # fixed K (single), chosen K (auto)
+KSELECT_ROWS = tuple(c for c, _ in kselect.ROWS)
+#: The prior every variant of the parts study is set beside, and the rows its fit fraction needs.
+BASELINE_PRIOR = "ours"
+FIT_FRAME = ("static", REFERENCE_NAMES[0])  # fixed K (single), chosen K (auto)
 
 
 def key(need: tuple) -> str:
@@ -91,16 +99,54 @@ def damping_needs(
     ]
 
 
+def parts_needs(
+    name: str,
+    trees: Sequence[str],
+    damping_trees: Sequence[str],
+    models: Sequence[str],
+    configs: Mapping[str, dict],
+    seeds: Sequence[int],
+) -> list[tuple]:
+    """What tab_parts or fig_parts reads. models: the parts study's variants (ours is added
+    first); configs: its configurations (name -> {K, ...}); damping_trees: the trees (of
+    ``trees``) also built as damping testbeds, where each prior's damping is scored. tab_parts:
+    every prior's evaluation, loss log and recovery on each tree (and damping testbed), the
+    null of each K, the static pose's and the ceiling's fit, and the segmentation record;
+    fig_parts: the segmentation records of the first seed."""
+    from physgs.testbed.variant import damping_id
+
+    priors = [BASELINE_PRIOR, *models]
+    if name == "fig_parts":
+        return [("parts", t, int(seeds[0])) for t in trees]
+    if name != "tab_parts":
+        raise ValueError(f"parts_needs: {name!r} is not one of {PARTS_OUTPUTS}")
+    out = []
+    for s in (int(x) for x in seeds):
+        for t in trees:
+            out += [(k, t, m, BASE_CONFIG, s) for m in FIT_FRAME for k in ("eval", "loss")]
+            for c in configs:
+                for m in priors:
+                    out += [(k, t, m, c, s) for k in ("eval", "loss", "prior_recovery")]
+                    if t in damping_trees:
+                        out.append(("prior_recovery", damping_id(t), m, c, s))
+            out += list(dict.fromkeys(("null", t, int(configs[c]["K"]), s) for c in configs))
+            out.append(("parts", t, s))
+    return out
+
+
 def claims_needs(
-    trees: Sequence[str], configs: Mapping[str, dict], seeds: Sequence[int]
+    trees: Sequence[str], configs: Mapping[str, dict], seeds: Sequence[int], parts: bool = False
 ) -> list[tuple]:
     """What the claims ledger reads: the tables' CSVs and ours' recovery (damping) of every seed
     in the joint K=32 configuration (the paper's), or the base configuration when the config
-    has none."""
+    has none; with ``parts``, tab_parts too (the parts study's hypotheses)."""
     c = CLAIMS_CONFIG if CLAIMS_CONFIG in configs else BASE_CONFIG
-    return [("table", n) for n in CLAIMS_TABLES] + [
-        ("recovery", t, c, int(s)) for t in trees for s in seeds
-    ]
+    extra = [("table", "tab_parts")] if parts else []
+    return (
+        [("table", n) for n in CLAIMS_TABLES]
+        + extra
+        + [("recovery", t, c, int(s)) for t in trees for s in seeds]
+    )
 
 
 def make_claims(inputs: Mapping[str, str], trees: Sequence[str], md_path, csv_path, stamp=None):
@@ -109,7 +155,8 @@ def make_claims(inputs: Mapping[str, str], trees: Sequence[str], md_path, csv_pa
     from physgs.atomic import atomic_path, write_text
     from physgs.report import claims
 
-    tabs = {n: pd.read_csv(inputs[key(("table", n))]) for n in CLAIMS_TABLES}
+    optional = [n for n in ("tab_parts",) if key(("table", n)) in inputs]
+    tabs = {n: pd.read_csv(inputs[key(("table", n))]) for n in (*CLAIMS_TABLES, *optional)}
     damping: dict[str, list] = {}
     for k, p in sorted(inputs.items()):  # recovery/<tree>/<config>/<seed>: one entry per seed
         if k.startswith("recovery/"):
@@ -142,6 +189,8 @@ def needs(
         raise ValueError(f"unknown output '{name}'; choose one of {TABLES + FIGURES}")
     if name == "tab_damping":
         raise ValueError("tab_damping reads the damping benchmark's testbeds: use damping_needs")
+    if name in PARTS_OUTPUTS:
+        raise ValueError(f"{name} reads the parts study's priors: use parts_needs")
     if not seeds:
         raise ValueError("needs: no training seeds given")
     seeds = [int(seeds[0])] if name in ONE_SEED_FIGURES else [int(s) for s in seeds]
@@ -203,6 +252,16 @@ def settings_for(name: str, cfg: dict) -> dict:
         out["zeta"] = float(cfg["testbed"]["zeta"])
     if name == "tab_kselect":
         out["method"] = cfg["models"]["kselect"]["method"]
+    if name in PARTS_OUTPUTS:
+        out["models"] = [BASELINE_PRIOR, *cfg["parts_study"]["models"]]
+    if name == "tab_parts":
+        out["configs"] = {
+            c: config_label(c, cfg["models"]["configs"][c]) for c in cfg["parts_study"]["configs"]
+        }
+        out["K"] = {c: int(cfg["models"]["configs"][c]["K"]) for c in cfg["parts_study"]["configs"]}
+        out["damping_trees"] = [t for t in cfg["damping_benchmark"]["trees"] if t in cfg["trees"]]
+        out["n_train"] = int(cfg["testbed"]["n_train"])
+        out["holdout_every"] = int(cfg["train"]["holdout_every"])
     return out
 
 
@@ -344,6 +403,8 @@ def make_table(
             for s in seeds
         }
         table = tab_damping(rows, trees, bones, settings["configs"], digits=d)
+    elif name == "tab_parts":
+        table = _tab_parts(path, settings, trees, bones, seeds, d)
     elif name == "tab_kselect":
         rows = {}
         for s in seeds:
@@ -367,6 +428,44 @@ def make_table(
         raise ValueError(f"unknown table '{name}'; choose one of {TABLES}")
     tables.write_table(table, tex_path, csv_path, stamp=stamp)
     return table
+
+
+def _tab_parts(path, settings, trees, bones, seeds, digits) -> Table:
+    from physgs.evaluate.parts import load_segmentations
+    from physgs.report import parts
+    from physgs.testbed.variant import damping_id
+
+    models, configs = settings["models"], settings["configs"]
+    n, every = int(settings["n_train"]), int(settings["holdout_every"])
+    rows: dict[int, dict] = {}
+    for s in seeds:
+        rows[s] = {}
+        for t in trees:
+            frame = {
+                m: fit_row(
+                    path("eval", t, m, BASE_CONFIG, s), path("loss", t, m, BASE_CONFIG, s), n, every
+                )
+                for m in FIT_FRAME
+            }
+            seg = load_segmentations(path("parts", t, s))
+            for c in configs:
+                null = load_null(path("null", t, int(settings["K"][c]), s))
+                for m in models:
+                    damp = (
+                        load_recovery(path("prior_recovery", damping_id(t), m, c, s))
+                        if t in settings["damping_trees"]
+                        else None
+                    )
+                    rows[s][(t, m, c)] = parts.row(
+                        fit_row(path("eval", t, m, c, s), path("loss", t, m, c, s), n, every),
+                        frame["static"]["fit"],
+                        frame[FIT_FRAME[1]]["fit"],
+                        load_recovery(path("prior_recovery", t, m, c, s)),
+                        null,
+                        damp,
+                        purity=float(seg[f"{m}/overall"]) if c == BASE_CONFIG else float("nan"),
+                    )
+    return parts.tab_parts(rows, trees, bones, models, configs, digits=digits)
 
 
 def _teaser_tree(trees: Sequence[str]) -> str:
@@ -426,5 +525,11 @@ def make_figure(
             for c in configs
         }
         figures.fig_damping(damping, trees, configs, float(settings["zeta"]), outputs)
+    elif name == "fig_parts":
+        from physgs.evaluate.parts import load_segmentations
+        from physgs.report.parts import fig_parts
+
+        recs = {t: load_segmentations(path("parts", t, s0)) for t in trees}
+        fig_parts(recs, trees, outputs, title=f"parts of each prior (single), training seed {s0}")
     else:
         raise ValueError(f"unknown figure '{name}'; choose one of {FIGURES}")

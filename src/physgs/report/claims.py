@@ -123,7 +123,7 @@ def measure(
     trees: Sequence[str],
 ) -> list[tuple[Claim, list[float]]]:
     """Every claim with its per-seed values, from the tables' CSVs (tab_psnr, tab_transfer,
-    tab_margin, tab_null, tab_testbed and, when given, tab_fit) and ours' damping summaries (tree -> median_zeta,
+    tab_margin, tab_null, tab_testbed and, when given, tab_fit and tab_parts) and ours' damping summaries (tree -> median_zeta,
     loglog_exponent, zeta_true, for the joint K=32 configuration)."""
     out: list[tuple[Claim, list[float]]] = []
 
@@ -342,6 +342,9 @@ def measure(
             lambda d, cell=cell: float(max(cell(d)[m] for m in LEARNED) - cell(d)["static"]),
         )
 
+    if "tab_parts" in tables:
+        out += _parts_claims(tables["tab_parts"], trees)
+
     mg = tables["tab_margin"]
     cols = [c for c in mg.columns if c.startswith("margin_")]
     for t in trees:
@@ -360,6 +363,62 @@ def measure(
             lambda d, t=t: float(
                 d.loc[d["tree"] == t, cols[-1]].iloc[0] - d.loc[d["tree"] == t, cols[0]].iloc[0]
             ),
+        )
+    return out
+
+
+def _parts_claims(df: pd.DataFrame, trees: Sequence[str]) -> list[tuple[Claim, list[float]]]:
+    """The paper's two hypotheses about its prior (section 6), from tab_parts: topology-aware
+    parts reduce the damping error (per tree with a damping testbed), and parent-child coupling
+    lifts the sparse tree's fit. Each compares two priors paired per seed in the study's first
+    configuration."""
+    out: list[tuple[Claim, list[float]]] = []
+    models, c0 = set(df["model"]), df["config"].iloc[0]
+
+    def value(d, t, m, col):
+        return float(d.loc[(d["tree"] == t) & (d["model"] == m) & (d["config"] == c0), col].iloc[0])
+
+    if "ours_topo" in models:
+        for t in trees:
+            if not np.isfinite(df.loc[df["tree"] == t, "zeta_rel_err_pct"]).any():
+                continue  # no damping testbed for this tree
+            out.append(
+                (
+                    Claim(
+                        f"topology_parts_reduce_damping_error/{t}",
+                        f"{t}: topology-aware parts reduce the damping error (damping testbed)",
+                        "hypothesis (k-means parts 'plausibly feed the damping bias')",
+                        f"tab_parts ({c0}): median rel. err. of zeta, topology - k-means parts",
+                        0.0,
+                        "<",
+                        "pp",
+                    ),
+                    [
+                        value(d, t, "ours_topo", "zeta_rel_err_pct")
+                        - value(d, t, "ours", "zeta_rel_err_pct")
+                        for d in _per_seed(df)
+                    ],
+                )
+            )
+    if {"ours_topo", "ours_chain"} <= models and "sparse" in trees:
+        out.append(
+            (
+                Claim(
+                    "coupling_lifts_sparse_fit",
+                    "sparse: parent-child coupling lifts the in-window fit",
+                    "hypothesis (independent parts 'represent no coupling')",
+                    f"tab_parts ({c0}): fraction of the ceiling's gain, chained - independent "
+                    "topology parts",
+                    0.0,
+                    ">",
+                    "fraction",
+                ),
+                [
+                    value(d, "sparse", "ours_chain", "ceiling_frac")
+                    - value(d, "sparse", "ours_topo", "ceiling_frac")
+                    for d in _per_seed(df)
+                ],
+            )
         )
     return out
 
