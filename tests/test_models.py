@@ -212,3 +212,26 @@ def test_field_time_encoding_puts_its_top_band_at_the_named_frequency(name, top_
     window_s = (ctx.n_train - 1) / ctx.fps
     f_hz = 2.0 ** (bands - 2) / window_s if top_hz == "window" else top_hz
     np.testing.assert_allclose(got, np.sin(2 * np.pi * f_hz * frames / FPS), atol=2e-5)
+
+
+@pytest.mark.parametrize(
+    "family, edited, kept", [("mlp", "mlp_wind", "mlp"), ("d3dgs", "d3dgs", "d3dgs_wind")]
+)
+def test_a_fields_time_scale_edit_leaves_its_sibling_field_up_to_date(family, edited, kept):
+    import copy
+
+    from physgs.experiments.recipe import job_spec
+    from oracles import quick_config
+
+    cfg = quick_config()
+    before = {m: job_spec(cfg, m, "single", seed=0) for m in (edited, kept)}
+    cfg2 = copy.deepcopy(cfg)
+    cfg2["models"][family]["time_top_hz"][edited] = 2.5
+    assert job_spec(cfg2, kept, "single", seed=0) == before[kept]
+    after = job_spec(cfg2, edited, "single", seed=0)
+    assert after != before[edited]
+    assert after["settings"][family]["time_top_hz"] == {edited: 2.5}
+    # the narrowed settings still build the field with its own time scale
+    ctx, _ = model_context(50, seed=0, lead_in=10)
+    field = build_model(edited, ctx, after["settings"])
+    assert field.time_top_hz == 2.5

@@ -157,3 +157,49 @@ def test_ledger_frame_is_a_dataframe_with_the_parts_claims():
     ).df
     led = claims.ledger(claims._parts_claims(df, ["sparse"]))
     assert isinstance(led, pd.DataFrame) and len(led) == 2
+
+
+def test_matched_k_is_the_smallest_k_within_the_tie():
+    from physgs.experiments.kmatch import matched_k
+
+    held = {4: 20.0, 8: 21.95, 16: 22.3, 32: 22.4}
+    assert matched_k(held, 22.0, 0.1) == 8  # 21.95 >= 21.9
+    assert matched_k(held, 22.4, 0.05) == 32
+    assert matched_k(held, 23.0, 0.1) is None
+    assert matched_k({4: float("nan"), 8: 22.0}, 22.0, 0.0) == 8
+
+
+def test_tab_parts_k_rows_and_matched_k_per_seed():
+    from physgs.report.parts import tab_parts_k
+
+    per_seed = {
+        0: {"sparse": {"ours": 25.0, "chain": {4: 24.0, 8: 24.95, 32: 25.5}}},
+        1: {"sparse": {"ours": 25.0, "chain": {4: 23.0, 8: 24.5, 32: 24.0}}},
+    }
+    t = tab_parts_k(per_seed, ["sparse"], {"sparse": 22}, 32, 0.1)
+    df = t.df
+    assert len(df) == 2 * 4
+    assert df.loc[df.seed == 0, "matched_k"].unique().tolist() == [8.0]
+    assert np.isnan(df.loc[df.seed == 1, "matched_k"]).all()  # no K within 0.1 dB of 25.0
+    assert "8, --" in t.tex
+    row = df[(df.seed == 1) & (df.model == "ours_chain") & (df.K == 8)].iloc[0]
+    assert row.heldout_psnr_db == 24.5
+
+
+def test_kmatch_point_job_keeps_the_chained_job_but_k():
+    from physgs.experiments.kmatch import point_job
+    from physgs.experiments.recipe import job_spec
+    from oracles import quick_config
+
+    job = job_spec(quick_config(), "ours_chain", "single", seed=2)
+    pj = point_job(job, 8)
+    assert pj["K"] == 8 and {k: v for k, v in pj.items() if k != "K"} == {
+        k: v for k, v in job.items() if k != "K"
+    }
+
+
+def test_k_candidates_must_be_below_the_base_k_and_train_the_chain():
+    msg = _refused(lambda c: c["parts_study"].update(k_candidates=[8, 32]))
+    assert "parts_study/k_candidates/1" in msg and "not below" in msg
+    msg = _refused(lambda c: c["parts_study"].update(models=["ours_topo"]))
+    assert "parts_study/k_candidates" in msg and "ours_chain" in msg

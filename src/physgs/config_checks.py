@@ -168,6 +168,21 @@ def parts_study_is_runnable(cfg: dict) -> Iterator[Problem]:
                 "compares each variant's damping error with ours' in the same configuration; "
                 "add it there or drop it here",
             )
+    single = cfg["models"]["configs"].get("single")
+    for i, k in enumerate(ps.get("k_candidates", [])):
+        if "ours_chain" not in ps["models"]:
+            yield (
+                ("parts_study", "k_candidates"),
+                "the K candidates train ours_chain, which parts_study/models does not list; "
+                "add it there or set k_candidates: []",
+            )
+            break
+        if single is not None and int(k) >= int(single["K"]):
+            yield (
+                ("parts_study", "k_candidates", i),
+                f"K = {k} is not below models/configs/single/K = {single['K']}, where the "
+                "chained prior is the pipeline's own ours_chain job; list only smaller K",
+            )
 
 
 #: The calm must last at least this many periods of the slowest band frequency (band_hz[0]) to

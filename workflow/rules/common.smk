@@ -4,6 +4,7 @@ import os
 
 import physgs.config as _config
 import physgs.experiments.fit_curve as _fit_curve
+import physgs.experiments.kmatch as _kmatch
 import physgs.experiments.kselect as _kselect
 import physgs.experiments.sweep as _sweep
 import physgs.models.registry as _models
@@ -52,6 +53,7 @@ TRAJ = "results/eval/{tree}/seed{seed}/{model}_{config}.traj.npz"
 PANELS = "results/eval/{tree}/seed{seed}/{model}_{config}.panels.npz"
 RECOVERY = "results/recovery/{tree}/seed{seed}/{model}_{config}.json"  # any oscillator prior
 PARTS_RECORD = "results/parts/{tree}/seed{seed}.npz"  # the priors' segmentations and purity
+KMATCH = "results/parts/{tree}/seed{seed}_chain_K{K}.json"  # the chained prior at a smaller K
 NULL = "results/recovery/{tree}/seed{seed}/null_K{K}.json"
 KSELECT = "results/kselect/{tree}/seed{seed}.json"
 SWEEP_POINT = "results/speed_accuracy/seed{seed}/{point}.json"
@@ -69,6 +71,7 @@ NEED_PATHS = {
     "recovery": RECOVERY.replace("{model}", "ours"),
     "prior_recovery": RECOVERY,
     "parts": PARTS_RECORD,
+    "kmatch": KMATCH,
     "null": NULL,
     "kselect": KSELECT,
     "stats": STATS,
@@ -145,6 +148,8 @@ def report_inputs(wildcards):
     """need key -> path of every file table or figure ``name`` reads."""
     if wildcards.name == "tab_damping":
         return need_paths(_build.damping_needs(DAMPING["trees"], DAMPING["configs"], SEEDS))
+    if wildcards.name == "tab_parts_k":
+        return need_paths(_build.kmatch_needs(TREES, PARTS["k_candidates"], STUDY_SEEDS))
     if wildcards.name in _build.PARTS_OUTPUTS:
         return need_paths(
             _build.parts_needs(
@@ -282,6 +287,11 @@ def parts_jobs():
         for m in PARTS_MODELS
         for c in PARTS_CONFIGS
     ]
+
+
+def kmatch_params(wildcards):
+    job = _job_spec(CFG, "ours_chain", _models.BASE_CONFIG, seed=int(wildcards.seed))
+    return _kmatch.point_job(job, int(wildcards.K))
 
 
 def recovery_damping_params(wildcards):

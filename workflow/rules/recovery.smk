@@ -47,24 +47,3 @@ rule null_control:
         null=null_params,
     script:
         "../scripts/null_control.py"
-
-
-# The parts study's check of the segmentations against the bones (reads truth.npz): each prior's
-# parts in the base configuration, their purity, pivots and parent links (tab_parts, fig_parts).
-rule parts_segmentation:
-    input:
-        unpack(parts_inputs),
-    output:
-        record=PARTS_RECORD,
-    log:
-        "logs/parts/{tree}/seed{seed}.log",
-    conda:
-        "../envs/physgs.yaml"
-    threads: 1
-    resources:
-        mem_mb=2000,
-        runtime=10,
-    params:
-        models=PRIORS,
-    script:
-        "../scripts/parts_segmentation.py"

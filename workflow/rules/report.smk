@@ -57,6 +57,7 @@ rule report:
                 if n != "tab_kselect"
                 and (n != "tab_damping" or DAMPING["trees"])
                 and (n not in _build.PARTS_OUTPUTS or PARTS_MODELS)
+                and (n != "tab_parts_k" or "ours_chain" in PARTS_MODELS)
             ],
         ),
         expand(

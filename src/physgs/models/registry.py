@@ -136,6 +136,9 @@ def model_settings(models_cfg: dict, model: str) -> dict:
         return out
     if spec.family != "static":
         out[spec.family] = models_cfg[spec.family]
+    if spec.family in FIELDS:  # its own time scale only: a sibling field's edit leaves it alone
+        section = models_cfg[spec.family]
+        out[spec.family] = {**section, "time_top_hz": {model: section["time_top_hz"][model]}}
     if spec.parts == "topology":
         out["topology"] = models_cfg["topology"]
     if spec.wind and spec.family in FIELDS:

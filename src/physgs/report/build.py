@@ -38,6 +38,7 @@ TABLES = (
     "tab_fit",
     "tab_damping",
     "tab_parts",
+    "tab_parts_k",
 )
 FIGURES = ("fig_temporal", "fig_teaser", "fig_results", "fig_damping", "fig_parts")
 #: The fields of each need tuple after its kind (what a workflow path template is formatted with).
@@ -49,6 +50,7 @@ NEED_FIELDS = {
     "recovery": ("tree", "config", "seed"),  # ours'
     "prior_recovery": ("tree", "model", "config", "seed"),  # any oscillator prior's
     "parts": ("tree", "seed"),  # the priors' segmentations (physgs.evaluate.parts)
+    "kmatch": ("tree", "K", "seed"),  # the chained prior at a smaller K (experiments.kmatch)
     "null": ("tree", "K", "seed"),
     "kselect": ("tree", "seed"),
     "stats": ("tree",),
@@ -58,7 +60,7 @@ NEED_FIELDS = {
 #: they show the first seed listed.
 ONE_SEED_FIGURES = ("fig_teaser", "fig_results", "fig_damping", "fig_parts")
 #: Outputs of the parts study (``parts_needs``), built only when it trains a variant.
-PARTS_OUTPUTS = ("tab_parts", "fig_parts")
+PARTS_OUTPUTS = ("tab_parts", "fig_parts", "tab_parts_k")
 #: Tables the claims ledger reads (their CSVs), and the configuration whose damping it reads.
 CLAIMS_TABLES = ("tab_psnr", "tab_transfer", "tab_margin", "tab_null", "tab_testbed", "tab_fit")
 CLAIMS_CONFIG = "joint32"
@@ -119,7 +121,9 @@ def parts_needs(
     if name == "fig_parts":
         return [("parts", t, int(seeds[0])) for t in trees]
     if name != "tab_parts":
-        raise ValueError(f"parts_needs: {name!r} is not one of {PARTS_OUTPUTS}")
+        raise ValueError(
+            f"parts_needs: {name!r} is not tab_parts or fig_parts (tab_parts_k: kmatch_needs)"
+        )
     out = []
     for s in (int(x) for x in seeds):
         for t in trees:
@@ -131,6 +135,20 @@ def parts_needs(
                         out.append(("prior_recovery", damping_id(t), m, c, s))
             out += list(dict.fromkeys(("null", t, int(configs[c]["K"]), s) for c in configs))
             out.append(("parts", t, s))
+    return out
+
+
+def kmatch_needs(
+    trees: Sequence[str], k_candidates: Sequence[int], seeds: Sequence[int]
+) -> list[tuple]:
+    """What tab_parts_k reads, at the studies' seeds: ours' and the chained prior's evaluation
+    in the base configuration (their held-out training-window frames) and the chained prior's
+    kmatch points at each smaller K."""
+    out = []
+    for s in (int(x) for x in seeds):
+        for t in trees:
+            out += [("eval", t, m, BASE_CONFIG, s) for m in (BASELINE_PRIOR, "ours_chain")]
+            out += [("kmatch", t, int(k), s) for k in k_candidates]
     return out
 
 
@@ -254,6 +272,15 @@ def settings_for(name: str, cfg: dict) -> dict:
         out["method"] = cfg["models"]["kselect"]["method"]
     if name in PARTS_OUTPUTS:
         out["models"] = [BASELINE_PRIOR, *cfg["parts_study"]["models"]]
+    if name == "tab_parts_k":
+        from physgs.config import study_seeds
+
+        out["seeds"] = [int(x) for x in study_seeds(cfg)]
+        out["K"] = int(cfg["models"]["configs"][BASE_CONFIG]["K"])
+        out["k_candidates"] = [int(k) for k in cfg["parts_study"]["k_candidates"]]
+        out["tie_db"] = float(cfg["models"]["kselect"]["tie_db"])
+        out["n_train"] = int(cfg["testbed"]["n_train"])
+        out["holdout_every"] = int(cfg["train"]["holdout_every"])
     if name == "tab_parts":
         out["configs"] = {
             c: config_label(c, cfg["models"]["configs"][c]) for c in cfg["parts_study"]["configs"]
@@ -292,7 +319,8 @@ def _summaries(path, trees, models, seeds):
 
 def fit_row(eval_path, loss_path, n_train: int, holdout_every: int) -> dict:
     """One tab_fit row from a model's evaluation and loss log: fit and held-out-frame PSNR (dB,
-    training camera and wind, frames < n_train), view and time PSNR (dB), training seconds."""
+    training camera and wind, frames < n_train), view and time PSNR (dB), training seconds
+    (NaN without a loss log)."""
     ev = load_eval(eval_path)
     cam = np.asarray(ev.camera_psnr[0, :n_train], dtype=np.float64)  # [n_train] dB
     if holdout_every:
@@ -300,7 +328,7 @@ def fit_row(eval_path, loss_path, n_train: int, holdout_every: int) -> dict:
     else:
         trained, held = np.arange(n_train), np.arange(0)
     s = ev.summary()
-    secs = pd.read_csv(loss_path)["seconds"]
+    secs = pd.read_csv(loss_path)["seconds"] if loss_path is not None else pd.Series([np.nan])
     return {
         "fit": float(cam[trained].mean()),
         "heldout": float(cam[held].mean()) if held.size else float("nan"),
@@ -405,6 +433,8 @@ def make_table(
         table = tab_damping(rows, trees, bones, settings["configs"], digits=d)
     elif name == "tab_parts":
         table = _tab_parts(path, settings, trees, bones, seeds, d)
+    elif name == "tab_parts_k":
+        table = _tab_parts_k(path, settings, trees, bones, seeds, d)
     elif name == "tab_kselect":
         rows = {}
         for s in seeds:
@@ -466,6 +496,28 @@ def _tab_parts(path, settings, trees, bones, seeds, digits) -> Table:
                         purity=float(seg[f"{m}/overall"]) if c == BASE_CONFIG else float("nan"),
                     )
     return parts.tab_parts(rows, trees, bones, models, configs, digits=digits)
+
+
+def _tab_parts_k(path, settings, trees, bones, seeds, digits) -> Table:
+    import json
+
+    from physgs.report import parts
+
+    n, every, K = int(settings["n_train"]), int(settings["holdout_every"]), int(settings["K"])
+
+    def held(m, t, s):
+        return fit_row(path("eval", t, m, BASE_CONFIG, s), None, n, every)["heldout"]
+
+    rows: dict[int, dict] = {}
+    for s in seeds:
+        rows[s] = {}
+        for t in trees:
+            chain = {K: held("ours_chain", t, s)}
+            for k in settings["k_candidates"]:
+                with open(path("kmatch", t, int(k), s)) as fh:
+                    chain[int(k)] = float(json.load(fh)["heldout_psnr"])
+            rows[s][t] = {"ours": held(BASELINE_PRIOR, t, s), "chain": chain}
+    return parts.tab_parts_k(rows, trees, bones, K, float(settings["tie_db"]), digits=digits)
 
 
 def _teaser_tree(trees: Sequence[str]) -> str:
