@@ -12,7 +12,7 @@ from __future__ import annotations
 
 import argparse
 
-from physgs.experiments.cost import extra_seed_wall_s, read_costs, summarise
+from physgs.experiments.cost import extra_seed_wall_s, read_costs, resources_by_stage, summarise
 
 
 def _min(s: float) -> str:
@@ -24,7 +24,8 @@ def main() -> None:
     ap.add_argument("--benchmarks", default="results/benchmarks")
     ap.add_argument("--wall-s", type=float, default=None, help="the run's measured wall seconds")
     args = ap.parse_args()
-    summary = summarise(read_costs(args.benchmarks))
+    jobs = read_costs(args.benchmarks)
+    summary = summarise(jobs)
     seeds = list(summary["per_seed"])
     cols = ["shared", *seeds]
     print("job minutes (sum of benchmarked job wall times)")
@@ -43,6 +44,15 @@ def main() -> None:
         f"{_min(summary['damping_s']).strip()} job-min "
         f"({', '.join(f'seed {s}: {_min(v).strip()}' for s, v in summary['damping_per_seed'].items())})"
     )
+    print("\nper job, by stage (to size a cluster's requests: docs/cluster.md)")
+    print(
+        f"{'stage':<16}{'jobs':>6}{'wall s mean/max':>20}{'CPU s mean/max':>20}{'peak RSS MB':>13}"
+    )
+    for stage, r in resources_by_stage(jobs).items():
+        print(
+            f"{stage:<16}{r['jobs']:>6}{r['wall_mean_s']:>11.0f} /{r['wall_max_s']:>6.0f}"
+            f"{r['cpu_mean_s']:>12.0f} /{r['cpu_max_s']:>6.0f}{r['rss_max_mb']:>13.0f}"
+        )
     if args.wall_s:
         extra = extra_seed_wall_s(summary, run_wall_s=args.wall_s)
         print(

@@ -66,3 +66,27 @@ def test_missing_or_foreign_files_are_named(tmp_path):
     (tmp_path / "x" / "bad.tsv").write_text("a\tb\n1\t2\n")
     with pytest.raises(ValueError, match="bad.tsv"):
         read_costs(tmp_path / "x")
+
+
+def test_resources_by_stage_read_cpu_and_peak_memory(tmp_path):
+    from physgs.experiments.cost import resources_by_stage
+
+    rows = {"train/a/seed0/x.tsv": (10.0, 300.5, 9.0), "train/a/seed1/x.tsv": (30.0, 700.0, 25.0)}
+    for rel, (s, rss, cpu) in rows.items():
+        f = tmp_path / rel
+        f.parent.mkdir(parents=True, exist_ok=True)
+        f.write_text(HEADER + f"{s}\t0:00:10\t{rss}\t1\t1\t1\t0\t0\t90\t{cpu}\n")
+    f = tmp_path / "evaluate/a/seed0/x.tsv"
+    f.parent.mkdir(parents=True)
+    f.write_text(HEADER + "5.0\t0:00:05\t-\t-\t-\t-\t-\t-\t-\t-\n")  # psutil measured nothing
+    r = resources_by_stage(read_costs(tmp_path))
+    assert r["train"] == {
+        "jobs": 2,
+        "wall_mean_s": 20.0,
+        "wall_max_s": 30.0,
+        "cpu_mean_s": 17.0,
+        "cpu_max_s": 25.0,
+        "rss_max_mb": 700.0,
+    }
+    assert r["evaluate"]["jobs"] == 1 and r["evaluate"]["wall_max_s"] == 5.0
+    assert r["evaluate"]["rss_max_mb"] != r["evaluate"]["rss_max_mb"]  # NaN, not 0

@@ -27,7 +27,8 @@ class JobCost:
     """One benchmarked job: ``stage`` (train, evaluate, ...), ``seed`` (None = shared by every
     seed), ``damping`` (part of the damping benchmark), wall seconds, its path, and when it ended
     (``end``: the benchmark file's modification time, seconds since the epoch; Snakemake writes
-    it as the job finishes, so the job ran from ``end - wall_s`` to ``end``)."""
+    it as the job finishes, so the job ran from ``end - wall_s`` to ``end``), its CPU seconds and
+    peak resident memory (NaN where the file has no such column or Snakemake wrote '-')."""
 
     stage: str
     seed: int | None
@@ -35,6 +36,8 @@ class JobCost:
     wall_s: float
     path: str
     end: float = float("nan")
+    cpu_s: float = float("nan")  # user + system CPU seconds (``cpu_time``)
+    max_rss_mb: float = float("nan")  # peak resident memory, MB (``max_rss``)
 
 
 def _seed_of(parts: tuple[str, ...]) -> int | None:
@@ -50,6 +53,13 @@ def _is_damping(part: str) -> bool:
     job ('stats_medium_damping_seed1'), read by the testbed ids' own parser."""
     testbed = _SEED.sub("", part).removeprefix("stats_")
     return parse_id(testbed)[1] == DAMPING
+
+
+def _number(x) -> float:
+    try:
+        return float(x)
+    except (TypeError, ValueError):  # absent, or '-' where psutil could not measure
+        return float("nan")
 
 
 def read_costs(benchmark_dir) -> list[JobCost]:
@@ -77,6 +87,8 @@ def read_costs(benchmark_dir) -> list[JobCost]:
                 wall_s=float(row["s"]),
                 path=str(rel),
                 end=f.stat().st_mtime,
+                cpu_s=_number(row.get("cpu_time")),
+                max_rss_mb=_number(row.get("max_rss")),
             )
         )
     if not jobs:
@@ -147,3 +159,31 @@ def wall_spans(jobs: list[JobCost]) -> dict:
     for j in jobs:
         stages.setdefault(j.stage, []).append(j)
     return {"run_s": span(jobs), "by_stage": {k: span(v) for k, v in sorted(stages.items())}}
+
+
+def resources_by_stage(jobs: list[JobCost]) -> dict[str, dict]:
+    """What each stage's jobs used, to size a cluster's requests from measurement: per stage
+    {jobs, wall_mean_s, wall_max_s, cpu_mean_s, cpu_max_s, rss_max_mb} (NaN-free maxima and
+    means over the jobs that report the quantity; NaN when none does)."""
+    import math
+
+    def stats(xs):
+        xs = [x for x in xs if not math.isnan(x)]
+        return (sum(xs) / len(xs), max(xs)) if xs else (float("nan"), float("nan"))
+
+    stages: dict[str, list[JobCost]] = {}
+    for j in jobs:
+        stages.setdefault(j.stage, []).append(j)
+    out = {}
+    for stage, js in sorted(stages.items()):
+        wm, wx = stats([j.wall_s for j in js])
+        cm, cx = stats([j.cpu_s for j in js])
+        out[stage] = {
+            "jobs": len(js),
+            "wall_mean_s": wm,
+            "wall_max_s": wx,
+            "cpu_mean_s": cm,
+            "cpu_max_s": cx,
+            "rss_max_mb": stats([j.max_rss_mb for j in js])[1],
+        }
+    return out
