@@ -185,6 +185,27 @@ def parts_study_is_runnable(cfg: dict) -> Iterator[Problem]:
             )
 
 
+def tracks_is_runnable(cfg: dict) -> Iterator[Problem]:
+    """The tracks control is fitted in configurations of ours (their conditions and K), and its
+    shortest fitted track fits in the training window. (Whether K exceeds the tracks kept is only
+    known once the video is tracked: the fit job refuses it, naming the key.)"""
+    tr = cfg.get("tracks") or {}
+    for i, c in enumerate(tr.get("configs", [])):
+        if c not in cfg["models"]["configs"]:
+            yield (
+                ("tracks", "configs", i),
+                f"'{c}' is not one of models/configs {sorted(cfg['models']['configs'])}: the "
+                "tracks control is fitted in ours' configurations (same conditions and K)",
+            )
+    n = int(cfg["testbed"]["n_train"])
+    if "min_track_frames" in tr and int(tr["min_track_frames"]) > n:
+        yield (
+            ("tracks", "min_track_frames"),
+            f"{tr['min_track_frames']} frames is longer than the training window (testbed/n_train "
+            f"= {n}): no track could be fitted; lower it to at most {n}",
+        )
+
+
 #: The calm must last at least this many periods of the slowest band frequency (band_hz[0]) to
 #: show a free decay: over less, the slowest bones do not complete one oscillation.
 MIN_CALM_PERIODS = 1.0
@@ -508,6 +529,7 @@ CHECKS: list[Check] = [
     study_seeds_in_seeds,
     damping_benchmark_is_runnable,
     parts_study_is_runnable,
+    tracks_is_runnable,
     presets_reach_bone_counts,
 ]
 

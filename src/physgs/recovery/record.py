@@ -67,21 +67,24 @@ def score_recovery(
     return RecoveryRecord(m, damping_summary(omega_hat, zeta_hat, zeta_true))
 
 
+def recovery_dict(rec: RecoveryRecord) -> dict:
+    """The JSON object ``save_recovery`` writes (``load_recovery`` ignores any other key, so a
+    method may add its own block beside these)."""
+    return {
+        "match": rec.match.to_dict(),
+        "damping": rec.damping.to_dict(),
+        "n_frozen": int(rec.n_frozen),
+        "n_trusted_visible": int(rec.n_trusted_visible),
+        "median_rel_err_visible": rec.median_rel_err_visible,
+        "damping_scores": (
+            rec.damping_scores.to_dict() if rec.damping_scores is not None else None
+        ),
+        "damping_null": (rec.damping_null.to_dict() if rec.damping_null is not None else None),
+    }
+
+
 def save_recovery(path, rec: RecoveryRecord) -> None:
-    write_json(
-        path,
-        {
-            "match": rec.match.to_dict(),
-            "damping": rec.damping.to_dict(),
-            "n_frozen": int(rec.n_frozen),
-            "n_trusted_visible": int(rec.n_trusted_visible),
-            "median_rel_err_visible": rec.median_rel_err_visible,
-            "damping_scores": (
-                rec.damping_scores.to_dict() if rec.damping_scores is not None else None
-            ),
-            "damping_null": (rec.damping_null.to_dict() if rec.damping_null is not None else None),
-        },
-    )
+    write_json(path, recovery_dict(rec))
 
 
 def load_recovery(path) -> RecoveryRecord:

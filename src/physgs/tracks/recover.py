@@ -3,11 +3,14 @@ the same matcher, trusted-part rule and records as ours (``physgs.recovery``).""
 
 from __future__ import annotations
 
+import dataclasses
+import json
 from dataclasses import dataclass
 
 import numpy as np
 
-from physgs.recovery.record import RecoveryRecord, score_recovery
+from physgs.atomic import write_json
+from physgs.recovery.record import RecoveryRecord, recovery_dict, score_recovery
 from physgs.tracks.fit import Oscillators, TrackFit, part_theta
 
 
@@ -20,6 +23,9 @@ class TracksRecovery:
     record: RecoveryRecord
     no_estimate: np.ndarray
     median_zeta: float  # over the parts with an estimate (a part without one keeps zeta_init)
+    #: [K] fitted tracks per part (every fitted condition) and the fewest a part needed
+    n_tracks: np.ndarray = dataclasses.field(default_factory=lambda: np.zeros(0, np.int64))
+    min_tracks: int = -1
 
     @property
     def n_no_estimate(self) -> int:
@@ -35,17 +41,69 @@ class TracksRecovery:
             "median_zeta": self.median_zeta,
             "n_no_estimate": self.n_no_estimate,
             "no_estimate": self.no_estimate.tolist(),
+            "n_tracks_per_part": [int(n) for n in self.n_tracks],
+            "min_tracks": int(self.min_tracks),
         }
 
 
-def recover_tracks(fit: TrackFit, osc: Oscillators, observed, truth) -> TracksRecovery:
-    """Match the fitted parts to bones under the training wind over the training window."""
+def recover_tracks(
+    fit: TrackFit,
+    osc: Oscillators,
+    observed,
+    truth,
+    bone_visible=None,
+    damping: dict | None = None,
+    min_tracks: int = -1,
+) -> TracksRecovery:
+    """Match the fitted parts to bones under the training wind over the training window.
+
+    bone_visible [B] bool: also score the parts matched to visible bones (as ours' recovery);
+    damping: {zeta_range, seed} to also score each trusted part's zeta against its bone's and
+    against the untrained draw from zeta_range (``physgs.recovery.damping_scores``, tab_damping),
+    exactly as ``physgs.recovery.run.recover_model`` does for ours; min_tracks: the fewest
+    tracks a part needed (recorded beside each part's count).
+    """
     th = part_theta(fit, osc, np.asarray(observed.wind[0], np.float64))  # [K, L+F]
     rec = score_recovery(
         th, fit.omega, fit.zeta, truth, int(observed.lead_in_frames), int(observed.n_train)
     )
     if np.any(rec.match.trusted & ~fit.estimated):  # theta = 0 correlates with nothing
         raise RuntimeError("a part with no estimate was matched as trusted; its theta is not 0")
+    if bone_visible is not None:
+        rec = rec.with_visibility(bone_visible)
+    if damping is not None:
+        from physgs.recovery.damping_scores import damping_null, score_match
+
+        zb, ob = np.asarray(truth.zeta, np.float64), np.asarray(truth.omega, np.float64)
+        m = rec.match
+        rec = dataclasses.replace(
+            rec,
+            damping_scores=score_match(m, np.asarray(fit.zeta, np.float64), zb, ob),
+            damping_null=damping_null(
+                m.bone,
+                m.trusted,
+                m.omega_hat,
+                zb,
+                ob,
+                damping["zeta_range"],
+                seed=int(damping["seed"]),
+            ),
+        )
     zeta = np.asarray(fit.zeta, np.float64)[fit.estimated]
     med = float(np.median(zeta)) if zeta.size else float("nan")
-    return TracksRecovery(rec, np.flatnonzero(~fit.estimated), med)
+    return TracksRecovery(
+        rec, np.flatnonzero(~fit.estimated), med, np.asarray(fit.n_tracks), int(min_tracks)
+    )
+
+
+def save_tracks_recovery(path, rec: TracksRecovery) -> None:
+    """Ours' recovery record (``physgs.recovery.record.load_recovery`` reads it) plus a
+    ``tracks`` block: the parts with no estimate (too few tracks), each part's track count
+    and the minimum, so a part left out of the trusted count is never silently dropped."""
+    write_json(path, {**recovery_dict(rec.record), "tracks": rec.to_dict()})
+
+
+def load_tracks_block(path) -> dict:
+    """The ``tracks`` block of a record written by ``save_tracks_recovery``."""
+    with open(path) as fh:
+        return json.load(fh)["tracks"]

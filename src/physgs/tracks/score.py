@@ -114,7 +114,14 @@ def score_tracker(tracks: Tracks, truth, camera, condition: int = 0) -> TrackerS
 
 
 def motion_errors(
-    pred: np.ndarray, tracks: Tracks, truth, camera, condition: int, frames, fit_condition: int = 0
+    pred: np.ndarray,
+    tracks: Tracks,
+    truth,
+    camera,
+    condition: int,
+    frames,
+    fit_condition: int = 0,
+    seed_xy: np.ndarray | None = None,
 ) -> dict:
     """Pixel errors of predicted tracks pred [P, F, 2] (rows NaN for unfitted tracks) of the
     tracks ``tracks`` (seeded in the video of ``fit_condition``) at recorded ``frames`` [F] of
@@ -124,6 +131,11 @@ def motion_errors(
     track's association offset (track minus vertex at its seed frame, measured once in the fitted
     video: the vertex is not the tracked point), "static_median_px": the same for a motionless
     prediction at each track's mean tracked position (the no-physics baseline), "n_tracks"}.
+
+    seed_xy [P, 2] px: the position the offset is measured from, in place of the tracked one at
+    each seed frame: a model scored at the tracked points (``model_point_tracks``) passes its own
+    position at the seed frame, so its motion error is, like the tracks control's, the error of
+    its displacement since the seed frame.
     """
     ok = np.isfinite(pred).all(axis=(1, 2))
     if not ok.any():
@@ -139,7 +151,8 @@ def motion_errors(
             for i in range(len(rows))
         ]
     )  # [p, 2]
-    offset = tracks.xy[rows, st] - seed_gt  # [p, 2]
+    seed = tracks.xy[rows, st] if seed_xy is None else np.asarray(seed_xy, np.float64)[rows]
+    offset = seed - seed_gt  # [p, 2]
     still = np.nanmean(np.where(tracks.valid[rows, :, None], tracks.xy[rows], np.nan), axis=1)
     p = pred[ok]
     return {
@@ -150,3 +163,18 @@ def motion_errors(
         ),
         "n_tracks": int(ok.sum()),
     }
+
+
+def model_point_tracks(
+    means_fn, truth, camera, vertices: np.ndarray, condition: int, frames
+) -> np.ndarray:
+    """[P, F, 2] px: a Gaussian model's prediction at mesh vertices ``vertices`` [P] (the
+    tracked points' vertices, ``associate``): the projection by ``camera`` of each vertex's
+    Gaussian (``truth.vertex_gaussian``: the observed Gaussians are stored in a random order)
+    at recorded ``frames`` [F] of ``condition``. means_fn(frame, condition) -> [N, 3] world
+    (``physgs.evaluate.adapter.model_means_fn``)."""
+    gauss = np.asarray(truth.vertex_gaussian, np.int64)[np.asarray(vertices, np.int64)]
+    frames = np.asarray(frames, np.int64)
+    xyz = np.stack([np.asarray(means_fn(int(j), condition))[gauss] for j in frames], axis=1)
+    uv, _ = camera.project(xyz.reshape(-1, 3).astype(np.float64))
+    return uv.reshape(len(gauss), len(frames), 2)

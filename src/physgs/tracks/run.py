@@ -1,0 +1,133 @@
+"""The tracks control's jobs as the Snakemake rules call them (``workflow/rules/tracks.smk``).
+
+- ``track_condition``: rule ``track``, one condition's training-camera video (observed only);
+- ``fit_job``: rule ``fit_tracks``, the oscillators of one configuration fitted to its tracks
+  (observed wind only), refusing a K above the tracks it can group, with the key named;
+- ``evaluate_job``: rule ``tracks_evaluate`` (reads the truth): the tracker's error, recovery
+  through ours' matcher, and the predicted tracks' pixel errors beyond the window and under the
+  unseen winds, beside a motionless prediction and beside ours' Gaussians at the same points.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from physgs.tracks.fit import FitSettings, Oscillators, TrackFit, fit_tracks, predict_tracks
+from physgs.tracks.recover import TracksRecovery, recover_tracks
+from physgs.tracks.track import Tracks, TrackSettings, track_video
+
+
+def track_condition(observed, condition: int, settings: dict) -> Tracks:
+    """Tracks of condition ``condition``'s training-camera video over the training window
+    (frames 0..n_train-1: what a method may train on). settings: ``TrackSettings`` fields."""
+    if not 0 <= condition < len(observed.conditions):
+        raise ValueError(f"condition {condition} is not one of the {len(observed.conditions)}")
+    frames = np.asarray(observed.frames[condition, : int(observed.n_train)])
+    return track_video(frames, observed.background, TrackSettings(**settings))
+
+
+def fit_job(tracks: list[Tracks], observed, job: dict) -> tuple[TrackFit, Oscillators]:
+    """Fit the oscillators of one configuration. tracks: one per condition of
+    ``job["conditions"]``, in that order; job: ``physgs.tracks.settings.fit_job``.
+
+    Raises ValueError naming ``job["K_key"]`` when K exceeds the tracks long enough to fit
+    (>= min_track_frames frames), which is only known once the video is tracked."""
+    if len(tracks) != len(job["conditions"]):
+        raise ValueError(
+            f"fit_job: {len(tracks)} track files for conditions {job['conditions']}; the rule "
+            "must pass one per fitted condition"
+        )
+    K, n_min = int(job["K"]), int(job["min_track_frames"])
+    n_long = int(sum(int((tr.length() >= n_min).sum()) for tr in tracks))
+    if K > n_long:
+        raise ValueError(
+            f"{job['K_key']} = {K} parts exceeds the {n_long} tracks of >= {n_min} frames "
+            f"(tracks/min_track_frames) that the tracker kept in conditions {job['conditions']}: "
+            f"k-means cannot make {K} groups. Lower {job['K_key']}, set tracks/K to an integer "
+            "for the tracks control alone, or drop the configuration from tracks/configs"
+        )
+    settings = FitSettings(
+        K=K,
+        iterations=int(job["iterations"]),
+        lr=float(job["lr"]),
+        min_track_frames=n_min,
+        min_tracks=int(job["min_tracks"]),
+        kmeans_n_init=int(job["kmeans_n_init"]),
+        seed=int(job["seed"]),
+    )
+    osc = Oscillators.from_config(job["ours"], observed)
+    fit = fit_tracks(tracks, list(job["conditions"]), observed.wind, osc, settings)
+    return fit, osc
+
+
+def motion_cases(observed) -> list[tuple[str, int, np.ndarray]]:
+    """(name, condition, recorded frames) scored for motion: "tail" (the training wind's frames
+    n_train..F-1, beyond the window) and "wind<c>" (condition c >= 1's window frames)."""
+    T = int(observed.n_train)
+    F = T + int(observed.n_tail)
+    out = [("tail", 0, np.arange(T, F))]
+    out += [(f"wind{c}", c, np.arange(T)) for c in range(1, len(observed.conditions))]
+    return out
+
+
+def evaluate_job(
+    fit: TrackFit,
+    osc: Oscillators,
+    tracks0: Tracks,
+    observed,
+    truth,
+    *,
+    bone_visible=None,
+    damping: dict | None = None,
+    min_tracks: int = -1,
+    ours=None,
+) -> tuple[TracksRecovery, dict]:
+    """Score one fit against the truth. tracks0: the tracks of condition 0 (the fit's first
+    entry); ours: ours' trained model in the same configuration (None: not scored).
+
+    Returns (recovery, scores): scores = {"tracker": ``TrackerScore`` dict of tracks0,
+    "fit": {K, seconds, loop_seconds, rms_px, n_fitted}, and per motion case (``motion_cases``)
+    {"tracks": motion_errors of the control, "ours": the same of ours' Gaussians at the same
+    tracked points (its displacement since each seed frame)}}.
+    """
+    from physgs.tracks.score import associate, model_point_tracks, motion_errors, score_tracker
+
+    if fit.conditions[0] != 0:
+        raise ValueError(f"the fit's first condition is {fit.conditions[0]}, not the training one")
+    cam = observed.train_camera
+    rec = recover_tracks(
+        fit, osc, observed, truth, bone_visible=bone_visible, damping=damping, min_tracks=min_tracks
+    )
+    lab = fit.labels[0]
+    fitted = (lab >= 0) & fit.estimated[np.maximum(lab, 0)]  # [P] tracks with a prediction
+    scores: dict = {
+        "tracker": score_tracker(tracks0, truth, cam, 0).to_dict(),
+        "fit": {
+            "K": int(len(fit.omega)),
+            "seconds": float(fit.seconds),
+            "loop_seconds": float(fit.loop_seconds),
+            "rms_px": float(fit.rms_px),
+            "n_fitted": int(fitted.sum()),
+        },
+    }
+    if ours is not None:
+        from physgs.evaluate.adapter import model_means_fn
+
+        means_fn = model_means_fn(ours, observed)
+        verts = associate(truth, cam, tracks0, 0)
+        rows = np.arange(tracks0.n_tracks)
+        # ours' own position at each seed frame: the origin of its displacement
+        seed_ours = np.full((tracks0.n_tracks, 2), np.nan)
+        for t0 in np.unique(tracks0.start[fitted]):
+            sel = rows[fitted & (tracks0.start == t0)]
+            seed_ours[sel] = model_point_tracks(means_fn, truth, cam, verts[sel], 0, [t0])[:, 0]
+    for name, c, frames in motion_cases(observed):
+        pred = predict_tracks(fit, osc, 0, observed.wind[c], frames)  # [P, F, 2]
+        scores[name] = {"tracks": motion_errors(pred, tracks0, truth, cam, c, frames, 0)}
+        if ours is not None:
+            po = np.full_like(pred, np.nan)
+            po[fitted] = model_point_tracks(means_fn, truth, cam, verts[fitted], c, frames)
+            scores[name]["ours"] = motion_errors(
+                po, tracks0, truth, cam, c, frames, 0, seed_xy=seed_ours
+            )
+    return rec, scores

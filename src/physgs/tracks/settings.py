@@ -1,0 +1,67 @@
+"""What each job of the tracks control reads from the resolved config (its narrow params).
+
+The workflow imports this module to plan jobs, so it imports neither torch nor OpenCV. A job's
+params hold only what it reads: editing the fit's iterations leaves the tracks up to date, and
+editing a tracker setting leaves ours' jobs alone.
+
+Config: ``tracks`` (``configs``: which of ``models.configs`` the control is fitted in, with their
+conditions and K; ``K``: ``same`` for each configuration's own K, or one integer for every
+configuration; ``iterations``, ``min_track_frames``, ``min_tracks``, ``kmeans_n_init``: the fit;
+``tracker``: ``physgs.tracks.track.TrackSettings``), ``models.ours`` (the oscillator's bounds,
+initialisation, RK4 substeps and guard) and ``train.lr.physics`` (Adam's rate on omega/zeta).
+"""
+
+from __future__ import annotations
+
+#: ``tracks.K`` value meaning "the configuration's own K" (``models.configs.<c>.K``)
+SAME_K = "same"
+#: ours' settings the oscillator fit reads (``physgs.tracks.fit.Oscillators.from_config``)
+OURS_KEYS = ("omega_hz", "zeta", "omega_init_hz", "zeta_init", "substeps", "rk4_guard")
+
+
+def tracker_settings(cfg: dict) -> dict:
+    """The tracker's settings (``TrackSettings`` fields), the only params of rule ``track``."""
+    return dict(cfg["tracks"]["tracker"])
+
+
+def condition_indices(spec: str, n_conditions: int) -> list[int]:
+    """Conditions a configuration fits: 'train' -> [0], 'all' -> every one (as ours trains)."""
+    if spec == "train":
+        return [0]
+    if spec == "all":
+        return list(range(n_conditions))
+    raise ValueError(f"unknown conditions {spec!r} in models.configs; use 'train' or 'all'")
+
+
+def parts(cfg: dict, config: str) -> tuple[int, str]:
+    """(K, the config key that sets it) of the tracks control in configuration ``config``:
+    ``models/configs/<config>/K``, or ``tracks/K`` when that overrides it."""
+    k = cfg["tracks"]["K"]
+    if k == SAME_K:
+        return int(cfg["models"]["configs"][config]["K"]), f"models/configs/{config}/K"
+    return int(k), "tracks/K"
+
+
+def fit_job(cfg: dict, config: str, seed: int) -> dict:
+    """The params of one fit: K and its key, the conditions fitted (indices), FitSettings' other
+    fields (lr = ``train.lr.physics``, k-means seed = the training seed) and ours' oscillator
+    settings."""
+    if config not in cfg["tracks"]["configs"]:
+        raise ValueError(
+            f"configuration {config!r} is not one of tracks/configs {cfg['tracks']['configs']}"
+        )
+    tr = cfg["tracks"]
+    K, key = parts(cfg, config)
+    n_cond = len(cfg["testbed"]["conditions"])
+    return {
+        "K": K,
+        "K_key": key,
+        "conditions": condition_indices(cfg["models"]["configs"][config]["conditions"], n_cond),
+        "iterations": int(tr["iterations"]),
+        "lr": float(cfg["train"]["lr"]["physics"]),
+        "min_track_frames": int(tr["min_track_frames"]),
+        "min_tracks": int(tr["min_tracks"]),
+        "kmeans_n_init": int(tr["kmeans_n_init"]),
+        "seed": int(seed),
+        "ours": {k: cfg["models"]["ours"][k] for k in OURS_KEYS},
+    }
