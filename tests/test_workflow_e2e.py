@@ -115,7 +115,11 @@ def test_tab_margin_is_ours_minus_mlp_wind(run):
 def test_tab_null_rows_columns_and_finite_where_defined(run):
     df = _csv(run, "tab_null")
     configs = list(QUICK["models"]["configs"])
-    assert len(df) == len(TREES) * len(configs)
+    # ours' rows, then the 2D-track control's (docs/tracks.md) at its own K beside its own null
+    assert list(df["method"]) == ["ours"] * len(TREES) * len(configs) + ["tracks"] * len(
+        TREES
+    ) * len(QUICK["tracks"]["configs"])
+    assert (df.loc[df["method"] == "tracks", "K"] == QUICK["tracks"]["K"]).all()
     for col in ("trained_parts_trusted", "null_parts_trusted", "nearest_bone_gap_pct"):
         assert np.isfinite(df[col].to_numpy(float)).all(), col
     # a median over no trusted part is undefined (empty cell), and only then
@@ -136,6 +140,36 @@ def test_tex_agrees_with_csv(run, name):
     for x in tex:
         ok = np.isclose(nums, x, atol=0.006) | np.isclose(nums * 100, x, atol=0.006)
         assert ok.any(), f"{name}.tex shows {x}, which is in no CSV cell"
+
+
+def test_tab_tracks_scores_every_tracks_fit(run):
+    """One row per tree and configuration of the tracks control: the tracker's numbers are the
+    same on every row of a tree (one training video), the fit took seconds, and each recovery
+    record lists its parts' track counts (summing to the tracks fitted) and the parts left
+    without an estimate."""
+    import json
+
+    df = _csv(run, "tab_tracks")
+    assert sorted(df["config"]) == sorted(QUICK["tracks"]["configs"])
+    assert (df["K"] == QUICK["tracks"]["K"]).all() and (df["fit_s"] > 0).all()
+    for col in ("n_tracks", "track_median_px", "track_p90_px", "tail_px", "tail_static_px"):
+        assert np.isfinite(df[col].to_numpy(float)).all(), col
+    for col in ("n_tracks", "track_median_px", "share_kept"):  # one video per tree
+        assert df.groupby("tree")[col].nunique().max() == 1, col
+    for _, r in df.iterrows():
+        rec = (
+            run
+            / "results"
+            / "recovery"
+            / r["tree"]
+            / f"seed{r['seed']}"
+            / f"tracks_{r['config']}.json"
+        )
+        block = json.loads(rec.read_text())["tracks"]
+        assert len(block["n_tracks_per_part"]) == r["K"]
+        est = [n >= block["min_tracks"] for n in block["n_tracks_per_part"]]
+        assert block["no_estimate"] == [p for p, e in enumerate(est) if not e]
+        assert sum(est) == r["parts_estimated"]
 
 
 def test_speed_accuracy_csv(run):

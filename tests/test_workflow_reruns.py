@@ -25,6 +25,7 @@ EDITS = {
     "table_digits": {"report": {"tab_psnr": {"digits": 3}}},
     "freeze_at": {"models": {"ours": {"freeze_at": 0.6}}},
     "kselect_tie": {"models": {"kselect": {"tie_db": 0.2}}},
+    "tracks_iterations": {"tracks": {"iterations": 200}},
 }
 
 
@@ -132,3 +133,18 @@ def test_kselect_tie_retrains_only_the_auto_model(plans):
     plan = _counts(out)
     assert plan.get("kselect") and "train" not in plan and "speed_accuracy_point" not in plan, plan
     assert _checkpoints(out) == {"ours_auto"}
+
+
+def test_tracks_fit_settings_refit_the_tracks_control_only(plans):
+    """The fit's iterations refit and rescore the tracks control (quick: sparse, two
+    configurations) and rebuild what reads it; the tracks and every trained model stay."""
+    plan = _counts(plans["tracks_iterations"])
+    assert plan == {
+        "fit_tracks": 2,
+        "tracks_evaluate": 2,
+        "table": 2,  # tab_null (its tracks rows) and tab_tracks
+        "figure": 1,  # fig_tracks colours the tracks by the fit's parts
+        "claims": 1,
+        "summary": 1,
+        "all": 1,
+    }, plan

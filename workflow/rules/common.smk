@@ -10,6 +10,7 @@ import physgs.experiments.sweep as _sweep
 import physgs.models.registry as _models
 import physgs.provenance as _provenance
 import physgs.testbed.variant as _variant
+import physgs.tracks.settings as _tracks
 from physgs.experiments.recipe import canonical as _canonical
 from physgs.experiments.recipe import job_spec as _job_spec
 from physgs.recovery.run import null_settings as _null_settings
@@ -36,6 +37,10 @@ PARTS_MODELS = list(PARTS["models"])
 PARTS_CONFIGS = {c: CONFIGS[c] for c in PARTS["configs"]} if PARTS_MODELS else {}
 PRIORS = ["ours", *PARTS_MODELS]  # every oscillator prior the run trains
 STAMP = _provenance.stamp(CFG)  # not a rerun trigger (see physgs.provenance.Stamp)
+# the 2D-track control (docs/tracks.md): ours' oscillators fitted to point tracks of the training
+# video, in these of ours' configurations, each with its K (tracks/K or the configuration's)
+TRACKS_CONFIGS = list(CFG["tracks"]["configs"])
+TRACKS_K = {c: _tracks.parts(CFG, c)[0] for c in TRACKS_CONFIGS}
 
 # ---- file layout ------------------------------------------------------------------------------
 # The testbed is one fixed instance per tree (testbed seed CFG["seed"]); every result of a
@@ -62,6 +67,13 @@ FIT_POINT = "results/fit_curve/{tree}/seed{seed}/{model}_it{iterations}.json"
 FIT_WINDOW_POINT = "results/fit_curve/{tree}/seed{seed}/{model}_it{iterations}_windowtime.json"
 TABLE = "results/tables/{name}.{ext}"
 FIGURE = "results/figures/{name}.{ext}"
+# the tracks control: one condition's tracks (observed only; per instance like the testbed), the
+# fit of one configuration, and its scores and recovery record (read the truth)
+TRACKS = "results/tracks/{tree}/c{condition}.npz"
+SEEDED_TRACKS = "results/tracks/{tree}/seed{seed}/c{condition}.npz"
+TRACKS_FIT = "results/tracks/{tree}/seed{seed}/fit_{config}.npz"
+TRACKS_EVAL = "results/tracks/{tree}/seed{seed}/eval_{config}.json"
+TRACKS_RECOVERY = RECOVERY.replace("{model}", "tracks")  # ours' record format, beside ours'
 #: need kind (physgs.report.build.needs) -> path template
 NEED_PATHS = {
     "eval": EVAL,
@@ -76,6 +88,12 @@ NEED_PATHS = {
     "kselect": KSELECT,
     "stats": STATS,
     "table": TABLE.replace("{ext}", "csv"),
+    "tracks_recovery": TRACKS_RECOVERY,
+    "tracks_eval": TRACKS_EVAL,
+    "tracks_fit": TRACKS_FIT,
+    # a figure reads the instance of its seed (the one instance without testbed_seeds)
+    "tracks": SEEDED_TRACKS if TESTBED_SEEDS else TRACKS,
+    "observed": SEEDED_OBSERVED if TESTBED_SEEDS else OBSERVED,
 }
 SA_TREE = CFG["speed_accuracy"]["tree"]
 SWEEP_POINTS = _sweep.sweep_points(CFG)
@@ -92,6 +110,7 @@ wildcard_constraints:
     point="|".join(SWEEP_POINTS),
     iterations=r"\d+",
     seed=r"\d+",
+    condition=r"\d+",
     name="|".join([*_build.TABLES, *_build.FIGURES]),
 
 
@@ -147,7 +166,10 @@ def need_paths(needs):
 def report_inputs(wildcards):
     """need key -> path of every file table or figure ``name`` reads."""
     if wildcards.name == "tab_damping":
-        return need_paths(_build.damping_needs(DAMPING["trees"], DAMPING["configs"], SEEDS))
+        tracks = [c for c in DAMPING["configs"] if c in TRACKS_CONFIGS]
+        return need_paths(_build.damping_needs(DAMPING["trees"], DAMPING["configs"], SEEDS, tracks))
+    if wildcards.name in _build.TRACKS_OUTPUTS:
+        return need_paths(_build.tracks_needs(wildcards.name, TREES, TRACKS_CONFIGS, SEEDS))
     if wildcards.name == "tab_parts_k":
         return need_paths(_build.kmatch_needs(TREES, PARTS["k_candidates"], STUDY_SEEDS))
     if wildcards.name in _build.PARTS_OUTPUTS:
@@ -161,7 +183,7 @@ def report_inputs(wildcards):
                 SEEDS,
             )
         )
-    return need_paths(_build.needs(wildcards.name, TREES, CONFIGS, SEEDS))
+    return need_paths(_build.needs(wildcards.name, TREES, CONFIGS, SEEDS, tracks=TRACKS_K))
 
 
 # ---- narrow params: each job sees only the settings it reads -------------------------------
@@ -303,4 +325,39 @@ def recovery_damping_params(wildcards):
     return {
         "zeta_range": [float(z) for z in CFG["testbed"]["damping"]["zeta_range"]],
         "seed": int(wildcards.seed),
+    }
+
+
+# ---- the 2D-track control (tracks.smk) ---------------------------------------------------------
+def tracks_file(tree, seed, condition):
+    """The tracks of ``condition``'s video of the instance training seed ``seed`` reads."""
+    return (SEEDED_TRACKS if TESTBED_SEEDS else TRACKS).format(
+        tree=tree, seed=seed, condition=condition
+    )
+
+
+def fit_tracks_params(wildcards):
+    """The fit's narrow settings (physgs.tracks.settings.fit_job): K and its key, the conditions,
+    the fit's settings and ours' oscillator settings."""
+    return _tracks.fit_job(CFG, wildcards.config, int(wildcards.seed))
+
+
+def fit_tracks_inputs(wildcards):
+    """The observed dataset (wind, frame rate, lead-in) and the tracks of every condition the
+    configuration fits (keys c<condition>); never the truth."""
+    out = {"observed": observed_input(wildcards)}
+    for c in fit_tracks_params(wildcards)["conditions"]:
+        out[f"c{c}"] = tracks_file(wildcards.tree, wildcards.seed, c)
+    return out
+
+
+def tracks_evaluate_inputs(wildcards):
+    """The fit, the training video's tracks, the dataset, the truth and its statistics, and ours'
+    checkpoint in the same configuration (scored at the same tracked points)."""
+    t, s, c = wildcards.tree, wildcards.seed, wildcards.config
+    return {
+        "fit": TRACKS_FIT.format(tree=t, seed=s, config=c),
+        "tracks": tracks_file(t, s, 0),
+        **testbed_files(t, s),
+        "ours": CKPT.format(tree=t, seed=s, model="ours", config=c),
     }

@@ -58,6 +58,7 @@ rule report:
                 and (n != "tab_damping" or DAMPING["trees"])
                 and (n not in _build.PARTS_OUTPUTS or PARTS_MODELS)
                 and (n != "tab_parts_k" or "ours_chain" in PARTS_MODELS)
+                and (n != "tab_tracks" or TRACKS_CONFIGS)
             ],
         ),
         expand(
@@ -74,7 +75,13 @@ rule claims:
     input:
         unpack(
             lambda wc: need_paths(
-                _build.claims_needs(TREES, CONFIGS, SEEDS, parts=bool(PARTS_MODELS))
+                _build.claims_needs(
+                    TREES,
+                    CONFIGS,
+                    SEEDS,
+                    parts=bool(PARTS_MODELS),
+                    tracks=bool(TRACKS_CONFIGS),
+                )
             )
         ),
     output:

@@ -39,8 +39,9 @@ TABLES = (
     "tab_damping",
     "tab_parts",
     "tab_parts_k",
+    "tab_tracks",
 )
-FIGURES = ("fig_temporal", "fig_teaser", "fig_results", "fig_damping", "fig_parts")
+FIGURES = ("fig_temporal", "fig_teaser", "fig_results", "fig_damping", "fig_parts", "fig_tracks")
 #: The fields of each need tuple after its kind (what a workflow path template is formatted with).
 NEED_FIELDS = {
     "eval": ("tree", "model", "config", "seed"),
@@ -55,12 +56,21 @@ NEED_FIELDS = {
     "kselect": ("tree", "seed"),
     "stats": ("tree",),
     "table": ("name",),
+    # the 2D-track control (physgs.tracks): its recovery record (ours' format), its evaluation
+    # record, its fit, one condition's tracks, and the observed dataset (fig_tracks' frame)
+    "tracks_recovery": ("tree", "config", "seed"),
+    "tracks_eval": ("tree", "config", "seed"),
+    "tracks_fit": ("tree", "config", "seed"),
+    "tracks": ("tree", "condition", "seed"),
+    "observed": ("tree", "seed"),
 }
 #: Figures that show one training seed (qualitative: images, trajectories, a damping scatter);
 #: they show the first seed listed.
-ONE_SEED_FIGURES = ("fig_teaser", "fig_results", "fig_damping", "fig_parts")
+ONE_SEED_FIGURES = ("fig_teaser", "fig_results", "fig_damping", "fig_parts", "fig_tracks")
 #: Outputs of the parts study (``parts_needs``), built only when it trains a variant.
 PARTS_OUTPUTS = ("tab_parts", "fig_parts", "tab_parts_k")
+#: Outputs of the 2D-track control (``tracks_needs``).
+TRACKS_OUTPUTS = ("tab_tracks", "fig_tracks")
 #: Tables the claims ledger reads (their CSVs), and the configuration whose damping it reads.
 CLAIMS_TABLES = ("tab_psnr", "tab_transfer", "tab_margin", "tab_null", "tab_testbed", "tab_fit")
 CLAIMS_CONFIG = "joint32"
@@ -86,10 +96,14 @@ def key(need: tuple) -> str:
 
 
 def damping_needs(
-    trees: Sequence[str], configs: Sequence[str], seeds: Sequence[int]
+    trees: Sequence[str],
+    configs: Sequence[str],
+    seeds: Sequence[int],
+    tracks_configs: Sequence[str] = (),
 ) -> list[tuple]:
     """What tab_damping reads: ours' recovery on each benchmark tree's faithful and damping
-    testbeds (``physgs.testbed.variant.damping_id``), per configuration and seed."""
+    testbeds (``physgs.testbed.variant.damping_id``), per configuration and seed, and the 2D-track
+    control's in ``tracks_configs``."""
     from physgs.testbed.variant import damping_id
 
     return [
@@ -98,7 +112,34 @@ def damping_needs(
         for tb in (t, damping_id(t))
         for c in configs
         for s in seeds
+    ] + [
+        ("tracks_recovery", tb, c, int(s))
+        for t in trees
+        for tb in (t, damping_id(t))
+        for c in tracks_configs
+        for s in seeds
     ]
+
+
+def tracks_needs(
+    name: str, trees: Sequence[str], configs: Sequence[str], seeds: Sequence[int]
+) -> list[tuple]:
+    """What tab_tracks or fig_tracks reads. configs: the configurations the control is fitted in
+    (``tracks.configs``). tab_tracks: its evaluation record per tree, configuration and seed;
+    fig_tracks: per tree, the observed frames, the training video's tracks and (with a
+    configuration) the first configuration's fit, of the first seed."""
+    if not seeds:
+        raise ValueError("tracks_needs: no training seeds given")
+    if name == "tab_tracks":
+        return [("tracks_eval", t, c, int(s)) for s in seeds for t in trees for c in configs]
+    if name == "fig_tracks":
+        s0 = int(seeds[0])
+        out = []
+        for t in trees:
+            out += [("observed", t, s0), ("tracks", t, 0, s0)]
+            out += [("tracks_fit", t, configs[0], s0)] if configs else []
+        return out
+    raise ValueError(f"tracks_needs: {name!r} is not one of {TRACKS_OUTPUTS}")
 
 
 def parts_needs(
@@ -153,13 +194,19 @@ def kmatch_needs(
 
 
 def claims_needs(
-    trees: Sequence[str], configs: Mapping[str, dict], seeds: Sequence[int], parts: bool = False
+    trees: Sequence[str],
+    configs: Mapping[str, dict],
+    seeds: Sequence[int],
+    parts: bool = False,
+    tracks: bool = False,
 ) -> list[tuple]:
     """What the claims ledger reads: the tables' CSVs and ours' recovery (damping) of every seed
     in the joint K=32 configuration (the paper's), or the base configuration when the config
-    has none; with ``parts``, tab_parts too (the parts study's hypotheses)."""
+    has none; with ``parts``, tab_parts too (the parts study's hypotheses); with ``tracks``,
+    tab_tracks (the 2D-track control's; its recovery rows are in tab_null)."""
     c = CLAIMS_CONFIG if CLAIMS_CONFIG in configs else BASE_CONFIG
     extra = [("table", "tab_parts")] if parts else []
+    extra += [("table", "tab_tracks")] if tracks else []
     return (
         [("table", n) for n in CLAIMS_TABLES]
         + extra
@@ -173,7 +220,7 @@ def make_claims(inputs: Mapping[str, str], trees: Sequence[str], md_path, csv_pa
     from physgs.atomic import atomic_path, write_text
     from physgs.report import claims
 
-    optional = [n for n in ("tab_parts",) if key(("table", n)) in inputs]
+    optional = [n for n in ("tab_parts", "tab_tracks") if key(("table", n)) in inputs]
     tabs = {n: pd.read_csv(inputs[key(("table", n))]) for n in (*CLAIMS_TABLES, *optional)}
     damping: dict[str, list] = {}
     for k, p in sorted(inputs.items()):  # recovery/<tree>/<config>/<seed>: one entry per seed
@@ -195,13 +242,19 @@ def make_claims(inputs: Mapping[str, str], trees: Sequence[str], md_path, csv_pa
 
 
 def needs(
-    name: str, trees: Sequence[str], configs: Mapping[str, dict], seeds: Sequence[int]
+    name: str,
+    trees: Sequence[str],
+    configs: Mapping[str, dict],
+    seeds: Sequence[int],
+    tracks: Mapping[str, int] | None = None,
 ) -> list[tuple]:
     """Every result an output reads, as need tuples (see the module docstring).
 
     configs: the config's ``models.configs`` (name -> {conditions, K}); the null control is
     keyed by K, so configurations sharing a K share one null. seeds: the training seeds; the
-    figures of ``ONE_SEED_FIGURES`` read the first only.
+    figures of ``ONE_SEED_FIGURES`` read the first only. tracks: the 2D-track control's
+    configurations (name -> its K, ``physgs.tracks.settings.parts``), whose recovery and null
+    tab_null also reads.
     """
     if name not in (*TABLES, *FIGURES):
         raise ValueError(f"unknown output '{name}'; choose one of {TABLES + FIGURES}")
@@ -209,6 +262,8 @@ def needs(
         raise ValueError("tab_damping reads the damping benchmark's testbeds: use damping_needs")
     if name in PARTS_OUTPUTS:
         raise ValueError(f"{name} reads the parts study's priors: use parts_needs")
+    if name in TRACKS_OUTPUTS:
+        raise ValueError(f"{name} reads the 2D-track control: use tracks_needs")
     if not seeds:
         raise ValueError("needs: no training seeds given")
     seeds = [int(seeds[0])] if name in ONE_SEED_FIGURES else [int(s) for s in seeds]
@@ -224,8 +279,13 @@ def needs(
         if name in ("tab_null", "fig_damping"):
             out += [("recovery", t, c, s) for t in trees for c in configs]
         if name == "tab_null":
+            tk = dict(tracks or {})
+            out += [("tracks_recovery", t, c, s) for t in trees for c in tk]
             out += list(
-                dict.fromkeys(("null", t, int(configs[c]["K"]), s) for t in trees for c in configs)
+                dict.fromkeys(
+                    [("null", t, int(configs[c]["K"]), s) for t in trees for c in configs]
+                    + [("null", t, int(k), s) for t in trees for k in tk.values()]
+                )
             )
         if name == "tab_kselect":
             for t in trees:
@@ -249,6 +309,11 @@ def settings_for(name: str, cfg: dict) -> dict:
             c: config_label(c, cfg["models"]["configs"][c])
             for c in cfg["damping_benchmark"]["configs"]
         }
+        out["tracks_configs"] = {
+            c: _tracks_label(cfg, c)
+            for c in cfg["damping_benchmark"]["configs"]
+            if c in cfg["tracks"]["configs"]
+        }
     if name not in ("tab_testbed", *ONE_SEED_FIGURES):
         out["seeds"] = [int(x) for x in cfg["seeds"]]
     elif name in ONE_SEED_FIGURES:
@@ -260,6 +325,24 @@ def settings_for(name: str, cfg: dict) -> dict:
             c: {"K": int(v["K"]), "conditions": v["conditions"]}
             for c, v in cfg["models"]["configs"].items()
         }
+    if name == "tab_null":
+        from physgs.tracks.settings import parts as tracks_k
+
+        out["tracks"] = {
+            c: {"K": tracks_k(cfg, c)[0], "label": _tracks_label(cfg, c)}
+            for c in cfg["tracks"]["configs"]
+        }
+    if name == "tab_tracks":
+        out["configs"] = {
+            c: {
+                "label": _tracks_label(cfg, c),
+                "conditions": cfg["models"]["configs"][c]["conditions"],
+            }
+            for c in cfg["tracks"]["configs"]
+        }
+        out["conditions"] = [float(c) for c in cfg["testbed"]["conditions"]]
+    if name == "fig_tracks":
+        out["configs"] = list(cfg["tracks"]["configs"])
     if name in ("tab_transfer", "tab_margin", "fig_teaser", "fig_results"):
         out["conditions"] = [float(c) for c in cfg["testbed"]["conditions"]]
     if name in ("fig_temporal", "tab_fit"):
@@ -290,6 +373,14 @@ def settings_for(name: str, cfg: dict) -> dict:
         out["n_train"] = int(cfg["testbed"]["n_train"])
         out["holdout_every"] = int(cfg["train"]["holdout_every"])
     return out
+
+
+def _tracks_label(cfg: dict, config: str) -> str:
+    """The LaTeX label of the 2D-track control's configuration ``config`` with its own K."""
+    from physgs.tracks.settings import parts as tracks_k
+
+    spec = {**cfg["models"]["configs"][config], "K": tracks_k(cfg, config)[0]}
+    return config_label(config, spec)
 
 
 def _reader(inputs: Mapping[str, str]):
@@ -415,7 +506,28 @@ def make_table(
             for s in seeds
         }
         labels = {c: config_label(c, v) for c, v in configs.items()}
-        table = tables.tab_null(rec, null, trees, bones, labels, digits=d)
+        tk = settings.get("tracks", {})
+        tracks = {
+            s: {
+                (t, c): (
+                    load_recovery(path("tracks_recovery", t, c, s)),
+                    load_null(path("null", t, int(tk[c]["K"]), s)),
+                )
+                for t in trees
+                for c in tk
+            }
+            for s in seeds
+        }
+        table = tables.tab_null(
+            rec,
+            null,
+            trees,
+            bones,
+            labels,
+            digits=d,
+            tracks=tracks,
+            tracks_configs={c: v["label"] for c, v in tk.items()},
+        )
     elif name == "tab_damping":
         from physgs.report.damping import tab_damping
         from physgs.testbed.variant import DAMPING, FAITHFUL, damping_id
@@ -430,9 +542,42 @@ def make_table(
             }
             for s in seeds
         }
-        table = tab_damping(rows, trees, bones, settings["configs"], digits=d)
+        tc = settings.get("tracks_configs", {})
+        tracks = {
+            s: {
+                (t, v, c): load_recovery(path("tracks_recovery", ids[v](t), c, s))
+                for t in trees
+                for v in ids
+                for c in tc
+            }
+            for s in seeds
+        }
+        table = tab_damping(
+            rows,
+            trees,
+            bones,
+            settings["configs"],
+            digits=d,
+            tracks=tracks,
+            tracks_configs=tc,
+        )
     elif name == "tab_parts":
         table = _tab_parts(path, settings, trees, bones, seeds, d)
+    elif name == "tab_tracks":
+        import json
+
+        from physgs.report.tracks import tab_tracks
+
+        scores = {}
+        for s in seeds:
+            scores[s] = {}
+            for t in trees:
+                for c in settings["configs"]:
+                    with open(path("tracks_eval", t, c, s)) as fh:
+                        scores[s][(t, c)] = json.load(fh)
+        table = tab_tracks(
+            scores, trees, bones, settings["configs"], settings["conditions"], digits=d
+        )
     elif name == "tab_parts_k":
         table = _tab_parts_k(path, settings, trees, bones, seeds, d)
     elif name == "tab_kselect":
@@ -583,5 +728,31 @@ def make_figure(
 
         recs = {t: load_segmentations(path("parts", t, s0)) for t in trees}
         fig_parts(recs, trees, outputs, title=f"parts of each prior (single), training seed {s0}")
+    elif name == "fig_tracks":
+        _fig_tracks(path, settings, trees, s0, outputs)
     else:
         raise ValueError(f"unknown figure '{name}'; choose one of {FIGURES}")
+
+
+def _fig_tracks(path, settings, trees, s0, outputs) -> None:
+    from physgs.report.tracks import fig_tracks
+    from physgs.tracks.store import load_fit, load_tracks
+
+    configs = list(settings["configs"])
+    frames, tracks, labels = {}, {}, {}
+    for t in trees:
+        with np.load(path("observed", t, s0)) as z:
+            frames[t] = z["frames"][0, 0]  # training condition, recorded frame 0 [H, W, 3]
+        tracks[t], _ = load_tracks(path("tracks", t, 0, s0))
+        labels[t] = (
+            load_fit(path("tracks_fit", t, configs[0], s0))[0].labels[0] if configs else None
+        )
+    what = f"parts of the {configs[0]} fit, " if configs else ""
+    fig_tracks(
+        frames,
+        tracks,
+        labels,
+        trees,
+        outputs,
+        title=f"tracks of the training video over frame 0 ({what}training seed {s0})",
+    )

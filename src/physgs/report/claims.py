@@ -109,6 +109,11 @@ def verdict(claim: Claim, values: Sequence[float]) -> str:
     return "undecided"
 
 
+def _ours(df: pd.DataFrame) -> pd.DataFrame:
+    """Ours' rows of a table that also holds the 2D-track control's (column ``method``)."""
+    return df[df["method"] == "ours"] if "method" in df.columns else df
+
+
 def _per_seed(df: pd.DataFrame) -> list[pd.DataFrame]:
     return [g for _, g in df.groupby("seed")] if "seed" in df.columns else [df]
 
@@ -180,7 +185,11 @@ def measure(
 
     for t in trees:
         tr, nl = PAPER_NULL.get(t, (np.nan, np.nan))
-        sel = lambda d, t=t: d[(d["tree"] == t) & (d["config"] == "joint32")]  # noqa: E731
+
+        def sel(d, t=t):
+            d = _ours(d)
+            return d[(d["tree"] == t) & (d["config"] == "joint32")]
+
         if t == "sparse":
             add(
                 Claim(
@@ -344,6 +353,8 @@ def measure(
 
     if "tab_parts" in tables:
         out += _parts_claims(tables["tab_parts"], trees)
+    if "tab_tracks" in tables:
+        out += _tracks_claims(tables["tab_null"], tables["tab_tracks"], trees)
 
     mg = tables["tab_margin"]
     cols = [c for c in mg.columns if c.startswith("margin_")]
@@ -420,6 +431,99 @@ def _parts_claims(df: pd.DataFrame, trees: Sequence[str]) -> list[tuple[Claim, l
                 ],
             )
         )
+    return out
+
+
+def _tracks_claims(
+    null: pd.DataFrame, tracks: pd.DataFrame, trees: Sequence[str]
+) -> list[tuple[Claim, list[float]]]:
+    """The 2D-track control's claims (issue 29): on the sparse tree it recovers omega better than
+    the untrained null and matches ours (tab_null, in the ledger's joint K=32 configuration when
+    the control is fitted there, else its first), and on every tree it extrapolates beyond the
+    window at least as well as ours' Gaussians at the same tracked points (tab_tracks, the base
+    configuration when fitted, else its first). A comparison with ours at another K (tracks/K
+    set to an integer) is not measured (NaN: 'undecided: not measured')."""
+    out: list[tuple[Claim, list[float]]] = []
+    mine = null[null["method"] == "tracks"] if "method" in null.columns else null.iloc[:0]
+    cfgs = list(dict.fromkeys(mine["config"]))
+    if "sparse" in trees and cfgs:
+        c = "joint32" if "joint32" in cfgs else cfgs[0]
+
+        def cell(d, method, col):
+            r = d[(d["tree"] == "sparse") & (d["config"] == c) & (d["method"] == method)]
+            return r.iloc[0][col]
+
+        out.append(
+            (
+                Claim(
+                    "tracks_beats_null/sparse",
+                    "sparse: oscillators fitted to 2D tracks recover omega better than the "
+                    "untrained null",
+                    "not run (the paper's closing proposal)",
+                    f"tab_null, 2D tracks {c}: null / tracks median rel. error",
+                    1.0,
+                    ">",
+                    "ratio",
+                ),
+                [
+                    float(
+                        cell(d, "tracks", "null_median_rel_err_pct")
+                        / cell(d, "tracks", "trained_median_rel_err_pct")
+                    )
+                    for d in _per_seed(null)
+                ],
+            )
+        )
+
+        def vs_ours(d):
+            if int(cell(d, "tracks", "K")) != int(cell(d, "ours", "K")):
+                return float("nan")  # another K: not the same question
+            return float(
+                cell(d, "tracks", "trained_median_rel_err_pct")
+                - cell(d, "ours", "trained_median_rel_err_pct")
+            )
+
+        out.append(
+            (
+                Claim(
+                    "tracks_match_ours/sparse",
+                    "sparse: oscillators fitted to 2D tracks match ours' omega recovery (ours "
+                    f"does not beat them by {NULL_MATCH_PP} points or more)",
+                    "not run (the paper's closing proposal)",
+                    f"tab_null, {c}: 2D tracks - ours median rel. error (points)",
+                    NULL_MATCH_PP,
+                    "<",
+                    "points",
+                ),
+                [vs_ours(d) for d in _per_seed(null)],
+            )
+        )
+    tc = list(dict.fromkeys(tracks["config"]))
+    if tc:
+        c = "single" if "single" in tc else tc[0]
+        for t in trees:
+            if not (tracks["tree"] == t).any():
+                continue
+
+            def tail(d, t=t):
+                r = d[(d["tree"] == t) & (d["config"] == c)].iloc[0]
+                return float(r["tail_px"] - r["tail_ours_px"])
+
+            out.append(
+                (
+                    Claim(
+                        f"tracks_extrapolate_as_ours/{t}",
+                        f"{t}: beyond the window, oscillators fitted to 2D tracks predict the "
+                        "tracked points at least as well as ours' Gaussians",
+                        "not run (the paper's closing proposal)",
+                        f"tab_tracks, {c}: tail displacement error, 2D tracks - ours (px)",
+                        0.0,
+                        "<",
+                        "px",
+                    ),
+                    [tail(d) for d in _per_seed(tracks)],
+                )
+            )
     return out
 
 

@@ -19,7 +19,7 @@ import numpy as np
 import pandas as pd
 
 from physgs.report import seeds as seedstats
-from physgs.report.tables import Table, _by_seed, _check, _seeds, _wrap, tree_label
+from physgs.report.tables import TRACKS_LABEL, Table, _by_seed, _check, _seeds, _wrap, tree_label
 from physgs.testbed.variant import DAMPING, FAITHFUL
 
 VARIANTS = (FAITHFUL, DAMPING)
@@ -42,22 +42,37 @@ def tab_damping(
     bones: Mapping[str, int],
     configs: Mapping[str, str],
     digits: int = 2,
+    tracks: Mapping[int, Mapping[tuple[str, str, str], object]] | None = None,
+    tracks_configs: Mapping[str, str] | None = None,
 ) -> Table:
     """``per_seed[seed][(tree, variant, config)]``: ``RecoveryRecord`` with damping scores and null;
     variant 'faithful' or 'damping'; configs: name -> LaTeX label, in row order. One CSV row per
     seed, tree, variant and configuration; the .tex gives mean +- sd over seeds and the paired
-    trained - null difference with its 95% interval."""
+    trained - null difference with its 95% interval.
+
+    tracks: the 2D-track control's records the same way (``physgs.tracks``, with damping scores),
+    for the configurations of ``tracks_configs`` (name -> LaTeX label); they follow ours' rows of
+    each testbed, column ``method`` 'tracks' (ours' rows: 'ours')."""
     seeds = _seeds(per_seed, "tab_damping")
-    keys = [(t, v, c) for t in trees for v in VARIANTS for c in configs]
+    tracks_configs = dict(tracks_configs or {})
+    block = [(c, "ours") for c in configs] + [(c, "tracks") for c in tracks_configs]
+    keys = [(t, v, c, m) for t in trees for v in VARIANTS for c, m in block]
     rows = []
     for s in seeds:
-        _check(keys, per_seed[s], f"tab_damping (seed {s})")
-        for t, v, c in keys:
-            rec = per_seed[s][(t, v, c)]
+        _check([k[:3] for k in keys if k[3] == "ours"], per_seed[s], f"tab_damping (seed {s})")
+        if tracks_configs:
+            _check(
+                [k[:3] for k in keys if k[3] == "tracks"],
+                (tracks or {}).get(s, {}),
+                f"tab_damping (tracks control, seed {s})",
+            )
+        for t, v, c, method in keys:
+            rec = per_seed[s][(t, v, c)] if method == "ours" else tracks[s][(t, v, c)]
             sc, nl = rec.damping_scores, rec.damping_null
             if sc is None or nl is None:
+                who = "" if method == "ours" else " (tracks control)"
                 raise ValueError(
-                    f"tab_damping: the recovery of {t}/{v}/{c} (seed {s}) has no "
+                    f"tab_damping: the recovery of {t}/{v}/{c}{who} (seed {s}) has no "
                     "damping scores; re-run its recovery rule with damping params"
                 )
             rows.append(
@@ -67,6 +82,7 @@ def tab_damping(
                     "bones": bones[t],
                     "testbed": v,
                     "config": c,
+                    "method": method,
                     "trusted": sc.n_trusted,
                     "rel_err_pct": 100 * sc.median_rel_err,
                     "null_rel_err_pct": 100 * nl.median_median_rel_err,
@@ -91,22 +107,24 @@ def tab_damping(
         r"& Null & $p$ (truth) \\",
         "    \\midrule",
     ]
+    per_tree = 2 * len(block)
     for i in range(len(keys)):
-        t, v, c = keys[i]
+        t, v, c, method = keys[i]
         head = (
-            rf"\multirow{{{2 * len(configs)}}}{{*}}{{{tree_label(t, bones[t])}}}"
-            if i % (2 * len(configs)) == 0
+            rf"\multirow{{{per_tree}}}{{*}}{{{tree_label(t, bones[t])}}}"
+            if i % per_tree == 0
             else ""
         )
         p = seedstats.pm(V["gamma_exponent"][:, i], ".2f")
         p_true = np.nanmean(V["gamma_exponent_true"][:, i])
+        label = configs[c] if method == "ours" else f"{TRACKS_LABEL}, {tracks_configs[c]}"
         lines.append(
             "    "
             + " & ".join(
                 [
                     head,
-                    v if i % len(configs) == 0 else "",
-                    configs[c],
+                    v if i % len(block) == 0 else "",
+                    label,
                     seedstats.pm(V["trusted"][:, i], ".1f"),  # a mean count: one decimal
                     pct(seedstats.pm(V["rel_err_pct"][:, i], ".0f")),
                     pct(seedstats.pm(V["null_rel_err_pct"][:, i], ".0f")),
@@ -118,7 +136,7 @@ def tab_damping(
             )
             + r" \\"
         )
-        if (i + 1) % (2 * len(configs)) == 0 and i + 1 < len(keys):
+        if (i + 1) % per_tree == 0 and i + 1 < len(keys):
             lines.append("    \\midrule")
     lines += ["    \\bottomrule", "  \\end{tabular}", ""]
     cap = (
@@ -132,6 +150,12 @@ def tab_damping(
         r"exponent $p$ of the fitted decay rate $\hat\gamma=\hat\zeta\hat\omega\propto"
         r"\hat\omega^p$ ($p\approx0$: a frequency-independent rate fitted in place of a "
         r"ratio), the truth's own $p$ on the matched bones in brackets."
+        + (
+            r" \emph{2D tracks}: the same oscillators fitted to point tracks of the training "
+            r"video (no renderer), scored on its own matching against its own null draw."
+            if tracks_configs
+            else ""
+        )
         + (
             rf" Mean $\pm$ sd over {len(seeds)} training seeds; differences bold when their 95\% "
             r"interval excludes 0, $^{\dagger}$ when not."

@@ -23,6 +23,10 @@ from physgs.models.registry import label
 from physgs.report import seeds as seedstats
 
 
+#: LaTeX name of the 2D-track control's rows (physgs.report.tracks, docs/tracks.md)
+TRACKS_LABEL = r"\emph{2D tracks}"
+
+
 @dataclass(frozen=True)
 class Table:
     name: str
@@ -352,6 +356,8 @@ def tab_null(
     bones: Mapping[str, int],
     configs: Mapping[str, str],
     digits: int = 2,
+    tracks: Mapping[int, Mapping[tuple[str, str], tuple]] | None = None,
+    tracks_configs: Mapping[str, str] | None = None,
 ) -> Table:
     """Frequency recovery of the trained model against the untrained null, per tree and config.
 
@@ -361,15 +367,39 @@ def tab_null(
     relative error (%), log-log R^2 for trained and null (null entries are medians over draws),
     trained - null (percentage points, paired per seed: negative means the trained model beats
     chance), and the median nearest-bone gap (%).
+
+    tracks: the 2D-track control's rows (``physgs.tracks``), ``tracks[seed][(tree, config)]`` =
+    (its ``RecoveryRecord``, the ``NullResult`` of its K), for the configurations of
+    ``tracks_configs`` (name -> LaTeX label, in row order); they follow ours' rows of each tree,
+    column ``method`` 'tracks' (ours' rows: 'ours').
     """
     seeds = _seeds(recovery, "tab_null")
-    keys = [(t, c) for t in trees for c in configs]
+    tracks_configs = dict(tracks_configs or {})
+    keys = [(t, c, "ours") for t in trees for c in configs]
+    keys += [(t, c, "tracks") for t in trees for c in tracks_configs]
     rows = []
     for s in seeds:
-        _check(keys, recovery.get(s, {}), f"tab_null (trained recovery, seed {s})")
-        _check(keys, null.get(s, {}), f"tab_null (null control, seed {s})")
-        for t, c in keys:
-            rec, nl = recovery[s][(t, c)], null[s][(t, c)]
+        _check(
+            [k[:2] for k in keys if k[2] == "ours"],
+            recovery.get(s, {}),
+            f"tab_null (trained recovery, seed {s})",
+        )
+        _check(
+            [k[:2] for k in keys if k[2] == "ours"],
+            null.get(s, {}),
+            f"tab_null (null control, seed {s})",
+        )
+        if tracks_configs:
+            _check(
+                [k[:2] for k in keys if k[2] == "tracks"],
+                (tracks or {}).get(s, {}),
+                f"tab_null (tracks control, seed {s})",
+            )
+        for t, c, method in keys:
+            if method == "ours":
+                rec, nl = recovery[s][(t, c)], null[s][(t, c)]
+            else:
+                rec, nl = tracks[s][(t, c)]
             m = rec.match
             if nl.n_parts != m.n_parts:
                 raise ValueError(
@@ -383,6 +413,7 @@ def tab_null(
                     "tree": t,
                     "bones": bones[t],
                     "config": c,
+                    "method": method,
                     "K": m.n_parts,
                     "trained_parts_trusted": float(m.n_trusted),
                     "trained_median_rel_err_pct": tr,
@@ -399,12 +430,22 @@ def tab_null(
                 }
             )
     df = pd.DataFrame(rows)
+    # each tree's rows together (ours', then the tracks control's), the same order every seed
+    order = {
+        (t, c, m): i for i, (t, c, m) in enumerate(sorted(keys, key=lambda k: trees.index(k[0])))
+    }
+    df = (
+        df.assign(_o=[order[(t, c, m)] for t, c, m in zip(df.tree, df.config, df.method)])
+        .sort_values(["seed", "_o"], kind="stable")
+        .drop(columns="_o")
+        .reset_index(drop=True)
+    )
     first = _first(df)
     first["_i"] = np.arange(len(first))
     V = {
         c: _by_seed(df, c, len(seeds))
         for c in df.columns
-        if c not in ("seed", "tree", "bones", "config", "K")
+        if c not in ("seed", "tree", "bones", "config", "method", "K")
     }
     d = int(digits)
     lines = [
@@ -429,7 +470,9 @@ def tab_null(
     def cells(r):
         i = r._i
         return [
-            configs[r.config],
+            configs[r.config]
+            if r.method == "ours"
+            else f"{TRACKS_LABEL}, {tracks_configs[r.config]}",
             parts("trained_parts_trusted", i, r.K),
             pct("trained_median_rel_err_pct", i),
             seedstats.pm(V["trained_loglog_r2"][:, i], ".3f"),
@@ -452,7 +495,15 @@ def tab_null(
         r"paired per seed (negative: the trained model beats chance); Gap: median nearest-bone "
         r"gap. Visible bones: the median errors restricted to parts matched to bones whose own "
         r"motion moves at least a pixel in the training camera (the CSV also gives the part "
-        r"counts)." + _seed_note(len(seeds))
+        r"counts)."
+        + (
+            r" \emph{2D tracks}: the same oscillators fitted to point tracks of the training "
+            r"video (no renderer), matched and trusted by the same rule, beside the null of its "
+            r"$K$; a part with too few tracks has no estimate and is never trusted."
+            if tracks_configs
+            else ""
+        )
+        + _seed_note(len(seeds))
     )
     return Table("tab_null", df, _wrap("\n".join(lines), cap, "tab:null"))
 

@@ -43,8 +43,9 @@ def fit_job(tracks: list[Tracks], observed, job: dict) -> tuple[TrackFit, Oscill
         raise ValueError(
             f"{job['K_key']} = {K} parts exceeds the {n_long} tracks of >= {n_min} frames "
             f"(tracks/min_track_frames) that the tracker kept in conditions {job['conditions']}: "
-            f"k-means cannot make {K} groups. Lower {job['K_key']}, set tracks/K to an integer "
-            "for the tracks control alone, or drop the configuration from tracks/configs"
+            f"k-means cannot make {K} groups. Lower {job['K_key']}"
+            + ("" if job["K_key"] == "tracks/K" else " or set tracks/K (the tracks control alone)")
+            + ", or drop the configuration from tracks/configs"
         )
     settings = FitSettings(
         K=K,
@@ -108,6 +109,7 @@ def evaluate_job(
             "loop_seconds": float(fit.loop_seconds),
             "rms_px": float(fit.rms_px),
             "n_fitted": int(fitted.sum()),
+            "n_estimated": int(fit.estimated.sum()),
         },
     }
     if ours is not None:

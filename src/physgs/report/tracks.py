@@ -1,0 +1,245 @@
+"""tab_tracks and fig_tracks: the 2D-track control (issue 29, ``physgs.tracks``, docs/tracks.md).
+
+tab_tracks, per tree, configuration and training seed, from the control's evaluation record
+(``physgs.tracks.run.evaluate_job``): the tracker against the truth-projected vertices (tracks
+started, share of the frame-0 tracks kept to the window's end, median and 90th-percentile
+position error and displacement error, px), the fit (K, parts with an estimate, fit seconds),
+and the motion errors (px, median over tracks and frames of the displacement error since each
+track's seed frame) of the control's predicted tracks beyond the window (the tail frames at the
+training wind) and under each unseen wind (window frames), beside ours' Gaussians at the same
+tracked points and a motionless prediction (each track's mean tracked position).
+
+fig_tracks: per tree, the training camera's frame 0 with the tracks' paths over the window,
+coloured by the part of the fit they were grouped into (grey: not fitted).
+"""
+
+from __future__ import annotations
+
+from typing import Mapping, Sequence
+
+import numpy as np
+import pandas as pd
+
+from physgs.report import seeds as seedstats
+from physgs.report.tables import (
+    TRACKS_LABEL,
+    Table,
+    _by_seed,
+    _check,
+    _seeds,
+    _wrap,
+    condition_label,
+    tree_label,
+)
+
+#: the method label of the tracks control's rows in tab_null and tab_damping (column ``method``)
+METHOD = "tracks"
+#: LaTeX name of the control in other tables' rows
+LABEL = TRACKS_LABEL
+TRACKER_COLUMNS = (
+    "n_tracks",
+    "n_seed0",
+    "share_kept",
+    "track_median_px",
+    "track_p90_px",
+    "disp_median_px",
+    "disp_p90_px",
+)
+
+
+def case_label(case: str, conditions: Sequence[float]) -> str:
+    """CSV column stem of a motion case: 'tail', or 'wind_<mult>v0' for case 'wind<c>'."""
+    if case == "tail":
+        return "tail"
+    return "wind_" + condition_label(float(conditions[int(case[4:])]), tex=False)
+
+
+def row(scores: Mapping, conditions: Sequence[float]) -> dict[str, float]:
+    """One tab_tracks row from an evaluation record (``evaluate_job``'s scores); conditions: the
+    testbed's mean-speed multipliers (the first is the training wind). Motion columns
+    ``<case>_px`` (the control), ``<case>_ours_px`` (ours' Gaussians at the same points; NaN when
+    not scored), ``<case>_static_px`` (motionless)."""
+    tr, fit = scores["tracker"], scores["fit"]
+    out = {
+        "n_tracks": float(tr["n_tracks"]),
+        "n_seed0": float(tr["n_seed0"]),
+        "share_kept": float(tr["share_kept"]),
+        "track_median_px": float(tr["median_px"]),
+        "track_p90_px": float(tr["p90_px"]),
+        "disp_median_px": float(tr["disp_median_px"]),
+        "disp_p90_px": float(tr["disp_p90_px"]),
+        "K": float(fit["K"]),
+        "parts_estimated": float(fit["n_estimated"]),
+        "n_fitted": float(fit["n_fitted"]),
+        "fit_s": float(fit["seconds"]),
+        "fit_rms_px": float(fit["rms_px"]),
+    }
+    cases = ["tail", *(f"wind{c}" for c in range(1, len(conditions)))]
+    for case in cases:
+        if case not in scores:
+            raise KeyError(f"tab_tracks: the evaluation record has no {case!r} motion scores")
+        stem, sc = case_label(case, conditions), scores[case]
+        ours = sc.get("ours")
+        out[f"{stem}_px"] = float(sc["tracks"]["motion_median_px"])
+        out[f"{stem}_ours_px"] = float(ours["motion_median_px"]) if ours else float("nan")
+        out[f"{stem}_static_px"] = float(sc["tracks"]["static_median_px"])
+    return out
+
+
+def tab_tracks(
+    per_seed: Mapping[int, Mapping[tuple[str, str], Mapping]],
+    trees: Sequence[str],
+    bones: Mapping[str, int],
+    configs: Mapping[str, Mapping],
+    conditions: Sequence[float],
+    digits: int = 2,
+) -> Table:
+    """``per_seed[seed][(tree, config)]``: an evaluation record (``evaluate_job``'s scores);
+    configs: name -> {"label": LaTeX, "conditions": 'train' | 'all'}, in row order; conditions:
+    the testbed's multipliers. One CSV row per seed, tree and configuration; the .tex gives the
+    mean +- sd over seeds (one seed: the value)."""
+    seeds = _seeds(per_seed, "tab_tracks")
+    keys = [(t, c) for t in trees for c in configs]
+    recs = []
+    for s in seeds:
+        _check(keys, per_seed[s], f"tab_tracks (seed {s})")
+        for t, c in keys:
+            recs.append(
+                {
+                    "seed": s,
+                    "tree": t,
+                    "bones": bones[t],
+                    "config": c,
+                    "conditions": configs[c]["conditions"],
+                    **row(per_seed[s][(t, c)], conditions),
+                }
+            )
+    df = pd.DataFrame(recs)
+    stems = ["tail", *(case_label(f"wind{c}", conditions) for c in range(1, len(conditions)))]
+    num = [c for c in df.columns if c not in ("seed", "tree", "bones", "config", "conditions")]
+    V = {c: _by_seed(df, c, len(seeds)) for c in num}
+    fmt = f".{int(digits)}f"
+    heads = ["beyond the window"] + [
+        f"wind {condition_label(float(conditions[c]))}" for c in range(1, len(conditions))
+    ]
+    ncol = 7 + 3 * len(stems)
+    lines = [
+        "  \\begin{tabular}{ll" + "c" * (ncol - 2) + "}",
+        "    \\toprule",
+        r"    & & \multicolumn{3}{c}{Tracker} & \multicolumn{2}{c}{Fit} & "
+        + " & ".join(rf"\multicolumn{{3}}{{c}}{{{h} (px)}}" for h in heads)
+        + r" \\",
+        "    "
+        + r"\cmidrule(lr){3-5}\cmidrule(lr){6-7}"
+        + "".join(rf"\cmidrule(lr){{{8 + 3 * i}-{10 + 3 * i}}}" for i in range(len(stems))),
+        r"    Tree & Config & Tracks (kept) & Error (px) & Displ.\ (px) & Parts & s & "
+        + " & ".join(["Tracks & Ours & Still"] * len(stems))
+        + r" \\",
+        "    \\midrule",
+    ]
+    for i, (t, c) in enumerate(keys):
+        head = (
+            rf"\multirow{{{len(configs)}}}{{*}}{{{tree_label(t, bones[t])}}}"
+            if i % len(configs) == 0
+            else ""
+        )
+        n = np.nanmean(V["n_tracks"][:, i])
+        kept = np.nanmean(V["share_kept"][:, i])
+        cells = [
+            head,
+            configs[c]["label"],
+            f"{n:.0f} ({100 * kept:.0f}\\%)",
+            seedstats.pm(V["track_median_px"][:, i], fmt)
+            + " / "
+            + seedstats.pm(V["track_p90_px"][:, i], fmt),
+            seedstats.pm(V["disp_median_px"][:, i], fmt)
+            + " / "
+            + seedstats.pm(V["disp_p90_px"][:, i], fmt),
+            f"{np.nanmean(V['parts_estimated'][:, i]):.0f}/{np.nanmean(V['K'][:, i]):.0f}",
+            seedstats.pm(V["fit_s"][:, i], ".0f"),
+        ]
+        for stem in stems:
+            cells += [
+                seedstats.pm(V[f"{stem}_px"][:, i], fmt),
+                seedstats.pm(V[f"{stem}_ours_px"][:, i], fmt),
+                seedstats.pm(V[f"{stem}_static_px"][:, i], fmt),
+            ]
+        lines.append("    " + " & ".join(cells) + r" \\")
+        if (i + 1) % len(configs) == 0 and i + 1 < len(keys):
+            lines.append("    \\midrule")
+    lines += ["    \\bottomrule", "  \\end{tabular}", ""]
+    joint = [c for c in configs if configs[c]["conditions"] != "train"]
+    cap = (
+        r"The 2D-track control: ours' oscillators fitted to Lucas--Kanade point tracks of the "
+        r"training video. \emph{Tracker}, against the truth-projected mesh vertices over the "
+        r"training window: tracks started (share of the frame-0 tracks kept to the window's "
+        r"end), median / 90th-percentile position error and displacement error since each "
+        r"track's seed frame (px). \emph{Fit}: parts with an estimate of $K$ (a part needs "
+        r"enough tracks), wall seconds of the fit. Motion: median displacement error (px) of "
+        r"the predicted tracks beyond the training window (training wind) and under each other "
+        r"wind (window frames), beside ours' Gaussians at the same tracked points and a "
+        r"motionless prediction (each track's mean tracked position)."
+        + (
+            " The joint configurations ("
+            + ", ".join(j.replace("_", r"\_") for j in joint)
+            + r") are fitted to every wind: their other-wind columns are not transfer."
+            if joint
+            else ""
+        )
+        + (
+            rf" Mean $\pm$ sd over {len(seeds)} training seeds."
+            if len(seeds) > 1
+            else " One training seed."
+        )
+    )
+    return Table("tab_tracks", df, _wrap("\n".join(lines), cap, "tab:tracks"))
+
+
+def fig_tracks(
+    frames: Mapping[str, np.ndarray],
+    tracks: Mapping[str, object],
+    labels: Mapping[str, np.ndarray | None],
+    trees: Sequence[str],
+    outputs: Sequence[str],
+    title: str = "",
+) -> None:
+    """One panel per tree: ``frames[tree]`` [H, W, 3] uint8 (the training camera's frame 0) under
+    the paths of ``tracks[tree]`` (``physgs.tracks.track.Tracks`` of that video; pixel centres at
+    integer + 0.5, so a path is drawn at xy - 0.5 in imshow's coordinates), each coloured by
+    ``labels[tree]`` [P] (its part; -1 or None: grey), its seed position a dot. Written to every
+    path of ``outputs`` (pdf, png)."""
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    from physgs.atomic import atomic_path
+
+    fig, axes = plt.subplots(1, len(trees), figsize=(3.6 * len(trees), 3.9), squeeze=False)
+    cmap = plt.get_cmap("tab20")
+    for ax, t in zip(axes[0], trees):
+        tr, lab = tracks[t], labels.get(t)
+        ax.imshow(frames[t], interpolation="nearest")
+        for p in range(tr.n_tracks):
+            xy = tr.xy[p, tr.valid[p]] - 0.5
+            part = -1 if lab is None else int(lab[p])
+            colour = "0.6" if part < 0 else cmap(part % 20)
+            ax.plot(xy[:, 0], xy[:, 1], "-", color=colour, lw=0.6 if part < 0 else 0.9)
+            ax.plot(xy[:1, 0], xy[:1, 1], ".", color=colour, ms=2)
+        s0 = tr.start == 0
+        kept = float(tr.valid[s0, -1].mean()) if s0.any() else 0.0
+        fitted = 0 if lab is None else int((np.asarray(lab) >= 0).sum())
+        ax.set_title(
+            f"{t}: {tr.n_tracks} tracks, {100 * kept:.0f}% of frame 0's kept,\n"
+            f"{fitted} fitted (coloured by part)",
+            fontsize=8,
+        )
+        ax.set_xticks([])
+        ax.set_yticks([])
+    if title:
+        fig.suptitle(title, fontsize=9)
+    fig.tight_layout()
+    for out in outputs:
+        with atomic_path(out) as tmp:
+            fig.savefig(tmp, dpi=150)
+    plt.close(fig)

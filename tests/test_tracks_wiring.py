@@ -1,0 +1,516 @@
+"""The 2D-track control as a method of the pipeline (issue 29): its config, its files, its rows in
+tab_null / tab_damping, tab_tracks, its ledger claims, what its outputs read, and its rules' plan
+(the tracker and the fit never read truth.npz)."""
+
+from __future__ import annotations
+
+import dataclasses
+import re
+import subprocess
+import sys
+from types import SimpleNamespace
+
+import numpy as np
+import pandas as pd
+import pytest
+
+from physgs.recovery.damping import damping_summary
+from physgs.recovery.damping_scores import damping_null, damping_scores
+from physgs.recovery.matcher import MatchResult
+from physgs.recovery.null import NullResult
+from physgs.recovery.record import RecoveryRecord, load_recovery
+from physgs.report import build, claims
+from physgs.report import tables as T
+from physgs.report.damping import tab_damping
+from physgs.report.tracks import tab_tracks
+from physgs.tracks import settings as tsettings
+from oracles import quick_config
+from test_config import _refused
+from workflow_helpers import ROOT
+
+BONES = {"sparse": 22, "medium": 224}
+
+
+# --- config ------------------------------------------------------------------------------------
+
+
+def test_tracks_configs_must_be_configurations_of_ours():
+    msg = _refused(lambda c: c["tracks"].update(configs=["single", "joint64"]))
+    assert "tracks/configs/1" in msg and "joint64" in msg and "models/configs" in msg
+
+
+def test_min_track_frames_longer_than_the_window_is_refused():
+    msg = _refused(lambda c: c["tracks"].update(min_track_frames=400))
+    assert "tracks/min_track_frames" in msg and "testbed/n_train = 300" in msg
+
+
+@pytest.mark.parametrize(
+    "edit, key",
+    [
+        (lambda c: c["tracks"]["tracker"].update(win_px=10), "tracks/tracker/win_px"),
+        (lambda c: c["tracks"].update(K="all"), "tracks/K"),
+        (lambda c: c["tracks"].update(K=0), "tracks/K"),
+        (lambda c: c["tracks"]["tracker"].update(reference="next"), "tracks/tracker/reference"),
+        (lambda c: c["tracks"].update(min_tracks=0), "tracks/min_tracks"),
+    ],
+)
+def test_bad_tracks_values_are_refused_by_the_schema(edit, key):
+    assert key in _refused(edit)
+
+
+def test_fit_params_are_the_configurations_k_and_conditions_or_the_override():
+    cfg = quick_config()  # quick: tracks/K = 2 for every configuration
+    job = tsettings.fit_job(cfg, "joint32", seed=3)
+    assert job["K"] == 2 and job["K_key"] == "tracks/K"
+    assert job["conditions"] == list(range(len(cfg["testbed"]["conditions"])))
+    assert job["seed"] == 3 and job["lr"] == cfg["train"]["lr"]["physics"]
+    assert set(job["ours"]) == set(tsettings.OURS_KEYS)
+    cfg["tracks"]["K"] = "same"
+    job = tsettings.fit_job(cfg, "single", seed=0)
+    assert job["K"] == cfg["models"]["configs"]["single"]["K"] and job["conditions"] == [0]
+    assert job["K_key"] == "models/configs/single/K"
+    with pytest.raises(ValueError, match="joint96"):  # quick fits single and joint32 only
+        tsettings.fit_job(cfg, "joint96", seed=0)
+
+
+def test_a_k_above_the_tracks_kept_stops_the_fit_naming_the_key():
+    from physgs.tracks.run import fit_job
+    from physgs.tracks.track import Tracks
+
+    T = 40
+    valid = np.zeros((5, T), bool)
+    valid[:3] = True  # three tracks span the window, two last 10 frames (< min_track_frames)
+    valid[3:, :10] = True
+    xy = np.where(valid[..., None], 10.0, np.nan)
+    tracks = Tracks(xy, valid, np.zeros(5, np.int64))
+    job = tsettings.fit_job(quick_config(), "single", seed=0)
+    job.update(K=4, K_key="models/configs/single/K")
+    with pytest.raises(ValueError, match=r"models/configs/single/K = 4 parts exceeds the 3 tracks"):
+        fit_job([tracks], SimpleNamespace(), job)
+
+
+# --- files -------------------------------------------------------------------------------------
+
+
+def test_tracks_and_fit_files_round_trip(tmp_path):
+    from physgs.tracks.fit import FitSettings, fit_tracks
+    from physgs.tracks.store import load_fit, load_tracks, save_fit, save_tracks
+    from test_tracks import _synthetic
+
+    tracks, wind, osc, _, _ = _synthetic()
+    save_tracks(tmp_path / "c0.npz", tracks, 0)
+    back, c = load_tracks(tmp_path / "c0.npz")
+    assert c == 0 and np.array_equal(back.xy, tracks.xy, equal_nan=True)
+    assert np.array_equal(back.valid, tracks.valid) and np.array_equal(back.start, tracks.start)
+    fit = fit_tracks([tracks], [0], wind, osc, FitSettings(K=2, iterations=3))
+    save_fit(tmp_path / "fit.npz", fit, osc, "models/configs/single/K", 3)
+    f2, o2, meta = load_fit(tmp_path / "fit.npz")
+    assert o2 == osc and meta == {"K_key": "models/configs/single/K", "min_tracks": 3}
+    for name in ("omega", "zeta", "estimated", "n_tracks", "loss_px2"):
+        np.testing.assert_array_equal(getattr(f2, name), getattr(fit, name))
+    np.testing.assert_array_equal(f2.d[0], fit.d[0])
+    assert f2.conditions == [0] and f2.seconds == fit.seconds
+
+
+def test_the_recovery_record_counts_parts_without_an_estimate(tmp_path):
+    """Six tracks in part 0, two in part 1 (< min_tracks = 3): part 1 has no estimate, is never
+    trusted, and the record says so with both counts; ours' loader reads the same file."""
+    from physgs.tracks.fit import FitSettings, fit_tracks
+    from physgs.tracks.recover import load_tracks_block, recover_tracks, save_tracks_recovery
+    from physgs.tracks.track import Tracks
+    from test_tracks import _synthetic
+
+    tracks, wind, osc, truth_om, _ = _synthetic(n_per_part=6)
+    keep = np.r_[np.arange(6), 6, 7]
+    few = Tracks(tracks.xy[keep], tracks.valid[keep], tracks.start[keep])
+    fit = fit_tracks([few], [0], wind, osc, FitSettings(K=2, iterations=5))
+    L, T = osc.lead_in, few.xy.shape[1]
+    theta = np.zeros((1, L + T, 2))  # two bones swinging like the two parts' true oscillators
+    from test_tracks import _simulate
+
+    for b, (om, ze) in enumerate(truth_om):
+        theta[0, :, b] = _simulate(om, ze, wind[0, : L + T], wind[0].mean(), 1 / 24, 1.0)
+    truth = SimpleNamespace(
+        omega=np.array([om for om, _ in truth_om]), zeta=np.array([0.06, 0.12]), theta=theta
+    )
+    observed = SimpleNamespace(wind=wind[:, : L + T], lead_in_frames=L, n_train=T)
+    rec = recover_tracks(fit, osc, observed, truth, min_tracks=3)
+    save_tracks_recovery(tmp_path / "r.json", rec)
+    block = load_tracks_block(tmp_path / "r.json")
+    assert block["n_tracks_per_part"] == [6, 2] and block["min_tracks"] == 3
+    assert block["no_estimate"] == [1] and block["n_no_estimate"] == 1
+    back = load_recovery(tmp_path / "r.json")
+    assert back.match.n_parts == 2 and not back.match.trusted[1]
+
+
+# --- tables ------------------------------------------------------------------------------------
+
+
+def _record(err, n_trusted=3, K=4):
+    rel = np.full(K, np.nan)
+    rel[:n_trusted] = err
+    trusted = np.arange(K) < n_trusted
+    m = MatchResult(
+        np.arange(K), np.ones(K), trusted, np.ones(K), np.ones(K), rel, n_trusted, K, err, 0.9
+    )
+    return RecoveryRecord(m, damping_summary(np.ones(K), np.full(K, 0.1), 0.08), 0, 2, err)
+
+
+def _null(err, K=4):
+    return NullResult(
+        np.array([3] * 8), np.full(8, err), np.full(8, 0.5), np.ones((1, 8)), K, 0.01, 0
+    )
+
+
+def test_tab_null_adds_the_tracks_rows_after_ours_and_leaves_ours_rows_as_they_were():
+    cfg = {"single": "single", "joint32": "joint"}
+    rec = {s: {(t, c): _record(0.02 + 0.001 * s) for t in BONES for c in cfg} for s in (0, 1)}
+    nl = {s: {(t, c): _null(0.05) for t in BONES for c in cfg} for s in (0, 1)}
+    tracks = {
+        s: {(t, "joint32"): (_record(0.03 + 0.002 * s, K=2), _null(0.06, K=2)) for t in BONES}
+        for s in (0, 1)
+    }
+    plain = T.tab_null(rec, nl, list(BONES), BONES, cfg).df
+    both = T.tab_null(
+        rec, nl, list(BONES), BONES, cfg, tracks=tracks, tracks_configs={"joint32": "j2"}
+    )
+    df = both.df
+    ours = df[df.method == "ours"].drop(columns="method").reset_index(drop=True)
+    pd.testing.assert_frame_equal(ours, plain.drop(columns="method"))
+    mine = df[df.method == "tracks"]
+    assert list(mine.config) == ["joint32"] * 4 and set(mine.K) == {2}
+    np.testing.assert_allclose(mine.trained_median_rel_err_pct, [3.0, 3.0, 3.2, 3.2])
+    np.testing.assert_allclose(mine.null_median_rel_err_pct, 6.0)
+    # each tree's rows together, the tracks row last, in the .tex as in the CSV
+    first = df[df.seed == 0]
+    assert list(zip(first.tree, first.method)) == [
+        ("sparse", "ours"),
+        ("sparse", "ours"),
+        ("sparse", "tracks"),
+        ("medium", "ours"),
+        ("medium", "ours"),
+        ("medium", "tracks"),
+    ]
+    assert r"\emph{2D tracks}, j2" in both.tex
+    bad = {0: {(t, "joint32"): (_record(0.03, K=2), _null(0.06, K=4)) for t in BONES}}
+    with pytest.raises(ValueError, match="K=4 but the model has K=2"):
+        T.tab_null(
+            {0: rec[0]},
+            {0: nl[0]},
+            list(BONES),
+            BONES,
+            cfg,
+            tracks=bad,
+            tracks_configs={"joint32": "j"},
+        )
+
+
+def _damped(zeta_hat, seed):
+    zb = np.array([0.03, 0.06, 0.1, 0.2])
+    om = np.array([2.0, 3.0, 5.0, 8.0])
+    m = MatchResult(np.arange(4), np.ones(4), np.ones(4, bool), om, om, np.zeros(4), 4, 4, 0.0, 1.0)
+    rec = RecoveryRecord(m, damping_summary(om, np.asarray(zeta_hat), 0.08))
+    return dataclasses.replace(
+        rec,
+        damping_scores=damping_scores(m.bone, m.trusted, zeta_hat, om, zb, om),
+        damping_null=damping_null(m.bone, m.trusted, om, zb, om, [0.03, 0.2], seed=seed),
+    )
+
+
+def test_tab_damping_adds_the_tracks_rows_with_their_own_scores():
+    zb = np.array([0.03, 0.06, 0.1, 0.2])
+    ours = {
+        s: {("sparse", v, c): _damped(zb * 1.1, s) for v in ("faithful", "damping") for c in "ab"}
+        for s in (0, 1)
+    }
+    mine = {
+        s: {("sparse", v, "a"): _damped(zb * 1.5, s) for v in ("faithful", "damping")}
+        for s in (0, 1)
+    }
+    tab = tab_damping(
+        ours,
+        ["sparse"],
+        {"sparse": 22},
+        {"a": "A", "b": "B"},
+        tracks=mine,
+        tracks_configs={"a": "A"},
+    )
+    df = tab.df
+    assert len(df) == 2 * 2 * 3 and set(df.method) == {"ours", "tracks"}
+    np.testing.assert_allclose(df[df.method == "ours"].rel_err_pct, 10.0)
+    np.testing.assert_allclose(df[df.method == "tracks"].rel_err_pct, 50.0)
+    assert list(df[df.seed == 0].method) == ["ours", "ours", "tracks"] * 2
+    assert r"\multirow{6}{*}" in tab.tex and r"\emph{2D tracks}, A" in tab.tex
+    none = {
+        s: {k: dataclasses.replace(r, damping_scores=None) for k, r in d.items()}
+        for s, d in mine.items()
+    }
+    with pytest.raises(ValueError, match="tracks control"):
+        tab_damping(
+            ours, ["sparse"], {"sparse": 22}, {"a": "A"}, tracks=none, tracks_configs={"a": "A"}
+        )
+
+
+def _scores(tail, tail_ours, n=40, kept=0.5):
+    """An evaluation record as tracks_evaluate writes it (three conditions)."""
+    mot = lambda a, b: {  # noqa: E731
+        "tracks": {
+            "motion_median_px": a,
+            "static_median_px": 0.9,
+            "median_px": a + 1,
+            "n_tracks": 7,
+        },
+        "ours": {"motion_median_px": b, "static_median_px": 0.9, "median_px": b + 1, "n_tracks": 7},
+    }
+    return {
+        "tracker": {
+            "median_px": 0.8,
+            "p90_px": 1.6,
+            "disp_median_px": 0.3,
+            "disp_p90_px": 0.7,
+            "share_kept": kept,
+            "n_tracks": n,
+            "n_seed0": 10,
+            "mean_length": 30.0,
+            "median_start_px": 0.5,
+        },
+        "fit": {
+            "K": 4,
+            "seconds": 12.5,
+            "loop_seconds": 10.0,
+            "rms_px": 0.2,
+            "n_fitted": 7,
+            "n_estimated": 3,
+        },
+        "tail": mot(tail, tail_ours),
+        "wind1": mot(0.41, 0.52),
+        "wind2": mot(0.43, 0.54),
+    }
+
+
+def test_tab_tracks_rows_are_the_records_values():
+    per_seed = {s: {("sparse", "single"): _scores(0.3 + 0.01 * s, 0.5)} for s in (0, 1)}
+    tab = tab_tracks(
+        per_seed,
+        ["sparse"],
+        {"sparse": 22},
+        {"single": {"label": "s", "conditions": "train"}},
+        [1.0, 0.84, 0.71],
+    )
+    df = tab.df
+    assert list(df.seed) == [0, 1]
+    np.testing.assert_allclose(df.tail_px, [0.3, 0.31])
+    np.testing.assert_allclose(df.tail_ours_px, 0.5)
+    np.testing.assert_allclose(df["wind_0.84v0_px"], 0.41)
+    np.testing.assert_allclose(df["wind_0.71v0_ours_px"], 0.54)
+    np.testing.assert_allclose(df["wind_0.71v0_static_px"], 0.9)
+    assert (
+        (df.track_p90_px == 1.6).all() and (df.share_kept == 0.5).all() and (df.fit_s == 12.5).all()
+    )
+    assert (df.parts_estimated == 3).all() and (df.K == 4).all()
+    assert "0.30 $\\pm$ 0.01" in tab.tex and "40 (50\\%)" in tab.tex and "3/4" in tab.tex
+    del per_seed[1][("sparse", "single")]["wind2"]
+    with pytest.raises(KeyError, match="wind2"):
+        tab_tracks(
+            per_seed,
+            ["sparse"],
+            {"sparse": 22},
+            {"single": {"label": "s", "conditions": "train"}},
+            [1.0, 0.84, 0.71],
+        )
+
+
+# --- the ledger --------------------------------------------------------------------------------
+
+
+def _null_csv(tracks_err, ours_err=2.0, null_err=5.0, tracks_k=32):
+    rows = []
+    for s, te in enumerate(tracks_err):
+        for method, err, K in (("ours", ours_err + 0.01 * s, 32), ("tracks", te, tracks_k)):
+            rows.append(
+                {
+                    "seed": s,
+                    "tree": "sparse",
+                    "config": "joint32",
+                    "method": method,
+                    "K": K,
+                    "trained_median_rel_err_pct": err,
+                    "null_median_rel_err_pct": null_err,
+                }
+            )
+    return pd.DataFrame(rows)
+
+
+def _tracks_csv(diffs):
+    return pd.DataFrame(
+        [
+            {
+                "seed": s,
+                "tree": "sparse",
+                "config": "single",
+                "tail_px": 0.4 + d,
+                "tail_ours_px": 0.4,
+            }
+            for s, d in enumerate(diffs)
+        ]
+    )
+
+
+@pytest.mark.parametrize(
+    "tracks_err, tail, beats, match, extrap",
+    [
+        ([2.0, 2.1, 2.05], [-0.1, -0.12, -0.11], "holds", "holds", "holds"),
+        ([8.0, 8.2, 8.1], [0.2, 0.21, 0.22], "fails", "fails", "fails"),
+    ],
+)
+def test_tracks_claims_follow_the_paired_values(tracks_err, tail, beats, match, extrap):
+    got = {
+        c.id: (c, v)
+        for c, v in claims._tracks_claims(_null_csv(tracks_err), _tracks_csv(tail), ["sparse"])
+    }
+    c, v = got["tracks_beats_null/sparse"]
+    assert v == pytest.approx([5.0 / e for e in tracks_err]) and claims.verdict(c, v) == beats
+    c, v = got["tracks_match_ours/sparse"]
+    assert v == pytest.approx([e - (2.0 + 0.01 * s) for s, e in enumerate(tracks_err)])
+    assert c.threshold == claims.NULL_MATCH_PP and claims.verdict(c, v) == match
+    c, v = got["tracks_extrapolate_as_ours/sparse"]
+    assert v == pytest.approx(tail) and claims.verdict(c, v) == extrap
+
+
+def test_a_tracks_fit_at_another_k_is_not_compared_with_ours():
+    got = {
+        c.id: (c, v)
+        for c, v in claims._tracks_claims(
+            _null_csv([2.0, 2.0], tracks_k=2), _tracks_csv([0, 0]), ["sparse"]
+        )
+    }
+    c, v = got["tracks_match_ours/sparse"]
+    assert np.isnan(v).all() and claims.verdict(c, v) == "undecided: not measured"
+
+
+def test_ours_claims_read_ours_rows_of_a_table_with_tracks_rows():
+    """null_loses/sparse reads ours' row even where the tracks row comes first."""
+    df = _null_csv([1.0, 1.0]).iloc[::-1]
+    sel = claims._ours(df)
+    assert set(sel.method) == {"ours"} and len(sel) == 2
+
+
+# --- what each output reads --------------------------------------------------------------------
+
+
+def test_needs_of_the_tracks_outputs():
+    assert build.tracks_needs("tab_tracks", ["sparse"], ["single", "joint32"], [0, 1]) == [
+        ("tracks_eval", "sparse", "single", 0),
+        ("tracks_eval", "sparse", "joint32", 0),
+        ("tracks_eval", "sparse", "single", 1),
+        ("tracks_eval", "sparse", "joint32", 1),
+    ]
+    assert build.tracks_needs("fig_tracks", ["sparse"], ["joint32"], [5, 6]) == [
+        ("observed", "sparse", 5),
+        ("tracks", "sparse", 0, 5),
+        ("tracks_fit", "sparse", "joint32", 5),
+    ]
+    null = build.needs("tab_null", ["sparse"], {"single": {"K": 32}}, [0], tracks={"single": 2})
+    assert ("tracks_recovery", "sparse", "single", 0) in null
+    assert ("null", "sparse", 2, 0) in null and ("null", "sparse", 32, 0) in null
+    assert not any(
+        n[0].startswith("tracks")
+        for n in build.needs("tab_null", ["sparse"], {"single": {"K": 32}}, [0])
+    )
+    damp = build.damping_needs(["sparse"], ["single", "joint32"], [0], ["joint32"])
+    assert ("tracks_recovery", "sparse_damping", "joint32", 0) in damp
+    assert not any(n[0] == "tracks_recovery" and n[2] == "single" for n in damp)
+    assert ("table", "tab_tracks") in build.claims_needs(
+        ["sparse"], {"single": {}}, [0], tracks=True
+    )
+    for name in ("tab_tracks", "fig_tracks"):
+        with pytest.raises(ValueError, match="tracks_needs"):
+            build.needs(name, ["sparse"], {"single": {"K": 32}}, [0])
+
+
+def test_settings_of_the_tracks_outputs_are_narrow():
+    cfg = quick_config()
+    s = build.settings_for("tab_tracks", cfg)
+    assert set(s["configs"]) == set(cfg["tracks"]["configs"])
+    assert s["configs"]["single"]["label"] == "single ($K{=}2$)"  # the control's own K
+    assert build.settings_for("tab_null", cfg)["tracks"]["joint32"]["K"] == 2
+    assert build.settings_for("fig_tracks", cfg)["seeds"] == [cfg["seeds"][0]]
+    assert "tracks" not in build.settings_for("tab_psnr", cfg)
+
+
+# --- the plan ----------------------------------------------------------------------------------
+
+
+@pytest.fixture(scope="module")
+def plan():
+    """One quick dry run of tab_tracks, fig_tracks and tab_null from an empty results folder (a
+    scratch copy of the workflow)."""
+    import tempfile
+    from pathlib import Path
+
+    from workflow_helpers import workflow_copy
+
+    with tempfile.TemporaryDirectory() as d:
+        wd = workflow_copy(Path(d))
+        r = subprocess.run(
+            [
+                sys.executable,
+                "-m",
+                "snakemake",
+                "-n",
+                "--cores",
+                "1",
+                "--config",
+                "profile=quick",
+                "--",
+                "results/tables/tab_tracks.tex",
+                "results/figures/fig_tracks.png",
+                "results/tables/tab_null.tex",
+            ],
+            cwd=wd,
+            capture_output=True,
+            text=True,
+            timeout=300,
+        )
+    assert r.returncode == 0, r.stderr[-2000:] + r.stdout[-2000:]
+    return r.stdout
+
+
+def _blocks(out, rule):
+    return re.findall(rf"rule {rule}:\n((?:    .*\n)+)", out)
+
+
+def test_the_tracker_and_the_fit_read_no_truth(plan):
+    cfg = quick_config()
+    n_cond = len(cfg["testbed"]["conditions"])
+    tracks = _blocks(plan, "track")
+    assert len(tracks) == len(cfg["trees"]) * n_cond  # joint32 fits every condition's tracks
+    fits = _blocks(plan, "fit_tracks")
+    assert len(fits) == len(cfg["trees"]) * len(cfg["tracks"]["configs"])
+    for b in tracks + fits:
+        inputs = re.search(r"input: (.*)", b).group(1)
+        assert "truth" not in inputs and "observed.npz" in inputs, inputs
+    for b in fits:
+        inputs = re.search(r"input: (.*)", b).group(1)
+        assert re.search(r"results/tracks/\w+/c0\.npz", inputs), inputs
+    evals = _blocks(plan, "tracks_evaluate")
+    assert evals and all("truth.npz" in re.search(r"input: (.*)", b).group(1) for b in evals)
+    # and in the rule file: only the evaluation names a truth-reading path or input function
+    text = (ROOT / "workflow" / "rules" / "tracks.smk").read_text()
+    rules = re.split(r"\n(?:rule|use rule) ", text)[1:]
+    readers = [
+        b.split(None, 1)[0].rstrip(":")
+        for b in rules
+        if re.search(r"TRUTH|truth_input|tracks_evaluate_inputs|testbed_files", b)
+    ]
+    assert readers == ["tracks_evaluate"], readers
+    common = (ROOT / "workflow" / "rules" / "common.smk").read_text()
+    fit_inputs = common.split("def fit_tracks_inputs", 1)[1].split("\ndef ", 1)[0]
+    assert not re.search(r"truth_input|testbed_files|TRUTH", fit_inputs)
+
+
+def test_tab_null_pairs_the_tracks_rows_with_the_null_of_their_k(plan):
+    table = [b for b in _blocks(plan, "table") if "tab_null" in b][0]
+    assert "results/recovery/sparse/seed0/tracks_joint32.json" in table
+    assert "results/recovery/sparse/seed0/null_K2.json" in table  # quick: tracks/K = 2
+    assert "rule fit_tracks" in plan and "rule tracks_evaluate" in plan

@@ -1,0 +1,89 @@
+# The 2D-track control (issue 29, docs/tracks.md): ours' oscillators fitted to point tracks of the
+# training video instead of to pixels, so the physics and the renderer are told apart. `track` and
+# `fit_tracks` read observed.npz only, like every training rule; `tracks_evaluate` reads the truth
+# (the tracker's error, recovery beside ours' null, motion beyond the window and under unseen wind).
+
+
+# one condition's training-camera video, tracked over the training window (observed only)
+rule track:
+    input:
+        observed=OBSERVED,
+    output:
+        tracks=TRACKS,
+    log:
+        "logs/tracks/{tree}/c{condition}.log",
+    benchmark:
+        "results/benchmarks/tracks/{tree}/c{condition}.tsv"
+    conda:
+        "../envs/physgs.yaml"
+    threads: 1
+    resources:
+        mem_mb=2000,
+        runtime=10,
+    params:
+        settings=_tracks.tracker_settings(CFG),
+    script:
+        "../scripts/track.py"
+
+
+# testbed_seeds: the instance of training seed {seed}
+use rule track as track_seeded with:
+    input:
+        observed=SEEDED_OBSERVED,
+    output:
+        tracks=SEEDED_TRACKS,
+    log:
+        "logs/tracks/{tree}/seed{seed}/c{condition}.log",
+    benchmark:
+        "results/benchmarks/tracks/{tree}/seed{seed}/c{condition}.tsv"
+
+
+# the oscillators of one configuration fitted to the tracks of its conditions (observed only);
+# a K above the tracks kept stops here, naming the key
+rule fit_tracks:
+    input:
+        unpack(fit_tracks_inputs),
+    output:
+        fit=TRACKS_FIT,
+    log:
+        "logs/tracks/{tree}/seed{seed}/fit_{config}.log",
+    benchmark:
+        "results/benchmarks/tracks/{tree}/seed{seed}/fit_{config}.tsv"
+    wildcard_constraints:
+        config="|".join(TRACKS_CONFIGS) or "(?!x)x",
+    conda:
+        "../envs/physgs.yaml"
+    threads: 1
+    resources:
+        mem_mb=2000,
+        runtime=30,
+    params:
+        job=fit_tracks_params,
+    script:
+        "../scripts/fit_tracks.py"
+
+
+# an evaluation (reads truth.npz): tracker error, recovery through ours' matcher (with damping
+# scores on the damping benchmark's testbeds), predicted tracks against the truth
+rule tracks_evaluate:
+    input:
+        unpack(tracks_evaluate_inputs),
+    output:
+        scores=TRACKS_EVAL,
+        record=TRACKS_RECOVERY,
+    log:
+        "logs/tracks/{tree}/seed{seed}/eval_{config}.log",
+    benchmark:
+        "results/benchmarks/tracks/{tree}/seed{seed}/eval_{config}.tsv"
+    wildcard_constraints:
+        config="|".join(TRACKS_CONFIGS) or "(?!x)x",
+    conda:
+        "../envs/physgs.yaml"
+    threads: 1
+    resources:
+        mem_mb=3000,
+        runtime=30,
+    params:
+        damping=recovery_damping_params,
+    script:
+        "../scripts/tracks_evaluate.py"
