@@ -1,4 +1,5 @@
-"""The 2D-track control (issue 29) on the built testbeds, outside the pipeline (not yet wired).
+"""The 2D-track control (issue 29) on the built testbeds, outside the pipeline (the pipeline's
+rules: workflow/rules/tracks.smk, docs/tracks.md).
 
     python benchmarks/tracks_control.py [--trees sparse,medium,dense] [--K 32] [--seed 0]
                                         [--conditions train|all] [--threads 1]
