@@ -514,3 +514,24 @@ def test_tab_null_pairs_the_tracks_rows_with_the_null_of_their_k(plan):
     assert "results/recovery/sparse/seed0/tracks_joint32.json" in table
     assert "results/recovery/sparse/seed0/null_K2.json" in table  # quick: tracks/K = 2
     assert "rule fit_tracks" in plan and "rule tracks_evaluate" in plan
+
+
+def test_fig_tracks_draws_fitted_and_unfitted_tracks(tmp_path):
+    from physgs.report.tracks import fig_tracks
+    from physgs.tracks.track import Tracks
+
+    valid = np.ones((3, 5), bool)
+    valid[2, 3:] = False
+    xy = np.cumsum(np.ones((3, 5, 2)), axis=1) + np.arange(3)[:, None, None] * 4
+    tr = Tracks(np.where(valid[..., None], xy, np.nan), valid, np.zeros(3, np.int64))
+    frame = np.full((16, 16, 3), 255, np.uint8)
+    outs = [str(tmp_path / "f.png"), str(tmp_path / "f.pdf")]
+    fig_tracks(
+        {"a": frame, "b": frame},
+        {"a": tr, "b": tr},
+        {"a": np.array([0, 1, -1]), "b": None},
+        ["a", "b"],
+        outs,
+        title="t",
+    )
+    assert all((tmp_path / f).stat().st_size > 1000 for f in ("f.png", "f.pdf"))

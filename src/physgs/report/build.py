@@ -744,15 +744,10 @@ def _fig_tracks(path, settings, trees, s0, outputs) -> None:
         with np.load(path("observed", t, s0)) as z:
             frames[t] = z["frames"][0, 0]  # training condition, recorded frame 0 [H, W, 3]
         tracks[t], _ = load_tracks(path("tracks", t, 0, s0))
-        labels[t] = (
-            load_fit(path("tracks_fit", t, configs[0], s0))[0].labels[0] if configs else None
-        )
-    what = f"parts of the {configs[0]} fit, " if configs else ""
-    fig_tracks(
-        frames,
-        tracks,
-        labels,
-        trees,
-        outputs,
-        title=f"tracks of the training video over frame 0 ({what}training seed {s0})",
-    )
+        labels[t] = None
+        if configs:  # each track's part; -1 (grey) where not fitted or its part has no estimate
+            fit = load_fit(path("tracks_fit", t, configs[0], s0))[0]
+            lab = fit.labels[0]
+            labels[t] = np.where((lab >= 0) & fit.estimated[np.maximum(lab, 0)], lab, -1)
+    what = f"colour: part in the {configs[0]} fit; " if configs else ""
+    fig_tracks(frames, tracks, labels, trees, outputs, title=f"2D tracks ({what}seed {s0})")

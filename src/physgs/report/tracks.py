@@ -206,8 +206,8 @@ def fig_tracks(
     """One panel per tree: ``frames[tree]`` [H, W, 3] uint8 (the training camera's frame 0) under
     the paths of ``tracks[tree]`` (``physgs.tracks.track.Tracks`` of that video; pixel centres at
     integer + 0.5, so a path is drawn at xy - 0.5 in imshow's coordinates), each coloured by
-    ``labels[tree]`` [P] (its part; -1 or None: grey), its seed position a dot. Written to every
-    path of ``outputs`` (pdf, png)."""
+    ``labels[tree]`` [P] (its part; -1 or None: grey, not fitted or in a part without an
+    estimate), its seed position a dot. Written to every path of ``outputs`` (pdf, png)."""
     import matplotlib
 
     matplotlib.use("Agg")
@@ -231,7 +231,7 @@ def fig_tracks(
         fitted = 0 if lab is None else int((np.asarray(lab) >= 0).sum())
         ax.set_title(
             f"{t}: {tr.n_tracks} tracks, {100 * kept:.0f}% of frame 0's kept,\n"
-            f"{fitted} fitted (coloured by part)",
+            f"{fitted} fitted in parts with an estimate",
             fontsize=8,
         )
         ax.set_xticks([])
