@@ -285,6 +285,7 @@ def _scores(tail, tail_ours, n=40, kept=0.5):
         "tail": mot(tail, tail_ours),
         "wind1": mot(0.41, 0.52),
         "wind2": mot(0.43, 0.54),
+        "ours_train_s": 321.0,
     }
 
 
@@ -307,7 +308,7 @@ def test_tab_tracks_rows_are_the_records_values():
     assert (
         (df.track_p90_px == 1.6).all() and (df.share_kept == 0.5).all() and (df.fit_s == 12.5).all()
     )
-    assert (df.parts_estimated == 3).all() and (df.K == 4).all()
+    assert (df.parts_estimated == 3).all() and (df.K == 4).all() and (df.ours_train_s == 321).all()
     assert "0.30 $\\pm$ 0.01" in tab.tex and "40 (50\\%)" in tab.tex and "3/4" in tab.tex
     del per_seed[1][("sparse", "single")]["wind2"]
     with pytest.raises(KeyError, match="wind2"):
@@ -401,9 +402,13 @@ def test_ours_claims_read_ours_rows_of_a_table_with_tracks_rows():
 def test_needs_of_the_tracks_outputs():
     assert build.tracks_needs("tab_tracks", ["sparse"], ["single", "joint32"], [0, 1]) == [
         ("tracks_eval", "sparse", "single", 0),
+        ("loss", "sparse", "ours", "single", 0),  # ours' training seconds beside the fit's
         ("tracks_eval", "sparse", "joint32", 0),
+        ("loss", "sparse", "ours", "joint32", 0),
         ("tracks_eval", "sparse", "single", 1),
+        ("loss", "sparse", "ours", "single", 1),
         ("tracks_eval", "sparse", "joint32", 1),
+        ("loss", "sparse", "ours", "joint32", 1),
     ]
     assert build.tracks_needs("fig_tracks", ["sparse"], ["joint32"], [5, 6]) == [
         ("observed", "sparse", 5),

@@ -125,13 +125,20 @@ def tracks_needs(
     name: str, trees: Sequence[str], configs: Sequence[str], seeds: Sequence[int]
 ) -> list[tuple]:
     """What tab_tracks or fig_tracks reads. configs: the configurations the control is fitted in
-    (``tracks.configs``). tab_tracks: its evaluation record per tree, configuration and seed;
+    (``tracks.configs``). tab_tracks: its evaluation record and ours' loss log (training seconds)
+    per tree, configuration and seed;
     fig_tracks: per tree, the observed frames, the training video's tracks and (with a
     configuration) the first configuration's fit, of the first seed."""
     if not seeds:
         raise ValueError("tracks_needs: no training seeds given")
     if name == "tab_tracks":
-        return [("tracks_eval", t, c, int(s)) for s in seeds for t in trees for c in configs]
+        return [
+            (kind, t, *m, c, int(s))
+            for s in seeds
+            for t in trees
+            for c in configs
+            for kind, m in (("tracks_eval", ()), ("loss", ("ours",)))  # ours' training seconds
+        ]
     if name == "fig_tracks":
         s0 = int(seeds[0])
         out = []
@@ -575,6 +582,8 @@ def make_table(
                 for c in settings["configs"]:
                     with open(path("tracks_eval", t, c, s)) as fh:
                         scores[s][(t, c)] = json.load(fh)
+                    loss = pd.read_csv(path("loss", t, "ours", c, s))
+                    scores[s][(t, c)]["ours_train_s"] = float(loss["seconds"].iloc[-1])
         table = tab_tracks(
             scores, trees, bones, settings["configs"], settings["conditions"], digits=d
         )

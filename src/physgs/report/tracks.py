@@ -55,8 +55,10 @@ def case_label(case: str, conditions: Sequence[float]) -> str:
 
 
 def row(scores: Mapping, conditions: Sequence[float]) -> dict[str, float]:
-    """One tab_tracks row from an evaluation record (``evaluate_job``'s scores); conditions: the
-    testbed's mean-speed multipliers (the first is the training wind). Motion columns
+    """One tab_tracks row from an evaluation record (``evaluate_job``'s scores, plus
+    ``ours_train_s``: ours' training seconds in the same configuration, NaN when absent);
+    conditions: the testbed's mean-speed multipliers (the first is the training wind). Motion
+    columns
     ``<case>_px`` (the control), ``<case>_ours_px`` (ours' Gaussians at the same points; NaN when
     not scored), ``<case>_static_px`` (motionless)."""
     tr, fit = scores["tracker"], scores["fit"]
@@ -72,6 +74,7 @@ def row(scores: Mapping, conditions: Sequence[float]) -> dict[str, float]:
         "parts_estimated": float(fit["n_estimated"]),
         "n_fitted": float(fit["n_fitted"]),
         "fit_s": float(fit["seconds"]),
+        "ours_train_s": float(scores.get("ours_train_s", float("nan"))),
         "fit_rms_px": float(fit["rms_px"]),
     }
     cases = ["tail", *(f"wind{c}" for c in range(1, len(conditions)))]
@@ -122,17 +125,17 @@ def tab_tracks(
     heads = ["beyond the window"] + [
         f"wind {condition_label(float(conditions[c]))}" for c in range(1, len(conditions))
     ]
-    ncol = 7 + 3 * len(stems)
+    ncol = 8 + 3 * len(stems)
     lines = [
         "  \\begin{tabular}{ll" + "c" * (ncol - 2) + "}",
         "    \\toprule",
-        r"    & & \multicolumn{3}{c}{Tracker} & \multicolumn{2}{c}{Fit} & "
+        r"    & & \multicolumn{3}{c}{Tracker} & \multicolumn{3}{c}{Fit} & "
         + " & ".join(rf"\multicolumn{{3}}{{c}}{{{h} (px)}}" for h in heads)
         + r" \\",
         "    "
-        + r"\cmidrule(lr){3-5}\cmidrule(lr){6-7}"
-        + "".join(rf"\cmidrule(lr){{{8 + 3 * i}-{10 + 3 * i}}}" for i in range(len(stems))),
-        r"    Tree & Config & Tracks (kept) & Error (px) & Displ.\ (px) & Parts & s & "
+        + r"\cmidrule(lr){3-5}\cmidrule(lr){6-8}"
+        + "".join(rf"\cmidrule(lr){{{9 + 3 * i}-{11 + 3 * i}}}" for i in range(len(stems))),
+        r"    Tree & Config & Tracks (kept) & Error (px) & Displ.\ (px) & Parts & s & ours (s) & "
         + " & ".join(["Tracks & Ours & Still"] * len(stems))
         + r" \\",
         "    \\midrule",
@@ -157,6 +160,7 @@ def tab_tracks(
             + seedstats.pm(V["disp_p90_px"][:, i], fmt),
             f"{np.nanmean(V['parts_estimated'][:, i]):.0f}/{np.nanmean(V['K'][:, i]):.0f}",
             seedstats.pm(V["fit_s"][:, i], ".0f"),
+            seedstats.pm(V["ours_train_s"][:, i], ".0f"),
         ]
         for stem in stems:
             cells += [
@@ -175,7 +179,8 @@ def tab_tracks(
         r"training window: tracks started (share of the frame-0 tracks kept to the window's "
         r"end), median / 90th-percentile position error and displacement error since each "
         r"track's seed frame (px). \emph{Fit}: parts with an estimate of $K$ (a part needs "
-        r"enough tracks), wall seconds of the fit. Motion: median displacement error (px) of "
+        r"enough tracks), wall seconds of the fit, beside ours' training seconds in the same "
+        r"configuration. Motion: median displacement error (px) of "
         r"the predicted tracks beyond the training window (training wind) and under each other "
         r"wind (window frames), beside ours' Gaussians at the same tracked points and a "
         r"motionless prediction (each track's mean tracked position)."
