@@ -69,8 +69,10 @@ def _counts(out: str) -> dict[str, int]:
 
 
 def _checkpoints(out: str) -> set[str]:
-    """The checkpoints a dry-run's output (re)trains, as '<model>_<config>'."""
-    return set(re.findall(r"results/models/\w+/seed\d+/(\w+?)\.pt", out))
+    """The checkpoints a dry-run's output (re)trains, as '<model>_<config>': its jobs' outputs
+    (a job that reruns lists checkpoints it only reads among its inputs: `all`, the summary)."""
+    outputs = "\n".join(re.findall(r"(?m)^    output: (.*)$", out))
+    return set(re.findall(r"results/models/\w+/seed\d+/(\w+?)\.pt", outputs))
 
 
 def test_an_unchanged_config_plans_nothing(plans):
