@@ -235,3 +235,47 @@ def test_a_fields_time_scale_edit_leaves_its_sibling_field_up_to_date(family, ed
     ctx, _ = model_context(50, seed=0, lead_in=10)
     field = build_model(edited, ctx, after["settings"])
     assert field.time_top_hz == 2.5
+
+
+def test_rotate_parts_equals_the_per_gaussian_rotation_exactly():
+    from physgs.models.gaussians import rotate_parts
+
+    g = torch.Generator().manual_seed(0)
+    N, K = 500, 7
+    means, quats = (
+        torch.randn(N, 3, generator=g),
+        torch.nn.functional.normalize(torch.randn(N, 4, generator=g), dim=-1),
+    )
+    lab = torch.randint(0, K, (N,), generator=g)
+    axis = torch.nn.functional.normalize(torch.randn(K, 3, generator=g), dim=-1)
+    angle, pivot = 0.3 * torch.randn(K, generator=g), torch.randn(K, 3, generator=g)
+    m1, q1 = rotate_parts(means, quats, lab, axis, angle, pivot)
+    m0, q0 = rotate_about_pivot(means, quats, axis[lab], angle[lab], pivot[lab])
+    assert torch.equal(m1, m0) and torch.equal(q1, q0)
+    # and against scipy's rotation of one Gaussian
+    p = int(lab[0])
+    R = Rotation.from_rotvec((axis[p] * angle[p]).double().numpy()).as_matrix()
+    ref = pivot[p].double().numpy() + R @ (means[0] - pivot[p]).double().numpy()
+    assert np.allclose(m1[0].double().numpy(), ref, atol=1e-5)
+
+
+def test_part_theta_without_autograd_reuses_its_series_until_a_parameter_changes():
+    ctx, wind = model_context(120, seed=4, lead_in=30)
+    model = build_model("ours", ctx, quick_models_cfg(), K=4)
+    with torch.no_grad():
+        model.gain_raw.copy_(torch.linspace(-0.5, 0.5, 4))
+    w = torch.as_tensor(wind)
+    with torch.no_grad():
+        a = model.part_theta(w)
+        assert model.part_theta(w) is a  # same series: not integrated again
+        w2 = w.clone()
+        w2[5] += 1.0
+        assert not torch.equal(model.part_theta(w2), a)  # another wind
+        model.gain_raw.mul_(2.0)  # in place: its version moves
+        b = model.part_theta(w)
+        assert torch.allclose(b, 2 * a, rtol=1e-10, atol=0)
+        model.freeze_parts(np.array([True, False, False, False]))
+        assert torch.equal(model.part_theta(w)[0], torch.zeros_like(a[0]))
+    with torch.enable_grad():
+        c = model.part_theta(w)
+    assert c.requires_grad and torch.equal(c.detach(), model._integrate_theta(w).detach())

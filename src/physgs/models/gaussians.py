@@ -93,6 +93,25 @@ def rotate_about_pivot(
     return new_means, new_quats
 
 
+def rotate_parts(
+    means: torch.Tensor,
+    quats: torch.Tensor,
+    labels: torch.Tensor,
+    axis: torch.Tensor,
+    angle: torch.Tensor,
+    pivot: torch.Tensor,
+) -> tuple[torch.Tensor, torch.Tensor]:
+    """``rotate_about_pivot`` with one rotation per part: means [N, 3]; quats [N, 4]; labels [N]
+    part of each Gaussian; axis [K, 3] unit; angle [K] rad; pivot [K, 3]. The K rotations are
+    built once and gathered (not N times, one per Gaussian): the same numbers elementwise, so the
+    result equals ``rotate_about_pivot(means, quats, axis[labels], angle[labels],
+    pivot[labels])`` exactly, at a K/N share of the rotation cost."""
+    RmI = rodrigues_minus_identity(axis, angle)  # [K, 3, 3]
+    q = axis_angle_quat(axis, angle)  # [K, 4]
+    new_means = means + (RmI[labels] @ (means - pivot[labels])[..., None])[..., 0]
+    return new_means, quat_multiply(q[labels], quats)
+
+
 def nearest_neighbour_scale(xyz: np.ndarray, k: int = 3) -> np.ndarray:
     """Isotropic scale [N] (world units): mean distance to the k nearest other points.
 

@@ -36,7 +36,7 @@ from torch import nn
 
 from physgs.models.base import BaseModel, ModelContext
 from physgs.models.chain import chain_deform, depth_levels
-from physgs.models.gaussians import GaussianState, rotate_about_pivot
+from physgs.models.gaussians import GaussianState, rotate_parts
 from physgs.models.oscillator import STABILITY_GUARD, fastest_rate, integrate, required_substeps
 from physgs.models.oscillator_params import OscillatorBounds, condition_vbar
 from physgs.models.parts import kmeans_parts
@@ -137,6 +137,7 @@ class OscillatorPrior(BaseModel):
         # Parts whose motion never reaches the image (physgs.models.visibility): theta = 0 and
         # their physics parameters take no further updates. Saved in checkpoints.
         self.register_buffer("frozen", torch.zeros(K, dtype=torch.bool))
+        self._theta_memo = None  # (versions, wind [L+F], theta [K, L+F]): part_theta, no autograd
 
     def freeze_parts(self, mask) -> None:
         """Freeze the parts in ``mask`` [K] bool (added to those already frozen)."""
@@ -179,6 +180,22 @@ class OscillatorPrior(BaseModel):
         wind = torch.as_tensor(wind, dtype=torch.float64)
         if wind.ndim != 1:
             raise ValueError(f"part_theta: wind must be [L+F], got shape {tuple(wind.shape)}")
+        if torch.is_grad_enabled():
+            return self._integrate_theta(wind)
+        # Without autograd (evaluation, recovery) every frame of a series asks for the same
+        # series: keep the last one, keyed by the wind's values and the versions of everything
+        # theta reads, so an in-place edit of a parameter or of the frozen mask (or a new tensor,
+        # e.g. after load_state_dict or .double()) recomputes it. Callers must not write to it.
+        reads = (self.omega_raw, self.zeta_raw, self.gain_raw, self.gain_scale, self.frozen)
+        key = tuple((t.data_ptr(), t._version) for t in reads)
+        hit = self._theta_memo
+        if hit is not None and hit[0] == key and torch.equal(hit[1], wind):
+            return hit[2]
+        theta = self._integrate_theta(wind)
+        self._theta_memo = (key, wind.clone(), theta)
+        return theta
+
+    def _integrate_theta(self, wind: torch.Tensor) -> torch.Tensor:
         vbar = condition_vbar(self.vbar_ratio, wind)
         theta = integrate(
             self.omega, self.zeta, self.gain, wind, vbar, self.dt, self.substeps, guard=self.guard
@@ -198,9 +215,7 @@ class OscillatorPrior(BaseModel):
                 c.means, c.quats, lab, self.axis, theta, self.pivot, self.levels
             )
         else:
-            means, quats = rotate_about_pivot(
-                c.means, c.quats, self.axis[lab], theta[lab], self.pivot[lab]
-            )
+            means, quats = rotate_parts(c.means, c.quats, lab, self.axis, theta, self.pivot)
         return GaussianState(
             means,
             quats,
