@@ -25,6 +25,13 @@ exit 1
 SINFO = """#!/bin/sh
 printf 'cpu*|2|21000|infinite\\ngpu|8|64000|2-00:00:00\\n'
 """
+# The plugin (2.8) refuses to import where sinfo exists but neither sacct nor squeue does, and
+# hangs when sacct is missing while it guesses an account: a stand-in sacct that fails, as
+# SLURM 22.05's does for that query (the plugin then goes on without an account).
+SACCT = """#!/bin/sh
+echo "sacct: stand-in, no accounting" >&2
+exit 1
+"""
 PARTITIONS = parse_sinfo("cpu*|2|21000|infinite\ngpu|8|64000|2-00:00:00\n")
 
 
@@ -62,7 +69,7 @@ def test_the_profile_names_no_account_or_partition():
 def _fake_slurm(tmp_path):
     bin_dir = tmp_path / "bin"
     bin_dir.mkdir()
-    for name, text in (("sbatch", SBATCH), ("sinfo", SINFO)):
+    for name, text in (("sbatch", SBATCH), ("sinfo", SINFO), ("sacct", SACCT)):
         p = bin_dir / name
         p.write_text(text)
         p.chmod(p.stat().st_mode | stat.S_IEXEC)
