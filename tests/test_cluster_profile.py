@@ -5,6 +5,7 @@ submission (a stand-in `sinfo` describes the partitions). The real SLURM run: te
 from __future__ import annotations
 
 import os
+import re
 import stat
 import subprocess
 import sys
@@ -117,3 +118,41 @@ def test_a_request_no_node_meets_is_refused_before_submission(tmp_path):
     out = proc.stdout + proc.stderr
     assert proc.returncode != 0 and not log.exists(), out[-3000:]  # nothing submitted
     assert "rule train: threads=8 but partition cpu's nodes have at most 2 CPUs" in out, out[-3000:]
+
+
+def _slurm_jobs(dry_run_log: str) -> list[tuple[str | None, list[str]]]:
+    """(group or None, member rules) of each SLURM job a cluster-profile dry run plans."""
+    jobs = []
+    for block in re.split(
+        r"\n(?=\[[^\]\n]+\](?: Group job \w+|\n(?:local)?rule \w+))", dry_run_log
+    ):
+        group = re.match(r"\[[^\]\n]+\] Group job (\w+)", block)
+        rules = re.findall(r"^\s*(?:local)?rule (\w+):", block, re.M)
+        if group or rules:
+            jobs.append((group.group(1) if group else None, rules))
+    return jobs
+
+
+@pytest.mark.slow
+def test_no_group_job_serialises_the_tail_of_the_run(tmp_path):
+    """The tables and the ledger read every job: grouped with the per-model jobs they joined all
+    of "post" into one SLURM job of ~60 members that ran one after another after the last
+    training. The cheap jobs still travel in groups of a few chains."""
+    wd, env, _ = _fake_slurm(tmp_path)
+    cmd = [
+        sys.executable,
+        "-m",
+        "snakemake",
+        "-n",
+        "--workflow-profile",
+        "workflow/profiles/cluster",
+    ]
+    cmd += ["--config", "profile=quick", 'trees=["sparse"]', "--", "all"]
+    proc = subprocess.run(cmd, cwd=wd, env=env, capture_output=True, text=True, timeout=300)
+    assert proc.returncode == 0, proc.stdout[-3000:] + proc.stderr[-3000:]
+    jobs = _slurm_jobs(proc.stdout)
+    post = [rules for group, rules in jobs if group == "post"]
+    grouped = {r for group, rules in jobs if group for r in rules}
+    assert len(post) >= 2 and max(map(len, post)) <= 20, [len(p) for p in post]
+    assert not grouped & {"table", "figure", "claims", "summary", "testbed_stats"}, grouped
+    assert any(group == "fit" and "evaluate" in rules for group, rules in jobs)
