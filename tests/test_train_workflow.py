@@ -22,6 +22,7 @@ def _dry_run(*targets, profile="quick"):
             "-m",
             "snakemake",
             "-n",
+            "--forceall",  # the whole plan, whatever results/ the checkout already holds
             "--cores",
             "2",
             *overlay,

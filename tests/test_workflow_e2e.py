@@ -43,10 +43,12 @@ def _csv(run, name) -> pd.DataFrame:
     return pd.read_csv(run / "results" / "tables" / f"{name}.csv")
 
 
-def _tex_numbers(run, name) -> list[float]:
+def _tex_numbers(run, name) -> list[tuple[float, int]]:
+    """Each decimal number in the table's rows (not its caption): (value, decimals printed)."""
     tex = (run / "results" / "tables" / f"{name}.tex").read_text()
-    body = tex.split(r"\midrule", 1)[1]
-    return [float(x) for x in re.findall(r"(?<![\w{])[-+]?\d+\.\d+", body)]
+    body = tex.split(r"\midrule", 1)[1].split(r"\bottomrule", 1)[0]
+    decimals = re.finditer(r"(?<![\w{])[-+]?\d+\.(\d+)", body)
+    return [(float(m.group(0)), len(m.group(1))) for m in decimals]
 
 
 def test_every_output_exists(run):
@@ -130,6 +132,17 @@ def test_tab_null_rows_columns_and_finite_where_defined(run):
 
 
 @pytest.mark.parametrize("name", BUILT)
+def test_tex_braces_balance(run, name):
+    """An unbalanced brace stops LaTeX (tab_parts_k's header once had one too many)."""
+    tex = (run / "results" / "tables" / f"{name}.tex").read_text()
+    depth = 0
+    for ch in re.sub(r"\\[{}%]|(?<!\\)%.*", "", tex):
+        depth += {"{": 1, "}": -1}.get(ch, 0)
+        assert depth >= 0, f"{name}.tex closes a brace it never opened"
+    assert depth == 0, f"{name}.tex leaves {depth} brace(s) open"
+
+
+@pytest.mark.parametrize("name", BUILT)
 def test_tex_agrees_with_csv(run, name):
     df = _csv(run, name)
     nums = df.select_dtypes("number").to_numpy(float).ravel()
@@ -137,8 +150,9 @@ def test_tex_agrees_with_csv(run, name):
     tex = _tex_numbers(run, name)
     assert tex, f"{name}.tex has no numbers"
     # every decimal in the .tex is a rounded CSV value (percentages are written x100)
-    for x in tex:
-        ok = np.isclose(nums, x, atol=0.006) | np.isclose(nums * 100, x, atol=0.006)
+    for x, decimals in tex:
+        atol = 0.6 * 10.0**-decimals  # half a unit of the last digit shown, and some slack
+        ok = np.isclose(nums, x, rtol=0, atol=atol) | np.isclose(nums * 100, x, rtol=0, atol=atol)
         assert ok.any(), f"{name}.tex shows {x}, which is in no CSV cell"
 
 

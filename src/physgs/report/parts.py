@@ -298,7 +298,7 @@ def tab_parts_k(
         "  \\begin{tabular}{l" + "c" * (len(ks) + 2) + "}",
         "    \\toprule",
         rf"    & Ours ($K{{=}}{base_k}$) & \multicolumn{{{len(ks)}}}{{c}}{{Chained topology "
-        r"parts}} & \\",
+        r"parts} & \\",
         rf"    \cmidrule(lr){{3-{len(ks) + 2}}}",
         rf"    Tree & held-out (dB) & {head} & matched $K$ \\",
         "    \\midrule",
