@@ -184,3 +184,43 @@ def test_ssim_gradients_against_finite_differences(target_grad):
     a = torch.tensor(rng.random((13, 12, 2)), requires_grad=True)
     b = torch.tensor(rng.random((13, 12, 2)), requires_grad=target_grad)
     assert torch.autograd.gradcheck(lambda u, v: ssim(u, v), (a, b), eps=1e-6, atol=1e-8)
+
+
+@pytest.mark.parametrize("tiled", [False, True])
+def test_blur_equals_scipys_zero_padded_correlation(tiled):
+    # Oracle: scipy.ndimage.correlate1d along each axis, float64, zeros outside the image (the
+    # 3DGS SSIM's padding), on a side that is not a multiple of the tile.
+    from scipy.ndimage import correlate1d
+
+    from physgs.train.losses import blur
+
+    rng = np.random.default_rng(3)
+    z = rng.random((2, 45, 70))
+    x = np.arange(11) - 5.0
+    g = np.exp(-(x**2) / (2 * 1.5**2))
+    g /= g.sum()
+    want = correlate1d(correlate1d(z, g, axis=1, mode="constant"), g, axis=2, mode="constant")
+    got = blur(torch.tensor(z), 11, 1.5, tiled=tiled).numpy()
+    np.testing.assert_allclose(got, want, rtol=0, atol=1e-14)
+
+
+def test_tiled_blur_gradients_against_finite_differences():
+    from physgs.train.losses import blur
+
+    z = torch.tensor(np.random.default_rng(4).random((1, 37, 33)), requires_grad=True)
+    assert torch.autograd.gradcheck(lambda u: blur(u, 11, 1.5, tiled=True), (z,), eps=1e-6)
+
+
+def test_ssim_on_large_images_takes_the_tiles_with_the_same_value(monkeypatch):
+    import physgs.train.losses as losses
+
+    rng = np.random.default_rng(5)
+    a = torch.tensor(rng.random((330, 341, 1)))
+    b = torch.tensor(np.clip(a.numpy() + 0.1 * rng.standard_normal(a.shape), 0, 1))
+    calls = []
+    tiled_rows = losses._blur_rows_tiled
+    monkeypatch.setattr(losses, "_blur_rows_tiled", lambda *x: calls.append(1) or tiled_rows(*x))
+    tiled = float(losses.ssim(a, b))
+    assert calls and min(a.shape[:2]) >= losses.TILED_BLUR_MIN_SIDE
+    monkeypatch.setattr(losses, "TILED_BLUR_MIN_SIDE", 10**6)
+    assert tiled == pytest.approx(float(losses.ssim(a, b)), abs=1e-13)
