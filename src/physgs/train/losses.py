@@ -9,7 +9,7 @@ import torch.nn.functional as F
 
 #: Image side (pixels) from which SSIM's blur runs in block-Toeplitz tiles rather than as one
 #: banded [n, n] matmul per side: the banded matmul does O(n) work per output pixel, the tiles
-#: O(TILE + window). Measured forward + backward of the 15 blurred maps of one 3-channel SSIM,
+#: O(TILE + window). Measured (benchmarks/ssim_blur.py) forward + backward of the 15 blurred maps,
 #: one thread (banded / tiles of 32): 128 px 4.1 / 5.8 ms, 256 px 25 / 23 ms, 384 px 80 / 54 ms,
 #: 512 px 180 / 106 ms. Below this side the banded matmul is kept (and with it the default
 #: profile's numbers, bit for bit).
