@@ -143,3 +143,30 @@ def test_a_single_seed_table_gives_one_seed_verdicts():
     df = C.ledger(C.measure(t, {}, ["sparse"]))
     needs = df[~df["id"].str.startswith("nearest_bone_gap")]
     assert needs["verdict"].str.startswith("undecided: one seed").all()
+
+
+def test_a_partial_run_gives_a_partial_ledger():
+    full_tables = _tables(seeds=(0, 1, 2))
+    full = C.ledger(C.measure(full_tables, {}, ["sparse", "medium"])).set_index("id")
+    part = C.ledger(C.measure({"tab_null": full_tables["tab_null"]}, {}, ["sparse", "medium"]))
+    part = part.set_index("id")
+    measured = part[part["seeds"] > 0]
+    # what tab_null holds is measured exactly as in the whole ledger
+    assert sorted(measured.index) == [
+        "null_factor/sparse",
+        "null_loses/sparse",
+        "null_matches/medium",
+    ]
+    for i in measured.index:
+        assert measured.loc[i, "verdict"] == full.loc[i, "verdict"]
+        assert measured.loc[i, "measured"] == pytest.approx(full.loc[i, "measured"])
+    # the rest is listed, not measured; the per-wind transfer rows need their table to exist
+    rest = part.drop(measured.index)
+    assert (rest["verdict"] == "undecided: not measured").all()
+    assert {
+        "fits_window/medium/mlp",
+        "margin_grows/sparse",
+        "ours_above_static_beyond/medium",
+    } <= set(rest.index)
+    assert not any(i.startswith("transfer_") for i in part.index)
+    assert set(part.index) <= set(full.index)

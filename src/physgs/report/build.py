@@ -221,14 +221,14 @@ def claims_needs(
     )
 
 
-def make_claims(inputs: Mapping[str, str], trees: Sequence[str], md_path, csv_path, stamp=None):
-    """Build the claims ledger (``physgs.report.claims``) from the files in ``inputs`` (need
-    key -> path, ``claims_needs``) and write results/claims.md and .csv; returns the ledger."""
-    from physgs.atomic import atomic_path, write_text
+def claims_frame(inputs: Mapping[str, str], trees: Sequence[str]) -> pd.DataFrame:
+    """The claims ledger (``physgs.report.claims``) from the files in ``inputs`` (need key ->
+    path, ``claims_needs``). The rule gives every table; a table left out of ``inputs`` leaves
+    its claims "undecided: not measured" (a partial run's ledger, ``tools/ledger.py``)."""
     from physgs.report import claims
 
-    optional = [n for n in ("tab_parts", "tab_tracks") if key(("table", n)) in inputs]
-    tabs = {n: pd.read_csv(inputs[key(("table", n))]) for n in (*CLAIMS_TABLES, *optional)}
+    names = (*CLAIMS_TABLES, "tab_parts", "tab_tracks")
+    tabs = {n: pd.read_csv(inputs[key(("table", n))]) for n in names if key(("table", n)) in inputs}
     damping: dict[str, list] = {}
     for k, p in sorted(inputs.items()):  # recovery/<tree>/<config>/<seed>: one entry per seed
         if k.startswith("recovery/"):
@@ -240,7 +240,16 @@ def make_claims(inputs: Mapping[str, str], trees: Sequence[str], md_path, csv_pa
                     "loglog_exponent": d.loglog_exponent,
                 }
             )
-    df = claims.ledger(claims.measure(tabs, damping, trees))
+    return claims.ledger(claims.measure(tabs, damping, trees))
+
+
+def make_claims(inputs: Mapping[str, str], trees: Sequence[str], md_path, csv_path, stamp=None):
+    """Build the claims ledger from the files in ``inputs`` (``claims_frame``) and write
+    results/claims.md and .csv; returns the ledger."""
+    from physgs.atomic import atomic_path, write_text
+    from physgs.report import claims
+
+    df = claims_frame(inputs, trees)
     sd = stamp.to_dict() if stamp is not None else None
     write_text(md_path, claims.ledger_markdown(df, sd))
     with atomic_path(csv_path) as tmp:

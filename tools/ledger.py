@@ -1,0 +1,60 @@
+"""The claims ledger of a partial run: every claim whose tables the run built, the rest listed as
+"undecided: not measured".
+
+    python tools/ledger.py [--results results] [--config config/trees.yaml] [--profile default]
+        [--seeds 0 1 2] [--out PATH.md]
+
+`snakemake claims` needs every table (the whole DAG). A run of some targets (for example the
+parts study and the 2D-track control at three seeds, without the learned fields) still decides
+the claims its tables hold; this reads the tables' CSVs and ours' joint K = 32 recovery records
+where the workflow writes them (`workflow/rules/common.smk`: TABLE, RECOVERY) and prints the
+ledger (`physgs.report.build.claims_frame`, the claims rule's own code) with its verdict counts.
+"""
+
+from __future__ import annotations
+
+import argparse
+from pathlib import Path
+
+import physgs.config
+from physgs.report import build, claims
+
+
+def main() -> None:
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("--results", default="results", type=Path)
+    ap.add_argument("--config", default="config/trees.yaml")
+    ap.add_argument("--profile", default="default")
+    ap.add_argument("--seeds", type=int, nargs="+", help="training seeds (default: the config's)")
+    ap.add_argument("--out", type=Path, help="also write the ledger here (Markdown)")
+    args = ap.parse_args()
+    cfg = physgs.config.load(args.config, args.profile)
+    seeds = args.seeds if args.seeds is not None else cfg["seeds"]
+    needs = build.claims_needs(cfg["trees"], cfg["models"]["configs"], seeds, True, True)
+    paths = {  # the workflow's layout (common.smk: TABLE, RECOVERY with model ours)
+        "table": "tables/{name}.csv",
+        "recovery": "recovery/{tree}/seed{seed}/ours_{config}.json",
+    }
+    inputs = {}
+    for need in needs:
+        fields = dict(zip(build.NEED_FIELDS[need[0]], need[1:]))
+        path = args.results / paths[need[0]].format(**fields)
+        if path.exists():
+            inputs[build.key(need)] = str(path)
+    missing = sorted({build.key(n) for n in needs} - set(inputs))
+    df = build.claims_frame(inputs, cfg["trees"])
+    md = claims.ledger_markdown(df, {"seeds": " ".join(map(str, seeds)), "partial": "yes"})
+    print(md)
+    print(f"not found under {args.results} ({len(missing)}): {', '.join(missing) or 'none'}")
+    measured = df[df["seeds"] > 0]
+    counts = measured["verdict"].str.split(":").str[0].value_counts().to_dict()
+    print(
+        f"{len(measured)} of {len(df)} claims measured: "
+        + ", ".join(f"{k} {v}" for k, v in sorted(counts.items()))
+    )
+    if args.out:
+        args.out.write_text(md)
+
+
+if __name__ == "__main__":
+    main()
