@@ -289,6 +289,32 @@ def _scores(tail, tail_ours, n=40, kept=0.5):
     }
 
 
+def test_tab_tracks_gives_the_best_learned_field_per_seed():
+    cases = ("tail", "wind1", "wind2")
+    per_seed = {}
+    for s, (mlp, d3) in enumerate([(0.7, 0.6), (0.5, 0.8)]):
+        rec = _scores(0.3, 0.5)
+        for case in cases:
+            rec[case]["fields"] = {
+                "mlp": {"motion_median_px": mlp + (case != "tail")},
+                "d3dgs": {"motion_median_px": d3 + (case != "tail")},
+            }
+        per_seed[s] = {("sparse", "single"): rec, ("sparse", "joint32"): _scores(0.3, 0.5)}
+    configs = {
+        "single": {"label": "s", "conditions": "train"},
+        "joint32": {"label": "j", "conditions": "all"},
+    }
+    tab = tab_tracks(per_seed, ["sparse"], {"sparse": 22}, configs, [1.0, 0.84, 0.71])
+    one = tab.df[tab.df.config == "single"].set_index("seed")
+    np.testing.assert_allclose(one.tail_field_mlp_px, [0.7, 0.5])
+    np.testing.assert_allclose(one.tail_best_field_px, [0.6, 0.5])  # d3dgs at seed 0, mlp at 1
+    np.testing.assert_allclose(one["wind_0.84v0_best_field_px"], [1.6, 1.5])
+    # no field trained in the joint configuration: no value, '--' in the .tex
+    assert tab.df[tab.df.config == "joint32"].tail_best_field_px.isna().all()
+    assert "0.55 $\\pm$ 0.07" in tab.tex  # mean +- sd of the per-seed best, 0.6 and 0.5
+    assert "Tracks & Ours & Field & Still" in tab.tex
+
+
 def test_tab_tracks_rows_are_the_records_values():
     per_seed = {s: {("sparse", "single"): _scores(0.3 + 0.01 * s, 0.5)} for s in (0, 1)}
     tab = tab_tracks(
@@ -512,6 +538,18 @@ def test_the_tracker_and_the_fit_read_no_truth(plan):
     common = (ROOT / "workflow" / "rules" / "common.smk").read_text()
     fit_inputs = common.split("def fit_tracks_inputs", 1)[1].split("\ndef ", 1)[0]
     assert not re.search(r"truth_input|testbed_files|TRUTH", fit_inputs)
+
+
+def test_the_learned_fields_are_scored_beside_ours_where_they_are_trained(plan):
+    cfg = quick_config()
+    fields = cfg["tracks"]["fields"]
+    assert fields and tsettings.fields_scored(cfg, "joint32") == []
+    for b in _blocks(plan, "tracks_evaluate"):
+        inputs = re.search(r"input: (.*)", b).group(1)
+        config = re.search(r"eval_(\w+)\.json", b).group(1)
+        for m in ("mlp", "mlp_wind", "d3dgs", "d3dgs_wind"):
+            want = m in fields and config == "single"
+            assert (f"/{m}_{config}.pt" in inputs) == want, (config, m, inputs)
 
 
 def test_tab_null_pairs_the_tracks_rows_with_the_null_of_their_k(plan):

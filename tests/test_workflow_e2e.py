@@ -170,6 +170,14 @@ def test_tab_tracks_scores_every_tracks_fit(run):
         assert np.isfinite(df[col].to_numpy(float)).all(), col
     for col in ("n_tracks", "track_median_px", "share_kept"):  # one video per tree
         assert df.groupby("tree")[col].nunique().max() == 1, col
+    # the learned fields, trained in single only, are scored at the same points there
+    per_field = [f"tail_field_{m}_px" for m in QUICK["tracks"]["fields"]]
+    single = df["config"] == "single"
+    assert np.isfinite(df.loc[single, per_field].to_numpy(float)).all()
+    np.testing.assert_allclose(
+        df.loc[single, "tail_best_field_px"], df.loc[single, per_field].min(axis=1)
+    )
+    assert df.loc[~single, "tail_best_field_px"].isna().all()
     for _, r in df.iterrows():
         rec = (
             run

@@ -352,12 +352,17 @@ def fit_tracks_inputs(wildcards):
 
 
 def tracks_evaluate_inputs(wildcards):
-    """The fit, the training video's tracks, the dataset, the truth and its statistics, and ours'
-    checkpoint in the same configuration (scored at the same tracked points)."""
+    """The fit, the training video's tracks, the dataset, the truth and its statistics, and the
+    checkpoints of ours and of the learned fields of tracks/fields trained in the same
+    configuration (scored at the same tracked points)."""
     t, s, c = wildcards.tree, wildcards.seed, wildcards.config
     return {
         "fit": TRACKS_FIT.format(tree=t, seed=s, config=c),
         "tracks": tracks_file(t, s, 0),
         **testbed_files(t, s),
         "ours": CKPT.format(tree=t, seed=s, model="ours", config=c),
+        **{
+            f"field_{m}": CKPT.format(tree=t, seed=s, model=m, config=c)
+            for m in _tracks.fields_scored(CFG, c)
+        },
     }

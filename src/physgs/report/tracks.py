@@ -7,7 +7,8 @@ position error and displacement error, px), the fit (K, parts with an estimate, 
 and the motion errors (px, median over tracks and frames of the displacement error since each
 track's seed frame) of the control's predicted tracks beyond the window (the tail frames at the
 training wind) and under each unseen wind (window frames), beside ours' Gaussians at the same
-tracked points and a motionless prediction (each track's mean tracked position).
+tracked points, the best learned field's (the lowest error of the fields scored there, per seed)
+and a motionless prediction (each track's mean tracked position).
 
 fig_tracks: per tree, the training camera's frame 0 with the tracks' paths over the window,
 coloured by the part of the fit they were grouped into (grey: not fitted).
@@ -60,7 +61,9 @@ def row(scores: Mapping, conditions: Sequence[float]) -> dict[str, float]:
     conditions: the testbed's mean-speed multipliers (the first is the training wind). Motion
     columns
     ``<case>_px`` (the control), ``<case>_ours_px`` (ours' Gaussians at the same points; NaN when
-    not scored), ``<case>_static_px`` (motionless)."""
+    not scored), ``<case>_field_<id>_px`` (each learned field scored, at the same points),
+    ``<case>_best_field_px`` (the lowest of them; NaN when none was scored),
+    ``<case>_static_px`` (motionless)."""
     tr, fit = scores["tracker"], scores["fit"]
     out = {
         "n_tracks": float(tr["n_tracks"]),
@@ -85,6 +88,11 @@ def row(scores: Mapping, conditions: Sequence[float]) -> dict[str, float]:
         ours = sc.get("ours")
         out[f"{stem}_px"] = float(sc["tracks"]["motion_median_px"])
         out[f"{stem}_ours_px"] = float(ours["motion_median_px"]) if ours else float("nan")
+        fields = {m: float(e["motion_median_px"]) for m, e in sc.get("fields", {}).items()}
+        for m, v in fields.items():
+            out[f"{stem}_field_{m}_px"] = v
+        finite = [v for v in fields.values() if np.isfinite(v)]
+        out[f"{stem}_best_field_px"] = min(finite) if finite else float("nan")
         out[f"{stem}_static_px"] = float(sc["tracks"]["static_median_px"])
     return out
 
@@ -125,18 +133,18 @@ def tab_tracks(
     heads = ["beyond the window"] + [
         f"wind {condition_label(float(conditions[c]))}" for c in range(1, len(conditions))
     ]
-    ncol = 8 + 3 * len(stems)
+    ncol = 8 + 4 * len(stems)
     lines = [
         "  \\begin{tabular}{ll" + "c" * (ncol - 2) + "}",
         "    \\toprule",
         r"    & & \multicolumn{3}{c}{Tracker} & \multicolumn{3}{c}{Fit} & "
-        + " & ".join(rf"\multicolumn{{3}}{{c}}{{{h} (px)}}" for h in heads)
+        + " & ".join(rf"\multicolumn{{4}}{{c}}{{{h} (px)}}" for h in heads)
         + r" \\",
         "    "
         + r"\cmidrule(lr){3-5}\cmidrule(lr){6-8}"
-        + "".join(rf"\cmidrule(lr){{{9 + 3 * i}-{11 + 3 * i}}}" for i in range(len(stems))),
+        + "".join(rf"\cmidrule(lr){{{9 + 4 * i}-{12 + 4 * i}}}" for i in range(len(stems))),
         r"    Tree & Config & Tracks (kept) & Error (px) & Displ.\ (px) & Parts & s & ours (s) & "
-        + " & ".join(["Tracks & Ours & Still"] * len(stems))
+        + " & ".join(["Tracks & Ours & Field & Still"] * len(stems))
         + r" \\",
         "    \\midrule",
     ]
@@ -166,6 +174,7 @@ def tab_tracks(
             cells += [
                 seedstats.pm(V[f"{stem}_px"][:, i], fmt),
                 seedstats.pm(V[f"{stem}_ours_px"][:, i], fmt),
+                seedstats.pm(V[f"{stem}_best_field_px"][:, i], fmt),
                 seedstats.pm(V[f"{stem}_static_px"][:, i], fmt),
             ]
         lines.append("    " + " & ".join(cells) + r" \\")
@@ -182,8 +191,10 @@ def tab_tracks(
         r"enough tracks), wall seconds of the fit, beside ours' training seconds in the same "
         r"configuration. Motion: median displacement error (px) of "
         r"the predicted tracks beyond the training window (training wind) and under each other "
-        r"wind (window frames), beside ours' Gaussians at the same tracked points and a "
-        r"motionless prediction (each track's mean tracked position)."
+        r"wind (window frames), beside ours' Gaussians at the same tracked points, the best "
+        r"learned field's (the lowest error of the fields trained in that configuration, per "
+        r"seed; -- where none is) and a motionless prediction (each track's mean tracked "
+        r"position)."
         + (
             " The joint configurations ("
             + ", ".join(j.replace("_", r"\_") for j in joint)

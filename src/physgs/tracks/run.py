@@ -82,14 +82,17 @@ def evaluate_job(
     damping: dict | None = None,
     min_tracks: int = -1,
     ours=None,
+    fields: dict | None = None,
 ) -> tuple[TracksRecovery, dict]:
     """Score one fit against the truth. tracks0: the tracks of condition 0 (the fit's first
-    entry); ours: ours' trained model in the same configuration (None: not scored).
+    entry); ours: ours' trained model in the same configuration (None: not scored); fields:
+    learned-field id -> its trained model in the same configuration, scored like ours.
 
     Returns (recovery, scores): scores = {"tracker": ``TrackerScore`` dict of tracks0,
     "fit": {K, seconds, loop_seconds, rms_px, n_fitted}, and per motion case (``motion_cases``)
     {"tracks": motion_errors of the control, "ours": the same of ours' Gaussians at the same
-    tracked points (its displacement since each seed frame)}}.
+    tracked points (its displacement since each seed frame), "fields": {id: the same of that
+    field's Gaussians}}}.
     """
     from physgs.tracks.score import associate, model_point_tracks, motion_errors, score_tracker
 
@@ -112,24 +115,32 @@ def evaluate_job(
             "n_estimated": int(fit.estimated.sum()),
         },
     }
-    if ours is not None:
+    models = {**({"ours": ours} if ours is not None else {}), **(fields or {})}
+    means, seed_xy = {}, {}
+    if models:
         from physgs.evaluate.adapter import model_means_fn
 
-        means_fn = model_means_fn(ours, observed)
         verts = associate(truth, cam, tracks0, 0)
         rows = np.arange(tracks0.n_tracks)
-        # ours' own position at each seed frame: the origin of its displacement
-        seed_ours = np.full((tracks0.n_tracks, 2), np.nan)
-        for t0 in np.unique(tracks0.start[fitted]):
-            sel = rows[fitted & (tracks0.start == t0)]
-            seed_ours[sel] = model_point_tracks(means_fn, truth, cam, verts[sel], 0, [t0])[:, 0]
+        for key, model in models.items():
+            means[key] = model_means_fn(model, observed)
+            # the model's own position at each seed frame: the origin of its displacement
+            seed_xy[key] = np.full((tracks0.n_tracks, 2), np.nan)
+            for t0 in np.unique(tracks0.start[fitted]):
+                sel = rows[fitted & (tracks0.start == t0)]
+                uv = model_point_tracks(means[key], truth, cam, verts[sel], 0, [t0])  # [p, 1, 2]
+                seed_xy[key][sel] = uv[:, 0]
     for name, c, frames in motion_cases(observed):
         pred = predict_tracks(fit, osc, 0, observed.wind[c], frames)  # [P, F, 2]
         scores[name] = {"tracks": motion_errors(pred, tracks0, truth, cam, c, frames, 0)}
-        if ours is not None:
-            po = np.full_like(pred, np.nan)
-            po[fitted] = model_point_tracks(means_fn, truth, cam, verts[fitted], c, frames)
-            scores[name]["ours"] = motion_errors(
-                po, tracks0, truth, cam, c, frames, 0, seed_xy=seed_ours
-            )
+        if fields:
+            scores[name]["fields"] = {}
+        for key in models:
+            po = np.full_like(pred, np.nan)  # [P, F, 2]: predictions at the fitted tracks only
+            po[fitted] = model_point_tracks(means[key], truth, cam, verts[fitted], c, frames)
+            err = motion_errors(po, tracks0, truth, cam, c, frames, 0, seed_xy=seed_xy[key])
+            if key == "ours" and ours is not None:
+                scores[name]["ours"] = err
+            else:
+                scores[name]["fields"][key] = err
     return rec, scores

@@ -7,7 +7,8 @@ editing a tracker setting leaves ours' jobs alone.
 Config: ``tracks`` (``configs``: which of ``models.configs`` the control is fitted in, with their
 conditions and K; ``K``: ``same`` for each configuration's own K, or one integer for every
 configuration; ``iterations``, ``min_track_frames``, ``min_tracks``, ``kmeans_n_init``: the fit;
-``tracker``: ``physgs.tracks.track.TrackSettings``), ``models.ours`` (the oscillator's bounds,
+``tracker``: ``physgs.tracks.track.TrackSettings``; ``fields``: the learned fields scored at
+the tracked points beside ours), ``models.ours`` (the oscillator's bounds,
 initialisation, RK4 substeps and guard) and ``train.lr.physics`` (Adam's rate on omega/zeta).
 """
 
@@ -40,6 +41,16 @@ def parts(cfg: dict, config: str) -> tuple[int, str]:
     if k == SAME_K:
         return int(cfg["models"]["configs"][config]["K"]), f"models/configs/{config}/K"
     return int(k), "tracks/K"
+
+
+def fields_scored(cfg: dict, config: str) -> list[str]:
+    """The learned fields of ``tracks.fields`` scored at the tracked points beside ours in
+    configuration ``config``: those trained there (the fields train in the base configuration
+    only, ``physgs.models.registry.configs_for``)."""
+    from physgs.models.registry import configs_for
+
+    configs = cfg["models"]["configs"]
+    return [m for m in cfg["tracks"].get("fields", []) if config in configs_for(m, configs)]
 
 
 def fit_job(cfg: dict, config: str, seed: int) -> dict:
