@@ -1,7 +1,8 @@
 """Is an oscillator prior's in-window fit limited by what it can express, or by finding the
 frequencies? A diagnostic that reads the truth (never a recipe input).
 
-    python benchmarks/prior_oracle.py results/testbed/sparse [--models ours,ours_chain] [--set K=V]
+    python benchmarks/prior_oracle.py results/testbed/sparse [--models ours,ours_chain] [--bones]
+        [--set KEY.PATH=VALUE]
 
 Trains each prior twice on one tree's training window, by the profile's recipe (the same
 ``physgs.experiments.fit`` as every job): as the pipeline does (every part starts at
@@ -12,13 +13,17 @@ pivots, Gaussians) starts and trains as usual. Prints fit and held-out PSNR (tra
 training wind, trained and held-out window frames) and each run's share of the true-motion
 ceiling's gain over the static pose. If the oracle start fits far better, the prior can express
 the motion and gradient descent from a common start does not find the frequencies; if not, the
-prior's structure is what limits it.
+prior's structure is what limits it. ``--bones`` adds the chained prior with the testbed's own
+parts: one part per bone, its parent the parent bone, its pivot the bone's head, and the oracle
+start (so only the gains and the Gaussians are left to learn): what the prior can reach when its
+parts are the true ones.
 """
 
 from __future__ import annotations
 
 import argparse
 import copy
+import functools
 import math
 from pathlib import Path
 
@@ -38,9 +43,15 @@ def _logit(p: np.ndarray) -> np.ndarray:
     return np.log(p / (1 - p))
 
 
-def oracle_start(model, truth) -> None:
-    """Set each part's omega, zeta (raw parameters) and swing axis from its majority bone."""
-    bone = np.asarray(truth.vertex_bone)[np.asarray(truth.gaussian_vertex)]  # [N] per Gaussian
+def bone_of_gaussian(truth) -> np.ndarray:
+    """[N] the bone of each Gaussian's mesh vertex."""
+    return np.asarray(truth.vertex_bone)[np.asarray(truth.gaussian_vertex)]
+
+
+def oracle_start(model, truth, gain: bool = False) -> None:
+    """Set each part's omega, zeta (raw parameters) and swing axis from its majority bone, and
+    with ``gain`` its force gain (rad/s^2 per m^2/s^2 in both)."""
+    bone = bone_of_gaussian(truth)  # [N]
     lab = model.part_labels.numpy()  # [N]
     b = model.bounds
     lo, hi = math.log(b.omega_lo), math.log(b.omega_hi)
@@ -56,6 +67,11 @@ def oracle_start(model, truth) -> None:
         model.zeta_raw.copy_(torch.tensor(_logit((ze - b.zeta_lo) / (b.zeta_hi - b.zeta_lo))))
         axis = torch.tensor(np.asarray(truth.swing_axis, dtype=np.float32))
         model.axis_raw.copy_(axis.repeat(model.K, 1))
+        if gain:
+            gain = np.array(
+                [truth.gain[np.bincount(bone[lab == p]).argmax()] for p in range(model.K)]
+            )
+            model.gain_raw.copy_(torch.tensor(gain, dtype=torch.float32) / model.gain_scale)
 
 
 def main() -> None:
@@ -64,21 +80,45 @@ def main() -> None:
     ap.add_argument("--models", default="ours,ours_chain")
     ap.add_argument("--profile", default="default")
     ap.add_argument("--set", action="append", default=[], help="KEY.PATH=VALUE override")
+    ap.add_argument(
+        "--bones", action="store_true", help="also the chained prior with one part per bone"
+    )
+    ap.add_argument(
+        "--relative",
+        action="store_true",
+        help="every run's angles relative to the canonical frame's: theta(t) - theta(t_0)",
+    )
+    ap.add_argument("--gain", action="store_true", help="the oracle start sets the gains too")
     args = ap.parse_args()
+    start = functools.partial(oracle_start, gain=args.gain)
     cfg = physgs.config.apply_overrides(
         physgs.config.load("config/trees.yaml", args.profile), args.set
     )
     obs = load_observed(args.dataset / "observed.npz")
+    if args.relative:  # the canonical Gaussians are the pose at recorded frame 0, not at rest
+        from physgs.models.ours import OscillatorPrior
+
+        L = int(obs.lead_in_frames)
+        own = OscillatorPrior._integrate_theta
+        OscillatorPrior._integrate_theta = lambda self, w: (lambda th: th - th[:, L : L + 1])(
+            own(self, w)
+        )
     truth = load_truth(args.dataset / "truth.npz")
     trained, held = heldout_split(int(obs.n_train), int(cfg["train"]["holdout_every"]))
 
-    def scores(m, start=None):
+    def scores(m, start=None, bones=False):
         build = recipe.build_model
         if start is not None:  # the oracle start, after the model is built and seeded
 
             def built(*a, **k):
+                if bones:  # one part per bone, its parent bone's part as parent
+                    k = {**k, "K": len(truth.omega), "labels": bone_of_gaussian(truth)}
+                    k["parent"] = np.asarray(truth.bone_parent)
                 model = build(*a, **k)
                 start(model, truth)
+                if bones:  # each pivot at its bone's head, the joint with the parent
+                    with torch.no_grad():
+                        model.pivot.copy_(torch.tensor(np.asarray(truth.bone_head)))
                 return model
 
             recipe.build_model = built
@@ -100,14 +140,20 @@ def main() -> None:
     print(
         f"{'model':12s} {'start':8s} {'fit dB':>7s} {'held dB':>7s} {'of gain (fit / held)':>22s}"
     )
-    for m in args.models.split(","):
-        for name, start in (("pipeline", None), ("oracle", oracle_start)):
-            f, h = scores(m, start)
-            print(
-                f"{m:12s} {name:8s} {f:7.2f} {h:7.2f} "
-                f"{100 * (f - s_f) / (c_f - s_f):10.0f}% / {100 * (h - s_h) / (c_h - s_h):.0f}%",
-                flush=True,
-            )
+    runs = [
+        (m, name, start, False)
+        for m in filter(None, args.models.split(","))
+        for name, start in (("pipeline", None), ("oracle", start))
+    ]
+    if args.bones:
+        runs.append(("ours_chain", "bones", start, True))
+    for m, name, start, bones in runs:
+        f, h = scores(m, start, bones)
+        print(
+            f"{m:12s} {name:8s} {f:7.2f} {h:7.2f} "
+            f"{100 * (f - s_f) / (c_f - s_f):10.0f}% / {100 * (h - s_h) / (c_h - s_h):.0f}%",
+            flush=True,
+        )
 
 
 if __name__ == "__main__":
