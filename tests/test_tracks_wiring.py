@@ -543,12 +543,15 @@ def test_the_tracker_and_the_fit_read_no_truth(plan):
 def test_the_learned_fields_are_scored_beside_ours_where_they_are_trained(plan):
     cfg = quick_config()
     fields = cfg["tracks"]["fields"]
-    assert fields and tsettings.fields_scored(cfg, "joint32") == []
+    assert fields and tsettings.fields_scored(cfg, "joint32", "sparse") == []
+    assert tsettings.fields_scored(cfg, "single", "sparse") == fields
+    assert tsettings.fields_scored(cfg, "single", "sparse_damping") == []  # no field trains there
     for b in _blocks(plan, "tracks_evaluate"):
         inputs = re.search(r"input: (.*)", b).group(1)
         config = re.search(r"eval_(\w+)\.json", b).group(1)
+        faithful = "_damping/" not in re.search(r"output: (.*)", b).group(1)
         for m in ("mlp", "mlp_wind", "d3dgs", "d3dgs_wind"):
-            want = m in fields and config == "single"
+            want = m in fields and config == "single" and faithful
             assert (f"/{m}_{config}.pt" in inputs) == want, (config, m, inputs)
 
 

@@ -353,8 +353,8 @@ def fit_tracks_inputs(wildcards):
 
 def tracks_evaluate_inputs(wildcards):
     """The fit, the training video's tracks, the dataset, the truth and its statistics, and the
-    checkpoints of ours and of the learned fields of tracks/fields trained in the same
-    configuration (scored at the same tracked points)."""
+    checkpoints of ours and of the learned fields of tracks/fields the pipeline trains there
+    (single, faithful testbeds), scored at the same tracked points."""
     t, s, c = wildcards.tree, wildcards.seed, wildcards.config
     return {
         "fit": TRACKS_FIT.format(tree=t, seed=s, config=c),
@@ -363,6 +363,6 @@ def tracks_evaluate_inputs(wildcards):
         "ours": CKPT.format(tree=t, seed=s, model="ours", config=c),
         **{
             f"field_{m}": CKPT.format(tree=t, seed=s, model=m, config=c)
-            for m in _tracks.fields_scored(CFG, c)
+            for m in _tracks.fields_scored(CFG, c, t)
         },
     }

@@ -43,12 +43,17 @@ def parts(cfg: dict, config: str) -> tuple[int, str]:
     return int(k), "tracks/K"
 
 
-def fields_scored(cfg: dict, config: str) -> list[str]:
+def fields_scored(cfg: dict, config: str, testbed: str) -> list[str]:
     """The learned fields of ``tracks.fields`` scored at the tracked points beside ours in
-    configuration ``config``: those trained there (the fields train in the base configuration
-    only, ``physgs.models.registry.configs_for``)."""
+    configuration ``config`` on ``testbed`` (a tree or a damping variant's id): those the
+    pipeline trains there anyway, i.e. in the base configuration on a faithful testbed (the
+    fields train in ``single`` only, ``physgs.models.registry.configs_for``, and on the damping
+    benchmark's testbeds only ours and its variants train)."""
     from physgs.models.registry import configs_for
+    from physgs.testbed.variant import FAITHFUL, parse_id
 
+    if parse_id(testbed)[1] != FAITHFUL:
+        return []
     configs = cfg["models"]["configs"]
     return [m for m in cfg["tracks"].get("fields", []) if config in configs_for(m, configs)]
 
