@@ -436,6 +436,9 @@ def test_needs_of_the_tracks_outputs():
         ("tracks_eval", "sparse", "joint32", 1),
         ("loss", "sparse", "ours", "joint32", 1),
     ]
+    assert build.tracks_needs("tab_tracks", ["sparse"], ["single"], [3], [("sparse", "single")])[
+        -1
+    ] == ("tracks_fields", "sparse", "single", 3)
     assert build.tracks_needs("fig_tracks", ["sparse"], ["joint32"], [5, 6]) == [
         ("observed", "sparse", 5),
         ("tracks", "sparse", 0, 5),
@@ -526,15 +529,15 @@ def test_the_tracker_and_the_fit_read_no_truth(plan):
         assert re.search(r"results/tracks/\w+/c0\.npz", inputs), inputs
     evals = _blocks(plan, "tracks_evaluate")
     assert evals and all("truth.npz" in re.search(r"input: (.*)", b).group(1) for b in evals)
-    # and in the rule file: only the evaluation names a truth-reading path or input function
+    # and in the rule file: only the evaluations name a truth-reading path or input function
     text = (ROOT / "workflow" / "rules" / "tracks.smk").read_text()
     rules = re.split(r"\n(?:rule|use rule) ", text)[1:]
     readers = [
         b.split(None, 1)[0].rstrip(":")
         for b in rules
-        if re.search(r"TRUTH|truth_input|tracks_evaluate_inputs|testbed_files", b)
+        if re.search(r"TRUTH|truth_input|tracks_(evaluate|fields)_inputs|testbed_files", b)
     ]
-    assert readers == ["tracks_evaluate"], readers
+    assert readers == ["tracks_evaluate", "tracks_fields"], readers
     common = (ROOT / "workflow" / "rules" / "common.smk").read_text()
     fit_inputs = common.split("def fit_tracks_inputs", 1)[1].split("\ndef ", 1)[0]
     assert not re.search(r"truth_input|testbed_files|TRUTH", fit_inputs)
@@ -546,13 +549,19 @@ def test_the_learned_fields_are_scored_beside_ours_where_they_are_trained(plan):
     assert fields and tsettings.fields_scored(cfg, "joint32", "sparse") == []
     assert tsettings.fields_scored(cfg, "single", "sparse") == fields
     assert tsettings.fields_scored(cfg, "single", "sparse_damping") == []  # no field trains there
+    # the recovery tables never wait for a field: the fields are scored by a rule of their own
     for b in _blocks(plan, "tracks_evaluate"):
         inputs = re.search(r"input: (.*)", b).group(1)
-        config = re.search(r"eval_(\w+)\.json", b).group(1)
-        faithful = "_damping/" not in re.search(r"output: (.*)", b).group(1)
+        assert not re.search(r"/(mlp|d3dgs)\w*_\w+\.pt", inputs), inputs
+    scored = _blocks(plan, "tracks_fields")
+    assert scored and len(scored) == len(cfg["trees"])  # quick: one faithful tree, single only
+    for b in scored:
+        assert "fields_single.json" in re.search(r"output: (.*)", b).group(1)
+        inputs = re.search(r"input: (.*)", b).group(1)
         for m in ("mlp", "mlp_wind", "d3dgs", "d3dgs_wind"):
-            want = m in fields and config == "single" and faithful
-            assert (f"/{m}_{config}.pt" in inputs) == want, (config, m, inputs)
+            assert (f"/{m}_single.pt" in inputs) == (m in fields), (m, inputs)
+    table = [b for b in _blocks(plan, "table") if "tab_tracks" in b][0]
+    assert "fields_single.json" in table and "fields_joint32.json" not in table
 
 
 def test_tab_null_pairs_the_tracks_rows_with_the_null_of_their_k(plan):

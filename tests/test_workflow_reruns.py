@@ -144,6 +144,7 @@ def test_tracks_fit_settings_refit_the_tracks_control_only(plans):
     assert plan == {
         "fit_tracks": 2,
         "tracks_evaluate": 2,
+        "tracks_fields": 1,  # the learned fields at the tracks of single
         "table": 2,  # tab_null (its tracks rows) and tab_tracks
         "figure": 1,  # fig_tracks colours the tracks by the fit's parts
         "claims": 1,

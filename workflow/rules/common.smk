@@ -41,6 +41,10 @@ STAMP = _provenance.stamp(CFG)  # not a rerun trigger (see physgs.provenance.Sta
 # video, in these of ours' configurations, each with its K (tracks/K or the configuration's)
 TRACKS_CONFIGS = list(CFG["tracks"]["configs"])
 TRACKS_K = {c: _tracks.parts(CFG, c)[0] for c in TRACKS_CONFIGS}
+# (tree, configuration) pairs whose learned fields tab_tracks scores at the tracked points
+TRACKS_FIELD_PAIRS = [
+    (t, c) for t in TREES for c in TRACKS_CONFIGS if _tracks.fields_scored(CFG, c, t)
+]
 
 # ---- file layout ------------------------------------------------------------------------------
 # The testbed is one fixed instance per tree (testbed seed CFG["seed"]); every result of a
@@ -74,6 +78,7 @@ SEEDED_TRACKS = "results/tracks/{tree}/seed{seed}/c{condition}.npz"
 TRACKS_FIT = "results/tracks/{tree}/seed{seed}/fit_{config}.npz"
 TRACKS_EVAL = "results/tracks/{tree}/seed{seed}/eval_{config}.json"
 TRACKS_RECOVERY = RECOVERY.replace("{model}", "tracks")  # ours' record format, beside ours'
+TRACKS_FIELDS = "results/tracks/{tree}/seed{seed}/fields_{config}.json"  # the fields at the tracks
 #: need kind (physgs.report.build.needs) -> path template
 NEED_PATHS = {
     "eval": EVAL,
@@ -90,6 +95,7 @@ NEED_PATHS = {
     "table": TABLE.replace("{ext}", "csv"),
     "tracks_recovery": TRACKS_RECOVERY,
     "tracks_eval": TRACKS_EVAL,
+    "tracks_fields": TRACKS_FIELDS,
     "tracks_fit": TRACKS_FIT,
     # a figure reads the instance of its seed (the one instance without testbed_seeds)
     "tracks": SEEDED_TRACKS if TESTBED_SEEDS else TRACKS,
@@ -169,7 +175,9 @@ def report_inputs(wildcards):
         tracks = [c for c in DAMPING["configs"] if c in TRACKS_CONFIGS]
         return need_paths(_build.damping_needs(DAMPING["trees"], DAMPING["configs"], SEEDS, tracks))
     if wildcards.name in _build.TRACKS_OUTPUTS:
-        return need_paths(_build.tracks_needs(wildcards.name, TREES, TRACKS_CONFIGS, SEEDS))
+        return need_paths(
+            _build.tracks_needs(wildcards.name, TREES, TRACKS_CONFIGS, SEEDS, TRACKS_FIELD_PAIRS)
+        )
     if wildcards.name == "tab_parts_k":
         return need_paths(_build.kmatch_needs(TREES, PARTS["k_candidates"], STUDY_SEEDS))
     if wildcards.name in _build.PARTS_OUTPUTS:
@@ -352,17 +360,27 @@ def fit_tracks_inputs(wildcards):
 
 
 def tracks_evaluate_inputs(wildcards):
-    """The fit, the training video's tracks, the dataset, the truth and its statistics, and the
-    checkpoints of ours and of the learned fields of tracks/fields the pipeline trains there
-    (single, faithful testbeds), scored at the same tracked points."""
+    """The fit, the training video's tracks, the dataset, the truth and its statistics, and ours'
+    checkpoint in the same configuration (scored at the same tracked points)."""
     t, s, c = wildcards.tree, wildcards.seed, wildcards.config
     return {
         "fit": TRACKS_FIT.format(tree=t, seed=s, config=c),
         "tracks": tracks_file(t, s, 0),
         **testbed_files(t, s),
         "ours": CKPT.format(tree=t, seed=s, model="ours", config=c),
-        **{
-            f"field_{m}": CKPT.format(tree=t, seed=s, model=m, config=c)
-            for m in _tracks.fields_scored(CFG, c, t)
-        },
+    }
+
+
+def tracks_fields_inputs(wildcards):
+    """The fit, the training video's tracks, the dataset and the truth, and the checkpoints of
+    the learned fields of tracks/fields the pipeline trains there (single, faithful testbeds)."""
+    t, s, c = wildcards.tree, wildcards.seed, wildcards.config
+    fields = _tracks.fields_scored(CFG, c, t)
+    if not fields:
+        raise ValueError(f"no learned field of tracks/fields is trained in {c} on {t}")
+    return {
+        "fit": TRACKS_FIT.format(tree=t, seed=s, config=c),
+        "tracks": tracks_file(t, s, 0),
+        **testbed_files(t, s),
+        **{f"field_{m}": CKPT.format(tree=t, seed=s, model=m, config=c) for m in fields},
     }

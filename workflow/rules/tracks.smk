@@ -87,3 +87,26 @@ rule tracks_evaluate:
         damping=recovery_damping_params,
     script:
         "../scripts/tracks_evaluate.py"
+
+
+# an evaluation (reads truth.npz): the learned fields trained in the same configuration, at the
+# control's tracked points (tab_tracks' best-field column; tab_null and tab_damping never need it)
+rule tracks_fields:
+    input:
+        unpack(tracks_fields_inputs),
+    output:
+        scores=TRACKS_FIELDS,
+    log:
+        "logs/tracks/{tree}/seed{seed}/fields_{config}.log",
+    benchmark:
+        "results/benchmarks/tracks/{tree}/seed{seed}/fields_{config}.tsv"
+    wildcard_constraints:
+        config="|".join(TRACKS_CONFIGS) or "(?!x)x",
+    conda:
+        "../envs/physgs.yaml"
+    threads: 1
+    resources:
+        mem_mb=3000,
+        runtime=30,
+    script:
+        "../scripts/tracks_fields.py"

@@ -1,7 +1,6 @@
 """Snakemake script of rule `tracks_evaluate`: the tracks control scored against the truth
 (tracker error, recovery through ours' matcher, motion beyond the window and under unseen wind
-beside the Gaussians of ours and of the learned fields at the same points). An evaluation:
-reads truth.npz."""
+beside ours' Gaussians at the same points). An evaluation: reads truth.npz."""
 
 from physgs.atomic import write_json
 from physgs.jobs import job
@@ -25,11 +24,6 @@ with job(sm) as log:
         damping=sm.params.damping,
         min_tracks=meta["min_tracks"],
         ours=load_checkpoint(sm.input.ours),
-        fields={
-            k.removeprefix("field_"): load_checkpoint(p)
-            for k, p in sm.input.items()
-            if k.startswith("field_")
-        },
     )
     save_tracks_recovery(sm.output.record, rec)
     write_json(sm.output.scores, scores)

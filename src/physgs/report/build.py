@@ -60,6 +60,7 @@ NEED_FIELDS = {
     # record, its fit, one condition's tracks, and the observed dataset (fig_tracks' frame)
     "tracks_recovery": ("tree", "config", "seed"),
     "tracks_eval": ("tree", "config", "seed"),
+    "tracks_fields": ("tree", "config", "seed"),  # the learned fields at the tracked points
     "tracks_fit": ("tree", "config", "seed"),
     "tracks": ("tree", "condition", "seed"),
     "observed": ("tree", "seed"),
@@ -122,11 +123,17 @@ def damping_needs(
 
 
 def tracks_needs(
-    name: str, trees: Sequence[str], configs: Sequence[str], seeds: Sequence[int]
+    name: str,
+    trees: Sequence[str],
+    configs: Sequence[str],
+    seeds: Sequence[int],
+    fields: Sequence[tuple[str, str]] = (),
 ) -> list[tuple]:
     """What tab_tracks or fig_tracks reads. configs: the configurations the control is fitted in
-    (``tracks.configs``). tab_tracks: its evaluation record and ours' loss log (training seconds)
-    per tree, configuration and seed;
+    (``tracks.configs``); fields: the (tree, configuration) pairs whose learned fields are scored
+    at the tracked points (``physgs.tracks.settings.fields_scored``). tab_tracks: its evaluation
+    record, ours' loss log (training seconds) and, for those pairs, the fields' scores, per tree,
+    configuration and seed;
     fig_tracks: per tree, the observed frames, the training video's tracks and (with a
     configuration) the first configuration's fit, of the first seed."""
     if not seeds:
@@ -138,7 +145,7 @@ def tracks_needs(
             for t in trees
             for c in configs
             for kind, m in (("tracks_eval", ()), ("loss", ("ours",)))  # ours' training seconds
-        ]
+        ] + [("tracks_fields", t, c, int(s)) for s in seeds for t, c in fields]
     if name == "fig_tracks":
         s0 = int(seeds[0])
         out = []
@@ -591,6 +598,10 @@ def make_table(
                 for c in settings["configs"]:
                     with open(path("tracks_eval", t, c, s)) as fh:
                         scores[s][(t, c)] = json.load(fh)
+                    if key(("tracks_fields", t, c, s)) in inputs:  # {case: {field: errors}}
+                        with open(path("tracks_fields", t, c, s)) as fh:
+                            for case, f in json.load(fh).items():
+                                scores[s][(t, c)][case]["fields"] = f
                     loss = pd.read_csv(path("loss", t, "ours", c, s))
                     scores[s][(t, c)]["ours_train_s"] = float(loss["seconds"].iloc[-1])
         table = tab_tracks(

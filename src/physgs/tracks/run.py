@@ -71,6 +71,37 @@ def motion_cases(observed) -> list[tuple[str, int, np.ndarray]]:
     return out
 
 
+def _fitted(fit: TrackFit) -> np.ndarray:
+    """[P] the tracks with a prediction: in a part that has an estimate."""
+    lab = fit.labels[0]
+    return (lab >= 0) & fit.estimated[np.maximum(lab, 0)]
+
+
+def models_at_tracks(models: dict, fit: TrackFit, tracks0: Tracks, observed, truth) -> dict:
+    """Each trained Gaussian model's prediction of the fitted tracked points, scored as the
+    control's: {case (``motion_cases``): {name: motion_errors}}, each model's displacement measured
+    since each track's seed frame. models: name -> model (``gaussians_at``)."""
+    from physgs.evaluate.adapter import model_means_fn
+    from physgs.tracks.score import associate, model_point_tracks, motion_errors
+
+    cam = observed.train_camera
+    fitted = _fitted(fit)
+    verts = associate(truth, cam, tracks0, 0)
+    rows = np.arange(tracks0.n_tracks)
+    out: dict = {name: {} for name, _, _ in motion_cases(observed)}
+    for key, model in models.items():
+        means = model_means_fn(model, observed)
+        seed_xy = np.full((tracks0.n_tracks, 2), np.nan)  # the model at each seed frame
+        for t0 in np.unique(tracks0.start[fitted]):
+            sel = rows[fitted & (tracks0.start == t0)]
+            seed_xy[sel] = model_point_tracks(means, truth, cam, verts[sel], 0, [t0])[:, 0]
+        for name, c, frames in motion_cases(observed):
+            po = np.full((tracks0.n_tracks, len(frames), 2), np.nan)  # [P, F, 2]
+            po[fitted] = model_point_tracks(means, truth, cam, verts[fitted], c, frames)
+            out[name][key] = motion_errors(po, tracks0, truth, cam, c, frames, 0, seed_xy=seed_xy)
+    return out
+
+
 def evaluate_job(
     fit: TrackFit,
     osc: Oscillators,
@@ -82,19 +113,16 @@ def evaluate_job(
     damping: dict | None = None,
     min_tracks: int = -1,
     ours=None,
-    fields: dict | None = None,
 ) -> tuple[TracksRecovery, dict]:
     """Score one fit against the truth. tracks0: the tracks of condition 0 (the fit's first
-    entry); ours: ours' trained model in the same configuration (None: not scored); fields:
-    learned-field id -> its trained model in the same configuration, scored like ours.
+    entry); ours: ours' trained model in the same configuration (None: not scored).
 
     Returns (recovery, scores): scores = {"tracker": ``TrackerScore`` dict of tracks0,
     "fit": {K, seconds, loop_seconds, rms_px, n_fitted}, and per motion case (``motion_cases``)
     {"tracks": motion_errors of the control, "ours": the same of ours' Gaussians at the same
-    tracked points (its displacement since each seed frame), "fields": {id: the same of that
-    field's Gaussians}}}.
+    tracked points (``models_at_tracks``)}}.
     """
-    from physgs.tracks.score import associate, model_point_tracks, motion_errors, score_tracker
+    from physgs.tracks.score import motion_errors, score_tracker
 
     if fit.conditions[0] != 0:
         raise ValueError(f"the fit's first condition is {fit.conditions[0]}, not the training one")
@@ -102,8 +130,7 @@ def evaluate_job(
     rec = recover_tracks(
         fit, osc, observed, truth, bone_visible=bone_visible, damping=damping, min_tracks=min_tracks
     )
-    lab = fit.labels[0]
-    fitted = (lab >= 0) & fit.estimated[np.maximum(lab, 0)]  # [P] tracks with a prediction
+    fitted = _fitted(fit)
     scores: dict = {
         "tracker": score_tracker(tracks0, truth, cam, 0).to_dict(),
         "fit": {
@@ -115,32 +142,10 @@ def evaluate_job(
             "n_estimated": int(fit.estimated.sum()),
         },
     }
-    models = {**({"ours": ours} if ours is not None else {}), **(fields or {})}
-    means, seed_xy = {}, {}
-    if models:
-        from physgs.evaluate.adapter import model_means_fn
-
-        verts = associate(truth, cam, tracks0, 0)
-        rows = np.arange(tracks0.n_tracks)
-        for key, model in models.items():
-            means[key] = model_means_fn(model, observed)
-            # the model's own position at each seed frame: the origin of its displacement
-            seed_xy[key] = np.full((tracks0.n_tracks, 2), np.nan)
-            for t0 in np.unique(tracks0.start[fitted]):
-                sel = rows[fitted & (tracks0.start == t0)]
-                uv = model_point_tracks(means[key], truth, cam, verts[sel], 0, [t0])  # [p, 1, 2]
-                seed_xy[key][sel] = uv[:, 0]
+    at = models_at_tracks({"ours": ours}, fit, tracks0, observed, truth) if ours is not None else {}
     for name, c, frames in motion_cases(observed):
         pred = predict_tracks(fit, osc, 0, observed.wind[c], frames)  # [P, F, 2]
         scores[name] = {"tracks": motion_errors(pred, tracks0, truth, cam, c, frames, 0)}
-        if fields:
-            scores[name]["fields"] = {}
-        for key in models:
-            po = np.full_like(pred, np.nan)  # [P, F, 2]: predictions at the fitted tracks only
-            po[fitted] = model_point_tracks(means[key], truth, cam, verts[fitted], c, frames)
-            err = motion_errors(po, tracks0, truth, cam, c, frames, 0, seed_xy=seed_xy[key])
-            if key == "ours" and ours is not None:
-                scores[name]["ours"] = err
-            else:
-                scores[name]["fields"][key] = err
+        if ours is not None:
+            scores[name]["ours"] = at[name]["ours"]
     return rec, scores
