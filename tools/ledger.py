@@ -2,7 +2,7 @@
 "undecided: not measured".
 
     python tools/ledger.py [--results results] [--config config/trees.yaml] [--profile default]
-        [--seeds 0 1 2] [--out PATH.md]
+        [--seeds 0 1 2] [--trees medium] [--out PATH.md]
 
 `snakemake claims` needs every table (the whole DAG). A run of some targets (for example the
 parts study and the 2D-track control at three seeds, without the learned fields) still decides
@@ -26,11 +26,13 @@ def main() -> None:
     ap.add_argument("--config", default="config/trees.yaml")
     ap.add_argument("--profile", default="default")
     ap.add_argument("--seeds", type=int, nargs="+", help="training seeds (default: the config's)")
+    ap.add_argument("--trees", nargs="+", help="the trees the run built (default: the config's)")
     ap.add_argument("--out", type=Path, help="also write the ledger here (Markdown)")
     args = ap.parse_args()
     cfg = physgs.config.load(args.config, args.profile)
     seeds = args.seeds if args.seeds is not None else cfg["seeds"]
-    needs = build.claims_needs(cfg["trees"], cfg["models"]["configs"], seeds, True, True)
+    trees = args.trees or cfg["trees"]
+    needs = build.claims_needs(trees, cfg["models"]["configs"], seeds, True, True)
     paths = {  # the workflow's layout (common.smk: TABLE, RECOVERY with model ours)
         "table": "tables/{name}.csv",
         "recovery": "recovery/{tree}/seed{seed}/ours_{config}.json",
@@ -42,7 +44,7 @@ def main() -> None:
         if path.exists():
             inputs[build.key(need)] = str(path)
     missing = sorted({build.key(n) for n in needs} - set(inputs))
-    df = build.claims_frame(inputs, cfg["trees"])
+    df = build.claims_frame(inputs, trees)
     md = claims.ledger_markdown(df, {"seeds": " ".join(map(str, seeds)), "partial": "yes"})
     print(md)
     print(f"not found under {args.results} ({len(missing)}): {', '.join(missing) or 'none'}")
