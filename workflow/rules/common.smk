@@ -378,9 +378,11 @@ def tracks_fields_inputs(wildcards):
     fields = _tracks.fields_scored(CFG, c, t)
     if not fields:
         raise ValueError(f"no learned field of tracks/fields is trained in {c} on {t}")
+    tb = testbed_files(t, s)  # the bones' visibility (stats) is not read here
     return {
         "fit": TRACKS_FIT.format(tree=t, seed=s, config=c),
         "tracks": tracks_file(t, s, 0),
-        **testbed_files(t, s),
+        "observed": tb["observed"],
+        "truth": tb["truth"],
         **{f"field_{m}": CKPT.format(tree=t, seed=s, model=m, config=c) for m in fields},
     }

@@ -325,9 +325,10 @@ def measure(
                 ),
             )
 
-    tr = tables.get("tab_transfer", pd.DataFrame(columns=["tree", "condition"]))
-    beyond = tr[tr["split"] == "beyond"] if "split" in tr.columns else tr
-    for (t, c), _ in beyond.groupby(["tree", "condition"], sort=False):
+    tr = tables.get("tab_transfer")  # its per-wind rows exist only with the table
+    beyond = tr if tr is None or "split" not in tr.columns else tr[tr["split"] == "beyond"]
+    cells = [] if beyond is None else beyond.groupby(["tree", "condition"], sort=False)
+    for (t, c), _ in cells:
 
         def cell(d, t=t, c=c):
             row = (d["split"] == "beyond") & (d["tree"] == t) & np.isclose(d["condition"], c)
@@ -365,8 +366,11 @@ def measure(
     if "tab_tracks" in tables and "tab_null" in tables:
         out += _tracks_claims(tables["tab_null"], tables["tab_tracks"], trees)
 
-    mg = tables.get("tab_margin", pd.DataFrame(columns=["margin_first", "margin_last"]))
-    cols = [c for c in mg.columns if c.startswith("margin_")]
+    # the margin columns, first and last wind (named generically when the table was not built)
+    mg = tables.get("tab_margin")
+    cols = (
+        [c for c in mg.columns if c.startswith("margin_")] if mg is not None else ["first", "last"]
+    )
     for t in trees:
         p = PAPER_MARGIN.get(t)
         add(
