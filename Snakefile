@@ -36,12 +36,13 @@ include: "workflow/rules/speed_accuracy.smk"
 include: "workflow/rules/kselect.smk"
 
 
-# everything `all` makes besides the summary, which reads these runs' benchmark files
+# everything `all` makes besides the summary, which reads these runs' benchmark files: the
+# paper's tables at every seed. The studies of the trade (the speed-accuracy sweep, the fit curve,
+# the chained prior's K match) are a target of their own, `studies`: three seeds of `all` already
+# take ~4 h of the 2 cores (docs/performance.md), the studies another ~100 job-minutes
 RUN = [
     rules.testbed.input,
     rules.report.input,
-    rules.speed_accuracy.output,
-    rules.fit_curve.output,
     expand(TABLE, name="tab_kselect", ext=("tex", "csv")),
     rules.claims.output,
 ]
@@ -54,6 +55,13 @@ rule all:
     input:
         RUN,
         rules.summary.output,
+
+
+rule studies:
+    input:
+        rules.speed_accuracy.output,
+        rules.fit_curve.output,
+        expand(TABLE, name="tab_parts_k", ext=("tex", "csv")) if "ours_chain" in PARTS_MODELS else [],
 
 
 # On SLURM, a request that no node of its partition can meet would wait PENDING for ever: every

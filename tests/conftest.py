@@ -113,6 +113,7 @@ def quick_dag(tmp_path_factory):
                     "--cores",
                     "2",
                     "all",
+                    "studies",
                     "--config",
                     "profile=quick",
                     'trees=["sparse"]',

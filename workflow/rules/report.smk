@@ -57,7 +57,7 @@ rule report:
                 if n != "tab_kselect"
                 and (n != "tab_damping" or DAMPING["trees"])
                 and (n not in _build.PARTS_OUTPUTS or PARTS_MODELS)
-                and (n != "tab_parts_k" or "ours_chain" in PARTS_MODELS)
+                and n != "tab_parts_k"  # a study: the `studies` target (Snakefile)
                 and (n != "tab_tracks" or TRACKS_CONFIGS)
             ],
         ),
