@@ -61,7 +61,9 @@ rule studies:
     input:
         rules.speed_accuracy.output,
         rules.fit_curve.output,
-        expand(TABLE, name="tab_parts_k", ext=("tex", "csv")) if "ours_chain" in PARTS_MODELS else [],
+        expand(TABLE, name="tab_parts_k", ext=("tex", "csv"))
+        if "ours_chain" in PARTS_MODELS
+        else [],
 
 
 # On SLURM, a request that no node of its partition can meet would wait PENDING for ever: every
