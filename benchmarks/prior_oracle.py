@@ -74,6 +74,38 @@ def oracle_start(model, truth, gain: bool = False) -> None:
             model.gain_raw.copy_(torch.tensor(gain, dtype=torch.float32) / model.gain_scale)
 
 
+def tracks_start(model, fit_npz: Path, camera, radius_px: float = 2.0) -> np.ndarray:
+    """Set each part's omega (raw parameter) from the 2D-track control's fit (observed data
+    only: the training video's tracks, ``physgs.tracks.fit``): the median omega of the fitted
+    track clusters of the tracks whose rest position (px) lies within ``radius_px`` of one of
+    the part's projected canonical Gaussians. Parts without such a track keep their start.
+    Returns [K] the number of tracks each part drew on."""
+    d = np.load(fit_npz)
+    om_k, est = d["omega"], d["estimated"]  # [Kt] rad/s, [Kt] bool
+    lab, c = d["labels_0"], d["c_0"]  # [M] cluster of each track (-1: not fitted), [M, 2] px
+    keep = (lab >= 0) & est[np.clip(lab, 0, None)]
+    lab, c = lab[keep], c[keep]
+    uv, _ = camera.project(np.asarray(model.ctx.canonical_xyz, dtype=np.float64))  # [N, 2]
+    parts = model.part_labels.numpy()  # [N]
+    from scipy.spatial import cKDTree
+
+    dist, idx = cKDTree(uv).query(c)  # nearest projected Gaussian of each track
+    near = dist <= radius_px
+    om = model.bounds.omega(model.omega_raw.detach()).numpy().astype(np.float64)
+    n = np.zeros(model.K, dtype=int)
+    for p in range(model.K):
+        sel = near & (parts[idx] == p)
+        n[p] = sel.sum()
+        if n[p]:
+            om[p] = np.median(om_k[lab[sel]])
+    b = model.bounds
+    lo, hi = math.log(b.omega_lo), math.log(b.omega_hi)
+    om = np.clip(om, b.omega_lo * 1.001, b.omega_hi * 0.999)
+    with torch.no_grad():
+        model.omega_raw.copy_(torch.tensor(_logit((np.log(om) - lo) / (hi - lo))))
+    return n
+
+
 def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("dataset", type=Path, help="folder with observed.npz and truth.npz")
@@ -89,6 +121,13 @@ def main() -> None:
         help="every run's angles relative to the canonical frame's: theta(t) - theta(t_0)",
     )
     ap.add_argument("--gain", action="store_true", help="the oracle start sets the gains too")
+    ap.add_argument(
+        "--tracks",
+        type=Path,
+        help="also a start from the 2D-track control's fit (its fit_<config>.npz): observed data only",
+    )
+    ap.add_argument("--no-oracle", action="store_true", help="skip the oracle-start runs")
+    ap.add_argument("--no-pipeline", action="store_true", help="skip the pipeline-start runs")
     args = ap.parse_args()
     start = functools.partial(oracle_start, gain=args.gain)
     cfg = physgs.config.apply_overrides(
@@ -140,10 +179,15 @@ def main() -> None:
     print(
         f"{'model':12s} {'start':8s} {'fit dB':>7s} {'held dB':>7s} {'of gain (fit / held)':>22s}"
     )
+    starts = ([] if args.no_pipeline else [("pipeline", None)]) + (
+        [] if args.no_oracle else [("oracle", start)]
+    )
+    if args.tracks is not None:
+        starts.append(
+            ("tracks", lambda model, _truth: tracks_start(model, args.tracks, obs.train_camera))
+        )
     runs = [
-        (m, name, start, False)
-        for m in filter(None, args.models.split(","))
-        for name, start in (("pipeline", None), ("oracle", start))
+        (m, name, st, False) for m in filter(None, args.models.split(",")) for name, st in starts
     ]
     if args.bones:
         runs.append(("ours_chain", "bones", start, True))
