@@ -74,16 +74,22 @@ def oracle_start(model, truth, gain: bool = False) -> None:
             model.gain_raw.copy_(torch.tensor(gain, dtype=torch.float32) / model.gain_scale)
 
 
-def tracks_start(model, fit_npz: Path, camera, radius_px: float = 2.0) -> np.ndarray:
+def tracks_start(
+    model, fit_npz: Path, tracks_npz: Path, camera, radius_px: float = 2.0
+) -> np.ndarray:
     """Set each part's omega (raw parameter) from the 2D-track control's fit (observed data
     only: the training video's tracks, ``physgs.tracks.fit``): the median omega of the fitted
-    track clusters of the tracks whose rest position (px) lies within ``radius_px`` of one of
-    the part's projected canonical Gaussians. Parts without such a track keep their start.
+    track clusters of the tracks whose first tracked position (px; ``tracks_npz``, the track
+    rule's c<condition>.npz) lies within ``radius_px`` of one of the part's projected canonical
+    Gaussians. Parts without such a track keep their start.
     Returns [K] the number of tracks each part drew on."""
     d = np.load(fit_npz)
     om_k, est = d["omega"], d["estimated"]  # [Kt] rad/s, [Kt] bool
-    lab, c = d["labels_0"], d["c_0"]  # [M] cluster of each track (-1: not fitted), [M, 2] px
-    keep = (lab >= 0) & est[np.clip(lab, 0, None)]
+    lab = d["labels_0"]  # [M] cluster of each track (-1: not fitted)
+    t = np.load(tracks_npz)
+    xy, valid = t["xy"], t["valid"]  # [M, F, 2] px, [M, F]
+    c = xy[np.arange(len(xy)), valid.argmax(1)]  # [M, 2] first tracked position
+    keep = (lab >= 0) & est[np.clip(lab, 0, None)] & valid.any(1)
     lab, c = lab[keep], c[keep]
     uv, _ = camera.project(np.asarray(model.ctx.canonical_xyz, dtype=np.float64))  # [N, 2]
     parts = model.part_labels.numpy()  # [N]
@@ -184,7 +190,12 @@ def main() -> None:
     )
     if args.tracks is not None:
         starts.append(
-            ("tracks", lambda model, _truth: tracks_start(model, args.tracks, obs.train_camera))
+            (
+                "tracks",
+                lambda model, _truth: tracks_start(
+                    model, args.tracks, args.tracks.parent.parent / "c0.npz", obs.train_camera
+                ),
+            )
         )
     runs = [
         (m, name, st, False) for m in filter(None, args.models.split(",")) for name, st in starts
