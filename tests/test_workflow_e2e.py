@@ -220,7 +220,16 @@ def test_tab_null_plan_trains_ours_only():
 def test_snakemake_report_collects_tables_and_figures(run, tmp_path):
     """`snakemake --report` on the finished DAG gives one HTML with every section and output."""
     html = tmp_path / "report.html"
-    snakemake(run, "--report", str(html), "--config", "profile=quick", 'trees=["sparse"]')
+    snakemake(
+        run,
+        "--report",
+        str(html),
+        "all",
+        "studies",
+        "--config",
+        "profile=quick",
+        'trees=["sparse"]',
+    )
     text = html.read_text(errors="replace")
     for name in (
         "1. Testbed",
