@@ -38,8 +38,8 @@ include: "workflow/rules/kselect.smk"
 
 # everything `all` makes besides the summary, which reads these runs' benchmark files: the
 # paper's tables at every seed. The studies of the trade (the speed-accuracy sweep, the fit curve,
-# the chained prior's K match) are a target of their own, `studies`: three seeds of `all` already
-# take ~4 h of the 2 cores (docs/performance.md), the studies another ~100 job-minutes
+# the chained prior's K match) are a target of their own, `studies`, at the studies' seeds: three
+# seeds of `all` already take over 3 h of the 2 cores (docs/performance.md, What a run costs)
 RUN = [
     rules.testbed.input,
     rules.report.input,

@@ -24,7 +24,6 @@ from __future__ import annotations
 import argparse
 import copy
 import functools
-import math
 from pathlib import Path
 
 import numpy as np
@@ -38,9 +37,17 @@ from physgs.experiments.recipe import heldout_split
 from physgs.testbed.dataset import load_observed, load_truth
 
 
-def _logit(p: np.ndarray) -> np.ndarray:
-    p = np.clip(p, 1e-6, 1 - 1e-6)
-    return np.log(p / (1 - p))
+def set_physics(model, omega=None, zeta=None) -> None:
+    """Set the raw parameters whose omega [K] (rad/s) and zeta [K] are given, each clipped just
+    inside the prior's bounds (``OscillatorBounds.omega_raw`` / ``zeta_raw``)."""
+    b = model.bounds
+    with torch.no_grad():
+        if omega is not None:
+            om = np.clip(omega, b.omega_lo * 1.001, b.omega_hi * 0.999)
+            model.omega_raw.copy_(torch.tensor([b.omega_raw(float(w)) for w in om]))
+        if zeta is not None:
+            ze = np.clip(zeta, b.zeta_lo * 1.001, b.zeta_hi * 0.999)
+            model.zeta_raw.copy_(torch.tensor([b.zeta_raw(float(z)) for z in ze]))
 
 
 def bone_of_gaussian(truth) -> np.ndarray:
@@ -53,62 +60,39 @@ def oracle_start(model, truth, gain: bool = False) -> None:
     with ``gain`` its force gain (rad/s^2 per m^2/s^2 in both)."""
     bone = bone_of_gaussian(truth)  # [N]
     lab = model.part_labels.numpy()  # [N]
-    b = model.bounds
-    lo, hi = math.log(b.omega_lo), math.log(b.omega_hi)
-    om = np.empty(model.K)
-    ze = np.empty(model.K)
-    for p in range(model.K):
-        major = np.bincount(bone[lab == p]).argmax()
-        om[p], ze[p] = truth.omega[major], truth.zeta[major]
-    om = np.clip(om, b.omega_lo * 1.001, b.omega_hi * 0.999)
-    ze = np.clip(ze, b.zeta_lo * 1.001, b.zeta_hi * 0.999)
+    major = [np.bincount(bone[lab == p]).argmax() for p in range(model.K)]
+    set_physics(model, np.asarray(truth.omega)[major], np.asarray(truth.zeta)[major])
     with torch.no_grad():
-        model.omega_raw.copy_(torch.tensor(_logit((np.log(om) - lo) / (hi - lo))))
-        model.zeta_raw.copy_(torch.tensor(_logit((ze - b.zeta_lo) / (b.zeta_hi - b.zeta_lo))))
         axis = torch.tensor(np.asarray(truth.swing_axis, dtype=np.float32))
         model.axis_raw.copy_(axis.repeat(model.K, 1))
         if gain:
-            gain = np.array(
-                [truth.gain[np.bincount(bone[lab == p]).argmax()] for p in range(model.K)]
-            )
-            model.gain_raw.copy_(torch.tensor(gain, dtype=torch.float32) / model.gain_scale)
+            gain = np.asarray(truth.gain, dtype=np.float32)[major]
+            model.gain_raw.copy_(torch.tensor(gain) / model.gain_scale)
 
 
-def tracks_start(
-    model, fit_npz: Path, tracks_npz: Path, camera, radius_px: float = 2.0
-) -> np.ndarray:
-    """Set each part's omega (raw parameter) from the 2D-track control's fit (observed data
-    only: the training video's tracks, ``physgs.tracks.fit``): the median omega of the fitted
-    track clusters of the tracks whose first tracked position (px; ``tracks_npz``, the track
-    rule's c<condition>.npz) lies within ``radius_px`` of one of the part's projected canonical
-    Gaussians. Parts without such a track keep their start.
-    Returns [K] the number of tracks each part drew on."""
-    d = np.load(fit_npz)
-    om_k, est = d["omega"], d["estimated"]  # [Kt] rad/s, [Kt] bool
-    lab = d["labels_0"]  # [M] cluster of each track (-1: not fitted)
-    t = np.load(tracks_npz)
-    xy, valid = t["xy"], t["valid"]  # [M, F, 2] px, [M, F]
-    c = xy[np.arange(len(xy)), valid.argmax(1)]  # [M, 2] first tracked position
-    keep = (lab >= 0) & est[np.clip(lab, 0, None)] & valid.any(1)
-    lab, c = lab[keep], c[keep]
-    uv, _ = camera.project(np.asarray(model.ctx.canonical_xyz, dtype=np.float64))  # [N, 2]
-    parts = model.part_labels.numpy()  # [N]
+def tracks_start(model, fit_npz: Path, tracks_npz: Path, camera, radius_px: float = 2.0):
+    """Set each part's omega from the 2D-track control's fit (observed data only: the training
+    video's tracks, ``physgs.tracks``): the median omega (rad/s) of the fitted clusters of the
+    tracks whose seed position (px; ``tracks_npz``, the track rule's c<condition>.npz) lies
+    within ``radius_px`` of one of the part's projected canonical Gaussians. Parts without such a
+    track keep their start. Returns [K] the number of tracks each part drew on."""
     from scipy.spatial import cKDTree
 
-    dist, idx = cKDTree(uv).query(c)  # nearest projected Gaussian of each track
-    near = dist <= radius_px
-    om = model.bounds.omega(model.omega_raw.detach()).numpy().astype(np.float64)
-    n = np.zeros(model.K, dtype=int)
-    for p in range(model.K):
-        sel = near & (parts[idx] == p)
-        n[p] = sel.sum()
-        if n[p]:
-            om[p] = np.median(om_k[lab[sel]])
-    b = model.bounds
-    lo, hi = math.log(b.omega_lo), math.log(b.omega_hi)
-    om = np.clip(om, b.omega_lo * 1.001, b.omega_hi * 0.999)
-    with torch.no_grad():
-        model.omega_raw.copy_(torch.tensor(_logit((np.log(om) - lo) / (hi - lo))))
+    from physgs.tracks.store import load_fit, load_tracks
+
+    fit, _, _ = load_fit(fit_npz)
+    tracks, _ = load_tracks(tracks_npz)
+    lab = fit.labels[0]  # [M] cluster of each track of the first condition (-1: not fitted)
+    keep = (lab >= 0) & fit.estimated[np.clip(lab, 0, None)]
+    lab, seed_xy = lab[keep], tracks.first_xy()[keep]  # [M'], [M', 2] px
+    uv, _ = camera.project(np.asarray(model.ctx.canonical_xyz, dtype=np.float64))  # [N, 2]
+    dist, idx = cKDTree(uv).query(seed_xy)  # nearest projected Gaussian of each track
+    part = np.where(dist <= radius_px, model.part_labels.numpy()[idx], -1)  # [M']
+    om = model.bounds.omega(model.omega_raw.detach()).numpy().astype(np.float64)  # [K]
+    n = np.bincount(part[part >= 0], minlength=model.K)  # [K]
+    for p in np.nonzero(n)[0]:
+        om[p] = np.median(fit.omega[lab[part == p]])
+    set_physics(model, om)
     return n
 
 

@@ -141,3 +141,20 @@ def test_short_tracks_are_not_fitted_and_k_above_track_count_names_the_key():
     short.valid[:, 10:] = False  # 10 frames each: shorter than MIN_TRACK_FRAMES
     with pytest.raises(ValueError, match="exceeds the 0 tracks"):
         fit_tracks([short], [0], wind, osc, FitSettings(K=1, iterations=1))
+
+
+@pytest.mark.parametrize("hz", [0.1001, 0.35, 0.7, 1.5, 2.999])
+def test_the_raw_maps_invert_the_bounded_parameterisation(hz):
+    """omega_raw / zeta_raw are the inverses of the bounded maps, checked against the closed form
+    omega = lo^(1-s) hi^s, s = sigmoid(raw) (the geometric interpolation the map defines)."""
+    import torch
+
+    b = OscillatorBounds.from_config([0.1, 3.0], [0.01, 0.5], 0.7, 0.1)
+    w = 2 * math.pi * hz
+    s = 1 / (1 + math.exp(-b.omega_raw(w)))
+    assert b.omega_lo ** (1 - s) * b.omega_hi**s == pytest.approx(w, rel=1e-12)
+    raw = torch.tensor([b.omega_raw(w)], dtype=torch.float64)
+    assert float(b.omega(raw)[0]) == pytest.approx(w, rel=1e-12)
+    z = 0.01 + 0.49 * (hz - 0.1) / 2.9 * 0.999 + 1e-4
+    assert float(b.zeta(torch.tensor([b.zeta_raw(z)], dtype=torch.float64))[0]) == pytest.approx(z)
+    assert b.omega_raw_init() == b.omega_raw(b.omega_init)

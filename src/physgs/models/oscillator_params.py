@@ -54,14 +54,22 @@ class OscillatorBounds:
             )
         return OscillatorBounds(lo, hi, zlo, zhi, w0, float(zeta_init))
 
+    def omega_raw(self, omega: float) -> float:
+        """The raw value whose omega is ``omega`` (rad/s, strictly inside the bounds)."""
+        lo, hi = math.log(self.omega_lo), math.log(self.omega_hi)
+        return _logit((math.log(omega) - lo) / (hi - lo))
+
+    def zeta_raw(self, zeta: float) -> float:
+        """The raw value whose zeta is ``zeta`` (strictly inside the bounds)."""
+        return _logit((zeta - self.zeta_lo) / (self.zeta_hi - self.zeta_lo))
+
     def omega_raw_init(self) -> float:
         """The raw value whose omega is omega_init."""
-        lo, hi = math.log(self.omega_lo), math.log(self.omega_hi)
-        return _logit((math.log(self.omega_init) - lo) / (hi - lo))
+        return self.omega_raw(self.omega_init)
 
     def zeta_raw_init(self) -> float:
         """The raw value whose zeta is zeta_init."""
-        return _logit((self.zeta_init - self.zeta_lo) / (self.zeta_hi - self.zeta_lo))
+        return self.zeta_raw(self.zeta_init)
 
     def omega(self, raw: torch.Tensor) -> torch.Tensor:
         """[K] natural frequencies, rad/s, from raw [K]."""
