@@ -173,6 +173,9 @@ def test_registry_variants_train_like_ours_but_stay_out_of_the_tables():
 def test_chained_model_poses_by_its_parts_and_reloads(tmp_path):
     ctx, wind = model_context(300, seed=5, lead_in=40)
     cfg = quick_models_cfg()
+    cfg["omega_search"][
+        "models"
+    ] = []  # the oscillators from the start (the bank: test_omega_search)
     model = build_model("ours_chain", ctx, cfg, K=6)
     assert model.chain and model.part_parent[0] == -1
     with torch.no_grad():

@@ -26,6 +26,7 @@ EDITS = {
     "freeze_at": {"models": {"ours": {"freeze_at": 0.6}}},
     "kselect_tie": {"models": {"kselect": {"tie_db": 0.2}}},
     "tracks_iterations": {"tracks": {"iterations": 200}},
+    "omega_search": {"models": {"omega_search": {"bank_scale": 0.01}}},
 }
 
 
@@ -130,6 +131,14 @@ def test_a_bare_snakemake_call_uses_the_default_profile(tmp_path):
 def test_freeze_at_retrains_ours_and_no_baseline(plans):
     trained = _checkpoints(plans["freeze_at"])
     assert trained and all(t.startswith("ours_") for t in trained), trained
+
+
+def test_omega_search_retrains_the_chained_prior_only(plans):
+    """The search's settings are ours_chain's alone: its checkpoints and its K-match points
+    retrain; ours, ours_topo and every field stay."""
+    out = plans["omega_search"]
+    assert _checkpoints(out) == {"ours_chain_single"}, _checkpoints(out)
+    assert _counts(out).get("kmatch_point"), _counts(out)
 
 
 def test_kselect_tie_retrains_only_the_auto_model(plans):

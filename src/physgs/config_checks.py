@@ -384,6 +384,32 @@ def freeze_inside_deformation_phase(cfg: dict) -> Iterator[Problem]:
             )
 
 
+def omega_search_is_runnable(cfg: dict) -> Iterator[Problem]:
+    """models/omega_search names oscillator priors only, and its bank phase ends after the
+    warm-up and before freezing in the training runs (``physgs.models.omega_search``)."""
+    from physgs.models.omega_search import search_problem
+    from physgs.models.registry import MODEL_NAMES, PRIOR_VARIANT_NAMES, is_prior
+
+    osr = cfg["models"].get("omega_search")
+    if not osr:
+        return
+    known = (*MODEL_NAMES, *PRIOR_VARIANT_NAMES)
+    for i, m in enumerate(osr["models"]):
+        if m not in known or not is_prior(m):
+            yield (
+                ("models", "omega_search", "models", i),
+                f"{m!r} is not an oscillator prior; valid: {[n for n in known if is_prior(n)]}",
+            )
+    o = cfg["models"]["ours"]
+    it, warm = int(cfg["train"]["iterations"]), int(cfg["train"]["warmup"])
+    if not 0 <= warm < it:
+        return  # warmup_below_iterations reports it
+    frz = None if float(o["freeze_below_px"]) == 0 else int(round(float(o["freeze_at"]) * it))
+    why = search_problem(float(osr["until"]), it, warm, frz)
+    if why is not None:
+        yield (("models", "omega_search", "until"), why)
+
+
 def ours_bounds_ordered(cfg: dict) -> Iterator[Problem]:
     """omega_hz and zeta are (low, high) with the initial values strictly inside."""
     o = cfg["models"]["ours"]
@@ -521,6 +547,7 @@ CHECKS: list[Check] = [
     holdout_leaves_training_frames,
     freeze_inside_deformation_phase,
     ours_bounds_ordered,
+    omega_search_is_runnable,
     configs_have_single,
     k_within_gaussians,
     sweep_tree_is_listed,

@@ -125,6 +125,8 @@ def fit(
     dataset's ``Truth`` (truth.npz), required by a reference (truth_motion) and refused for a
     method. Returns the TrainResult (model in eval mode).
     """
+    from physgs.models.omega_search import chain_hooks, omega_search_callback
+    from physgs.models.registry import searches_omega
     from physgs.models.visibility import freeze_callback
     from physgs.train.loop import condition_indices, train_model
     from physgs.train.seeding import seed_everything
@@ -152,7 +154,12 @@ def fit(
     every = int(job.train.get("holdout_every", 0))
     if frame_pool is None and every:
         frame_pool = heldout_split(int(observed.n_train), every)[0]
-    hook = freeze_callback(observed, job.settings, job.train) if is_prior(job.model) else None
+    hooks = []
+    if is_prior(job.model):
+        hooks.append(freeze_callback(observed, job.settings, job.train))
+    if searches_omega(job.settings, job.model):
+        hooks.append(omega_search_callback(observed, job.settings, job.train, conds))
+    hook = chain_hooks([h for h in hooks if h is not None])
     result = train_model(
         model,
         observed,

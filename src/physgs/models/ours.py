@@ -24,6 +24,12 @@ Two options (registry ids ``ours_topo`` and ``ours_chain``; ``ours`` is the pape
   transform is composed with its ancestors' (``physgs.models.chain``): a branch is carried by
   its parent. ``part_theta`` stays each part's OWN angle theta_p(t), the quantity the
   oscillator models and recovery compares with each bone's own angle.
+
+The models listed in ``models.omega_search`` (the topology variants) start with a search over
+omega (``physgs.models.omega_search``): until ``until`` x iterations each part's angle is a
+linear combination of a fixed bank of oscillators' responses (``bank_weights``), then each part
+is projected onto the single oscillator of a grid that best fits it (``end_bank_phase``) and
+the oscillators take over. After training ``bank_active`` is False: the model is the prior above.
 """
 
 from __future__ import annotations
@@ -38,6 +44,12 @@ from physgs.models.base import BaseModel, ModelContext
 from physgs.models.chain import chain_deform, depth_levels
 from physgs.models.gaussians import GaussianState, rotate_parts
 from physgs.models.oscillator import STABILITY_GUARD, fastest_rate, integrate, required_substeps
+from physgs.models.omega_search import (
+    OmegaSearch,
+    log_grid,
+    project_to_oscillators,
+    unit_responses,
+)
 from physgs.models.oscillator_params import OscillatorBounds, condition_vbar
 from physgs.models.parts import kmeans_parts
 from physgs.models.topology import KNN, topology_parts
@@ -77,6 +89,7 @@ class OscillatorPrior(BaseModel):
         knn: int = KNN,
         chain: bool = False,
         parent: np.ndarray | None = None,
+        search: OmegaSearch | None = None,
     ):
         super().__init__(ctx, canonical_cfg)
         # the parameterisation the 2D-track control shares (physgs.models.oscillator_params)
@@ -137,6 +150,15 @@ class OscillatorPrior(BaseModel):
         # Parts whose motion never reaches the image (physgs.models.visibility): theta = 0 and
         # their physics parameters take no further updates. Saved in checkpoints.
         self.register_buffer("frozen", torch.zeros(K, dtype=torch.bool))
+        # The search over omega (physgs.models.omega_search): while bank_active, theta is a
+        # linear combination of a fixed bank's responses, W [K, M] in radians (each response is
+        # scaled as the gain is, by omega_m^2 / std of the training forcing: quasi-static units).
+        self.search = search
+        if search is not None:
+            self.bank_omega = log_grid(b.omega_lo, b.omega_hi, search.bank_size)  # [M] rad/s
+            self.bank_weights = nn.Parameter(torch.zeros(K, search.bank_size))
+            self.register_buffer("bank_active", torch.tensor(True))
+            self._bank_memo: dict = {}  # wind bytes -> scaled responses [M, L+F]
         self._theta_memo = None  # (versions, wind [L+F], theta [K, L+F]): part_theta, no autograd
 
     def freeze_parts(self, mask) -> None:
@@ -187,6 +209,8 @@ class OscillatorPrior(BaseModel):
         # theta reads, so an in-place edit of a parameter or of the frozen mask (or a new tensor,
         # e.g. after load_state_dict or .double()) recomputes it. Callers must not write to it.
         reads = (self.omega_raw, self.zeta_raw, self.gain_raw, self.gain_scale, self.frozen)
+        if self.search is not None:
+            reads = (*reads, self.bank_weights, self.bank_active)
         key = tuple((t.data_ptr(), t._version) for t in reads)
         hit = self._theta_memo
         if hit is not None and hit[0] == key and torch.equal(hit[1], wind):
@@ -195,7 +219,65 @@ class OscillatorPrior(BaseModel):
         self._theta_memo = (key, wind.clone(), theta)
         return theta
 
+    def _bank_responses(self, wind: torch.Tensor) -> torch.Tensor:
+        """The bank's responses [M, L+F] to wind [L+F] (m/s), scaled to quasi-static radians."""
+        key = wind.numpy().tobytes()
+        if key not in self._bank_memo:
+            vbar = condition_vbar(self.vbar_ratio, wind)
+            om = self.bank_omega
+            r = unit_responses(
+                om, np.full_like(om, self.search.bank_zeta), wind, vbar, self.dt, self.substeps
+            )  # [M, L+F]
+            scale = self.search.bank_scale * om**2 / float(self.ctx.wind_force_std)
+            self._bank_memo[key] = torch.as_tensor(r * scale[:, None], dtype=torch.float32)
+        return self._bank_memo[key]
+
+    def end_bank_phase(self, windows) -> dict:
+        """Project each part's bank angle onto one oscillator and hand over to the oscillators.
+
+        windows: [(wind [L+F] m/s, slice of the samples fitted)] of the trained conditions. Sets
+        omega, zeta (grid of ``search.grid`` over the bounds) and gain by least squares
+        (``project_to_oscillators``); the bank is switched off. Returns statistics (the median
+        share of each part's angle energy the oscillator explains, the omega quartiles in Hz).
+        """
+        if self.search is None or not bool(self.bank_active):
+            raise RuntimeError("end_bank_phase: this prior has no bank phase running")
+        b, (n_om, n_ze) = self.bounds, self.search.grid
+        # strictly inside the bounds: the raw parameters are logits of them
+        shrink = 1e-3
+        om_g = log_grid(b.omega_lo * (1 + shrink), b.omega_hi * (1 - shrink), n_om)
+        ze_g = np.linspace(
+            b.zeta_lo + shrink * (b.zeta_hi - b.zeta_lo),
+            b.zeta_hi - shrink * (b.zeta_hi - b.zeta_lo),
+            n_ze,
+        )
+        om_all, ze_all = (a.ravel() for a in np.meshgrid(om_g, ze_g, indexing="ij"))
+        thetas, resp = [], []
+        with torch.no_grad():
+            for wind, samples in windows:
+                w = torch.as_tensor(np.asarray(wind), dtype=torch.float64)
+                thetas.append((self.bank_weights @ self._bank_responses(w)).double().numpy())
+                vbar = condition_vbar(self.vbar_ratio, w)
+                r = unit_responses(om_all, ze_all, w, vbar, self.dt, self.substeps)
+                thetas[-1], r = thetas[-1][:, samples], r[:, samples]
+                resp.append(r)
+            omega, zeta, gain, explained = project_to_oscillators(
+                np.concatenate(thetas, axis=1), np.concatenate(resp, axis=1), om_all, ze_all
+            )
+            self.omega_raw.copy_(torch.tensor([b.omega_raw(float(o)) for o in omega]))
+            self.zeta_raw.copy_(torch.tensor([b.zeta_raw(float(z)) for z in zeta]))
+            self.gain_raw.copy_(torch.as_tensor(gain / float(self.gain_scale)))
+            self.bank_active.fill_(False)
+        hz = np.percentile(omega / (2 * np.pi), [25, 50, 75])
+        return {
+            "omega_search_explained_median": float(np.median(explained)),
+            "omega_search_hz_quartiles": [float(h) for h in hz],
+        }
+
     def _integrate_theta(self, wind: torch.Tensor) -> torch.Tensor:
+        if self.search is not None and bool(self.bank_active):
+            theta = self.bank_weights @ self._bank_responses(wind)  # [K, L+F]
+            return theta
         vbar = condition_vbar(self.vbar_ratio, wind)
         theta = integrate(
             self.omega, self.zeta, self.gain, wind, vbar, self.dt, self.substeps, guard=self.guard
@@ -228,7 +310,8 @@ class OscillatorPrior(BaseModel):
         return [
             {
                 "name": "physics",
-                "params": [self.omega_raw, self.zeta_raw, self.gain_raw, self.axis_raw],
+                "params": [self.omega_raw, self.zeta_raw, self.gain_raw, self.axis_raw]
+                + ([self.bank_weights] if self.search is not None else []),
                 "lr": lr["physics"],
             },
             {"name": "pivot", "params": [self.pivot], "lr": lr["pivot"] * self.extent},

@@ -141,9 +141,17 @@ def model_settings(models_cfg: dict, model: str) -> dict:
         out[spec.family] = {**section, "time_top_hz": {model: section["time_top_hz"][model]}}
     if spec.parts == "topology":
         out["topology"] = models_cfg["topology"]
+    if searches_omega(models_cfg, model):  # its own entry only: another model's leaves it alone
+        out["omega_search"] = {**models_cfg["omega_search"], "models": [model]}
     if spec.wind and spec.family in FIELDS:
         out["wind_window"] = models_cfg["wind_window"]
     return out
+
+
+def searches_omega(models_cfg: dict, model: str) -> bool:
+    """Whether ``model`` starts with the search over omega (``models.omega_search.models``;
+    ``physgs.models.omega_search``)."""
+    return model in (models_cfg.get("omega_search") or {}).get("models", ())
 
 
 def build_model(
@@ -234,8 +242,12 @@ def build_model(
     o = cfg["ours"]
     spec = spec_of(name)
     topo = {}
+    if searches_omega(cfg, name):
+        from physgs.models.omega_search import OmegaSearch
+
+        topo["search"] = OmegaSearch.from_config(cfg["omega_search"])
     if spec.parts == "topology":
-        topo = dict(segmentation="topology", knn=int(cfg["topology"]["knn"]), parent=parent)
+        topo.update(segmentation="topology", knn=int(cfg["topology"]["knn"]), parent=parent)
     return OscillatorPrior(
         ctx,
         canon,

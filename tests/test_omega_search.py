@@ -1,0 +1,187 @@
+"""The search over omega before the descent (physgs.models.omega_search): the projection against
+scipy's exact LTI solution, the bank phase of the prior and its hand-over to the oscillators, the
+training hook, the config's checks and the rerun scoping of its settings."""
+
+import copy
+
+import numpy as np
+import pytest
+import torch
+
+import physgs.config
+from physgs.config_checks import omega_search_is_runnable
+from physgs.models import build_model
+from physgs.models.omega_search import (
+    OmegaSearch,
+    chain_hooks,
+    log_grid,
+    project_to_oscillators,
+    search_iteration,
+    unit_responses,
+)
+from physgs.models.registry import model_settings, searches_omega
+from oracles import gusty_wind, model_context, quick_config, quick_models_cfg, wind_lsim
+
+DT = 1 / 24
+
+
+def test_projection_recovers_an_oscillator_simulated_by_scipy():
+    # theta from scipy's exact first-order-hold solution; the grid's responses from physgs's RK4
+    wind = gusty_wind(900, seed=3)
+    vbar = float(wind.mean())
+    true = [(2.6, 0.06, 0.02), (7.0, 0.2, -0.05)]  # (omega rad/s, zeta, gain)
+    theta = np.stack([wind_lsim(o, z, g, wind, vbar, DT) for o, z, g in true])  # [2, T]
+    om, ze = np.meshgrid(log_grid(1.0, 15.0, 120), np.linspace(0.02, 0.4, 20), indexing="ij")
+    om, ze = om.ravel(), ze.ravel()
+    r = unit_responses(om, ze, wind, vbar, DT, 4)
+    s = slice(240, 900)  # a window after a lead-in, as the prior fits
+    omega, zeta, gain, explained = project_to_oscillators(theta[:, s], r[:, s], om, ze)
+    step = (15.0 / 1.0) ** (1 / 119)  # ratio between grid neighbours
+    for k, (o, z, g) in enumerate(true):
+        assert abs(np.log(omega[k] / o)) <= np.log(step)  # the nearest grid omega or next to it
+        assert abs(zeta[k] - z) <= 0.03
+        assert gain[k] == pytest.approx(g, rel=0.1)
+        assert explained[k] > 0.98
+
+
+def test_projection_refuses_mismatched_samples_and_scores_a_zero_angle():
+    r = np.ones((3, 5))
+    with pytest.raises(ValueError, match="share S"):
+        project_to_oscillators(np.zeros((2, 4)), r, np.ones(3), np.ones(3))
+    _, _, gain, explained = project_to_oscillators(np.zeros((1, 5)), r, np.ones(3), np.ones(3))
+    assert gain[0] == 0.0 and explained[0] == 0.0
+
+
+def _search_prior(K=3, search=None):
+    ctx, wind = model_context(60, seed=1, lead_in=96)
+    cfg = quick_models_cfg()
+    cfg["omega_search"] = {**cfg["omega_search"], "models": ["ours_chain"]}
+    if search:
+        cfg["omega_search"].update(search)
+    return build_model("ours_chain", ctx, cfg, K=K), wind
+
+
+def test_bank_phase_is_linear_in_the_weights_and_hands_over_to_matching_oscillators():
+    model, wind = _search_prior()
+    w = torch.as_tensor(wind, dtype=torch.float64)
+    assert model.search is not None and bool(model.bank_active)
+    assert torch.count_nonzero(model.part_theta(w)) == 0  # starts at the canonical pose
+    M = model.search.bank_size
+    with torch.no_grad():  # each part rides one bank member: its angle is that response
+        model.bank_weights.zero_()
+        for p, m in enumerate((3, M // 2, M - 4)):
+            model.bank_weights[p, m] = 0.05 * (p + 1)
+    bank_theta = model.part_theta(w).clone()  # [K, L+F]
+    # linear in the weights: doubling them doubles the angle
+    with torch.no_grad():
+        model.bank_weights.mul_(2.0)
+    assert torch.allclose(model.part_theta(w), 2 * bank_theta)
+    with torch.no_grad():
+        model.bank_weights.mul_(0.5)
+    lead, n = model.lead_in, model.ctx.n_train
+    stats = model.end_bank_phase([(wind, slice(lead, lead + n))])
+    assert not bool(model.bank_active)
+    # the projection's grid spans the bounds: each part's omega lands next to its bank member's
+    for p, m in enumerate((3, M // 2, M - 4)):
+        assert abs(np.log(float(model.omega[p].detach()) / model.bank_omega[m])) < 0.05
+    after = model.part_theta(w)  # the oscillators now: the same motion over the window
+    err = (after - bank_theta)[:, lead : lead + n].norm(dim=1)
+    assert (err <= 0.15 * bank_theta[:, lead : lead + n].norm(dim=1)).all()
+    assert stats["omega_search_explained_median"] > 0.95
+    with pytest.raises(RuntimeError, match="no bank phase"):
+        model.end_bank_phase([(wind, slice(lead, lead + n))])
+
+
+def test_gradients_reach_the_bank_weights_only_during_the_bank_phase():
+    model, wind = _search_prior()
+    w = torch.as_tensor(wind, dtype=torch.float64)
+    model.part_theta(w).sum().backward()
+    assert model.bank_weights.grad is not None and model.omega_raw.grad is None
+    model.zero_grad(set_to_none=True)
+    model.end_bank_phase([(wind, slice(96, 396))])
+    with torch.no_grad():
+        model.gain_raw.fill_(0.1)
+    model.part_theta(w).sum().backward()
+    assert model.bank_weights.grad is None and model.omega_raw.grad is not None
+
+
+def test_search_hook_trains_through_the_hand_over(swaying, tmp_path):
+    from physgs.experiments.recipe import fit
+    from physgs.models import load_checkpoint, save_checkpoint
+
+    cfg = quick_config()
+    cfg["train"].update(iterations=24, warmup=4, backend="fast", holdout_every=0)
+    cfg["models"]["configs"]["single"]["K"] = 3
+    cfg["models"]["omega_search"]["until"] = 0.5
+    from physgs.experiments import job_spec
+
+    job = job_spec(cfg, "ours_chain", "single", 0)
+    res = fit(swaying, job, progress=False)
+    assert res.stats["omega_search_at"] == 12
+    assert not bool(res.model.bank_active)
+    assert len(res.stats["omega_search_hz_quartiles"]) == 3
+    # the checkpoint reloads as oscillators, not as a bank
+    path = tmp_path / "chain.pt"
+    save_checkpoint(
+        path,
+        res.model,
+        name="ours_chain",
+        config="single",
+        seed=0,
+        stats=res.stats,
+        models_cfg=job["settings"],
+        train_cfg=job["train"],
+    )
+    back = load_checkpoint(path)
+    w = torch.as_tensor(swaying.wind[0], dtype=torch.float64)
+    assert not bool(back.bank_active)
+    assert torch.equal(back.part_theta(w), res.model.part_theta(w))
+    # the independent prior does not search: same job without the hook's statistics
+    res_ours = fit(swaying, job_spec(cfg, "ours", "single", 0), progress=False)
+    assert "omega_search_at" not in res_ours.stats
+
+
+def test_search_iteration_must_fall_between_warmup_and_freezing():
+    s = OmegaSearch(0.3, 8, 0.15, 0.02, (10, 4), 0.05)
+    assert search_iteration(s, {"iterations": 3000, "warmup": 50}, 1500) == 900
+    with pytest.raises(ValueError, match="models.omega_search.until"):
+        search_iteration(s, {"iterations": 30, "warmup": 10}, None)
+    with pytest.raises(ValueError, match="freezing"):
+        search_iteration(s, {"iterations": 3000, "warmup": 50}, 600)
+
+
+def test_config_check_names_the_key():
+    cfg = physgs.config.load("config/trees.yaml", "default")
+    assert list(omega_search_is_runnable(cfg)) == []
+    bad = copy.deepcopy(cfg)
+    bad["models"]["omega_search"]["until"] = 0.6  # after freeze_at 0.5
+    bad["models"]["omega_search"]["models"] = ["ours_chain", "mlp"]
+    keys = [k for k, _ in omega_search_is_runnable(bad)]
+    assert ("models", "omega_search", "models", 1) in keys
+    assert ("models", "omega_search", "until") in keys
+
+
+def test_only_the_searching_models_read_its_settings():
+    cfg = quick_models_cfg()
+    assert searches_omega(cfg, "ours_chain") and not searches_omega(cfg, "ours")
+    assert "omega_search" in model_settings(cfg, "ours_chain")
+    assert "omega_search" not in model_settings(cfg, "ours")
+    assert model_settings(cfg, "ours_chain")["omega_search"]["models"] == ["ours_chain"]
+    cfg["omega_search"]["models"] = ["ours_chain"]
+    assert "omega_search" not in model_settings(cfg, "ours_topo")
+
+
+def test_chain_hooks_merges_statistics():
+    calls = []
+
+    def a(it, m, o):
+        calls.append(("a", it))
+        return {"x": 1}
+
+    def b(it, m, o):
+        calls.append(("b", it))
+        return None
+
+    h = chain_hooks([a, b])
+    assert h(5, None, None) == {"x": 1} and calls == [("a", 5), ("b", 5)]
+    assert chain_hooks([]) is None and chain_hooks([a]) is a
