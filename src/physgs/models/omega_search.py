@@ -29,6 +29,10 @@ from dataclasses import dataclass
 
 import numpy as np
 
+#: Relative inset of the projection's grid from the prior's bounds: omega and zeta are sigmoids
+#: of raw parameters, so a grid point on a bound would need an infinite raw value.
+GRID_INSET = 1e-3
+
 
 @dataclass(frozen=True)
 class OmegaSearch:

@@ -45,6 +45,7 @@ from physgs.models.chain import chain_deform, depth_levels
 from physgs.models.gaussians import GaussianState, rotate_parts
 from physgs.models.oscillator import STABILITY_GUARD, fastest_rate, integrate, required_substeps
 from physgs.models.omega_search import (
+    GRID_INSET,
     OmegaSearch,
     log_grid,
     project_to_oscillators,
@@ -151,8 +152,8 @@ class OscillatorPrior(BaseModel):
         # their physics parameters take no further updates. Saved in checkpoints.
         self.register_buffer("frozen", torch.zeros(K, dtype=torch.bool))
         # The search over omega (physgs.models.omega_search): while bank_active, theta is a
-        # linear combination of a fixed bank's responses, W [K, M] in radians (each response is
-        # scaled as the gain is, by omega_m^2 / std of the training forcing: quasi-static units).
+        # linear combination of a fixed bank's responses with weights W [K, M] (each response
+        # scaled as the gain is, by omega_m^2 / std of the training forcing, times bank_scale).
         self.search = search
         if search is not None:
             self.bank_omega = log_grid(b.omega_lo, b.omega_hi, search.bank_size)  # [M] rad/s
@@ -244,23 +245,20 @@ class OscillatorPrior(BaseModel):
             raise RuntimeError("end_bank_phase: this prior has no bank phase running")
         b, (n_om, n_ze) = self.bounds, self.search.grid
         # strictly inside the bounds: the raw parameters are logits of them
-        shrink = 1e-3
-        om_g = log_grid(b.omega_lo * (1 + shrink), b.omega_hi * (1 - shrink), n_om)
-        ze_g = np.linspace(
-            b.zeta_lo + shrink * (b.zeta_hi - b.zeta_lo),
-            b.zeta_hi - shrink * (b.zeta_hi - b.zeta_lo),
-            n_ze,
-        )
-        om_all, ze_all = (a.ravel() for a in np.meshgrid(om_g, ze_g, indexing="ij"))
-        thetas, resp = [], []
+        inset = GRID_INSET
+        om_g = log_grid(b.omega_lo * (1 + inset), b.omega_hi * (1 - inset), n_om)
+        dz = inset * (b.zeta_hi - b.zeta_lo)
+        ze_g = np.linspace(b.zeta_lo + dz, b.zeta_hi - dz, n_ze)
+        om_all, ze_all = (a.ravel() for a in np.meshgrid(om_g, ze_g, indexing="ij"))  # [G]
+        thetas, resp = [], []  # [K, S_c] and [G, S_c] per condition c
         with torch.no_grad():
             for wind, samples in windows:
                 w = torch.as_tensor(np.asarray(wind), dtype=torch.float64)
-                thetas.append((self.bank_weights @ self._bank_responses(w)).double().numpy())
+                theta = (self.bank_weights @ self._bank_responses(w)).double().numpy()
                 vbar = condition_vbar(self.vbar_ratio, w)
                 r = unit_responses(om_all, ze_all, w, vbar, self.dt, self.substeps)
-                thetas[-1], r = thetas[-1][:, samples], r[:, samples]
-                resp.append(r)
+                thetas.append(theta[:, samples])
+                resp.append(r[:, samples])
             omega, zeta, gain, explained = project_to_oscillators(
                 np.concatenate(thetas, axis=1), np.concatenate(resp, axis=1), om_all, ze_all
             )
@@ -276,8 +274,7 @@ class OscillatorPrior(BaseModel):
 
     def _integrate_theta(self, wind: torch.Tensor) -> torch.Tensor:
         if self.search is not None and bool(self.bank_active):
-            theta = self.bank_weights @ self._bank_responses(wind)  # [K, L+F]
-            return theta
+            return self.bank_weights @ self._bank_responses(wind)  # [K, L+F]
         vbar = condition_vbar(self.vbar_ratio, wind)
         theta = integrate(
             self.omega, self.zeta, self.gain, wind, vbar, self.dt, self.substeps, guard=self.guard
