@@ -133,11 +133,11 @@ def test_freeze_at_retrains_ours_and_no_baseline(plans):
     assert trained and all(t.startswith("ours_") for t in trained), trained
 
 
-def test_omega_search_retrains_the_chained_prior_only(plans):
-    """The search's settings are ours_chain's alone: its checkpoints and its K-match points
-    retrain; ours, ours_topo and every field stay."""
+def test_omega_search_retrains_the_topology_variants_only(plans):
+    """The search's settings are read by the models it lists (the topology variants): their
+    checkpoints and the chained prior's K-match points retrain; ours and every field stay."""
     out = plans["omega_search"]
-    assert _checkpoints(out) == {"ours_chain_single"}, _checkpoints(out)
+    assert _checkpoints(out) == {"ours_topo_single", "ours_chain_single"}, _checkpoints(out)
     assert _counts(out).get("kmatch_point"), _counts(out)
 
 
