@@ -256,3 +256,31 @@ def test_chained_swing_counts_the_descendants(swaying):
             best = max(best, np.linalg.norm(uv - uv0[moved], axis=1).max())
         assert swing[p] == pytest.approx(best, rel=1e-6)
         assert moved.sum() >= (lab == p).sum()
+
+
+def test_from_frame0_poses_the_canonical_set_at_frame_0():
+    # the canonical Gaussians are the pose at recorded frame 0: turning each part by
+    # theta(t) - theta(frame 0) leaves frame 0 exactly there, and frame j turned by the difference
+    ctx, wind = model_context(200, seed=6, lead_in=40)
+    cfg = quick_models_cfg()
+    cfg["omega_search"]["models"] = []
+    cfg["topology"]["from_frame0"] = True
+    model = build_model("ours_chain", ctx, cfg, K=5)
+    with torch.no_grad():
+        model.gain_raw.copy_(torch.linspace(-0.6, 0.6, 5))
+    w = torch.as_tensor(wind)
+    theta = model.part_theta(w)  # [K, L+F]
+    assert theta[:, model.lead_in].abs().max() > 1e-3  # the oscillators are not at rest there
+    c = model.canonical
+    assert torch.equal(model.deform(0, w).means, c.means)
+    st = model.deform(7, w)
+    own = theta[:, model.lead_in + 7] - theta[:, model.lead_in]
+    ref, _ = chain_deform(
+        c.means, c.quats, model.part_labels, model.axis, own, model.pivot, model.levels
+    )
+    assert torch.allclose(st.means, ref)
+    cfg["topology"]["from_frame0"] = False  # off: frame 0 is turned by theta(frame 0)
+    absolute = build_model("ours_chain", ctx, cfg, K=5)
+    with torch.no_grad():
+        absolute.gain_raw.copy_(torch.linspace(-0.6, 0.6, 5))
+    assert not torch.allclose(absolute.deform(0, w).means, absolute.canonical.means)

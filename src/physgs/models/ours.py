@@ -30,6 +30,9 @@ omega (``physgs.models.omega_search``): until ``until`` x iterations each part's
 linear combination of a fixed bank of oscillators' responses (``bank_weights``), then each part
 is projected onto the single oscillator of a grid that best fits it (``end_bank_phase``) and
 the oscillators take over. After training ``bank_active`` is False: the model is the prior above.
+With ``models.topology.from_frame0`` the topology variants turn each part by theta_p(t) -
+theta_p(frame 0) (the canonical Gaussians are the pose at recorded frame 0, not the rest pose);
+``part_theta`` and recovery are unchanged.
 """
 
 from __future__ import annotations
@@ -91,6 +94,7 @@ class OscillatorPrior(BaseModel):
         chain: bool = False,
         parent: np.ndarray | None = None,
         search: OmegaSearch | None = None,
+        from_frame0: bool = False,
     ):
         super().__init__(ctx, canonical_cfg)
         # the parameterisation the 2D-track control shares (physgs.models.oscillator_params)
@@ -155,6 +159,9 @@ class OscillatorPrior(BaseModel):
         # linear combination of a fixed bank's responses with weights W [K, M] (each response
         # scaled as the gain is, by omega_m^2 / std of the training forcing, times bank_scale).
         self.search = search
+        # the canonical set is the pose at recorded frame 0: with from_frame0 each part turns by
+        # theta(t) - theta(frame 0), so frame 0 poses exactly the canonical set
+        self.from_frame0 = bool(from_frame0)
         if search is not None:
             self.bank_omega = log_grid(b.omega_lo, b.omega_hi, search.bank_size)  # [M] rad/s
             self.bank_weights = nn.Parameter(torch.zeros(K, search.bank_size))
@@ -286,7 +293,10 @@ class OscillatorPrior(BaseModel):
         return torch.where(self.frozen[:, None], torch.zeros_like(theta), theta)
 
     def deform(self, frame_idx: int, wind: torch.Tensor) -> GaussianState:
-        theta = self.part_theta(wind)[:, self.lead_in + frame_idx]  # [K]
+        theta_all = self.part_theta(wind)  # [K, L+F]
+        theta = theta_all[:, self.lead_in + frame_idx]  # [K]
+        if self.from_frame0:
+            theta = theta - theta_all[:, self.lead_in]
         lab = self.part_labels
         c = self.canonical
         if self.chain:

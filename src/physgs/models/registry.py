@@ -247,7 +247,13 @@ def build_model(
 
         topo["search"] = OmegaSearch.from_config(cfg["omega_search"])
     if spec.parts == "topology":
-        topo.update(segmentation="topology", knn=int(cfg["topology"]["knn"]), parent=parent)
+        t = cfg["topology"]
+        topo.update(
+            segmentation="topology",
+            knn=int(t["knn"]),
+            parent=parent,
+            from_frame0=bool(t.get("from_frame0", False)),
+        )
     return OscillatorPrior(
         ctx,
         canon,
