@@ -21,12 +21,14 @@ QUICK = ["--config", "profile=quick", 'trees=["sparse"]']  # as the quick_dag fi
 EDITS = {
     "unchanged": {},
     "sweep_K": {"profiles": {"quick": {"speed_accuracy": {"knobs": {"K": [8, 16]}}}}},
-    "mlp_width": {"models": {"mlp": {"width": 96}}},
+    # two scoped edits in one dry run (each dry run costs seconds): a leak shows as an extra model
+    "mlp_width_and_search": {
+        "models": {"mlp": {"width": 96}, "omega_search": {"bank_scale": 0.01}}
+    },
     "table_digits": {"report": {"tab_psnr": {"digits": 3}}},
     "freeze_at": {"models": {"ours": {"freeze_at": 0.6}}},
     "kselect_tie": {"models": {"kselect": {"tie_db": 0.2}}},
     "tracks_iterations": {"tracks": {"iterations": 200}},
-    "omega_search": {"models": {"omega_search": {"bank_scale": 0.01}}},
 }
 
 
@@ -88,9 +90,19 @@ def test_sweep_knobs_plan_no_training(plans):
     assert plan == {"speed_accuracy_point": 1, "speed_accuracy": 1, "studies": 1}, plan
 
 
-def test_mlp_width_retrains_the_mlp_models_only(plans):
-    trained = _checkpoints(plans["mlp_width"])
-    assert trained == {"mlp_single", "mlp_wind_single"}, trained
+def test_mlp_width_and_search_retrain_their_own_models_only(plans):
+    """The MLP's width retrains the two MLP models; the search over omega's settings the models
+    it lists (the topology variants) and the chained prior's K-match points; ours, the other
+    fields and the references stay."""
+    out = plans["mlp_width_and_search"]
+    trained = _checkpoints(out)
+    assert trained == {
+        "mlp_single",
+        "mlp_wind_single",
+        "ours_topo_single",
+        "ours_chain_single",
+    }, trained
+    assert _counts(out).get("kmatch_point"), _counts(out)
 
 
 def test_table_format_rebuilds_that_table_only(plans):
@@ -131,14 +143,6 @@ def test_a_bare_snakemake_call_uses_the_default_profile(tmp_path):
 def test_freeze_at_retrains_ours_and_no_baseline(plans):
     trained = _checkpoints(plans["freeze_at"])
     assert trained and all(t.startswith("ours_") for t in trained), trained
-
-
-def test_omega_search_retrains_the_topology_variants_only(plans):
-    """The search's settings are read by the models it lists (the topology variants): their
-    checkpoints and the chained prior's K-match points retrain; ours and every field stay."""
-    out = plans["omega_search"]
-    assert _checkpoints(out) == {"ours_topo_single", "ours_chain_single"}, _checkpoints(out)
-    assert _counts(out).get("kmatch_point"), _counts(out)
 
 
 def test_kselect_tie_retrains_only_the_auto_model(plans):
