@@ -1,4 +1,4 @@
-"""A search over each part's natural frequency before the descent (the chained prior's start).
+"""A search over each part's natural frequency before the descent (the topology variants' start).
 
 Gradient descent on omega from one common start finds few parts' frequencies: an oscillator's
 response to the wind dephases with omega, so the photometric loss has a valley about every
