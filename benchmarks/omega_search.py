@@ -3,8 +3,8 @@
     python benchmarks/omega_search.py results/testbed/sparse [--model ours_chain] [--seeds 0,1,2]
         [--set models.omega_search.until=0.3 ...]
 
-Trains the prior by the profile's recipe (the same hooks as ``physgs.experiments.fit``: freezing
-and the search) and prints per seed the mean PSNR (dB, training camera and wind) of the bank at
+Trains the prior by the profile's recipe (the hooks of ``physgs.experiments.fit``, from
+``training_hooks``: freezing and the search) and prints per seed the mean PSNR (dB, training camera and wind) of the bank at
 the end of its phase, of the oscillators just after the projection, and after the descent, on
 every 6th trained frame; the share of the bank angles' energy the projected oscillators explain
 (median over parts); and at the end the fit (every 3rd trained frame) and held-out frames
@@ -25,27 +25,27 @@ import numpy as np
 import physgs.config
 from physgs.evaluate.run import training_camera_scores
 from physgs.experiments import job_spec
-from physgs.experiments.recipe import heldout_split
-from physgs.models.omega_search import chain_hooks, omega_search_callback
-from physgs.models.registry import build_model, searches_omega
-from physgs.models.visibility import freeze_callback
+from physgs.experiments.recipe import Job, heldout_split, training_hooks
+from physgs.models.omega_search import SearchHook
+from physgs.models.registry import build_model
 from physgs.testbed.dataset import load_observed
 from physgs.train.loop import condition_indices, train_model
 from physgs.train.seeding import seed_everything
 
 
 def run(obs, cfg: dict, model_id: str, seed: int) -> dict:
-    """Train one prior as ``physgs.experiments.fit`` does, scoring around the projection."""
-    job = job_spec(copy.deepcopy(cfg), model_id, "single", seed)
-    if not searches_omega(job["settings"], model_id):
-        raise SystemExit(f"{model_id} is not in models.omega_search.models: nothing to show")
-    trained, held = heldout_split(int(obs.n_train), int(job["train"]["holdout_every"]) or 10)
+    """Train one prior as ``physgs.experiments.fit`` does (its hooks, ``training_hooks``),
+    scoring the probe frames just before and just after the projection."""
+    job = Job.from_dict(job_spec(copy.deepcopy(cfg), model_id, "single", seed))
+    trained, held = heldout_split(int(obs.n_train), int(job.train["holdout_every"]) or 10)
     probe = trained[::6]
     seed_everything(seed)
-    model = build_model(model_id, obs, job["settings"], K=job["K"], seed=seed)
-    conds = condition_indices(job["conditions"], len(obs.conditions))
-    search = omega_search_callback(obs, job["settings"], job["train"], conds)
-    at = _search_at(job)
+    model = build_model(model_id, obs, job.settings, K=job.K, seed=seed)
+    conds = condition_indices(job.conditions, len(obs.conditions))
+    hooks = training_hooks(obs, job, conds)
+    search = next((h for h in hooks if isinstance(h, SearchHook)), None)
+    if search is None:
+        raise SystemExit(f"{model_id} is not in models.omega_search.models: nothing to show")
     out: dict = {}
 
     def score(m) -> float:
@@ -55,7 +55,7 @@ def run(obs, cfg: dict, model_id: str, seed: int) -> dict:
         return p
 
     def around(it, m, opt):
-        before = score(m) if it == at else None
+        before = score(m) if it == search.at else None
         stats = search(it, m, opt)
         if stats:
             out.update(
@@ -63,34 +63,20 @@ def run(obs, cfg: dict, model_id: str, seed: int) -> dict:
             )
         return stats
 
-    hook = chain_hooks(
-        [h for h in (freeze_callback(obs, job["settings"], job["train"]), around) if h]
-    )
     res = train_model(
         model,
         obs,
-        job["train"],
+        job.train,
         conditions=conds,
         seed=seed,
         progress=False,
         frame_pool=trained,
-        on_iteration=hook,
+        on_iteration=[around if h is search else h for h in hooks],
     )
     out["fit"] = float(np.mean(training_camera_scores(res.model, obs, trained[::3])[1]))
     out["held"] = float(np.mean(training_camera_scores(res.model, obs, held)[1]))
     out["wall_s"] = res.stats["wall_s"]
     return out
-
-
-def _search_at(job) -> int:
-    from physgs.models.omega_search import OmegaSearch, search_iteration
-    from physgs.models.visibility import freeze_schedule
-
-    return search_iteration(
-        OmegaSearch.from_config(job["settings"]["omega_search"]),
-        job["train"],
-        freeze_schedule(job["settings"], job["train"]),
-    )
 
 
 def main(argv: list[str] | None = None) -> None:

@@ -13,8 +13,8 @@ from physgs.config_checks import omega_search_is_runnable
 from physgs.models import build_model
 from physgs.models.omega_search import (
     OmegaSearch,
-    chain_hooks,
     log_grid,
+    SearchHook,
     project_to_oscillators,
     search_iteration,
     unit_responses,
@@ -171,17 +171,47 @@ def test_only_the_searching_models_read_its_settings():
     assert "omega_search" not in model_settings(cfg, "ours_topo")
 
 
-def test_chain_hooks_merges_statistics():
+def test_training_calls_every_hook_in_order_and_merges_their_statistics(swaying):
+    from physgs.train.loop import train_model
+
+    cfg = quick_config()
+    cfg["train"].update(iterations=6, warmup=2, backend="fast")
     calls = []
 
     def a(it, m, o):
         calls.append(("a", it))
-        return {"x": 1}
+        return {"x": 1} if it == 3 else None
 
     def b(it, m, o):
         calls.append(("b", it))
-        return None
+        return {"y": 2} if it == 4 else None
 
-    h = chain_hooks([a, b])
-    assert h(5, None, None) == {"x": 1} and calls == [("a", 5), ("b", 5)]
-    assert chain_hooks([]) is None and chain_hooks([a]) is a
+    model = build_model("static", swaying, cfg["models"])
+    res = train_model(
+        model, swaying, cfg["train"], conditions=[0], seed=0, progress=False, on_iteration=[a, b]
+    )
+    assert calls == [(h, it) for it in range(6) for h in ("a", "b")]
+    assert res.stats["x"] == 1 and res.stats["y"] == 2
+
+
+def test_search_hook_scales_the_physics_rate_and_drops_its_moments():
+    model, wind = _search_prior()
+    opt = torch.optim.Adam(
+        [
+            {"name": "physics", "params": [model.axis_raw, model.bank_weights], "lr": 0.05},
+            {"name": "pivot", "params": [model.pivot], "lr": 0.01},
+        ]
+    )
+    for g in opt.param_groups:
+        g["base_lr"] = g["lr"]
+    w = torch.as_tensor(wind, dtype=torch.float64)
+    (model.part_theta(w).sum() + model.axis.sum() + model.pivot.sum()).backward()
+    opt.step()
+    hook = SearchHook(3, [(wind, slice(96, 396))])
+    assert hook(2, model, opt) is None and bool(model.bank_active)
+    stats = hook(3, model, opt)
+    assert stats["omega_search_at"] == 3 and not bool(model.bank_active)
+    phys, piv = opt.param_groups
+    assert phys["base_lr"] == pytest.approx(0.05 * model.search.physics_lr_after)
+    assert piv["base_lr"] == 0.01  # other groups untouched
+    assert model.axis_raw not in opt.state and model.pivot in opt.state

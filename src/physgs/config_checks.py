@@ -360,6 +360,12 @@ def holdout_leaves_training_frames(cfg: dict) -> Iterator[Problem]:
         )
 
 
+def _freeze_iteration(ours: dict, iterations: int) -> int:
+    """The iteration at which freezing runs, round(freeze_at x iterations), as
+    ``physgs.models.visibility.freeze_schedule`` computes it (that module loads torch)."""
+    return int(round(float(ours["freeze_at"]) * iterations))
+
+
 def freeze_inside_deformation_phase(cfg: dict) -> Iterator[Problem]:
     """models/ours/freeze_at falls after the warm-up, for train and the K-selection runs alike.
 
@@ -374,7 +380,7 @@ def freeze_inside_deformation_phase(cfg: dict) -> Iterator[Problem]:
         it, warm = int(node["iterations"]), int(node["warmup"])
         if not 0 <= warm < it:
             continue  # warmup_below_iterations reports it
-        frz = int(round(at * it))
+        frz = _freeze_iteration(o, it)
         if not warm < frz < it:
             yield (
                 ("models", "ours", "freeze_at"),
@@ -404,7 +410,7 @@ def omega_search_is_runnable(cfg: dict) -> Iterator[Problem]:
     it, warm = int(cfg["train"]["iterations"]), int(cfg["train"]["warmup"])
     if not 0 <= warm < it:
         return  # warmup_below_iterations reports it
-    frz = None if float(o["freeze_below_px"]) == 0 else int(round(float(o["freeze_at"]) * it))
+    frz = None if float(o["freeze_below_px"]) == 0 else _freeze_iteration(o, it)
     why = search_problem(float(osr["until"]), it, warm, frz)
     if why is not None:
         yield (("models", "omega_search", "until"), why)

@@ -125,9 +125,6 @@ def fit(
     dataset's ``Truth`` (truth.npz), required by a reference (truth_motion) and refused for a
     method. Returns the TrainResult (model in eval mode).
     """
-    from physgs.models.omega_search import chain_hooks, omega_search_callback
-    from physgs.models.registry import searches_omega
-    from physgs.models.visibility import freeze_callback
     from physgs.train.loop import condition_indices, train_model
     from physgs.train.seeding import seed_everything
 
@@ -154,12 +151,6 @@ def fit(
     every = int(job.train.get("holdout_every", 0))
     if frame_pool is None and every:
         frame_pool = heldout_split(int(observed.n_train), every)[0]
-    hooks = []
-    if is_prior(job.model):
-        hooks.append(freeze_callback(observed, job.settings, job.train))
-    if searches_omega(job.settings, job.model):
-        hooks.append(omega_search_callback(observed, job.settings, job.train, conds))
-    hook = chain_hooks([h for h in hooks if h is not None])
     result = train_model(
         model,
         observed,
@@ -169,11 +160,26 @@ def fit(
         name=name or job.name,
         progress=progress,
         frame_pool=frame_pool,
-        on_iteration=hook,
+        on_iteration=training_hooks(observed, job, conds),
     )
     if is_prior(job.model):
         result.stats["frozen_parts"] = int(result.model.frozen.sum())
     return result
+
+
+def training_hooks(observed, job: Job, conditions: list[int]) -> list:
+    """The ``on_iteration`` hooks of ``job``'s training, in order: freezing invisible parts
+    (oscillator priors, unless off) and the search over omega (the models it lists)."""
+    from physgs.models.omega_search import omega_search_callback
+    from physgs.models.registry import searches_omega
+    from physgs.models.visibility import freeze_callback
+
+    hooks = []
+    if is_prior(job.model):
+        hooks.append(freeze_callback(observed, job.settings, job.train))
+    if searches_omega(job.settings, job.model):
+        hooks.append(omega_search_callback(observed, job.settings, job.train, conditions))
+    return [h for h in hooks if h is not None]
 
 
 def _check_precision(job: Job) -> None:

@@ -19,7 +19,7 @@ resonance only ~zeta wide. The search replaces omega by something the loss is sm
    it: docs/parts.md).
 
 Pure functions over arrays here; the prior (``physgs.models.ours``) holds the bank and calls
-``project_to_oscillators``; ``search_callback`` is the training loop's hook. torch loads only
+``project_to_oscillators``; ``SearchHook`` is the training loop's hook. torch loads only
 when a response is integrated: the config's checks import ``search_iteration`` to plan.
 """
 
@@ -144,7 +144,7 @@ def search_iteration(search: OmegaSearch, train_cfg: dict, freeze_at: int | None
 
 
 def omega_search_callback(observed, models_cfg: dict, train_cfg: dict, conditions: list[int]):
-    """``on_iteration`` hook for ``train_model`` that ends the prior's bank phase once, fitting the
+    """The ``SearchHook`` of one training run: it ends the prior's bank phase once, fitting the
     trained conditions' winds over the training window (recorded frames 0 .. n_train - 1; the
     held-out training frames lie inside it, and their images are never read)."""
     from physgs.models.visibility import freeze_schedule
@@ -153,43 +153,28 @@ def omega_search_callback(observed, models_cfg: dict, train_cfg: dict, condition
     at = search_iteration(search, train_cfg, freeze_schedule(models_cfg, train_cfg))
     lead, n = int(observed.lead_in_frames), int(observed.n_train)
     winds = np.asarray(observed.wind, dtype=np.float64)  # [C, L+F]
-    windows = [(winds[c], slice(lead, lead + n)) for c in conditions]
-    return search_callback(at, windows)
+    return SearchHook(at, [(winds[c], slice(lead, lead + n)) for c in conditions])
 
 
-def chain_hooks(hooks):
-    """One ``on_iteration`` hook calling each of ``hooks`` in turn (their statistics merged), or
-    None for none."""
-    if not hooks:
-        return None
-    if len(hooks) == 1:
-        return hooks[0]
-
-    def on_iteration(it, model, optimizer):
-        out: dict = {}
-        for h in hooks:
-            out.update(h(it, model, optimizer) or {})
-        return out or None
-
-    return on_iteration
-
-
-def search_callback(at: int, windows: list[tuple[np.ndarray, slice]]):
+@dataclass(frozen=True)
+class SearchHook:
     """``on_iteration`` hook for ``train_model``: at iteration ``at`` it ends the prior's bank
     phase (``OscillatorPrior.end_bank_phase``) on the trained winds and frames ``windows``
-    [(wind [L+F] m/s, the samples of the trained frames)], and scales the physics group's rate
-    by the model's ``physics_lr_after``. Returns the statistics it adds."""
+    [(wind [L+F] m/s, the samples of the trained frames)], scales the physics group's rate by
+    the model's ``physics_lr_after`` and drops that group's Adam moments (built under the bank:
+    the axis' too). Returns the statistics it adds."""
 
-    def on_iteration(it, model, optimizer):
-        if it != at:
+    at: int
+    windows: list
+
+    def __call__(self, it, model, optimizer) -> dict | None:
+        if it != self.at:
             return None
-        stats = model.end_bank_phase(windows)
+        stats = model.end_bank_phase(self.windows)
         factor = model.search.physics_lr_after
         for g in optimizer.param_groups:
             if g["name"] == "physics":
                 g["base_lr"] *= factor
-                for p in g["params"]:  # moments from the bank phase are the weights' alone
+                for p in g["params"]:
                     optimizer.state.pop(p, None)
         return {"omega_search_at": it, **stats}
-
-    return on_iteration

@@ -241,17 +241,18 @@ def build_model(
         K = spec["K"]
     o = cfg["ours"]
     spec = spec_of(name)
-    topo = {}
+    options = {}
     if searches_omega(cfg, name):
         from physgs.models.omega_search import OmegaSearch
 
-        topo["search"] = OmegaSearch.from_config(cfg["omega_search"])
+        options["search"] = OmegaSearch.from_config(cfg["omega_search"])
     if spec.parts == "topology":
         t = cfg["topology"]
-        topo.update(
+        options.update(
             segmentation="topology",
             knn=int(t["knn"]),
             parent=parent,
+            # a checkpoint written before the key existed turned parts from rest
             from_frame0=bool(t.get("from_frame0", False)),
         )
     return OscillatorPrior(
@@ -268,7 +269,7 @@ def build_model(
         seed=seed,
         labels=labels,
         chain=spec.chain,
-        **topo,
+        **options,
     )
 
 

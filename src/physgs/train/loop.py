@@ -77,8 +77,9 @@ def train_model(
     ``physgs.train.divergence``), or if the model's forward pass raises (chained).
 
     frame_pool: recorded-frame indices (< n_train) to draw from instead of all of them (K
-    selection holds some out). on_iteration(it, model, optimizer) -> dict | None is called
-    before each iteration; the dicts it returns are merged into the statistics (freezing).
+    selection holds some out). on_iteration: a hook on_iteration(it, model, optimizer) -> dict |
+    None, or a list of them called in order, before each iteration; the dicts they return are
+    merged into the statistics (freezing, the search over omega).
     """
     name = name or model.name
     iterations, warmup = int(train_cfg["iterations"]), int(train_cfg["warmup"])
@@ -95,6 +96,12 @@ def train_model(
                 f"{observed.n_train}); got {frame_pool.size} frames"
             )
     extra: dict = {}
+    if on_iteration is None:
+        hooks = []
+    elif callable(on_iteration):
+        hooks = [on_iteration]
+    else:
+        hooks = list(on_iteration)
     rng = np.random.default_rng(seed)
     torch.manual_seed(seed)
     groups = model.param_groups(train_cfg["lr"])
@@ -125,8 +132,8 @@ def train_model(
     t0 = time.perf_counter()
     bar = tqdm(range(iterations), desc=f"train {name}", disable=not progress, mininterval=2.0)
     for it in bar:
-        if on_iteration is not None:
-            extra.update(on_iteration(it, model, opt) or {})
+        for hook in hooks:
+            extra.update(hook(it, model, opt) or {})
         c = int(conditions[rng.integers(len(conditions))])
         j = int(
             rng.integers(observed.n_train)
