@@ -5,8 +5,11 @@ from __future__ import annotations
 
 import hashlib
 import json
+import platform
+import subprocess
 from dataclasses import asdict, dataclass
 from importlib.metadata import PackageNotFoundError, version
+from pathlib import Path
 
 
 def package_version() -> str:
@@ -44,3 +47,26 @@ class Stamp:
 def stamp(cfg: dict) -> Stamp:
     """The stamp of a resolved config (its ``profile`` key names the profile)."""
     return Stamp(str(cfg.get("profile", "unknown")), config_hash(cfg), package_version())
+
+
+def machine_cpu(cpuinfo: str | Path = "/proc/cpuinfo") -> str:
+    """The CPU's model and whether it computes bf16 natively (AVX-512 BF16, AMX): what a
+    timing depends on (the fields run in bf16).
+
+    Args:
+        cpuinfo: the kernel's CPU description (Linux); elsewhere ``platform.processor()``.
+    """
+    info = Path(cpuinfo).read_text() if Path(cpuinfo).is_file() else ""
+    model = next(
+        (ln.split(":", 1)[1].strip() for ln in info.splitlines() if "model name" in ln), ""
+    )
+    flags = [f for f in ("avx512_bf16", "amx_bf16") if f in info.split()]
+    return f"{model or platform.processor() or 'unknown CPU'} ({', '.join(flags) or 'no bf16'})"
+
+
+def git_commit(cwd: str | Path = ".") -> str:
+    """``git describe --always --dirty`` of ``cwd``, or ``unknown`` outside a checkout."""
+    out = subprocess.run(
+        ["git", "describe", "--always", "--dirty"], capture_output=True, text=True, cwd=cwd
+    )
+    return out.stdout.strip() or "unknown"

@@ -1,0 +1,358 @@
+"""The committed record of a finished run: what the documentation and the README show.
+
+A run's outputs (``results/``) are not committed; the record is: the run's stamp (date, commit,
+profile, config hash, seeds, the machine's CPU, wall time and job-minutes by stage), its
+``summary.md``, the claims ledger, every table as CSV and as a Markdown table, and the figures as
+PNG sized for the web. The Results page includes the record's files (never a copy of their
+numbers), and the README's "what it found" and "what it costs" lines are printed from the record
+by :func:`readme_block`, so neither can disagree with the run they describe.
+
+What each command costs is measured by ``tools/timed.py`` (one row per command in
+``costs.csv``, the command's last measured wall time on this machine's CPU).
+
+Pure over paths: every function takes the files it reads and the folder it writes.
+"""
+
+from __future__ import annotations
+
+import json
+import math
+import shutil
+from collections.abc import Mapping, Sequence
+from dataclasses import asdict, dataclass, field
+from pathlib import Path
+
+import numpy as np
+import pandas as pd
+
+#: The claim families that carry the paper's story, in the order the README tells it, each with
+#: the words a reader needs. A family is the claim id before its first ``/``.
+HEADLINE: tuple[tuple[str, str], ...] = (
+    ("ours_above_static_beyond", "ours above the static pose beyond the training window"),
+    ("baselines_below_static_beyond", "every learned field below static beyond the window"),
+    ("transfer_ours_ahead", "ours ahead of the best learned field under unseen wind"),
+    ("null_factor", "ours beats the untrained null by the paper's factor on frequency"),
+    ("null_matches", "the untrained null matches ours on frequency"),
+    ("damping_not_recovered", "damping is not recovered"),
+)
+#: The commands whose cost the README states, keyed as ``tools/timed.py --name`` records them.
+COMMANDS: tuple[tuple[str, str], ...] = (
+    ("quick_all", "snakemake --cores 2 all --config profile=quick"),
+    ("tab_null", "snakemake --cores 2 results/tables/tab_null.tex"),
+    ("all", "snakemake --cores 2 all"),
+    ("studies", "snakemake --cores 2 studies"),
+    ("tests", "python -m pytest -q"),
+)
+#: Widest figure in the record, px: the documentation's content column.
+FIGURE_WIDTH_PX = 1200
+COSTS_COLUMNS = ("name", "command", "wall_s", "date", "commit", "cpu", "from_nothing")
+BEGIN, END = "<!-- record:begin -->", "<!-- record:end -->"
+
+
+@dataclass(frozen=True)
+class Stamp:
+    """Where a record comes from.
+
+    Attributes:
+        date: ISO date the record was made.
+        commit: the commit the run was made at (``git describe --always --dirty``).
+        profile: the config profile of the run.
+        config_hash: the run's config hash (the tables' stamp).
+        seeds: training seeds of the run.
+        trees: trees of the run.
+        cpu: the machine's CPU model and its bf16/AMX flags.
+        wall_s: wall time of the run, s (first job start to last job end, or as measured).
+        job_min_by_stage: job-minutes per stage, from the run's benchmark files.
+    """
+
+    date: str
+    commit: str
+    profile: str
+    config_hash: str
+    seeds: tuple[int, ...]
+    trees: tuple[str, ...]
+    cpu: str
+    wall_s: float
+    job_min_by_stage: dict[str, float] = field(default_factory=dict)
+
+    def markdown(self) -> str:
+        """The stamp as a short Markdown list."""
+        stages = ", ".join(f"{k} {v:.1f}" for k, v in self.job_min_by_stage.items())
+        total = sum(self.job_min_by_stage.values())
+        return "\n".join(
+            [
+                f"- **Run**: profile `{self.profile}`, config hash `{self.config_hash}`, "
+                f"seeds {', '.join(map(str, self.seeds))}, trees {', '.join(self.trees)}",
+                f"- **Made at** commit `{self.commit}`; record written {self.date}",
+                f"- **Machine**: {self.cpu}, 2 cores",
+                f"- **Wall time** {format_duration(self.wall_s)}; {total:.0f} job-minutes"
+                + (f" ({stages})" if stages else ""),
+                "",
+            ]
+        )
+
+
+def format_duration(seconds: float) -> str:
+    """``3 h 8 min``, ``29 min 9 s`` or ``42 s``; ``--`` for a missing value."""
+    if not math.isfinite(seconds):
+        return "--"
+    s = round(seconds)
+    h, rest = divmod(s, 3600)
+    m, s = divmod(rest, 60)
+    if h:
+        return f"{h} h {m} min"
+    return f"{m} min {s} s" if m else f"{s} s"
+
+
+def _cell(x) -> str:
+    if isinstance(x, (float, np.floating)):
+        if not math.isfinite(x):
+            return "--"
+        return f"{x:.4g}"
+    if x is None or (isinstance(x, float) and math.isnan(x)):
+        return "--"
+    return str(x).replace("|", "\\|")
+
+
+def markdown_table(df: pd.DataFrame) -> str:
+    """A DataFrame as a Markdown table; floats to 4 significant digits, NaN as ``--``."""
+    lines = ["| " + " | ".join(map(str, df.columns)) + " |", "|" + "---|" * len(df.columns)]
+    for row in df.itertuples(index=False):
+        lines.append("| " + " | ".join(_cell(x) for x in row) + " |")
+    return "\n".join(lines) + "\n"
+
+
+def demote(markdown: str) -> str:
+    """Every Markdown heading one level down (``# x`` -> ``## x``), so that an included page sits
+    under the including page's title."""
+    return "\n".join(
+        "#" + ln if ln.startswith("#") and ln.lstrip("#").startswith(" ") else ln
+        for ln in markdown.split("\n")
+    )
+
+
+def _png_for_web(src: Path, dst: Path) -> None:
+    """Copy a PNG, downscaled to :data:`FIGURE_WIDTH_PX` wide if wider."""
+    from PIL import Image
+
+    with Image.open(src) as im:
+        if im.width > FIGURE_WIDTH_PX:
+            h = round(im.height * FIGURE_WIDTH_PX / im.width)
+            im = im.resize((FIGURE_WIDTH_PX, h), Image.LANCZOS)
+        im.save(dst, optimize=True)
+
+
+def write_record(
+    out_dir: str | Path,
+    *,
+    stamp: Stamp,
+    summary_md: str | Path,
+    claims_csv: str | Path,
+    claims_md: str | Path,
+    tables: Sequence[str | Path],
+    figures: Sequence[str | Path],
+) -> list[Path]:
+    """Write a run's record into ``out_dir`` (replacing the record there).
+
+    Args:
+        out_dir: the record's folder (the project keeps it at ``docs/record``).
+        stamp: where the run comes from.
+        summary_md: the run's ``summary.md``.
+        claims_csv: the claims ledger as CSV.
+        claims_md: the claims ledger as Markdown.
+        tables: the run's table CSVs; each becomes ``tables/<name>.csv`` and ``.md``.
+        figures: the run's figure PNGs; each becomes ``figures/<name>.png``, web-sized.
+
+    Returns:
+        The files written.
+
+    Raises:
+        FileNotFoundError: naming the first input that is missing.
+    """
+    inputs = [Path(p) for p in (summary_md, claims_csv, claims_md, *tables, *figures)]
+    for p in inputs:
+        if not p.is_file():
+            raise FileNotFoundError(f"{p}: missing; finish the run first (snakemake --cores 2 all)")
+    out = Path(out_dir)
+    costs = out / "costs.csv"
+    kept = costs.read_bytes() if costs.is_file() else None
+    if out.exists():
+        shutil.rmtree(out)
+    (out / "tables").mkdir(parents=True)
+    (out / "figures").mkdir()
+    written: list[Path] = []
+
+    def put(name: str, text: str) -> None:
+        (out / name).write_text(text)
+        written.append(out / name)
+
+    if kept is not None:  # measured by tools/timed.py, not by the run: it outlives the record
+        costs.write_bytes(kept)
+        written.append(costs)
+    put("stamp.json", json.dumps(asdict(stamp), indent=2) + "\n")
+    put("stamp.md", stamp.markdown())
+    put("summary.md", demote(Path(summary_md).read_text()))
+    put("claims.md", demote(Path(claims_md).read_text()))
+    shutil.copyfile(claims_csv, out / "claims.csv")
+    written.append(out / "claims.csv")
+    index = []
+    for t in sorted(Path(p) for p in tables):
+        df = pd.read_csv(t, dtype={"config_hash": str})
+        shutil.copyfile(t, out / "tables" / t.name)
+        put(f"tables/{t.stem}.md", markdown_table(df))
+        written.append(out / "tables" / t.name)
+        index += [f"### `{t.stem}`", "", f'--8<-- "docs/record/tables/{t.stem}.md"', ""]
+    put("tables.md", "\n".join(index))
+    gallery = []
+    for f in sorted(Path(p) for p in figures):
+        _png_for_web(f, out / "figures" / f.name)
+        written.append(out / "figures" / f.name)
+        gallery += [f"### `{f.stem}`", "", f"![{f.stem}](record/figures/{f.name})", ""]
+    put("figures.md", "\n".join(gallery))
+    put(
+        "index.md",
+        "\n".join(
+            [
+                "## The run",
+                "",
+                '--8<-- "docs/record/stamp.md"',
+                "",
+                '--8<-- "docs/record/summary.md"',
+                "",
+                "## Every table",
+                "",
+                "One row per seed, as the run wrote it (`tables/<name>.csv` beside each).",
+                "",
+                '--8<-- "docs/record/tables.md"',
+                "",
+                "## Figures",
+                "",
+                '--8<-- "docs/record/figures.md"',
+                "",
+            ]
+        ),
+    )
+    return written
+
+
+def write_unrecorded(out_dir: str | Path) -> Path:
+    """``index.md`` of a record folder that holds no run yet, saying how to make one."""
+    out = Path(out_dir)
+    out.mkdir(parents=True, exist_ok=True)
+    (out / "index.md").write_text(
+        "No full run is recorded yet. After `snakemake --cores 2 all` at the default profile, "
+        "`python tools/record.py results` writes it here.\n"
+    )
+    return out / "index.md"
+
+
+def headline_lines(claims: pd.DataFrame) -> list[str]:
+    """What the run found, in a few lines: the ledger's counts, then each :data:`HEADLINE`
+    family's verdict per cell with its measured value and 95% interval.
+
+    Args:
+        claims: the ledger (``claims.csv``: id, measured, ci_low, ci_high, unit, verdict).
+    """
+    kind = claims["verdict"].astype(str).str.split(":").str[0]
+    counts = kind.value_counts()
+    lines = [
+        f"- **{len(claims)} claims of the paper measured: {int(counts.get('holds', 0))} hold, "
+        f"{int(counts.get('fails', 0))} fail, {int(counts.get('undecided', 0))} undecided** "
+        "(95% intervals over seeds)."
+    ]
+    family = claims["id"].astype(str).str.split("/").str[0]
+    for fam, words in HEADLINE:
+        rows = claims[family == fam]
+        if rows.empty:
+            continue
+        cells = []
+        for (_, r), k in zip(rows.iterrows(), kind[family == fam]):
+            where = "/".join(str(r["id"]).split("/")[1:]) or "all"
+            value = (
+                f"{r['measured']:+.3g} [{r['ci_low']:+.3g}, {r['ci_high']:+.3g}] {r['unit']}"
+                if math.isfinite(r["ci_low"])
+                else (f"{r['measured']:+.3g} {r['unit']}" if math.isfinite(r["measured"]) else "--")
+            )
+            cells.append(f"{where} **{k}** ({value.strip()})")
+        lines.append(f"- {words[0].upper() + words[1:]}: " + "; ".join(cells) + ".")
+    return lines
+
+
+def cost_lines(costs: pd.DataFrame) -> list[str]:
+    """What each of :data:`COMMANDS` costs on 2 cores, from ``costs.csv``; ``not measured``
+    where the record has no row for it."""
+    lines = ["| command | wall time on 2 cores | measured on |", "|---|---|---|"]
+    by_name = {r["name"]: r for _, r in costs.iterrows()} if len(costs) else {}
+    for name, command in COMMANDS:
+        r = by_name.get(name)
+        if r is None:
+            lines.append(f"| `{command}` | not measured | |")
+            continue
+        start = "from nothing" if bool(r["from_nothing"]) else "on a finished run"
+        lines.append(
+            f"| `{command}` | {format_duration(float(r['wall_s']))} ({start}) | "
+            f"{r['date']}, commit `{r['commit']}`, {r['cpu']} |"
+        )
+    return lines
+
+
+def read_costs(path: str | Path) -> pd.DataFrame:
+    """``costs.csv`` of a record, or an empty frame with its columns where there is none."""
+    p = Path(path)
+    if not p.is_file():
+        return pd.DataFrame(columns=list(COSTS_COLUMNS))
+    text = {c: str for c in COSTS_COLUMNS if c not in ("wall_s", "from_nothing")}
+    return pd.read_csv(p, dtype=text)  # a commit of digits or a command `true` stays text
+
+
+def readme_block(record_dir: str | Path) -> str:
+    """The README's "what it found" and "what it costs" block, from a record folder.
+
+    Args:
+        record_dir: the record (``docs/record``); where it holds no ledger yet, the block says so.
+    """
+    lines = [BEGIN, "", *found_lines(record_dir), END]
+    return "\n".join(lines)
+
+
+def found_lines(record_dir: str | Path) -> list[str]:
+    """The lines of :func:`readme_block` without its markers: what the home page includes."""
+    record = Path(record_dir)
+    lines = ["**What the last full run found** (its record: `docs/record/`):", ""]
+    if (record / "claims.csv").is_file():
+        stamp = json.loads((record / "stamp.json").read_text())
+        claims = pd.read_csv(record / "claims.csv", dtype={"config_hash": str})
+        lines += [
+            f"Profile `{stamp['profile']}`, seeds {', '.join(map(str, stamp['seeds']))}, "
+            f"commit `{stamp['commit']}`:",
+            "",
+            *headline_lines(claims),
+        ]
+    else:
+        lines.append(
+            "no full run is recorded yet: `python tools/record.py results` writes the record "
+            "after `snakemake --cores 2 all`."
+        )
+    lines += ["", "**What each command costs:**", "", *cost_lines(read_costs(record / "costs.csv"))]
+    return [*lines, ""]
+
+
+def replace_block(text: str, block: str) -> str:
+    """``text`` with the part between :data:`BEGIN` and :data:`END` replaced by ``block``.
+
+    Raises:
+        ValueError: when the markers are missing or out of order.
+    """
+    i, j = text.find(BEGIN), text.find(END)
+    if i < 0 or j < i:
+        raise ValueError(f"no {BEGIN} ... {END} block to replace")
+    return text[:i] + block + text[j + len(END) :]
+
+
+def record_costs(path: str | Path, row: Mapping[str, object]) -> None:
+    """Set the row of ``row['name']`` in ``costs.csv`` (the command's last measured cost)."""
+    df = read_costs(path)
+    df = df[df["name"] != row["name"]]
+    df = pd.concat([df, pd.DataFrame([{k: row[k] for k in COSTS_COLUMNS}])], ignore_index=True)
+    Path(path).parent.mkdir(parents=True, exist_ok=True)
+    df.to_csv(path, index=False)

@@ -1,0 +1,244 @@
+"""The committed record of a run (physgs.report.record, tools/record.py): what it writes, that the
+README and the home page say what the record holds, and that no page types a result table."""
+
+import json
+import re
+import subprocess
+import sys
+from pathlib import Path
+
+import numpy as np
+import pandas as pd
+import pytest
+from PIL import Image
+
+from physgs.report import record
+
+ROOT = Path(__file__).resolve().parents[1]
+RECORD = ROOT / "docs" / "record"
+
+
+def _run(tmp_path):
+    """A finished run's files, small: two tables, a ledger, a summary, a wide and a small PNG."""
+    r = tmp_path / "results"
+    (r / "tables").mkdir(parents=True)
+    (r / "figures").mkdir()
+    fit = pd.DataFrame(
+        {
+            "tree": ["sparse", "sparse"],
+            "model": ["ours", "ours"],
+            "seed": [0, 1],
+            "ceiling_frac": [0.13456789, np.nan],
+            "profile": ["default"] * 2,
+            "config_hash": ["0123abcd"] * 2,
+        }
+    )
+    fit.to_csv(r / "tables" / "tab_fit.csv", index=False)
+    pd.DataFrame({"tree": ["medium"], "psnr_db": [24.6049]}).to_csv(
+        r / "tables" / "tab_psnr.csv", index=False
+    )
+    claims = pd.DataFrame(
+        {
+            "id": [
+                "ours_above_static_beyond/sparse",
+                "ours_above_static_beyond/medium",
+                "null_factor/sparse",
+                "fits_window/medium/mlp",
+            ],
+            "measured": [1.99, 6.25, 1.27, 0.346],
+            "ci_low": [1.2, 4.1, 0.56, np.nan],
+            "ci_high": [2.77, 8.4, 1.97, np.nan],
+            "unit": ["dB", "dB", "x", ""],
+            "threshold": [0, 0, 2.5, 0.5],
+            "verdict": ["holds", "holds", "fails", "undecided: one seed"],
+        }
+    )
+    claims.to_csv(r / "claims.csv", index=False)
+    (r / "claims.md").write_text("# Claims ledger\n\ntext\n")
+    (r / "summary.md").write_text("# Run summary\n\n## Claims ledger\n\n#not a heading\n")
+    Image.new("RGB", (2400, 600), (10, 20, 30)).save(r / "figures" / "fig_wide.png")
+    Image.new("RGB", (300, 200), (200, 20, 30)).save(r / "figures" / "fig_small.png")
+    return r, fit, claims
+
+
+def _stamp():
+    return record.Stamp(
+        date="2026-01-02",
+        commit="abc1234",
+        profile="default",
+        config_hash="0123abcd",
+        seeds=(0, 1),
+        trees=("sparse",),
+        cpu="test CPU (no bf16)",
+        wall_s=11285.0,
+        job_min_by_stage={"training": 287.0, "evaluation": 29.0},
+    )
+
+
+def _parse_md_table(text):
+    rows = [ln.strip().strip("|").split("|") for ln in text.strip().splitlines()]
+    head, body = [c.strip() for c in rows[0]], rows[2:]
+    return head, [[c.strip() for c in row] for row in body]
+
+
+def test_write_record_copies_every_table_as_csv_and_markdown_that_agree(tmp_path):
+    r, fit, _ = _run(tmp_path)
+    out = tmp_path / "record"
+    record.write_record(
+        out,
+        stamp=_stamp(),
+        summary_md=r / "summary.md",
+        claims_csv=r / "claims.csv",
+        claims_md=r / "claims.md",
+        tables=sorted((r / "tables").glob("*.csv")),
+        figures=sorted((r / "figures").glob("*.png")),
+    )
+    assert (out / "tables" / "tab_fit.csv").read_bytes() == (r / "tables/tab_fit.csv").read_bytes()
+    head, body = _parse_md_table((out / "tables" / "tab_fit.md").read_text())
+    assert head == list(fit.columns)
+    col = head.index("ceiling_frac")
+    assert float(body[0][col]) == pytest.approx(0.13456789, rel=5e-4)  # 4 significant digits
+    assert body[1][col] == "--"  # NaN is shown as missing, never as 0
+    assert body[0][head.index("config_hash")] == "0123abcd"  # a hash is not read as a number
+    # the index includes each table's Markdown and embeds each figure
+    tables = (out / "tables.md").read_text()
+    assert '--8<-- "docs/record/tables/tab_fit.md"' in tables and "tab_psnr" in tables
+    assert "![fig_wide](record/figures/fig_wide.png)" in (out / "figures.md").read_text()
+    assert '--8<-- "docs/record/summary.md"' in (out / "index.md").read_text()
+    stamp = json.loads((out / "stamp.json").read_text())
+    assert stamp["seeds"] == [0, 1] and stamp["wall_s"] == 11285.0
+    assert "3 h 8 min" in (out / "stamp.md").read_text()
+    assert "316 job-minutes" in (out / "stamp.md").read_text()
+    # headings one level down, so the included summary sits under the Results page's title
+    summary = (out / "summary.md").read_text().splitlines()
+    assert summary[0] == "## Run summary" and "### Claims ledger" in summary
+    assert "#not a heading" in summary
+
+
+def test_figures_are_web_sized_and_keep_their_aspect(tmp_path):
+    r, _, _ = _run(tmp_path)
+    out = tmp_path / "record"
+    record.write_record(
+        out,
+        stamp=_stamp(),
+        summary_md=r / "summary.md",
+        claims_csv=r / "claims.csv",
+        claims_md=r / "claims.md",
+        tables=[],
+        figures=sorted((r / "figures").glob("*.png")),
+    )
+    with Image.open(out / "figures" / "fig_wide.png") as im:
+        assert (im.width, im.height) == (record.FIGURE_WIDTH_PX, 300)
+    with Image.open(out / "figures" / "fig_small.png") as im:
+        assert (im.width, im.height) == (300, 200)  # never enlarged
+
+
+def test_a_missing_input_is_named_and_costs_outlive_a_new_record(tmp_path):
+    r, _, _ = _run(tmp_path)
+    out = tmp_path / "record"
+    record.record_costs(
+        out / "costs.csv",
+        dict(
+            name="all",
+            command="snakemake --cores 2 all",
+            wall_s=100.0,
+            date="d",
+            commit="c",
+            cpu="x",
+            from_nothing=True,
+        ),
+    )
+    with pytest.raises(FileNotFoundError, match="summary.md"):
+        record.write_record(
+            out,
+            stamp=_stamp(),
+            summary_md=r / "nope" / "summary.md",
+            claims_csv=r / "claims.csv",
+            claims_md=r / "claims.md",
+            tables=[],
+            figures=[],
+        )
+    record.write_record(
+        out,
+        stamp=_stamp(),
+        summary_md=r / "summary.md",
+        claims_csv=r / "claims.csv",
+        claims_md=r / "claims.md",
+        tables=[],
+        figures=[],
+    )
+    assert record.read_costs(out / "costs.csv")["wall_s"].tolist() == [100.0]
+
+
+def test_headline_counts_the_verdicts_and_gives_each_story_claim_its_interval():
+    claims = pd.DataFrame(
+        {
+            "id": ["ours_above_static_beyond/sparse", "null_factor/sparse", "other/x", "other/y"],
+            "measured": [1.99, 1.27, 0.0, 0.0],
+            "ci_low": [1.2, 0.56, np.nan, np.nan],
+            "ci_high": [2.77, 1.97, np.nan, np.nan],
+            "unit": ["dB", "x", "", ""],
+            "verdict": ["holds", "fails", "undecided: one seed", "holds"],
+        }
+    )
+    lines = record.headline_lines(claims)
+    assert "4 claims" in lines[0] and "2 hold, 1 fail, 1 undecided" in lines[0]
+    assert len(lines) == 3  # counts, then the two story families present, in HEADLINE's order
+    assert lines[1].startswith("- Ours above the static pose")
+    assert "sparse **holds** (+1.99 [+1.2, +2.77] dB)" in lines[1]
+    assert "sparse **fails** (+1.27 [+0.56, +1.97] x)" in lines[2]
+
+
+def test_costs_say_not_measured_rather_than_guess():
+    lines = record.cost_lines(record.read_costs("/nonexistent/costs.csv"))
+    assert len(lines) == 2 + len(record.COMMANDS)
+    assert all("not measured" in ln for ln in lines[2:])
+
+
+def test_timed_records_a_command_and_passes_a_failure_on(tmp_path):
+    costs = tmp_path / "costs.csv"
+    ok = subprocess.run(
+        [sys.executable, "tools/timed.py", "--name", "tests", "--costs", str(costs), "--", "true"],
+        cwd=ROOT,
+        capture_output=True,
+        text=True,
+    )
+    assert ok.returncode == 0, ok.stderr
+    row = record.read_costs(costs).iloc[0]
+    assert row["name"] == "tests" and row["command"] == "true" and 0 <= row["wall_s"] < 30
+    bad = subprocess.run(
+        [sys.executable, "tools/timed.py", "--name", "all", "--costs", str(costs), "--", "false"],
+        cwd=ROOT,
+        capture_output=True,
+        text=True,
+    )
+    assert bad.returncode == 1
+    assert record.read_costs(costs)["name"].tolist() == ["tests"]
+
+
+def test_readme_and_home_page_say_what_the_record_holds():
+    readme = (ROOT / "README.md").read_text()
+    want = record.readme_block(RECORD)
+    assert record.replace_block(readme, want) == readme, (
+        "the README's record block differs from docs/record: run `python tools/record.py "
+        "--readme-only`"
+    )
+    assert (RECORD / "found.md").read_text() == "\n".join(record.found_lines(RECORD))
+    assert '--8<-- "docs/record/found.md"' in (ROOT / "docs" / "index.md").read_text()
+    assert '--8<-- "docs/record/index.md"' in (ROOT / "docs" / "results.md").read_text()
+
+
+#: A table cell that states a measured result: a PSNR, a percentage, an interval, a duration.
+RESULT_CELL = re.compile(r"\d\s*dB\b|\d\s*%|±|\d\s*(min|ms)\b|\[\s*[-+]?\d[\d.]*\s*,")
+
+
+def test_no_page_types_a_result_table():
+    found = []
+    for page in sorted((ROOT / "docs").glob("*.md")):
+        for n, line in enumerate(page.read_text().splitlines(), 1):
+            if not line.startswith("|") or re.match(r"^\|[-| :]+\|\s*$", line):
+                continue
+            cells = line.strip().strip("|").split("|")[1:]
+            if any(RESULT_CELL.search(c) for c in cells):
+                found.append(f"docs/{page.name}:{n}: {line[:90]}")
+    assert not found, "result tables typed by hand (the record shows results):\n" + "\n".join(found)

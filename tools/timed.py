@@ -1,0 +1,59 @@
+"""Run a command, measure its wall time, and record it as that command's cost.
+
+    python tools/timed.py --name all [--from-nothing] -- snakemake --cores 2 all
+
+Runs the command (its output goes through), then sets the row `--name` of
+`docs/record/costs.csv` (`physgs.report.record.record_costs`): the command, its wall time, the
+date, the commit and the machine's CPU. The README's "what each command costs" lines are printed
+from that file (`python tools/record.py --readme-only`). Names the README reads:
+`physgs.report.record.COMMANDS`. A command that fails records nothing and passes its exit code on.
+"""
+
+from __future__ import annotations
+
+import argparse
+import datetime
+import shlex
+import subprocess
+import sys
+import time
+from pathlib import Path
+
+from physgs.report import record
+from physgs.provenance import git_commit, machine_cpu
+
+
+def main() -> int:
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("--name", required=True, choices=[n for n, _ in record.COMMANDS])
+    ap.add_argument("--from-nothing", action="store_true", help="results/ was removed first")
+    ap.add_argument("--costs", default="docs/record/costs.csv", type=Path)
+    ap.add_argument("command", nargs=argparse.REMAINDER)
+    args = ap.parse_args()
+    cmd = args.command[1:] if args.command[:1] == ["--"] else args.command
+    if not cmd:
+        ap.error("no command given (after --)")
+    t0 = time.monotonic()
+    rc = subprocess.call(cmd)
+    wall = time.monotonic() - t0
+    if rc != 0:
+        print(f"{shlex.join(cmd)}: exit {rc}; no cost recorded", file=sys.stderr)
+        return rc
+    record.record_costs(
+        args.costs,
+        {
+            "name": args.name,
+            "command": shlex.join(cmd),
+            "wall_s": round(wall, 1),
+            "date": datetime.date.today().isoformat(),
+            "commit": git_commit(),
+            "cpu": machine_cpu(),
+            "from_nothing": args.from_nothing,
+        },
+    )
+    print(f"{args.name}: {record.format_duration(wall)} recorded in {args.costs}")
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
