@@ -66,7 +66,7 @@ from physgs.models.parts import kmeans_parts
 from physgs.models.topology import KNN, topology_parts
 
 #: What the canonical set is taken for (``models.topology.canonical_pose``; module docstring).
-CANONICAL_POSES = ("rest", "frame0", "frame0_angles")
+CANONICAL_POSES = ("rest", "frame0", "frame0_angles", "frame0_offset")
 
 
 def prior_substeps(omega_hz, zeta, substeps: int, dt: float, guard: float = STABILITY_GUARD) -> int:
@@ -179,6 +179,8 @@ class OscillatorPrior(BaseModel):
         if canonical_pose != "rest" and segmentation != "topology":
             raise ValueError("canonical_pose other than 'rest' is a topology variants' option")
         self.canonical_pose = canonical_pose
+        if canonical_pose == "frame0_offset":  # frame 0's angles plus a learned turn per part
+            self.pose_offset = nn.Parameter(torch.zeros(K))  # [K] rad
         if search is not None:
             self.bank_omega = log_grid(b.omega_lo, b.omega_hi, search.bank_size)  # [M] rad/s
             self.bank_weights = nn.Parameter(torch.zeros(K, search.bank_size))
@@ -318,9 +320,11 @@ class OscillatorPrior(BaseModel):
         theta_all = self.part_theta(wind)  # [K, L+F]
         theta = theta_all[:, self.lead_in + frame_idx]  # [K]
         theta0 = theta_all[:, self.lead_in]  # [K] at recorded frame 0
+        if self.canonical_pose == "frame0_offset":
+            theta0 = theta0 + self.pose_offset
         lab = self.part_labels
         c = self.canonical
-        if self.canonical_pose == "frame0" and self.chain:
+        if self.canonical_pose in ("frame0", "frame0_offset") and self.chain:
             means, quats = chain_deform_from(
                 c.means, c.quats, lab, self.axis, theta, theta0, self.pivot, self.levels
             )
@@ -351,4 +355,9 @@ class OscillatorPrior(BaseModel):
                 "lr": lr["physics"],
             },
             {"name": "pivot", "params": [self.pivot], "lr": lr["pivot"] * self.extent},
-        ]
+        ] + (
+            # radians of the rest pose's turn: the pivot's rate without the scene's extent
+            [{"name": "pivot", "params": [self.pose_offset], "lr": lr["pivot"]}]
+            if self.canonical_pose == "frame0_offset"
+            else []
+        )
