@@ -19,7 +19,7 @@ from physgs.models.registry import (
     training_jobs,
 )
 from physgs.testbed.kinematics import pose_points
-from oracles import model_context, quick_models_cfg
+from oracles import model_context, quick_config, quick_models_cfg
 
 ID_Q = torch.tensor([[1.0, 0.0, 0.0, 0.0]], dtype=torch.float64)
 
@@ -330,10 +330,38 @@ def test_frame0_poses_put_frame_0_on_the_canonical_set(pose):
     assert not torch.allclose(absolute.deform(0, w).means, absolute.canonical.means, atol=1e-4)
 
 
+def test_frame0_offset_turns_the_rest_pose_by_a_learned_angle():
+    # frame0_offset: the rest pose is frame 0's transform at theta(frame 0) + offset undone, so
+    # at offset 0 it is frame0, and otherwise frame 0 sits at T(theta0) T(theta0 + offset)^-1
+    ctx, wind = model_context(200, seed=6, lead_in=40)
+    cfg = quick_models_cfg()
+    cfg["omega_search"]["models"] = []
+    cfg["topology"]["canonical_pose"] = "frame0_offset"
+    model = build_model("ours_chain", ctx, cfg, K=5)
+    with torch.no_grad():
+        model.gain_raw.copy_(torch.linspace(-0.6, 0.6, 5))
+    w = torch.as_tensor(wind)
+    c = model.canonical
+    assert torch.allclose(model.deform(0, w).means, c.means, atol=1e-6)
+    offset = torch.tensor([0.1, -0.2, 0.0, 0.05, 0.3])
+    with torch.no_grad():
+        model.pose_offset.copy_(offset)
+    th0 = model.part_theta(w)[:, model.lead_in]
+    args = (c.means, c.quats, model.part_labels, model.axis)
+    ref, _ = chain_deform_from(*args, th0, th0 + offset, model.pivot, model.levels)
+    got = model.deform(0, w).means
+    assert torch.allclose(got, ref, atol=1e-6)
+    assert not torch.allclose(got, c.means, atol=1e-3)
+    lr = quick_config()["train"]["lr"]
+    trained = {id(p) for g in model.param_groups(lr) for p in g["params"]}
+    assert id(model.pose_offset) in trained
+    got.sum().backward()
+    assert model.pose_offset.grad.abs().max() > 0
+
+
 def test_canonical_pose_is_validated_and_old_checkpoints_keep_theirs():
     import physgs.config
     from physgs.models.registry import canonical_pose_of
-    from oracles import quick_config
 
     with pytest.raises(physgs.config.ConfigError, match="canonical_pose"):
         physgs.config.apply_overrides(quick_config(), ["models.topology.canonical_pose=frame1"])
