@@ -37,8 +37,11 @@ frame 0's vertices): frame 0's transform is undone before theta(t)'s is applied
 (``physgs.models.chain.chain_deform_from``; for independent parts, a turn by theta_p(t) -
 theta_p(frame 0)), so frame 0 poses the canonical set and the motion cannot displace it;
 ``frame0_angles``, each part turned by theta_p(t) - theta_p(frame 0) (the same as ``frame0`` for
-independent parts, to first order in the angles for chained ones). In both frame-0 poses the
-search's projection fits each part's angle relative to frame 0 (what the images see).
+independent parts, to first order in the angles for chained ones); ``frame0_offset``, as
+``frame0`` with a learned turn per part (``pose_offset`` [K] rad, from 0 at the pivot rate)
+added to frame 0's angles. In the frame-0 poses the search's projection fits each part's angle
+relative to frame 0 (what the images see). ``rest`` is the default: the frame-0 poses fit the
+sparse tree's training window worse (docs/parts.md, the held-out views of the sparse tree).
 ``part_theta`` and recovery are unchanged.
 """
 
