@@ -10,7 +10,9 @@ motion (truth.npz's bone angles posed by the testbed's skinning), on condition 0
 over the training window and the tail its motion from frame 0 against the vertex's (RMS, mm),
 each split across the training camera's ray through the true point (what its image shows) and
 along it (what it cannot see, the held-out views do). A Gaussian may also slide along its own
-branch unseen by any view: placement errors bound what the images show from above. An evaluation diagnostic that
+branch unseen by any view: placement errors bound what the images show from above. Frame 0's
+placement error is also split into the canonical positions' drift from the vertices they start
+at and the deformation at frame 0 (the canonical set is frame 0's vertices). An evaluation diagnostic that
 reads the truth: it chooses nothing.
 """
 
@@ -78,6 +80,15 @@ def main(argv: list[str] | None = None) -> None:
         model = load_checkpoint(path)
         gt0, p0 = positions(model, obs, truth, np.array([0]))
         off_x, off_a = split_on_rays(p0 - gt0, gt0, c)  # where frame 0 puts each Gaussian
+        # frame 0's error = the canonical positions' drift from the vertices they start at
+        # (frame 0's) + the deformation at frame 0
+        canon = model.canonical.means.detach().double().numpy()  # [N, 3]
+        dr_x, dr_a = split_on_rays(canon - np.asarray(obs.canonical_xyz), gt0[0], c)
+        de_x, de_a = split_on_rays(p0[0] - canon, gt0[0], c)
+        print(
+            f"{m:12s} frame 0 = drift {_rms(dr_x):.1f} / {_rms(dr_a):.1f} + deformation "
+            f"{_rms(de_x):.1f} / {_rms(de_a):.1f} (across / along)"
+        )
         for span, frames in spans.items():
             gt, pred = positions(model, obs, truth, frames)
             # motion from frame 0, true and predicted: the placement's offset cancels

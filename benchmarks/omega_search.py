@@ -1,7 +1,7 @@
 """What the search over omega does, step by step, on training-window data only.
 
     python benchmarks/omega_search.py results/testbed/sparse [--model ours_chain] [--seeds 0,1,2]
-        [--set models.omega_search.until=0.3 ...]
+        [--set models.omega_search.until=0.3 ...] [--save DIR]
 
 Trains the prior by the profile's recipe (the hooks of ``physgs.experiments.fit``, from
 ``training_hooks``: freezing and the search) and prints per seed the mean PSNR (dB, training camera and wind) of the bank at
@@ -27,15 +27,16 @@ from physgs.evaluate.run import training_camera_scores
 from physgs.experiments import job_spec
 from physgs.experiments.recipe import Job, heldout_split, training_hooks
 from physgs.models.omega_search import SearchHook
-from physgs.models.registry import build_model
+from physgs.models.registry import build_model, save_checkpoint
 from physgs.testbed.dataset import load_observed
 from physgs.train.loop import condition_indices, train_model
 from physgs.train.seeding import seed_everything
 
 
-def run(obs, cfg: dict, model_id: str, seed: int) -> dict:
+def run(obs, cfg: dict, model_id: str, seed: int, save: Path | None = None) -> dict:
     """Train one prior as ``physgs.experiments.fit`` does (its hooks, ``training_hooks``),
-    scoring the probe frames just before and just after the projection."""
+    scoring the probe frames just before and just after the projection; with ``save`` (a
+    folder) the trained model is written there as ``<model>_seed<seed>.pt``."""
     job = Job.from_dict(job_spec(copy.deepcopy(cfg), model_id, "single", seed))
     trained, held = heldout_split(int(obs.n_train), int(job.train["holdout_every"]) or 10)
     probe = trained[::6]
@@ -76,6 +77,18 @@ def run(obs, cfg: dict, model_id: str, seed: int) -> dict:
     out["fit"] = float(np.mean(training_camera_scores(res.model, obs, trained[::3])[1]))
     out["held"] = float(np.mean(training_camera_scores(res.model, obs, held)[1]))
     out["wall_s"] = res.stats["wall_s"]
+    if save is not None:
+        save.mkdir(parents=True, exist_ok=True)
+        save_checkpoint(
+            save / f"{model_id}_seed{seed}.pt",
+            res.model,
+            name=model_id,
+            config=job.config,
+            seed=seed,
+            models_cfg=job.settings,
+            train_cfg=job.train,
+            stats=res.stats,
+        )
     return out
 
 
@@ -89,6 +102,7 @@ def main(argv: list[str] | None = None) -> None:
     ap.add_argument("--set", action="append", default=[], help="KEY.PATH=VALUE override")
     ap.add_argument("--static", type=float, help="static's fit dB (for the ceiling share)")
     ap.add_argument("--ceiling", type=float, help="truth_motion's fit dB")
+    ap.add_argument("--save", type=Path, help="write each trained model to this folder")
     args = ap.parse_args(argv)
     cfg = physgs.config.apply_overrides(
         physgs.config.load("config/trees.yaml", args.profile), args.set
@@ -101,7 +115,7 @@ def main(argv: list[str] | None = None) -> None:
     )
     fits, helds = [], []
     for seed in (int(s) for s in args.seeds.split(",")):
-        r = run(obs, cfg, args.model, seed)
+        r = run(obs, cfg, args.model, seed, args.save)
         share = (
             f"{100 * (r['fit'] - args.static) / (args.ceiling - args.static):5.0f}%"
             if args.static is not None and args.ceiling is not None

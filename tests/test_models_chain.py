@@ -9,7 +9,7 @@ import torch
 from scipy.spatial.transform import Rotation
 
 from physgs.models import build_model, load_checkpoint, save_checkpoint
-from physgs.models.chain import chain_deform, depth_levels
+from physgs.models.chain import chain_deform, chain_deform_from, depth_levels
 from physgs.models.gaussians import rotate_about_pivot
 from physgs.models.registry import (
     MODEL_NAMES,
@@ -19,7 +19,7 @@ from physgs.models.registry import (
     training_jobs,
 )
 from physgs.testbed.kinematics import pose_points
-from oracles import model_context, quick_models_cfg
+from oracles import model_context, quick_config, quick_models_cfg
 
 ID_Q = torch.tensor([[1.0, 0.0, 0.0, 0.0]], dtype=torch.float64)
 
@@ -258,29 +258,113 @@ def test_chained_swing_counts_the_descendants(swaying):
         assert moved.sum() >= (lab == p).sum()
 
 
-def test_from_frame0_poses_the_canonical_set_at_frame_0():
-    # the canonical Gaussians are the pose at recorded frame 0: turning each part by
-    # theta(t) - theta(frame 0) leaves frame 0 exactly there, and frame j turned by the difference
+def test_from_frame0_undoes_frame_0s_chained_transform_as_scipy_rotations_do():
+    # the canonical points are the pose at angles theta0: their rest pose is T(theta0)^-1 of
+    # them, then T(theta) moves them; built here from scipy rotations, point by point
+    rng = np.random.default_rng(3)
+    axis = rng.normal(size=(3, 3))
+    axis /= np.linalg.norm(axis, axis=1, keepdims=True)
+    theta, theta0 = rng.uniform(-0.6, 0.6, 3), rng.uniform(-0.6, 0.6, 3)
+    pivot = rng.normal(size=(3, 3))
+    x = rng.normal(size=(3, 3))  # one point per part of the chain 0 <- 1 <- 2
+
+    def world(th):  # [(rotation, translation)] of each part's chained map x -> R x + t
+        out = []
+        for p in range(3):
+            R = Rotation.from_rotvec(axis[p] * th[p])
+            own = (R, pivot[p] - R.apply(pivot[p]))
+            if p:
+                Rq, tq = out[p - 1]
+                own = (Rq * own[0], Rq.apply(own[1]) + tq)
+            out.append(own)
+        return out
+
+    now, then = world(theta), world(theta0)
+    oracle = np.array(
+        [now[p][0].apply(then[p][0].inv().apply(x[p] - then[p][1])) + now[p][1] for p in range(3)]
+    )
+    q = torch.tensor(rng.normal(size=(3, 4)))
+    args = (t64(x), q, torch.arange(3), t64(axis))
+    lv = depth_levels([-1, 0, 1])
+    m, qn = chain_deform_from(*args, t64(theta), t64(theta0), t64(pivot), lv)
+    assert np.allclose(m.numpy(), oracle, atol=1e-12)
+    own = Rotation.from_quat(q[2].numpy()[[1, 2, 3, 0]])
+    want = (now[2][0] * then[2][0].inv() * own).as_quat()[[3, 0, 1, 2]]
+    got = qn[2].numpy() / np.linalg.norm(qn[2].numpy())
+    assert np.allclose(got, want, atol=1e-12) or np.allclose(got, -want, atol=1e-12)
+    # not the turn by the angles' differences: the two differ beyond first order
+    diff, _ = chain_deform(*args, t64(theta - theta0), t64(pivot), lv)
+    assert not np.allclose(diff.numpy(), oracle, atol=1e-3)
+    same, _ = chain_deform_from(*args, t64(theta0), t64(theta0), t64(pivot), lv)
+    assert np.allclose(same.numpy(), x, atol=1e-14)
+
+
+@pytest.mark.parametrize("pose", ["frame0", "frame0_angles"])
+def test_frame0_poses_put_frame_0_on_the_canonical_set(pose):
+    # the canonical Gaussians are the pose at recorded frame 0: in either frame-0 pose frame 0
+    # is exactly there, and frame j moves by the chained transforms from frame 0's angles
     ctx, wind = model_context(200, seed=6, lead_in=40)
     cfg = quick_models_cfg()
     cfg["omega_search"]["models"] = []
-    cfg["topology"]["from_frame0"] = True
+    cfg["topology"]["canonical_pose"] = pose
     model = build_model("ours_chain", ctx, cfg, K=5)
     with torch.no_grad():
         model.gain_raw.copy_(torch.linspace(-0.6, 0.6, 5))
     w = torch.as_tensor(wind)
     theta = model.part_theta(w)  # [K, L+F]
-    assert theta[:, model.lead_in].abs().max() > 1e-3  # the oscillators are not at rest there
+    th0, th7 = theta[:, model.lead_in], theta[:, model.lead_in + 7]
+    assert th0.abs().max() > 1e-3  # the oscillators are not at rest there
     c = model.canonical
-    assert torch.equal(model.deform(0, w).means, c.means)
+    assert torch.allclose(model.deform(0, w).means, c.means, atol=1e-6)
     st = model.deform(7, w)
-    own = theta[:, model.lead_in + 7] - theta[:, model.lead_in]
-    ref, _ = chain_deform(
-        c.means, c.quats, model.part_labels, model.axis, own, model.pivot, model.levels
-    )
-    assert torch.allclose(st.means, ref)
-    cfg["topology"]["from_frame0"] = False  # off: frame 0 is turned by theta(frame 0)
+    args = (c.means, c.quats, model.part_labels, model.axis)
+    if pose == "frame0":
+        ref, _ = chain_deform_from(*args, th7, th0, model.pivot, model.levels)
+    else:
+        ref, _ = chain_deform(*args, th7 - th0, model.pivot, model.levels)
+    assert torch.allclose(st.means, ref, atol=1e-6)
+    cfg["topology"]["canonical_pose"] = "rest"  # frame 0 is turned by theta(frame 0)
     absolute = build_model("ours_chain", ctx, cfg, K=5)
     with torch.no_grad():
         absolute.gain_raw.copy_(torch.linspace(-0.6, 0.6, 5))
-    assert not torch.allclose(absolute.deform(0, w).means, absolute.canonical.means)
+    assert not torch.allclose(absolute.deform(0, w).means, absolute.canonical.means, atol=1e-4)
+
+
+def test_frame0_offset_turns_the_rest_pose_by_a_learned_angle():
+    # frame0_offset: the rest pose is frame 0's transform at theta(frame 0) + offset undone, so
+    # at offset 0 it is frame0, and otherwise frame 0 sits at T(theta0) T(theta0 + offset)^-1
+    ctx, wind = model_context(200, seed=6, lead_in=40)
+    cfg = quick_models_cfg()
+    cfg["omega_search"]["models"] = []
+    cfg["topology"]["canonical_pose"] = "frame0_offset"
+    model = build_model("ours_chain", ctx, cfg, K=5)
+    with torch.no_grad():
+        model.gain_raw.copy_(torch.linspace(-0.6, 0.6, 5))
+    w = torch.as_tensor(wind)
+    c = model.canonical
+    assert torch.allclose(model.deform(0, w).means, c.means, atol=1e-6)
+    offset = torch.tensor([0.1, -0.2, 0.0, 0.05, 0.3])
+    with torch.no_grad():
+        model.pose_offset.copy_(offset)
+    th0 = model.part_theta(w)[:, model.lead_in]
+    args = (c.means, c.quats, model.part_labels, model.axis)
+    ref, _ = chain_deform_from(*args, th0, th0 + offset, model.pivot, model.levels)
+    got = model.deform(0, w).means
+    assert torch.allclose(got, ref, atol=1e-6)
+    assert not torch.allclose(got, c.means, atol=1e-3)
+    lr = quick_config()["train"]["lr"]
+    trained = {id(p) for g in model.param_groups(lr) for p in g["params"]}
+    assert id(model.pose_offset) in trained
+    got.sum().backward()
+    assert model.pose_offset.grad.abs().max() > 0
+
+
+def test_canonical_pose_is_validated_and_old_checkpoints_keep_theirs():
+    import physgs.config
+    from physgs.models.registry import canonical_pose_of
+
+    with pytest.raises(physgs.config.ConfigError, match="canonical_pose"):
+        physgs.config.apply_overrides(quick_config(), ["models.topology.canonical_pose=frame1"])
+    assert canonical_pose_of({"knn": 10}) == "rest"
+    assert canonical_pose_of({"knn": 10, "from_frame0": True}) == "frame0_angles"
+    assert canonical_pose_of({"knn": 10, "canonical_pose": "frame0"}) == "frame0"

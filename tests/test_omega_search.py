@@ -12,6 +12,7 @@ import physgs.config
 from physgs.config_checks import omega_search_is_runnable
 from physgs.models import build_model
 from physgs.models.omega_search import (
+    GRID_INSET,
     OmegaSearch,
     log_grid,
     SearchHook,
@@ -19,6 +20,7 @@ from physgs.models.omega_search import (
     search_iteration,
     unit_responses,
 )
+from physgs.models.oscillator_params import condition_vbar
 from physgs.models.registry import model_settings, searches_omega
 from oracles import gusty_wind, model_context, quick_config, quick_models_cfg, wind_lsim
 
@@ -90,6 +92,50 @@ def test_bank_phase_is_linear_in_the_weights_and_hands_over_to_matching_oscillat
     assert stats["omega_search_explained_median"] > 0.95
     with pytest.raises(RuntimeError, match="no bank phase"):
         model.end_bank_phase([(wind, slice(lead, lead + n))])
+
+
+def test_projection_from_frame_0_fits_each_angle_relative_to_frame_0():
+    # with a frame-0 canonical pose the images see theta(t) - theta(frame 0): the projection
+    # must fit that, the grid point whose responses' differences a least-squares gain fits best
+    # (oracle: numpy lstsq per grid point), not the absolute angle
+    def projected(pose):
+        model, wind = _search_prior(K=1)
+        model.canonical_pose = pose
+        M = model.search.bank_size
+        with torch.no_grad():  # two bank members of unequal weight: no single oscillator fits
+            model.bank_weights[0, 2] = 0.08
+            model.bank_weights[0, M - 6] = 0.03
+        lead, n = model.lead_in, model.ctx.n_train
+        w = torch.as_tensor(wind, dtype=torch.float64)
+        bank = model.part_theta(w)[0, lead : lead + n].detach().double().numpy()  # [S]
+        model.end_bank_phase([(wind, slice(lead, lead + n))])
+        return model, w, bank
+
+    model, w, bank = projected("frame0")
+    b, (n_om, n_ze) = model.bounds, model.search.grid
+    om = np.exp(
+        np.linspace(
+            np.log(b.omega_lo * (1 + GRID_INSET)), np.log(b.omega_hi * (1 - GRID_INSET)), n_om
+        )
+    )
+    dz = GRID_INSET * (b.zeta_hi - b.zeta_lo)
+    om, ze = (
+        a.ravel()
+        for a in np.meshgrid(om, np.linspace(b.zeta_lo + dz, b.zeta_hi - dz, n_ze), indexing="ij")
+    )
+    lead, n = model.lead_in, model.ctx.n_train
+    vbar = condition_vbar(model.vbar_ratio, w)
+    r = unit_responses(om, ze, w, vbar, model.dt, model.substeps)[:, lead : lead + n]  # [G, S]
+    rel, r_rel = bank - bank[0], r - r[:, :1]
+    resid = [np.linalg.lstsq(g[:, None], rel, rcond=None)[1].sum() for g in r_rel]
+    best = int(np.argmin(resid))
+    assert float(model.omega[0].detach()) == pytest.approx(om[best], rel=1e-5)
+    assert float(model.zeta[0].detach()) == pytest.approx(ze[best], rel=1e-5)
+    after = model.part_theta(w)[0, lead : lead + n].detach().double().numpy()
+    gain = (r_rel[best] @ rel) / (r_rel[best] @ r_rel[best])
+    assert np.allclose(after - after[0], gain * r_rel[best], atol=1e-6 * np.abs(rel).max())
+    rest, _, _ = projected("rest")  # fitting the absolute angle picks another oscillator
+    assert abs(np.log(float(rest.omega[0].detach()) / om[best])) > 0.01
 
 
 def test_gradients_reach_the_bank_weights_only_during_the_bank_phase():

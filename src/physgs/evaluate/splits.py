@@ -127,6 +127,23 @@ def evaluate(
             rgb, alpha = _render(render_fn, j, c, observed.train_camera, (H, W))
             cam_psnr[c, j] = psnr(rgb, frames[c, j])
             cen[c, j] = centroid_error(alpha, observed.masks[c, j])
+    return EvalResult(
+        cam_psnr,
+        cen,
+        view_psnr(render_fn, observed, progress=progress),
+        np.asarray(observed.conditions, dtype=np.float64),
+        np.asarray(observed.heldout_azimuths_deg, dtype=np.float64),
+        np.asarray(observed.heldout_frame_idx, dtype=np.int64),
+        int(observed.n_train),
+        int(observed.n_tail),
+    )
+
+
+def view_psnr(
+    render_fn: RenderFn, observed, *, progress: Callable[[str], None] | None = None
+) -> np.ndarray:
+    """The view split: PSNR (dB) [A, M] of the held-out azimuths x held-out frames (training
+    condition, inside the window) of ``observed``, through the render callback."""
     A, M = len(observed.heldout_cameras), len(observed.heldout_frame_idx)
     view = np.empty((A, M))
     if progress:
@@ -135,13 +152,4 @@ def evaluate(
         for a, cam in enumerate(observed.heldout_cameras):
             rgb, _ = _render(render_fn, j, 0, cam, observed.heldout_frames.shape[2:4])
             view[a, m] = psnr(rgb, observed.heldout_frames[a, m])
-    return EvalResult(
-        cam_psnr,
-        cen,
-        view,
-        np.asarray(observed.conditions, dtype=np.float64),
-        np.asarray(observed.heldout_azimuths_deg, dtype=np.float64),
-        np.asarray(observed.heldout_frame_idx, dtype=np.int64),
-        int(observed.n_train),
-        int(observed.n_tail),
-    )
+    return view

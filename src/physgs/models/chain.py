@@ -79,3 +79,36 @@ def chain_deform(
     rel = (means - pivot[labels])[..., None]  # [N, 3, 1]
     new_means = means + u[labels] + (E[labels] @ rel)[..., 0]
     return new_means, quat_multiply(q[labels], quats)
+
+
+def chain_deform_from(
+    means: torch.Tensor,
+    quats: torch.Tensor,
+    labels: torch.Tensor,
+    axis: torch.Tensor,
+    theta: torch.Tensor,
+    theta0: torch.Tensor,
+    pivot: torch.Tensor,
+    levels,
+) -> tuple[torch.Tensor, torch.Tensor]:
+    """Move Gaussians posed at angles ``theta0`` to angles ``theta``: T(theta) o T(theta0)^-1.
+
+    For a canonical set that is the pose at angles theta0 (the recorded frame 0), not the rest
+    pose: frame 0's chained transform is undone (its rest pose is T_p(theta0)^-1 of it), then
+    the transform at theta applied. With T_p(x) = c_p + u_p + Rw_p (x - c_p) (``chain_transforms``):
+
+        T_p(theta) T_p(theta0)^-1 (x) = x + (u_p - u0_p) + (Rw_p Rw0_p^T - I)(x - c_p - u0_p).
+
+    means [N, 3]; quats [N, 4] (w, x, y, z); labels [N]; axis [K, 3]; theta, theta0 [K] rad;
+    pivot [K, 3] (rest-pose pivots); levels: ``depth_levels(parent)``. Returns (means [N, 3],
+    quats [N, 4]); the input (to rounding) at theta = theta0. Differentiable in axis, both angles
+    and pivot.
+    """
+    E, u, q = chain_transforms(axis, theta, pivot, levels)  # [K, 3, 3], [K, 3], [K, 4]
+    E0, u0, q0 = chain_transforms(axis, theta0, pivot, levels)
+    # Rw Rw0^T - I = E + E0^T + E E0^T, kept apart from I as chain_transforms keeps E
+    M = E + E0.transpose(-1, -2) + E @ E0.transpose(-1, -2)  # [K, 3, 3]
+    q0_inv = q0 * torch.tensor([1.0, -1.0, -1.0, -1.0], dtype=q0.dtype, device=q0.device)
+    rel = (means - pivot[labels] - u0[labels])[..., None]  # [N, 3, 1]
+    new_means = means + (u - u0)[labels] + (M[labels] @ rel)[..., 0]
+    return new_means, quat_multiply(quat_multiply(q, q0_inv)[labels], quats)

@@ -30,8 +30,18 @@ omega (``physgs.models.omega_search``): until ``until`` x iterations each part's
 linear combination of a fixed bank of oscillators' responses (``bank_weights``), then each part
 is projected onto the single oscillator of a grid that best fits it (``end_bank_phase``) and
 the oscillators take over. After training ``bank_active`` is False: the model is the prior above.
-With ``models.topology.from_frame0`` the topology variants turn each part by theta_p(t) -
-theta_p(frame 0) (the canonical Gaussians are the pose at recorded frame 0, not the rest pose);
+``models.topology.canonical_pose`` says what the topology variants take the canonical set for
+(``CANONICAL_POSES``): ``rest``, each part turned by theta_p(t) as if the canonical set were the
+rest pose; ``frame0``, the pose at recorded frame 0, which it is (the canonical Gaussians sit at
+frame 0's vertices): frame 0's transform is undone before theta(t)'s is applied
+(``physgs.models.chain.chain_deform_from``; for independent parts, a turn by theta_p(t) -
+theta_p(frame 0)), so frame 0 poses the canonical set and the motion cannot displace it;
+``frame0_angles``, each part turned by theta_p(t) - theta_p(frame 0) (the same as ``frame0`` for
+independent parts, to first order in the angles for chained ones); ``frame0_offset``, as
+``frame0`` with a learned turn per part (``pose_offset`` [K] rad, from 0 at the pivot rate)
+added to frame 0's angles. In the frame-0 poses the search's projection fits each part's angle
+relative to frame 0 (what the images see). ``rest`` is the default: the frame-0 poses fit the
+sparse tree's training window worse (docs/parts.md, the held-out views of the sparse tree).
 ``part_theta`` and recovery are unchanged.
 """
 
@@ -44,7 +54,7 @@ import torch
 from torch import nn
 
 from physgs.models.base import BaseModel, ModelContext
-from physgs.models.chain import chain_deform, depth_levels
+from physgs.models.chain import chain_deform, chain_deform_from, depth_levels
 from physgs.models.gaussians import GaussianState, rotate_parts
 from physgs.models.oscillator import STABILITY_GUARD, fastest_rate, integrate, required_substeps
 from physgs.models.omega_search import (
@@ -57,6 +67,9 @@ from physgs.models.omega_search import (
 from physgs.models.oscillator_params import OscillatorBounds, condition_vbar
 from physgs.models.parts import kmeans_parts
 from physgs.models.topology import KNN, topology_parts
+
+#: What the canonical set is taken for (``models.topology.canonical_pose``; module docstring).
+CANONICAL_POSES = ("rest", "frame0", "frame0_angles", "frame0_offset")
 
 
 def prior_substeps(omega_hz, zeta, substeps: int, dt: float, guard: float = STABILITY_GUARD) -> int:
@@ -94,7 +107,7 @@ class OscillatorPrior(BaseModel):
         chain: bool = False,
         parent: np.ndarray | None = None,
         search: OmegaSearch | None = None,
-        from_frame0: bool = False,
+        canonical_pose: str = "rest",
     ):
         super().__init__(ctx, canonical_cfg)
         # the parameterisation the 2D-track control shares (physgs.models.oscillator_params)
@@ -159,9 +172,18 @@ class OscillatorPrior(BaseModel):
         # linear combination of a fixed bank's responses with weights W [K, M] (each response
         # scaled as the gain is, by omega_m^2 / std of the training forcing, times bank_scale).
         self.search = search
-        # the canonical set is the pose at recorded frame 0: with from_frame0 each part turns by
-        # theta(t) - theta(frame 0), so frame 0 poses exactly the canonical set
-        self.from_frame0 = bool(from_frame0)
+        # what the canonical set is: the rest pose, or the pose at recorded frame 0 (module
+        # docstring); in the frame-0 poses frame 0 poses the canonical set exactly
+        if canonical_pose not in CANONICAL_POSES:
+            raise ValueError(
+                f"models.topology.canonical_pose must be one of {CANONICAL_POSES}, got "
+                f"{canonical_pose!r}"
+            )
+        if canonical_pose != "rest" and segmentation != "topology":
+            raise ValueError("canonical_pose other than 'rest' is a topology variants' option")
+        self.canonical_pose = canonical_pose
+        if canonical_pose == "frame0_offset":  # frame 0's angles plus a learned turn per part
+            self.pose_offset = nn.Parameter(torch.zeros(K))  # [K] rad
         if search is not None:
             self.bank_omega = log_grid(b.omega_lo, b.omega_hi, search.bank_size)  # [M] rad/s
             self.bank_weights = nn.Parameter(torch.zeros(K, search.bank_size))
@@ -264,8 +286,13 @@ class OscillatorPrior(BaseModel):
                 theta = (self.bank_weights @ self._bank_responses(w)).double().numpy()
                 vbar = condition_vbar(self.vbar_ratio, w)
                 r = unit_responses(om_all, ze_all, w, vbar, self.dt, self.substeps)
-                thetas.append(theta[:, samples])
-                resp.append(r[:, samples])
+                theta, r = theta[:, samples], r[:, samples]  # [K, S], [G, S]
+                if self.canonical_pose != "rest":
+                    # the images see each angle relative to frame 0 (the window's first sample):
+                    # the bank's angle there is unconstrained, so fit the differences
+                    theta, r = theta - theta[:, :1], r - r[:, :1]
+                thetas.append(theta)
+                resp.append(r)
             omega, zeta, gain, explained = project_to_oscillators(
                 np.concatenate(thetas, axis=1), np.concatenate(resp, axis=1), om_all, ze_all
             )
@@ -295,15 +322,24 @@ class OscillatorPrior(BaseModel):
     def deform(self, frame_idx: int, wind: torch.Tensor) -> GaussianState:
         theta_all = self.part_theta(wind)  # [K, L+F]
         theta = theta_all[:, self.lead_in + frame_idx]  # [K]
-        if self.from_frame0:
-            theta = theta - theta_all[:, self.lead_in]
+        theta0 = theta_all[:, self.lead_in]  # [K] at recorded frame 0
+        if self.canonical_pose == "frame0_offset":
+            theta0 = theta0 + self.pose_offset
         lab = self.part_labels
         c = self.canonical
-        if self.chain:
+        if self.canonical_pose in ("frame0", "frame0_offset") and self.chain:
+            means, quats = chain_deform_from(
+                c.means, c.quats, lab, self.axis, theta, theta0, self.pivot, self.levels
+            )
+        elif self.chain:
+            if self.canonical_pose != "rest":
+                theta = theta - theta0
             means, quats = chain_deform(
                 c.means, c.quats, lab, self.axis, theta, self.pivot, self.levels
             )
         else:
+            if self.canonical_pose != "rest":  # one rotation: undoing frame 0's is the difference
+                theta = theta - theta0
             means, quats = rotate_parts(c.means, c.quats, lab, self.axis, theta, self.pivot)
         return GaussianState(
             means,
@@ -322,4 +358,9 @@ class OscillatorPrior(BaseModel):
                 "lr": lr["physics"],
             },
             {"name": "pivot", "params": [self.pivot], "lr": lr["pivot"] * self.extent},
-        ]
+        ] + (
+            # radians of the rest pose's turn: the pivot's rate without the scene's extent
+            [{"name": "pivot", "params": [self.pose_offset], "lr": lr["pivot"]}]
+            if self.canonical_pose == "frame0_offset"
+            else []
+        )

@@ -154,6 +154,15 @@ def searches_omega(models_cfg: dict, model: str) -> bool:
     return model in (models_cfg.get("omega_search") or {}).get("models", ())
 
 
+def canonical_pose_of(topology_cfg: dict) -> str:
+    """``models.topology.canonical_pose`` of a (possibly older) topology section: checkpoints
+    written before the key existed carry ``from_frame0`` (true: ``frame0_angles``) or neither
+    (``rest``)."""
+    if "canonical_pose" in topology_cfg:
+        return str(topology_cfg["canonical_pose"])
+    return "frame0_angles" if topology_cfg.get("from_frame0", False) else "rest"
+
+
 def build_model(
     name: str,
     observed,
@@ -252,8 +261,7 @@ def build_model(
             segmentation="topology",
             knn=int(t["knn"]),
             parent=parent,
-            # a checkpoint written before the key existed turned parts from rest
-            from_frame0=bool(t.get("from_frame0", False)),
+            canonical_pose=canonical_pose_of(t),
         )
     return OscillatorPrior(
         ctx,
