@@ -89,6 +89,45 @@ def test_a_k_above_the_tracks_kept_stops_the_fit_naming_the_key():
         fit_job([tracks], SimpleNamespace(), job)
 
 
+def test_a_min_track_frames_that_leaves_too_few_tracks_names_the_largest_that_works():
+    """min_track_frames at the window's length keeps the 3 full tracks only: K = 4 cannot be
+    made, and the refusal names tracks/min_track_frames with the 4th longest track's length (10),
+    the largest value that keeps 4 tracks (checked: at 10 the fit goes past this check)."""
+    from physgs.tracks.run import fit_job
+    from physgs.tracks.track import Tracks
+
+    T = 40
+    valid = np.zeros((5, T), bool)
+    valid[:3] = True
+    valid[3:, :10] = True
+    tracks = Tracks(np.where(valid[..., None], 10.0, np.nan), valid, np.zeros(5, np.int64))
+    job = tsettings.fit_job(quick_config(), "single", seed=0)
+    job.update(K=4, K_key="tracks/K", min_track_frames=T)
+    with pytest.raises(ValueError, match=r"tracks/min_track_frames \(now 40\) to at most 10\b"):
+        fit_job([tracks], SimpleNamespace(), job)
+    job.update(min_track_frames=11)
+    with pytest.raises(ValueError, match="at most 10"):
+        fit_job([tracks], SimpleNamespace(), job)
+    job.update(min_track_frames=10)  # past the check: it now needs the observed record
+    with pytest.raises(AttributeError):
+        fit_job([tracks], SimpleNamespace(), job)
+
+
+def test_a_min_tracks_no_part_reaches_names_the_key_and_the_largest_that_works():
+    from physgs.tracks.fit import FitSettings, fit_tracks
+    from test_tracks import _synthetic
+
+    tracks, wind, osc, _, _ = _synthetic()  # two parts of 6 tracks each
+    s = dict(K=2, iterations=1, seed=0)
+    with pytest.raises(ValueError) as e:
+        fit_tracks([tracks], [0], wind, osc, FitSettings(**s, min_tracks=1000))
+    msg = str(e.value)
+    assert "tracks/min_tracks = 1000" in msg and "to at most 6" in msg, msg
+    with pytest.raises(ValueError, match="at most 6"):
+        fit_tracks([tracks], [0], wind, osc, FitSettings(**s, min_tracks=7))
+    assert fit_tracks([tracks], [0], wind, osc, FitSettings(**s, min_tracks=6)).estimated.all()
+
+
 # --- files -------------------------------------------------------------------------------------
 
 

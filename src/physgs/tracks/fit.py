@@ -213,9 +213,12 @@ def fit_tracks(
     ze_raw = torch.full((s.K,), b.zeta_raw_init(), dtype=torch.float64, requires_grad=True)
     opt = torch.optim.Adam([om_raw, ze_raw], lr=s.lr)
     n_obs = sum(float(w.sum()) for w in ws) * 2
-    if n_obs == 0:
+    if n_obs == 0:  # the parts do not depend on min_tracks: their largest count is what works
         raise ValueError(
-            f"no part has {s.min_tracks} tracks of >= {s.min_track_frames} frames: nothing to fit"
+            f"no part has tracks/min_tracks = {s.min_tracks} tracks of >= {s.min_track_frames} "
+            f"frames (tracks/min_track_frames): nothing to fit. The {s.K} parts have "
+            f"{sorted(n_tracks.tolist(), reverse=True)} tracks: set tracks/min_tracks to at most "
+            f"{int(n_tracks.max())}, or lower tracks/min_track_frames"
         )
     sel = [
         torch.as_tensor(lab[(lab >= 0) & estimated[np.maximum(lab, 0)]]) for lab in labels
