@@ -128,6 +128,16 @@ def test_a_min_tracks_no_part_reaches_names_the_key_and_the_largest_that_works()
     assert fit_tracks([tracks], [0], wind, osc, FitSettings(**s, min_tracks=6)).estimated.all()
 
 
+def test_a_tracks_fit_pinned_at_its_bounds_stops_naming_the_rate():
+    from physgs.tracks.fit import FitSettings, fit_tracks
+    from test_tracks import _synthetic
+
+    tracks, wind, osc, _, _ = _synthetic()
+    with pytest.raises(ValueError, match=r"sits on a bound.*train\.lr\.physics \(now 1000"):
+        fit_tracks([tracks], [0], wind, osc, FitSettings(K=2, iterations=20, lr=1e3))
+    fit_tracks([tracks], [0], wind, osc, FitSettings(K=2, iterations=20))  # the default rate
+
+
 # --- files -------------------------------------------------------------------------------------
 
 

@@ -40,6 +40,7 @@ from physgs.models.oscillator import STABILITY_GUARD, integrate
 from physgs.models.oscillator_params import OscillatorBounds, condition_vbar
 from physgs.models.ours import prior_substeps
 from physgs.tracks.track import Tracks
+from physgs.train.divergence import pinned
 
 #: tracks shorter than this many frames (1 s at 24 fps: a third of the slowest 0.35 Hz period,
 #: a whole period at 1 Hz) do not enter the fit: a shorter track fixes its own c_i, d_i and
@@ -241,6 +242,18 @@ def fit_tracks(
         opt.step()
         losses.append(float(loss.detach()))
     loop_seconds = time.perf_counter() - t_loop
+    with torch.no_grad():  # every estimated omega and zeta on a bound: a saturated fit
+        d = pinned(
+            {
+                "omega": torch.sigmoid(om_raw).numpy()[estimated],
+                "zeta": torch.sigmoid(ze_raw).numpy()[estimated],
+            }
+        )
+    if d is not None:
+        raise ValueError(
+            f"the tracks fit: {d.what}; likely setting: train.lr.physics (now {s.lr:g}, Adam's "
+            "rate on the raw omega and zeta); lower it"
+        )
     with torch.no_grad():
         om, ze = b.omega(om_raw), b.zeta(ze_raw)
         final = float(loss_fn())
