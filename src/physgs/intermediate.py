@@ -12,6 +12,7 @@ from __future__ import annotations
 
 import json
 import zipfile
+from collections.abc import Iterable
 from pathlib import Path
 
 import numpy as np
@@ -21,7 +22,7 @@ class IntermediateFileError(ValueError):
     """A missing or unreadable intermediate file; the message names the file and its rule."""
 
 
-def refuse(path, what: str, rule: str) -> IntermediateFileError:
+def refuse(path: str | Path, what: str, rule: str) -> IntermediateFileError:
     """Remove the unreadable ``path`` and say so: the error to raise (``what``: what is wrong)."""
     path = Path(path)
     path.unlink(missing_ok=True)
@@ -37,7 +38,7 @@ def _missing(path: Path, rule: str) -> IntermediateFileError:
     )
 
 
-def read_npz(path, keys, *, rule: str) -> dict[str, np.ndarray]:
+def read_npz(path: str | Path, keys: Iterable[str], *, rule: str) -> dict[str, np.ndarray]:
     """The arrays of an intermediate ``.npz`` (no pickled objects), every one of ``keys`` present.
 
     Args:
@@ -68,7 +69,7 @@ def read_npz(path, keys, *, rule: str) -> dict[str, np.ndarray]:
     return d
 
 
-def read_json(path, keys=(), *, rule: str) -> dict:
+def read_json(path: str | Path, keys: Iterable[str] = (), *, rule: str) -> dict:
     """The mapping of an intermediate ``.json`` holding every one of ``keys`` (as ``read_npz``)."""
     path = Path(path)
     if not path.is_file():
