@@ -148,6 +148,16 @@ def test_a_configfile_is_read_as_yaml_1_2_and_a_bad_value_names_it(tmp_path):
     assert f"Fix --configfile {bad}." in msg
 
 
+def test_a_configfile_with_profiles_is_a_base_not_an_overlay(tmp_path):
+    """`--configfile config/trees.yaml extra.yaml` (tests/test_workflow_reruns.py) must still run
+    the quick profile: a file with a profiles section sits under the profile, as the base does."""
+    copy = tmp_path / "trees.yaml"
+    copy.write_text((ROOT / "config" / "trees.yaml").read_text())
+    got = physgs.config.load_workflow_config(_raw(), "quick", configfiles=[copy])
+    assert got == physgs.config.load_workflow_config(_raw(), "quick")
+    assert got["train"]["iterations"] == 30  # quick's, not the file's top-level 3000
+
+
 def test_the_config_file_reads_1e_3_as_a_number_and_refuses_nan_naming_itself():
     raw = _raw()
     raw["train"]["lr"]["deform"] = "1e-3"  # what PyYAML makes of a plain 1e-3

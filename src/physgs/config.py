@@ -209,6 +209,13 @@ def _non_finite(node, path: tuple = ()) -> Iterator[tuple[tuple, float]]:
 Layer = tuple[str, dict]
 
 
+def _beats_profile(values: dict) -> bool:
+    """Whether a layer's values beat the profile's: an overlay does; a file with a ``profiles``
+    section is a config file of its own (a copy of config/trees.yaml, say), whose top-level
+    values are defaults that the profile overrides, as the base file's are."""
+    return "profiles" not in values
+
+
 def _sets(values, path: tuple) -> bool:
     """Whether nested ``values`` set the leaf at ``path`` (or a whole value above it)."""
     node = values
@@ -231,7 +238,7 @@ def _attribute(
 ) -> tuple[str, str]:
     """(' (set by 'profiles/<p>/...')' or '', the source holding the value) for a resolved (or
     raw) config's key path: a command-line layer that sets it wins, then the profile."""
-    src = _source_of(path, layers, "")
+    src = _source_of(path, [(s, v) for s, v in layers if _beats_profile(v)], "")
     if src:
         return "", src
     by = _origin(path, raw, profile)
@@ -440,8 +447,9 @@ def load_workflow_config(
     configfiles: the ``--configfile`` paths (Snakemake's ``workflow.config_settings.configfiles``),
     read again here as YAML 1.2; command_line: the ``--config KEY=VALUE`` pairs (Snakemake's
     ``workflow.config_settings.config``). Whatever these set, at any depth, beats the profile's
-    value (``--config 'tracks={configs: [single]}'`` fits single only under any profile); a
-    ``profiles`` section in them edits the profile bodies instead. Every number is read as YAML 1.2
+    value (``--config 'tracks={configs: [single]}'`` fits single only under any profile), except
+    in a ``--configfile`` that holds a ``profiles`` section: such a file is a config of its own
+    (``--configfile config/trees.yaml`` is the base again), merged under the profile. Every number is read as YAML 1.2
     reads it (:func:`scalars`), and a problem names the source that holds the bad value. Returns
     the resolved config; raises ConfigError before anything runs.
     """
@@ -458,9 +466,8 @@ def load_workflow_config(
     validate(config, source=source, layers=layers)
     resolved = resolve(config, config.get("profile"))
     for _, values in layers:  # the command line beats the profile
-        resolved = deep_merge(
-            resolved, {k: v for k, v in values.items() if k not in ("profile", "profiles")}
-        )
+        if _beats_profile(values):
+            resolved = deep_merge(resolved, {k: v for k, v in values.items() if k != "profile"})
     validate(resolved, raw=config, source=source, layers=layers)
     check(resolved, raw=config, source=source, layers=layers)
     return resolved
