@@ -128,6 +128,27 @@ def test_a_min_tracks_no_part_reaches_names_the_key_and_the_largest_that_works()
     assert fit_tracks([tracks], [0], wind, osc, FitSettings(**s, min_tracks=6)).estimated.all()
 
 
+def test_a_min_track_frames_that_leaves_no_part_enough_tracks_names_the_largest_that_works():
+    """Part 0's six tracks last 240, 240, 240, 200, 200 and 200 frames, part 1's 100 each: at
+    min_track_frames 201 three tracks are kept, and two parts of three tracks cannot give one
+    3; at 200 six are kept, and two parts of six always give one at least 3: 200 is the largest
+    value that works, whatever k-means does (checked: 200 fits)."""
+    from physgs.tracks.fit import FitSettings, fit_tracks
+    from physgs.tracks.track import Tracks
+    from test_tracks import _synthetic
+
+    tracks, wind, osc, _, _ = _synthetic()
+    valid = tracks.valid.copy()
+    for i, n in enumerate([240] * 3 + [200] * 3 + [100] * 6):
+        valid[i, n:] = False
+    cut = Tracks(np.where(valid[..., None], tracks.xy, np.nan), valid, tracks.start)
+    s = dict(K=2, iterations=1, seed=0, min_tracks=3)
+    for frames in (239, 201):
+        with pytest.raises(ValueError, match=r"lower tracks/min_track_frames to at most 200$"):
+            fit_tracks([cut], [0], wind, osc, FitSettings(**s, min_track_frames=frames))
+    assert fit_tracks([cut], [0], wind, osc, FitSettings(**s, min_track_frames=200)).estimated.any()
+
+
 def test_a_tracks_fit_pinned_at_its_bounds_stops_naming_the_rate():
     from physgs.tracks.fit import FitSettings, fit_tracks
     from test_tracks import _synthetic
