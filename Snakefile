@@ -13,8 +13,12 @@ configfile: "config/trees.yaml"
 
 # validates the raw config and every profile body against the packaged schema, resolves the
 # profile, validates the result and runs the cross-key checks: a bad config stops here
-# (a command-line --config seeds=[...] beats the profile's seeds: physgs.config)
-CFG = physgs.config.load_workflow_config(config, command_line=dict(workflow.config_settings.config))
+# (what --config and --configfile set, at any depth, beats the profile: physgs.config)
+CFG = physgs.config.load_workflow_config(
+    config,
+    command_line=dict(workflow.config_settings.config),
+    configfiles=workflow.config_settings.configfiles,
+)
 TREES = CFG["trees"]
 # a bfloat16 field on a CPU that would emulate bf16 (~48x slower) stops here, before any job
 # (torch loads only when a field asks for bf16, so a float32 plan stays light)

@@ -26,7 +26,6 @@ from types import SimpleNamespace
 import numba
 import numpy as np
 import torch
-import yaml
 
 import physgs.config
 import physgs.render.fast
@@ -226,12 +225,9 @@ def main() -> None:
     args = ap.parse_args()
     torch.set_num_threads(args.threads)
     numba.set_num_threads(args.threads)
-    with open("config/trees.yaml") as f:
-        raw = yaml.safe_load(f)
-    for overlay in args.configfile:
-        with open(overlay) as f:
-            raw = physgs.config.deep_merge(raw, yaml.safe_load(f))
-    cfg = physgs.config.load_workflow_config(raw, args.profile, source="config/trees.yaml")
+    raw = physgs.config.read_yaml("config/trees.yaml")
+    # the overlays beat the profile, as Snakemake's --configfile does (physgs.config)
+    cfg = physgs.config.load_workflow_config(raw, args.profile, configfiles=args.configfile)
     trees = args.trees or cfg["trees"]
     it_total, warm = cfg["train"]["iterations"], cfg["train"]["warmup"]
     jobs = training_jobs(cfg["models"]["configs"])

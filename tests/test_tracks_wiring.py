@@ -89,6 +89,76 @@ def test_a_k_above_the_tracks_kept_stops_the_fit_naming_the_key():
         fit_job([tracks], SimpleNamespace(), job)
 
 
+def test_a_min_track_frames_that_leaves_too_few_tracks_names_the_largest_that_works():
+    """min_track_frames at the window's length keeps the 3 full tracks only: K = 4 cannot be
+    made, and the refusal names tracks/min_track_frames with the 4th longest track's length (10),
+    the largest value that keeps 4 tracks (checked: at 10 the fit goes past this check)."""
+    from physgs.tracks.run import fit_job
+    from physgs.tracks.track import Tracks
+
+    T = 40
+    valid = np.zeros((5, T), bool)
+    valid[:3] = True
+    valid[3:, :10] = True
+    tracks = Tracks(np.where(valid[..., None], 10.0, np.nan), valid, np.zeros(5, np.int64))
+    job = tsettings.fit_job(quick_config(), "single", seed=0)
+    job.update(K=4, K_key="tracks/K", min_track_frames=T)
+    with pytest.raises(ValueError, match=r"tracks/min_track_frames \(now 40\) to at most 10\b"):
+        fit_job([tracks], SimpleNamespace(), job)
+    job.update(min_track_frames=11)
+    with pytest.raises(ValueError, match="at most 10"):
+        fit_job([tracks], SimpleNamespace(), job)
+    job.update(min_track_frames=10)  # past the check: it now needs the observed record
+    with pytest.raises(AttributeError):
+        fit_job([tracks], SimpleNamespace(), job)
+
+
+def test_a_min_tracks_no_part_reaches_names_the_key_and_the_largest_that_works():
+    from physgs.tracks.fit import FitSettings, fit_tracks
+    from test_tracks import _synthetic
+
+    tracks, wind, osc, _, _ = _synthetic()  # two parts of 6 tracks each
+    s = dict(K=2, iterations=1, seed=0)
+    with pytest.raises(ValueError) as e:
+        fit_tracks([tracks], [0], wind, osc, FitSettings(**s, min_tracks=1000))
+    msg = str(e.value)
+    assert "tracks/min_tracks = 1000" in msg and "to at most 6" in msg, msg
+    with pytest.raises(ValueError, match="at most 6"):
+        fit_tracks([tracks], [0], wind, osc, FitSettings(**s, min_tracks=7))
+    assert fit_tracks([tracks], [0], wind, osc, FitSettings(**s, min_tracks=6)).estimated.all()
+
+
+def test_a_min_track_frames_that_leaves_no_part_enough_tracks_names_the_largest_that_works():
+    """Part 0's six tracks last 240, 240, 240, 200, 200 and 200 frames, part 1's 100 each: at
+    min_track_frames 201 three tracks are kept, and two parts of three tracks cannot give one
+    3; at 200 six are kept, and two parts of six always give one at least 3: 200 is the largest
+    value that works, whatever k-means does (checked: 200 fits)."""
+    from physgs.tracks.fit import FitSettings, fit_tracks
+    from physgs.tracks.track import Tracks
+    from test_tracks import _synthetic
+
+    tracks, wind, osc, _, _ = _synthetic()
+    valid = tracks.valid.copy()
+    for i, n in enumerate([240] * 3 + [200] * 3 + [100] * 6):
+        valid[i, n:] = False
+    cut = Tracks(np.where(valid[..., None], tracks.xy, np.nan), valid, tracks.start)
+    s = dict(K=2, iterations=1, seed=0, min_tracks=3)
+    for frames in (239, 201):
+        with pytest.raises(ValueError, match=r"lower tracks/min_track_frames to at most 200$"):
+            fit_tracks([cut], [0], wind, osc, FitSettings(**s, min_track_frames=frames))
+    assert fit_tracks([cut], [0], wind, osc, FitSettings(**s, min_track_frames=200)).estimated.any()
+
+
+def test_a_tracks_fit_pinned_at_its_bounds_stops_naming_the_rate():
+    from physgs.tracks.fit import FitSettings, fit_tracks
+    from test_tracks import _synthetic
+
+    tracks, wind, osc, _, _ = _synthetic()
+    with pytest.raises(ValueError, match=r"sits on a bound.*train\.lr\.physics \(now 1000"):
+        fit_tracks([tracks], [0], wind, osc, FitSettings(K=2, iterations=20, lr=1e3))
+    fit_tracks([tracks], [0], wind, osc, FitSettings(K=2, iterations=20))  # the default rate
+
+
 # --- files -------------------------------------------------------------------------------------
 
 

@@ -261,3 +261,75 @@ def test_a_healthy_run_past_the_loss_grace_does_not_trip(name, data):
     cfg = _cfg(iterations=10 + dv.LOSS_GRACE + 10, warmup=10)
     res = _train(name, data, cfg)
     assert len(res.log) == cfg["train"]["iterations"]
+
+
+# -- a fit pinned at its bounds is a failed fit ---------------------------------------------------
+
+
+def test_pinned_needs_every_bounded_parameter_on_a_bound():
+    on = {"omega": np.array([0.0, 1.0, 1 - 1e-4]), "zeta": np.array([1e-5, 1.0, 0.0])}
+    d = dv.pinned(on)
+    assert d is not None and d.groups == ("physics",)
+    assert "omega: 1 low / 2 high" in d.what and "zeta: 2 low / 1 high" in d.what, d.what
+    one_inside = {**on, "zeta": np.array([1e-5, 0.5, 0.0])}
+    assert dv.pinned(one_inside) is None  # one part still fits: not saturated
+    assert dv.pinned({}) is None and dv.pinned({"omega": np.zeros(0)}) is None
+
+
+def test_ours_positions_are_the_sigmoids_of_the_live_parts(data):
+    model = build_model("ours", data, _cfg()["models"], seed=0)
+    with torch.no_grad():
+        model.omega_raw.copy_(torch.tensor([-30.0, 0.0, 30.0, 2.0]))
+    model.freeze_parts(np.array([False, False, False, True]))
+    pos = model.bounded_positions()
+    np.testing.assert_allclose(pos["omega"], [0.0, 0.5, 1.0], atol=1e-12)
+    assert pos["zeta"].shape == (3,)
+
+
+def test_a_physics_rate_that_pins_every_part_stops_the_run(data):
+    """train.lr.physics = 1e3 drives every omega and zeta onto a bound without any explosion
+    (the issue's sparse run scored 23.67 dB against 26.18 and exited 0): it must stop, named."""
+    with pytest.raises(TrainingError) as e:
+        _train("ours", data, _cfg(physics=1e3))
+    msg = str(e.value)
+    assert "model 'ours'" in msg and "every bounded physical parameter sits on a bound" in msg
+    assert "likely setting: train.lr.physics (now 1000)" in msg and "no checkpoint" in msg, msg
+
+
+def test_a_run_with_one_part_inside_its_bounds_passes(data):
+    def pin_all_but_one(it, model, opt):
+        with torch.no_grad():
+            model.omega_raw.fill_(30.0)
+            model.zeta_raw.fill_(-30.0)
+            model.zeta_raw[0] = 0.0
+
+    res = _train("ours", data, _cfg(), on_iteration=pin_all_but_one)
+    assert len(res.log) == 12
+
+
+def test_a_huge_bank_scale_is_blamed_on_bank_scale_not_the_rate(data):
+    """During the bank phase the bank weights move at Adam's normal pace; a bank_scale of 1e6
+    turns that pace into huge angles: the setting named first is bank_scale."""
+    cfg = _cfg(iterations=24, warmup=4)
+    cfg["models"]["omega_search"].update(until=0.5, bank_scale=1e6)
+    with pytest.raises(TrainingError) as e:
+        from physgs.experiments import fit, job_spec
+
+        fit(data, job_spec(cfg, "ours_chain", "single", 0), progress=False)
+    msg = str(e.value)
+    assert "likely setting: models.omega_search.bank_scale (now 1e+06) or train.lr.physics" in msg
+
+
+def test_the_rate_is_named_first_when_the_parameters_grew():
+    from physgs.train.loop import _likely
+
+    scales = {"physics": [("models.omega_search.bank_scale", 5e-3)]}
+    lr = {"physics": 1e3}
+    reach = {"physics": 1 + 10 * 1e3}  # ten steps at 1e3
+    grown = _likely(("physics",), lr, {"physics": 500.0}, scales, reach)
+    assert grown.startswith("likely setting: train.lr.physics (now 1000) or models.omega_search")
+    calm = _likely(("physics",), lr, {"physics": 1.0}, scales, reach)
+    assert calm.startswith("likely setting: models.omega_search.bank_scale (now 0.005) or")
+    # grown far past what ten steps at 0.05 reach: set by something else (the hand-over)
+    beyond = _likely(("physics",), {"physics": 0.05}, {"physics": 1e7}, scales, {"physics": 1.5})
+    assert beyond.startswith("likely setting: models.omega_search.bank_scale (now 0.005) or")

@@ -10,7 +10,14 @@ packaged schema (``physgs/schemas/config.schema.yaml``; each profile body agains
 with every ``required`` dropped, :func:`partial_schema`), resolves the profile, validates the
 resolved config, and runs the cross-key checks of :mod:`physgs.config_checks`. Every failure is a
 :class:`ConfigError` that names the full key path (``profiles/quick/trian``), the nearest valid key
-where one exists, and the fix.
+where one exists, where the value came from and the fix.
+
+Sources, in order (a later one wins on the leaves it sets): ``config/trees.yaml`` and its chosen
+profile, then each ``--configfile`` and the ``--config`` pairs (or a script's ``--set``). What the
+command line sets beats the profile: ``--config 'tracks={configs: [single]}'`` means those
+configurations under any profile. Numbers are read as YAML 1.2 and Python read them at every depth
+and from every source (``1e-3`` is a number; :func:`scalars`), and NaN or infinity is refused
+wherever a number is allowed.
 """
 
 from __future__ import annotations
@@ -18,7 +25,9 @@ from __future__ import annotations
 import copy
 import difflib
 import functools
+import math
 import re
+from collections.abc import Iterator
 from importlib import resources
 from pathlib import Path
 
@@ -135,6 +144,109 @@ def _nest(path, value):
     return value
 
 
+# --------------------------------------------------------------------------------------------
+# Scalars as YAML 1.2 and Python read them
+
+#: a decimal number as YAML 1.2's core schema and Python's float() read it (1e-3, .5, 2., -1.0E+6)
+_NUMBER = re.compile(r"[+-]?(\d+\.?\d*|\.\d+)([eE][+-]?\d+)?")
+_INT = re.compile(r"[+-]?\d+")
+#: YAML 1.2's and Python's spellings of infinity and NaN (.inf, -.Inf, .nan, inf, nan)
+_SPECIAL = re.compile(r"[+-]?\.?(inf|infinity|nan)", re.IGNORECASE)
+_BOOL = {"true": True, "True": True, "TRUE": True, "false": False, "False": False, "FALSE": False}
+_NULL = ("null", "Null", "NULL", "~")
+
+
+def scalar(value):
+    """A string read as YAML 1.2's core schema and Python read it (anything else unchanged):
+    '1e-3' -> 0.001, '3' -> 3, '.nan' -> nan, 'true' -> True, 'null' -> None, 'single' ->
+    'single'. PyYAML follows YAML 1.1, where ``1e-3`` (no dot) is a string, and Snakemake hands a
+    ``--config`` value's nested scalars over as strings (YAML's BaseLoader)."""
+    if not isinstance(value, str):
+        return value
+    v = value.strip()
+    if _INT.fullmatch(v):
+        return int(v)
+    if _NUMBER.fullmatch(v) or _SPECIAL.fullmatch(v):
+        return float(re.sub(r"\.(?=[a-zA-Z])", "", v))  # '.nan', '-.inf' as Python spells them
+    if v in _BOOL:
+        return _BOOL[v]
+    return None if v in _NULL else value
+
+
+def scalars(value):
+    """``value`` with :func:`scalar` applied to every string at every depth (keys unchanged)."""
+    if isinstance(value, dict):
+        return {k: scalars(v) for k, v in value.items()}
+    if isinstance(value, (list, tuple)):
+        return [scalars(v) for v in value]
+    return scalar(value)
+
+
+def read_yaml(path: Path | str):
+    """A config file's contents, numbers read as YAML 1.2 reads them (:func:`scalars`)."""
+    with open(path) as f:
+        return scalars(yaml.safe_load(f))
+
+
+def _non_finite(node, path: tuple = ()) -> Iterator[tuple[tuple, float]]:
+    """(key path, value) of every NaN or infinite number below ``node``."""
+    if isinstance(node, dict):
+        for k, v in node.items():
+            yield from _non_finite(v, path + (k,))
+    elif isinstance(node, list):
+        for i, v in enumerate(node):
+            yield from _non_finite(v, path + (i,))
+    elif isinstance(node, float) and not math.isfinite(node):
+        yield path, node
+
+
+# --------------------------------------------------------------------------------------------
+# Where a value came from
+
+
+#: (source, values): one command-line source of settings (``--configfile FILE``, ``--config``,
+#: ``--set KEY=VALUE``) and the nested values it sets, in the order they apply
+Layer = tuple[str, dict]
+
+
+def _beats_profile(values: dict) -> bool:
+    """Whether a layer's values beat the profile's: an overlay does; a file with a ``profiles``
+    section is a config file of its own (a copy of config/trees.yaml, say), whose top-level
+    values are defaults that the profile overrides, as the base file's are."""
+    return "profiles" not in values
+
+
+def _sets(values, path: tuple) -> bool:
+    """Whether nested ``values`` set the leaf at ``path`` (or a whole value above it)."""
+    node = values
+    for k in path:
+        if not isinstance(node, dict) or k not in node:
+            return False
+        node = node[k]
+        if not isinstance(node, dict):
+            return True
+    return True
+
+
+def _source_of(path: tuple, layers: list[Layer], base: str) -> str:
+    """The last of ``layers`` that sets ``path``, else ``base`` (the config file)."""
+    return next((src for src, vals in reversed(layers) if _sets(vals, path)), base)
+
+
+def _attribute(
+    path: tuple, raw: dict | None, profile: str | None, layers: list[Layer], base: str
+) -> tuple[str, str]:
+    """(' (set by 'profiles/<p>/...')' or '', the source holding the value) for a resolved (or
+    raw) config's key path: a command-line layer that sets it wins, then the profile."""
+    src = _source_of(path, [(s, v) for s, v in layers if _beats_profile(v)], "")
+    if src:
+        return "", src
+    by = _origin(path, raw, profile)
+    if by:
+        return by, _source_of(("profiles", profile, *path), layers, base)
+    return "", _source_of(path, layers, base)
+
+
 def _unknown_key(
     where: tuple, key: str, node: dict, instance: dict, raw: dict | None, source: str
 ) -> str:
@@ -170,11 +282,12 @@ def _unknown_key(
     if not where and raw is not None:  # the raw config's top level is where --config lands
         profile = raw.get("profile", "default")
         value = instance.get(key)
-        override = yaml.safe_dump(
-            _nest(("profiles", profile) + hits[0], value), default_flow_style=True, width=1000
-        ).strip()
+        flow = functools.partial(yaml.safe_dump, default_flow_style=True, width=1000)
+        nested_cl = flow(_nest(hits[0][1:], value)).strip()
+        override = flow(_nest(("profiles", profile) + hits[0], value)).strip()
         msg += (
-            f" --config KEY=VALUE sets top-level keys only (profile, seed, ...); set "
+            f" --config sets a nested key as a mapping: --config '{hits[0][0]}={nested_cl}' "
+            f"(it beats the profile's value); or set "
             f"'{_fmt(('profiles', profile) + hits[0])}' in {source}, or pass "
             f"--configfile FILE with FILE holding {override}"
         )
@@ -195,45 +308,73 @@ def _origin(path: tuple, raw: dict | None, profile: str | None) -> str:
     return f" (set by '{_fmt(('profiles', profile) + tuple(path))}')"
 
 
-def _problems(cfg: dict, *, raw: dict | None, profile: str | None, source: str) -> list[str]:
+def _line(path: tuple, msg: str, attr: tuple[str, str], base: str) -> tuple[str, str]:
+    by, src = attr
+    came = f" (from {src})" if src != base else ""
+    return f"config key '{_fmt(path)}'{by}{came}: {msg}", src
+
+
+def _problems(
+    cfg: dict, *, raw: dict | None, profile: str | None, source: str, layers: list[Layer]
+) -> list[tuple[str, str]]:
+    """(line, source) of every problem: schema violations and non-finite numbers."""
     root = _schema()
     cls = jsonschema.validators.validator_for(root)
     errors = sorted(cls(root).iter_errors(cfg), key=lambda e: [str(p) for p in e.absolute_path])
-    lines: list[str] = []
+    lines: list[tuple[str, str]] = []
     for e in errors:
         where = tuple(e.absolute_path)
         if e.validator == "additionalProperties" and e.validator_value is False:
             for key in e.instance:
                 if not _declared(key, e.schema):
+                    src = _source_of(where + (key,), layers, source)
                     lines.append(
-                        _unknown_key(
-                            where, key, e.schema, e.instance, raw if raw is cfg else None, source
+                        (
+                            _unknown_key(
+                                where, key, e.schema, e.instance, raw if raw is cfg else None, src
+                            ),
+                            src,
                         )
                     )
         elif e.validator == "required":
             for key in e.validator_value:
                 if isinstance(e.instance, dict) and key not in e.instance:
-                    lines.append(f"config key '{_fmt(where + (key,))}' is missing")
+                    lines.append((f"config key '{_fmt(where + (key,))}' is missing", source))
         else:
-            lines.append(f"config key '{_fmt(where)}'{_origin(where, raw, profile)}: {e.message}")
+            attr = _attribute(where, raw, profile, layers, source)
+            lines.append(_line(where, e.message, attr, source))
+    for path, v in _non_finite(cfg):
+        attr = _attribute(path, raw, profile, layers, source)
+        lines.append(
+            _line(path, f"{v} is not a finite number (NaN and infinity are refused)", attr, source)
+        )
     return list(dict.fromkeys(lines))  # one line per problem, in order
 
 
-def _raise(lines: list[str], source: str, profile: str | None) -> None:
+def _raise(lines: list[tuple[str, str]], source: str, profile: str | None) -> None:
     if not lines:
         return
+    fix = " and ".join(dict.fromkeys(src for _, src in lines))
     if len(lines) == 1:
-        raise ConfigError(f"{lines[0]}\nFix {source}.")
+        raise ConfigError(f"{lines[0][0]}\nFix {fix}.")
     where = source + (f" (profile '{profile}')" if profile else "")
-    items = "\n".join(f"  - {ln}" for ln in lines)
-    raise ConfigError(f"{len(lines)} problems in {where}:\n{items}\nFix {source}.")
+    items = "\n".join(f"  - {ln}" for ln, _ in lines)
+    raise ConfigError(f"{len(lines)} problems in {where}:\n{items}\nFix {fix}.")
 
 
-def validate(cfg: dict, *, raw: dict | None = None, source: str = DEFAULT_SOURCE) -> None:
-    """Validate ``cfg`` (raw, with ``profiles``, or resolved) against the packaged schema.
+def validate(
+    cfg: dict,
+    *,
+    raw: dict | None = None,
+    source: str = DEFAULT_SOURCE,
+    layers: list[Layer] = (),
+) -> None:
+    """Validate ``cfg`` (raw, with ``profiles``, or resolved) against the packaged schema and
+    refuse NaN and infinity wherever they stand.
 
-    Raise ConfigError naming every offending key path; an unknown key gets the nearest valid one.
-    ``raw``: the raw config ``cfg`` was resolved from, to say which values a profile set.
+    Raise ConfigError naming every offending key path, where its value came from and the fix; an
+    unknown key gets the nearest valid one. ``raw``: the raw config ``cfg`` was resolved from, to
+    say which values a profile set; ``layers``: the command-line sources over ``source``.
     """
     if not isinstance(cfg, dict):
         raise ConfigError(
@@ -241,17 +382,29 @@ def validate(cfg: dict, *, raw: dict | None = None, source: str = DEFAULT_SOURCE
         )
     profile = cfg.get("profile") if raw is not None else None
     _raise(
-        _problems(cfg, raw=raw if raw is not None else cfg, profile=profile, source=source),
+        _problems(
+            cfg,
+            raw=raw if raw is not None else cfg,
+            profile=profile,
+            source=source,
+            layers=list(layers),
+        ),
         source,
         profile,
     )
 
 
-def check(cfg: dict, *, raw: dict | None = None, source: str = DEFAULT_SOURCE) -> None:
+def check(
+    cfg: dict,
+    *,
+    raw: dict | None = None,
+    source: str = DEFAULT_SOURCE,
+    layers: list[Layer] = (),
+) -> None:
     """Run the cross-key checks (:data:`physgs.config_checks.CHECKS`) on a resolved config."""
     profile = cfg.get("profile")
     lines = [
-        f"config key '{_fmt(path)}'{_origin(path, raw, profile)}: {msg}"
+        _line(tuple(path), msg, _attribute(tuple(path), raw, profile, list(layers), source), source)
         for path, msg in config_checks.problems(cfg)
     ]
     _raise(lines, source, profile)
@@ -278,72 +431,60 @@ def resolve(cfg: dict, profile: str | None = None) -> dict:
     return out
 
 
-_INT = re.compile(r"[+-]?\d+")
-
-
-def _from_command_line(value):
-    """A ``--config`` value as the YAML file would hold it: Snakemake parses a list value with
-    YAML's BaseLoader, so ``seeds=[0,1]`` arrives as ['0', '1']; integer strings become ints
-    (anything else, '1.5' or 'a', stays a string for the schema to refuse)."""
-    if isinstance(value, str) and _INT.fullmatch(value.strip()):
-        return int(value)
-    if isinstance(value, (list, tuple)):
-        return [_from_command_line(v) for v in value]
-    return value
-
-
 def load_workflow_config(
     config: dict,
     profile: str | None = None,
     *,
     source: str = DEFAULT_SOURCE,
     command_line: dict | None = None,
+    configfiles=(),
 ) -> dict:
-    """The one way in: validate a raw config, resolve its profile, validate and check the result.
+    """The one way in: validate a raw config, resolve its profile, put the command line over it,
+    validate and check the result.
 
-    config: the raw config (what Snakemake's ``config`` holds: ``config/trees.yaml`` plus any
-    ``--config KEY=VALUE``, which arrive as top-level keys); profile: overrides
-    ``config['profile']``; command_line: the command line's own overrides (Snakemake's
-    ``workflow.config_settings.config``, the ``--config KEY=VALUE`` pairs only): their top-level
-    values that are not sections (``seeds``, ``seed``, ...) beat the profile's, so ``--config
-    seeds=[0,1,2]`` means those seeds under any profile. Returns the resolved config; raises
-    ConfigError before anything runs.
+    config: the raw config (what Snakemake's ``config`` holds: ``config/trees.yaml`` with any
+    ``--configfile`` and ``--config`` merged in); profile: overrides ``config['profile']``;
+    configfiles: the ``--configfile`` paths (Snakemake's ``workflow.config_settings.configfiles``),
+    read again here as YAML 1.2; command_line: the ``--config KEY=VALUE`` pairs (Snakemake's
+    ``workflow.config_settings.config``). Whatever these set, at any depth, beats the profile's
+    value (``--config 'tracks={configs: [single]}'`` fits single only under any profile), except
+    in a ``--configfile`` that holds a ``profiles`` section: such a file is a config of its own
+    (``--configfile config/trees.yaml`` is the base again), merged under the profile. Every number is read as YAML 1.2
+    reads it (:func:`scalars`), and a problem names the source that holds the bad value. Returns
+    the resolved config; raises ConfigError before anything runs.
     """
-    cl = {
-        k: _from_command_line(v)
-        for k, v in dict(command_line or {}).items()
-        if k != "profile" and not isinstance(v, dict)
-    }
-    if profile is not None and isinstance(config, dict):
+    layers: list[Layer] = [(f"--configfile {p}", read_yaml(p) or {}) for p in configfiles]
+    if command_line:
+        layers.append(("--config", scalars(dict(command_line))))
+    if not isinstance(config, dict):
+        validate(config, source=source)
+    config = scalars(config)
+    for _, values in layers:
+        config = deep_merge(config, values)
+    if profile is not None:
         config = {**config, "profile": profile}
-    if cl and isinstance(config, dict):
-        config = {**config, **cl}
-    validate(config, source=source)
+    validate(config, source=source, layers=layers)
     resolved = resolve(config, config.get("profile"))
-    resolved.update(copy.deepcopy(cl))
-    validate(resolved, raw=config, source=source)
-    check(resolved, raw=config, source=source)
+    for _, values in layers:  # the command line beats the profile
+        if _beats_profile(values):
+            resolved = deep_merge(resolved, {k: v for k, v in values.items() if k != "profile"})
+    validate(resolved, raw=config, source=source, layers=layers)
+    check(resolved, raw=config, source=source, layers=layers)
     return resolved
 
 
 def load(path: Path | str, profile: str | None = None) -> dict:
     """Read, validate, resolve and check a config file."""
-    with open(path) as f:
-        cfg = yaml.safe_load(f)
-    return load_workflow_config(cfg, profile, source=str(path))
-
-
-_NUMBER_LIKE = re.compile(r"[+-]?(\d+\.?\d*|\.\d+)([eE][+-]?\d+)?")
+    return load_workflow_config(read_yaml(path), profile, source=str(path))
 
 
 def apply_overrides(cfg: dict, assignments: list[str]) -> dict:
     """A resolved config with ``KEY.PATH=VALUE`` overrides (a script's ``--set``) applied, then
-    validated against the schema and the cross-key checks exactly as the config is: an unknown key
-    or a value of the wrong type is refused with the key and the ``--set`` named, before any work.
-
-    VALUE is read as YAML, as the config file is (so ``1e6`` is the string '1e6', which a number
-    key refuses; the message says to write ``1.0e+6``)."""
+    validated against the schema and the cross-key checks exactly as the config is: an unknown key,
+    a value of the wrong type or a NaN is refused with the key and its ``--set`` named, before any
+    work. VALUE is read as YAML 1.2 and Python read it (``1e-3`` is a number)."""
     out = copy.deepcopy(cfg)
+    layers: list[Layer] = []
     for a in assignments:
         key, eq, value = a.partition("=")
         if not eq or not key.strip():
@@ -355,18 +496,11 @@ def apply_overrides(cfg: dict, assignments: list[str]) -> dict:
                 where = "/".join(path[: i + 1])
                 raise ConfigError(f"--set {a!r}: config key '{where}' is not a section")
             node = node[k]
-        node[last] = yaml.safe_load(value)
-    source = "the --set overrides " + " ".join(assignments)
-    try:
-        validate(out, source=source)
-        check(out, source=source)
-    except ConfigError as err:
-        hints = [
-            f" ('{v}' is read as a string, as in YAML 1.1; write a number as 1.0e+6)"
-            for v in (a.partition("=")[2].strip() for a in assignments)
-            if _NUMBER_LIKE.fullmatch(v) and isinstance(yaml.safe_load(v), str)
-        ]
-        raise ConfigError(f"{err}{hints[0] if hints else ''}") from None
+        node[last] = scalars(yaml.safe_load(value))
+        layers.append((f"--set {a}", _nest([*path, last], node[last])))
+    source = f"{DEFAULT_SOURCE} (profile '{cfg.get('profile')}')"
+    validate(out, source=source, layers=layers)
+    check(out, source=source, layers=layers)
     return out
 
 

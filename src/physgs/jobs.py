@@ -1,20 +1,77 @@
-"""The prologue every workflow script shares: thread counts from the rule, output to the job's
-log, and any traceback into that log before the job fails."""
+"""The prologue every workflow script shares: a lock on the job's outputs, thread counts from
+the rule, output to the job's log, and any traceback into that log before the job fails.
+
+The lock is the project's own, beside Snakemake's: Snakemake 9.27.1 deletes its whole lock
+folder when any run ends (``_delete_locks``: ``shutil.rmtree(.snakemake/locks)``), so a run
+started after a run on other targets finished can plan a job that a third run is still doing
+(docs/reliability.md, Two runs, one output). Each job takes an exclusive ``flock`` on one lock
+file per output (under LOCK_DIR, named by the output's absolute path); a job whose output is
+locked stops at once, naming the output and the process that holds it, instead of doing the
+same work a second time. The kernel drops the lock when the holder exits, even on SIGKILL.
+"""
 
 from __future__ import annotations
 
 import contextlib
+import fcntl
+import hashlib
+import os
 import sys
+import time
 import traceback
+from pathlib import Path
+
+#: where the output locks live, relative to the workflow's working directory (not Snakemake's
+#: own ``.snakemake/locks``, which a finishing run deletes whole)
+LOCK_DIR = Path(".snakemake") / "physgs-locks"
+
+
+class OutputLockedError(RuntimeError):
+    """Another process is making this output now; the message names the output and the holder."""
+
+
+@contextlib.contextmanager
+def output_locks(outputs, lock_dir: Path | str | None = None):
+    """Hold an exclusive lock on each of ``outputs`` (paths) for the body; raise
+    OutputLockedError at once if another process holds one (no waiting: that process is doing
+    this work). The lock files record the holder's pid, host and start time, and stay (empty of
+    meaning once released: a lock is the ``flock``, not the file). lock_dir: default LOCK_DIR."""
+    lock_dir = Path(LOCK_DIR if lock_dir is None else lock_dir)
+    lock_dir.mkdir(parents=True, exist_ok=True)
+    held = []
+    try:
+        for out in sorted({os.path.abspath(str(o)) for o in outputs}):
+            name = hashlib.sha256(out.encode()).hexdigest()[:24] + ".lock"
+            fd = os.open(lock_dir / name, os.O_RDWR | os.O_CREAT, 0o666)
+            try:
+                fcntl.flock(fd, fcntl.LOCK_EX | fcntl.LOCK_NB)
+            except BlockingIOError:
+                holder = os.pread(fd, 200, 0).decode(errors="replace").strip() or "unknown"
+                os.close(fd)
+                raise OutputLockedError(
+                    f"another job is making {os.path.relpath(out)} now ({holder}): this job stops "
+                    "instead of making it a second time at once. Let that run finish, then rerun "
+                    "this command: Snakemake will find the file made (docs/reliability.md, Two "
+                    "runs, one output)"
+                ) from None
+            os.ftruncate(fd, 0)
+            stamp = f"pid {os.getpid()} on {os.uname().nodename} since {time.strftime('%H:%M:%S')}"
+            os.pwrite(fd, stamp.encode(), 0)
+            held.append(fd)
+        yield
+    finally:
+        for fd in held:
+            os.close(fd)  # closing drops the flock
 
 
 @contextlib.contextmanager
 def job(sm):
     """Run a Snakemake script's body: ``with job(snakemake) as log: ...``.
 
-    Sets torch's and numba's thread counts to the rule's ``threads``, sends stdout and stderr
-    (progress bars included) to ``sm.log[0]``, and writes the traceback of a failure there too
-    (not only to the console) before re-raising it.
+    Locks the job's outputs (:func:`output_locks`: a job whose output another run is making
+    stops at once), sets torch's and numba's thread counts to the rule's ``threads``, sends stdout
+    and stderr (progress bars included) to ``sm.log[0]``, and writes the traceback of a failure
+    there too (not only to the console) before re-raising it.
     """
     threads = max(1, int(getattr(sm, "threads", 1)))
     import numba
@@ -23,6 +80,7 @@ def job(sm):
     torch.set_num_threads(threads)
     numba.set_num_threads(min(threads, numba.config.NUMBA_NUM_THREADS))
     with (
+        output_locks(list(sm.output)),
         open(sm.log[0], "w") as log,
         contextlib.redirect_stderr(log),
         contextlib.redirect_stdout(log),

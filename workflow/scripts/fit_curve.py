@@ -1,9 +1,8 @@
 """Snakemake script of rule `fit_curve`: the fit curve's CSV and fig_fit_curve."""
 
-import json
-
 from physgs.atomic import atomic_path
 from physgs.experiments.fit_curve import ceiling_fraction, collect
+from physgs.intermediate import read_json
 from physgs.jobs import job
 from physgs.report.build import fit_row
 from physgs.report.figures import fig_fit_curve
@@ -11,7 +10,7 @@ from physgs.report.figures import fig_fit_curve
 sm = snakemake  # noqa: F821 (injected by Snakemake)
 p = sm.params
 with job(sm) as log:
-    points = [json.load(open(f)) for f in sm.input.points]
+    points = [read_json(f, rule="fit_curve_point") for f in sm.input.points]
     own = {
         s: {
             m: fit_row(

@@ -88,5 +88,6 @@ def save_segmentations(path, record: dict[str, np.ndarray]) -> None:
 
 def load_segmentations(path) -> dict[str, np.ndarray]:
     """The arrays of a parts record written by ``save_segmentations``."""
-    with np.load(path, allow_pickle=False) as z:
-        return {k: z[k] for k in z.files}
+    from physgs.intermediate import read_npz
+
+    return read_npz(path, (), rule="parts_segmentation")

@@ -76,16 +76,9 @@ class EvalResult:
 
 def load_eval(path) -> EvalResult:
     """Read an EvalResult written by ``EvalResult.save``."""
-    try:
-        with np.load(path) as z:
-            d = {k: z[k] for k in z.files}
-    except (OSError, ValueError) as e:
-        raise ValueError(
-            f"cannot read evaluation file {path}: {e}; delete it and re-run its rule"
-        ) from e
-    missing = {f.name for f in fields(EvalResult)} - set(d)
-    if missing:
-        raise ValueError(f"evaluation file {path} lacks {sorted(missing)}; re-run its rule")
+    from physgs.intermediate import read_npz
+
+    d = read_npz(path, [f.name for f in fields(EvalResult)], rule="evaluate")
     d["n_train"], d["n_tail"] = int(d["n_train"]), int(d["n_tail"])
     return EvalResult(**d)
 

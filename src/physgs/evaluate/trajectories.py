@@ -37,8 +37,9 @@ class Trajectories:
 
 
 def load_trajectories(path) -> Trajectories:
-    with np.load(path) as z:
-        d = {k: z[k] for k in z.files}
+    from physgs.intermediate import read_npz
+
+    d = read_npz(path, [f.name for f in fields(Trajectories)], rule="evaluate")
     d["condition"], d["n_train"] = int(d["condition"]), int(d["n_train"])
     return Trajectories(**d)
 

@@ -19,7 +19,6 @@ Both choices are recorded whichever ``method`` picks the K used.
 
 from __future__ import annotations
 
-import json
 import time
 from dataclasses import asdict, dataclass
 
@@ -91,13 +90,13 @@ def save_selection(path, sel: KSelection) -> None:
 
 
 def load_selection(path) -> KSelection:
+    from physgs.intermediate import read_json, refuse
+
+    d = read_json(path, rule="kselect")
     try:
-        with open(path) as fh:
-            return KSelection.from_dict(json.load(fh))
-    except (OSError, json.JSONDecodeError, KeyError, TypeError) as e:
-        raise ValueError(
-            f"cannot read the K selection {path} ({e}); delete it and re-run the kselect rule"
-        ) from None
+        return KSelection.from_dict(d)
+    except (KeyError, TypeError) as e:
+        raise refuse(path, f"is not a K selection ({type(e).__name__}: {e})", "kselect") from None
 
 
 def _check_cfg(ks: dict, n_gaussians: int) -> list[int]:

@@ -159,3 +159,13 @@ class BaseModel(nn.Module):
 
     def deformation_param_groups(self, lr: dict) -> list[dict]:
         return []
+
+    def bounded_positions(self) -> dict[str, np.ndarray]:
+        """Where each bounded physical parameter sits between its bounds: name -> [n] in [0, 1]
+        (0: the lower bound, 1: the upper). Models without bounded parameters: empty."""
+        return {}
+
+    def scale_settings(self) -> dict[str, list[tuple[str, float]]]:
+        """Config settings besides a group's rate that scale what the group's parameters do now:
+        parameter group -> [(dotted config key, value)]; named when that group is suspect."""
+        return {}

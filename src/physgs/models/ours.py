@@ -349,6 +349,23 @@ class OscillatorPrior(BaseModel):
             torch.sigmoid(c.color_logits),
         )
 
+    def bounded_positions(self) -> dict[str, np.ndarray]:
+        """sigmoid of omega_raw and zeta_raw (their place between the bounds) of the parts that
+        are not frozen (a frozen part's parameters take no updates)."""
+        live = ~self.frozen.cpu().numpy()
+        with torch.no_grad():
+            return {
+                name: torch.sigmoid(raw.detach().double()).cpu().numpy()[live]
+                for name, raw in (("omega", self.omega_raw), ("zeta", self.zeta_raw))
+            }
+
+    def scale_settings(self) -> dict[str, list[tuple[str, float]]]:
+        """With the search, the physics group's bank weights act through bank_scale, and the
+        hand-over sets the gains from them."""
+        if self.search is not None:
+            return {"physics": [("models.omega_search.bank_scale", float(self.search.bank_scale))]}
+        return {}
+
     def deformation_param_groups(self, lr: dict) -> list[dict]:
         return [
             {

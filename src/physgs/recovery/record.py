@@ -3,12 +3,12 @@
 from __future__ import annotations
 
 import dataclasses
-import json
 from dataclasses import dataclass
 
 import numpy as np
 
 from physgs.atomic import write_json
+from physgs.intermediate import read_json
 from physgs.recovery.damping import DampingResult, damping_summary
 from physgs.recovery.damping_scores import DampingNull, DampingScores
 from physgs.recovery.matcher import MatchResult, match_parts, restricted, training_window
@@ -88,7 +88,7 @@ def save_recovery(path, rec: RecoveryRecord) -> None:
 
 
 def load_recovery(path) -> RecoveryRecord:
-    d = _read(path)
+    d = read_json(path, rule="recovery (tracks_evaluate for the tracks control's)")
     return RecoveryRecord(
         MatchResult.from_dict(d["match"]),
         DampingResult.from_dict(d["damping"]),
@@ -105,17 +105,7 @@ def save_null(path, res: NullResult) -> None:
 
 
 def load_null(path) -> NullResult:
-    return NullResult.from_dict(_read(path))
-
-
-def _read(path) -> dict:
-    try:
-        with open(path) as fh:
-            return json.load(fh)
-    except (OSError, json.JSONDecodeError) as e:
-        raise ValueError(
-            f"cannot read recovery file {path}: {e}; delete it and re-run its rule"
-        ) from e
+    return NullResult.from_dict(read_json(path, rule="null_control"))
 
 
 def run_null(

@@ -20,6 +20,7 @@ from physgs.evaluate.splits import load_eval
 from physgs.evaluate.trajectories import load_trajectories
 from physgs.experiments.kselect import load_selection
 from physgs.experiments.recipe import heldout_split
+from physgs.intermediate import read_json
 from physgs.models.registry import BASE_CONFIG, MODEL_NAMES, REFERENCE_NAMES, config_label
 from physgs.recovery.record import load_null, load_recovery
 from physgs.report import kselect
@@ -587,8 +588,6 @@ def make_table(
     elif name == "tab_parts":
         table = _tab_parts(path, settings, trees, bones, seeds, d)
     elif name == "tab_tracks":
-        import json
-
         from physgs.report.tracks import tab_tracks
 
         scores = {}
@@ -596,12 +595,13 @@ def make_table(
             scores[s] = {}
             for t in trees:
                 for c in settings["configs"]:
-                    with open(path("tracks_eval", t, c, s)) as fh:
-                        scores[s][(t, c)] = json.load(fh)
+                    scores[s][(t, c)] = read_json(
+                        path("tracks_eval", t, c, s), rule="tracks_evaluate"
+                    )
                     if key(("tracks_fields", t, c, s)) in inputs:  # {case: {field: errors}}
-                        with open(path("tracks_fields", t, c, s)) as fh:
-                            for case, f in json.load(fh).items():
-                                scores[s][(t, c)][case]["fields"] = f
+                        fields = read_json(path("tracks_fields", t, c, s), rule="tracks_fields")
+                        for case, f in fields.items():
+                            scores[s][(t, c)][case]["fields"] = f
                     loss = pd.read_csv(path("loss", t, "ours", c, s))
                     scores[s][(t, c)]["ours_train_s"] = float(loss["seconds"].iloc[-1])
         table = tab_tracks(
@@ -673,7 +673,6 @@ def _tab_parts(path, settings, trees, bones, seeds, digits) -> Table:
 
 
 def _tab_parts_k(path, settings, trees, bones, seeds, digits) -> Table:
-    import json
 
     from physgs.report import parts
 
@@ -688,8 +687,10 @@ def _tab_parts_k(path, settings, trees, bones, seeds, digits) -> Table:
         for t in trees:
             chain = {K: held("ours_chain", t, s)}
             for k in settings["k_candidates"]:
-                with open(path("kmatch", t, int(k), s)) as fh:
-                    chain[int(k)] = float(json.load(fh)["heldout_psnr"])
+                point = read_json(
+                    path("kmatch", t, int(k), s), ("heldout_psnr",), rule="kmatch_point"
+                )
+                chain[int(k)] = float(point["heldout_psnr"])
             rows[s][t] = {"ours": held(BASELINE_PRIOR, t, s), "chain": chain}
     return parts.tab_parts_k(rows, trees, bones, K, float(settings["tie_db"]), digits=digits)
 

@@ -268,13 +268,7 @@ def save_stats(path, stats: dict) -> None:
 
 def load_stats(path) -> dict:
     """Read ``save_stats``'s JSON back; per-bone lists become arrays."""
-    import json
+    from physgs.intermediate import read_json
 
-    try:
-        with open(path) as fh:
-            d = json.load(fh)
-    except (OSError, json.JSONDecodeError) as e:
-        raise ValueError(
-            f"cannot read testbed statistics {path}: {e}; delete it and re-run its rule"
-        ) from e
+    d = read_json(path, rule="testbed_stats")
     return {k: (np.asarray(v) if isinstance(v, list) else v) for k, v in d.items()}

@@ -40,6 +40,7 @@ from physgs.models.oscillator import STABILITY_GUARD, integrate
 from physgs.models.oscillator_params import OscillatorBounds, condition_vbar
 from physgs.models.ours import prior_substeps
 from physgs.tracks.track import Tracks
+from physgs.train.divergence import pinned
 
 #: tracks shorter than this many frames (1 s at 24 fps: a third of the slowest 0.35 Hz period,
 #: a whole period at 1 Hz) do not enter the fit: a shorter track fixes its own c_i, d_i and
@@ -174,6 +175,21 @@ class TrackFit:
     rms_px: float
 
 
+def _largest_min_frames(tracks: list[Tracks], s: FitSettings) -> int | None:
+    """The largest min_track_frames below ``s.min_track_frames`` at which some part of the same
+    k-means gets ``s.min_tracks`` tracks (None: none does). Tried from the longest track length
+    down; run only to word a refusal."""
+    lengths = np.concatenate([tr.length() for tr in tracks])
+    for n in sorted({int(x) for x in lengths if 0 < x < s.min_track_frames}, reverse=True):
+        seed_xy = np.concatenate([tr.first_xy()[tr.length() >= n] for tr in tracks])
+        if len(seed_xy) < s.K:
+            continue
+        counts = np.bincount(track_parts(seed_xy, s.K, s.seed, s.kmeans_n_init), minlength=s.K)
+        if counts.max() >= s.min_tracks:
+            return n
+    return None
+
+
 def fit_tracks(
     tracks: list[Tracks],
     conditions: list[int],
@@ -213,9 +229,14 @@ def fit_tracks(
     ze_raw = torch.full((s.K,), b.zeta_raw_init(), dtype=torch.float64, requires_grad=True)
     opt = torch.optim.Adam([om_raw, ze_raw], lr=s.lr)
     n_obs = sum(float(w.sum()) for w in ws) * 2
-    if n_obs == 0:
+    if n_obs == 0:  # the parts do not depend on min_tracks: their largest count is what works
+        frames = _largest_min_frames(tracks, s)
         raise ValueError(
-            f"no part has {s.min_tracks} tracks of >= {s.min_track_frames} frames: nothing to fit"
+            f"no part has tracks/min_tracks = {s.min_tracks} tracks of >= {s.min_track_frames} "
+            f"frames (tracks/min_track_frames): nothing to fit. The {s.K} parts have "
+            f"{sorted(n_tracks.tolist(), reverse=True)} tracks: set tracks/min_tracks to at most "
+            f"{int(n_tracks.max())}, or lower tracks/min_track_frames"
+            + (f" to at most {frames}" if frames is not None else "")
         )
     sel = [
         torch.as_tensor(lab[(lab >= 0) & estimated[np.maximum(lab, 0)]]) for lab in labels
@@ -238,6 +259,18 @@ def fit_tracks(
         opt.step()
         losses.append(float(loss.detach()))
     loop_seconds = time.perf_counter() - t_loop
+    with torch.no_grad():  # every estimated omega and zeta on a bound: a saturated fit
+        d = pinned(
+            {
+                "omega": torch.sigmoid(om_raw).numpy()[estimated],
+                "zeta": torch.sigmoid(ze_raw).numpy()[estimated],
+            }
+        )
+    if d is not None:
+        raise ValueError(
+            f"the tracks fit: {d.what}; likely setting: train.lr.physics (now {s.lr:g}, Adam's "
+            "rate on the raw omega and zeta); lower it"
+        )
     with torch.no_grad():
         om, ze = b.omega(om_raw), b.zeta(ze_raw)
         final = float(loss_fn())

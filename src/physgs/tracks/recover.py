@@ -4,7 +4,6 @@ the same matcher, trusted-part rule and records as ours (``physgs.recovery``).""
 from __future__ import annotations
 
 import dataclasses
-import json
 from dataclasses import dataclass
 
 import numpy as np
@@ -105,5 +104,6 @@ def save_tracks_recovery(path, rec: TracksRecovery) -> None:
 
 def load_tracks_block(path) -> dict:
     """The ``tracks`` block of a record written by ``save_tracks_recovery``."""
-    with open(path) as fh:
-        return json.load(fh)["tracks"]
+    from physgs.intermediate import read_json
+
+    return read_json(path, ("tracks",), rule="tracks_evaluate")["tracks"]

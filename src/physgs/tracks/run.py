@@ -38,13 +38,21 @@ def fit_job(tracks: list[Tracks], observed, job: dict) -> tuple[TrackFit, Oscill
             "must pass one per fitted condition"
         )
     K, n_min = int(job["K"]), int(job["min_track_frames"])
-    n_long = int(sum(int((tr.length() >= n_min).sum()) for tr in tracks))
+    lengths = np.sort(np.concatenate([tr.length() for tr in tracks]))[::-1]  # [P] longest first
+    n_long = int((lengths >= n_min).sum())
     if K > n_long:
+        # the largest min_track_frames that keeps K tracks: the K-th longest track's length
+        frames_fix = (
+            f", or lower tracks/min_track_frames (now {n_min}) to at most {int(lengths[K - 1])}"
+            if len(lengths) >= K and lengths[K - 1] > 0
+            else ""
+        )
         raise ValueError(
             f"{job['K_key']} = {K} parts exceeds the {n_long} tracks of >= {n_min} frames "
             f"(tracks/min_track_frames) that the tracker kept in conditions {job['conditions']}: "
             f"k-means cannot make {K} groups. Lower {job['K_key']}"
             + ("" if job["K_key"] == "tracks/K" else " or set tracks/K (the tracks control alone)")
+            + frames_fix
             + ", or drop the configuration from tracks/configs"
         )
     settings = FitSettings(

@@ -12,11 +12,14 @@ import dataclasses
 import numpy as np
 
 from physgs.atomic import save_npz
+from physgs.intermediate import read_npz, refuse
 from physgs.tracks.fit import Oscillators, TrackFit
 from physgs.tracks.track import Tracks
 
 #: the scalar fields of ``Oscillators`` besides its bounds
 _OSC_SCALARS = ("substeps", "fps", "lead_in", "vbar_ratio", "gain", "guard")
+#: the workflow rules that write each file (named when one cannot be read)
+TRACKS_RULE, FIT_RULE = "track", "fit_tracks"
 
 
 def save_tracks(path, tracks: Tracks, condition: int) -> None:
@@ -32,8 +35,18 @@ def save_tracks(path, tracks: Tracks, condition: int) -> None:
 
 def load_tracks(path) -> tuple[Tracks, int]:
     """(Tracks, condition index) from ``save_tracks``."""
-    with np.load(path) as z:
-        return Tracks(z["xy"], z["valid"].astype(bool), z["start"]), int(z["condition"])
+    d = read_npz(path, ("xy", "valid", "start", "condition"), rule=TRACKS_RULE)
+    xy, valid, start = d["xy"], d["valid"], d["start"]
+    P = xy.shape[0] if xy.ndim == 3 else -1
+    if not (
+        xy.ndim == 3 and xy.shape[2] == 2 and valid.shape == xy.shape[:2] and start.shape == (P,)
+    ):
+        raise refuse(
+            path,
+            f"is inconsistent (xy {xy.shape}, valid {valid.shape}, start {start.shape})",
+            TRACKS_RULE,
+        )
+    return Tracks(xy, valid.astype(bool), start), int(d["condition"])
 
 
 def save_fit(path, fit: TrackFit, osc: Oscillators, K_key: str, min_tracks: int) -> None:
@@ -69,9 +82,14 @@ def load_fit(path) -> tuple[TrackFit, Oscillators, dict]:
     """(TrackFit, Oscillators, {"K_key", "min_tracks"}) from ``save_fit``."""
     from physgs.models.oscillator_params import OscillatorBounds
 
-    with np.load(path) as z:
-        d = {k: z[k] for k in z.files}
+    scalars = ["omega", "zeta", "estimated", "n_tracks", "conditions", "loss_px2", "seconds"]
+    scalars += ["loop_seconds", "rms_px", "K_key", "min_tracks"]
+    scalars += [f"bounds_{f.name}" for f in dataclasses.fields(OscillatorBounds)]
+    d = read_npz(path, scalars + [f"osc_{name}" for name in _OSC_SCALARS], rule=FIT_RULE)
     n = len(d["conditions"])
+    absent = [k for i in range(n) for k in (f"labels_{i}", f"c_{i}", f"d_{i}") if k not in d]
+    if absent:
+        raise refuse(path, f"lacks {absent}", FIT_RULE)
     fit = TrackFit(
         d["omega"],
         d["zeta"],

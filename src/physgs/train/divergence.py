@@ -67,6 +67,12 @@ SUSPECT_SHARE = 0.1
 #: initial scale), so every candidate group is named.
 SUSPECT_GROWN = 2.0
 
+#: A bounded physical parameter (omega, zeta: a sigmoid of a raw value between two bounds) whose
+#: sigmoid is within this of 0 or 1 sits on its bound (raw beyond +-6.9). A fit with every one
+#: of them there has no physics left to fit (train.lr.physics at 1e3 pins all 64 of the sparse
+#: tree's; the default rate none).
+PIN_TOL = 1e-3
+
 #: Parameter groups of the canonical set (``BaseModel.param_groups``); the rest deform it.
 CANONICAL_GROUPS = ("means", "quats", "scales", "opacities", "colors")
 
@@ -78,6 +84,30 @@ class Divergence:
 
     what: str
     groups: tuple[str, ...]
+
+
+def pinned(positions: Mapping[str, np.ndarray], group: str = "physics") -> Divergence | None:
+    """A Divergence when every bounded parameter sits on a bound (within PIN_TOL), else None.
+
+    positions: name -> [n] places between the bounds, 0..1 (``BaseModel.bounded_positions``);
+    group: the parameter group (``train.lr`` key) that trains them.
+    """
+    arrays = {k: np.asarray(v, np.float64).ravel() for k, v in positions.items()}
+    n = sum(a.size for a in arrays.values())
+    if n == 0:
+        return None
+    on = {k: (a <= PIN_TOL) | (a >= 1 - PIN_TOL) for k, a in arrays.items()}
+    if not all(m.all() for m in on.values()):
+        return None
+    counts = ", ".join(
+        f"{k}: {int((a <= PIN_TOL).sum())} low / {int((a >= 1 - PIN_TOL).sum())} high"
+        for k, a in arrays.items()
+    )
+    return Divergence(
+        f"every bounded physical parameter sits on a bound ({counts}): the fit has no physics "
+        "left (a saturated fit, not a result)",
+        (group,),
+    )
 
 
 @dataclass

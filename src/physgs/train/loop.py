@@ -14,7 +14,7 @@ from tqdm import tqdm
 from physgs.atomic import atomic_path
 from physgs.models.base import BaseModel
 from physgs.render import rasterization
-from physgs.train.divergence import SUSPECT_GROWN, Divergence, DivergenceGuard
+from physgs.train.divergence import SUSPECT_GROWN, Divergence, DivergenceGuard, pinned
 from physgs.train.losses import photometric_loss
 from physgs.train.schedule import lr_factor
 
@@ -115,10 +115,19 @@ def train_model(
         model.ctx.canonical_xyz, _abs_maxes(named), {n: group_of[id(p)] for n, p in named}, warmup
     )
 
+    # what Adam's rates alone could have moved each group by so far (it moves a parameter by
+    # about its rate per step at most): a group grown past that was moved by something else
+    moved = {g["name"]: 0.0 for g in groups}
+
+    def likely(suspects) -> str:
+        reach = {g: 1.0 + m for g, m in moved.items()}
+        return _likely(suspects, lr_cfg, guard.growth(), model.scale_settings(), reach)
+
     def diverged(it: int, d: Divergence, when: str = "at") -> TrainingError:
         return TrainingError(
             f"model '{name}': training diverged {when} iteration {it}: {d.what}; "
-            f"{_likely(d.groups, lr_cfg)}; no checkpoint written"
+            f"{likely(d.groups)}; "
+            "no checkpoint written"
         )
 
     winds = torch.as_tensor(np.asarray(observed.wind), dtype=torch.float32)  # [C, L+F]
@@ -158,7 +167,8 @@ def train_model(
             raise TrainingError(
                 f"model '{name}': its {'canonical state' if warm else 'deformation'} failed at "
                 f"iteration {it} (condition {c}, frame {j}) with {type(e).__name__}: {e}; "
-                f"{_likely(shaping, lr_cfg)}{note}; no checkpoint written"
+                f"{likely(shaping)}{note}; "
+                "no checkpoint written"
             ) from e
         bad = [k for k in _STATE_GROUP if not _finite(getattr(s, k))]
         if bad:
@@ -202,6 +212,7 @@ def train_model(
             raise diverged(it, d)
         for g in opt.param_groups:
             g["lr"] = g["base_lr"] * lr_factor(g["name"], it, iterations, warmup, final)
+            moved[g["name"]] += g["lr"]
         opt.zero_grad(set_to_none=True)
         loss.backward()
         opt.step()
@@ -223,6 +234,13 @@ def train_model(
         if it % 10 == 0:
             bar.set_postfix(loss=f"{loss.item():.4f}")
     wall = time.perf_counter() - t0
+    d = pinned(model.bounded_positions())
+    if d is not None:  # a saturated fit is a failed fit, not a checkpoint to score
+        raise TrainingError(
+            f"model '{name}': after {iterations} iterations {d.what}; "
+            f"{likely(d.groups)}; "
+            "no checkpoint written"
+        )
     model.eval()
     tail = [r["loss"] for r in log[-max(1, iterations // 10) :]]
     stats = {
@@ -267,17 +285,33 @@ def _abs_maxes(named) -> dict[str, float]:
     return out
 
 
-def _likely(groups, lr_cfg: dict) -> str:
+#: A group grown past this multiple of what its rate could reach was moved by something else.
+BEYOND_RATE = 2.0
+
+
+def _likely(groups, lr_cfg: dict, growth=None, scales=None, reach=None) -> str:
     """'likely setting: train.lr.physics (now 1e+06) or train.lr.pivot (now 0.00016); lower it'
-    for parameter groups (= train.lr keys), most likely first."""
+    for parameter groups (= train.lr keys), most likely first.
+
+    growth: group -> growth of its parameters (``DivergenceGuard.growth``); scales: group -> the
+    other settings that scale what it does (``BaseModel.scale_settings``); reach: group -> the
+    growth its rates alone could reach (1 + the sum of its rates so far). The rate is named
+    first only when it explains the growth: a group that barely grew (<= SUSPECT_GROWN: a step
+    of normal size did the damage) or grew past BEYOND_RATE x its reach (something else set it,
+    as the search's hand-over sets the gains from the bank) names its scaling settings first."""
     if not groups:
         return "likely setting: the learning rates in train.lr; lower them"
-    parts = [
-        f"train.lr.{g}"
-        + (f" (now {lr_cfg[g]:g})" if isinstance(lr_cfg.get(g), (int, float)) else "")
-        for g in groups
-    ]
-    return "likely setting: " + " or ".join(parts) + "; lower it"
+    growth, scales, reach = growth or {}, scales or {}, reach or {}
+    parts = []
+    for g in groups:
+        rate = f"train.lr.{g}" + (
+            f" (now {lr_cfg[g]:g})" if isinstance(lr_cfg.get(g), (int, float)) else ""
+        )
+        other = [f"{k} (now {v:g})" for k, v in scales.get(g, [])]
+        grew = growth.get(g, 0.0)
+        by_rate = SUSPECT_GROWN < grew <= BEYOND_RATE * reach.get(g, float("inf"))
+        parts += [rate, *other] if by_rate else [*other, rate]
+    return "likely setting: " + " or ".join(dict.fromkeys(parts)) + "; lower it"
 
 
 def write_loss_log(path, log: list[dict]) -> None:

@@ -1,0 +1,89 @@
+"""Reading the workflow's intermediate files (tracks, fits, trajectories, records): one loader
+that names the file and the rule that rebuilds it, and removes a file it cannot read.
+
+Every intermediate file is written atomically (:mod:`physgs.atomic`), so a corrupt one comes from
+outside the pipeline (a full disk, a copy cut short, a hand edit). Snakemake reruns a job only
+when its output is missing or older than its inputs, so a corrupt file left in place would be
+read again, and fail again, by every later run. The loader therefore deletes it before raising:
+rerunning the same command rebuilds it with the rule named in the message, then goes on.
+"""
+
+from __future__ import annotations
+
+import json
+import zipfile
+from collections.abc import Iterable
+from pathlib import Path
+
+import numpy as np
+
+
+class IntermediateFileError(ValueError):
+    """A missing or unreadable intermediate file; the message names the file and its rule."""
+
+
+def refuse(path: str | Path, what: str, rule: str) -> IntermediateFileError:
+    """Remove the unreadable ``path`` and say so: the error to raise (``what``: what is wrong)."""
+    path = Path(path)
+    path.unlink(missing_ok=True)
+    return IntermediateFileError(
+        f"{path} {what}; it was removed, so rerunning the same snakemake command rebuilds it "
+        f"(rule `{rule}`) and goes on"
+    )
+
+
+def _missing(path: Path, rule: str) -> IntermediateFileError:
+    return IntermediateFileError(
+        f"{path} does not exist; build it with rule `{rule}` (snakemake --cores 2 {path})"
+    )
+
+
+def read_npz(path: str | Path, keys: Iterable[str], *, rule: str) -> dict[str, np.ndarray]:
+    """The arrays of an intermediate ``.npz`` (no pickled objects), every one of ``keys`` present.
+
+    Args:
+        path: the file.
+        keys: names the file must hold (it may hold more).
+        rule: the workflow rule that writes it (named in the error).
+
+    Returns:
+        name -> array, for every array in the file.
+
+    Raises:
+        IntermediateFileError: the file is missing, or is not a readable ``.npz`` of plain arrays
+            holding ``keys`` (then it is removed first, so the next run rebuilds it).
+    """
+    path = Path(path)
+    if not path.is_file():
+        raise _missing(path, rule)
+    try:
+        with np.load(path, allow_pickle=False) as z:
+            d = {k: z[k] for k in z.files}
+    except PermissionError:
+        raise  # not the file's fault: keep it
+    except (zipfile.BadZipFile, ValueError, OSError, EOFError, KeyError) as e:
+        raise refuse(path, f"is corrupt ({type(e).__name__}: {e})", rule) from None
+    absent = [k for k in keys if k not in d]
+    if absent:
+        raise refuse(path, f"lacks {absent} (another version, or not this rule's file)", rule)
+    return d
+
+
+def read_json(path: str | Path, keys: Iterable[str] = (), *, rule: str) -> dict:
+    """The mapping of an intermediate ``.json`` holding every one of ``keys`` (as ``read_npz``)."""
+    path = Path(path)
+    if not path.is_file():
+        raise _missing(path, rule)
+    try:
+        with open(path) as fh:
+            d = json.load(fh)
+    except PermissionError:
+        raise
+    except (OSError, UnicodeDecodeError, json.JSONDecodeError) as e:
+        raise refuse(path, f"is corrupt ({type(e).__name__}: {e})", rule) from None
+    if not isinstance(d, dict):
+        raise refuse(path, f"holds a {type(d).__name__}, not a mapping", rule)
+    absent = [k for k in keys if k not in d]
+    if absent:
+        raise refuse(path, f"lacks {absent} (another version, or not this rule's file)", rule)
+    return d
