@@ -1,0 +1,32 @@
+"""What each job of the output-only analysis reads from the resolved config (its narrow params).
+
+The workflow imports this module to plan jobs, so it imports neither pyOMA-2 nor OpenCV.
+"""
+
+from __future__ import annotations
+
+
+def identify_params(cfg: dict) -> dict:
+    """Rule ``oma_identify``: the flow, components and SSI settings, and ours' omega bounds
+    (a mode outside them is dropped). Nothing about the wind."""
+    o = cfg["oma"]
+    return {
+        "flow": dict(o["flow"]),
+        "components": int(o["components"]),
+        "ssi": dict(o["ssi"]),
+        "omega_hz": [float(x) for x in cfg["models"]["ours"]["omega_hz"]],
+    }
+
+
+def recovery_params(cfg: dict, config: str, seed: int) -> dict:
+    """Rule ``oma_recovery``: K of the configuration, the training seed and ours' k-means
+    restarts (the cells' parts), and ours' solver settings (the null's, ``null_settings``)."""
+    from physgs.recovery.run import null_settings
+
+    K = int(cfg["models"]["configs"][config]["K"])
+    return {
+        "K": K,
+        "seed": int(seed),
+        "kmeans_n_init": int(cfg["models"]["ours"]["kmeans_n_init"]),
+        "solver": null_settings(cfg, K, seed),
+    }
