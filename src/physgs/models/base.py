@@ -63,11 +63,15 @@ class ModelContext:
         )
 
 
-def context_from_observed(obs) -> ModelContext:
-    """ModelContext from a ``physgs.testbed.dataset.Observed`` (training condition = index 0)."""
-    w = np.asarray(obs.wind[0], dtype=np.float64)  # [L+F] m/s
+def context_from_observed(obs, wind: bool = True) -> ModelContext:
+    """ModelContext from a ``physgs.testbed.dataset.Observed`` (training condition = index 0).
+
+    wind=False: a model that never reads the wind (``ModelSpec.wind``): the wind statistics are
+    NaN and the observed wind is not looked at (it may be NaN itself).
+    """
+    w = np.asarray(obs.wind[0], dtype=np.float64) if wind else np.full(2, np.nan)  # [L+F] m/s
     std = float(w.std())
-    if not np.isfinite(w).all() or std <= 0:
+    if wind and (not np.isfinite(w).all() or std <= 0):
         raise ValueError(
             "the training condition's observed wind is constant or not finite; a wind-driven "
             "model needs varying wind: regenerate the testbed dataset"
