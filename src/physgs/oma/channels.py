@@ -51,7 +51,7 @@ class Channels:
         return int(self.cell_xy.shape[0])
 
 
-def flow_channels(frames: np.ndarray, background, s: FlowSettings) -> Channels:
+def flow_channels(frames: np.ndarray, background: np.ndarray, s: FlowSettings) -> Channels:
     """Dense-flow channels of one video.
 
     Args:
