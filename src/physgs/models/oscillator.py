@@ -203,6 +203,21 @@ def _reference(omega, zeta, gain, u, dt, substeps):
     return torch.stack(out, dim=1)
 
 
+def _check_args(omega, zeta, gain, dt, substeps, backend) -> None:
+    """The shape, step and backend checks ``integrate`` and ``integrate_forcing`` share."""
+    if backend not in ("fast", "reference"):
+        raise ValueError(f"integrate: backend must be 'fast' or 'reference', got {backend!r}")
+    if not (omega.ndim == 1 and omega.shape == zeta.shape == gain.shape):
+        raise ValueError(
+            "integrate: omega, zeta and gain must be 1-D tensors of one length K; got shapes "
+            f"{tuple(omega.shape)}, {tuple(zeta.shape)}, {tuple(gain.shape)}"
+        )
+    if isinstance(substeps, bool) or int(substeps) != substeps or substeps < 1:
+        raise ValueError(f"integrate: substeps must be a positive integer, got {substeps!r}")
+    if not dt > 0:
+        raise ValueError(f"integrate: dt must be > 0 seconds, got {dt}")
+
+
 def integrate(
     omega: torch.Tensor,
     zeta: torch.Tensor,
@@ -225,17 +240,7 @@ def integrate(
     Raises StabilityError if max |lambda| * dt / substeps > guard, |lambda| = fastest_rate(omega,
     zeta) (= omega unless over-damped).
     """
-    if backend not in ("fast", "reference"):
-        raise ValueError(f"integrate: backend must be 'fast' or 'reference', got {backend!r}")
-    if not (omega.ndim == 1 and omega.shape == zeta.shape == gain.shape):
-        raise ValueError(
-            "integrate: omega, zeta and gain must be 1-D tensors of one length K; got shapes "
-            f"{tuple(omega.shape)}, {tuple(zeta.shape)}, {tuple(gain.shape)}"
-        )
-    if isinstance(substeps, bool) or int(substeps) != substeps or substeps < 1:
-        raise ValueError(f"integrate: substeps must be a positive integer, got {substeps!r}")
-    if not dt > 0:
-        raise ValueError(f"integrate: dt must be > 0 seconds, got {dt}")
+    _check_args(omega, zeta, gain, dt, substeps, backend)
     w = torch.as_tensor(wind).detach().to("cpu", torch.float64)
     if w.ndim != 1 or w.shape[0] < 1 or not torch.isfinite(w).all():
         raise ValueError(
@@ -266,17 +271,7 @@ def integrate_forcing(
     ``integrate``.
     """
     if not _checked:
-        if backend not in ("fast", "reference"):
-            raise ValueError(f"integrate: backend must be 'fast' or 'reference', got {backend!r}")
-        if not (omega.ndim == 1 and omega.shape == zeta.shape == gain.shape):
-            raise ValueError(
-                "integrate: omega, zeta and gain must be 1-D tensors of one length K; got "
-                f"shapes {tuple(omega.shape)}, {tuple(zeta.shape)}, {tuple(gain.shape)}"
-            )
-        if isinstance(substeps, bool) or int(substeps) != substeps or substeps < 1:
-            raise ValueError(f"integrate: substeps must be a positive integer, got {substeps!r}")
-        if not dt > 0:
-            raise ValueError(f"integrate: dt must be > 0 seconds, got {dt}")
+        _check_args(omega, zeta, gain, dt, substeps, backend)
     u = torch.as_tensor(u).detach().to("cpu", torch.float64)
     if u.ndim != 1 or u.shape[0] < 1 or not torch.isfinite(u).all():
         raise ValueError(
