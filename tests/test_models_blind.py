@@ -119,3 +119,44 @@ def test_the_wind_is_never_read():
         context_from_observed(obs, wind=False)
     with pytest.raises(ValueError, match="wind"):
         context_from_observed(obs, wind=True)
+
+
+def test_evaluation_says_not_defined_beyond_the_window_and_under_other_winds():
+    """Through ours' render callback the blind prior refuses frames past the window and every
+    other condition; the evaluation turns each refusal into NaN (never a score) and keeps the
+    frames it does predict."""
+    from types import SimpleNamespace
+
+    from physgs.evaluate.adapter import model_render_fn
+    from physgs.evaluate.splits import NotDefined, evaluate
+
+    m = _model()
+    fn = model_render_fn(
+        m, SimpleNamespace(wind=np.zeros((2, LEAD + N_TRAIN + 10)), background=[1, 1, 1])
+    )
+    with pytest.raises(NotDefined):
+        fn(5, 1, None)
+    with pytest.raises(NotDefined):
+        fn(N_TRAIN, 0, None)
+
+    def render(frame, cond, cam):  # predicts condition 0 inside a 2-frame window
+        if not (cond == 0 and frame < 2):
+            raise NotDefined("beyond")
+        return np.full((4, 4, 3), 0.5), np.ones((4, 4))
+
+    rng = np.random.default_rng(0)
+    obs = SimpleNamespace(
+        frames=rng.integers(0, 255, (2, 4, 4, 4, 3), dtype=np.uint8),
+        masks=np.ones((2, 4, 4, 4), bool),
+        n_train=2,
+        n_tail=2,
+        train_camera=None,
+        heldout_cameras=[None],
+        heldout_frame_idx=np.array([1]),
+        heldout_frames=rng.integers(0, 255, (1, 1, 4, 4, 3), dtype=np.uint8),
+        conditions=np.array([1.0, 0.8]),
+        heldout_azimuths_deg=np.array([0.0]),
+    )
+    s = evaluate(render, obs).summary()
+    assert np.isnan(s["time"]) and np.isnan(s["train_c1"]) and np.isnan(s["beyond_c0"])
+    assert np.isfinite(s["train_c0"]) and np.isfinite(s["view"])

@@ -22,6 +22,12 @@ def model_render_fn(model, observed, *, backend: str = "auto"):
     # models blind to the wind, every condition (the evaluation visits frames in that order)
 
     def render_fn(frame_idx: int, condition: int, camera):
+        if not model.defined(int(frame_idx), int(condition)):
+            from physgs.evaluate.splits import NotDefined
+
+            raise NotDefined(
+                f"{model.name}: no prediction at frame {frame_idx}, condition {condition}"
+            )
         key = (int(frame_idx), int(condition) if reads_wind else 0)
         with torch.no_grad():
             if last.get("key") != key:

@@ -133,6 +133,11 @@ class BaseModel(nn.Module):
     # every condition, which lets the evaluation deform each frame once).
     use_wind: bool = True
 
+    def defined(self, frame_idx: int, condition: int) -> bool:
+        """Whether the model predicts recorded frame ``frame_idx`` under condition ``condition``
+        (every model but a prior with a learned forcing predicts everything)."""
+        return True
+
     def canonical_state(self) -> GaussianState:
         """The undeformed canonical Gaussians (used by the shared static warm-up)."""
         return self.canonical.state()

@@ -32,12 +32,13 @@ import numpy as np
 import torch
 from torch import nn
 
+from physgs.evaluate.splits import NotDefined
 from physgs.models.oscillator import integrate_forcing
 from physgs.models.ours import OscillatorPrior
 
 
-class ForcingNotDefined(ValueError):
-    """The learned forcing covers the training window only."""
+class ForcingNotDefined(NotDefined, ValueError):
+    """The learned forcing covers the training window of the training condition only."""
 
 
 def harmonics(n_samples: int, fps: float, forcing_hz: float) -> np.ndarray:
@@ -123,6 +124,10 @@ class BlindOscillatorPrior(OscillatorPrior):
                 f"{self.n_train - 1}): the learned forcing is not defined there"
             )
         return super().deform(frame_idx, wind)
+
+    def defined(self, frame_idx: int, condition: int) -> bool:
+        """Only the training window of the training condition (the forcing's span)."""
+        return int(condition) == 0 and 0 <= int(frame_idx) < self.n_train
 
     def _check(self, frame_idx: int, wind: torch.Tensor) -> None:  # the wind is not read
         if not 0 <= frame_idx < self.n_train:
