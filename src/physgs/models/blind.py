@@ -77,7 +77,7 @@ def causal_convolve(r0: torch.Tensor, h: torch.Tensor, f: torch.Tensor) -> torch
 class BlindOscillatorPrior(OscillatorPrior):
     """Ours driven by a learned band-limited forcing shared by every part (module docstring)."""
 
-    name = "ours_blind"
+    name = "ours_blind"  # also ours_chain_blind: the chained prior's options, this forcing
     use_wind = False
 
     def __init__(self, ctx, canonical_cfg: dict, *, forcing_hz: float, seed: int = 0, **kw):

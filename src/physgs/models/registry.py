@@ -65,6 +65,15 @@ PRIOR_VARIANTS: dict[str, ModelSpec] = {
     # issue 42: ours with a learned forcing shared by every part instead of the measured wind
     # (physgs.models.blind); trained in `single` only (one window, one forcing)
     "ours_blind": ModelSpec("Ours, learned forcing", "blind", "ours", False, forcing="learned"),
+    "ours_chain_blind": ModelSpec(
+        "Ours, chained topology parts, learned forcing",
+        "chained, blind",
+        "ours",
+        False,
+        parts="topology",
+        chain=True,
+        forcing="learned",
+    ),
 }
 PRIOR_VARIANT_NAMES = tuple(PRIOR_VARIANTS)
 #: Reference models: not methods (no recovery, null or method result depends on them), so kept
@@ -273,7 +282,8 @@ def build_model(
 
         if options.get("search") is not None:
             raise ValueError(f"{name} has no search over omega: remove it from models/omega_search")
-        cls, options = BlindOscillatorPrior, {"forcing_hz": float(cfg["blind"]["forcing_hz"])}
+        cls = BlindOscillatorPrior
+        options["forcing_hz"] = float(cfg["blind"]["forcing_hz"])
     else:
         cls = OscillatorPrior
     return cls(
