@@ -160,3 +160,24 @@ def test_evaluation_says_not_defined_beyond_the_window_and_under_other_winds():
     s = evaluate(render, obs).summary()
     assert np.isnan(s["time"]) and np.isnan(s["train_c1"]) and np.isnan(s["beyond_c0"])
     assert np.isfinite(s["train_c0"]) and np.isfinite(s["view"])
+
+
+def test_undefined_splits_are_the_ones_outside_the_window_and_wind():
+    """The NaN summary keys evaluate_checkpoint accepts for the blind prior, and none for ours'
+    kind of model (every frame defined): a NaN there would still stop the job as corrupt."""
+    from types import SimpleNamespace
+
+    from physgs.evaluate.run import undefined_splits
+
+    obs = SimpleNamespace(
+        n_train=N_TRAIN, conditions=[1.0, 0.8], heldout_frame_idx=np.arange(9, N_TRAIN, 10)
+    )
+    assert undefined_splits(_model(), obs) == {
+        "time",
+        "beyond_c0",
+        "centroid_c0",
+        "train_c1",
+        "beyond_c1",
+        "centroid_c1",
+    }
+    assert undefined_splits(SimpleNamespace(defined=lambda j, c: True), obs) == set()

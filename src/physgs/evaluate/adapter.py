@@ -57,6 +57,8 @@ def model_means_fn(model, observed):
     winds = [torch.as_tensor(w, dtype=torch.float32) for w in observed.wind]
 
     def means_fn(frame_idx: int, condition: int) -> np.ndarray:
+        if not model.defined(int(frame_idx), int(condition)):  # no prediction: NaN, not a path
+            return np.full((model.canonical_state().means.shape[0], 3), np.nan, np.float32)
         with torch.no_grad():
             return model.gaussians_at(int(frame_idx), winds[condition]).means.cpu().numpy()
 
