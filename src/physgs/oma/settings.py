@@ -19,11 +19,13 @@ def identify_params(cfg: dict) -> dict:
 
 
 def recovery_params(cfg: dict, config: str, seed: int) -> dict:
-    """Rule ``oma_recovery``: K of the configuration, the training seed and ours' k-means
+    """Rule ``oma_recovery``: K (``oma.K``: ``same`` for the configuration's, or an integer),
+    the training seed and ours' k-means
     restarts (the cells' parts), and ours' solver settings (the null's, ``null_settings``)."""
     from physgs.recovery.run import null_settings
 
-    K = int(cfg["models"]["configs"][config]["K"])
+    k = cfg["oma"].get("K", "same")
+    K = int(cfg["models"]["configs"][config]["K"]) if k == "same" else int(k)
     return {
         "K": K,
         "seed": int(seed),
