@@ -98,3 +98,11 @@ def test_identification_reads_the_frames_only():
     script = (ROOT / "workflow/scripts/oma_identify.py").read_text()
     used = set(re.findall(r"obs\.(\w+)", script))
     assert used == {"frames", "n_train", "background", "fps"}, used
+
+
+def test_more_parts_than_cells_stops_naming_the_key():
+    from physgs.oma.parts import cell_parts
+
+    with pytest.raises(ValueError, match="oma/flow/cell_px"):
+        cell_parts(np.arange(8.0).reshape(4, 2), 5, seed=0, n_init=1)
+    assert cell_parts(np.arange(8.0).reshape(4, 2), 2, seed=0, n_init=1).tolist().count(0) == 2
