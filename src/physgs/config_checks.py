@@ -214,6 +214,13 @@ def oma_is_runnable(cfg: dict) -> Iterator[Problem]:
     o = cfg.get("oma") or {}
     if not o.get("configs"):
         return
+    for i, c in enumerate(o["configs"]):
+        if c not in cfg["models"]["configs"]:
+            yield (
+                ("oma", "configs", i),
+                f"'{c}' is not one of models/configs {sorted(cfg['models']['configs'])}: the "
+                "analysis runs in ours' configurations (their winds' videos and K)",
+            )
     from physgs.oma.ssi import SSISettings, check_record
 
     try:

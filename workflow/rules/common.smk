@@ -397,6 +397,11 @@ def tracks_fields_inputs(wildcards):
 
 
 # ---- output-only modal analysis (oma.smk) -------------------------------------------------------
+def oma_identify_params(wildcards):
+    """The configuration's conditions and the analysis' settings (physgs.oma.settings)."""
+    return _oma.identify_params(CFG, wildcards.config)
+
+
 def oma_recovery_params(wildcards):
     """K, seed, k-means restarts and ours' solver settings (physgs.oma.settings)."""
     return _oma.recovery_params(CFG, wildcards.config, int(wildcards.seed))

@@ -21,7 +21,7 @@ rule oma_identify:
         mem_mb=3000,
         runtime=10,
     params:
-        settings=_oma.identify_params(CFG),
+        settings=oma_identify_params,
     script:
         "../scripts/oma_identify.py"
 

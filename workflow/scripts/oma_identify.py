@@ -1,5 +1,5 @@
-"""Snakemake script of rule `oma_identify`: SSI-cov of the training video's dense flow
-(observed.npz's frames of the training window only; never the wind)."""
+"""Snakemake script of rule `oma_identify`: SSI-cov of the dense flow of the configuration's
+videos (observed.npz's frames of the training window only; never the wind)."""
 
 from physgs.jobs import job
 from physgs.oma.run import OMASettings, identify_video, load_identification, save_identification
@@ -10,7 +10,8 @@ with job(sm) as log:
     p = sm.params.settings
     s = OMASettings.from_config(p, {"omega_hz": p["omega_hz"]})
     obs = load_observed(sm.input.observed)
-    ident = identify_video(obs.frames[0, : obs.n_train], obs.background, obs.fps, s)
+    videos = [obs.frames[c, : obs.n_train] for c in p["conditions"]]
+    ident = identify_video(videos, obs.background, obs.fps, s)
     save_identification(sm.output.modes, ident, s)
     load_identification(sm.output.modes)  # the file reads back before the job counts as done
     m = ident.modes

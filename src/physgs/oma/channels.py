@@ -51,13 +51,18 @@ class Channels:
         return int(self.cell_xy.shape[0])
 
 
-def flow_channels(frames: np.ndarray, background: np.ndarray, s: FlowSettings) -> Channels:
+def flow_channels(
+    frames: np.ndarray, background: np.ndarray, s: FlowSettings, reference: np.ndarray | None = None
+) -> Channels:
     """Dense-flow channels of one video.
 
     Args:
         frames: [T, H, W, 3] uint8, the training window of one condition's training camera.
         background: [3] background colour in [0, 1].
         s: the settings.
+        reference: a [H, W, 3] uint8 frame whose foreground picks the cells (default
+            this video's first frame): the other winds' videos take the training video's, so
+            every record has the same channels in the same order.
 
     Returns:
         ``Channels`` over the cells whose foreground share in frame 0 reaches ``s.min_fg``.
@@ -68,7 +73,8 @@ def flow_channels(frames: np.ndarray, background: np.ndarray, s: FlowSettings) -
 
     gray = to_gray(frames)  # [T, H, W]
     T, H, W = gray.shape
-    fg0 = foreground(frames[:1], background, s.fg_tol, s.fg_dilate_px)[0]  # [H, W]
+    ref = frames[:1] if reference is None else np.asarray(reference)[None]
+    fg0 = foreground(ref, background, s.fg_tol, s.fg_dilate_px)[0]  # [H, W]
     ny, nx = H // s.cell_px, W // s.cell_px
     cells = fg0[: ny * s.cell_px, : nx * s.cell_px].reshape(ny, s.cell_px, nx, s.cell_px)
     share = cells.mean(axis=(1, 3))  # [ny, nx]

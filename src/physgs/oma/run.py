@@ -18,7 +18,7 @@ import numpy as np
 from physgs.atomic import atomic_path, write_json
 from physgs.oma.channels import Channels, FlowSettings, flow_channels, principal_channels
 from physgs.oma.parts import PartModes, assign_modes, cell_parts
-from physgs.oma.ssi import Modes, SSISettings, Stabilisation, identify
+from physgs.oma.ssi import Modes, SSISettings, Stabilisation, identify_records
 
 
 @dataclass(frozen=True)
@@ -51,21 +51,27 @@ class Identification:
     seconds: float  # wall time of flow + SSI
 
 
-def identify_video(frames: np.ndarray, background, fps: float, s: OMASettings) -> Identification:
-    """Flow channels of the window's frames [T, H, W, 3] uint8, their principal components,
-    SSI-cov, and the modes (shapes mapped back over the cell channels) inside ours' bounds."""
+def identify_video(
+    videos: list[np.ndarray], background, fps: float, s: OMASettings
+) -> Identification:
+    """Flow channels of each video's window frames [T, H, W, 3] uint8 (the first video's cells
+    for all), the principal components of all records together, SSI-cov over the records
+    (``identify_records``), and the modes inside ours' bounds, their shapes mapped back over
+    the cell channels."""
     import time
 
     t0 = time.perf_counter()
-    ch = flow_channels(frames, background, s.flow)
-    z, load = principal_channels(ch.y, min(s.components, *ch.y.shape))
-    m = identify(z, fps, s.ssi)
+    chans = [flow_channels(v, background, s.flow, reference=videos[0][0]) for v in videos]
+    ys = [c.y - c.y.mean(axis=0) for c in chans]
+    stacked = np.concatenate(ys)  # [sum T, C]
+    _, load = principal_channels(stacked, min(s.components, *stacked.shape))
+    m = identify_records([y @ load.T for y in ys], fps, s.ssi)
     keep = (m.freq_hz >= s.omega_hz[0]) & (m.freq_hz <= s.omega_hz[1])
     shape = m.shape[keep] @ load  # [M, C] over the cell channels
     modes = Modes(
         m.freq_hz[keep], m.zeta[keep], shape, m.n_stable[keep], m.freq_spread[keep], m.stab
     )
-    return Identification(ch, modes, time.perf_counter() - t0)
+    return Identification(chans[0], modes, time.perf_counter() - t0)
 
 
 def save_identification(path, ident: Identification, s: OMASettings) -> None:

@@ -6,11 +6,16 @@ The workflow imports this module to plan jobs, so it imports neither pyOMA-2 nor
 from __future__ import annotations
 
 
-def identify_params(cfg: dict) -> dict:
-    """Rule ``oma_identify``: the flow, components and SSI settings, and ours' omega bounds
-    (a mode outside them is dropped). Nothing about the wind."""
+def identify_params(cfg: dict, config: str) -> dict:
+    """Rule ``oma_identify``: the conditions of ``config`` (``models.configs``: train -> [0],
+    all -> every wind's video, one record each), the flow, components and SSI settings, and
+    ours' omega bounds (a mode outside them is dropped). Nothing about the wind."""
+    from physgs.tracks.settings import condition_indices
+
     o = cfg["oma"]
+    n = len(cfg["testbed"]["conditions"])
     return {
+        "conditions": condition_indices(cfg["models"]["configs"][config]["conditions"], n),
         "flow": dict(o["flow"]),
         "components": int(o["components"]),
         "ssi": dict(o["ssi"]),

@@ -11,7 +11,6 @@ broadband excitation and nothing else.
 
 from __future__ import annotations
 
-import logging
 from dataclasses import dataclass
 
 import numpy as np
@@ -154,43 +153,57 @@ def group_stable_poles(
 
 
 def identify(y: np.ndarray, fs: float, s: SSISettings) -> Modes:
-    """SSI-cov of a channel matrix through pyOMA-2, and its modes.
+    """SSI-cov of one record (``identify_records`` of ``[y]``)."""
+    return identify_records([y], fs, s)
+
+
+def identify_records(ys: list[np.ndarray], fs: float, s: SSISettings) -> Modes:
+    """SSI-cov through pyOMA-2's functions, and its modes.
+
+    Several records of the same channels (the same cells of one camera under each wind) give one
+    system: pyOMA-2 builds each record's block Hankel matrix of output covariances, and their
+    mean (the covariances averaged over the records, each a stationary stretch of the same
+    system) goes through its SSI and pole computation, as its ``SSI`` algorithm does for one.
 
     Args:
-        y: [T, C] output channels (any unit; each is centred here), T samples at ``fs``.
+        ys: records [T_i, C] of the same C channels (any unit; each is centred here), at ``fs``.
         fs: sampling rate (Hz).
-        s: the settings (``check_record`` runs first).
+        s: the settings (``check_record`` runs first on each record).
 
     Returns:
         ``Modes``: frequencies (Hz), damping ratios, shapes over the C channels, and the
         stabilisation diagram.
     """
-    from pyoma2.algorithms import SSI
-    from pyoma2.setup import SingleSetup
+    from pyoma2.functions import gen, ssi
 
-    y = np.asarray(y, np.float64)
-    if y.ndim != 2 or not np.all(np.isfinite(y)):
-        raise ValueError(f"identify needs a finite [T, C] channel matrix, got {y.shape}")
-    check_record(*y.shape, s)
-    y = y - y.mean(axis=0)
-    logging.getLogger("pyoma2").setLevel(logging.WARNING)  # its per-order progress is noise here
-    setup = SingleSetup(y, fs=float(fs))
-    alg = SSI(
-        name="ssicov",
-        method="cov",
-        br=int(s.block_rows),
-        ordmax=int(s.order_max),
+    if not ys or len({np.shape(y)[1] if np.ndim(y) == 2 else -1 for y in ys}) != 1:
+        raise ValueError("identify_records needs records [T_i, C] of one channel count C")
+    hs = []
+    for y in ys:
+        y = np.asarray(y, np.float64)
+        if y.ndim != 2 or not np.all(np.isfinite(y)):
+            raise ValueError(f"identify needs a finite [T, C] channel matrix, got {y.shape}")
+        check_record(*y.shape, s)
+        yt = (y - y.mean(axis=0)).T  # [C, T]
+        hs.append(ssi.build_hank(Y=yt, Yref=yt, br=int(s.block_rows), method="cov")[0])
+    H = np.mean(hs, axis=0)
+    obs, A, C, _ = ssi.SSI_fast(H, int(s.block_rows), int(s.order_max), step=int(s.order_step))
+    freq, xi, phi, *_ = ssi.SSI_poles(
+        obs,
+        A,
+        C,
+        int(s.order_max),
+        1.0 / float(fs),
         step=int(s.order_step),
-        sc={"err_fn": s.err_fn, "err_xi": s.err_xi, "err_phi": s.err_phi},
-        hc={"xi_max": s.xi_max, "mpc_lim": None, "mpd_lim": None, "CoV_max": None},
+        HC=True,
+        xi_max=float(s.xi_max),
     )
-    setup.add_algorithms(alg)
-    setup.run_by_name("ssicov")
-    r = alg.result
-    freq = np.asarray(r.Fn_poles, np.float64)  # [P, O]
-    xi = np.asarray(r.Xi_poles, np.float64)
-    phi = np.asarray(r.Phi_poles, np.complex128)  # [P, O, C]
-    stable = np.asarray(r.Lab) == 1
+    lab = gen.SC_apply(
+        freq, xi, phi, 0, int(s.order_max), int(s.order_step), s.err_fn, s.err_xi, s.err_phi
+    )
+    freq, xi = np.asarray(freq, np.float64), np.asarray(xi, np.float64)  # [P, O]
+    phi = np.asarray(phi, np.complex128)  # [P, O, C]
+    stable = np.asarray(lab) == 1
     orders = np.arange(0, s.order_max + 1, s.order_step)[: freq.shape[1]]
     fm, zm, sh, ns, spread = group_stable_poles(freq, xi, phi, stable, s)
     return Modes(fm, zm, sh, ns, spread, Stabilisation(freq, stable, orders))
