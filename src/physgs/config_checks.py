@@ -206,6 +206,30 @@ def tracks_is_runnable(cfg: dict) -> Iterator[Problem]:
         )
 
 
+def oma_is_runnable(cfg: dict) -> Iterator[Problem]:
+    """The training window carries the SSI model the output-only analysis asks for: 4 x
+    block_rows samples at least, and an order no higher than block_rows x components (the
+    channels SSI reads). Fewer channels than components are only known once the video is seen:
+    the job then stops, naming the key (``physgs.oma.ssi.check_record``)."""
+    o = cfg.get("oma") or {}
+    if not o.get("configs"):
+        return
+    for i, c in enumerate(o["configs"]):
+        if c not in cfg["models"]["configs"]:
+            yield (
+                ("oma", "configs", i),
+                f"'{c}' is not one of models/configs {sorted(cfg['models']['configs'])}: the "
+                "analysis runs in ours' configurations (their winds' videos and K)",
+            )
+    from physgs.oma.ssi import SSISettings, check_record
+
+    try:
+        check_record(int(cfg["testbed"]["n_train"]), int(o["components"]), SSISettings(**o["ssi"]))
+    except ValueError as e:
+        key, _, msg = str(e).partition(" ")
+        yield tuple(key.split("/")), f"{msg} (testbed/n_train, oma/components)"
+
+
 #: The calm must last at least this many periods of the slowest band frequency (band_hz[0]) to
 #: show a free decay: over less, the slowest bones do not complete one oscillation.
 MIN_CALM_PERIODS = 1.0
@@ -566,6 +590,7 @@ CHECKS: list[Check] = [
     damping_benchmark_is_runnable,
     parts_study_is_runnable,
     tracks_is_runnable,
+    oma_is_runnable,
     presets_reach_bone_counts,
 ]
 

@@ -10,6 +10,7 @@ import physgs.experiments.sweep as _sweep
 import physgs.models.registry as _models
 import physgs.provenance as _provenance
 import physgs.testbed.variant as _variant
+import physgs.oma.settings as _oma
 import physgs.tracks.settings as _tracks
 from physgs.experiments.recipe import canonical as _canonical
 from physgs.experiments.recipe import job_spec as _job_spec
@@ -42,6 +43,8 @@ STAMP = _provenance.stamp(CFG)  # not a rerun trigger (see physgs.provenance.Sta
 TRACKS_CONFIGS = list(CFG["tracks"]["configs"])
 TRACKS_K = {c: _tracks.parts(CFG, c)[0] for c in TRACKS_CONFIGS}
 # (tree, configuration) pairs whose learned fields tab_tracks scores at the tracked points
+# output-only modal analysis of the training video (docs/blind.md): the configurations it runs in
+OMA_CONFIGS = list(CFG["oma"]["configs"])
 TRACKS_FIELD_PAIRS = [
     (t, c) for t in TREES for c in TRACKS_CONFIGS if _tracks.fields_scored(CFG, c, t)
 ]
@@ -79,6 +82,11 @@ TRACKS_FIT = "results/tracks/{tree}/seed{seed}/fit_{config}.npz"
 TRACKS_EVAL = "results/tracks/{tree}/seed{seed}/eval_{config}.json"
 TRACKS_RECOVERY = RECOVERY.replace("{model}", "tracks")  # ours' record format, beside ours'
 TRACKS_FIELDS = "results/tracks/{tree}/seed{seed}/fields_{config}.json"  # the fields at the tracks
+# output-only modal analysis: the modes of the training video (observed only), its recovery record
+# (ours' format, beside ours') and each tree's stabilisation diagram
+OMA_MODES = "results/oma/{tree}/seed{seed}/modes_{config}.npz"
+OMA_RECOVERY = RECOVERY.replace("{model}", "oma")
+OMA_FIGURE = "results/figures/fig_stabilisation_{tree}.png"
 #: need kind (physgs.report.build.needs) -> path template
 NEED_PATHS = {
     "eval": EVAL,
@@ -386,3 +394,20 @@ def tracks_fields_inputs(wildcards):
         "truth": tb["truth"],
         **{f"field_{m}": CKPT.format(tree=t, seed=s, model=m, config=c) for m in fields},
     }
+
+
+# ---- output-only modal analysis (oma.smk) -------------------------------------------------------
+def oma_identify_params(wildcards):
+    """The configuration's conditions and the analysis' settings (physgs.oma.settings)."""
+    return _oma.identify_params(CFG, wildcards.config)
+
+
+def oma_recovery_params(wildcards):
+    """K, seed, k-means restarts and ours' solver settings (physgs.oma.settings)."""
+    return _oma.recovery_params(CFG, wildcards.config, int(wildcards.seed))
+
+
+def oma_recovery_inputs(wildcards):
+    """The modes, the dataset (wind for the matcher's simulation), the truth and its statistics."""
+    t, s, c = wildcards.tree, wildcards.seed, wildcards.config
+    return {"modes": OMA_MODES.format(tree=t, seed=s, config=c), **testbed_files(t, s)}

@@ -22,6 +22,12 @@ def model_render_fn(model, observed, *, backend: str = "auto"):
     # models blind to the wind, every condition (the evaluation visits frames in that order)
 
     def render_fn(frame_idx: int, condition: int, camera):
+        if not model.defined(int(frame_idx), int(condition)):
+            from physgs.evaluate.splits import NotDefined
+
+            raise NotDefined(
+                f"{model.name}: no prediction at frame {frame_idx}, condition {condition}"
+            )
         key = (int(frame_idx), int(condition) if reads_wind else 0)
         with torch.no_grad():
             if last.get("key") != key:
@@ -51,6 +57,8 @@ def model_means_fn(model, observed):
     winds = [torch.as_tensor(w, dtype=torch.float32) for w in observed.wind]
 
     def means_fn(frame_idx: int, condition: int) -> np.ndarray:
+        if not model.defined(int(frame_idx), int(condition)):  # no prediction: NaN, not a path
+            return np.full((model.canonical_state().means.shape[0], 3), np.nan, np.float32)
         with torch.no_grad():
             return model.gaussians_at(int(frame_idx), winds[condition]).means.cpu().numpy()
 

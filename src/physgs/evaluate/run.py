@@ -11,7 +11,7 @@ import numpy as np
 from physgs.evaluate.adapter import model_means_fn, model_render_fn
 from physgs.atomic import save_npz
 from physgs.evaluate.metrics import psnr
-from physgs.evaluate.splits import evaluate
+from physgs.evaluate.splits import NotDefined, evaluate
 from physgs.evaluate.trajectories import tip_trajectories
 
 
@@ -43,7 +43,13 @@ def render_panels(render_fn, observed) -> dict[str, np.ndarray]:
         else:
             m = int(np.flatnonzero(np.asarray(observed.heldout_frame_idx) == j)[0])
             cam, gt = observed.heldout_cameras[a], observed.heldout_frames[a, m]
-        rgb, _ = render_fn(j, c, cam)
+        try:
+            rgb, _ = render_fn(j, c, cam)
+        except NotDefined:  # a blank panel and a NaN score: "not defined"
+            out[f"{split}_pred"] = np.zeros(np.asarray(gt).shape, np.uint8)
+            out[f"{split}_gt"] = np.asarray(gt)
+            out[f"{split}_psnr"] = np.asarray(float("nan"))
+            continue
         out[f"{split}_pred"] = (np.clip(rgb, 0, 1) * 255 + 0.5).astype(np.uint8)
         out[f"{split}_gt"] = np.asarray(gt)
         out[f"{split}_psnr"] = np.asarray(float(psnr(rgb, gt)))
@@ -63,6 +69,24 @@ def training_camera_scores(
         mse.append(float(np.mean((rgb - gt) ** 2)))
         score.append(float(psnr(rgb, observed.frames[condition, j])))
     return np.asarray(mse), np.asarray(score)
+
+
+def undefined_splits(model, observed) -> set[str]:
+    """The summary keys (``EvalResult.summary``) holding a frame the model does not predict
+    (``model.defined``): a learned forcing has none beyond its window or under another wind."""
+    n, C = int(observed.n_train), len(observed.conditions)
+    out = set()
+    if not model.defined(n, 0):
+        out.add("time")
+    if not all(model.defined(int(j), 0) for j in observed.heldout_frame_idx):
+        out.add("view")
+    for c in range(C):
+        train = all(model.defined(j, c) for j in (0, n - 1))
+        beyond = model.defined(n, c)
+        out |= {f"train_c{c}"} if not train else set()
+        out |= {f"beyond_c{c}"} if not beyond else set()
+        out |= {f"centroid_c{c}"} if not (train and beyond) else set()
+    return out
 
 
 def evaluate_checkpoint(
@@ -87,7 +111,8 @@ def evaluate_checkpoint(
     traj = tip_trajectories(model_means_fn(model, observed), truth, observed, condition=0)
     panels = render_panels(render_fn, observed)
     summary = res.summary()
-    bad = [k for k, v in summary.items() if not np.isfinite(v)]
+    undefined = undefined_splits(model, observed)  # NaN there is "not defined", not corruption
+    bad = [k for k, v in summary.items() if not np.isfinite(v) and k not in undefined]
     if bad:
         raise FloatingPointError(
             f"evaluation produced non-finite scores for {bad}; "

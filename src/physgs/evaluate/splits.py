@@ -16,6 +16,13 @@ import numpy as np
 from physgs.atomic import save_npz
 from physgs.evaluate.metrics import centroid_error, psnr, to_float_image
 
+
+class NotDefined(Exception):
+    """A model makes no prediction for this frame or condition (a prior with a learned forcing
+    beyond its window or under another wind): the evaluation records NaN, "not defined", never
+    a score."""
+
+
 RenderFn = Callable[[int, int, object], tuple[np.ndarray, np.ndarray]]
 
 
@@ -99,6 +106,9 @@ def evaluate(
 ) -> EvalResult:
     """Score a model through its render callback on every split of SPEC section 4.
 
+    A frame the callback refuses with ``NotDefined`` (a learned forcing beyond its window or
+    under another wind) scores NaN: its split means are NaN, "not defined", never a number.
+
     observed: a ``physgs.testbed.dataset.Observed``. Renders C x F frames at the training camera
     and A x M held-out views (training condition). Returns per-frame PSNR (dB) and centroid
     errors (px); means per split come from ``EvalResult.summary()``.
@@ -117,7 +127,11 @@ def evaluate(
         if progress and j % 50 == 0:
             progress(f"training camera, frame {j + 1}/{F}, {C} conditions")
         for c in range(C):
-            rgb, alpha = _render(render_fn, j, c, observed.train_camera, (H, W))
+            try:
+                rgb, alpha = _render(render_fn, j, c, observed.train_camera, (H, W))
+            except NotDefined:  # no prediction there: "not defined", never a score
+                cam_psnr[c, j] = cen[c, j] = np.nan
+                continue
             cam_psnr[c, j] = psnr(rgb, frames[c, j])
             cen[c, j] = centroid_error(alpha, observed.masks[c, j])
     return EvalResult(

@@ -63,11 +63,15 @@ class ModelContext:
         )
 
 
-def context_from_observed(obs) -> ModelContext:
-    """ModelContext from a ``physgs.testbed.dataset.Observed`` (training condition = index 0)."""
-    w = np.asarray(obs.wind[0], dtype=np.float64)  # [L+F] m/s
+def context_from_observed(obs, wind: bool = True) -> ModelContext:
+    """ModelContext from a ``physgs.testbed.dataset.Observed`` (training condition = index 0).
+
+    wind=False: a model that never reads the wind (``ModelSpec.wind``): the wind statistics are
+    NaN and the observed wind is not looked at (it may be NaN itself).
+    """
+    w = np.asarray(obs.wind[0], dtype=np.float64) if wind else np.full(2, np.nan)  # [L+F] m/s
     std = float(w.std())
-    if not np.isfinite(w).all() or std <= 0:
+    if wind and (not np.isfinite(w).all() or std <= 0):
         raise ValueError(
             "the training condition's observed wind is constant or not finite; a wind-driven "
             "model needs varying wind: regenerate the testbed dataset"
@@ -128,6 +132,11 @@ class BaseModel(nn.Module):
     # Whether the deformation reads the wind (a model that does not gives the same Gaussians under
     # every condition, which lets the evaluation deform each frame once).
     use_wind: bool = True
+
+    def defined(self, frame_idx: int, condition: int) -> bool:
+        """Whether the model predicts recorded frame ``frame_idx`` under condition ``condition``
+        (every model but a prior with a learned forcing predicts everything)."""
+        return True
 
     def canonical_state(self) -> GaussianState:
         """The undeformed canonical Gaussians (used by the shared static warm-up)."""

@@ -203,6 +203,21 @@ def _reference(omega, zeta, gain, u, dt, substeps):
     return torch.stack(out, dim=1)
 
 
+def _check_args(omega, zeta, gain, dt, substeps, backend) -> None:
+    """The shape, step and backend checks ``integrate`` and ``integrate_forcing`` share."""
+    if backend not in ("fast", "reference"):
+        raise ValueError(f"integrate: backend must be 'fast' or 'reference', got {backend!r}")
+    if not (omega.ndim == 1 and omega.shape == zeta.shape == gain.shape):
+        raise ValueError(
+            "integrate: omega, zeta and gain must be 1-D tensors of one length K; got shapes "
+            f"{tuple(omega.shape)}, {tuple(zeta.shape)}, {tuple(gain.shape)}"
+        )
+    if isinstance(substeps, bool) or int(substeps) != substeps or substeps < 1:
+        raise ValueError(f"integrate: substeps must be a positive integer, got {substeps!r}")
+    if not dt > 0:
+        raise ValueError(f"integrate: dt must be > 0 seconds, got {dt}")
+
+
 def integrate(
     omega: torch.Tensor,
     zeta: torch.Tensor,
@@ -225,24 +240,45 @@ def integrate(
     Raises StabilityError if max |lambda| * dt / substeps > guard, |lambda| = fastest_rate(omega,
     zeta) (= omega unless over-damped).
     """
-    if backend not in ("fast", "reference"):
-        raise ValueError(f"integrate: backend must be 'fast' or 'reference', got {backend!r}")
-    if not (omega.ndim == 1 and omega.shape == zeta.shape == gain.shape):
-        raise ValueError(
-            "integrate: omega, zeta and gain must be 1-D tensors of one length K; got shapes "
-            f"{tuple(omega.shape)}, {tuple(zeta.shape)}, {tuple(gain.shape)}"
-        )
-    if isinstance(substeps, bool) or int(substeps) != substeps or substeps < 1:
-        raise ValueError(f"integrate: substeps must be a positive integer, got {substeps!r}")
-    if not dt > 0:
-        raise ValueError(f"integrate: dt must be > 0 seconds, got {dt}")
+    _check_args(omega, zeta, gain, dt, substeps, backend)
     w = torch.as_tensor(wind).detach().to("cpu", torch.float64)
     if w.ndim != 1 or w.shape[0] < 1 or not torch.isfinite(w).all():
         raise ValueError(
             f"integrate: wind must be a finite 1-D series [T] in m/s; got shape {tuple(w.shape)}"
         )
+    u = w * w - float(vbar) ** 2  # [T] forcing before the gain, m^2/s^2
+    return integrate_forcing(
+        omega, zeta, gain, u, dt, substeps, guard=guard, backend=backend, _checked=True
+    )
+
+
+def integrate_forcing(
+    omega: torch.Tensor,
+    zeta: torch.Tensor,
+    gain: torch.Tensor,
+    u,
+    dt: float,
+    substeps: int,
+    *,
+    guard: float = STABILITY_GUARD,
+    backend: str = "fast",
+    _checked: bool = False,
+) -> torch.Tensor:
+    """``integrate`` for a forcing u [T] given directly instead of a wind (``integrate``'s
+    v^2 - vbar^2): theta'' + 2 zeta omega theta' + omega^2 theta = gain u(t), from rest at
+    sample 0, u linear between samples. Returns theta [K, T] (rad per unit of gain x u);
+    differentiable w.r.t. omega, zeta, gain (not u). Same checks and StabilityError as
+    ``integrate``.
+    """
+    if not _checked:
+        _check_args(omega, zeta, gain, dt, substeps, backend)
+    u = torch.as_tensor(u).detach().to("cpu", torch.float64)
+    if u.ndim != 1 or u.shape[0] < 1 or not torch.isfinite(u).all():
+        raise ValueError(
+            f"integrate: the forcing must be a finite 1-D series [T]; got {tuple(u.shape)}"
+        )
     if omega.numel() == 0:
-        return omega.new_zeros((0, w.shape[0]))
+        return omega.new_zeros((0, u.shape[0]))
     om_min, ze_min = float(omega.detach().min()), float(zeta.detach().min())
     if not om_min > 0:
         raise ValueError(
@@ -269,7 +305,6 @@ def integrate(
             f"h = dt/substeps = {dt:.4g}/{substeps} = {h:.4g} s gives |lambda|*h = {rate * h:.3g} "
             f"> {guard}; use substeps >= {need} (or lower the omega / zeta upper bounds)"
         )
-    u = w * w - float(vbar) ** 2  # [T] forcing before the gain, m^2/s^2
     if backend == "reference":
         return _reference(omega, zeta, gain, u.to(omega.dtype), float(dt), int(substeps))
     return _RK4Sensitivity.apply(omega, zeta, gain, u.numpy(), float(dt), int(substeps))

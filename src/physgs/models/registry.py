@@ -39,6 +39,7 @@ class ModelSpec:
     wind: bool  # reads the observed wind
     parts: str = "kmeans"  # oscillator priors: how parts are cut ("kmeans" or "topology")
     chain: bool = False  # oscillator priors: each part's transform composed with its parent's
+    forcing: str = "wind"  # oscillator priors: "wind" (measured) or "learned" (physgs.models.blind)
 
 
 #: The one source of model ids and labels; order = row order of every table.
@@ -60,6 +61,18 @@ PRIOR_VARIANTS: dict[str, ModelSpec] = {
     "ours_topo": ModelSpec("Ours, topology parts", "topology", "ours", True, parts="topology"),
     "ours_chain": ModelSpec(
         "Ours, chained topology parts", "chained", "ours", True, parts="topology", chain=True
+    ),
+    # issue 42: ours with a learned forcing shared by every part instead of the measured wind
+    # (physgs.models.blind); trained in `single` only (one window, one forcing)
+    "ours_blind": ModelSpec("Ours, learned forcing", "blind", "ours", False, forcing="learned"),
+    "ours_chain_blind": ModelSpec(
+        "Ours, chained topology parts, learned forcing",
+        "chained, blind",
+        "ours",
+        False,
+        parts="topology",
+        chain=True,
+        forcing="learned",
     ),
 }
 PRIOR_VARIANT_NAMES = tuple(PRIOR_VARIANTS)
@@ -114,11 +127,14 @@ def config_label(name: str, spec: dict, tex: bool = True) -> str:
 
 def configs_for(model: str, configs) -> tuple[str, ...]:
     """Configurations a model is trained in: every model (references too) `single`, ours (and
-    its variants) every configuration.
+    its wind-driven variants) every configuration; a prior with a learned forcing `single`
+    only (one training window, one forcing).
 
     configs: the names of the config's ``models.configs`` (the one source of configurations).
     """
-    return tuple(configs) if is_prior(model) else (BASE_CONFIG,)
+    if is_prior(model) and spec_of(model).forcing == "wind":
+        return tuple(configs)
+    return (BASE_CONFIG,)
 
 
 def training_jobs(configs) -> list[tuple[str, str]]:
@@ -141,6 +157,8 @@ def model_settings(models_cfg: dict, model: str) -> dict:
         out[spec.family] = {**section, "time_top_hz": {model: section["time_top_hz"][model]}}
     if spec.parts == "topology":
         out["topology"] = models_cfg["topology"]
+    if spec.forcing == "learned":
+        out["blind"] = models_cfg["blind"]
     if searches_omega(models_cfg, model):  # its own entry only: another model's leaves it alone
         out["omega_search"] = {**models_cfg["omega_search"], "models": [model]}
     if spec.wind and spec.family in FIELDS:
@@ -201,7 +219,11 @@ def build_model(
             f"model {name!r} is a method: it may not read the ground truth "
             f"(truth.npz); only the references {REFERENCE_NAMES} do"
         )
-    ctx = observed if isinstance(observed, ModelContext) else context_from_observed(observed)
+    ctx = (  # a prior with a learned forcing never looks at the observed wind
+        observed
+        if isinstance(observed, ModelContext)
+        else context_from_observed(observed, wind=spec_of(name).forcing == "wind")
+    )
     canon = dict(cfg["canonical"])
     if is_reference(name):
         if truth is None:
@@ -263,7 +285,16 @@ def build_model(
             parent=parent,
             canonical_pose=canonical_pose_of(t),
         )
-    return OscillatorPrior(
+    if spec.forcing == "learned":
+        from physgs.models.blind import BlindOscillatorPrior
+
+        if options.get("search") is not None:
+            raise ValueError(f"{name} has no search over omega: remove it from models/omega_search")
+        cls = BlindOscillatorPrior
+        options["forcing_hz"] = float(cfg["blind"]["forcing_hz"])
+    else:
+        cls = OscillatorPrior
+    return cls(
         ctx,
         canon,
         K=int(K),

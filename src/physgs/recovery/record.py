@@ -67,6 +67,23 @@ def score_recovery(
     return RecoveryRecord(m, damping_summary(omega_hat, zeta_hat, zeta_true))
 
 
+def with_damping_scores(rec: RecoveryRecord, zeta_hat, truth, damping: dict) -> RecoveryRecord:
+    """``rec`` with each trusted part's zeta scored against its bone's true zeta and against
+    the untrained null drawn log-uniformly from ``damping['zeta_range']`` with seed
+    ``damping['seed']`` (``physgs.recovery.damping_scores``; tab_damping). zeta_hat [K]."""
+    from physgs.recovery.damping_scores import damping_null, score_match
+
+    zb, ob = np.asarray(truth.zeta, np.float64), np.asarray(truth.omega, np.float64)
+    m = rec.match
+    return dataclasses.replace(
+        rec,
+        damping_scores=score_match(m, np.asarray(zeta_hat, np.float64), zb, ob),
+        damping_null=damping_null(
+            m.bone, m.trusted, m.omega_hat, zb, ob, damping["zeta_range"], seed=int(damping["seed"])
+        ),
+    )
+
+
 def recovery_dict(rec: RecoveryRecord) -> dict:
     """The JSON object ``save_recovery`` writes (``load_recovery`` ignores any other key, so a
     method may add its own block beside these)."""

@@ -28,7 +28,7 @@ def recover_model(
     """
     import torch
 
-    from physgs.recovery.record import score_recovery
+    from physgs.recovery.record import score_recovery, with_damping_scores
 
     if not hasattr(model, "part_theta"):
         raise TypeError(f"recovery needs the oscillator prior ('ours'); got {type(model).__name__}")
@@ -43,23 +43,7 @@ def recover_model(
     if bone_visible is not None:
         rec = rec.with_visibility(bone_visible)
     if damping is not None:
-        from physgs.recovery.damping_scores import damping_null, score_match
-
-        zb, ob = np.asarray(truth.zeta, np.float64), np.asarray(truth.omega, np.float64)
-        m = rec.match
-        rec = dataclasses.replace(
-            rec,
-            damping_scores=score_match(m, zeta, zb, ob),
-            damping_null=damping_null(
-                m.bone,
-                m.trusted,
-                m.omega_hat,
-                zb,
-                ob,
-                damping["zeta_range"],
-                seed=int(damping["seed"]),
-            ),
-        )
+        rec = with_damping_scores(rec, zeta, truth, damping)
     frozen = getattr(model, "frozen", None)
     if frozen is None or not bool(frozen.any()):
         return rec

@@ -365,6 +365,8 @@ def measure(
         out += _parts_claims(tables["tab_parts"], trees)
     if "tab_tracks" in tables and "tab_null" in tables:
         out += _tracks_claims(tables["tab_null"], tables["tab_tracks"], trees)
+    if "tab_null" in tables:
+        out += _blind_claims(tables["tab_null"], tables.get("tab_damping"), trees)
 
     # the margin columns, first and last wind (named generically when the table was not built)
     mg = tables.get("tab_margin")
@@ -535,6 +537,96 @@ def _tracks_claims(
                         "px",
                     ),
                     [tail(d) for d in _per_seed(tracks)],
+                )
+            )
+    return out
+
+
+#: methods of tab_null / tab_damping that read no wind (issue 42, docs/blind.md)
+OMA, BLIND = "oma", "ours_blind"
+
+
+def _blind_claims(
+    null: pd.DataFrame, damping: pd.DataFrame | None, trees: Sequence[str]
+) -> list[tuple[Claim, list[float]]]:
+    """The forcing-free methods' claims (issue 42), in ``single`` (the one configuration both
+    run in), from tab_null / tab_damping rows whose column ``method`` is ``oma`` or
+    ``ours_blind``; a claim whose rows are absent is not added.
+
+    - ``anemometer_needed/<tree>``: ours with a learned forcing minus ours (median omega error,
+      points) above 0: the measured wind helps recovery;
+    - ``oma_beats_null/sparse``: null / output-only median omega error above 1;
+    - ``oma_recovers_zeta/<tree>``: output-only minus null median zeta error (points, the
+      damping benchmark's testbed) below 0.
+    """
+    out: list[tuple[Claim, list[float]]] = []
+    if "method" not in null.columns:
+        return out
+    c = "single"
+
+    def cell(d, tree, method, col):
+        r = d[(d["tree"] == tree) & (d["config"] == c) & (d["method"] == method)]
+        return float(r.iloc[0][col]) if len(r) else float("nan")
+
+    have = set(null["method"])
+    for t in trees:
+        if BLIND in have and (null["tree"] == t).any():
+            out.append(
+                (
+                    Claim(
+                        f"anemometer_needed/{t}",
+                        f"{t}: without the measured wind (a learned forcing) ours recovers "
+                        "omega worse",
+                        "the paper's closing limit: 'real footage needs an anemometer'",
+                        f"tab_null, {c}: ours_blind - ours median rel. error (points)",
+                        0.0,
+                        ">",
+                        "pp",
+                    ),
+                    [
+                        cell(d, t, BLIND, "trained_median_rel_err_pct")
+                        - cell(d, t, "ours", "trained_median_rel_err_pct")
+                        for d in _per_seed(null)
+                    ],
+                )
+            )
+    if OMA in have and "sparse" in trees:
+        out.append(
+            (
+                Claim(
+                    "oma_beats_null/sparse",
+                    "sparse: output-only modal analysis of the video recovers omega better "
+                    "than the untrained null",
+                    "not run",
+                    f"tab_null, {c}: null / output-only median rel. error",
+                    1.0,
+                    ">",
+                    "ratio",
+                ),
+                [
+                    cell(d, "sparse", OMA, "null_median_rel_err_pct")
+                    / cell(d, "sparse", OMA, "trained_median_rel_err_pct")
+                    for d in _per_seed(null)
+                ],
+            )
+        )
+    if damping is not None and "method" in damping.columns and OMA in set(damping["method"]):
+        for t in trees:
+            if not (damping["tree"] == t).any():
+                continue
+            out.append(
+                (
+                    Claim(
+                        f"oma_recovers_zeta/{t}",
+                        f"{t} (damping testbed): output-only modal analysis recovers zeta "
+                        "better than the untrained null",
+                        "no method here recovers zeta (the paper)",
+                        f"tab_damping, {c}: output-only - null median zeta error (points)",
+                        0.0,
+                        "<",
+                        "pp",
+                    ),
+                    [cell(d, t, OMA, "trained_minus_null_pp") for d in _per_seed(damping)],
                 )
             )
     return out

@@ -9,7 +9,12 @@ from dataclasses import dataclass
 import numpy as np
 
 from physgs.atomic import write_json
-from physgs.recovery.record import RecoveryRecord, recovery_dict, score_recovery
+from physgs.recovery.record import (
+    RecoveryRecord,
+    recovery_dict,
+    score_recovery,
+    with_damping_scores,
+)
 from physgs.tracks.fit import Oscillators, TrackFit, part_theta
 
 
@@ -71,23 +76,7 @@ def recover_tracks(
     if bone_visible is not None:
         rec = rec.with_visibility(bone_visible)
     if damping is not None:
-        from physgs.recovery.damping_scores import damping_null, score_match
-
-        zb, ob = np.asarray(truth.zeta, np.float64), np.asarray(truth.omega, np.float64)
-        m = rec.match
-        rec = dataclasses.replace(
-            rec,
-            damping_scores=score_match(m, np.asarray(fit.zeta, np.float64), zb, ob),
-            damping_null=damping_null(
-                m.bone,
-                m.trusted,
-                m.omega_hat,
-                zb,
-                ob,
-                damping["zeta_range"],
-                seed=int(damping["seed"]),
-            ),
-        )
+        rec = with_damping_scores(rec, np.asarray(fit.zeta, np.float64), truth, damping)
     zeta = np.asarray(fit.zeta, np.float64)[fit.estimated]
     med = float(np.median(zeta)) if zeta.size else float("nan")
     return TracksRecovery(

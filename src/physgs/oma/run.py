@@ -1,0 +1,184 @@
+"""Output-only modal analysis of one tree's training video, and its recovery record.
+
+``identify_video`` reads the frames of the training window and the background colour, nothing
+else (never the wind: ``tests/test_oma.py`` replaces it by NaN). ``recover_oma`` is evaluation:
+each part with a mode is integrated as ours' oscillator (omega, zeta from the mode, ours'
+solver) under the training wind over the training window, exactly as the untrained null draws
+are, and pushed through ours' matcher and trusted-part rule, so its row and the null's compare
+like with like.
+"""
+
+from __future__ import annotations
+
+import json
+from dataclasses import asdict, dataclass
+
+import numpy as np
+
+from physgs.atomic import atomic_path, write_json
+from physgs.oma.channels import Channels, FlowSettings, flow_channels, principal_channels
+from physgs.oma.parts import PartModes, assign_modes, cell_parts
+from physgs.oma.ssi import Modes, SSISettings, Stabilisation, identify_records
+
+
+@dataclass(frozen=True)
+class OMASettings:
+    """flow: the channels; components: principal components SSI reads; ssi: SSI-cov;
+    omega_hz: ours' frequency bounds (Hz): a mode outside them is not a part's estimate, as
+    ours cannot reach it either."""
+
+    flow: FlowSettings
+    components: int
+    ssi: SSISettings
+    omega_hz: tuple[float, float]
+
+    @staticmethod
+    def from_config(oma: dict, ours: dict) -> "OMASettings":
+        return OMASettings(
+            FlowSettings(**oma["flow"]),
+            int(oma["components"]),
+            SSISettings(**oma["ssi"]),
+            (float(ours["omega_hz"][0]), float(ours["omega_hz"][1])),
+        )
+
+
+@dataclass(frozen=True)
+class Identification:
+    """The channels' geometry and the modes identified from them."""
+
+    channels: Channels
+    modes: Modes
+    seconds: float  # wall time of flow + SSI
+
+
+def identify_video(
+    videos: list[np.ndarray], background, fps: float, s: OMASettings
+) -> Identification:
+    """Flow channels of each video's window frames [T, H, W, 3] uint8 (the first video's cells
+    for all), the principal components of all records together, SSI-cov over the records
+    (``identify_records``), and the modes inside ours' bounds, their shapes mapped back over
+    the cell channels."""
+    import time
+
+    t0 = time.perf_counter()
+    chans = [flow_channels(v, background, s.flow, reference=videos[0][0]) for v in videos]
+    ys = [c.y - c.y.mean(axis=0) for c in chans]
+    stacked = np.concatenate(ys)  # [sum T, C]
+    _, load = principal_channels(stacked, min(s.components, *stacked.shape))
+    m = identify_records([y @ load.T for y in ys], fps, s.ssi)
+    keep = (m.freq_hz >= s.omega_hz[0]) & (m.freq_hz <= s.omega_hz[1])
+    shape = m.shape[keep] @ load  # [M, C] over the cell channels
+    modes = Modes(
+        m.freq_hz[keep], m.zeta[keep], shape, m.n_stable[keep], m.freq_spread[keep], m.stab
+    )
+    return Identification(chans[0], modes, time.perf_counter() - t0)
+
+
+def save_identification(path, ident: Identification, s: OMASettings) -> None:
+    m, ch = ident.modes, ident.channels
+    with atomic_path(path) as tmp:
+        with open(tmp, "wb") as fh:
+            np.savez(
+                fh,
+                freq_hz=m.freq_hz,
+                zeta=m.zeta,
+                shape=m.shape,
+                n_stable=m.n_stable,
+                freq_spread=m.freq_spread,
+                stab_freq_hz=m.stab.freq_hz,
+                stab_stable=m.stab.stable,
+                stab_orders=m.stab.orders,
+                cell_xy=ch.cell_xy,
+                channel_cell=ch.channel_cell,
+                seconds=ident.seconds,
+                settings=json.dumps(asdict(s)),
+            )
+
+
+def load_identification(path) -> Identification:
+    with np.load(path) as d:
+        modes = Modes(
+            d["freq_hz"],
+            d["zeta"],
+            d["shape"],
+            d["n_stable"],
+            d["freq_spread"],
+            Stabilisation(d["stab_freq_hz"], d["stab_stable"], d["stab_orders"]),
+        )
+        ch = Channels(np.zeros((0, d["channel_cell"].size)), d["cell_xy"], d["channel_cell"])
+        return Identification(ch, modes, float(d["seconds"]))
+
+
+def part_modes(ident: Identification, K: int, seed: int, n_init: int) -> PartModes:
+    """The cells' K parts (k-means, training seed) and each part's mode."""
+    parts = cell_parts(ident.channels.cell_xy, K, seed, n_init)
+    m = ident.modes
+    return assign_modes(m.freq_hz, m.zeta, m.shape, ident.channels.channel_cell, parts, K)
+
+
+def recover_oma(
+    pm: PartModes,
+    observed,
+    truth,
+    solver: dict,
+    bone_visible=None,
+    damping: dict | None = None,
+):
+    """Ours' recovery record for the parts' modal estimates (evaluation: reads wind and truth).
+
+    solver: ours' settings (``physgs.recovery.run.null_settings``: omega_hz, zeta, zeta_init,
+    substeps, rk4_guard); a part without a mode keeps ours' initial values and theta = 0.
+    Returns (RecoveryRecord, the ``oma`` block of the record).
+    """
+    import torch
+
+    from physgs.models.oscillator import integrate
+    from physgs.models.ours import prior_substeps
+    from physgs.recovery.record import score_recovery, with_damping_scores
+
+    dt = 1.0 / float(observed.fps)
+    sub = prior_substeps(
+        solver["omega_hz"], solver["zeta"], solver["substeps"], dt, solver["rk4_guard"]
+    )
+    est = pm.estimated
+    K = est.size
+    omega = np.where(est, pm.omega, 2 * np.pi * float(np.sqrt(np.prod(solver["omega_hz"]))))
+    zeta = np.where(est, pm.zeta, float(solver["zeta_init"]))
+    zeta = np.clip(zeta, *solver["zeta"])  # ours' bounds: the solver's guard holds
+    wind = np.asarray(observed.wind[0], np.float64)  # [L+F]
+    with torch.no_grad():
+        th = integrate(
+            torch.as_tensor(omega),
+            torch.as_tensor(zeta),
+            torch.ones(K, dtype=torch.float64),
+            wind,
+            float(np.asarray(observed.vbar)[0]),
+            dt,
+            sub,
+        ).numpy()  # [K, L+F]
+    th[~est] = 0.0  # no estimate: correlates with nothing, never trusted
+    rec = score_recovery(
+        th, omega, zeta, truth, int(observed.lead_in_frames), int(observed.n_train)
+    )
+    if np.any(rec.match.trusted & ~est):
+        raise RuntimeError("a part with no mode was matched as trusted; its theta is not 0")
+    if bone_visible is not None:
+        rec = rec.with_visibility(bone_visible)
+    if damping is not None:
+        rec = with_damping_scores(rec, zeta, truth, damping)
+    block = {
+        "n_parts": int(K),
+        "n_modes": int(pm.mode_part.size),
+        "n_no_estimate": int((~est).sum()),
+        "no_estimate": np.flatnonzero(~est).tolist(),
+        "mode_part": pm.mode_part.tolist(),
+        "median_zeta": float(np.median(pm.zeta[est])) if est.any() else float("nan"),
+    }
+    return rec, block
+
+
+def save_oma_recovery(path, rec, block: dict) -> None:
+    """Ours' recovery record (``load_recovery`` reads it) plus an ``oma`` block."""
+    from physgs.recovery.record import recovery_dict
+
+    write_json(path, {**recovery_dict(rec), "oma": block})

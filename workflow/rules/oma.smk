@@ -1,0 +1,77 @@
+# Output-only modal analysis (issue 42, docs/blind.md): SSI-cov of the training video's dense flow.
+# `oma_identify` reads observed.npz's frames only (never the wind); `oma_recovery` and
+# `fig_stabilisation` read the truth (the matcher's bones; the true frequencies drawn).
+
+
+rule oma_identify:
+    input:
+        observed=observed_input,
+    output:
+        modes=OMA_MODES,
+    log:
+        "logs/oma/{tree}/seed{seed}/modes_{config}.log",
+    benchmark:
+        "results/benchmarks/oma/{tree}/seed{seed}/modes_{config}.tsv"
+    wildcard_constraints:
+        config="|".join(OMA_CONFIGS) or "(?!x)x",
+    conda:
+        "../envs/physgs.yaml"
+    threads: 1
+    resources:
+        mem_mb=3000,
+        runtime=10,
+    params:
+        settings=oma_identify_params,
+    script:
+        "../scripts/oma_identify.py"
+
+
+# an evaluation (reads truth.npz): the modes mapped to parts, through ours' matcher
+rule oma_recovery:
+    input:
+        unpack(oma_recovery_inputs),
+    output:
+        record=OMA_RECOVERY,
+    log:
+        "logs/oma/{tree}/seed{seed}/recovery_{config}.log",
+    benchmark:
+        "results/benchmarks/oma/{tree}/seed{seed}/recovery_{config}.tsv"
+    wildcard_constraints:
+        config="|".join(OMA_CONFIGS) or "(?!x)x",
+    conda:
+        "../envs/physgs.yaml"
+    threads: 1
+    resources:
+        mem_mb=2000,
+        runtime=10,
+    params:
+        job=oma_recovery_params,
+        damping=recovery_damping_params,
+    script:
+        "../scripts/oma_recovery.py"
+
+
+# the first seed's stabilisation diagram of each tree, the true bone frequencies beside it
+rule fig_stabilisation:
+    input:
+        modes=lambda w: OMA_MODES.format(tree=w.tree, seed=SEEDS[0], config=OMA_CONFIGS[0]),
+        truth=lambda w: testbed_files(w.tree, SEEDS[0])["truth"],
+    output:
+        figure=OMA_FIGURE,
+    log:
+        "logs/oma/{tree}/fig_stabilisation.log",
+    conda:
+        "../envs/physgs.yaml"
+    threads: 1
+    resources:
+        mem_mb=2000,
+        runtime=10,
+    script:
+        "../scripts/oma_figure.py"
+
+
+# every record and figure of the analysis (not yet in `all`: the tables read them once wired)
+rule oma:
+    input:
+        expand(OMA_RECOVERY, tree=TESTBEDS, seed=SEEDS, config=OMA_CONFIGS),
+        expand(OMA_FIGURE, tree=TREES) if OMA_CONFIGS else [],
