@@ -132,3 +132,34 @@ def test_gsplat_matches_fast():
     # gsplat cuts footprints at 3 sigma where the CPU path uses the exact 1/255 contour.
     for a, b in zip((cpu.rgb, cpu.alpha, cpu.depth), (gpu.rgb, gpu.alpha, gpu.depth)):
         np.testing.assert_allclose(b.cpu().numpy(), a.numpy(), atol=2e-2)
+
+
+def test_work_count_matches_a_per_pixel_count(scene):
+    # The benchmark's work count: pairs composited before transmittance saturates, counted here
+    # independently per pixel (numpy, the reference's projection, every Gaussian in depth order).
+    from physgs.render.constants import ALPHA_MAX, ALPHA_MIN, T_MIN
+    from physgs.render.fast import work_count
+    from physgs.render.project import project_gaussians
+
+    means, quats, scales, opac, colors, cam, bg = scene
+    work = work_count(means, quats, scales, opac, colors, cam, bg)
+    proj = project_gaussians(means, quats, scales, cam)
+    keep = proj.valid.numpy()
+    m2, con = proj.means2d.numpy()[keep], proj.conics.numpy()[keep]
+    o, z = opac.numpy()[keep], proj.depths.numpy()[keep]
+    order = np.argsort(z, kind="stable")
+    m2, con, o = m2[order], con[order], o[order]
+    pairs = 0
+    for py in range(cam.height):
+        for px in range(cam.width):
+            d = np.array([px + 0.5, py + 0.5]) - m2  # [n, 2]
+            sigma = con[:, 0] * d[:, 0] ** 2 + 2 * con[:, 1] * d[:, 0] * d[:, 1]
+            sigma += con[:, 2] * d[:, 1] ** 2
+            a = np.minimum(ALPHA_MAX, o * np.exp(-0.5 * sigma))
+            a = a[a >= ALPHA_MIN]
+            T = np.cumprod(np.concatenate([[1.0], 1.0 - a]))  # T before each, then after
+            stop = np.flatnonzero(T[1:] < T_MIN)
+            pairs += int(stop[0]) if stop.size else a.size
+    assert work["pairs"] == pairs > 1000
+    assert work["footprint_pixels"] >= work["pairs"]
+    assert work["gaussians"] == 400 and work["rows"] <= work["footprint_pixels"]
