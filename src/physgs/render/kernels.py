@@ -51,10 +51,13 @@ def bin_tiles(boxes, order, tile, tiles_x, tiles_y):  # pragma: no cover - compi
     """
     n_tiles = tiles_x * tiles_y
     start = np.zeros(n_tiles + 1, np.int64)
+    span = np.empty((order.shape[0], 4), np.int64)  # tile ranges, one integer division each
     for k in range(order.shape[0]):
         g = order[k]
-        for ty in range(boxes[g, 2] // tile, boxes[g, 3] // tile + 1):
-            for tx in range(boxes[g, 0] // tile, boxes[g, 1] // tile + 1):
+        for j in range(4):
+            span[k, j] = boxes[g, j] // tile
+        for ty in range(span[k, 2], span[k, 3] + 1):
+            for tx in range(span[k, 0], span[k, 1] + 1):
                 start[ty * tiles_x + tx + 1] += 1
     for t in range(n_tiles):
         start[t + 1] += start[t]
@@ -63,9 +66,9 @@ def bin_tiles(boxes, order, tile, tiles_x, tiles_y):  # pragma: no cover - compi
     pair_rows = np.zeros(start[n_tiles] + 1, np.int64)
     for k in range(order.shape[0]):
         g = order[k]
-        for ty in range(boxes[g, 2] // tile, boxes[g, 3] // tile + 1):
+        for ty in range(span[k, 2], span[k, 3] + 1):
             n_rows = min(boxes[g, 3], ty * tile + tile - 1) - max(boxes[g, 2], ty * tile) + 1
-            for tx in range(boxes[g, 0] // tile, boxes[g, 1] // tile + 1):
+            for tx in range(span[k, 0], span[k, 1] + 1):
                 t = ty * tiles_x + tx
                 pair_gid[cursor[t]] = g
                 pair_rows[cursor[t] + 1] = n_rows
