@@ -4,6 +4,7 @@ log, and any traceback into that log before the job fails."""
 from __future__ import annotations
 
 import contextlib
+import os
 import sys
 import traceback
 
@@ -12,16 +13,21 @@ import traceback
 def job(sm):
     """Run a Snakemake script's body: ``with job(snakemake) as log: ...``.
 
-    Sets torch's and numba's thread counts to the rule's ``threads``, sends stdout and stderr
+    Sets torch's and numba's thread counts to the rule's ``threads`` (those imported now, and
+    through OMP_NUM_THREADS / NUMBA_NUM_THREADS those imported later), sends stdout and stderr
     (progress bars included) to ``sm.log[0]``, and writes the traceback of a failure there too
     (not only to the console) before re-raising it.
     """
     threads = max(1, int(getattr(sm, "threads", 1)))
-    import numba
-    import torch
-
-    torch.set_num_threads(threads)
-    numba.set_num_threads(min(threads, numba.config.NUMBA_NUM_THREADS))
+    # torch and numba are set where the script has imported them; a job that never does (the
+    # tracker) does not pay their start-up, and a later import reads the same count from the
+    # environment (OpenMP and numba read it when they load)
+    os.environ["OMP_NUM_THREADS"] = os.environ["NUMBA_NUM_THREADS"] = str(threads)
+    if "torch" in sys.modules:
+        sys.modules["torch"].set_num_threads(threads)
+    if "numba" in sys.modules:
+        numba = sys.modules["numba"]
+        numba.set_num_threads(min(threads, numba.config.NUMBA_NUM_THREADS))
     with (
         open(sm.log[0], "w") as log,
         contextlib.redirect_stderr(log),

@@ -8,12 +8,15 @@ gain, guard), so its evaluation integrates exactly the fitted model without read
 from __future__ import annotations
 
 import dataclasses
+from typing import TYPE_CHECKING
 
 import numpy as np
 
 from physgs.atomic import save_npz
-from physgs.tracks.fit import Oscillators, TrackFit
 from physgs.tracks.track import Tracks
+
+if TYPE_CHECKING:  # the fit's module imports torch: the tracker's job reads tracks only
+    from physgs.tracks.fit import Oscillators, TrackFit
 
 #: the scalar fields of ``Oscillators`` besides its bounds
 _OSC_SCALARS = ("substeps", "fps", "lead_in", "vbar_ratio", "gain", "guard")
@@ -68,6 +71,7 @@ def save_fit(path, fit: TrackFit, osc: Oscillators, K_key: str, min_tracks: int)
 def load_fit(path) -> tuple[TrackFit, Oscillators, dict]:
     """(TrackFit, Oscillators, {"K_key", "min_tracks"}) from ``save_fit``."""
     from physgs.models.oscillator_params import OscillatorBounds
+    from physgs.tracks.fit import Oscillators, TrackFit
 
     with np.load(path) as z:
         d = {k: z[k] for k in z.files}
