@@ -16,7 +16,8 @@ loops per pair (``kernels.FLOPS_PER_PAIR_FORWARD`` + ``_BACKWARD``, 76 for RGB),
 arithmetic ('Mflop') and its time at ``--gflops`` (default 4: a scalar float64 core sustaining
 ~1.5 flops a cycle at 2.6 GHz); 'ns/pair' is the measured forward+backward (fastest, CPU) per
 pair. The distance between 'ideal' and 'cpu min' is what projection, binning, allocation, the
-torch boundary and the kernels' own overheads (row spans, exps, branches) cost.
+torch boundary and the kernels' own overheads (row spans, exps, branches) cost; a second
+table splits each fast cell's forward + backward into those components (:func:`breakdown`).
 
 Per cell: median forward (no autograd) and forward+backward milliseconds, the fastest fast-path
 forward+backward in wall and in CPU seconds of the process (the best estimates on a shared
@@ -94,6 +95,7 @@ def one(backend: str, spec: str, reps: int) -> dict:
         for p in params:
             p.grad = None
     peak = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024 - base
+    parts = breakdown(params, cam, bg, reps) if backend == "fast" else {}
     return {
         "n": int(means.shape[0]),
         "res": f"{cam.width}x{cam.height}",
@@ -105,7 +107,58 @@ def one(backend: str, spec: str, reps: int) -> dict:
         "cover": float((out.alpha > 1.0 / 255.0).float().mean()),
         "pairs": work.get("pairs", 0),
         "flops": flops,
+        "parts": parts,
     }
+
+
+#: the fast path's numba kernels by the component of :data:`PARTS` they belong to
+KERNEL_PARTS = {
+    "project_forward": "project",
+    "pixel_boxes": "project",
+    "bin_tiles": "bin",
+    "forward": "composite",
+    "backward": "composite_bwd",
+    "reduce_pairs": "reduce",
+    "project_backward": "project_bwd",
+}
+PARTS = ("project", "bin", "composite", "composite_bwd", "reduce", "project_bwd", "rest")
+
+
+def breakdown(params, cam, bg, reps: int) -> dict[str, float]:
+    """Mean CPU ms per forward + backward call in each component (:data:`PARTS`), timed by
+    wrapping the fast path's kernels; 'rest' is the call's CPU time outside them: the depth sort,
+    per-call allocation, float64 copies in and out, input checks and the autograd boundary."""
+    from physgs.render import kernels, rasterization
+
+    sec = dict.fromkeys(PARTS, 0.0)
+    saved = {name: getattr(kernels, name) for name in KERNEL_PARTS}
+
+    def timed(name, fn):
+        def call(*a):
+            c0 = time.process_time()
+            try:
+                return fn(*a)
+            finally:
+                sec[KERNEL_PARTS[name]] += time.process_time() - c0
+
+        return call
+
+    total = 0.0
+    try:
+        for name, fn in saved.items():
+            setattr(kernels, name, timed(name, fn))
+        for _ in range(reps):
+            c0 = time.process_time()
+            out = rasterization(*params, cam, bg)
+            (out.rgb.sum() + out.alpha.sum() + out.depth.sum()).backward()
+            total += time.process_time() - c0
+            for p in params:
+                p.grad = None
+    finally:
+        for name, fn in saved.items():
+            setattr(kernels, name, fn)
+    sec["rest"] = total - sum(sec.values())
+    return {k: 1e3 * v / reps for k, v in sec.items()}
 
 
 def run_cell(backend: str, spec: str, reps: int) -> dict:
@@ -149,6 +202,7 @@ def main() -> None:
         f"{'ns/pair':>7} | {'ref fwd':>9} {'ref f+b':>9} {'MiB':>6} | "
         f"{'speed-up f+b':>12}"
     )
+    parts = []
     for spec, name in specs:
         f = run_cell("fast", spec, a.reps)
         line = (
@@ -166,6 +220,11 @@ def main() -> None:
                 f"{r['fb_ms'] / f['fb_ms']:>11.1f}x"
             )
         print(line, flush=True)
+        parts.append((name, f["parts"]))
+    print("\nfast path, CPU ms per forward + backward (mean of the reps) by component:")
+    print(f"{'scene':<8} " + " ".join(f"{p:>13}" for p in PARTS))
+    for name, p in parts:
+        print(f"{name:<8} " + " ".join(f"{p[k]:>13.2f}" for k in PARTS))
 
 
 if __name__ == "__main__":
