@@ -65,8 +65,13 @@ def load_scene(spec: str):
 
 
 def one(backend: str, spec: str, reps: int) -> dict:
-    """Time one cell in this process (called in a subprocess)."""
+    """Time one cell in this process (called in a subprocess), with the allocator as a
+    workflow job sets it (:func:`physgs.allocator.retain_freed_memory`)."""
     import torch
+
+    from physgs.allocator import retain_freed_memory
+
+    retain_freed_memory()
 
     from physgs.render import kernels, rasterization
     from physgs.render.fast import work_count

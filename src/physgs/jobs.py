@@ -8,17 +8,21 @@ import os
 import sys
 import traceback
 
+from physgs.allocator import retain_freed_memory
+
 
 @contextlib.contextmanager
 def job(sm):
     """Run a Snakemake script's body: ``with job(snakemake) as log: ...``.
 
-    Sets torch's and numba's thread counts to the rule's ``threads`` (those imported now, and
+    Keeps freed memory in the process (:func:`physgs.allocator.retain_freed_memory`), sets
+    torch's and numba's thread counts to the rule's ``threads`` (those imported now, and
     through OMP_NUM_THREADS / NUMBA_NUM_THREADS those imported later), sends stdout and stderr
     (progress bars included) to ``sm.log[0]``, and writes the traceback of a failure there too
     (not only to the console) before re-raising it.
     """
     threads = max(1, int(getattr(sm, "threads", 1)))
+    retain_freed_memory()  # no page faults of fresh memory every training iteration
     # torch and numba are set where the script has imported them; a job that never does (the
     # tracker) does not pay their start-up, and a later import reads the same count from the
     # environment (OpenMP and numba read it when they load)
