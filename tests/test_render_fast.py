@@ -73,6 +73,30 @@ def test_fast_matches_reference_across_footprint_sizes(n, spacing, label):
         )
 
 
+@pytest.mark.parametrize("D", [1, 2, 5])
+def test_fast_matches_reference_for_other_channel_counts(scene, D):
+    # The kernels unroll RGB (D = 3); every other channel count takes their generic loops.
+    means, quats, scales, opac, colors, cam, bg = scene
+    g = torch.Generator().manual_seed(D)
+    colors = torch.rand((colors.shape[0], D), generator=g, dtype=torch.float64)
+    bg = torch.rand(D, generator=g, dtype=torch.float64)
+    grads = {}
+    for backend in ("reference", "fast"):
+        params = [x.detach().requires_grad_(True) for x in (means, quats, scales, opac, colors, bg)]
+        out = rasterization(*params[:5], cam, params[5], backend=backend)
+        w = torch.rand(
+            out.rgb.shape, generator=torch.Generator().manual_seed(0), dtype=out.rgb.dtype
+        )
+        ((out.rgb * w).sum() + out.alpha.sum() + out.depth.sum()).backward()
+        grads[backend] = [out.rgb, out.alpha, out.depth] + [p.grad for p in params]
+    assert grads["fast"][0].shape[-1] == D
+    for name, a, b in zip(NAMES, grads["reference"], grads["fast"]):
+        scale = max(1.0, a.abs().max().item())
+        np.testing.assert_allclose(
+            b.detach().numpy(), a.detach().numpy(), rtol=0, atol=1e-10 * scale, err_msg=name
+        )
+
+
 def test_float32_paths_close_to_float64_reference(scene):
     # float32 inputs go through float64 kernels: the fast path's only error is the final cast.
     scene32 = [x.float() if isinstance(x, torch.Tensor) else x for x in scene]

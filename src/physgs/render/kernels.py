@@ -136,6 +136,13 @@ def _row_gauss(ca, cb, cc, mx, dy, x0, step):  # pragma: no cover - compiled
     return math.exp(-0.5 * sigma), math.exp(-ca * (dx + 0.5) - cb * dy) if step else 0.0
 
 
+@nb.njit(cache=True, inline="always")
+def _rgb(col):  # pragma: no cover - compiled
+    """The first three channels of col [D] as scalars (zeros past D): the kernels' RGB path."""
+    D = col.shape[0]
+    return col[0] if D > 0 else 0.0, col[1] if D > 1 else 0.0, col[2] if D > 2 else 0.0
+
+
 @nb.njit(cache=True)
 def pixel_boxes(means2d, cov2d, opac, valid, width, height, boxes):  # pragma: no cover
     """Numba twin of :func:`physgs.render.project.pixel_bounds` (the reference's binning; same
@@ -229,6 +236,7 @@ def forward(
             z = depths[g]
             for c in range(D):  # a local copy: the compiler cannot hoist loads past cacc stores
                 col_g[c] = colors[g, c]
+            c0, c1, c2 = _rgb(col_g)
             thr = _footprint(o)
             det = ca * cc - cb * cb
             ica = 1.0 / ca if ca > 0.0 else 0.0
@@ -265,8 +273,13 @@ def forward(
                         n_done += 1
                         continue
                     w = a * Tp
-                    for c in range(D):
-                        cacc[p, c] += w * col_g[c]
+                    if D == 3:  # RGB unrolled: the loop's operations in its order, ~8% faster
+                        cacc[p, 0] += w * c0
+                        cacc[p, 1] += w * c1
+                        cacc[p, 2] += w * c2
+                    else:
+                        for c in range(D):
+                            cacc[p, c] += w * col_g[c]
                     dacc[p] += w * z
                     cnt[p] += 1
                     T[p] = nt
@@ -367,6 +380,10 @@ def backward(
             for c in range(D):
                 col_g[c] = colors[g, c]
                 g_col[c] = 0.0
+            c0, c1, c2 = _rgb(col_g)
+            gr0 = 0.0  # RGB's colour gradients (D == 3), g_col's otherwise
+            gr1 = 0.0
+            gr2 = 0.0
             q = math.exp(-ca)
             g_mx = 0.0
             g_my = 0.0
@@ -402,10 +419,21 @@ def backward(
                         continue
                     w = a * Tp
                     u = up_d[p] * z
-                    for c in range(D):
-                        gc = up_c[p, c]
-                        u += gc * col_g[c]
-                        g_col[c] += gc * w
+                    if D == 3:  # RGB unrolled, as in the forward
+                        u0 = up_c[p, 0]
+                        u1 = up_c[p, 1]
+                        u2 = up_c[p, 2]
+                        u += u0 * c0
+                        u += u1 * c1
+                        u += u2 * c2
+                        gr0 += u0 * w
+                        gr1 += u1 * w
+                        gr2 += u2 * w
+                    else:
+                        for c in range(D):
+                            gc = up_c[p, c]
+                            u += gc * col_g[c]
+                            g_col[c] += gc * w
                     g_z += up_d[p] * w
                     Sp = S[p] - w * u
                     S[p] = Sp
@@ -427,6 +455,10 @@ def backward(
             pair_grad[k, 4] = g_c
             pair_grad[k, 5] = g_o
             pair_grad[k, 6] = g_z
+            if D == 3:
+                g_col[0] = gr0
+                g_col[1] = gr1
+                g_col[2] = gr2
             for c in range(D):
                 pair_grad[k, N_GRAD + c] = g_col[c]
 
