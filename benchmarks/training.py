@@ -28,6 +28,7 @@ import numpy as np
 import torch
 
 import physgs.config
+from physgs.allocator import retain_freed_memory
 import physgs.render.fast
 import physgs.train.loop
 from physgs.models import build_model, training_jobs
@@ -223,6 +224,7 @@ def main() -> None:
         "Snakemake's --configfile; config/float32.yaml on a CPU without native bf16)",
     )
     args = ap.parse_args()
+    retain_freed_memory()  # as a workflow job (physgs.jobs)
     torch.set_num_threads(args.threads)
     numba.set_num_threads(args.threads)
     raw = physgs.config.read_yaml("config/trees.yaml")

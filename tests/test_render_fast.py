@@ -73,6 +73,30 @@ def test_fast_matches_reference_across_footprint_sizes(n, spacing, label):
         )
 
 
+@pytest.mark.parametrize("D", [1, 2, 5])
+def test_fast_matches_reference_for_other_channel_counts(scene, D):
+    # The kernels unroll RGB (D = 3); every other channel count takes their generic loops.
+    means, quats, scales, opac, colors, cam, bg = scene
+    g = torch.Generator().manual_seed(D)
+    colors = torch.rand((colors.shape[0], D), generator=g, dtype=torch.float64)
+    bg = torch.rand(D, generator=g, dtype=torch.float64)
+    grads = {}
+    for backend in ("reference", "fast"):
+        params = [x.detach().requires_grad_(True) for x in (means, quats, scales, opac, colors, bg)]
+        out = rasterization(*params[:5], cam, params[5], backend=backend)
+        w = torch.rand(
+            out.rgb.shape, generator=torch.Generator().manual_seed(0), dtype=out.rgb.dtype
+        )
+        ((out.rgb * w).sum() + out.alpha.sum() + out.depth.sum()).backward()
+        grads[backend] = [out.rgb, out.alpha, out.depth] + [p.grad for p in params]
+    assert grads["fast"][0].shape[-1] == D
+    for name, a, b in zip(NAMES, grads["reference"], grads["fast"]):
+        scale = max(1.0, a.abs().max().item())
+        np.testing.assert_allclose(
+            b.detach().numpy(), a.detach().numpy(), rtol=0, atol=1e-10 * scale, err_msg=name
+        )
+
+
 def test_float32_paths_close_to_float64_reference(scene):
     # float32 inputs go through float64 kernels: the fast path's only error is the final cast.
     scene32 = [x.float() if isinstance(x, torch.Tensor) else x for x in scene]
@@ -132,3 +156,34 @@ def test_gsplat_matches_fast():
     # gsplat cuts footprints at 3 sigma where the CPU path uses the exact 1/255 contour.
     for a, b in zip((cpu.rgb, cpu.alpha, cpu.depth), (gpu.rgb, gpu.alpha, gpu.depth)):
         np.testing.assert_allclose(b.cpu().numpy(), a.numpy(), atol=2e-2)
+
+
+def test_work_count_matches_a_per_pixel_count(scene):
+    # The benchmark's work count: pairs composited before transmittance saturates, counted here
+    # independently per pixel (numpy, the reference's projection, every Gaussian in depth order).
+    from physgs.render.constants import ALPHA_MAX, ALPHA_MIN, T_MIN
+    from physgs.render.fast import work_count
+    from physgs.render.project import project_gaussians
+
+    means, quats, scales, opac, colors, cam, bg = scene
+    work = work_count(means, quats, scales, opac, colors, cam, bg)
+    proj = project_gaussians(means, quats, scales, cam)
+    keep = proj.valid.numpy()
+    m2, con = proj.means2d.numpy()[keep], proj.conics.numpy()[keep]
+    o, z = opac.numpy()[keep], proj.depths.numpy()[keep]
+    order = np.argsort(z, kind="stable")
+    m2, con, o = m2[order], con[order], o[order]
+    pairs = 0
+    for py in range(cam.height):
+        for px in range(cam.width):
+            d = np.array([px + 0.5, py + 0.5]) - m2  # [n, 2]
+            sigma = con[:, 0] * d[:, 0] ** 2 + 2 * con[:, 1] * d[:, 0] * d[:, 1]
+            sigma += con[:, 2] * d[:, 1] ** 2
+            a = np.minimum(ALPHA_MAX, o * np.exp(-0.5 * sigma))
+            a = a[a >= ALPHA_MIN]
+            T = np.cumprod(np.concatenate([[1.0], 1.0 - a]))  # T before each, then after
+            stop = np.flatnonzero(T[1:] < T_MIN)
+            pairs += int(stop[0]) if stop.size else a.size
+    assert work["pairs"] == pairs > 1000
+    assert work["footprint_pixels"] >= work["pairs"]
+    assert work["gaussians"] == 400 and work["rows"] <= work["footprint_pixels"]

@@ -590,7 +590,11 @@ def test_the_tracker_and_the_fit_read_no_truth(plan):
     tracks = _blocks(plan, "track")
     assert len(tracks) == len(cfg["trees"]) * n_cond  # joint32 fits every condition's tracks
     fits = _blocks(plan, "fit_tracks")
-    assert len(fits) == len(cfg["trees"]) * len(cfg["tracks"]["configs"])
+    # one job per tree and seed fits every configuration (they read the same files)
+    assert len(fits) == len(cfg["trees"]) * len(cfg["seeds"])
+    for b in fits:
+        outputs = re.search(r"output: (.*)", b).group(1)
+        assert all(f"fit_{c}.npz" in outputs for c in cfg["tracks"]["configs"]), outputs
     for b in tracks + fits:
         inputs = re.search(r"input: (.*)", b).group(1)
         assert "truth" not in inputs and "observed.npz" in inputs, inputs

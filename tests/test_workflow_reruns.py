@@ -157,8 +157,8 @@ def test_tracks_fit_settings_refit_the_tracks_control_only(plans):
     configurations) and rebuild what reads it; the tracks and every trained model stay."""
     plan = _counts(plans["tracks_iterations"])
     assert plan == {
-        "fit_tracks": 2,
-        "tracks_evaluate": 2,
+        "fit_tracks": 1,  # one job fits (and one scores) both configurations
+        "tracks_evaluate": 1,
         "tracks_fields": 1,  # the learned fields at the tracks of single
         "table": 2,  # tab_null (its tracks rows) and tab_tracks
         "figure": 1,  # fig_tracks colours the tracks by the fit's parts

@@ -21,6 +21,8 @@ import time
 import traceback
 from pathlib import Path
 
+from physgs.allocator import retain_freed_memory
+
 #: where the output locks live, relative to the workflow's working directory (not Snakemake's
 #: own ``.snakemake/locks``, which a finishing run deletes whole)
 LOCK_DIR = Path(".snakemake") / "physgs-locks"
@@ -69,16 +71,23 @@ def job(sm):
     """Run a Snakemake script's body: ``with job(snakemake) as log: ...``.
 
     Locks the job's outputs (:func:`output_locks`: a job whose output another run is making
-    stops at once), sets torch's and numba's thread counts to the rule's ``threads``, sends stdout
-    and stderr (progress bars included) to ``sm.log[0]``, and writes the traceback of a failure
-    there too (not only to the console) before re-raising it.
+    stops at once), keeps freed memory in the process
+    (:func:`physgs.allocator.retain_freed_memory`), sets torch's and numba's thread counts to the
+    rule's ``threads`` (those imported now, and through OMP_NUM_THREADS / NUMBA_NUM_THREADS those
+    imported later), sends stdout and stderr (progress bars included) to ``sm.log[0]``, and
+    writes the traceback of a failure there too (not only to the console) before re-raising it.
     """
     threads = max(1, int(getattr(sm, "threads", 1)))
-    import numba
-    import torch
-
-    torch.set_num_threads(threads)
-    numba.set_num_threads(min(threads, numba.config.NUMBA_NUM_THREADS))
+    retain_freed_memory()  # no page faults of fresh memory every training iteration
+    # torch and numba are set where the script has imported them; a job that never does (the
+    # tracker) does not pay their start-up, and a later import reads the same count from the
+    # environment (OpenMP and numba read it when they load)
+    os.environ["OMP_NUM_THREADS"] = os.environ["NUMBA_NUM_THREADS"] = str(threads)
+    if "torch" in sys.modules:
+        sys.modules["torch"].set_num_threads(threads)
+    if "numba" in sys.modules:
+        numba = sys.modules["numba"]
+        numba.set_num_threads(min(threads, numba.config.NUMBA_NUM_THREADS))
     with (
         output_locks(list(sm.output)),
         open(sm.log[0], "w") as log,

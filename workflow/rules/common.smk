@@ -1,6 +1,7 @@
 # Paths, wildcard constraints, input functions and narrow params of every rule. The workflow
 # owns the file layout; the library receives the files (and only the settings) a job reads.
 import os
+from types import SimpleNamespace
 
 import physgs.config as _config
 import physgs.experiments.fit_curve as _fit_curve
@@ -42,6 +43,8 @@ STAMP = _provenance.stamp(CFG)  # not a rerun trigger (see physgs.provenance.Sta
 # video, in these of ours' configurations, each with its K (tracks/K or the configuration's)
 TRACKS_CONFIGS = list(CFG["tracks"]["configs"])
 TRACKS_K = {c: _tracks.parts(CFG, c)[0] for c in TRACKS_CONFIGS}
+# on a damping testbed, the control runs in the damping benchmark's configurations only
+TRACKS_DAMPING_CONFIGS = [c for c in DAMPING["configs"] if c in TRACKS_CONFIGS]
 # (tree, configuration) pairs whose learned fields tab_tracks scores at the tracked points
 # output-only modal analysis of the training video (docs/blind.md): the configurations it runs in
 OMA_CONFIGS = list(CFG["oma"]["configs"])
@@ -352,31 +355,56 @@ def tracks_file(tree, seed, condition):
     )
 
 
+def tracks_configs(tree):
+    """The configurations the tracks control fits and scores on testbed ``tree``, in the order
+    of the batched rules' outputs: tracks/configs on a faithful tree, the damping benchmark's
+    among them on a damping testbed."""
+    return TRACKS_DAMPING_CONFIGS if tree in DAMPING_TREES else TRACKS_CONFIGS
+
+
+def tracks_outputs(pattern, configs):
+    """``pattern`` for each configuration ({tree} and {seed} left to the job): the batched
+    rules' outputs. With none, the pattern itself, which their config constraint never
+    matches (the rule then makes nothing)."""
+    return expand(pattern, config=configs, allow_missing=True) if configs else [pattern]
+
+
 def fit_tracks_params(wildcards):
-    """The fit's narrow settings (physgs.tracks.settings.fit_job): K and its key, the conditions,
-    the fit's settings and ours' oscillator settings."""
-    return _tracks.fit_job(CFG, wildcards.config, int(wildcards.seed))
+    """The fits' narrow settings, one per configuration of the tree in output order
+    (physgs.tracks.settings.fit_job): K and its key, the conditions, the fit's settings and
+    ours' oscillator settings."""
+    seed = int(wildcards.seed)
+    return [_tracks.fit_job(CFG, c, seed) for c in tracks_configs(wildcards.tree)]
 
 
 def fit_tracks_inputs(wildcards):
-    """The observed dataset (wind, frame rate, lead-in) and the tracks of every condition the
-    configuration fits (keys c<condition>); never the truth."""
+    """The observed dataset (wind, frame rate, lead-in) and the tracks of every condition a
+    configuration of the tree fits (keys c<condition>); never the truth."""
     out = {"observed": observed_input(wildcards)}
-    for c in fit_tracks_params(wildcards)["conditions"]:
-        out[f"c{c}"] = tracks_file(wildcards.tree, wildcards.seed, c)
+    for j in fit_tracks_params(wildcards):
+        for c in j["conditions"]:
+            out[f"c{c}"] = tracks_file(wildcards.tree, wildcards.seed, c)
     return out
 
 
 def tracks_evaluate_inputs(wildcards):
-    """The fit, the training video's tracks, the dataset, the truth and its statistics, and ours'
-    checkpoint in the same configuration (scored at the same tracked points)."""
-    t, s, c = wildcards.tree, wildcards.seed, wildcards.config
-    return {
-        "fit": TRACKS_FIT.format(tree=t, seed=s, config=c),
-        "tracks": tracks_file(t, s, 0),
-        **testbed_files(t, s),
-        "ours": CKPT.format(tree=t, seed=s, model="ours", config=c),
-    }
+    """Per configuration of the tree its fit and ours' checkpoint in it (scored at the same
+    tracked points; keys fit_<config>, ours_<config>), the training video's tracks, the dataset,
+    the truth and its statistics."""
+    t, s = wildcards.tree, wildcards.seed
+    out = {"tracks": tracks_file(t, s, 0), **testbed_files(t, s)}
+    for c in tracks_configs(t):
+        out[f"fit_{c}"] = TRACKS_FIT.format(tree=t, seed=s, config=c)
+        out[f"ours_{c}"] = CKPT.format(tree=t, seed=s, model="ours", config=c)
+    return out
+
+
+def tracks_evaluate_params(wildcards):
+    """recovery_damping_params of each configuration of the tree, in output order."""
+    return [
+        recovery_damping_params(SimpleNamespace(tree=wildcards.tree, seed=wildcards.seed, config=c))
+        for c in tracks_configs(wildcards.tree)
+    ]
 
 
 def tracks_fields_inputs(wildcards):

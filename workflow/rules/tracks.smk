@@ -38,18 +38,21 @@ use rule track as track_seeded with:
         "results/benchmarks/tracks/{tree}/seed{seed}/c{condition}.tsv"
 
 
-# the oscillators of one configuration fitted to the tracks of its conditions (observed only);
-# a K above the tracks kept stops here, naming the key
+# the oscillators of each configuration of the tree fitted to the tracks of its conditions
+# (observed only), one job per tree and seed: the configurations read the same files, and one
+# process saves each of them the start-up of another; a K above the tracks kept stops here,
+# naming the key
 rule fit_tracks:
     input:
         unpack(fit_tracks_inputs),
     output:
-        fit=TRACKS_FIT,
+        fits=tracks_outputs(TRACKS_FIT, TRACKS_CONFIGS),
     log:
-        "logs/tracks/{tree}/seed{seed}/fit_{config}.log",
+        "logs/tracks/{tree}/seed{seed}/fit.log",
     benchmark:
-        "results/benchmarks/tracks/{tree}/seed{seed}/fit_{config}.tsv"
+        "results/benchmarks/tracks/{tree}/seed{seed}/fit.tsv"
     wildcard_constraints:
+        tree="|".join(TREES),
         config="|".join(TRACKS_CONFIGS) or "(?!x)x",
     conda:
         "../envs/physgs.yaml"
@@ -58,24 +61,35 @@ rule fit_tracks:
         mem_mb=2000,
         runtime=30,
     params:
-        job=fit_tracks_params,
+        jobs=fit_tracks_params,
     script:
         "../scripts/fit_tracks.py"
 
 
-# an evaluation (reads truth.npz): tracker error, recovery through ours' matcher (with damping
-# scores on the damping benchmark's testbeds), predicted tracks against the truth
+# a damping testbed: the damping benchmark's configurations only
+use rule fit_tracks as fit_tracks_damping with:
+    output:
+        fits=tracks_outputs(TRACKS_FIT, TRACKS_DAMPING_CONFIGS),
+    wildcard_constraints:
+        tree="|".join(DAMPING_TREES) or "(?!x)x",
+        config="|".join(TRACKS_DAMPING_CONFIGS) or "(?!x)x",
+
+
+# an evaluation (reads truth.npz) of each configuration of the tree, one job per tree and seed:
+# tracker error, recovery through ours' matcher (with damping scores on the damping benchmark's
+# testbeds), predicted tracks against the truth
 rule tracks_evaluate:
     input:
         unpack(tracks_evaluate_inputs),
     output:
-        scores=TRACKS_EVAL,
-        record=TRACKS_RECOVERY,
+        scores=tracks_outputs(TRACKS_EVAL, TRACKS_CONFIGS),
+        records=tracks_outputs(TRACKS_RECOVERY, TRACKS_CONFIGS),
     log:
-        "logs/tracks/{tree}/seed{seed}/eval_{config}.log",
+        "logs/tracks/{tree}/seed{seed}/eval.log",
     benchmark:
-        "results/benchmarks/tracks/{tree}/seed{seed}/eval_{config}.tsv"
+        "results/benchmarks/tracks/{tree}/seed{seed}/eval.tsv"
     wildcard_constraints:
+        tree="|".join(TREES),
         config="|".join(TRACKS_CONFIGS) or "(?!x)x",
     conda:
         "../envs/physgs.yaml"
@@ -84,9 +98,19 @@ rule tracks_evaluate:
         mem_mb=3000,
         runtime=30,
     params:
-        damping=recovery_damping_params,
+        configs=lambda wildcards: tracks_configs(wildcards.tree),
+        damping=tracks_evaluate_params,
     script:
         "../scripts/tracks_evaluate.py"
+
+
+use rule tracks_evaluate as tracks_evaluate_damping with:
+    output:
+        scores=tracks_outputs(TRACKS_EVAL, TRACKS_DAMPING_CONFIGS),
+        records=tracks_outputs(TRACKS_RECOVERY, TRACKS_DAMPING_CONFIGS),
+    wildcard_constraints:
+        tree="|".join(DAMPING_TREES) or "(?!x)x",
+        config="|".join(TRACKS_DAMPING_CONFIGS) or "(?!x)x",
 
 
 # an evaluation (reads truth.npz): the learned fields trained in the same configuration, at the

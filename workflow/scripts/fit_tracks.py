@@ -1,5 +1,6 @@
-"""Snakemake script of rule `fit_tracks`: ours' oscillators fitted to the tracks of the
-configuration's conditions (observed.npz and the tracks only)."""
+"""Snakemake script of rule `fit_tracks`: ours' oscillators fitted to the tracks of each
+configuration's conditions, every configuration of one tree and seed (observed.npz and the tracks
+only)."""
 
 from physgs.jobs import job
 from physgs.testbed.dataset import load_observed
@@ -8,14 +9,15 @@ from physgs.tracks.store import load_fit, load_tracks, save_fit
 
 sm = snakemake  # noqa: F821 (injected by Snakemake)
 with job(sm) as log:
-    j = sm.params.job
-    tracks = [load_tracks(sm.input[f"c{c}"])[0] for c in j["conditions"]]
-    fit, osc = fit_job(tracks, load_observed(sm.input.observed), j)
-    save_fit(sm.output.fit, fit, osc, j["K_key"], j["min_tracks"])
-    load_fit(sm.output.fit)  # the file reads back before the job counts as done
-    print(
-        f"K={j['K']} ({j['K_key']}), conditions {j['conditions']}: tracks per part "
-        f"{fit.n_tracks.tolist()}, {int(fit.estimated.sum())} parts estimated; rms "
-        f"{fit.rms_px:.3f} px; {fit.seconds:.1f} s ({fit.loop_seconds:.1f} s in the Adam loop)",
-        file=log,
-    )
+    observed = load_observed(sm.input.observed)
+    for path, j in zip(sm.output.fits, sm.params.jobs, strict=True):
+        tracks = [load_tracks(sm.input[f"c{c}"])[0] for c in j["conditions"]]
+        fit, osc = fit_job(tracks, observed, j)
+        save_fit(path, fit, osc, j["K_key"], j["min_tracks"])
+        load_fit(path)  # the file reads back before the job counts as done
+        print(
+            f"{path}: K={j['K']} ({j['K_key']}), conditions {j['conditions']}: tracks per part "
+            f"{fit.n_tracks.tolist()}, {int(fit.estimated.sum())} parts estimated; rms "
+            f"{fit.rms_px:.3f} px; {fit.seconds:.1f} s ({fit.loop_seconds:.1f} s in the Adam loop)",
+            file=log,
+        )

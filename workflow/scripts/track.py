@@ -3,8 +3,8 @@ the training window (observed.npz only)."""
 
 from physgs.jobs import job
 from physgs.testbed.dataset import load_observed
-from physgs.tracks.run import track_condition
 from physgs.tracks.store import save_tracks
+from physgs.tracks.track import track_condition
 
 sm = snakemake  # noqa: F821 (injected by Snakemake)
 with job(sm) as log:

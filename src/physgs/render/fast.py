@@ -14,7 +14,7 @@ import torch
 from physgs.camera import Camera
 from physgs.render import kernels
 from physgs.render.constants import EPS2D, TILE
-from physgs.render.project import fov_clamp_limits, pixel_bounds
+from physgs.render.project import fov_clamp_limits
 
 
 def _np(x: torch.Tensor) -> np.ndarray:
@@ -56,12 +56,15 @@ def _forward(means, quats, scales, opacities, colors, background, camera):
     cov = np.empty((n, 3))
     valid = np.empty(n, np.bool_)
     kernels.project_forward(m, q, s, *cam, camera.near, EPS2D, m2, con, dep, cov, valid)
-    boxes = pixel_bounds(m2, cov, o, valid, W, H)
+    boxes = np.empty((n, 4), np.int64)
+    kernels.pixel_boxes(m2, cov, o, valid, W, H, boxes)
     touches = boxes[:, 0] <= boxes[:, 1]
     order = np.argsort(np.where(touches, dep, np.inf), kind="stable")[: int(touches.sum())]
     tiles_x = (W + TILE - 1) // TILE
     tiles_y = (H + TILE - 1) // TILE
-    tile_start, pair_gid = kernels.bin_tiles(boxes, order.astype(np.int64), TILE, tiles_x, tiles_y)
+    tile_start, pair_gid, row_start = kernels.bin_tiles(
+        boxes, order.astype(np.int64), TILE, tiles_x, tiles_y
+    )
     rgb = np.empty((H, W, D))
     alpha = np.empty((H, W))
     depth = np.empty((H, W))
@@ -69,9 +72,28 @@ def _forward(means, quats, scales, opacities, colors, background, camera):
     acc_d = np.empty((H, W))
     t_final = np.empty((H, W))
     n_contrib = np.empty((H, W), np.int64)
-    comp = (m2, con, o, col, dep, bg, boxes, tile_start, pair_gid, TILE, tiles_x, W, H)
-    kernels.forward(*comp, rgb, alpha, depth, acc_c, acc_d, t_final, n_contrib)
-    return (rgb, alpha, depth), (m, q, s, cam, camera.near, valid, comp, acc_c, acc_d, t_final)
+    # the rows each (tile, Gaussian) pair composited, for the backward (bin_tiles' capacity)
+    rows = (
+        np.empty((row_start[-1], 3), np.int32),
+        np.empty((row_start[-1], 2)),
+        np.zeros(pair_gid.shape[0], np.int64),
+    )
+    comp = (m2, con, o, col, dep, bg, boxes, tile_start, pair_gid, row_start, TILE, tiles_x, W, H)
+    kernels.forward(*comp, rgb, alpha, depth, acc_c, acc_d, t_final, n_contrib, *rows)
+    return (rgb, alpha, depth), (
+        m,
+        q,
+        s,
+        cam,
+        camera.near,
+        valid,
+        comp,
+        acc_c,
+        acc_d,
+        t_final,
+        rows,
+        n_contrib,
+    )
 
 
 class _FastRasterize(torch.autograd.Function):
@@ -83,7 +105,7 @@ class _FastRasterize(torch.autograd.Function):
 
     @staticmethod
     def backward(ctx, g_rgb, g_alpha, g_depth):
-        m, q, s, cam, near, valid, comp, acc_c, acc_d, t_final = ctx.saved
+        m, q, s, cam, near, valid, comp, acc_c, acc_d, t_final, rows, _ = ctx.saved
         H, W = t_final.shape
         D = comp[3].shape[1]
         n = m.shape[0]
@@ -98,7 +120,7 @@ class _FastRasterize(torch.autograd.Function):
         g_depth = up(g_depth, (H, W))
         pair_gid = comp[8]
         pair_grad = np.zeros((pair_gid.shape[0], kernels.N_GRAD + D))
-        kernels.backward(*comp, acc_c, acc_d, t_final, g_rgb, g_alpha, g_depth, pair_grad)
+        kernels.backward(*comp, acc_c, acc_d, t_final, *rows, g_rgb, g_alpha, g_depth, pair_grad)
         G = kernels.reduce_pairs(pair_gid, pair_grad, n)  # [N, 7 + D]
         v_means = np.empty((n, 3))
         v_quats = np.empty((n, 4))
@@ -121,6 +143,32 @@ class _FastRasterize(torch.autograd.Function):
         g_bg = np.einsum("hwd,hw->d", g_rgb, t_final)
         out = (v_means, v_quats, v_scales, G[:, 5], G[:, kernels.N_GRAD :], g_bg)
         return tuple(_to_torch(x, ctx.like) for x in out) + (None,)
+
+
+def work_count(means, quats, scales, opacities, colors, camera, background) -> dict[str, int]:
+    """How much compositing one forward + backward of :func:`rasterize_fast` does (ints):
+
+    pairs: pixel-Gaussian pairs composited before transmittance saturates (each costs
+    ``kernels.FLOPS_PER_PAIR`` flops, forward + backward); footprint_pixels: pixels inside the
+    1/255 contours of the tile pairs reached (pairs plus the ones skipped after saturation);
+    rows: pixel rows of those footprints (the forward finds each one's span and two exps);
+    tile_pairs: (tile, Gaussian) pairs binned; gaussians: N.
+    """
+    with torch.no_grad():
+        _, state = _forward(means, quats, scales, opacities, colors, background, camera)
+    row_start = state[6][9]  # [P + 1] each pair's row capacity; its first n_rows are written
+    row_pix, _, n_rows = state[10]
+    slot = np.arange(row_pix.shape[0])
+    pair = np.searchsorted(row_start, slot, side="right") - 1
+    used = slot - row_start[pair] < n_rows[pair]
+    n_contrib = state[11]
+    return {
+        "pairs": int(n_contrib.sum()),
+        "footprint_pixels": int((row_pix[used, 2] - row_pix[used, 1] + 1).sum()),
+        "rows": int(n_rows.sum()),
+        "tile_pairs": int(n_rows.shape[0]),
+        "gaussians": int(means.shape[0]),
+    }
 
 
 def rasterize_fast(

@@ -1,6 +1,7 @@
 """The tracks control's jobs as the Snakemake rules call them (``workflow/rules/tracks.smk``).
 
-- ``track_condition``: rule ``track``, one condition's training-camera video (observed only);
+- rule ``track`` calls :func:`physgs.tracks.track.track_condition` (one condition's
+  training-camera video, observed only), whose module imports no torch;
 - ``fit_job``: rule ``fit_tracks``, the oscillators of one configuration fitted to its tracks
   (observed wind only), refusing a K above the tracks it can group, with the key named;
 - ``evaluate_job``: rule ``tracks_evaluate`` (reads the truth): the tracker's error, recovery
@@ -14,16 +15,7 @@ import numpy as np
 
 from physgs.tracks.fit import FitSettings, Oscillators, TrackFit, fit_tracks, predict_tracks
 from physgs.tracks.recover import TracksRecovery, recover_tracks
-from physgs.tracks.track import Tracks, TrackSettings, track_video
-
-
-def track_condition(observed, condition: int, settings: dict) -> Tracks:
-    """Tracks of condition ``condition``'s training-camera video over the training window
-    (frames 0..n_train-1: what a method may train on). settings: ``TrackSettings`` fields."""
-    if not 0 <= condition < len(observed.conditions):
-        raise ValueError(f"condition {condition} is not one of the {len(observed.conditions)}")
-    frames = np.asarray(observed.frames[condition, : int(observed.n_train)])
-    return track_video(frames, observed.background, TrackSettings(**settings))
+from physgs.tracks.track import Tracks
 
 
 def fit_job(tracks: list[Tracks], observed, job: dict) -> tuple[TrackFit, Oscillators]:

@@ -8,13 +8,16 @@ gain, guard), so its evaluation integrates exactly the fitted model without read
 from __future__ import annotations
 
 import dataclasses
+from typing import TYPE_CHECKING
 
 import numpy as np
 
 from physgs.atomic import save_npz
 from physgs.intermediate import read_npz, refuse
-from physgs.tracks.fit import Oscillators, TrackFit
 from physgs.tracks.track import Tracks
+
+if TYPE_CHECKING:  # the fit's module imports torch: the tracker's job reads tracks only
+    from physgs.tracks.fit import Oscillators, TrackFit
 
 #: the scalar fields of ``Oscillators`` besides its bounds
 _OSC_SCALARS = ("substeps", "fps", "lead_in", "vbar_ratio", "gain", "guard")
@@ -81,6 +84,7 @@ def save_fit(path, fit: TrackFit, osc: Oscillators, K_key: str, min_tracks: int)
 def load_fit(path) -> tuple[TrackFit, Oscillators, dict]:
     """(TrackFit, Oscillators, {"K_key", "min_tracks"}) from ``save_fit``."""
     from physgs.models.oscillator_params import OscillatorBounds
+    from physgs.tracks.fit import Oscillators, TrackFit
 
     scalars = ["omega", "zeta", "estimated", "n_tracks", "conditions", "loss_px2", "seconds"]
     scalars += ["loop_seconds", "rms_px", "K_key", "min_tracks"]

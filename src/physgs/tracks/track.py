@@ -219,3 +219,12 @@ def track_video(frames: np.ndarray, background, settings: TrackSettings | None =
     xy = np.stack(xs) + CV_TO_PX  # [P, T, 2] package px
     valid = np.isfinite(xy).all(axis=-1)
     return Tracks(xy, valid, np.asarray(starts, np.int64))
+
+
+def track_condition(observed, condition: int, settings: dict) -> Tracks:
+    """Tracks of condition ``condition``'s training-camera video over the training window
+    (frames 0..n_train-1: what a method may train on). settings: ``TrackSettings`` fields."""
+    if not 0 <= condition < len(observed.conditions):
+        raise ValueError(f"condition {condition} is not one of the {len(observed.conditions)}")
+    frames = np.asarray(observed.frames[condition, : int(observed.n_train)])
+    return track_video(frames, observed.background, TrackSettings(**settings))
