@@ -224,6 +224,9 @@ def test_readme_and_home_page_say_what_the_record_holds():
         "--readme-only`"
     )
     assert (RECORD / "found.md").read_text() == "\n".join(record.found_lines(RECORD))
+    costs = record.cost_lines(record.read_costs(RECORD / "costs.csv"))
+    assert (RECORD / "costs.md").read_text() == "\n".join(costs) + "\n"
+    assert '--8<-- "docs/record/costs.md"' in (ROOT / "docs" / "performance.md").read_text()
     assert '--8<-- "docs/record/found.md"' in (ROOT / "docs" / "index.md").read_text()
     assert '--8<-- "docs/record/index.md"' in (ROOT / "docs" / "results.md").read_text()
 

@@ -62,6 +62,8 @@ def main() -> None:
     if not (args.out / "stamp.json").is_file():
         record.write_unrecorded(args.out)
     (args.out / "found.md").write_text("\n".join(record.found_lines(args.out)))
+    costs = record.cost_lines(record.read_costs(args.out / "costs.csv"))
+    (args.out / "costs.md").write_text("\n".join(costs) + "\n")
     text = args.readme.read_text()
     args.readme.write_text(record.replace_block(text, record.readme_block(args.out)))
     print(f"{args.readme}: the record block rewritten")
