@@ -19,6 +19,7 @@ import pandas as pd
 from physgs.models.registry import BASE_CONFIG
 from physgs.recovery.record import load_recovery
 from physgs.report.outputs import NEED_FIELDS, OUTPUTS, Plan, key, reader
+from physgs.report.outputs.recovery import other_priors
 from physgs.report.outputs.views import fit_row
 
 if TYPE_CHECKING:
@@ -52,9 +53,9 @@ def claims_needs(
     parts: bool = False,
     tracks: bool = False,
 ) -> list[tuple]:
-    """What the claims ledger reads: the tables' CSVs and ours' recovery (damping) of every seed
-    in the joint K=32 configuration (the paper's), or the base configuration when the config
-    has none; with ``parts``, tab_parts too (the parts study's hypotheses); with ``tracks``,
+    """What the claims ledger reads: the tables' CSVs and every prior's recovery (damping) of
+    every seed in the joint K=32 configuration (the paper's), or the base configuration when the
+    config has none; with ``parts``, tab_parts too (the parts study's hypotheses); with ``tracks``,
     tab_tracks (the 2D-track control's; its recovery rows are in tab_null)."""
     c = CLAIMS_CONFIG if CLAIMS_CONFIG in configs else BASE_CONFIG
     extra = [("table", "tab_parts")] if parts else []
@@ -63,6 +64,12 @@ def claims_needs(
         [("table", n) for n in CLAIMS_TABLES]
         + extra
         + [("recovery", t, c, int(s)) for t in trees for s in seeds]
+        + [
+            ("prior_recovery", t, m, c, int(s))
+            for m in other_priors()
+            for t in trees
+            for s in seeds
+        ]
     )
 
 
@@ -75,17 +82,21 @@ def claims_frame(inputs: Mapping[str, str], trees: Sequence[str]) -> pd.DataFram
     names = (*CLAIMS_TABLES, "tab_parts", "tab_tracks")
     tabs = {n: pd.read_csv(inputs[key(("table", n))]) for n in names if key(("table", n)) in inputs}
     damping: dict[str, list] = {}
+    prior_damping: dict[str, dict[str, list]] = {}
     for k, p in sorted(inputs.items()):  # recovery/<tree>/<config>/<seed>: one entry per seed
-        if k.startswith("recovery/"):
-            d = load_recovery(p).damping
-            damping.setdefault(k.split("/")[1], []).append(
-                {
-                    "median_zeta": d.median_zeta,
-                    "zeta_true": d.zeta_true,
-                    "loglog_exponent": d.loglog_exponent,
-                }
-            )
-    return claims.ledger(claims.measure(tabs, damping, trees))
+        kind, tree, *rest = k.split("/")  # prior_recovery/<tree>/<model>/<config>/<seed>
+        if kind not in ("recovery", "prior_recovery"):
+            continue
+        d = load_recovery(p).damping
+        into = damping if kind == "recovery" else prior_damping.setdefault(rest[0], {})
+        into.setdefault(tree, []).append(
+            {
+                "median_zeta": d.median_zeta,
+                "zeta_true": d.zeta_true,
+                "loglog_exponent": d.loglog_exponent,
+            }
+        )
+    return claims.ledger(claims.measure(tabs, damping, trees, prior_damping))
 
 
 def make_claims(inputs: Mapping[str, str], trees: Sequence[str], md_path, csv_path, stamp=None):

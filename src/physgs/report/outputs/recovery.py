@@ -4,7 +4,7 @@ against the untrained null), tab_damping (the damping benchmark), fig_damping an
 
 from __future__ import annotations
 
-from physgs.models.registry import config_label
+from physgs.models.registry import config_label, models_of
 from physgs.recovery.record import load_null, load_recovery
 from physgs.report import kselect
 from physgs.report.outputs.base import Output
@@ -21,6 +21,12 @@ def tracks_label(cfg: dict, config: str) -> str:
     return config_label(config, spec)
 
 
+def other_priors() -> tuple[str, ...]:
+    """The priors besides ours (the paper's, read through the ``recovery`` need kind): each read
+    through ``prior_recovery`` and set beside ours' rows."""
+    return tuple(m for m in models_of("prior") if m != "ours")
+
+
 def _configs(cfg: dict) -> dict:
     return {
         "configs": {
@@ -35,6 +41,12 @@ def _null_needs(plan, seeds):
     out = []
     for s in seeds:
         out += [("recovery", t, c, s) for t in plan.trees for c in plan.configs]
+        out += [
+            ("prior_recovery", t, m, c, s)
+            for t in plan.trees
+            for m in other_priors()
+            for c in plan.configs
+        ]
         out += [("tracks_recovery", t, c, s) for t in plan.trees for c in plan.tracks]
         out += list(
             dict.fromkeys(
@@ -98,6 +110,17 @@ def _tab_null(path, settings, inputs, out):
         digits=settings["digits"],
         tracks=tracks,
         tracks_configs={c: v["label"] for c, v in tk.items()},
+        priors={
+            m: {
+                s: {
+                    (t, c): load_recovery(path("prior_recovery", t, m, c, s))
+                    for t in trees
+                    for c in configs
+                }
+                for s in seeds
+            }
+            for m in other_priors()
+        },
     )
 
 
@@ -114,19 +137,30 @@ def _testbeds(tree: str) -> dict:
 
 def _damping_needs(plan, seeds):
     tracks = [c for c in plan.damping_configs if c in plan.tracks]
-    return [
-        ("recovery", tb, c, int(s))
-        for t in plan.damping_trees
-        for tb in _testbeds(t).values()
-        for c in plan.damping_configs
-        for s in seeds
-    ] + [
-        ("tracks_recovery", tb, c, int(s))
-        for t in plan.damping_trees
-        for tb in _testbeds(t).values()
-        for c in tracks
-        for s in seeds
-    ]
+    return (
+        [
+            ("recovery", tb, c, int(s))
+            for t in plan.damping_trees
+            for tb in _testbeds(t).values()
+            for c in plan.damping_configs
+            for s in seeds
+        ]
+        + [
+            ("prior_recovery", tb, m, c, int(s))
+            for t in plan.damping_trees
+            for tb in _testbeds(t).values()
+            for m in other_priors()
+            for c in plan.damping_configs
+            for s in seeds
+        ]
+        + [
+            ("tracks_recovery", tb, c, int(s))
+            for t in plan.damping_trees
+            for tb in _testbeds(t).values()
+            for c in tracks
+            for s in seeds
+        ]
+    )
 
 
 def _damping_settings(cfg: dict) -> dict:
@@ -170,6 +204,18 @@ def _tab_damping(path, settings, inputs, out):
         digits=settings["digits"],
         tracks=tracks,
         tracks_configs=tc,
+        priors={
+            m: {
+                s: {
+                    (t, v, c): load_recovery(path("prior_recovery", tb, m, c, s))
+                    for t in trees
+                    for v, tb in _testbeds(t).items()
+                    for c in settings["configs"]
+                }
+                for s in seeds
+            }
+            for m in other_priors()
+        },
     )
 
 

@@ -145,6 +145,8 @@ def _tab_margin(path, settings, inputs, out):
         settings["trees"],
         settings["bones"],
         settings["conditions"],
+        priors=models_of("prior"),
+        baseline=MARGIN_BASELINE,
         digits=settings["digits"],
     )
 
@@ -209,8 +211,12 @@ def _fig_teaser(path, settings, inputs, out):
 
     t, s0 = teaser_tree(settings["trees"]), settings["seeds"][0]
     evals = {m: load_eval(path("eval", t, m, BASE_CONFIG, s0)) for m in models_of(*METHODS)}
-    base = figures.best_baseline({m: e.summary() for m, e in evals.items()}, key="time")
-    shown = ("ours", base)
+    base = figures.best_baseline(
+        {m: e.summary() for m, e in evals.items()},
+        key="time",
+        exclude=models_of("control", "prior"),
+    )
+    shown = (*models_of("prior"), base)  # every prior beside the best learned field
     traj = {m: load_trajectories(path("traj", t, m, BASE_CONFIG, s0)) for m in shown}
     cen = {m: evals[m].centroid_err for m in shown}
     figures.fig_teaser(
