@@ -9,18 +9,11 @@ import json
 from physgs.models.registry import BASE_CONFIG, REFERENCE_NAMES, config_label
 from physgs.recovery.record import load_null, load_recovery
 from physgs.report.outputs.base import Output
-from physgs.report.outputs.views import fit_row
+from physgs.report.outputs.views import fit_row, fit_settings
 
 #: The prior every variant of the parts study is set beside, and the rows its fit fraction needs.
 BASELINE_PRIOR = "ours"
 FIT_FRAME = ("static", REFERENCE_NAMES[0])
-
-
-def _fit_settings(cfg: dict) -> dict:
-    return {
-        "n_train": int(cfg["testbed"]["n_train"]),
-        "holdout_every": int(cfg["train"]["holdout_every"]),
-    }
 
 
 def _studied(plan) -> bool:
@@ -57,7 +50,7 @@ def _parts_settings(cfg: dict) -> dict:
         "configs": {c: config_label(c, cfg["models"]["configs"][c]) for c in study["configs"]},
         "K": {c: int(cfg["models"]["configs"][c]["K"]) for c in study["configs"]},
         "damping_trees": [t for t in cfg["damping_benchmark"]["trees"] if t in cfg["trees"]],
-        **_fit_settings(cfg),
+        **fit_settings(cfg),
     }
 
 
@@ -152,7 +145,7 @@ def _kmatch_settings(cfg: dict) -> dict:
         "K": int(cfg["models"]["configs"][BASE_CONFIG]["K"]),
         "k_candidates": [int(k) for k in cfg["parts_study"]["k_candidates"]],
         "tie_db": float(cfg["models"]["kselect"]["tie_db"]),
-        **_fit_settings(cfg),
+        **fit_settings(cfg),
     }
 
 

@@ -73,7 +73,8 @@ def fit_row(eval_path, loss_path, n_train: int, holdout_every: int) -> dict:
     }
 
 
-def _fit_settings(cfg: dict) -> dict:
+def fit_settings(cfg: dict) -> dict:
+    """What ``fit_row`` reads: the training window's length and its held-out stride."""
     return {
         "n_train": int(cfg["testbed"]["n_train"]),
         "holdout_every": int(cfg["train"]["holdout_every"]),
@@ -164,7 +165,7 @@ TAB_FIT = Output(
     METHODS + REFERENCES,
     _evals(("eval", "loss"), METHODS + REFERENCES),
     _tab_fit,
-    settings=_fit_settings,
+    settings=fit_settings,
 )
 TAB_TRANSFER = Output(
     "tab_transfer",
