@@ -199,3 +199,23 @@ def test_the_summary_counts_the_splits_where_the_chain_beats_every_field():
     behind = C.ledger(prior_claims("ours_chain", _tables(-1.0), {}, ["sparse"]))
     assert "**0 of 4**" in prior_lines(behind)[0]
     assert prior_lines(C.ledger(C.measure({}, {}, ["sparse"]))) == []
+
+
+def test_tab_damping_sets_each_prior_beside_ours_on_both_testbeds():
+    from physgs.report.damping import tab_damping
+    from test_tracks_wiring import _damped
+
+    zb = np.array([0.03, 0.06, 0.1, 0.2])  # the bones' zeta in _damped
+    keys = [("sparse", v, c) for v in ("faithful", "damping") for c in ("a", "b")]
+    ours = {s: {k: _damped(zb * 1.1, s) for k in keys} for s in (0, 1)}
+    chain = {s: {k: _damped(zb * 1.02, s) for k in keys} for s in (0, 1)}
+    configs = {"a": "A", "b": "B"}
+    tab = tab_damping(ours, ["sparse"], {"sparse": 22}, configs, priors={"ours_chain": chain})
+    df = tab.df
+    assert list(df[df.seed == 0].method) == ["ours", "ours", "ours_chain", "ours_chain"] * 2
+    # |1.1 zeta - zeta| / zeta = 10 %, |1.02 zeta - zeta| / zeta = 2 %: by hand
+    np.testing.assert_allclose(df[df.method == "ours"].rel_err_pct, 10.0)
+    np.testing.assert_allclose(df[df.method == "ours_chain"].rel_err_pct, 2.0)
+    assert f"{label('ours_chain')}, B" in tab.tex and r"\multirow{8}{*}" in tab.tex
+    with pytest.raises(KeyError, match="ours_chain"):
+        tab_damping(ours, ["sparse"], {"sparse": 22}, configs, priors={"ours_chain": {0: {}}})
