@@ -83,7 +83,7 @@ def prior_lines(claims: pd.DataFrame) -> list[str]:
         held = mine[mine["verdict"].astype(str) == "holds"]
         where = ", ".join(i.split(f"/{AHEAD}/", 1)[1] for i in held["id"].astype(str))
         lines += [
-            f"The {label(m)} beats every learned field on **{len(held)} of {len(mine)}** "
+            f"{label(m)}: beats every learned field on **{len(held)} of {len(mine)}** "
             "splits and trees (paired 95% interval above 0; views, beyond the window, each "
             f"unseen wind at training timestamps and beyond){': ' + where if where else ''}.",
             "",
