@@ -675,16 +675,18 @@ def tab_margin(
     V = {c: _by_seed(df, c, len(seeds)) for c in cols}
     fmt = f".{int(digits)}f"
     lines = ["  \\begin{tabular}{l" + "c" * len(cols) + "}", "    \\toprule"]
-    for k, p in enumerate(priors):
-        if k:
-            lines.append("    \\midrule")
+    for k, p in enumerate(priors):  # the first prior's block under the conditions' heading
         name = "Ours" if p == "ours" else label(p)
-        lines += [
-            rf"    {name} $-$ (Deformation MLP $+$\,wind) & "
-            + " & ".join(condition_label(m) for m in conditions)
-            + r" \\",
-            "    \\midrule",
-        ]
+        what = rf"{name} $-$ (Deformation MLP $+$\,wind)"
+        if k == 0:
+            heads = " & ".join(condition_label(m) for m in conditions)
+            lines += [f"    {what} & {heads}" + r" \\", "    \\midrule"]
+        else:
+            lines += [
+                "    \\midrule",
+                rf"    \multicolumn{{{1 + len(cols)}}}{{l}}{{{what}}} \\",
+                "    \\midrule",
+            ]
         for i in np.flatnonzero(first["model"].to_numpy() == p):
             r = first.iloc[i]
             lines.append(
