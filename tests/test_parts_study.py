@@ -13,7 +13,7 @@ import pytest
 from physgs.evaluate.parts import load_segmentations, save_segmentations, segmentation_record
 from physgs.models import build_model
 from physgs.report import claims
-from physgs.report.build import parts_needs
+from physgs.report.build import Plan, needs
 from physgs.report.parts import row, tab_parts
 from oracles import model_context, quick_models_cfg
 from test_config import _refused
@@ -129,17 +129,25 @@ def test_parts_claims_follow_the_paired_seed_differences(chain_gain, topo_zeta, 
 
 
 def test_parts_needs_read_every_prior_and_no_damping_where_none_is_built():
-    needs = parts_needs(
-        "tab_parts", ["sparse", "medium"], ["medium"], ["ours_chain"], {"single": {"K": 32}}, [0, 1]
+    single = {"single": {"K": 32}}
+    plan = Plan(
+        ["sparse", "medium"],
+        single,
+        [0, 1],
+        damping_trees=["medium", "dense"],  # dense: a damping tree the run does not build
+        parts_models=["ours_chain"],
+        parts_configs=single,
     )
-    assert ("prior_recovery", "sparse", "ours_chain", "single", 1) in needs
-    assert ("prior_recovery", "medium_damping", "ours", "single", 0) in needs
-    assert not any(n[:2] == ("prior_recovery", "sparse_damping") for n in needs)
-    assert ("eval", "sparse", "truth_motion", "single", 0) in needs
-    assert ("parts", "medium", 1) in needs and ("null", "medium", 32, 0) in needs
-    assert parts_needs("fig_parts", ["sparse"], [], ["ours_chain"], {}, [4, 5]) == [
-        ("parts", "sparse", 4)
-    ]
+    got = needs("tab_parts", plan)
+    assert ("prior_recovery", "sparse", "ours_chain", "single", 1) in got
+    assert ("prior_recovery", "medium_damping", "ours", "single", 0) in got
+    assert not any(
+        n[:2] in {("prior_recovery", t) for t in ("sparse_damping", "dense_damping")} for n in got
+    )
+    assert ("eval", "sparse", "truth_motion", "single", 0) in got
+    assert ("parts", "medium", 1) in got and ("null", "medium", 32, 0) in got
+    plan = Plan(["sparse"], {}, [4, 5], parts_models=["ours_chain"])
+    assert needs("fig_parts", plan) == [("parts", "sparse", 4)]
 
 
 def test_parts_study_configs_must_be_configs_of_ours_and_of_the_damping_benchmark():

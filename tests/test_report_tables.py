@@ -75,26 +75,29 @@ def test_one_seed_tab_psnr_agrees_and_bolds_nothing(tmp_path):
     tab = T.tab_psnr(per_seed(1), TREES, BONES)
     cols = ["sparse_view", "sparse_time", "medium_view", "medium_time"]
     assert list(tab.df.columns) == ["seed", "model", *cols, "difference"]
-    assert list(tab.df.model[:6]) == [T.label(m) for m in T.MODELS]
+    n = len(T.MODELS)  # the paper's five and its prior, and this project's chained prior
+    assert list(tab.df.model[:n]) == [T.label(m) for m in T.MODELS] and n == 7
     T.write_table(tab, tmp_path / "t.tex", tmp_path / "t.csv")
     csv = pd.read_csv(tmp_path / "t.csv")
     rows = tex_rows((tmp_path / "t.tex").read_text())
-    assert len(rows) == len(csv) == 8  # six models, two differences
+    assert len(rows) == len(csv) == n + 4  # the models, two differences per prior
     for (nums, bold), (_, r) in zip(rows, csv.iterrows()):
         np.testing.assert_allclose(nums, np.round(r[cols].to_numpy(float), 2), atol=1e-9)
         assert not any(bold)  # one seed: no interval, nothing decided
     S = per_seed(1)[0]
-    ours_static = S[("medium", "ours")]["time"] - S[("medium", "static")]["time"]
-    assert csv.loc[6, "medium_time"] == pytest.approx(ours_static)
     best_view = max(S[("sparse", m)]["view"] for m in ("mlp", "mlp_wind", "d3dgs", "d3dgs_wind"))
-    assert csv.loc[7, "sparse_view"] == pytest.approx(S[("sparse", "ours")]["view"] - best_view)
+    for i, p in ((n, "ours"), (n + 2, "ours_chain")):  # each prior: - static, - best field
+        assert csv.loc[i, "model"] == f"{T.label(p)} - {T.label('static')}"
+        p_static = S[("medium", p)]["time"] - S[("medium", "static")]["time"]
+        assert csv.loc[i, "medium_time"] == pytest.approx(p_static)
+        assert csv.loc[i + 1, "sparse_view"] == pytest.approx(S[("sparse", p)]["view"] - best_view)
     assert T.seedstats.UNDECIDED in tab.tex
 
 
 def test_seeds_give_mean_sd_and_a_decided_best(tmp_path):
     data = per_seed(4, noise=0.05)
     tab = T.tab_psnr(data, TREES, BONES)
-    assert sorted(tab.df.seed.unique()) == [0, 1, 2, 3] and len(tab.df) == 4 * 8
+    assert sorted(tab.df.seed.unique()) == [0, 1, 2, 3] and len(tab.df) == 4 * 11
     ours = tab.df[tab.df.model == T.label("ours")]["medium_time"].to_numpy()
     m, sd = ours.mean(), ours.std(ddof=1)  # independent of the module: numpy
     assert f"{m:.2f} $\\pm$ {sd:.2f}" in tab.tex
@@ -171,6 +174,7 @@ def test_tab_margin_values():
     tab = T.tab_margin(S, TREES, BONES, COND)
     assert list(tab.df.columns) == [
         "seed",
+        "model",
         "tree",
         "bones",
         "margin_v0",
@@ -180,6 +184,13 @@ def test_tab_margin_values():
     exp = S[0][("medium", "ours")]["train_c1"] - S[0][("medium", "mlp_wind")]["train_c1"]
     assert tab.df.loc[1, "margin_0.84v0"] == pytest.approx(exp)
     assert f"${exp:+.2f}$" + T.seedstats.UNDECIDED in tab.tex
+    # every prior a block of its own, ours first and unchanged
+    both = T.tab_margin(S, TREES, BONES, COND, priors=("ours", "ours_chain"))
+    assert list(both.df.model) == ["ours", "ours", "ours_chain", "ours_chain"]
+    pd.testing.assert_frame_equal(both.df.iloc[:2], tab.df)
+    chain = S[0][("sparse", "ours_chain")]["train_c2"] - S[0][("sparse", "mlp_wind")]["train_c2"]
+    assert both.df.loc[2, "margin_0.71v0"] == pytest.approx(chain)
+    assert rf"{T.label('ours_chain')} $-$ (Deformation MLP" in both.tex
 
 
 def test_results_not_keyed_by_seed_are_refused():
@@ -273,7 +284,8 @@ def test_tab_psnr_reference_row_is_separate_and_never_bold():
             S[s][(t, "truth_motion")] = {"view": 40.0 + 0.1 * s, "time": 40.0}  # above every method
     tab = T.tab_psnr(S, TREES, BONES, references=("truth_motion",))
     first = tab.df[tab.df.seed == 0]
-    assert first.reference.tolist() == [False] * 6 + [True, False, False]
+    n = len(T.MODELS)  # the methods, the reference, two differences per prior
+    assert first.reference.tolist() == [False] * n + [True] + [False] * 4
     assert r"\textbf{40.10" not in tab.tex and r"\emph{True motion" in tab.tex
     # one bold per column at most, on a method row (the reference is never a candidate)
     body = [ln for ln in tab.tex.splitlines() if "textbf" in ln]

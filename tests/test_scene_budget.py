@@ -233,7 +233,7 @@ def test_select_k_then_train_auto(data, tmp_path):
 
 
 def test_tab_kselect_rows_and_undefined_entries():
-    from physgs.report.build import needs
+    from physgs.report.build import Plan, needs
     from physgs.report.kselect import tab_kselect
 
     rows = {
@@ -253,7 +253,7 @@ def test_tab_kselect_rows_and_undefined_entries():
     t = tab_kselect({0: rows}, ["sparse"], {"sparse": 22}, "heldout")
     assert t.df["K"].tolist() == [32, 16] and t.df["median_rel_err_pct"].iloc[0] == 5.0
     assert "10/32" in t.tex and "0/16" in t.tex and "--" in t.tex  # NaN median shown as --
-    assert ("kselect", "sparse", 3) in needs("tab_kselect", ["sparse"], {}, [3])
+    assert ("kselect", "sparse", 3) in needs("tab_kselect", Plan(["sparse"], {}, [3]))
     # a second seed that chose another K: both choices shown, the rest averaged
     rows1 = {k: dict(v) for k, v in rows.items()}
     rows1[("sparse", "auto")].update(K=64, time_psnr=26.5)

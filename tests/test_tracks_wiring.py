@@ -496,7 +496,12 @@ def test_ours_claims_read_ours_rows_of_a_table_with_tracks_rows():
 
 
 def test_needs_of_the_tracks_outputs():
-    assert build.tracks_needs("tab_tracks", ["sparse"], ["single", "joint32"], [0, 1]) == [
+    def plan(configs, seeds, fields=()):
+        return build.Plan(
+            ["sparse"], {"single": {"K": 32}}, seeds, tracks=configs, tracks_fields=fields
+        )
+
+    assert build.needs("tab_tracks", plan({"single": 2, "joint32": 2}, [0, 1])) == [
         ("tracks_eval", "sparse", "single", 0),
         ("loss", "sparse", "ours", "single", 0),  # ours' training seconds beside the fit's
         ("tracks_eval", "sparse", "joint32", 0),
@@ -506,30 +511,43 @@ def test_needs_of_the_tracks_outputs():
         ("tracks_eval", "sparse", "joint32", 1),
         ("loss", "sparse", "ours", "joint32", 1),
     ]
-    assert build.tracks_needs("tab_tracks", ["sparse"], ["single"], [3], [("sparse", "single")])[
-        -1
-    ] == ("tracks_fields", "sparse", "single", 3)
-    assert build.tracks_needs("fig_tracks", ["sparse"], ["joint32"], [5, 6]) == [
+    assert build.needs("tab_tracks", plan({"single": 2}, [3], [("sparse", "single")]))[-1] == (
+        "tracks_fields",
+        "sparse",
+        "single",
+        3,
+    )
+    assert build.needs("fig_tracks", plan({"joint32": 2}, [5, 6])) == [
         ("observed", "sparse", 5),
         ("tracks", "sparse", 0, 5),
         ("tracks_fit", "sparse", "joint32", 5),
     ]
-    null = build.needs("tab_null", ["sparse"], {"single": {"K": 32}}, [0], tracks={"single": 2})
+    null = build.needs("tab_null", plan({"single": 2}, [0]))
     assert ("tracks_recovery", "sparse", "single", 0) in null
     assert ("null", "sparse", 2, 0) in null and ("null", "sparse", 32, 0) in null
-    assert not any(
-        n[0].startswith("tracks")
-        for n in build.needs("tab_null", ["sparse"], {"single": {"K": 32}}, [0])
+    assert not any(n[0].startswith("tracks") for n in build.needs("tab_null", plan({}, [0])))
+    damp = build.needs(
+        "tab_damping",
+        build.Plan(
+            ["sparse"],
+            {"single": {"K": 32}, "joint32": {"K": 32}},
+            [0],
+            tracks={"joint32": 2},
+            damping_trees=["sparse"],
+            damping_configs=["single", "joint32"],
+        ),
     )
-    damp = build.damping_needs(["sparse"], ["single", "joint32"], [0], ["joint32"])
     assert ("tracks_recovery", "sparse_damping", "joint32", 0) in damp
     assert not any(n[0] == "tracks_recovery" and n[2] == "single" for n in damp)
     assert ("table", "tab_tracks") in build.claims_needs(
         ["sparse"], {"single": {}}, [0], tracks=True
     )
-    for name in ("tab_tracks", "fig_tracks"):
-        with pytest.raises(ValueError, match="tracks_needs"):
-            build.needs(name, ["sparse"], {"single": {"K": 32}}, [0])
+    # a run without the control builds neither of its outputs (fig_tracks: without parts)
+    assert not build.in_report("tab_tracks", plan({}, [0]))
+    assert build.needs("fig_tracks", plan({}, [0])) == [
+        ("observed", "sparse", 0),
+        ("tracks", "sparse", 0, 0),
+    ]
 
 
 def test_settings_of_the_tracks_outputs_are_narrow():

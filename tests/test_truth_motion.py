@@ -369,7 +369,7 @@ def test_truth_of_another_dataset_is_refused(pair):
 def test_registry_keeps_methods_apart_from_the_reference(pair):
     observed, truth = pair
     assert "truth_motion" not in MODEL_NAMES and "truth_motion" in REFERENCES
-    assert MODEL_NAMES == ("static", "mlp", "mlp_wind", "d3dgs", "d3dgs_wind", "ours")
+    assert MODEL_NAMES == ("static", "mlp", "mlp_wind", "d3dgs", "d3dgs_wind", "ours", "ours_chain")
     assert all(m != "truth_motion" for m, _ in training_jobs(["single", "joint32"]))
     assert configs_for("truth_motion", ["single", "joint32"]) == ("single",)
     assert label("truth_motion") == "True motion (ceiling)"

@@ -31,6 +31,7 @@ MODELS = [
     "Deformable-3DGS",
     "Deformable-3DGS + wind",
     "Ours",
+    "Chained prior (this project)",
 ]
 
 
@@ -65,15 +66,17 @@ def test_every_output_exists(run):
 
 def test_tab_psnr_rows_columns_and_finite(run):
     df = _csv(run, "tab_psnr")
-    # the models, the reference, then the two paired differences; one seed
+    # the models, the reference, then each prior's two paired differences; one seed
     assert list(df["model"]) == [
         *MODELS,
         "True motion (ceiling)",
         "Ours - Static pose",
         "Ours - best learned field",
+        "Chained prior (this project) - Static pose",
+        "Chained prior (this project) - best learned field",
     ]
-    assert list(df["reference"]) == [False] * len(MODELS) + [True, False, False]
-    assert list(df["difference"]) == [False] * (len(MODELS) + 1) + [True, True]
+    assert list(df["reference"]) == [False] * len(MODELS) + [True] + [False] * 4
+    assert list(df["difference"]) == [False] * (len(MODELS) + 1) + [True] * 4
     assert set(df["seed"]) == set(QUICK["seeds"])
     cols = [f"{t}_{s}" for t in TREES for s in ("view", "time")]
     assert list(df.columns[2 : 2 + len(cols)]) == cols
@@ -92,14 +95,16 @@ def test_tab_transfer_rows_columns_and_finite(run):
     unseen = len(QUICK["testbed"]["conditions"]) - 1
     assert len(df) == 2 * len(TREES) * unseen
     assert set(df["split"]) == {"train", "beyond"}
-    models = ["static", "mlp", "mlp_wind", "d3dgs", "d3dgs_wind", "ours"]
+    models = ["static", "mlp", "mlp_wind", "d3dgs", "d3dgs_wind", "ours", "ours_chain"]
     assert [c for c in df.columns if c in models] == models
     assert np.isfinite(df[models].to_numpy(float)).all()
 
 
 def test_tab_margin_is_ours_minus_mlp_wind(run):
     df = _csv(run, "tab_margin")
-    assert list(df["tree"]) == TREES
+    assert list(df["tree"]) == TREES * 2 and list(df["model"]) == ["ours"] * len(TREES) + [
+        "ours_chain"
+    ] * len(TREES)
     assert [c for c in df.columns if c.startswith("margin_")] == [
         "margin_v0",
         "margin_0.84v0",
@@ -109,7 +114,7 @@ def test_tab_margin_is_ours_minus_mlp_wind(run):
 
     for _, row in df.iterrows():
         ev = run / "results" / "eval" / row["tree"] / f"seed{row['seed']}"
-        ours = load_eval(ev / "ours_single.npz").summary()
+        ours = load_eval(ev / f"{row['model']}_single.npz").summary()
         base = load_eval(ev / "mlp_wind_single.npz").summary()
         assert row["margin_v0"] == pytest.approx(ours["train_c0"] - base["train_c0"], abs=1e-4)
 
@@ -117,10 +122,11 @@ def test_tab_margin_is_ours_minus_mlp_wind(run):
 def test_tab_null_rows_columns_and_finite_where_defined(run):
     df = _csv(run, "tab_null")
     configs = list(QUICK["models"]["configs"])
-    # ours' rows, then the 2D-track control's (docs/tracks.md) at its own K beside its own null
-    assert list(df["method"]) == ["ours"] * len(TREES) * len(configs) + ["tracks"] * len(
+    # ours' rows, the chained prior's, then the 2D-track control's (docs/tracks.md) at its own
+    # K beside its own null
+    assert list(df["method"]) == ["ours"] * len(TREES) * len(configs) + ["ours_chain"] * len(
         TREES
-    ) * len(QUICK["tracks"]["configs"])
+    ) * len(configs) + ["tracks"] * len(TREES) * len(QUICK["tracks"]["configs"])
     assert (df.loc[df["method"] == "tracks", "K"] == QUICK["tracks"]["K"]).all()
     for col in ("trained_parts_trusted", "null_parts_trusted", "nearest_bone_gap_pct"):
         assert np.isfinite(df[col].to_numpy(float)).all(), col
@@ -202,7 +208,7 @@ def test_speed_accuracy_csv(run):
 
 
 def test_tab_null_plan_trains_ours_only():
-    """`snakemake results/tables/tab_null.tex` must train no baseline."""
+    """`snakemake results/tables/tab_null.tex` must train no baseline: the priors only."""
     import tempfile
     from pathlib import Path
 
@@ -213,7 +219,7 @@ def test_tab_null_plan_trains_ours_only():
         ).stdout
     trained = re.findall(r"results/models/\w+/seed\d+/(\w+?)_(single|joint32|joint96)\.pt", out)
     assert trained, "the plan trains nothing"
-    assert {m for m, _ in trained} == {"ours"}
+    assert {m for m, _ in trained} == {"ours", "ours_chain"}
     assert "rule evaluate:" not in out
 
 
@@ -315,10 +321,10 @@ def test_a_second_seed_pairs_with_the_first(run, tmp_path):
     trained = set(re.findall(r"results/models/\w+/(seed\d+)/\w+\.pt", out))
     assert trained == {"seed1"}, trained
     two = pd.read_csv(wd / "results" / "tables" / "tab_margin.csv")
-    assert list(two["seed"]) == [0, 1]
+    assert list(two["seed"]) == [0, 0, 1, 1]  # ours', then the chained prior's, per seed
     cols = ["margin_v0", "margin_0.84v0", "margin_0.71v0"]
     np.testing.assert_allclose(two.loc[0, cols].to_numpy(float), one.loc[0, cols].to_numpy(float))
-    d = two["margin_v0"].to_numpy(float)
+    d = two.loc[two["model"] == "ours", "margin_v0"].to_numpy(float)
     lo, hi = stats.t.interval(0.95, 1, loc=d.mean(), scale=stats.sem(d))
     tex = (wd / "results" / "tables" / "tab_margin.tex").read_text()
     assert f"${d.mean():+.2f}$ [{lo:.2f}, {hi:.2f}]" in tex

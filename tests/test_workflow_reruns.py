@@ -100,7 +100,10 @@ def test_mlp_width_and_search_retrain_their_own_models_only(plans):
         "mlp_single",
         "mlp_wind_single",
         "ours_topo_single",
+        # the chained prior: a method of every table, trained in every configuration
         "ours_chain_single",
+        "ours_chain_joint32",
+        "ours_chain_joint96",
     }, trained
     assert _counts(out).get("kmatch_point"), _counts(out)
 
@@ -110,6 +113,26 @@ def test_table_format_rebuilds_that_table_only(plans):
     ledger; nothing upstream, no other table."""
     plan = _counts(plans["table_digits"])
     assert plan == {"table": 1, "claims": 1, "summary": 1, "all": 1}, plan
+
+
+def test_the_chained_priors_rows_plan_its_own_jobs_only(tmp_path):
+    """tab_null reads the chained prior's recovery in every configuration, tab_damping on both
+    testbeds of the damping benchmark's configurations: a fresh plan trains and scores it there,
+    and evaluates it in the base configuration only (no table reads a joint evaluation)."""
+    from workflow_helpers import workflow_copy
+
+    wd = workflow_copy(tmp_path)
+    targets = ["results/tables/tab_null.tex", "results/tables/tab_damping.tex"]
+    out = snakemake(wd, "-n", "--cores", "2", *targets, "--config", "seeds=[0]").stdout
+    trained = {c for c in _checkpoints(out) if c.startswith("ours_chain")}
+    assert trained == {"ours_chain_single", "ours_chain_joint32", "ours_chain_joint96"}, trained
+    outputs = "\n".join(re.findall(r"(?m)^    output: (.*)$", out))
+    scored = set(re.findall(r"results/recovery/(\w+)/seed0/ours_chain_(\w+)\.json", outputs))
+    trees = ("sparse", "medium", "dense")
+    want = {(t, c) for t in trees for c in ("single", "joint32", "joint96")}
+    want |= {(f"{t}_damping", c) for t in trees for c in ("single", "joint32")}
+    assert scored == want, scored ^ want
+    assert not re.search(r"results/eval/\w+/seed0/ours_chain_joint", outputs)
 
 
 def test_job_params_ignore_key_order():

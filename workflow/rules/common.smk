@@ -38,6 +38,8 @@ PARTS = CFG["parts_study"]
 PARTS_MODELS = list(PARTS["models"])
 PARTS_CONFIGS = {c: CONFIGS[c] for c in PARTS["configs"]} if PARTS_MODELS else {}
 PRIORS = ["ours", *PARTS_MODELS]  # every oscillator prior the run trains
+#: what this run builds, as the report outputs' needs read it (physgs.report.outputs.Plan)
+REPORT_PLAN = _build.Plan.from_config(CFG)
 STAMP = _provenance.stamp(CFG)  # not a rerun trigger (see physgs.provenance.Stamp)
 # the 2D-track control (docs/tracks.md): ours' oscillators fitted to point tracks of the training
 # video, in these of ours' configurations, each with its K (tracks/K or the configuration's)
@@ -182,27 +184,7 @@ def need_paths(needs):
 
 def report_inputs(wildcards):
     """need key -> path of every file table or figure ``name`` reads."""
-    if wildcards.name == "tab_damping":
-        tracks = [c for c in DAMPING["configs"] if c in TRACKS_CONFIGS]
-        return need_paths(_build.damping_needs(DAMPING["trees"], DAMPING["configs"], SEEDS, tracks))
-    if wildcards.name in _build.TRACKS_OUTPUTS:
-        return need_paths(
-            _build.tracks_needs(wildcards.name, TREES, TRACKS_CONFIGS, SEEDS, TRACKS_FIELD_PAIRS)
-        )
-    if wildcards.name == "tab_parts_k":
-        return need_paths(_build.kmatch_needs(TREES, PARTS["k_candidates"], STUDY_SEEDS))
-    if wildcards.name in _build.PARTS_OUTPUTS:
-        return need_paths(
-            _build.parts_needs(
-                wildcards.name,
-                TREES,
-                [t for t in DAMPING["trees"] if t in TREES],
-                PARTS_MODELS,
-                PARTS_CONFIGS,
-                SEEDS,
-            )
-        )
-    return need_paths(_build.needs(wildcards.name, TREES, CONFIGS, SEEDS, tracks=TRACKS_K))
+    return need_paths(_build.needs(wildcards.name, REPORT_PLAN))
 
 
 # ---- narrow params: each job sees only the settings it reads -------------------------------

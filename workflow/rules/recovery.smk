@@ -15,7 +15,9 @@ rule recovery:
     log:
         "logs/recovery/{tree}/seed{seed}/{model}_{config}.log",
     wildcard_constraints:
-        model="|".join(["ours", *_models.PRIOR_VARIANT_NAMES]),
+        model="|".join(
+            m for m in (*_models.MODEL_NAMES, *_models.PRIOR_VARIANT_NAMES) if _models.is_prior(m)
+        ),
     conda:
         "../envs/physgs.yaml"
     threads: 1

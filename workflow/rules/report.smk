@@ -51,19 +51,11 @@ rule report:
         expand(
             TABLE,
             ext=("tex", "csv"),
-            name=[
-                n
-                for n in _build.TABLES
-                if n != "tab_kselect"
-                and (n != "tab_damping" or DAMPING["trees"])
-                and (n not in _build.PARTS_OUTPUTS or PARTS_MODELS)
-                and n != "tab_parts_k"  # a study: the `studies` target (Snakefile)
-                and (n != "tab_tracks" or TRACKS_CONFIGS)
-            ],
+            name=[n for n in _build.TABLES if _build.in_report(n, REPORT_PLAN)],
         ),
         expand(
             FIGURE,
-            name=[f for f in _build.FIGURES if f not in _build.PARTS_OUTPUTS or PARTS_MODELS],
+            name=[f for f in _build.FIGURES if _build.in_report(f, REPORT_PLAN)],
             ext=("pdf", "png"),
         ),
         parts_jobs(),

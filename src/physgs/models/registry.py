@@ -37,30 +37,49 @@ class ModelSpec:
     short: str  # column head under a family heading (tab_transfer)
     family: str  # config section of its architecture ("static", "mlp", "d3dgs", "ours")
     wind: bool  # reads the observed wind
+    role: str  # what it is in the comparison (``ROLES``): which tables' rows it joins
     parts: str = "kmeans"  # oscillator priors: how parts are cut ("kmeans" or "topology")
     chain: bool = False  # oscillator priors: each part's transform composed with its parent's
     forcing: str = "wind"  # oscillator priors: "wind" (measured) or "learned" (physgs.models.blind)
 
 
+#: The roles a model plays in the comparison. A report output (``physgs.report.outputs``) declares
+#: the roles it reads and gets every model of those roles (``models_of``), in registry order:
+#: control (the static pose: no motion), field (a learned deformation field), prior (an
+#: oscillator prior: trained in every configuration, scored on recovery against the null),
+#: reference (not a method: the true-motion ceiling). The untrained null is no model: it is the
+#: recovery tables' own control, drawn per K (``physgs.recovery.null``).
+ROLES = ("control", "field", "prior", "reference")
+
 #: The one source of model ids and labels; order = row order of every table.
 MODELS: dict[str, ModelSpec] = {
-    "static": ModelSpec("Static pose", "Static", "static", False),
-    "mlp": ModelSpec("Deformation MLP", "no wind", "mlp", False),
-    "mlp_wind": ModelSpec("Deformation MLP + wind", r"+\,wind", "mlp", True),
-    "d3dgs": ModelSpec("Deformable-3DGS", "no wind", "d3dgs", False),
-    "d3dgs_wind": ModelSpec("Deformable-3DGS + wind", r"+\,wind", "d3dgs", True),
-    "ours": ModelSpec("Ours", "Ours", "ours", True),
+    "static": ModelSpec("Static pose", "Static", "static", False, "control"),
+    "mlp": ModelSpec("Deformation MLP", "no wind", "mlp", False, "field"),
+    "mlp_wind": ModelSpec("Deformation MLP + wind", r"+\,wind", "mlp", True, "field"),
+    "d3dgs": ModelSpec("Deformable-3DGS", "no wind", "d3dgs", False, "field"),
+    "d3dgs_wind": ModelSpec("Deformable-3DGS + wind", r"+\,wind", "d3dgs", True, "field"),
+    "ours": ModelSpec("Ours", "Ours", "ours", True, "prior"),
+    # this project's prior, not the paper's (issue 28/40): parts cut along the tree, each
+    # part's transform composed with its parent's, omega searched before the descent
+    "ours_chain": ModelSpec(
+        "Chained prior (this project)",
+        "Chained",
+        "ours",
+        True,
+        "prior",
+        parts="topology",
+        chain=True,
+    ),
 }
 MODEL_NAMES = tuple(MODELS)
-#: Variants of the oscillator prior (issue 28): topology-aware parts (physgs.models.topology),
-#: independent or chained (physgs.models.chain). Ids of their own, not options of ``ours``, so
-#: one run can train all three side by side under one recipe (``job_spec``/``fit`` treat every
-#: model of family "ours" alike) and a table can compare them. Kept out of MODELS until the
-#: workflow trains them and tab_parts reads them: every table and the job plan iterate MODELS.
+#: Variants of the oscillator prior (issue 28) studied beside ours in tab_parts only:
+#: topology-aware parts (physgs.models.topology) without the chain. Ids of their own, not
+#: options of ``ours``, so one run can train them side by side under one recipe (``job_spec``/
+#: ``fit`` treat every model of family "ours" alike). Kept out of MODELS: every table and the
+#: job plan iterate MODELS (the chained variant graduated there: issue 40).
 PRIOR_VARIANTS: dict[str, ModelSpec] = {
-    "ours_topo": ModelSpec("Ours, topology parts", "topology", "ours", True, parts="topology"),
-    "ours_chain": ModelSpec(
-        "Ours, chained topology parts", "chained", "ours", True, parts="topology", chain=True
+    "ours_topo": ModelSpec(
+        "Ours, topology parts", "topology", "ours", True, "prior", parts="topology"
     ),
     # issue 42: ours with a learned forcing shared by every part instead of the measured wind
     # (physgs.models.blind); trained in `single` only (one window, one forcing)
@@ -80,11 +99,25 @@ PRIOR_VARIANT_NAMES = tuple(PRIOR_VARIANTS)
 #: out of MODELS / MODEL_NAMES. truth_motion moves the canonical Gaussians by the ground-truth
 #: skinning (physgs.models.truth_motion): the ceiling; the only model that reads truth.npz.
 REFERENCES: dict[str, ModelSpec] = {
-    "truth_motion": ModelSpec("True motion (ceiling)", "True motion", "truth_motion", True),
+    "truth_motion": ModelSpec(
+        "True motion (ceiling)", "True motion", "truth_motion", True, "reference"
+    ),
 }
 REFERENCE_NAMES = tuple(REFERENCES)
+
+
+def models_of(*roles: str) -> tuple[str, ...]:
+    """The ids of the methods (``MODELS``) and references of the given roles (``ROLES``), in
+    registry order (methods first): what a table reads when it reads those roles (the study
+    variants, ``PRIOR_VARIANTS``, are not among them)."""
+    bad = [r for r in roles if r not in ROLES]
+    if bad:
+        raise ValueError(f"unknown model role(s) {bad}; choose from {ROLES}")
+    return tuple(m for m, s in (*MODELS.items(), *REFERENCES.items()) if s.role in roles)
+
+
 FIELDS = ("mlp", "d3dgs")  # learned deformation-field architectures
-#: Every model is trained in this configuration; ours also in every other one of the config.
+#: Every model is trained in this configuration; the priors also in every other one of the config.
 BASE_CONFIG = "single"
 FORMAT = "physgs-model-v2"
 #: Ours with K chosen from the data (physgs.experiments.kselect); its K is passed explicitly.

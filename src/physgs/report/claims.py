@@ -126,6 +126,7 @@ def measure(
     tables: Mapping[str, pd.DataFrame],
     damping: Mapping[str, Mapping[str, float]],
     trees: Sequence[str],
+    prior_damping: Mapping[str, Mapping[str, Sequence[Mapping[str, float]]]] | None = None,
 ) -> list[tuple[Claim, list[float]]]:
     """Every claim with its per-seed values, from the tables' CSVs (tab_psnr, tab_transfer,
     tab_margin, tab_null, tab_testbed and, when given, tab_fit, tab_parts and tab_tracks) and
@@ -135,7 +136,16 @@ def measure(
     A partial run gives a partial ledger: a claim whose table is not in ``tables`` is listed with
     no values (verdict "undecided: not measured"), except the per-wind rows of tab_transfer,
     whose set of winds only that table holds (left out), and the optional tables' claims (listed
-    when their tables are given). A damping claim is listed for each tree in ``damping``."""
+    when their tables are given). A damping claim is listed for each tree in ``damping``.
+
+    The headline claims are then asked again of every other prior of the registry (role
+    "prior", ``physgs.report.claims_priors``), with its damping from ``prior_damping`` (model
+    -> tree -> per-seed summaries, as ``damping``)."""
+    from physgs.models.registry import label, models_of
+    from physgs.report.claims_priors import prior_claims
+
+    # the other priors the run's tables hold (a run made before one joined them lists none)
+    others = [m for m in models_of("prior") if m != "ours" and _holds(tables, m, label(m))]
     out: list[tuple[Claim, list[float]]] = []
 
     def add(claim: Claim, table: str, fn: Callable[[pd.DataFrame], float]):
@@ -307,11 +317,11 @@ def measure(
 
     # the premise of every comparison: the fields fit their window
     for t in trees:
-        for m in (*LEARNED, "ours"):
+        for m in (*LEARNED, "ours", *others):
             add(
                 Claim(
                     f"fits_window/{t}/{m}",
-                    f"{t}: {LABELS[m]} fits its training window (reaches {FIT_BAR:.0%} of "
+                    f"{t}: {LABELS.get(m) or label(m)} fits its training window (reaches {FIT_BAR:.0%} of "
                     "the true-motion ceiling's in-window gain over static)",
                     "the fields 'fit the training window well'",
                     "tab_fit: (fit - static) / (ceiling - static) on the trained frames",
@@ -320,9 +330,7 @@ def measure(
                     "fraction",
                 ),
                 "tab_fit",
-                lambda d, t=t, m=m: float(
-                    d.loc[(d["tree"] == t) & (d["model"] == m), "ceiling_frac"].iloc[0]
-                ),
+                lambda d, t=t, m=m: _cell(d, (d["tree"] == t) & (d["model"] == m), "ceiling_frac"),
             )
 
     tr = tables.get("tab_transfer")  # its per-wind rows exist only with the table
@@ -387,10 +395,37 @@ def measure(
             ),
             "tab_margin",
             lambda d, t=t: float(
-                d.loc[d["tree"] == t, cols[-1]].iloc[0] - d.loc[d["tree"] == t, cols[0]].iloc[0]
+                _ours_margin(d, t)[cols[-1]].iloc[0] - _ours_margin(d, t)[cols[0]].iloc[0]
             ),
         )
+    for m in others:
+        out += prior_claims(m, tables, (prior_damping or {}).get(m, {}), trees)
     return out
+
+
+def _holds(tables: Mapping[str, pd.DataFrame], model: str, name: str) -> bool:
+    """Whether any of ``tables`` has a row or column of ``model`` (its id, or its label in
+    tab_psnr)."""
+    for df in tables.values():
+        if model in df.columns:
+            return True
+        for col, v in (("model", model), ("model", name), ("method", model)):
+            if col in df.columns and (df[col].astype(str) == v).any():
+                return True
+    return False
+
+
+def _ours_margin(df: pd.DataFrame, tree: str) -> pd.DataFrame:
+    """Ours' tab_margin rows of ``tree`` (the table also holds the other priors': ``model``)."""
+    mine = df["tree"] == tree
+    return df[mine & (df["model"] == "ours")] if "model" in df.columns else df[mine]
+
+
+def _cell(df: pd.DataFrame, mask, col: str) -> float:
+    """The single cell of ``col`` where ``mask`` holds; NaN where no row does (a model the
+    run's table does not hold: "undecided: not measured")."""
+    v = df.loc[mask, col]
+    return float(v.iloc[0]) if len(v) else float("nan")
 
 
 def _parts_claims(df: pd.DataFrame, trees: Sequence[str]) -> list[tuple[Claim, list[float]]]:

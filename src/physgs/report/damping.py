@@ -18,6 +18,7 @@ from typing import Mapping, Sequence
 import numpy as np
 import pandas as pd
 
+from physgs.models.registry import label as model_label
 from physgs.report import seeds as seedstats
 from physgs.report.tables import TRACKS_LABEL, Table, _by_seed, _check, _seeds, _wrap, tree_label
 from physgs.testbed.variant import DAMPING, FAITHFUL
@@ -44,6 +45,7 @@ def tab_damping(
     digits: int = 2,
     tracks: Mapping[int, Mapping[tuple[str, str, str], object]] | None = None,
     tracks_configs: Mapping[str, str] | None = None,
+    priors: Mapping[str, Mapping[int, Mapping[tuple[str, str, str], object]]] | None = None,
 ) -> Table:
     """``per_seed[seed][(tree, variant, config)]``: ``RecoveryRecord`` with damping scores and null;
     variant 'faithful' or 'damping'; configs: name -> LaTeX label, in row order. One CSV row per
@@ -52,10 +54,17 @@ def tab_damping(
 
     tracks: the 2D-track control's records the same way (``physgs.tracks``, with damping scores),
     for the configurations of ``tracks_configs`` (name -> LaTeX label); they follow ours' rows of
-    each testbed, column ``method`` 'tracks' (ours' rows: 'ours')."""
+    each testbed, column ``method`` 'tracks' (ours' rows: 'ours').
+
+    priors: the other oscillator priors' records, ``priors[model][seed][(tree, variant,
+    config)]``, in every configuration of ``configs``; their rows follow ours' of each testbed,
+    column ``method`` the model id."""
     seeds = _seeds(per_seed, "tab_damping")
     tracks_configs = dict(tracks_configs or {})
-    block = [(c, "ours") for c in configs] + [(c, "tracks") for c in tracks_configs]
+    priors = dict(priors or {})
+    block = [(c, "ours") for c in configs]
+    block += [(c, p) for p in priors for c in configs]
+    block += [(c, "tracks") for c in tracks_configs]
     keys = [(t, v, c, m) for t in trees for v in VARIANTS for c, m in block]
     rows = []
     for s in seeds:
@@ -66,11 +75,22 @@ def tab_damping(
                 (tracks or {}).get(s, {}),
                 f"tab_damping (tracks control, seed {s})",
             )
+        for p in priors:
+            _check(
+                [k[:3] for k in keys if k[3] == p],
+                priors[p].get(s, {}),
+                f"tab_damping ({p}, seed {s})",
+            )
         for t, v, c, method in keys:
-            rec = per_seed[s][(t, v, c)] if method == "ours" else tracks[s][(t, v, c)]
+            if method == "ours":
+                rec = per_seed[s][(t, v, c)]
+            elif method in priors:
+                rec = priors[method][s][(t, v, c)]
+            else:
+                rec = tracks[s][(t, v, c)]
             sc, nl = rec.damping_scores, rec.damping_null
             if sc is None or nl is None:
-                who = "" if method == "ours" else " (tracks control)"
+                who = {"ours": "", "tracks": " (tracks control)"}.get(method, f" ({method})")
                 raise ValueError(
                     f"tab_damping: the recovery of {t}/{v}/{c}{who} (seed {s}) has no "
                     "damping scores; re-run its recovery rule with damping params"
@@ -117,7 +137,12 @@ def tab_damping(
         )
         p = seedstats.pm(V["gamma_exponent"][:, i], ".2f")
         p_true = np.nanmean(V["gamma_exponent_true"][:, i])
-        label = configs[c] if method == "ours" else f"{TRACKS_LABEL}, {tracks_configs[c]}"
+        if method == "ours":
+            label = configs[c]
+        elif method in priors:
+            label = f"{model_label(method)}, {configs[c]}"
+        else:
+            label = f"{TRACKS_LABEL}, {tracks_configs[c]}"
         lines.append(
             "    "
             + " & ".join(

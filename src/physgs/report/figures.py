@@ -22,7 +22,7 @@ from matplotlib.ticker import LogLocator, NullFormatter, ScalarFormatter  # noqa
 from physgs.atomic import atomic_path  # noqa: E402
 from physgs.models.registry import MODEL_NAMES as MODELS  # noqa: E402
 from physgs.models.registry import REFERENCE_NAMES  # noqa: E402
-from physgs.models.registry import label  # noqa: E402
+from physgs.models.registry import label, spec_of  # noqa: E402
 from physgs.report.tables import condition_label  # noqa: E402
 
 COLORS = {
@@ -32,6 +32,7 @@ COLORS = {
     "d3dgs": "tab:purple",
     "d3dgs_wind": "tab:brown",
     "ours": "tab:blue",
+    "ours_chain": "tab:green",
     "gt": "k",
 }
 GOOD, BAD = "#1a9850", "#f46d43"  # green where ours is best, orange where a baseline beats it
@@ -100,7 +101,7 @@ def fig_temporal(
                 x,
                 y,
                 color=COLORS.get(m),
-                lw=1.6 if m == "ours" else 1.0,
+                lw=1.6 if spec_of(m).role == "prior" else 1.0,
                 ls="--" if m == "static" else "-",
                 label=label(m),
             )

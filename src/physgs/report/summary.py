@@ -18,7 +18,9 @@ import numpy as np
 import pandas as pd
 
 from physgs.experiments.cost import read_costs, summarise, wall_spans
+from physgs.models.registry import label
 from physgs.report.claims import FIT_BAR, LABELS
+from physgs.report.claims_priors import AHEAD
 from physgs.report.seeds import interval
 
 VERDICTS = ("holds", "fails", "undecided")
@@ -57,6 +59,7 @@ def claims_section(claims: pd.DataFrame) -> list[str]:
         + ". The claims, the paper's figures and the cells each verdict comes from: "
         "[claims.md](claims.md).",
         "",
+        *prior_lines(claims),
         "| claim | measured [95% interval] | threshold | verdict |",
         "|---|---|---|---|",
     ]
@@ -66,6 +69,26 @@ def claims_section(claims: pd.DataFrame) -> list[str]:
             meas += f" [{r['ci_low']:+.3g}, {r['ci_high']:+.3g}]"
         lines.append(f"| `{r['id']}` | {meas} | {r['threshold']} | {r['verdict']} |")
     return lines + [""]
+
+
+def prior_lines(claims: pd.DataFrame) -> list[str]:
+    """One line per prior other than ours with ``<model>/ahead_of_fields/...`` claims: on how
+    many splits and trees it beats every learned field (the claim holds: its paired 95% interval
+    above 0), and which."""
+    ids = claims["id"].astype(str)
+    ahead = claims[ids.str.contains(f"/{AHEAD}/", regex=False)]
+    lines = []
+    for m in dict.fromkeys(ids[ahead.index].str.split("/").str[0]):
+        mine = ahead[ahead["id"].astype(str).str.startswith(f"{m}/{AHEAD}/")]
+        held = mine[mine["verdict"].astype(str) == "holds"]
+        where = ", ".join(i.split(f"/{AHEAD}/", 1)[1] for i in held["id"].astype(str))
+        lines += [
+            f"{label(m)}: beats every learned field on **{len(held)} of {len(mine)}** "
+            "splits and trees (paired 95% interval above 0; views, beyond the window, each "
+            f"unseen wind at training timestamps and beyond){': ' + where if where else ''}.",
+            "",
+        ]
+    return lines
 
 
 def fit_section(tab_fit: pd.DataFrame) -> list[str]:
@@ -98,7 +121,7 @@ def fit_section(tab_fit: pd.DataFrame) -> list[str]:
             if np.isfinite(lo):
                 cell += f" [{lo:.0f}, {hi:.0f}]"
             cells.append(cell)
-        lines.append(f"| {LABELS.get(m, m)} | " + " | ".join(cells) + " |")
+        lines.append(f"| {LABELS.get(m) or label(m)} | " + " | ".join(cells) + " |")
     return lines + [""]
 
 

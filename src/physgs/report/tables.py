@@ -19,7 +19,7 @@ from physgs.atomic import atomic_path, write_text
 from physgs.evaluate.metrics import ceiling_fraction
 from physgs.models.registry import MODEL_NAMES as MODELS
 from physgs.models.registry import MODELS as SPECS
-from physgs.models.registry import label
+from physgs.models.registry import label, spec_of
 from physgs.report import seeds as seedstats
 
 
@@ -156,8 +156,9 @@ def tab_psnr(
     ``per_seed[seed][(tree, model)]``: ``EvalResult.summary()`` of the model trained ``single`` with
     that training seed. Below the models: references (the true-motion ceiling; never bold) and
     two paired differences, ours - static and ours - the best learned field (per seed, the
-    learned field with the highest PSNR in that column). The best method per column is bold when
-    its paired difference to the runner-up is decided; digits: decimals shown in the .tex.
+    learned field with the highest PSNR in that column), for every prior among ``models`` (role
+    "prior" in the registry: ours, then the chained prior). The best method per column is bold
+    when its paired difference to the runner-up is decided; digits: decimals shown in the .tex.
     """
     fmt = f".{int(digits)}f"
     seeds = _seeds(per_seed, "tab_psnr")
@@ -167,7 +168,8 @@ def tab_psnr(
             per_seed[s],
             f"tab_psnr (seed {s})",
         )
-    learned = [m for m in models if m not in ("static", "ours")]
+    learned = [m for m in models if spec_of(m).role == "field"]
+    priors = [m for m in models if spec_of(m).role == "prior"]
     cols = [f"{t}_{sp}" for t in trees for sp in ("view", "time")]
     rows = []
     for s in seeds:
@@ -186,26 +188,27 @@ def tab_psnr(
                     "difference": False,
                 }
             )
-        if "ours" in models and "static" in models:
-            rows.append(
-                {
-                    "seed": s,
-                    "model": f"{label('ours')} - {label('static')}",
-                    **{c: val["ours"][c] - val["static"][c] for c in cols},
-                    "reference": False,
-                    "difference": True,
-                }
-            )
-        if "ours" in models and learned:
-            rows.append(
-                {
-                    "seed": s,
-                    "model": f"{label('ours')} - best learned field",
-                    **{c: val["ours"][c] - max(val[m][c] for m in learned) for c in cols},
-                    "reference": False,
-                    "difference": True,
-                }
-            )
+        for p in priors:
+            if "static" in models:
+                rows.append(
+                    {
+                        "seed": s,
+                        "model": f"{label(p)} - {label('static')}",
+                        **{c: val[p][c] - val["static"][c] for c in cols},
+                        "reference": False,
+                        "difference": True,
+                    }
+                )
+            if learned:
+                rows.append(
+                    {
+                        "seed": s,
+                        "model": f"{label(p)} - best learned field",
+                        **{c: val[p][c] - max(val[m][c] for m in learned) for c in cols},
+                        "reference": False,
+                        "difference": True,
+                    }
+                )
     df = pd.DataFrame(rows)
     first = _first(df)
     ref, diff = first["reference"].to_numpy(bool), first["difference"].to_numpy(bool)
@@ -358,6 +361,7 @@ def tab_null(
     digits: int = 2,
     tracks: Mapping[int, Mapping[tuple[str, str], tuple]] | None = None,
     tracks_configs: Mapping[str, str] | None = None,
+    priors: Mapping[str, Mapping[int, Mapping[tuple[str, str], object]]] | None = None,
 ) -> Table:
     """Frequency recovery of the trained model against the untrained null, per tree and config.
 
@@ -372,10 +376,17 @@ def tab_null(
     (its ``RecoveryRecord``, the ``NullResult`` of its K), for the configurations of
     ``tracks_configs`` (name -> LaTeX label, in row order); they follow ours' rows of each tree,
     column ``method`` 'tracks' (ours' rows: 'ours').
+
+    priors: the other oscillator priors' records, ``priors[model][seed][(tree, config)]``, in
+    every configuration of ``configs``, each beside the null of its K (the same draws as ours':
+    a null depends on K only); their rows follow ours' of each tree, column ``method`` the
+    model id.
     """
     seeds = _seeds(recovery, "tab_null")
     tracks_configs = dict(tracks_configs or {})
+    priors = dict(priors or {})
     keys = [(t, c, "ours") for t in trees for c in configs]
+    keys += [(t, c, p) for t in trees for p in priors for c in configs]
     keys += [(t, c, "tracks") for t in trees for c in tracks_configs]
     rows = []
     for s in seeds:
@@ -395,9 +406,17 @@ def tab_null(
                 (tracks or {}).get(s, {}),
                 f"tab_null (tracks control, seed {s})",
             )
+        for p in priors:
+            _check(
+                [k[:2] for k in keys if k[2] == p],
+                priors[p].get(s, {}),
+                f"tab_null ({p}, seed {s})",
+            )
         for t, c, method in keys:
             if method == "ours":
                 rec, nl = recovery[s][(t, c)], null[s][(t, c)]
+            elif method in priors:
+                rec, nl = priors[method][s][(t, c)], null[s][(t, c)]
             else:
                 rec, nl = tracks[s][(t, c)]
             m = rec.match
@@ -430,7 +449,8 @@ def tab_null(
                 }
             )
     df = pd.DataFrame(rows)
-    # each tree's rows together (ours', then the tracks control's), the same order every seed
+    # each tree's rows together (ours', the other priors', the tracks control's), the same
+    # order every seed
     order = {
         (t, c, m): i for i, (t, c, m) in enumerate(sorted(keys, key=lambda k: trees.index(k[0])))
     }
@@ -472,6 +492,8 @@ def tab_null(
         return [
             configs[r.config]
             if r.method == "ours"
+            else f"{label(r.method)}, {configs[r.config]}"
+            if r.method in priors
             else f"{TRACKS_LABEL}, {tracks_configs[r.config]}",
             parts("trained_parts_trusted", i, r.K),
             pct("trained_median_rel_err_pct", i),
@@ -501,6 +523,12 @@ def tab_null(
             r"video (no renderer), matched and trusted by the same rule, beside the null of its "
             r"$K$; a part with too few tracks has no estimate and is never trusted."
             if tracks_configs
+            else ""
+        )
+        + (
+            f" {', '.join(label(p) for p in priors)}: the same scoring of its own parts, beside "
+            r"the null of its $K$ (a null depends on $K$ only)."
+            if priors
             else ""
         )
         + _seed_note(len(seeds))
@@ -558,11 +586,7 @@ def tab_transfer(
     }
     fmt = f".{int(digits)}f"
     lines = ["  \\begin{tabular}{ll" + "c" * len(models) + "}", "    \\toprule"]
-    if tuple(models) == MODELS:
-        lines += [
-            r"    & & & \multicolumn{2}{c}{Deformation MLP} & \multicolumn{2}{c}{Deformable-3DGS} & \\",
-            r"    \cmidrule(lr){4-5}\cmidrule(lr){6-7}",
-        ]
+    lines += _family_heads(models)
     lines += [
         "    Split & Tree / unseen wind & " + " & ".join(SPECS[m].short for m in models) + r" \\",
         "    \\midrule",
@@ -589,55 +613,95 @@ def tab_transfer(
     return Table("tab_transfer", df, _wrap("\n".join(lines), cap, "tab:transfer"))
 
 
+#: a family heading over the learned fields' columns of tab_transfer
+FAMILY_HEADS = {"mlp": "Deformation MLP", "d3dgs": "Deformable-3DGS"}
+
+
+def _family_heads(models: Sequence[str]) -> list[str]:
+    """The heading row over runs of columns of one field family (``FAMILY_HEADS``) and its
+    rules; none when no family has two adjacent columns."""
+    fam = [spec_of(m).family if spec_of(m).role == "field" else None for m in models]
+    runs, i = [], 0  # (family or None, first column, width)
+    while i < len(fam):
+        j = i
+        while j + 1 < len(fam) and fam[j + 1] is not None and fam[j + 1] == fam[i]:
+            j += 1
+        runs.append((fam[i] if j > i else None, i, j - i + 1))
+        i = j + 1
+    if not any(f for f, _, _ in runs):
+        return []
+    cells = ["", ""]  # the split and tree columns
+    rules = ""
+    for f, i, w in runs:
+        if f:
+            cells.append(rf"\multicolumn{{{w}}}{{c}}{{{FAMILY_HEADS[f]}}}")
+            rules += rf"\cmidrule(lr){{{i + 3}-{i + 2 + w}}}"
+        else:
+            cells += [""] * w
+    toks = [t for k, c in enumerate(cells) for t in (["&"] if k else []) + ([c] if c else [])]
+    return ["    " + " ".join(toks) + r" \\", f"    {rules}"]
+
+
 # --------------------------------------------------------------------------------------------
 def tab_margin(
     per_seed: Mapping[int, Mapping[tuple[str, str], Mapping[str, float]]],
     trees: Sequence[str],
     bones: Mapping[str, int],
     conditions: Sequence[float],
-    ours: str = "ours",
+    priors: Sequence[str] = ("ours",),
     baseline: str = "mlp_wind",
     digits: int = 2,
 ) -> Table:
-    """Ours minus Deformation MLP + wind, PSNR (dB) at training timestamps, per tree and condition
-    (including the training condition), paired per seed. Positive: ours ahead. A margin is bold
-    when its 95% interval excludes 0, marked undecided when not."""
+    """Each prior minus Deformation MLP + wind, PSNR (dB) at training timestamps, per tree and
+    condition (including the training condition), paired per seed. Positive: the prior ahead.
+    A margin is bold when its 95% interval excludes 0, marked undecided when not. One block of
+    rows per prior of ``priors`` (column ``model``: its id), in that order."""
     seeds = _seeds(per_seed, "tab_margin")
     rows = []
     for s in seeds:
         S = per_seed[s]
-        _check([(t, m) for t in trees for m in (ours, baseline)], S, f"tab_margin (seed {s})")
-        for t in trees:
-            r = {"seed": s, "tree": t, "bones": bones[t]}
-            for c, mult in enumerate(conditions):
-                r[f"margin_{condition_label(mult, tex=False)}"] = (
-                    S[(t, ours)][f"train_c{c}"] - S[(t, baseline)][f"train_c{c}"]
-                )
-            rows.append(r)
+        _check([(t, m) for t in trees for m in (*priors, baseline)], S, f"tab_margin (seed {s})")
+        for p in priors:
+            for t in trees:
+                r = {"seed": s, "model": p, "tree": t, "bones": bones[t]}
+                for c, mult in enumerate(conditions):
+                    r[f"margin_{condition_label(mult, tex=False)}"] = (
+                        S[(t, p)][f"train_c{c}"] - S[(t, baseline)][f"train_c{c}"]
+                    )
+                rows.append(r)
     df = pd.DataFrame(rows)
     first = _first(df)
     cols = [c for c in df.columns if c.startswith("margin_")]
     V = {c: _by_seed(df, c, len(seeds)) for c in cols}
     fmt = f".{int(digits)}f"
-    lines = [
-        "  \\begin{tabular}{l" + "c" * len(cols) + "}",
-        "    \\toprule",
-        r"    Ours $-$ (Deformation MLP $+$\,wind) & "
-        + " & ".join(condition_label(m) for m in conditions)
-        + r" \\",
-        "    \\midrule",
-    ]
-    for i, r in first.iterrows():
-        lines.append(
-            f"    {tree_label(r.tree, r.bones)} & "
-            + " & ".join(seedstats.difference(V[c][:, i], fmt) for c in cols)
-            + r" \\"
-        )
+    lines = ["  \\begin{tabular}{l" + "c" * len(cols) + "}", "    \\toprule"]
+    for k, p in enumerate(priors):  # the first prior's block under the conditions' heading
+        name = "Ours" if p == "ours" else label(p)
+        what = rf"{name} $-$ (Deformation MLP $+$\,wind)"
+        if k == 0:
+            heads = " & ".join(condition_label(m) for m in conditions)
+            lines += [f"    {what} & {heads}" + r" \\", "    \\midrule"]
+        else:
+            lines += [
+                "    \\midrule",
+                rf"    \multicolumn{{{1 + len(cols)}}}{{l}}{{{what}}} \\",
+                "    \\midrule",
+            ]
+        for i in np.flatnonzero(first["model"].to_numpy() == p):
+            r = first.iloc[i]
+            lines.append(
+                f"    {tree_label(r.tree, r.bones)} & "
+                + " & ".join(seedstats.difference(V[c][:, i], fmt) for c in cols)
+                + r" \\"
+            )
     lines += ["    \\bottomrule", "  \\end{tabular}", ""]
+    others = [label(p) for p in priors if p != "ours"]
     cap = (
         r"Margin against the wind-conditioned baseline: ours minus Deformation MLP\,$+$\,wind, "
         r"PSNR (dB) at training timestamps, on the training condition and the two unseen ones. "
-        r"Positive means ours is ahead." + _seed_note(len(seeds))
+        r"Positive means ours is ahead."
+        + (f" Below, the same for: {', '.join(others)}." if others else "")
+        + _seed_note(len(seeds))
     )
     return Table("tab_margin", df, _wrap("\n".join(lines), cap, "tab:margin"))
 

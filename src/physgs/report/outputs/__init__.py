@@ -1,0 +1,51 @@
+"""The report's tables and figures, each declared once (``Output``): the registry roles it
+reads, its needs, its settings and its builder. ``OUTPUTS`` lists them in build order; a model
+joins every output that reads its role through its registry entry
+(``physgs.models.registry.MODELS``), and a new output is one ``Output`` added here."""
+
+from physgs.report.outputs.base import NEED_FIELDS, Output, Plan, key, reader
+from physgs.report.outputs.recovery import FIG_DAMPING, TAB_DAMPING, TAB_KSELECT, TAB_NULL
+from physgs.report.outputs.studies import FIG_PARTS, TAB_PARTS, TAB_PARTS_K
+from physgs.report.outputs.testbed import TAB_TESTBED
+from physgs.report.outputs.tracks import FIG_TRACKS, TAB_TRACKS
+from physgs.report.outputs.views import (
+    FIG_RESULTS,
+    FIG_TEASER,
+    FIG_TEMPORAL,
+    TAB_FIT,
+    TAB_MARGIN,
+    TAB_PSNR,
+    TAB_TRANSFER,
+)
+
+#: name -> Output, tables then figures, in the order the report lists them
+OUTPUTS: dict[str, Output] = {
+    o.name: o
+    for o in (
+        TAB_TESTBED,
+        TAB_PSNR,
+        TAB_NULL,
+        TAB_TRANSFER,
+        TAB_MARGIN,
+        TAB_KSELECT,
+        TAB_FIT,
+        TAB_DAMPING,
+        TAB_PARTS,
+        TAB_PARTS_K,
+        TAB_TRACKS,
+        FIG_TEMPORAL,
+        FIG_TEASER,
+        FIG_RESULTS,
+        FIG_DAMPING,
+        FIG_PARTS,
+        FIG_TRACKS,
+    )
+}
+
+
+def reading(role: str) -> tuple[str, ...]:
+    """The outputs that read the models of ``role`` (what a new model of that role joins)."""
+    return tuple(n for n, o in OUTPUTS.items() if role in o.roles)
+
+
+__all__ = ["NEED_FIELDS", "OUTPUTS", "Output", "Plan", "key", "reader", "reading"]

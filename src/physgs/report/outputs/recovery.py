@@ -1,0 +1,304 @@
+"""The outputs that score recovered physics against the ground truth: tab_null (frequencies
+against the untrained null), tab_damping (the damping benchmark), fig_damping and tab_kselect
+(ours with K chosen from the data)."""
+
+from __future__ import annotations
+
+from physgs.models.registry import config_label, models_of
+from physgs.recovery.record import load_null, load_recovery
+from physgs.report import kselect
+from physgs.report.outputs.base import Output
+
+#: tab_kselect's rows: ours at the fixed K of the base configuration, and at the chosen K
+KSELECT_ROWS = tuple(c for c, _ in kselect.ROWS)
+
+
+def tracks_label(cfg: dict, config: str) -> str:
+    """The LaTeX label of the 2D-track control's configuration ``config`` with its own K."""
+    from physgs.tracks.settings import parts as tracks_k
+
+    spec = {**cfg["models"]["configs"][config], "K": tracks_k(cfg, config)[0]}
+    return config_label(config, spec)
+
+
+def other_priors() -> tuple[str, ...]:
+    """The priors besides ours (the paper's, read through the ``recovery`` need kind): each read
+    through ``prior_recovery`` and set beside ours' rows."""
+    return tuple(m for m in models_of("prior") if m != "ours")
+
+
+def _configs(cfg: dict) -> dict:
+    return {
+        "configs": {
+            c: {"K": int(v["K"]), "conditions": v["conditions"]}
+            for c, v in cfg["models"]["configs"].items()
+        }
+    }
+
+
+# ---- tab_null ------------------------------------------------------------------------------
+def _null_needs(plan, seeds):
+    out = []
+    for s in seeds:
+        out += [("recovery", t, c, s) for t in plan.trees for c in plan.configs]
+        out += [
+            ("prior_recovery", t, m, c, s)
+            for t in plan.trees
+            for m in other_priors()
+            for c in plan.configs
+        ]
+        out += [("tracks_recovery", t, c, s) for t in plan.trees for c in plan.tracks]
+        out += list(
+            dict.fromkeys(
+                [
+                    ("null", t, int(plan.configs[c]["K"]), s)
+                    for t in plan.trees
+                    for c in plan.configs
+                ]
+                + [("null", t, int(k), s) for t in plan.trees for k in plan.tracks.values()]
+            )
+        )
+    return out
+
+
+def _null_settings(cfg: dict) -> dict:
+    from physgs.tracks.settings import parts as tracks_k
+
+    return {
+        **_configs(cfg),
+        "tracks": {
+            c: {"K": tracks_k(cfg, c)[0], "label": tracks_label(cfg, c)}
+            for c in cfg["tracks"]["configs"]
+        },
+    }
+
+
+def _tab_null(path, settings, inputs, out):
+    from physgs.report import tables
+
+    trees, seeds, configs = settings["trees"], settings["seeds"], settings["configs"]
+    rec = {
+        s: {(t, c): load_recovery(path("recovery", t, c, s)) for t in trees for c in configs}
+        for s in seeds
+    }
+    null = {
+        s: {
+            (t, c): load_null(path("null", t, int(configs[c]["K"]), s))
+            for t in trees
+            for c in configs
+        }
+        for s in seeds
+    }
+    tk = settings.get("tracks", {})
+    tracks = {
+        s: {
+            (t, c): (
+                load_recovery(path("tracks_recovery", t, c, s)),
+                load_null(path("null", t, int(tk[c]["K"]), s)),
+            )
+            for t in trees
+            for c in tk
+        }
+        for s in seeds
+    }
+    return tables.tab_null(
+        rec,
+        null,
+        trees,
+        settings["bones"],
+        {c: config_label(c, v) for c, v in configs.items()},
+        digits=settings["digits"],
+        tracks=tracks,
+        tracks_configs={c: v["label"] for c, v in tk.items()},
+        priors={
+            m: {
+                s: {
+                    (t, c): load_recovery(path("prior_recovery", t, m, c, s))
+                    for t in trees
+                    for c in configs
+                }
+                for s in seeds
+            }
+            for m in other_priors()
+        },
+    )
+
+
+TAB_NULL = Output("tab_null", "table", ("prior",), _null_needs, _tab_null, settings=_null_settings)
+
+
+# ---- tab_damping ---------------------------------------------------------------------------
+def _testbeds(tree: str) -> dict:
+    """{variant: testbed id} of a damping-benchmark tree: its faithful and damping testbeds."""
+    from physgs.testbed.variant import DAMPING, FAITHFUL, damping_id
+
+    return {FAITHFUL: tree, DAMPING: damping_id(tree)}
+
+
+def _damping_needs(plan, seeds):
+    tracks = [c for c in plan.damping_configs if c in plan.tracks]
+    return (
+        [
+            ("recovery", tb, c, int(s))
+            for t in plan.damping_trees
+            for tb in _testbeds(t).values()
+            for c in plan.damping_configs
+            for s in seeds
+        ]
+        + [
+            ("prior_recovery", tb, m, c, int(s))
+            for t in plan.damping_trees
+            for tb in _testbeds(t).values()
+            for m in other_priors()
+            for c in plan.damping_configs
+            for s in seeds
+        ]
+        + [
+            ("tracks_recovery", tb, c, int(s))
+            for t in plan.damping_trees
+            for tb in _testbeds(t).values()
+            for c in tracks
+            for s in seeds
+        ]
+    )
+
+
+def _damping_settings(cfg: dict) -> dict:
+    configs = cfg["damping_benchmark"]["configs"]
+    return {
+        "configs": {c: config_label(c, cfg["models"]["configs"][c]) for c in configs},
+        "tracks_configs": {
+            c: tracks_label(cfg, c) for c in configs if c in cfg["tracks"]["configs"]
+        },
+    }
+
+
+def _tab_damping(path, settings, inputs, out):
+    from physgs.report.damping import tab_damping
+
+    trees, seeds = settings["trees"], settings["seeds"]
+    rows = {
+        s: {
+            (t, v, c): load_recovery(path("recovery", tb, c, s))
+            for t in trees
+            for v, tb in _testbeds(t).items()
+            for c in settings["configs"]
+        }
+        for s in seeds
+    }
+    tc = settings.get("tracks_configs", {})
+    tracks = {
+        s: {
+            (t, v, c): load_recovery(path("tracks_recovery", tb, c, s))
+            for t in trees
+            for v, tb in _testbeds(t).items()
+            for c in tc
+        }
+        for s in seeds
+    }
+    return tab_damping(
+        rows,
+        trees,
+        settings["bones"],
+        settings["configs"],
+        digits=settings["digits"],
+        tracks=tracks,
+        tracks_configs=tc,
+        priors={
+            m: {
+                s: {
+                    (t, v, c): load_recovery(path("prior_recovery", tb, m, c, s))
+                    for t in trees
+                    for v, tb in _testbeds(t).items()
+                    for c in settings["configs"]
+                }
+                for s in seeds
+            }
+            for m in other_priors()
+        },
+    )
+
+
+TAB_DAMPING = Output(
+    "tab_damping",
+    "table",
+    ("prior",),
+    _damping_needs,
+    _tab_damping,
+    settings=_damping_settings,
+    trees="damping_benchmark",
+    in_report=lambda plan: bool(plan.damping_trees),
+)
+
+
+# ---- fig_damping ---------------------------------------------------------------------------
+def _fig_damping(path, settings, inputs, out):
+    from physgs.report import figures
+
+    trees, configs, s0 = settings["trees"], list(settings["configs"]), settings["seeds"][0]
+    damping = {
+        (t, c): load_recovery(path("recovery", t, c, s0)).damping for t in trees for c in configs
+    }
+    figures.fig_damping(damping, trees, configs, float(settings["zeta"]), out)
+
+
+FIG_DAMPING = Output(
+    "fig_damping",
+    "figure",
+    ("prior",),
+    lambda plan, seeds: [
+        ("recovery", t, c, s) for s in seeds for t in plan.trees for c in plan.configs
+    ],
+    _fig_damping,
+    settings=lambda cfg: {**_configs(cfg), "zeta": float(cfg["testbed"]["zeta"])},
+    seeds="first",
+)
+
+
+# ---- tab_kselect ---------------------------------------------------------------------------
+def _kselect_needs(plan, seeds):
+    out = []
+    for s in seeds:
+        for t in plan.trees:
+            out.append(("kselect", t, s))
+            out += [
+                x for c in KSELECT_ROWS for x in (("eval", t, "ours", c, s), ("recovery", t, c, s))
+            ]
+    return out
+
+
+def _tab_kselect(path, settings, inputs, out):
+    from physgs.evaluate.splits import load_eval
+    from physgs.experiments.kselect import load_selection
+
+    rows = {}
+    for s in settings["seeds"]:
+        rows[s] = {}
+        for t in settings["trees"]:
+            sel = load_selection(path("kselect", t, s))
+            for c in KSELECT_ROWS:
+                ev = load_eval(path("eval", t, "ours", c, s)).summary()
+                rec = load_recovery(path("recovery", t, c, s))
+                rows[s][(t, c)] = {
+                    "K": rec.match.n_parts,
+                    "time_psnr": ev["time"],
+                    "median_rel_err": rec.match.median_rel_err,
+                    "trusted": rec.match.n_trusted,
+                    "frozen": rec.n_frozen,
+                    "k_heldout": sel.k_heldout,
+                    "k_bic": sel.k_bic,
+                }
+    return kselect.tab_kselect(
+        rows, settings["trees"], settings["bones"], settings["method"], digits=settings["digits"]
+    )
+
+
+TAB_KSELECT = Output(
+    "tab_kselect",
+    "table",
+    ("prior",),
+    _kselect_needs,
+    _tab_kselect,
+    settings=lambda cfg: {"method": cfg["models"]["kselect"]["method"]},
+    in_report=lambda plan: False,  # `all` builds it (Snakefile): K selection costs trainings
+)

@@ -1,0 +1,119 @@
+"""The 2D-track control's outputs (docs/tracks.md): tab_tracks (the fit's scores beside ours'
+and the learned fields' at the tracked points) and fig_tracks (the tracks and their parts)."""
+
+from __future__ import annotations
+
+import numpy as np
+import pandas as pd
+
+from physgs.intermediate import read_json
+from physgs.report.outputs.base import Output, key
+from physgs.report.outputs.recovery import tracks_label
+
+
+def _controlled(plan) -> bool:
+    return bool(plan.tracks)
+
+
+# ---- tab_tracks ----------------------------------------------------------------------------
+def _tab_tracks_needs(plan, seeds):
+    """Its evaluation record, ours' loss log (training seconds) and, for ``plan.tracks_fields``,
+    the fields' scores, per tree, configuration and seed."""
+    return [
+        (kind, t, *m, c, int(s))
+        for s in seeds
+        for t in plan.trees
+        for c in plan.tracks
+        for kind, m in (("tracks_eval", ()), ("loss", ("ours",)))  # ours' training seconds
+    ] + [("tracks_fields", t, c, int(s)) for s in seeds for t, c in plan.tracks_fields]
+
+
+def _tab_tracks_settings(cfg: dict) -> dict:
+    return {
+        "configs": {
+            c: {
+                "label": tracks_label(cfg, c),
+                "conditions": cfg["models"]["configs"][c]["conditions"],
+            }
+            for c in cfg["tracks"]["configs"]
+        },
+        "conditions": [float(c) for c in cfg["testbed"]["conditions"]],
+    }
+
+
+def _tab_tracks(path, settings, inputs, out):
+    from physgs.report.tracks import tab_tracks
+
+    scores = {}
+    for s in settings["seeds"]:
+        scores[s] = {}
+        for t in settings["trees"]:
+            for c in settings["configs"]:
+                scores[s][(t, c)] = read_json(path("tracks_eval", t, c, s), rule="tracks_evaluate")
+                if key(("tracks_fields", t, c, s)) in inputs:  # {case: {field: errors}}
+                    fields = read_json(path("tracks_fields", t, c, s), rule="tracks_fields")
+                    for case, f in fields.items():
+                        scores[s][(t, c)][case]["fields"] = f
+                loss = pd.read_csv(path("loss", t, "ours", c, s))
+                scores[s][(t, c)]["ours_train_s"] = float(loss["seconds"].iloc[-1])
+    return tab_tracks(
+        scores,
+        settings["trees"],
+        settings["bones"],
+        settings["configs"],
+        settings["conditions"],
+        digits=settings["digits"],
+    )
+
+
+TAB_TRACKS = Output(
+    "tab_tracks",
+    "table",
+    ("prior", "field"),
+    _tab_tracks_needs,
+    _tab_tracks,
+    settings=_tab_tracks_settings,
+    in_report=_controlled,
+)
+
+
+# ---- fig_tracks ----------------------------------------------------------------------------
+def _fig_tracks_needs(plan, seeds):
+    """Per tree, the observed frames, the training video's tracks and (with a configuration)
+    the first configuration's fit, of the first seed."""
+    s0, configs = int(seeds[0]), list(plan.tracks)
+    out = []
+    for t in plan.trees:
+        out += [("observed", t, s0), ("tracks", t, 0, s0)]
+        out += [("tracks_fit", t, configs[0], s0)] if configs else []
+    return out
+
+
+def _fig_tracks(path, settings, inputs, out):
+    from physgs.report.tracks import fig_tracks
+    from physgs.tracks.store import load_fit, load_tracks
+
+    trees, s0, configs = settings["trees"], settings["seeds"][0], list(settings["configs"])
+    frames, tracks, labels = {}, {}, {}
+    for t in trees:
+        with np.load(path("observed", t, s0)) as z:
+            frames[t] = z["frames"][0, 0]  # training condition, recorded frame 0 [H, W, 3]
+        tracks[t], _ = load_tracks(path("tracks", t, 0, s0))
+        labels[t] = None
+        if configs:  # each track's part; -1 (grey) where not fitted or its part has no estimate
+            fit = load_fit(path("tracks_fit", t, configs[0], s0))[0]
+            lab = fit.labels[0]
+            labels[t] = np.where((lab >= 0) & fit.estimated[np.maximum(lab, 0)], lab, -1)
+    what = f"colour: part in the {configs[0]} fit; " if configs else ""
+    fig_tracks(frames, tracks, labels, trees, out, title=f"2D tracks ({what}seed {s0})")
+
+
+FIG_TRACKS = Output(
+    "fig_tracks",
+    "figure",
+    (),
+    _fig_tracks_needs,
+    _fig_tracks,
+    settings=lambda cfg: {"configs": list(cfg["tracks"]["configs"])},
+    seeds="first",  # drawn without a fit's parts when the control fits nothing
+)
