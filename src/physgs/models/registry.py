@@ -83,12 +83,15 @@ PRIOR_VARIANTS: dict[str, ModelSpec] = {
     ),
     # issue 42: ours with a learned forcing shared by every part instead of the measured wind
     # (physgs.models.blind); trained in `single` only (one window, one forcing)
-    "ours_blind": ModelSpec("Ours, learned forcing", "blind", "ours", False, forcing="learned"),
+    "ours_blind": ModelSpec(
+        "Ours, learned forcing", "blind", "ours", False, "prior", forcing="learned"
+    ),
     "ours_chain_blind": ModelSpec(
         "Ours, chained topology parts, learned forcing",
         "chained, blind",
         "ours",
         False,
+        "prior",
         parts="topology",
         chain=True,
         forcing="learned",
