@@ -76,7 +76,8 @@ def test_only_the_reference_rule_reads_the_truth(plan):
 
 def test_train_jobs_read_only_the_observed_dataset(plan):
     blocks = _blocks(plan, "train")
-    assert len(blocks) == 24  # 3 trees x (5 baselines single + ours single/joint32/joint96)
+    # 3 trees x (5 baselines single + each prior, ours and the chained, single/joint32/joint96)
+    assert len(blocks) == 33
     for b in blocks:
         inputs = re.search(r"input: (.*)", b).group(1)
         assert re.fullmatch(r"results/testbed/\w+/observed\.npz", inputs.strip()), inputs
@@ -90,22 +91,33 @@ def test_train_jobs_read_only_the_observed_dataset(plan):
 
 
 def test_tab_damping_plans_ours_on_both_testbeds_of_each_tree():
-    """tab_damping (default profile: the quick one builds no damping testbed) trains ours alone,
-    in the benchmark's configurations, per seed, on each tree and its <tree>_damping copy, whose
-    dataset is built by the same testbed rule with the damping variant."""
+    """tab_damping (default profile: the quick one builds no damping testbed) trains the priors
+    alone (ours and the chained prior), in the benchmark's configurations, per seed, on each tree
+    and its <tree>_damping copy, whose dataset is built by the same testbed rule with the damping
+    variant; and ours in the 2D-track control's other configurations on the faithful trees (the
+    control scores every configuration of a tree and seed in one job)."""
     from physgs import config as pconfig
+    from physgs.models.registry import models_of
 
     cfg = pconfig.load(ROOT / "config" / "trees.yaml", "default")
     db = cfg["damping_benchmark"]
     r = _dry_run("results/tables/tab_damping.tex", profile="default")
     assert r.returncode == 0, r.stderr[-2000:] + r.stdout[-2000:]
-    trained = set(re.findall(r"results/models/(\w+)/seed(\d+)/(\w+?)_(\w+)\.pt", r.stdout))
+    priors = "|".join(sorted(models_of("prior"), key=len, reverse=True))
+    trained = set(re.findall(rf"results/models/(\w+)/seed(\d+)/({priors})_(\w+)\.pt", r.stdout))
     want = {
-        (tb, str(s), "ours", c)
+        (tb, str(s), m, c)
         for t in db["trees"]
         for tb in (t, f"{t}_damping")
         for s in cfg["seeds"]
+        for m in models_of("prior")
         for c in db["configs"]
+    }
+    want |= {
+        (t, str(s), "ours", c)
+        for t in db["trees"]
+        for s in cfg["seeds"]
+        for c in cfg["tracks"]["configs"]
     }
     assert trained == want
     built = [b for b in _blocks(r.stdout, "testbed_dataset") if "_damping/observed" in b]

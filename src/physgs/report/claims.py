@@ -403,10 +403,15 @@ def measure(
     return out
 
 
+#: The tables the other priors' claims read (``claims_priors``): a prior is asked them when one
+#: of these holds it (tab_parts held the chained prior before it joined them).
+PRIOR_TABLES = ("tab_psnr", "tab_transfer", "tab_margin", "tab_null")
+
+
 def _holds(tables: Mapping[str, pd.DataFrame], model: str, name: str) -> bool:
-    """Whether any of ``tables`` has a row or column of ``model`` (its id, or its label in
-    tab_psnr)."""
-    for df in tables.values():
+    """Whether any of :data:`PRIOR_TABLES` has a row or column of ``model`` (its id, or its
+    label in tab_psnr)."""
+    for df in (tables[k] for k in PRIOR_TABLES if k in tables):
         if model in df.columns:
             return True
         for col, v in (("model", model), ("model", name), ("method", model)):
