@@ -84,6 +84,15 @@ class Camera:
 
     @staticmethod
     def from_dict(d: dict) -> "Camera":
+        """The camera that [to_dict][physgs.camera.Camera.to_dict] wrote.
+
+        Args:
+            d: mapping with ``viewmat`` [4, 4] (world to camera), ``intrinsics`` [4] (fx, fy, cx, cy
+                in px), ``size`` [2] (width, height in px) and ``near`` (scene units).
+
+        Returns:
+            The camera.
+        """
         v = np.asarray(d["viewmat"], dtype=np.float64)
         fx, fy, cx, cy = (float(x) for x in np.asarray(d["intrinsics"]))
         w, h = (int(x) for x in np.asarray(d["size"]))

@@ -23,6 +23,8 @@ class ClusterRequestError(RuntimeError):
 
 @dataclass(frozen=True)
 class Partition:
+    """The largest node of one Slurm partition, as ``sinfo`` reports it."""
+
     name: str
     default: bool
     cpus: int  # most CPUs on one node
@@ -87,6 +89,8 @@ def sinfo() -> dict[str, Partition]:
 
 @dataclass(frozen=True)
 class Request:
+    """What one rule's jobs ask the cluster for (threads, memory in MB, runtime in minutes)."""
+
     rule: str
     threads: int
     mem_mb: float | None

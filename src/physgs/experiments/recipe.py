@@ -55,16 +55,37 @@ class Job:
 
     @property
     def name(self) -> str:
+        """The job's run name, ``<model>_<config>``."""
         return f"{self.model}_{self.config}"
 
     def to_dict(self) -> dict:
+        """The job as a plain dict, keys sorted at every level.
+
+        See [canonical][physgs.experiments.recipe.canonical].
+        """
         return canonical(asdict(self))
 
     @staticmethod
     def from_dict(d: dict) -> "Job":
+        """The job that [to_dict][physgs.experiments.recipe.Job.to_dict] wrote.
+
+        Args:
+            d: field name -> value (extra keys are ignored).
+
+        Returns:
+            The job.
+        """
         return Job(**{k: d[k] for k in Job.__dataclass_fields__})
 
     def replace(self, **kw) -> "Job":
+        """A copy of the job with the fields in ``kw`` changed.
+
+        Args:
+            **kw: field name -> new value.
+
+        Returns:
+            The new job.
+        """
         return Job.from_dict({**asdict(self), **kw})
 
 
