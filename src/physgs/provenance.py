@@ -41,6 +41,7 @@ class Stamp:
     physgs_version: str
 
     def to_dict(self) -> dict:
+        """The stamp as a plain dict (profile, config_hash, physgs_version)."""
         return asdict(self)
 
 

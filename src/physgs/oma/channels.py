@@ -48,6 +48,7 @@ class Channels:
 
     @property
     def n_cells(self) -> int:
+        """The number of cells, N (the channels are 2 N)."""
         return int(self.cell_xy.shape[0])
 
 

@@ -97,6 +97,7 @@ class Modes:
 
     @property
     def n_modes(self) -> int:
+        """The number of identified modes, M."""
         return int(self.freq_hz.size)
 
 
