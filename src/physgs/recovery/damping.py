@@ -31,12 +31,21 @@ class DampingResult:
     zeta_true: float
 
     def to_dict(self) -> dict:
+        """The result as a JSON-ready dict (arrays as lists)."""
         return {
             k: (v.tolist() if isinstance(v, np.ndarray) else v) for k, v in asdict(self).items()
         }
 
     @staticmethod
     def from_dict(d: dict) -> "DampingResult":
+        """The result that [to_dict][physgs.recovery.damping.DampingResult.to_dict] wrote.
+
+        Args:
+            d: field name -> value (arrays as lists).
+
+        Returns:
+            The result.
+        """
         return DampingResult(
             np.asarray(d["zeta"]),
             np.asarray(d["omega"]),

@@ -55,10 +55,19 @@ class DampingScores:
     gamma_exponent_true: float
 
     def to_dict(self) -> dict:
+        """The scores as a plain dict (field name -> value)."""
         return asdict(self)
 
     @staticmethod
     def from_dict(d: dict) -> "DampingScores":
+        """The scores that [to_dict][physgs.recovery.damping_scores.DampingScores.to_dict] wrote.
+
+        Args:
+            d: field name -> value.
+
+        Returns:
+            The scores.
+        """
         return DampingScores(
             int(d["n_trusted"]),
             *(
@@ -182,19 +191,30 @@ class DampingNull:
 
     @property
     def median_log_corr(self) -> float:
+        """Median over draws of each draw's log-log correlation (NaN draws skipped)."""
         return self._median(self.log_corr)
 
     @property
     def median_gamma_exponent(self) -> float:
+        """Median over draws of each draw's gamma exponent (NaN draws skipped)."""
         return self._median(self.gamma_exponent)
 
     def to_dict(self) -> dict:
+        """The null as a JSON-ready dict (arrays as lists)."""
         return {
             k: (v.tolist() if isinstance(v, np.ndarray) else v) for k, v in asdict(self).items()
         }
 
     @staticmethod
     def from_dict(d: dict) -> "DampingNull":
+        """The null that [to_dict][physgs.recovery.damping_scores.DampingNull.to_dict] wrote.
+
+        Args:
+            d: field name -> value (arrays as lists).
+
+        Returns:
+            The null.
+        """
         return DampingNull(
             *(
                 np.asarray(d[k], float)

@@ -79,12 +79,21 @@ class MatchResult:
     loglog_r2: float
 
     def to_dict(self) -> dict:
+        """The result as a JSON-ready dict (arrays as lists)."""
         return {
             k: (v.tolist() if isinstance(v, np.ndarray) else v) for k, v in asdict(self).items()
         }
 
     @staticmethod
     def from_dict(d: dict) -> "MatchResult":
+        """The result that [to_dict][physgs.recovery.matcher.MatchResult.to_dict] wrote.
+
+        Args:
+            d: field name -> value (arrays as lists).
+
+        Returns:
+            The result.
+        """
         arr = {
             k: np.asarray(d[k])
             for k in ("bone", "corr", "trusted", "omega_hat", "omega_true", "rel_err")

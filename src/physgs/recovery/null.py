@@ -47,6 +47,7 @@ class NullResult:
 
     @property
     def median_n_trusted(self) -> float:
+        """Median over draws of the trusted parts."""
         return float(np.median(self.n_trusted))
 
     @property
@@ -70,16 +71,26 @@ class NullResult:
 
     @property
     def median_loglog_r2(self) -> float:
+        """Median over draws of the log-log R^2 of omega against the bones' (NaN draws skipped)."""
         v = self.loglog_r2[np.isfinite(self.loglog_r2)]
         return float(np.median(v)) if v.size else float("nan")
 
     def to_dict(self) -> dict:
+        """The result as a JSON-ready dict (arrays as lists)."""
         return {
             k: (v.tolist() if isinstance(v, np.ndarray) else v) for k, v in asdict(self).items()
         }
 
     @staticmethod
     def from_dict(d: dict) -> "NullResult":
+        """The result that [to_dict][physgs.recovery.null.NullResult.to_dict] wrote.
+
+        Args:
+            d: field name -> value (arrays as lists; the visible-bone scores may be absent or None).
+
+        Returns:
+            The result.
+        """
         opt = {
             k: (np.asarray(d[k], float) if d.get(k) is not None else None)
             for k in ("n_trusted_visible", "median_rel_err_visible")

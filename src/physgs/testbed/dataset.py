@@ -124,6 +124,8 @@ def _seed(seed: int, *parts) -> np.random.SeedSequence:
 
 @dataclass(frozen=True)
 class TreeSim:
+    """One simulated tree: skeleton, mesh, true motion and the winds [C, L+F] m/s."""
+
     skeleton: weberpenn.Skeleton
     mesh: TreeMesh
     truth: Truth

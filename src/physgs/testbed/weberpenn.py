@@ -87,6 +87,7 @@ class Stem:
 
     @property
     def length(self) -> float:
+        """The polyline's length, m."""
         return float(np.linalg.norm(np.diff(self.points, axis=0), axis=1).sum())
 
     def radius_at(self, z: np.ndarray | float) -> np.ndarray:
@@ -112,6 +113,7 @@ class Skeleton:
 
     @property
     def n_bones(self) -> int:
+        """The number of bones, B."""
         return int(self.head.shape[0])
 
 
