@@ -3,8 +3,8 @@
 A job whose threads, memory or run time no node of its partition can give waits PENDING for ever
 (reason PartitionConfig or Resources), and Snakemake waits with it without a word. The Snakefile's
 ``onstart`` hook (run after the DAG is built, before the first submission, only with the SLURM
-executor) calls :func:`check_jobs` with what ``sinfo`` reports, and stops with every offending
-rule and request named.
+executor) calls [`check_jobs`][physgs.cluster.check_jobs] with what ``sinfo`` reports, and stops
+with every offending rule and request named.
 """
 
 from __future__ import annotations

@@ -1,8 +1,8 @@
 """Differentiable 3D Gaussian Splatting rasterizer (CPU fast path, PyTorch reference, gsplat).
 
-One entry point, :func:`rasterization`, in the spirit of gsplat's: Gaussians + camera +
-background -> RGB, accumulated alpha and expected depth, differentiable w.r.t. means, quats,
-scales, opacities and colours.
+One entry point, [`rasterization`][physgs.render.rasterization], in the spirit of gsplat's:
+Gaussians + camera + background -> RGB, accumulated alpha and expected depth, differentiable w.r.t.
+means, quats, scales, opacities and colours.
 """
 
 from __future__ import annotations
@@ -123,7 +123,8 @@ def rasterization(
 
     backend: "fast" (numba CPU kernels with an explicit backward), "reference" (pure PyTorch
     autograd), "gsplat" (CUDA, needs gsplat installed) or "auto" (gsplat on CUDA when installed,
-    else fast). Returns :class:`RenderOutput` on the device and dtype of ``means``.
+    else fast). Returns [`RenderOutput`][physgs.render.RenderOutput] on the device and dtype of
+    ``means``.
     """
     if backend not in BACKENDS:
         raise ValueError(f"rasterization: unknown backend {backend!r}; choose one of {BACKENDS}")

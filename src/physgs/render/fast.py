@@ -1,5 +1,5 @@
-"""Fast CPU rasterizer: fused numba projection + tile compositing behind one
-torch.autograd.Function with an explicit backward (kernels in :mod:`physgs.render.kernels`).
+"""Fast CPU rasterizer: fused numba projection + tile compositing behind one torch.autograd.Function
+with an explicit backward (kernels in [`physgs.render.kernels`][physgs.render.kernels]).
 
 Everything between the input tensors and the output images runs in numba or vectorised numpy:
 no Python loop over Gaussians and no small torch ops (whose OpenMP barriers cost more than the
@@ -29,9 +29,10 @@ def _to_torch(x: np.ndarray, like: torch.Tensor) -> torch.Tensor:
 
 
 def camera_arrays(camera: Camera):
-    """(Rc [3, 3], tc [3], intr [4], lims [4]) float64 for the kernels; lims are gsplat's
-    tangent clamps (x-, x+, y-, y+) of the projection Jacobian, from
-    :func:`physgs.render.project.fov_clamp_limits` (the reference path uses the same)."""
+    """(Rc [3, 3], tc [3], intr [4], lims [4]) float64 for the kernels; lims are gsplat's tangent
+    clamps (x-, x+, y-, y+) of the projection Jacobian, from
+    [`fov_clamp_limits`][physgs.render.project.fov_clamp_limits] (the reference path uses the
+    same)."""
     intr = np.array([camera.fx, camera.fy, camera.cx, camera.cy], dtype=np.float64)
     lims = np.array(fov_clamp_limits(camera), dtype=np.float64)
     return (
@@ -146,7 +147,8 @@ class _FastRasterize(torch.autograd.Function):
 
 
 def work_count(means, quats, scales, opacities, colors, camera, background) -> dict[str, int]:
-    """How much compositing one forward + backward of :func:`rasterize_fast` does (ints):
+    """How much compositing one forward + backward of
+    [`rasterize_fast`][physgs.render.fast.rasterize_fast] does (ints):
 
     pairs: pixel-Gaussian pairs composited before transmittance saturates (each costs
     ``kernels.FLOPS_PER_PAIR`` flops, forward + backward); footprint_pixels: pixels inside the
@@ -181,7 +183,7 @@ def rasterize_fast(
     background: torch.Tensor,
     return_depth: bool = True,
 ):
-    """Fast CPU backend of :func:`physgs.render.rasterization` (same shapes and units).
+    """Fast CPU backend of [`rasterization`][physgs.render.rasterization] (same shapes and units).
 
     Returns (rgb [H, W, D], alpha [H, W], depth [H, W] or None). Tensors on another device are
     copied to the CPU and back. Arithmetic is float64 inside the kernels for any input dtype.

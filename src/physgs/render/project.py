@@ -6,7 +6,7 @@ R_q S S^T R_q^T, perspective Jacobian evaluated at x/z, y/z clamped to the image
 principal point, as 3DGS), so Gaussians far off to the side do not blow up, +0.3 px^2 dilation of
 the 2D covariance, conic = its inverse. Culled Gaussians (behind the near plane, degenerate) get a
 mask and finite zero outputs, never NaN: every division uses a clamped denominator, so gradients
-stay finite too. Thresholds live in :mod:`physgs.render.constants`.
+stay finite too. Thresholds live in [`physgs.render.constants`][physgs.render.constants].
 """
 
 from __future__ import annotations
@@ -101,7 +101,8 @@ def project_gaussians(
 ) -> Projected:
     """Project Gaussians (means [N, 3] world units, quats [N, 4] wxyz, scales [N, 3] world units).
 
-    Returns a :class:`Projected`; differentiable w.r.t. means, quats and scales.
+    Returns a [`Projected`][physgs.render.project.Projected]; differentiable w.r.t. means, quats and
+    scales.
     """
     R, t = camera_tensors(camera, means)
     xyz = means @ R.T + t  # [N, 3] camera coordinates

@@ -97,7 +97,7 @@ def pose_points(
 def pose_vertices(truth, theta_b: np.ndarray) -> np.ndarray:
     """Mesh vertices posed by bone angles theta_b [..., B] (rad) -> [..., N, 3] (m).
 
-    ``truth`` is a :class:`physgs.testbed.dataset.Truth` (or anything with its bone fields).
+    ``truth`` is a [`Truth`][physgs.testbed.dataset.Truth] (or anything with its bone fields).
     """
     return pose_points(
         truth.rest_vertices,

@@ -55,7 +55,7 @@ def _tile_matrix(tile: int, size: int, sigma: float, dtype, device) -> torch.Ten
 
 def _blur_rows_tiled(z: torch.Tensor, size: int, sigma: float) -> torch.Tensor:
     """Zero-padded 1D Gaussian blur of z [..., H, W] along H, BLUR_TILE output rows at a time:
-    the same sums as the banded matrix of :func:`_blur_matrix`, without its zeros."""
+    the same sums as the banded matrix of ``_blur_matrix``, without its zeros."""
     H, r = z.shape[-2], size // 2
     n_tiles = -(-H // BLUR_TILE)
     zp = F.pad(z, (0, 0, r, n_tiles * BLUR_TILE - H + r))  # [..., tiles*TILE + size-1, W]
@@ -83,7 +83,7 @@ def blur(z: torch.Tensor, size: int = 11, sigma: float = 1.5, tiled: bool | None
 def ssim(a: torch.Tensor, b: torch.Tensor, window: int = 11, sigma: float = 1.5) -> torch.Tensor:
     """Mean SSIM of images a, b [H, W, C] in [0, 1] (Gaussian 11x11 window, sigma 1.5, zero
     padding: the 3DGS implementation), differentiable w.r.t. both; the window's separable blur
-    runs as two banded matmuls, or in tiles on large images (:func:`blur`)."""
+    runs as two banded matmuls, or in tiles on large images ([`blur`][physgs.train.losses.blur])."""
     if a.shape != b.shape or a.ndim != 3:
         raise ValueError(
             f"ssim: images must share shape [H, W, C]; got {tuple(a.shape)}, {tuple(b.shape)}"
