@@ -36,7 +36,7 @@ class Trajectories:
         """Write the trajectories to a ``.npz`` atomically (read back by `load_trajectories`).
 
         Args:
-            path: the ``.npz`` file to write.
+            path (str | os.PathLike): the ``.npz`` file to write.
         """
         save_npz(path, **{f.name: np.asarray(getattr(self, f.name)) for f in fields(self)})
 
@@ -45,7 +45,7 @@ def load_trajectories(path) -> Trajectories:
     """Read the trajectories that [save][physgs.evaluate.trajectories.Trajectories.save] wrote.
 
     Args:
-        path: the ``.npz`` file.
+        path (str | os.PathLike): the ``.npz`` file.
 
     Returns:
         The trajectories (``gt_px``, ``pred_px`` [P, F, 2] px, ``tips`` [P]).

@@ -98,7 +98,7 @@ def save_selection(path, sel: KSelection) -> None:
     """Write the K selection to ``path`` as JSON, atomically.
 
     Args:
-        path: the ``.json`` file to write.
+        path (str | os.PathLike): the ``.json`` file to write.
         sel: the selection.
     """
     write_json(path, sel.to_dict())
@@ -108,7 +108,7 @@ def load_selection(path) -> KSelection:
     """Read the K selection that [save_selection][physgs.experiments.kselect.save_selection] wrote.
 
     Args:
-        path: the ``.json`` file.
+        path (str | os.PathLike): the ``.json`` file.
 
     Returns:
         The selection.

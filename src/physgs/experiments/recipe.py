@@ -81,7 +81,7 @@ class Job:
         """A copy of the job with the fields in ``kw`` changed.
 
         Args:
-            **kw: field name -> new value.
+            **kw (Any): field name -> new value.
 
         Returns:
             The new job.

@@ -137,9 +137,6 @@ class BlindOscillatorPrior(OscillatorPrior):
             frame_idx: recorded frame, 0 .. n_train - 1.
             wind: ignored (any [L+F] series, NaN included).
 
-        Returns:
-            The deformed Gaussians.
-
         Raises:
             ForcingNotDefined: the frame lies beyond the training window.
         """

@@ -89,7 +89,7 @@ def save_identification(path, ident: Identification, s: OMASettings) -> None:
     The channels' displacements are not stored, only their geometry.
 
     Args:
-        path: the ``.npz`` file to write.
+        path (str | os.PathLike): the ``.npz`` file to write.
         ident: the channels' geometry, the modes and the seconds it took.
         s: the settings it was made with (stored as JSON).
     """
@@ -117,7 +117,7 @@ def load_identification(path) -> Identification:
     """Read the identification that [save_identification][physgs.oma.run.save_identification] wrote.
 
     Args:
-        path: the ``.npz`` file.
+        path (str | os.PathLike): the ``.npz`` file.
 
     Returns:
         The identification; its channels' displacements ``y`` are empty ([0, C]).

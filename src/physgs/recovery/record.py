@@ -104,7 +104,7 @@ def save_recovery(path, rec: RecoveryRecord) -> None:
     """Write the recovery record to ``path`` as JSON, atomically.
 
     Args:
-        path: the ``.json`` file to write.
+        path (str | os.PathLike): the ``.json`` file to write.
         rec: the record.
     """
     write_json(path, recovery_dict(rec))
@@ -117,7 +117,7 @@ def load_recovery(path) -> RecoveryRecord:
     defaults (none frozen, -1 / NaN, None).
 
     Args:
-        path: the ``.json`` file.
+        path (str | os.PathLike): the ``.json`` file.
 
     Returns:
         The record.
@@ -141,7 +141,7 @@ def save_null(path, res: NullResult) -> None:
     """Write the null control's result to ``path`` as JSON, atomically.
 
     Args:
-        path: the ``.json`` file to write.
+        path (str | os.PathLike): the ``.json`` file to write.
         res: the result.
     """
     write_json(path, res.to_dict())
@@ -151,7 +151,7 @@ def load_null(path) -> NullResult:
     """Read the null control's result that [save_null][physgs.recovery.record.save_null] wrote.
 
     Args:
-        path: the ``.json`` file.
+        path (str | os.PathLike): the ``.json`` file.
 
     Returns:
         The result.
