@@ -110,13 +110,13 @@ def ceiling_fraction(fit, static, ceiling):
     (fit - static) / (ceiling - static); arrays broadcast.
 
     Args:
-        fit: the model's PSNR, dB.
-        static: the static pose's PSNR, dB.
-        ceiling: the true-motion ceiling's PSNR, dB.
+        fit (np.ndarray | float): the model's PSNR, dB.
+        static (np.ndarray | float): the static pose's PSNR, dB.
+        ceiling (np.ndarray | float): the true-motion ceiling's PSNR, dB.
 
     Returns:
-        The fraction (unitless, float64); NaN where the ceiling does not beat the static pose (no
-        gain to measure against).
+        (np.ndarray): The fraction (unitless, float64); NaN where the ceiling does not beat the
+            static pose (no gain to measure against).
     """
     fit, static, ceiling = (np.asarray(x, dtype=np.float64) for x in (fit, static, ceiling))
     gain = ceiling - static

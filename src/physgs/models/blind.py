@@ -84,12 +84,12 @@ class BlindOscillatorPrior(OscillatorPrior):
         """Ours' oscillators and a learned forcing series of the lead-in and training window.
 
         Args:
-            ctx: the observed-dataset facts.
+            ctx (ModelContext): the observed-dataset facts.
             canonical_cfg: keyword arguments of the canonical set (config ``models.canonical``).
             forcing_hz: the forcing's band limit, Hz (harmonics j / S <= forcing_hz).
             seed: seeds the forcing's starting coefficients and ours' k-means.
-            **kw: ours' options ([OscillatorPrior][physgs.models.ours.OscillatorPrior]); the search
-                over omega is refused.
+            **kw (Any): ours' options ([OscillatorPrior][physgs.models.ours.OscillatorPrior]); the
+                search over omega is refused.
 
         Raises:
             ValueError: a search over omega is asked for.

@@ -180,9 +180,9 @@ class SearchHook:
         """End the bank phase at iteration ``at`` (see the class docstring); a no-op at the others.
 
         Args:
-            it: the training iteration.
-            model: the prior being trained.
-            optimizer: its optimiser (groups named as in ``param_groups``).
+            it (int): the training iteration.
+            model (OscillatorPrior): the prior being trained.
+            optimizer (torch.optim.Optimizer): its optimiser (groups named as in ``param_groups``).
 
         Returns:
             The statistics to log at ``at``, else None.

@@ -45,11 +45,11 @@ def fastest_rate(omega, zeta):
     omega alone lets it blow up.
 
     Args:
-        omega: natural frequencies, rad/s (scalar or array).
-        zeta: damping ratios, dimensionless (same shape as omega, or broadcastable).
+        omega (np.ndarray | float): natural frequencies, rad/s (scalar or array).
+        zeta (np.ndarray | float): damping ratios, dimensionless (broadcastable to omega).
 
     Returns:
-        |lambda|, rad/s, float64, the broadcast shape.
+        (np.ndarray): |lambda|, rad/s, float64, the broadcast shape.
     """
     omega = np.asarray(omega, dtype=np.float64)
     zeta = np.asarray(zeta, dtype=np.float64)
@@ -67,7 +67,7 @@ def required_substeps(omega_max: float, dt: float, limit: float = STABILITY_GUAR
 
     Returns:
         The substeps, >= 1 (with the same slack, GUARD_RTOL, as ``integrate``'s check, so the
-        count is always accepted there).
+            count is always accepted there).
 
     Raises:
         ValueError: omega_max, dt or limit not > 0.
@@ -256,7 +256,8 @@ def integrate(
         omega: [K] natural frequencies, rad/s (> 0).
         zeta: [K] damping ratios, dimensionless (>= 0).
         gain: [K] force gains, rad / m^2.
-        wind: [T] wind speed, m/s, sampled every ``dt`` (tensor or array; not differentiated).
+        wind (torch.Tensor | np.ndarray): [T] wind speed, m/s, sampled every ``dt`` (tensor or
+            array; not differentiated).
         vbar: m/s, the speed whose square is subtracted from v^2.
         dt: seconds between wind samples.
         substeps: RK4 steps per sample.
@@ -306,7 +307,8 @@ def integrate_forcing(
         omega: [K] natural frequencies, rad/s (> 0).
         zeta: [K] damping ratios, dimensionless (>= 0).
         gain: [K] force gains, rad/s^2 per unit of u (rad / m^2 for u in m^2/s^2).
-        u: [T] forcing (``integrate``'s v^2 - vbar^2, m^2/s^2), sampled every ``dt``.
+        u (torch.Tensor | np.ndarray): [T] forcing (``integrate``'s v^2 - vbar^2, m^2/s^2), sampled
+            every ``dt``.
         dt: seconds between samples.
         substeps: RK4 steps per sample.
         guard: bound on |lambda| * h, rad.

@@ -355,7 +355,7 @@ class OscillatorPrior(BaseModel):
 
         Returns:
             The deformed Gaussians (positions and orientations rotated; scales, opacities, colours
-            those of the canonical set).
+                those of the canonical set).
         """
         theta_all = self.part_theta(wind)  # [K, L+F]
         theta = theta_all[:, self.lead_in + frame_idx]  # [K]

@@ -173,7 +173,7 @@ def identify_records(ys: list[np.ndarray], fs: float, s: SSISettings) -> Modes:
 
     Returns:
         ``Modes``: frequencies (Hz), damping ratios, shapes over the C channels, and the
-        stabilisation diagram.
+            stabilisation diagram.
     """
     from pyoma2.functions import gen, ssi
 

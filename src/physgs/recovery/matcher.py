@@ -77,7 +77,7 @@ def loglog_r2(omega_hat: np.ndarray, omega_true: np.ndarray) -> float:
 
     Returns:
         R^2 in [0, 1]; NaN when fewer than 3 pairs (undefined / trivially 1); 0 when either side
-        has no spread (nothing explained), so a degenerate match never yields NaN from 0/0.
+            has no spread (nothing explained), so a degenerate match never yields NaN from 0/0.
     """
     x, y = np.log(np.asarray(omega_hat, float)), np.log(np.asarray(omega_true, float))
     if x.size < 3:
@@ -153,7 +153,7 @@ def match_parts(
 
     Returns:
         The [`MatchResult`][physgs.recovery.matcher.MatchResult]: each part's bone, |corr|, trust,
-        relative error, and the median relative error and log-log R^2 over trusted parts.
+            relative error, and the median relative error and log-log R^2 over trusted parts.
 
     Raises:
         ValueError: frequencies of the wrong shape or not positive, or NaN/inf trajectories.
@@ -192,7 +192,7 @@ def restricted(m: MatchResult, bone_mask: np.ndarray) -> tuple[int, float]:
 
     Returns:
         (trusted parts matched to a kept bone, their median relative error as a fraction; NaN when
-        there is none).
+            there is none).
     """
     sel = np.asarray(m.trusted, bool) & np.asarray(bone_mask, bool)[np.asarray(m.bone, int)]
     return int(sel.sum()), float(np.median(m.rel_err[sel])) if sel.any() else float("nan")

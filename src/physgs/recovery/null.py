@@ -169,7 +169,7 @@ def null_control(
 
     Returns:
         The [`NullResult`][physgs.recovery.null.NullResult]: per-draw scores [D], the draws
-        [D, K] rad/s and the median nearest-bone gap.
+            [D, K] rad/s and the median nearest-bone gap.
     """
     import torch  # here, not at the top: reading a null record needs no torch
 

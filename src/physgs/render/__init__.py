@@ -123,7 +123,8 @@ def rasterization(
         opacities: [N] in [0, 1].
         colors: [N, 3] in [0, 1] (any D channels work).
         camera: the camera; the image is camera.height x camera.width px.
-        background: [3] (tensor, array or list; same channels as colors).
+        background (torch.Tensor | np.ndarray | list): [3] (tensor, array or list; same channels as
+            colors).
         backend: ``"fast"`` (numba CPU kernels with an explicit backward), ``"reference"`` (pure
             PyTorch autograd), ``"gsplat"`` (CUDA, needs gsplat installed) or ``"auto"`` (gsplat on
             CUDA when installed, else fast).

@@ -35,11 +35,11 @@ def camera_arrays(camera: Camera):
         camera: the pinhole camera.
 
     Returns:
-        (Rc [3, 3], tc [3] world units, intr [4] (fx, fy, cx, cy) px, lims [4]): the
-        world-to-camera rotation and translation, the intrinsics, and gsplat's tangent clamps
-        (x-, x+, y-, y+) of the projection Jacobian from
-        [`fov_clamp_limits`][physgs.render.project.fov_clamp_limits] (the reference path uses the
-        same).
+        (tuple[np.ndarray, ...]): (Rc, tc, intr, lims), float64: Rc [3, 3] and tc [3] (world
+            units) the world-to-camera rotation and translation; intr [4] (fx, fy, cx, cy) px;
+            lims [4] gsplat's tangent clamps (x-, x+, y-, y+) of the projection Jacobian from
+            [`fov_clamp_limits`][physgs.render.project.fov_clamp_limits] (the reference path uses
+            the same).
     """
     intr = np.array([camera.fx, camera.fy, camera.cx, camera.cy], dtype=np.float64)
     lims = np.array(fov_clamp_limits(camera), dtype=np.float64)
@@ -161,20 +161,21 @@ def work_count(means, quats, scales, opacities, colors, camera, background) -> d
     counts what it did.
 
     Args:
-        means: [N, 3] world units.
-        quats: [N, 4] (w, x, y, z).
-        scales: [N, 3] world units.
-        opacities: [N] in [0, 1].
-        colors: [N, D] in [0, 1].
-        camera: the camera.
-        background: [D] in [0, 1].
+        means (torch.Tensor): [N, 3] world units.
+        quats (torch.Tensor): [N, 4] (w, x, y, z).
+        scales (torch.Tensor): [N, 3] world units.
+        opacities (torch.Tensor): [N] in [0, 1].
+        colors (torch.Tensor): [N, D] in [0, 1].
+        camera (Camera): the camera.
+        background (torch.Tensor): [D] in [0, 1].
 
     Returns:
-        Counts (ints): ``pairs``, pixel-Gaussian pairs composited before transmittance saturates
-        (each costs ``kernels.FLOPS_PER_PAIR`` flops, forward + backward); ``footprint_pixels``,
-        pixels inside the 1/255 contours of the tile pairs reached (pairs plus the ones skipped
-        after saturation); ``rows``, pixel rows of those footprints (the forward finds each one's
-        span and two exps); ``tile_pairs``, (tile, Gaussian) pairs binned; ``gaussians``, N.
+        The counts by name, ints. ``pairs``, pixel-Gaussian pairs composited before transmittance
+            saturates (each costs ``kernels.FLOPS_PER_PAIR`` flops, forward + backward);
+            ``footprint_pixels``, pixels inside the 1/255 contours of the tile pairs reached (pairs
+            plus the ones skipped after saturation); ``rows``, pixel rows of those footprints (the
+            forward finds each one's span and two exps); ``tile_pairs``, (tile, Gaussian) pairs
+            binned; ``gaussians``, N.
     """
     with torch.no_grad():
         _, state = _forward(means, quats, scales, opacities, colors, background, camera)
@@ -221,8 +222,8 @@ def rasterize_fast(
         return_depth: whether to return the expected depth.
 
     Returns:
-        (rgb [H, W, D], alpha [H, W], depth [H, W] world units or None), on the device and dtype of
-        ``means``.
+        (tuple[torch.Tensor, ...]): (rgb [H, W, D], alpha [H, W], depth [H, W] world units or
+            None), on the device and dtype of ``means``.
     """
     inputs = (means, quats, scales, opacities, colors, background)
     if torch.is_grad_enabled() and any(x.requires_grad for x in inputs):

@@ -135,7 +135,7 @@ def project_gaussians(
 
     Returns:
         A [`Projected`][physgs.render.project.Projected]: means2d [N, 2] px, conics [N, 3]
-        1/px^2, depths [N] world units, cov2d [N, 3] px^2 (detached), valid [N] bool.
+            1/px^2, depths [N] world units, cov2d [N, 3] px^2 (detached), valid [N] bool.
     """
     R, t = camera_tensors(camera, means)
     xyz = means @ R.T + t  # [N, 3] camera coordinates
@@ -198,7 +198,7 @@ def pixel_bounds(
 
     Returns:
         int64 [N, 4] (x0, x1, y0, y1) inclusive pixel index ranges clipped to the image; x0 > x1
-        marks a Gaussian that touches no pixel (invalid, too faint, or off the image).
+            marks a Gaussian that touches no pixel (invalid, too faint, or off the image).
     """
     n = means2d.shape[0]
     out = np.empty((n, 4), dtype=np.int64)

@@ -45,7 +45,8 @@ def composite_reference(
         return_depth: whether to compute the expected depth.
 
     Returns:
-        (rgb [H, W, D], alpha [H, W], depth [H, W] world units or None), the inputs' dtype.
+        (tuple[torch.Tensor, ...]): (rgb [H, W, D], alpha [H, W], depth [H, W] world units or
+            None), the inputs' dtype.
     """
     D = colors.shape[1]
     boxes = pixel_bounds(

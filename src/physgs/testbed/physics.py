@@ -23,11 +23,11 @@ def calibrate_omega(
     Args:
         radius: [B] bone radii, m.
         length: [B] bone lengths, m.
-        band_hz: (lo, hi), Hz, 0 < lo < hi.
+        band_hz (tuple[float, float]): (lo, hi), Hz, 0 < lo < hi.
 
     Returns:
         (omega [B] rad/s clamped into the band, c in rad/s * m, clamped [B] bool: the bones whose
-        raw c r / L^2 fell outside the band).
+            raw c r / L^2 fell outside the band).
 
     Raises:
         ValueError: the band is not 0 < lo < hi.
@@ -54,7 +54,7 @@ def foh_matrices(omega: np.ndarray, zeta: np.ndarray, dt: float):
         dt: the step, s.
 
     Returns:
-        (Phi [B, 2, 2], G0 [B, 2], G1 [B, 2]), float64.
+        (tuple[np.ndarray, ...]): (Phi [B, 2, 2], G0 [B, 2], G1 [B, 2]), float64.
     """
     B = len(omega)
     M = np.zeros((B, 4, 4))
