@@ -115,9 +115,16 @@ def damping_scores(
 ) -> DampingScores:
     """Score zeta_hat over the trusted parts of a matching.
 
-    bone [K] int: the bone each part is matched to; trusted [K] bool (``MatchResult.bone`` and
-    ``.trusted``); zeta_hat [K]; omega_hat [K] rad/s; zeta_bones [B] the true per-bone ratios;
-    omega_bones [B] rad/s the true frequencies (only for ``gamma_exponent_true``).
+    Args:
+        bone: [K] int, the bone each part is matched to (``MatchResult.bone``).
+        trusted: [K] bool (``MatchResult.trusted``).
+        zeta_hat: [K] the parts' damping ratios.
+        omega_hat: [K] the parts' natural frequencies, rad/s.
+        zeta_bones: [B] the true per-bone damping ratios.
+        omega_bones: [B] the true natural frequencies, rad/s (only for ``gamma_exponent_true``).
+
+    Returns:
+        The [`DampingScores`][physgs.recovery.damping_scores.DampingScores].
     """
     bone = np.asarray(bone, dtype=np.int64)
     trusted = np.asarray(trusted, dtype=bool)
@@ -236,9 +243,27 @@ def damping_null(
     seed: int,
     n_draws: int = N_DRAWS,
 ) -> DampingNull:
-    """Score n_draws log-uniform zeta draws (``draw_null_zetas``) exactly as ``damping_scores``
-    scores zeta_hat: same matching (bone [K], trusted [K]), same omega_hat [K] rad/s, same truth
-    (zeta_bones [B], omega_bones [B] rad/s). Seeded: same seed, same draws."""
+    """Score log-uniform zeta draws exactly as ``damping_scores`` scores zeta_hat.
+
+    Same matching, same omega_hat, same truth; only zeta is drawn (``draw_null_zetas``). Seeded:
+    same seed, same draws.
+
+    Args:
+        bone: [K] int, the bone each part is matched to.
+        trusted: [K] bool.
+        omega_hat: [K] the parts' natural frequencies, rad/s.
+        zeta_bones: [B] the true per-bone damping ratios.
+        omega_bones: [B] the true natural frequencies, rad/s.
+        zeta_range (tuple[float, float]): (lo, hi) of the draws, 0 < lo <= hi.
+        seed: seeds the draws.
+        n_draws: D, draws.
+
+    Returns:
+        The [`DampingNull`][physgs.recovery.damping_scores.DampingNull]: per-draw scores [D].
+
+    Raises:
+        ValueError: the range is not 0 < lo <= hi.
+    """
     draws = draw_null_zetas(zeta_range, len(np.asarray(bone)), n_draws, seed)
     s = [damping_scores(bone, trusted, z, omega_hat, zeta_bones, omega_bones) for z in draws]
     return DampingNull(
