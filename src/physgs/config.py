@@ -479,7 +479,18 @@ def load_workflow_config(
 
 
 def load(path: Path | str, profile: str | None = None) -> dict:
-    """Read, validate, resolve and check a config file."""
+    """Read, validate, resolve and check a config file.
+
+    Args:
+        path: the YAML file (read as YAML 1.2).
+        profile: overrides the file's ``profile``.
+
+    Returns:
+        The resolved config.
+
+    Raises:
+        ConfigError: the config is invalid (the message names the key and the fix).
+    """
     return load_workflow_config(read_yaml(path), profile, source=str(path))
 
 
