@@ -596,7 +596,15 @@ CHECKS: list[Check] = [
 
 
 def problems(cfg: dict, checks: list[Check] | None = None) -> list[Problem]:
-    """All ``(key path, message)`` problems of a resolved, schema-valid config."""
+    """All problems of a resolved, schema-valid config.
+
+    Args:
+        cfg: the resolved config.
+        checks: the checks to run; None: every check in ``CHECKS``.
+
+    Returns:
+        ``(key path, message)`` pairs, empty when the config passes.
+    """
     out: list[Problem] = []
     for chk in CHECKS if checks is None else checks:
         out.extend(chk(cfg))

@@ -70,7 +70,20 @@ def read_npz(path: str | Path, keys: Iterable[str], *, rule: str) -> dict[str, n
 
 
 def read_json(path: str | Path, keys: Iterable[str] = (), *, rule: str) -> dict:
-    """The mapping of an intermediate ``.json`` holding every one of ``keys`` (as ``read_npz``)."""
+    """The mapping of an intermediate ``.json`` holding every one of ``keys``.
+
+    Args:
+        path: the file.
+        keys: names the mapping must hold (it may hold more).
+        rule: the workflow rule that writes it (named in the error).
+
+    Returns:
+        The mapping.
+
+    Raises:
+        IntermediateFileError: the file is missing, corrupt, not a mapping or lacks a key (a
+            file that is there is then removed, so rerunning the same command rebuilds it).
+    """
     path = Path(path)
     if not path.is_file():
         raise _missing(path, rule)
