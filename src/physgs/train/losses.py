@@ -77,7 +77,7 @@ def blur(z: torch.Tensor, size: int = 11, sigma: float = 1.5, tiled: bool | None
         tiled: force the tiled (True) or the matmul (False) path; None: by size.
 
     Returns:
-        [..., H, W] the blurred maps.
+        (torch.Tensor): [..., H, W] the blurred maps.
     """
     H, W = z.shape[-2:]
     if tiled is None:
