@@ -37,9 +37,15 @@ def current_umask() -> int:
 def atomic_path(path: str | os.PathLike) -> Iterator[Path]:
     """Yield a temporary path beside ``path``; on success rename it onto ``path``.
 
-    The temporary name keeps the final suffix, so writers that pick a format from the
-    extension (matplotlib, numpy) behave as for the real name. On error it is removed. The
-    output gets the mode of an ordinary new file: 0666 less the process's umask.
+    The temporary name keeps the final suffix, so writers that pick a format from the extension
+    (matplotlib, numpy) behave as for the real name. On error it is removed. The output gets the
+    mode of an ordinary new file: 0666 less the process's umask.
+
+    Args:
+        path: the final file.
+
+    Yields:
+        The temporary path to write.
     """
     path = Path(path)
     path.parent.mkdir(parents=True, exist_ok=True)
@@ -59,18 +65,38 @@ def atomic_path(path: str | os.PathLike) -> Iterator[Path]:
 
 
 def write_text(path: str | os.PathLike, text: str) -> None:
-    """Write ``text`` to ``path`` atomically."""
+    """Write ``text`` to ``path`` atomically.
+
+    Args:
+        path: the file.
+        text: its contents.
+    """
     with atomic_path(path) as tmp:
         tmp.write_text(text)
 
 
 def write_json(path: str | os.PathLike, obj) -> None:
-    """Write a JSON-serialisable object atomically (NaN written as NaN, as Python's json does)."""
+    """Write a JSON-serialisable object atomically, keys sorted, indented by 2.
+
+    NaN is written as NaN, as Python's json does.
+
+    Args:
+        path: the file.
+        obj (Any): the object.
+    """
     write_text(path, json.dumps(obj, indent=2, sort_keys=True) + "\n")
 
 
 def save_npz(path: str | os.PathLike, **arrays: np.ndarray) -> None:
-    """np.savez to ``path`` atomically (``path`` must end in .npz)."""
+    """``np.savez`` to ``path`` atomically.
+
+    Args:
+        path: the file; it must end in ``.npz`` (numpy would append it silently).
+        **arrays: name -> array.
+
+    Raises:
+        ValueError: ``path`` does not end in ``.npz``.
+    """
     if not str(path).endswith(".npz"):
         raise ValueError(f"save_npz: {path!r} must end in .npz (numpy would append it silently)")
     with atomic_path(path) as tmp:

@@ -84,6 +84,15 @@ class Camera:
 
     @staticmethod
     def from_dict(d: dict) -> "Camera":
+        """The camera that [to_dict][physgs.camera.Camera.to_dict] wrote.
+
+        Args:
+            d: mapping with ``viewmat`` [4, 4] (world to camera), ``intrinsics`` [4] (fx, fy, cx, cy
+                in px), ``size`` [2] (width, height in px) and ``near`` (scene units).
+
+        Returns:
+            The camera.
+        """
         v = np.asarray(d["viewmat"], dtype=np.float64)
         fx, fy, cx, cy = (float(x) for x in np.asarray(d["intrinsics"]))
         w, h = (int(x) for x in np.asarray(d["size"]))
@@ -93,7 +102,23 @@ class Camera:
 def look_at(
     eye, target, up=(0.0, 0.0, 1.0), *, fov_deg: float, width: int, height: int, near: float = 0.01
 ) -> Camera:
-    """Camera at ``eye`` looking at ``target`` with vertical field of view ``fov_deg`` (degrees)."""
+    """Camera at ``eye`` looking at ``target`` (OpenCV axes: z forward, y down).
+
+    Args:
+        eye (ArrayLike): [3] camera centre, world units.
+        target (ArrayLike): [3] the point the optical axis passes through, world units.
+        up (ArrayLike): [3] world up (image up is its projection).
+        fov_deg: vertical field of view, degrees.
+        width: image width, px.
+        height: image height, px.
+        near: near-plane depth, world units.
+
+    Returns:
+        The camera: square pixels (fx = fy), principal point at the image centre.
+
+    Raises:
+        ValueError: the viewing direction is parallel to ``up``.
+    """
     eye, target, up = (np.asarray(a, dtype=np.float64) for a in (eye, target, up))
     z = target - eye
     z /= np.linalg.norm(z)

@@ -3,8 +3,8 @@
 A job whose threads, memory or run time no node of its partition can give waits PENDING for ever
 (reason PartitionConfig or Resources), and Snakemake waits with it without a word. The Snakefile's
 ``onstart`` hook (run after the DAG is built, before the first submission, only with the SLURM
-executor) calls :func:`check_jobs` with what ``sinfo`` reports, and stops with every offending
-rule and request named.
+executor) calls [`check_jobs`][physgs.cluster.check_jobs] with what ``sinfo`` reports, and stops
+with every offending rule and request named.
 """
 
 from __future__ import annotations
@@ -23,6 +23,8 @@ class ClusterRequestError(RuntimeError):
 
 @dataclass(frozen=True)
 class Partition:
+    """The largest node of one Slurm partition, as ``sinfo`` reports it."""
+
     name: str
     default: bool
     cpus: int  # most CPUs on one node
@@ -31,7 +33,14 @@ class Partition:
 
 
 def parse_time_limit(text: str) -> float:
-    """sinfo's %l ('infinite', 'MM', 'HH:MM:SS', 'D-HH:MM:SS', 'MM:SS') in minutes."""
+    """A Slurm time limit in minutes.
+
+    Args:
+        text: sinfo's %l (``infinite``, ``MM``, ``MM:SS``, ``HH:MM:SS``, ``D-HH:MM:SS``).
+
+    Returns:
+        Minutes (inf: no limit).
+    """
     text = text.strip()
     if text in ("infinite", "UNLIMITED", "n/a", ""):
         return float("inf")
@@ -50,8 +59,16 @@ def parse_time_limit(text: str) -> float:
 
 
 def parse_sinfo(text: str) -> dict[str, Partition]:
-    """Partitions from ``sinfo -h -o '%P|%c|%m|%l'`` (one line per partition and node kind:
-    the largest node counts, a job needs one node that fits)."""
+    """Partitions from the output of ``sinfo -h -o '%P|%c|%m|%l'``.
+
+    One line per partition and node kind: the largest node counts (a job needs one node that fits).
+
+    Args:
+        text: sinfo's output.
+
+    Returns:
+        Partition name -> [`Partition`][physgs.cluster.Partition] (the default one marked).
+    """
     out: dict[str, Partition] = {}
     for line in text.splitlines():
         if not line.strip():
@@ -87,6 +104,8 @@ def sinfo() -> dict[str, Partition]:
 
 @dataclass(frozen=True)
 class Request:
+    """What one rule's jobs ask the cluster for (threads, memory in MB, runtime in minutes)."""
+
     rule: str
     threads: int
     mem_mb: float | None
@@ -95,7 +114,15 @@ class Request:
 
 
 def problems(requests: list[Request], partitions: dict[str, Partition]) -> list[str]:
-    """One line per (rule, what) that no node of the job's partition can give."""
+    """What no node of each job's partition can give.
+
+    Args:
+        requests: the rules' requests.
+        partitions: name -> partition.
+
+    Returns:
+        One line per (rule, what), sorted.
+    """
     default = next((p for p in partitions.values() if p.default), None)
     out: set[str] = set()
     for r in requests:
@@ -132,9 +159,15 @@ def _num(v):
 
 
 def check_jobs(jobs, partitions: dict[str, Partition] | None = None) -> None:
-    """Raise ClusterRequestError naming every rule whose request no node can meet.
+    """Stop before submission if any rule asks for more than a node of its partition has.
 
-    jobs: Snakemake jobs (``rule.name``, ``threads``, ``resources``)."""
+    Args:
+        jobs (Iterable): Snakemake jobs (``rule.name``, ``threads``, ``resources``).
+        partitions: name -> partition; None: read from ``sinfo``.
+
+    Raises:
+        ClusterRequestError: naming every rule whose request no node can meet.
+    """
     requests = []
     for job in jobs:
         res = job.resources

@@ -5,19 +5,21 @@ values replace the base ones (deep merge). The resolved config is what every rul
 function reads; it no longer holds the ``profiles`` table.
 
 One entry point does everything, for the Snakefile and for Python alike:
-:func:`load_workflow_config` (or :func:`load` for a file) validates the raw config against the
-packaged schema (``physgs/schemas/config.schema.yaml``; each profile body against the same schema
-with every ``required`` dropped, :func:`partial_schema`), resolves the profile, validates the
-resolved config, and runs the cross-key checks of :mod:`physgs.config_checks`. Every failure is a
-:class:`ConfigError` that names the full key path (``profiles/quick/trian``), the nearest valid key
-where one exists, where the value came from and the fix.
+[`load_workflow_config`][physgs.config.load_workflow_config] (or [`load`][physgs.config.load] for a
+file) validates the raw config against the packaged schema (``physgs/schemas/config.schema.yaml``;
+each profile body against the same schema with every ``required`` dropped,
+[`partial_schema`][physgs.config.partial_schema]), resolves the profile, validates the resolved
+config, and runs the cross-key checks of [`physgs.config_checks`][physgs.config_checks]. Every
+failure is a [`ConfigError`][physgs.config.ConfigError] that names the full key path
+(``profiles/quick/trian``), the nearest valid key where one exists, where the value came from and
+the fix.
 
 Sources, in order (a later one wins on the leaves it sets): ``config/trees.yaml`` and its chosen
 profile, then each ``--configfile`` and the ``--config`` pairs (or a script's ``--set``). What the
 command line sets beats the profile: ``--config 'tracks={configs: [single]}'`` means those
 configurations under any profile. Numbers are read as YAML 1.2 and Python read them at every depth
-and from every source (``1e-3`` is a number; :func:`scalars`), and NaN or infinity is refused
-wherever a number is allowed.
+and from every source (``1e-3`` is a number; [`scalars`][physgs.config.scalars]), and NaN or
+infinity is refused wherever a number is allowed.
 """
 
 from __future__ import annotations
@@ -174,7 +176,8 @@ def scalar(value):
 
 
 def scalars(value):
-    """``value`` with :func:`scalar` applied to every string at every depth (keys unchanged)."""
+    """``value`` with [`scalar`][physgs.config.scalar] applied to every string at every depth (keys
+    unchanged)."""
     if isinstance(value, dict):
         return {k: scalars(v) for k, v in value.items()}
     if isinstance(value, (list, tuple)):
@@ -183,7 +186,8 @@ def scalars(value):
 
 
 def read_yaml(path: Path | str):
-    """A config file's contents, numbers read as YAML 1.2 reads them (:func:`scalars`)."""
+    """A config file's contents, numbers read as YAML 1.2 reads them
+    ([`scalars`][physgs.config.scalars])."""
     with open(path) as f:
         return scalars(yaml.safe_load(f))
 
@@ -401,7 +405,7 @@ def check(
     source: str = DEFAULT_SOURCE,
     layers: list[Layer] = (),
 ) -> None:
-    """Run the cross-key checks (:data:`physgs.config_checks.CHECKS`) on a resolved config."""
+    """Run the cross-key checks (``physgs.config_checks.CHECKS``) on a resolved config."""
     profile = cfg.get("profile")
     lines = [
         _line(tuple(path), msg, _attribute(tuple(path), raw, profile, list(layers), source), source)
@@ -447,11 +451,12 @@ def load_workflow_config(
     configfiles: the ``--configfile`` paths (Snakemake's ``workflow.config_settings.configfiles``),
     read again here as YAML 1.2; command_line: the ``--config KEY=VALUE`` pairs (Snakemake's
     ``workflow.config_settings.config``). Whatever these set, at any depth, beats the profile's
-    value (``--config 'tracks={configs: [single]}'`` fits single only under any profile), except
-    in a ``--configfile`` that holds a ``profiles`` section: such a file is a config of its own
-    (``--configfile config/trees.yaml`` is the base again), merged under the profile. Every number is read as YAML 1.2
-    reads it (:func:`scalars`), and a problem names the source that holds the bad value. Returns
-    the resolved config; raises ConfigError before anything runs.
+    value (``--config 'tracks={configs: [single]}'`` fits single only under any profile), except in
+    a ``--configfile`` that holds a ``profiles`` section: such a file is a config of its own
+    (``--configfile config/trees.yaml`` is the base again), merged under the profile. Every number
+    is read as YAML 1.2 reads it ([`scalars`][physgs.config.scalars]), and a problem names the
+    source that holds the bad value. Returns the resolved config; raises ConfigError before anything
+    runs.
     """
     layers: list[Layer] = [(f"--configfile {p}", read_yaml(p) or {}) for p in configfiles]
     if command_line:
@@ -474,7 +479,18 @@ def load_workflow_config(
 
 
 def load(path: Path | str, profile: str | None = None) -> dict:
-    """Read, validate, resolve and check a config file."""
+    """Read, validate, resolve and check a config file.
+
+    Args:
+        path: the YAML file (read as YAML 1.2).
+        profile: overrides the file's ``profile``.
+
+    Returns:
+        The resolved config.
+
+    Raises:
+        ConfigError: the config is invalid (the message names the key and the fix).
+    """
     return load_workflow_config(read_yaml(path), profile, source=str(path))
 
 

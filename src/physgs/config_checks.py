@@ -2,10 +2,10 @@
 
 Each check takes the resolved config (after the profile merge, already schema-valid) and yields
 ``(key path, message)`` pairs, the message saying what is wrong and how to fix it; the key path is
-the key to change. :func:`problems` runs every check in :data:`CHECKS`; ``physgs.config`` turns the
-pairs into one ``ConfigError``. They run when the Snakefile loads, so a bad config stops in seconds
-with nothing written, instead of in the first job that needs the value. To add a check, write a
-function here and append it to :data:`CHECKS`.
+the key to change. [`problems`][physgs.config_checks.problems] runs every check in ``CHECKS``;
+``physgs.config`` turns the pairs into one ``ConfigError``. They run when the Snakefile loads, so a
+bad config stops in seconds with nothing written, instead of in the first job that needs the value.
+To add a check, write a function here and append it to ``CHECKS``.
 """
 
 from __future__ import annotations
@@ -596,7 +596,15 @@ CHECKS: list[Check] = [
 
 
 def problems(cfg: dict, checks: list[Check] | None = None) -> list[Problem]:
-    """All ``(key path, message)`` problems of a resolved, schema-valid config."""
+    """All problems of a resolved, schema-valid config.
+
+    Args:
+        cfg: the resolved config.
+        checks: the checks to run; None: every check in ``CHECKS``.
+
+    Returns:
+        ``(key path, message)`` pairs, empty when the config passes.
+    """
     out: list[Problem] = []
     for chk in CHECKS if checks is None else checks:
         out.extend(chk(cfg))

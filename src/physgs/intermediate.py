@@ -1,9 +1,9 @@
 """Reading the workflow's intermediate files (tracks, fits, trajectories, records): one loader
 that names the file and the rule that rebuilds it, and removes a file it cannot read.
 
-Every intermediate file is written atomically (:mod:`physgs.atomic`), so a corrupt one comes from
-outside the pipeline (a full disk, a copy cut short, a hand edit). Snakemake reruns a job only
-when its output is missing or older than its inputs, so a corrupt file left in place would be
+Every intermediate file is written atomically ([`physgs.atomic`][physgs.atomic]), so a corrupt one
+comes from outside the pipeline (a full disk, a copy cut short, a hand edit). Snakemake reruns a job
+only when its output is missing or older than its inputs, so a corrupt file left in place would be
 read again, and fail again, by every later run. The loader therefore deletes it before raising:
 rerunning the same command rebuilds it with the rule named in the message, then goes on.
 """
@@ -70,7 +70,20 @@ def read_npz(path: str | Path, keys: Iterable[str], *, rule: str) -> dict[str, n
 
 
 def read_json(path: str | Path, keys: Iterable[str] = (), *, rule: str) -> dict:
-    """The mapping of an intermediate ``.json`` holding every one of ``keys`` (as ``read_npz``)."""
+    """The mapping of an intermediate ``.json`` holding every one of ``keys``.
+
+    Args:
+        path: the file.
+        keys: names the mapping must hold (it may hold more).
+        rule: the workflow rule that writes it (named in the error).
+
+    Returns:
+        The mapping.
+
+    Raises:
+        IntermediateFileError: the file is missing, corrupt, not a mapping or lacks a key (a
+            file that is there is then removed, so rerunning the same command rebuilds it).
+    """
     path = Path(path)
     if not path.is_file():
         raise _missing(path, rule)

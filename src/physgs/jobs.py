@@ -70,12 +70,12 @@ def output_locks(outputs, lock_dir: Path | str | None = None):
 def job(sm):
     """Run a Snakemake script's body: ``with job(snakemake) as log: ...``.
 
-    Locks the job's outputs (:func:`output_locks`: a job whose output another run is making
-    stops at once), keeps freed memory in the process
-    (:func:`physgs.allocator.retain_freed_memory`), sets torch's and numba's thread counts to the
-    rule's ``threads`` (those imported now, and through OMP_NUM_THREADS / NUMBA_NUM_THREADS those
-    imported later), sends stdout and stderr (progress bars included) to ``sm.log[0]``, and
-    writes the traceback of a failure there too (not only to the console) before re-raising it.
+    Locks the job's outputs ([`output_locks`][physgs.jobs.output_locks]: a job whose output another
+    run is making stops at once), keeps freed memory in the process
+    (``physgs.allocator.retain_freed_memory``), sets torch's and numba's thread counts to the rule's
+    ``threads`` (those imported now, and through OMP_NUM_THREADS / NUMBA_NUM_THREADS those imported
+    later), sends stdout and stderr (progress bars included) to ``sm.log[0]``, and writes the
+    traceback of a failure there too (not only to the console) before re-raising it.
     """
     threads = max(1, int(getattr(sm, "threads", 1)))
     retain_freed_memory()  # no page faults of fresh memory every training iteration

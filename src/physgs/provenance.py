@@ -21,8 +21,14 @@ def package_version() -> str:
 
 
 def config_hash(cfg: dict) -> str:
-    """12 hex digits of the SHA-256 of the resolved config as canonical JSON (sorted keys), so
-    reordering keys keeps the hash and changing any value changes it."""
+    """Hash of the resolved config, unchanged by key order and changed by any value.
+
+    Args:
+        cfg: the resolved config.
+
+    Returns:
+        12 hex digits of the SHA-256 of the config as canonical JSON (sorted keys).
+    """
     blob = json.dumps(cfg, sort_keys=True, separators=(",", ":"), default=str)
     return hashlib.sha256(blob.encode()).hexdigest()[:12]
 
@@ -41,11 +47,19 @@ class Stamp:
     physgs_version: str
 
     def to_dict(self) -> dict:
+        """The stamp as a plain dict (profile, config_hash, physgs_version)."""
         return asdict(self)
 
 
 def stamp(cfg: dict) -> Stamp:
-    """The stamp of a resolved config (its ``profile`` key names the profile)."""
+    """The stamp of a resolved config.
+
+    Args:
+        cfg: the resolved config (its ``profile`` key names the profile).
+
+    Returns:
+        The [`Stamp`][physgs.provenance.Stamp]: profile, config hash and physgs' version.
+    """
     return Stamp(str(cfg.get("profile", "unknown")), config_hash(cfg), package_version())
 
 

@@ -6,7 +6,19 @@ import numpy as np
 
 
 def to_float_image(img: np.ndarray) -> np.ndarray:
-    """uint8 images -> float64 in [0, 1]; float images are checked to lie in [0, 1]."""
+    """Images as float64 in [0, 1].
+
+    Args:
+        img: [..., H, W, C] uint8 (divided by 255) or float already in [0, 1] (round-off beyond
+            the range by up to 1e-6 is clipped).
+
+    Returns:
+        The images, float64 in [0, 1], same shape.
+
+    Raises:
+        TypeError: a dtype other than uint8 or float.
+        ValueError: NaN/inf, or float values outside [0, 1].
+    """
     img = np.asarray(img)
     if img.dtype == np.uint8:
         return img.astype(np.float64) / 255.0
@@ -24,10 +36,18 @@ def to_float_image(img: np.ndarray) -> np.ndarray:
 
 
 def psnr(pred: np.ndarray, gt: np.ndarray) -> np.ndarray:
-    """PSNR in dB with data range 1 over whole images (background included).
+    """PSNR with data range 1 over whole images (background included).
 
-    pred, gt: [..., H, W, 3] uint8 or float in [0, 1]; leading axes are frames.
-    Returns [...] (a 0-d array for one image). Identical images give +inf.
+    Args:
+        pred: [..., H, W, 3] uint8 or float in [0, 1]; leading axes are frames.
+        gt: the ground truth, same shape and conventions.
+
+    Returns:
+        [...] PSNR, dB (a 0-d array for one image); identical images give +inf.
+
+    Raises:
+        ValueError: the shapes differ, or an image is invalid (see
+            [`to_float_image`][physgs.evaluate.metrics.to_float_image]).
     """
     p, g = to_float_image(pred), to_float_image(gt)
     if p.shape != g.shape:
@@ -38,11 +58,20 @@ def psnr(pred: np.ndarray, gt: np.ndarray) -> np.ndarray:
 
 
 def silhouette_centroid(weight: np.ndarray) -> np.ndarray:
-    """Centroid (x, y) in pixels of a silhouette: bool mask or soft alpha [H, W] in [0, 1].
+    """Centroid of a silhouette, px.
 
     Pixel (row i, col j) has its centre at (j + 0.5, i + 0.5) (camera.py convention). A soft
     alpha is used as weights, so a faded canopy still has a defined centroid.
-    Raises ValueError on an empty silhouette (nothing rendered: the centroid is undefined).
+
+    Args:
+        weight: [H, W] bool mask or soft alpha in [0, 1].
+
+    Returns:
+        [2] (x, y), px (x right, y down).
+
+    Raises:
+        ValueError: not [H, W], or an empty silhouette (nothing rendered: the centroid is
+            undefined).
     """
     w = np.asarray(weight, dtype=np.float64)
     if w.ndim != 2:
@@ -58,9 +87,17 @@ def silhouette_centroid(weight: np.ndarray) -> np.ndarray:
 
 
 def centroid_error(alpha_pred: np.ndarray, mask_gt: np.ndarray) -> float:
-    """Canopy-centroid error in pixels: |centroid(rendered alpha) - centroid(ground-truth mask)|.
+    """Canopy-centroid error: |centroid(rendered alpha) - centroid(ground-truth mask)|.
 
-    alpha_pred: [H, W] float in [0, 1] (accumulated alpha of the render); mask_gt: [H, W] bool.
+    Args:
+        alpha_pred: [H, W] float in [0, 1], the render's accumulated alpha.
+        mask_gt: [H, W] bool, the ground-truth silhouette.
+
+    Returns:
+        The distance, px.
+
+    Raises:
+        ValueError: the shapes differ, or either silhouette is empty.
     """
     if np.shape(alpha_pred) != np.shape(mask_gt):
         raise ValueError(f"alpha shape {np.shape(alpha_pred)} != mask shape {np.shape(mask_gt)}")
@@ -68,9 +105,19 @@ def centroid_error(alpha_pred: np.ndarray, mask_gt: np.ndarray) -> float:
 
 
 def ceiling_fraction(fit, static, ceiling):
-    """(fit - static) / (ceiling - static): the fraction of the true-motion ceiling's PSNR gain
-    over the static pose that a model reaches (dB in, unitless out; arrays broadcast). NaN where
-    the ceiling does not beat the static pose (no gain to measure against)."""
+    """The share of the true-motion ceiling's PSNR gain over the static pose a model reaches.
+
+    (fit - static) / (ceiling - static); arrays broadcast.
+
+    Args:
+        fit (np.ndarray | float): the model's PSNR, dB.
+        static (np.ndarray | float): the static pose's PSNR, dB.
+        ceiling (np.ndarray | float): the true-motion ceiling's PSNR, dB.
+
+    Returns:
+        (np.ndarray): The fraction (unitless, float64); NaN where the ceiling does not beat the
+            static pose (no gain to measure against).
+    """
     fit, static, ceiling = (np.asarray(x, dtype=np.float64) for x in (fit, static, ceiling))
     gain = ceiling - static
     with np.errstate(divide="ignore", invalid="ignore"):

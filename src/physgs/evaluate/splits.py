@@ -82,7 +82,17 @@ class EvalResult:
 
 
 def load_eval(path) -> EvalResult:
-    """Read an EvalResult written by ``EvalResult.save``."""
+    """Read the scores that ``EvalResult.save`` wrote.
+
+    Args:
+        path (str | os.PathLike): the ``.npz`` file.
+
+    Returns:
+        The [`EvalResult`][physgs.evaluate.splits.EvalResult].
+
+    Raises:
+        IntermediateFileError: the file is missing or not an evaluation (rule ``evaluate``).
+    """
     from physgs.intermediate import read_npz
 
     d = read_npz(path, [f.name for f in fields(EvalResult)], rule="evaluate")
@@ -104,14 +114,25 @@ def _render(render_fn: RenderFn, frame: int, cond: int, camera, shape: tuple[int
 def evaluate(
     render_fn: RenderFn, observed, *, progress: Callable[[str], None] | None = None
 ) -> EvalResult:
-    """Score a model through its render callback on every split of SPEC section 4.
+    """Score a model through its render callback on every split.
 
-    A frame the callback refuses with ``NotDefined`` (a learned forcing beyond its window or
-    under another wind) scores NaN: its split means are NaN, "not defined", never a number.
+    Renders C x F frames at the training camera (every condition, window and tail) and A x M
+    held-out views (training condition). A frame the callback refuses with
+    [`NotDefined`][physgs.evaluate.splits.NotDefined] (a learned forcing beyond its window or under
+    another wind) scores NaN: its split means are NaN, "not defined", never a number.
 
-    observed: a ``physgs.testbed.dataset.Observed``. Renders C x F frames at the training camera
-    and A x M held-out views (training condition). Returns per-frame PSNR (dB) and centroid
-    errors (px); means per split come from ``EvalResult.summary()``.
+    Args:
+        render_fn: ``render_fn(frame, condition, camera) -> (rgb [H, W, 3] uint8 or float in
+            [0, 1], alpha [H, W] in [0, 1])`` at recorded frame ``frame`` of ``condition``.
+        observed (Observed): the testbed's observed dataset.
+        progress: called with a line of progress, or None.
+
+    Returns:
+        Per-frame PSNR (dB) and centroid errors (px); means per split come from
+            ``EvalResult.summary()``.
+
+    Raises:
+        ValueError: the callback returns images of another size than the camera's.
     """
     frames = observed.frames  # [C, F, H, W, 3] uint8
     C, F, H, W, _ = frames.shape

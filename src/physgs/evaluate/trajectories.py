@@ -33,10 +33,26 @@ class Trajectories:
         return np.linalg.norm(self.pred_px - self.gt_px, axis=-1)
 
     def save(self, path) -> None:
+        """Write the trajectories to a ``.npz`` atomically (read back by `load_trajectories`).
+
+        Args:
+            path (str | os.PathLike): the ``.npz`` file to write.
+        """
         save_npz(path, **{f.name: np.asarray(getattr(self, f.name)) for f in fields(self)})
 
 
 def load_trajectories(path) -> Trajectories:
+    """Read the trajectories that [save][physgs.evaluate.trajectories.Trajectories.save] wrote.
+
+    Args:
+        path (str | os.PathLike): the ``.npz`` file.
+
+    Returns:
+        The trajectories (``gt_px``, ``pred_px`` [P, F, 2] px, ``tips`` [P]).
+
+    Raises:
+        IntermediateFileError: the file is missing or not a trajectories file (rule ``evaluate``).
+    """
     from physgs.intermediate import read_npz
 
     d = read_npz(path, [f.name for f in fields(Trajectories)], rule="evaluate")

@@ -78,18 +78,45 @@ class KSelection:
     chosen_k: int
 
     def to_dict(self) -> dict:
+        """The selection as a plain JSON-serialisable dict (field name -> value)."""
         return asdict(self)
 
     @staticmethod
     def from_dict(d: dict) -> "KSelection":
+        """The selection that [to_dict][physgs.experiments.kselect.KSelection.to_dict] wrote.
+
+        Args:
+            d: field name -> value (extra keys are ignored).
+
+        Returns:
+            The selection.
+        """
         return KSelection(**{k: d[k] for k in KSelection.__dataclass_fields__})
 
 
 def save_selection(path, sel: KSelection) -> None:
+    """Write the K selection to ``path`` as JSON, atomically.
+
+    Args:
+        path (str | os.PathLike): the ``.json`` file to write.
+        sel: the selection.
+    """
     write_json(path, sel.to_dict())
 
 
 def load_selection(path) -> KSelection:
+    """Read the K selection that [save_selection][physgs.experiments.kselect.save_selection] wrote.
+
+    Args:
+        path (str | os.PathLike): the ``.json`` file.
+
+    Returns:
+        The selection.
+
+    Raises:
+        IntermediateFileError: the file is missing or not a K selection (it is removed, so rule
+            ``kselect`` rebuilds it).
+    """
     from physgs.intermediate import read_json, refuse
 
     d = read_json(path, rule="kselect")

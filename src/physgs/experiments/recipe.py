@@ -55,25 +55,58 @@ class Job:
 
     @property
     def name(self) -> str:
+        """The job's run name, ``<model>_<config>``."""
         return f"{self.model}_{self.config}"
 
     def to_dict(self) -> dict:
+        """The job as a plain dict, keys sorted at every level.
+
+        See [canonical][physgs.experiments.recipe.canonical].
+        """
         return canonical(asdict(self))
 
     @staticmethod
     def from_dict(d: dict) -> "Job":
+        """The job that [to_dict][physgs.experiments.recipe.Job.to_dict] wrote.
+
+        Args:
+            d: field name -> value (extra keys are ignored).
+
+        Returns:
+            The job.
+        """
         return Job(**{k: d[k] for k in Job.__dataclass_fields__})
 
     def replace(self, **kw) -> "Job":
+        """A copy of the job with the fields in ``kw`` changed.
+
+        Args:
+            **kw (Any): field name -> new value.
+
+        Returns:
+            The new job.
+        """
         return Job.from_dict({**asdict(self), **kw})
 
 
 def job_spec(cfg: dict, model: str, config: str, seed: int | None = None) -> dict:
     """The narrow settings of one (model, configuration) training job, as a sorted plain dict.
 
-    cfg: the resolved config. What the workflow passes as the train rule's params: editing a
-    key outside it (another model's architecture, a table's format, the sweep) leaves the job
-    up to date. References (``truth_motion``) are trained in ``single`` only.
+    What the workflow passes as the train rule's params: editing a key outside it (another model's
+    architecture, a table's format, the sweep) leaves the job up to date. References
+    (``truth_motion``) are trained in ``single`` only.
+
+    Args:
+        cfg: the resolved config.
+        model: a registry id.
+        config: a configuration name (``models.configs``).
+        seed: the job's seed; None: the config's.
+
+    Returns:
+        The job's fields ([`Job`][physgs.experiments.recipe.Job]) as a canonical dict.
+
+    Raises:
+        ValueError: the model is not trained in that configuration.
     """
     configs = cfg["models"]["configs"]
     if config not in configs_for(model, configs):
@@ -115,15 +148,30 @@ def fit(
     progress: bool = True,
     name: str | None = None,
 ) -> TrainResult:
-    """Seed, build and train one model on ``observed`` (a testbed ``Observed``).
+    """Seed, build and train one model.
 
     Every random source is seeded from ``job.seed`` before the model is built, so the same job
     gives bitwise-equal weights in any process. Ours freezes parts whose swing stays under
-    ``models.ours.freeze_below_px`` pixels (``freeze_at``); frame_pool restricts the training
-    frames; by default every ``train.holdout_every``-th training frame is held out (0 = none),
-    so the fit and the interpolation to unseen in-window frames can be told apart. truth: the
-    dataset's ``Truth`` (truth.npz), required by a reference (truth_motion) and refused for a
-    method. Returns the TrainResult (model in eval mode).
+    ``models.ours.freeze_below_px`` pixels (``freeze_at``); by default every
+    ``train.holdout_every``-th training frame is held out (0 = none), so the fit and the
+    interpolation to unseen in-window frames can be told apart.
+
+    Args:
+        observed (Observed): the testbed's observed dataset.
+        job: the job, or its dict.
+        truth (Truth | None): the dataset's ground truth (truth.npz), required by a reference
+            (truth_motion) and refused for a method.
+        frame_pool (np.ndarray | None): recorded-frame indices (< n_train) to draw from; None:
+            every training frame not held out.
+        progress: show a progress bar.
+        name: the name the progress and errors use; None: the job's.
+
+    Returns:
+        The [`TrainResult`][physgs.train.loop.TrainResult] (model in eval mode).
+
+    Raises:
+        ValueError: an unknown model, or a truth given to a method.
+        TrainingError: the fit diverged or the model failed (no result).
     """
     from physgs.train.loop import condition_indices, train_model
     from physgs.train.seeding import seed_everything
@@ -215,9 +263,22 @@ def check_precision_supported(settings: dict, families: tuple[str, ...] = ("mlp"
 def train_and_save(
     observed, job: Job | dict, *, checkpoint_path, loss_path, progress: bool = True, truth=None
 ) -> TrainResult:
-    """``fit``, then write the loss log and the checkpoint (each atomically, the checkpoint
-    last). Nothing is written if training fails. truth: as in ``fit`` (references only); the
-    checkpoint of a reference carries its motion, so it reloads without truth.npz."""
+    """[`fit`][physgs.experiments.recipe.fit], then write the loss log and the checkpoint.
+
+    Each is written atomically, the checkpoint last; nothing is written if training fails. The
+    checkpoint of a reference carries its motion, so it reloads without truth.npz.
+
+    Args:
+        observed (Observed): the testbed's observed dataset.
+        job: the job, or its dict.
+        checkpoint_path (str | os.PathLike): where the checkpoint goes.
+        loss_path (str | os.PathLike): where the per-iteration loss log goes.
+        progress: show a progress bar.
+        truth (Truth | None): as in ``fit`` (references only).
+
+    Returns:
+        The [`TrainResult`][physgs.train.loop.TrainResult].
+    """
     from physgs.train.loop import write_loss_log
 
     job = Job.from_dict(job) if isinstance(job, dict) else job

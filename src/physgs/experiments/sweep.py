@@ -76,6 +76,17 @@ def sweep_points(cfg: dict) -> list[str]:
 
 
 def parse_point(name: str) -> tuple[str | None, int | None]:
+    """The knob and value a sweep point's name stands for.
+
+    Args:
+        name: ``'base'`` or ``'<knob>-<int>'`` with the knob one of ``KNOBS``.
+
+    Returns:
+        (knob, value), or (None, None) for the base point.
+
+    Raises:
+        ValueError: the name is neither.
+    """
     if name == BASE:
         return None, None
     knob, _, value = name.rpartition("-")

@@ -50,6 +50,14 @@ class ModelContext:
 
     @staticmethod
     def from_dict(d: dict) -> "ModelContext":
+        """The context that [to_dict][physgs.models.base.ModelContext.to_dict] wrote.
+
+        Args:
+            d: field name -> value; ``vbar_ratio`` defaults to 1.0 when absent (older checkpoints).
+
+        Returns:
+            The context.
+        """
         return ModelContext(
             np.asarray(d["canonical_xyz"], dtype=np.float32),
             int(d["fps"]),
@@ -101,6 +109,14 @@ class BaseModel(nn.Module):
     name = "base"
 
     def __init__(self, ctx: ModelContext, canonical_cfg: dict):
+        """Build the canonical set from the context.
+
+        Args:
+            ctx: the observed-dataset facts (canonical positions [N, 3], fps, wind statistics).
+            canonical_cfg: keyword arguments of
+                [CanonicalGaussians][physgs.models.gaussians.CanonicalGaussians] (config
+                ``models.canonical``).
+        """
         super().__init__()
         self.ctx = ctx
         self.fps = ctx.fps
@@ -149,6 +165,15 @@ class BaseModel(nn.Module):
         return self.deform(int(frame_idx), wind)
 
     def deform(self, frame_idx: int, wind: torch.Tensor) -> GaussianState:
+        """The Gaussians at recorded frame ``frame_idx``; each model implements it.
+
+        Args:
+            frame_idx: recorded frame, 0-based (0 .. n_train - 1 in the window, beyond it the tail).
+            wind: the condition's observed wind [L+F], m/s, lead-in included.
+
+        Returns:
+            The deformed, activated Gaussians (N of them).
+        """
         raise NotImplementedError
 
     def param_groups(self, lr: dict) -> list[dict]:
@@ -167,6 +192,14 @@ class BaseModel(nn.Module):
         return groups + self.deformation_param_groups(lr)
 
     def deformation_param_groups(self, lr: dict) -> list[dict]:
+        """Adam parameter groups of the deformation (`param_groups` adds the canonical set's).
+
+        Args:
+            lr: config ``train.lr``.
+
+        Returns:
+            The groups (``name``, ``params``, ``lr``); none for a model without deformation.
+        """
         return []
 
     def bounded_positions(self) -> dict[str, np.ndarray]:

@@ -81,6 +81,19 @@ class BlindOscillatorPrior(OscillatorPrior):
     use_wind = False
 
     def __init__(self, ctx, canonical_cfg: dict, *, forcing_hz: float, seed: int = 0, **kw):
+        """Ours' oscillators and a learned forcing series of the lead-in and training window.
+
+        Args:
+            ctx (ModelContext): the observed-dataset facts.
+            canonical_cfg: keyword arguments of the canonical set (config ``models.canonical``).
+            forcing_hz: the forcing's band limit, Hz (harmonics j / S <= forcing_hz).
+            seed: seeds the forcing's starting coefficients and ours' k-means.
+            **kw (Any): ours' options ([OscillatorPrior][physgs.models.ours.OscillatorPrior]); the
+                search over omega is refused.
+
+        Raises:
+            ValueError: a search over omega is asked for.
+        """
         super().__init__(ctx, canonical_cfg, seed=seed, **kw)
         if self.search is not None:
             raise ValueError("the blind prior has no search over omega (models/omega_search)")
@@ -118,6 +131,15 @@ class BlindOscillatorPrior(OscillatorPrior):
         return theta
 
     def deform(self, frame_idx: int, wind: torch.Tensor):
+        """The Gaussians at frame ``frame_idx`` of the training window (the wind is not read).
+
+        Args:
+            frame_idx: recorded frame, 0 .. n_train - 1.
+            wind: ignored (any [L+F] series, NaN included).
+
+        Raises:
+            ForcingNotDefined: the frame lies beyond the training window.
+        """
         if frame_idx >= self.n_train:
             raise ForcingNotDefined(
                 f"ours_blind: frame {frame_idx} is beyond the training window (frames 0 .. "
@@ -137,6 +159,14 @@ class BlindOscillatorPrior(OscillatorPrior):
             )
 
     def deformation_param_groups(self, lr: dict) -> list[dict]:
+        """Ours' physics and pivot groups, the forcing's coefficients added to the physics group.
+
+        Args:
+            lr: config ``train.lr``.
+
+        Returns:
+            The parameter groups.
+        """
         groups = super().deformation_param_groups(lr)
         groups[0]["params"] = [*groups[0]["params"], self.forcing_coef]
         return groups

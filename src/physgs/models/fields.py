@@ -55,6 +55,20 @@ class DeformationField(nn.Module):
         heads: tuple[str, ...],
         precision: str = "float32",
     ):
+        """An MLP with ``depth`` hidden layers of ``width`` ReLU units and the named output heads.
+
+        Args:
+            in_dim: input features per Gaussian.
+            depth: hidden layers.
+            width: units per hidden layer.
+            skip: hidden layer (0-based, in [0, depth - 1)) after which the input is
+                concatenated, or None.
+            heads: output heads among ``dx`` [3], ``dq`` [4], ``ds`` [3].
+            precision: ``float32`` or ``bfloat16`` (the hidden layers under autocast).
+
+        Raises:
+            ValueError: an unknown precision or a skip layer out of range.
+        """
         super().__init__()
         if precision not in PRECISIONS:
             raise ValueError(f"field precision {precision!r}: use one of {PRECISIONS}")
@@ -75,6 +89,14 @@ class DeformationField(nn.Module):
             nn.init.zeros_(h.bias)
 
     def forward(self, x: torch.Tensor) -> dict[str, torch.Tensor]:  # x [N, in_dim] float32
+        """The heads' outputs for the inputs ``x``.
+
+        Args:
+            x: [N, in_dim] float32 features.
+
+        Returns:
+            head name -> [N, dim] float32 (``dx`` [N, 3] scene units, ``dq`` [N, 4], ``ds`` [N, 3]).
+        """
         h = x
         with torch.autocast(
             x.device.type, dtype=torch.bfloat16, enabled=self.precision == "bfloat16"
@@ -112,6 +134,27 @@ class FieldModel(BaseModel):
         precision: str = "float32",
         time_top_hz: float | str = WINDOW_TIME,
     ):
+        """A deformation field over the canonical set.
+
+        Args:
+            ctx: the observed-dataset facts (canonical positions, fps, n_train, wind statistics).
+            canonical_cfg: keyword arguments of the canonical set (config ``models.canonical``).
+            arch: ``mlp`` (position offset) or ``d3dgs`` (position, rotation and scale offsets).
+            pos_bands: Fourier bands of the normalised position.
+            time_bands: Fourier bands of time.
+            depth: hidden layers of the MLP.
+            width: units per hidden layer.
+            skip: hidden layer after which the input is concatenated, or None.
+            wind: whether the 48-value wind history is an input.
+            window_seconds: the wind history's span, s (wind-conditioned fields only).
+            window_values: the wind history's values (wind-conditioned fields only).
+            name: the registry id the model reports.
+            precision: ``float32`` or ``bfloat16`` hidden layers.
+            time_top_hz: the top time band's frequency, Hz, or ``"window"`` (normalised time).
+
+        Raises:
+            ValueError: an unknown architecture, or a wind-conditioned field without a window.
+        """
         super().__init__(ctx, canonical_cfg)
         if arch not in ("mlp", "d3dgs"):
             raise ValueError(f"unknown field architecture {arch!r}; use 'mlp' or 'd3dgs'")
@@ -159,6 +202,15 @@ class FieldModel(BaseModel):
         return torch.cat(parts, dim=-1)
 
     def deform(self, frame_idx: int, wind: torch.Tensor) -> GaussianState:
+        """The canonical set moved by the field's offsets at recorded frame ``frame_idx``.
+
+        Args:
+            frame_idx: recorded frame, 0-based.
+            wind: the condition's observed wind [L+F], m/s (read only by wind-conditioned fields).
+
+        Returns:
+            The deformed Gaussians.
+        """
         c = self.canonical
         out = self.field(self.features(frame_idx, wind))
         means = c.means + out["dx"]
@@ -175,4 +227,12 @@ class FieldModel(BaseModel):
         )
 
     def deformation_param_groups(self, lr: dict) -> list[dict]:
+        """One group, ``deform``, holding the field's weights at rate ``lr["deform"]``.
+
+        Args:
+            lr: config ``train.lr``.
+
+        Returns:
+            The parameter groups.
+        """
         return [{"name": "deform", "params": list(self.field.parameters()), "lr": lr["deform"]}]

@@ -152,6 +152,18 @@ class CanonicalGaussians(nn.Module):
         knn: int = 3,
         scale_factor: float = 1.0,
     ):
+        """One Gaussian per vertex of ``xyz``.
+
+        Args:
+            xyz: [N, 3] mesh vertices, world units.
+            opacity: starting opacity, in (0, 1).
+            color: starting grey level, in (0, 1).
+            knn: neighbours whose mean distance sets the starting scale.
+            scale_factor: factor on that distance.
+
+        Raises:
+            ValueError: opacity or colour outside (0, 1).
+        """
         super().__init__()
         if not (0 < opacity < 1 and 0 < color < 1):
             raise ValueError(
@@ -173,6 +185,7 @@ class CanonicalGaussians(nn.Module):
 
     @property
     def n(self) -> int:
+        """The number of Gaussians, N."""
         return self.means.shape[0]
 
     def state(self) -> GaussianState:

@@ -54,6 +54,15 @@ class OmegaSearch:
 
     @staticmethod
     def from_config(section: dict) -> OmegaSearch:
+        """The search's settings from config ``models.omega_search``.
+
+        Args:
+            section: the config section (``until``, ``bank_size``, ``bank_zeta``, ``bank_scale``,
+                ``grid``, ``physics_lr_after``).
+
+        Returns:
+            The settings.
+        """
         return OmegaSearch(
             float(section["until"]),
             int(section["bank_size"]),
@@ -168,6 +177,16 @@ class SearchHook:
     windows: list
 
     def __call__(self, it, model, optimizer) -> dict | None:
+        """End the bank phase at iteration ``at`` (see the class docstring); a no-op at the others.
+
+        Args:
+            it (int): the training iteration.
+            model (OscillatorPrior): the prior being trained.
+            optimizer (torch.optim.Optimizer): its optimiser (groups named as in ``param_groups``).
+
+        Returns:
+            The statistics to log at ``at``, else None.
+        """
         if it != self.at:
             return None
         stats = model.end_bank_phase(self.windows)

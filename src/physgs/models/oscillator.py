@@ -38,11 +38,18 @@ class StabilityError(ValueError):
 
 
 def fastest_rate(omega, zeta):
-    """Largest eigenvalue magnitude |lambda| (rad/s) of theta'' + 2 zeta omega theta' + omega^2 theta.
+    """Largest eigenvalue magnitude |lambda| of theta'' + 2 zeta omega theta' + omega^2 theta = 0.
 
-    omega rad/s, zeta dimensionless (scalars or arrays of one shape). Underdamped and critical
-    (zeta <= 1): |lambda| = omega. Over-damped: the stiff real pole omega (zeta + sqrt(zeta^2 - 1)),
-    about 2 zeta omega, which RK4 must resolve too: guarding omega alone lets it blow up.
+    Underdamped and critical (zeta <= 1): |lambda| = omega. Over-damped: the stiff real pole
+    omega (zeta + sqrt(zeta^2 - 1)), about 2 zeta omega, which RK4 must resolve too: guarding
+    omega alone lets it blow up.
+
+    Args:
+        omega (np.ndarray | float): natural frequencies, rad/s (scalar or array).
+        zeta (np.ndarray | float): damping ratios, dimensionless (broadcastable to omega).
+
+    Returns:
+        (np.ndarray): |lambda|, rad/s, float64, the broadcast shape.
     """
     omega = np.asarray(omega, dtype=np.float64)
     zeta = np.asarray(zeta, dtype=np.float64)
@@ -50,10 +57,20 @@ def fastest_rate(omega, zeta):
 
 
 def required_substeps(omega_max: float, dt: float, limit: float = STABILITY_GUARD) -> int:
-    """Smallest number of RK4 substeps per sample so that omega_max * dt / substeps <= limit.
+    """Smallest number of RK4 substeps per sample with omega_max * dt / substeps <= limit.
 
-    omega_max: rad/s (for over-damped parts pass ``fastest_rate(omega, zeta)``); dt: seconds
-    between wind samples; limit: bound on omega * h (rad).
+    Args:
+        omega_max: the fastest rate, rad/s (for over-damped parts pass
+            [`fastest_rate`][physgs.models.oscillator.fastest_rate]).
+        dt: seconds between wind samples.
+        limit: bound on omega * h, rad (h = dt / substeps).
+
+    Returns:
+        The substeps, >= 1 (with the same slack, GUARD_RTOL, as ``integrate``'s check, so the
+            count is always accepted there).
+
+    Raises:
+        ValueError: omega_max, dt or limit not > 0.
     """
     if not (omega_max > 0 and dt > 0 and limit > 0):
         raise ValueError(
@@ -232,13 +249,29 @@ def integrate(
 ) -> torch.Tensor:
     """Swing angles of K wind-driven damped oscillators, from rest at wind sample 0.
 
-    omega [K] rad/s (> 0), zeta [K] (dimensionless), gain [K] (rad / m^2), torch tensors;
-    wind [T] m/s sampled every dt seconds (tensor or array; not differentiated);
-    vbar: m/s, the speed whose square is subtracted from v^2; dt: seconds; substeps: RK4 steps
-    per sample. Returns theta [K, T] in rad (dtype of omega), theta[:, j] at sample j.
-    Differentiable w.r.t. omega, zeta, gain.
-    Raises StabilityError if max |lambda| * dt / substeps > guard, |lambda| = fastest_rate(omega,
-    zeta) (= omega unless over-damped).
+    Solves theta'' + 2 zeta omega theta' + omega^2 theta = gain (v(t)^2 - vbar^2), v^2 linear
+    between samples. Differentiable w.r.t. omega, zeta and gain (not the wind).
+
+    Args:
+        omega: [K] natural frequencies, rad/s (> 0).
+        zeta: [K] damping ratios, dimensionless (>= 0).
+        gain: [K] force gains, rad / m^2.
+        wind (torch.Tensor | np.ndarray): [T] wind speed, m/s, sampled every ``dt`` (tensor or
+            array; not differentiated).
+        vbar: m/s, the speed whose square is subtracted from v^2.
+        dt: seconds between wind samples.
+        substeps: RK4 steps per sample.
+        guard: bound on |lambda| * h, rad.
+        backend: ``"fast"`` (numba with forward sensitivities) or ``"reference"`` (torch autograd).
+
+    Returns:
+        theta [K, T], rad, dtype of omega; theta[:, j] at sample j.
+
+    Raises:
+        StabilityError: max |lambda| * dt / substeps > guard, |lambda| =
+            [`fastest_rate`][physgs.models.oscillator.fastest_rate] (= omega unless over-damped).
+        ValueError: shapes that differ, a non-positive omega, dt or substeps, a negative zeta, a
+            wind that is not a finite [T] series, or an unknown backend.
     """
     _check_args(omega, zeta, gain, dt, substeps, backend)
     w = torch.as_tensor(wind).detach().to("cpu", torch.float64)
@@ -264,11 +297,30 @@ def integrate_forcing(
     backend: str = "fast",
     _checked: bool = False,
 ) -> torch.Tensor:
-    """``integrate`` for a forcing u [T] given directly instead of a wind (``integrate``'s
-    v^2 - vbar^2): theta'' + 2 zeta omega theta' + omega^2 theta = gain u(t), from rest at
-    sample 0, u linear between samples. Returns theta [K, T] (rad per unit of gain x u);
-    differentiable w.r.t. omega, zeta, gain (not u). Same checks and StabilityError as
-    ``integrate``.
+    """Swing angles under a forcing given directly instead of a wind.
+
+    As [`integrate`][physgs.models.oscillator.integrate], for theta'' + 2 zeta omega theta' +
+    omega^2 theta = gain u(t), from rest at sample 0, u linear between samples. Differentiable
+    w.r.t. omega, zeta and gain (not u).
+
+    Args:
+        omega: [K] natural frequencies, rad/s (> 0).
+        zeta: [K] damping ratios, dimensionless (>= 0).
+        gain: [K] force gains, rad/s^2 per unit of u (rad / m^2 for u in m^2/s^2).
+        u (torch.Tensor | np.ndarray): [T] forcing (``integrate``'s v^2 - vbar^2, m^2/s^2), sampled
+            every ``dt``.
+        dt: seconds between samples.
+        substeps: RK4 steps per sample.
+        guard: bound on |lambda| * h, rad.
+        backend: ``"fast"`` or ``"reference"``.
+        _checked: the arguments were already checked (``integrate`` passes True).
+
+    Returns:
+        theta [K, T], rad per unit of gain x u, dtype of omega.
+
+    Raises:
+        StabilityError: as ``integrate``.
+        ValueError: as ``integrate`` (u instead of the wind).
     """
     if not _checked:
         _check_args(omega, zeta, gain, dt, substeps, backend)

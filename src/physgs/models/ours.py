@@ -109,6 +109,33 @@ class OscillatorPrior(BaseModel):
         search: OmegaSearch | None = None,
         canonical_pose: str = "rest",
     ):
+        """The prior's parts, oscillators, axes and pivots (module docstring).
+
+        Args:
+            ctx: the observed-dataset facts (canonical positions [N, 3], fps, wind statistics).
+            canonical_cfg: keyword arguments of the canonical set (config ``models.canonical``).
+            K: parts.
+            omega_hz: [lo, hi] natural-frequency bounds, Hz.
+            zeta: [lo, hi] damping-ratio bounds.
+            omega_init_hz: starting natural frequency, Hz.
+            zeta_init: starting damping ratio.
+            substeps: RK4 substeps per wind sample (raised until every allowed oscillator is
+                stable).
+            rk4_guard: the stability guard on the step (rate x step).
+            kmeans_n_init: k-means restarts (k-means parts).
+            seed: seeds k-means.
+            labels: [N] part of each Gaussian, in [0, K); None: computed here.
+            segmentation: ``kmeans`` or ``topology``.
+            knn: neighbours of the topology graph.
+            chain: compose each part's transform with its ancestors' (topology parts only).
+            parent: [K] parent of each part (root -1); None: computed with the topology parts.
+            search: the search over omega, or None.
+            canonical_pose: what the canonical set is taken for, one of ``CANONICAL_POSES``.
+
+        Raises:
+            ValueError: inconsistent options (unknown segmentation or pose, chain without topology,
+                labels or parents of the wrong shape).
+        """
         super().__init__(ctx, canonical_cfg)
         # the parameterisation the 2D-track control shares (physgs.models.oscillator_params)
         self.bounds = b = OscillatorBounds.from_config(omega_hz, zeta, omega_init_hz, zeta_init)
@@ -320,6 +347,16 @@ class OscillatorPrior(BaseModel):
         return torch.where(self.frozen[:, None], torch.zeros_like(theta), theta)
 
     def deform(self, frame_idx: int, wind: torch.Tensor) -> GaussianState:
+        """The canonical set turned part by part by theta_p at recorded frame ``frame_idx``.
+
+        Args:
+            frame_idx: recorded frame, 0-based.
+            wind: the condition's observed wind [L+F], m/s, lead-in included.
+
+        Returns:
+            The deformed Gaussians (positions and orientations rotated; scales, opacities, colours
+                those of the canonical set).
+        """
         theta_all = self.part_theta(wind)  # [K, L+F]
         theta = theta_all[:, self.lead_in + frame_idx]  # [K]
         theta0 = theta_all[:, self.lead_in]  # [K] at recorded frame 0
@@ -367,6 +404,14 @@ class OscillatorPrior(BaseModel):
         return {}
 
     def deformation_param_groups(self, lr: dict) -> list[dict]:
+        """The ``physics`` group (omega, zeta, gain, axis, bank weights) and the ``pivot`` group.
+
+        Args:
+            lr: config ``train.lr`` (the pivot rate is multiplied by the scene extent).
+
+        Returns:
+            The parameter groups.
+        """
         return [
             {
                 "name": "physics",

@@ -15,4 +15,13 @@ class StaticModel(BaseModel):
     use_wind = False
 
     def deform(self, frame_idx: int, wind: torch.Tensor) -> GaussianState:
+        """The canonical Gaussians, whatever the frame and wind.
+
+        Args:
+            frame_idx: recorded frame (not read).
+            wind: the observed wind [L+F], m/s (not read).
+
+        Returns:
+            The activated canonical Gaussians.
+        """
         return self.canonical.state()

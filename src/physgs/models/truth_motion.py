@@ -132,6 +132,16 @@ class TruthMotionModel(BaseModel):
     use_wind = True  # it reads the condition (off the wind), so it is not the same under every one
 
     def __init__(self, ctx: ModelContext, canonical_cfg: dict, motion: TrueMotion):
+        """The reference over the recorded conditions of ``motion``.
+
+        Args:
+            ctx: the observed-dataset facts.
+            canonical_cfg: keyword arguments of the canonical set (config ``models.canonical``).
+            motion: the ground-truth bone motion in Gaussian order.
+
+        Raises:
+            ValueError: the motion's shapes disagree with each other or with the canonical set.
+        """
         super().__init__(ctx, canonical_cfg)
         m = motion
         theta = torch.as_tensor(np.asarray(m.theta, dtype=np.float64))
@@ -171,6 +181,7 @@ class TruthMotionModel(BaseModel):
 
     @property
     def n_conditions(self) -> int:
+        """The number of recorded conditions, C."""
         return int(self.theta.shape[0])
 
     def condition_of(self, wind: torch.Tensor) -> int:
@@ -197,6 +208,18 @@ class TruthMotionModel(BaseModel):
         return self._dphi[condition, frame_idx], self._dhead[condition, frame_idx]
 
     def deform(self, frame_idx: int, wind: torch.Tensor) -> GaussianState:
+        """The canonical set moved rigidly with its bones at recorded frame ``frame_idx``.
+
+        Args:
+            frame_idx: recorded frame, 0-based.
+            wind: one recorded condition's observed wind [L+F], m/s (it names the condition).
+
+        Returns:
+            The deformed Gaussians.
+
+        Raises:
+            ValueError: the wind is none of the recorded conditions'.
+        """
         c = self.condition_of(wind)
         dphi, dhead = self.bone_motion(frame_idx, c)
         b = self.gaussian_bone

@@ -48,6 +48,7 @@ class Channels:
 
     @property
     def n_cells(self) -> int:
+        """The number of cells, N (the channels are 2 N)."""
         return int(self.cell_xy.shape[0])
 
 
@@ -117,7 +118,7 @@ def principal_channels(y: np.ndarray, n_components: int) -> tuple[np.ndarray, np
 
     Returns:
         (z [T, n] component series, loadings [n, C]; a shape phi over the components is
-        ``phi @ loadings`` over the cells' channels).
+            ``phi @ loadings`` over the cells' channels).
     """
     y = np.asarray(y, np.float64)
     if not 1 <= n_components <= min(y.shape):

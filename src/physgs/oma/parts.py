@@ -29,6 +29,7 @@ class PartModes:
 
     @property
     def estimated(self) -> np.ndarray:
+        """[K] bool: whether a mode gave the part an estimate."""
         return self.mode_of_part >= 0
 
 

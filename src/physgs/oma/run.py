@@ -34,6 +34,15 @@ class OMASettings:
 
     @staticmethod
     def from_config(oma: dict, ours: dict) -> "OMASettings":
+        """The settings from the config's ``oma`` section and ours' frequency bounds.
+
+        Args:
+            oma: config ``oma`` (``flow``, ``components``, ``ssi``).
+            ours: config ``models.ours`` (its ``omega_hz`` [lo, hi], Hz).
+
+        Returns:
+            The settings.
+        """
         return OMASettings(
             FlowSettings(**oma["flow"]),
             int(oma["components"]),
@@ -75,6 +84,15 @@ def identify_video(
 
 
 def save_identification(path, ident: Identification, s: OMASettings) -> None:
+    """Write an identification and its settings to ``path`` (a ``.npz``) atomically.
+
+    The channels' displacements are not stored, only their geometry.
+
+    Args:
+        path (str | os.PathLike): the ``.npz`` file to write.
+        ident: the channels' geometry, the modes and the seconds it took.
+        s: the settings it was made with (stored as JSON).
+    """
     m, ch = ident.modes, ident.channels
     with atomic_path(path) as tmp:
         with open(tmp, "wb") as fh:
@@ -96,6 +114,14 @@ def save_identification(path, ident: Identification, s: OMASettings) -> None:
 
 
 def load_identification(path) -> Identification:
+    """Read the identification that [save_identification][physgs.oma.run.save_identification] wrote.
+
+    Args:
+        path (str | os.PathLike): the ``.npz`` file.
+
+    Returns:
+        The identification; its channels' displacements ``y`` are empty ([0, C]).
+    """
     with np.load(path) as d:
         modes = Modes(
             d["freq_hz"],

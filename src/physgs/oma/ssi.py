@@ -97,6 +97,7 @@ class Modes:
 
     @property
     def n_modes(self) -> int:
+        """The number of identified modes, M."""
         return int(self.freq_hz.size)
 
 
@@ -172,7 +173,7 @@ def identify_records(ys: list[np.ndarray], fs: float, s: SSISettings) -> Modes:
 
     Returns:
         ``Modes``: frequencies (Hz), damping ratios, shapes over the C channels, and the
-        stabilisation diagram.
+            stabilisation diagram.
     """
     from pyoma2.functions import gen, ssi
 

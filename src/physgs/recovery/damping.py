@@ -31,12 +31,21 @@ class DampingResult:
     zeta_true: float
 
     def to_dict(self) -> dict:
+        """The result as a JSON-ready dict (arrays as lists)."""
         return {
             k: (v.tolist() if isinstance(v, np.ndarray) else v) for k, v in asdict(self).items()
         }
 
     @staticmethod
     def from_dict(d: dict) -> "DampingResult":
+        """The result that [to_dict][physgs.recovery.damping.DampingResult.to_dict] wrote.
+
+        Args:
+            d: field name -> value (arrays as lists).
+
+        Returns:
+            The result.
+        """
         return DampingResult(
             np.asarray(d["zeta"]),
             np.asarray(d["omega"]),
@@ -52,10 +61,19 @@ class DampingResult:
 def damping_summary(
     omega_hat: np.ndarray, zeta_hat: np.ndarray, zeta_true: float, mask: np.ndarray | None = None
 ) -> DampingResult:
-    """Summarise recovered damping over the parts selected by ``mask`` [K] (default: all).
+    """Summarise recovered damping over the parts selected by ``mask``.
 
-    omega_hat [K] rad/s, zeta_hat [K] dimensionless, zeta_true the testbed's constant ratio.
-    Fits need at least 2 parts with distinct omega; otherwise slope/exponent are NaN.
+    Fits need at least 2 parts with distinct omega; otherwise slope and exponent are NaN.
+
+    Args:
+        omega_hat: [K] natural frequencies, rad/s.
+        zeta_hat: [K] damping ratios, dimensionless.
+        zeta_true: the testbed's constant damping ratio.
+        mask: [K] bool, the parts to summarise; None: all.
+
+    Returns:
+        The [`DampingResult`][physgs.recovery.damping.DampingResult]: gamma = zeta omega (1/s)
+            per part, its least-squares line in omega and its log-log exponent.
     """
     omega = np.asarray(omega_hat, dtype=np.float64)
     zeta = np.asarray(zeta_hat, dtype=np.float64)

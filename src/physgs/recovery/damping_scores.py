@@ -55,10 +55,19 @@ class DampingScores:
     gamma_exponent_true: float
 
     def to_dict(self) -> dict:
+        """The scores as a plain dict (field name -> value)."""
         return asdict(self)
 
     @staticmethod
     def from_dict(d: dict) -> "DampingScores":
+        """The scores that [to_dict][physgs.recovery.damping_scores.DampingScores.to_dict] wrote.
+
+        Args:
+            d: field name -> value.
+
+        Returns:
+            The scores.
+        """
         return DampingScores(
             int(d["n_trusted"]),
             *(
@@ -106,9 +115,16 @@ def damping_scores(
 ) -> DampingScores:
     """Score zeta_hat over the trusted parts of a matching.
 
-    bone [K] int: the bone each part is matched to; trusted [K] bool (``MatchResult.bone`` and
-    ``.trusted``); zeta_hat [K]; omega_hat [K] rad/s; zeta_bones [B] the true per-bone ratios;
-    omega_bones [B] rad/s the true frequencies (only for ``gamma_exponent_true``).
+    Args:
+        bone: [K] int, the bone each part is matched to (``MatchResult.bone``).
+        trusted: [K] bool (``MatchResult.trusted``).
+        zeta_hat: [K] the parts' damping ratios.
+        omega_hat: [K] the parts' natural frequencies, rad/s.
+        zeta_bones: [B] the true per-bone damping ratios.
+        omega_bones: [B] the true natural frequencies, rad/s (only for ``gamma_exponent_true``).
+
+    Returns:
+        The [`DampingScores`][physgs.recovery.damping_scores.DampingScores].
     """
     bone = np.asarray(bone, dtype=np.int64)
     trusted = np.asarray(trusted, dtype=bool)
@@ -182,19 +198,30 @@ class DampingNull:
 
     @property
     def median_log_corr(self) -> float:
+        """Median over draws of each draw's log-log correlation (NaN draws skipped)."""
         return self._median(self.log_corr)
 
     @property
     def median_gamma_exponent(self) -> float:
+        """Median over draws of each draw's gamma exponent (NaN draws skipped)."""
         return self._median(self.gamma_exponent)
 
     def to_dict(self) -> dict:
+        """The null as a JSON-ready dict (arrays as lists)."""
         return {
             k: (v.tolist() if isinstance(v, np.ndarray) else v) for k, v in asdict(self).items()
         }
 
     @staticmethod
     def from_dict(d: dict) -> "DampingNull":
+        """The null that [to_dict][physgs.recovery.damping_scores.DampingNull.to_dict] wrote.
+
+        Args:
+            d: field name -> value (arrays as lists).
+
+        Returns:
+            The null.
+        """
         return DampingNull(
             *(
                 np.asarray(d[k], float)
@@ -216,9 +243,27 @@ def damping_null(
     seed: int,
     n_draws: int = N_DRAWS,
 ) -> DampingNull:
-    """Score n_draws log-uniform zeta draws (``draw_null_zetas``) exactly as ``damping_scores``
-    scores zeta_hat: same matching (bone [K], trusted [K]), same omega_hat [K] rad/s, same truth
-    (zeta_bones [B], omega_bones [B] rad/s). Seeded: same seed, same draws."""
+    """Score log-uniform zeta draws exactly as ``damping_scores`` scores zeta_hat.
+
+    Same matching, same omega_hat, same truth; only zeta is drawn (``draw_null_zetas``). Seeded:
+    same seed, same draws.
+
+    Args:
+        bone: [K] int, the bone each part is matched to.
+        trusted: [K] bool.
+        omega_hat: [K] the parts' natural frequencies, rad/s.
+        zeta_bones: [B] the true per-bone damping ratios.
+        omega_bones: [B] the true natural frequencies, rad/s.
+        zeta_range (tuple[float, float]): (lo, hi) of the draws, 0 < lo <= hi.
+        seed: seeds the draws.
+        n_draws: D, draws.
+
+    Returns:
+        The [`DampingNull`][physgs.recovery.damping_scores.DampingNull]: per-draw scores [D].
+
+    Raises:
+        ValueError: the range is not 0 < lo <= hi.
+    """
     draws = draw_null_zetas(zeta_range, len(np.asarray(bone)), n_draws, seed)
     s = [damping_scores(bone, trusted, z, omega_hat, zeta_bones, omega_bones) for z in draws]
     return DampingNull(

@@ -14,7 +14,19 @@ TRUST_THRESHOLD = 0.7  # |corr| at or above which a match is trusted (paper, SPE
 
 
 def training_window(theta: np.ndarray, lead_in_frames: int, n_train: int) -> np.ndarray:
-    """Columns of recorded frames 0..n_train-1 from a series [..., L+F] that starts at the lead-in."""
+    """The columns of recorded frames 0..n_train-1 of a series that starts at the lead-in.
+
+    Args:
+        theta: [..., L+F] series (any unit), column L = recorded frame 0.
+        lead_in_frames: L, samples before recorded frame 0.
+        n_train: training frames.
+
+    Returns:
+        [..., n_train] view of ``theta``.
+
+    Raises:
+        ValueError: the series is shorter than L + n_train.
+    """
     theta = np.asarray(theta)
     if theta.shape[-1] < lead_in_frames + n_train:
         raise ValueError(
@@ -25,9 +37,19 @@ def training_window(theta: np.ndarray, lead_in_frames: int, n_train: int) -> np.
 
 
 def pearson_matrix(a: np.ndarray, b: np.ndarray) -> np.ndarray:
-    """Pearson correlation of every row of a [K, T] with every row of b [B, T] -> [K, B].
+    """Pearson correlation of every row of ``a`` with every row of ``b``.
 
     A constant row has no defined correlation; it gets 0 (no evidence of a match), never NaN.
+
+    Args:
+        a: [K, T] rows (e.g. part angles, rad).
+        b: [B, T] rows over the same T samples.
+
+    Returns:
+        [K, B] correlations in [-1, 1], float64.
+
+    Raises:
+        ValueError: shapes that are not [K, T] and [B, T], or NaN/inf in either input.
     """
     a = np.asarray(a, dtype=np.float64)
     b = np.asarray(b, dtype=np.float64)
@@ -49,8 +71,13 @@ def pearson_matrix(a: np.ndarray, b: np.ndarray) -> np.ndarray:
 def loglog_r2(omega_hat: np.ndarray, omega_true: np.ndarray) -> float:
     """Squared Pearson correlation of log omega_hat against log omega_true.
 
-    NaN when fewer than 3 pairs (undefined / trivially 1); 0 when either side has no spread
-    (nothing explained), so a degenerate match never yields NaN from 0/0.
+    Args:
+        omega_hat: [n] estimated natural frequencies, rad/s (> 0).
+        omega_true: [n] the matched bones' natural frequencies, rad/s (> 0).
+
+    Returns:
+        R^2 in [0, 1]; NaN when fewer than 3 pairs (undefined / trivially 1); 0 when either side
+            has no spread (nothing explained), so a degenerate match never yields NaN from 0/0.
     """
     x, y = np.log(np.asarray(omega_hat, float)), np.log(np.asarray(omega_true, float))
     if x.size < 3:
@@ -79,12 +106,21 @@ class MatchResult:
     loglog_r2: float
 
     def to_dict(self) -> dict:
+        """The result as a JSON-ready dict (arrays as lists)."""
         return {
             k: (v.tolist() if isinstance(v, np.ndarray) else v) for k, v in asdict(self).items()
         }
 
     @staticmethod
     def from_dict(d: dict) -> "MatchResult":
+        """The result that [to_dict][physgs.recovery.matcher.MatchResult.to_dict] wrote.
+
+        Args:
+            d: field name -> value (arrays as lists).
+
+        Returns:
+            The result.
+        """
         arr = {
             k: np.asarray(d[k])
             for k in ("bone", "corr", "trusted", "omega_hat", "omega_true", "rel_err")
@@ -107,8 +143,20 @@ def match_parts(
 ) -> MatchResult:
     """Match each part to the bone whose trajectory it correlates with best (by |corr|).
 
-    part_theta [K, T], bone_theta [B, T]: angles (rad) over the same samples (the training
-    window at the training wind). omega_hat [K], omega_bones [B]: rad/s.
+    Args:
+        part_theta: [K, T] part angles, rad, over the same samples as ``bone_theta`` (the training
+            window at the training wind).
+        bone_theta: [B, T] bone angles, rad.
+        omega_hat: [K] the parts' natural frequencies, rad/s.
+        omega_bones: [B] the bones' natural frequencies, rad/s.
+        threshold: |corr| at or above which a match is trusted.
+
+    Returns:
+        The [`MatchResult`][physgs.recovery.matcher.MatchResult]: each part's bone, |corr|, trust,
+            relative error, and the median relative error and log-log R^2 over trusted parts.
+
+    Raises:
+        ValueError: frequencies of the wrong shape or not positive, or NaN/inf trajectories.
     """
     omega_hat = np.asarray(omega_hat, dtype=np.float64)
     omega_bones = np.asarray(omega_bones, dtype=np.float64)
@@ -133,10 +181,18 @@ def match_parts(
 
 
 def restricted(m: MatchResult, bone_mask: np.ndarray) -> tuple[int, float]:
-    """(trusted parts matched to a bone in ``bone_mask`` [B] bool, their median relative error).
+    """The match's scores restricted to the parts matched to the bones in ``bone_mask``.
 
-    The median is NaN when no such part is trusted. Used to score recovery only on bones whose
-    own motion is visible in the training camera (``physgs.testbed.stats``).
+    Used to score recovery only on bones whose own motion is visible in the training camera
+    (``physgs.testbed.stats``).
+
+    Args:
+        m: the match.
+        bone_mask: [B] bool, the bones to keep.
+
+    Returns:
+        (trusted parts matched to a kept bone, their median relative error as a fraction; NaN when
+            there is none).
     """
     sel = np.asarray(m.trusted, bool) & np.asarray(bone_mask, bool)[np.asarray(m.bone, int)]
     return int(sel.sum()), float(np.median(m.rel_err[sel])) if sel.any() else float("nan")

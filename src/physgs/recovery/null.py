@@ -18,14 +18,32 @@ N_DRAWS = 8
 
 
 def draw_null_omegas(omega_bones: np.ndarray, n_parts: int, n_draws: int, seed: int) -> np.ndarray:
-    """[n_draws, n_parts] rad/s, log-uniform on [min omega_bones, max omega_bones], seeded."""
+    """Draw natural frequencies log-uniformly over the bones' range, seeded.
+
+    Args:
+        omega_bones: [B] the bones' natural frequencies, rad/s (> 0).
+        n_parts: K, frequencies per draw.
+        n_draws: D, draws.
+        seed: the generator's seed (same seed, same draws).
+
+    Returns:
+        [D, K] rad/s, log-uniform on [min omega_bones, max omega_bones].
+    """
     lo, hi = np.log(np.min(omega_bones)), np.log(np.max(omega_bones))
     rng = np.random.default_rng(seed)
     return np.exp(rng.uniform(lo, hi, size=(n_draws, n_parts)))
 
 
 def nearest_bone_gap(omega: np.ndarray, omega_bones: np.ndarray) -> np.ndarray:
-    """min_b |omega - omega_b| / omega_b for every entry of omega [...] -> [...] (fraction)."""
+    """Relative distance of each frequency to the nearest bone's, min_b |omega - omega_b| / omega_b.
+
+    Args:
+        omega: [...] natural frequencies, rad/s.
+        omega_bones: [B] the bones' natural frequencies, rad/s (> 0).
+
+    Returns:
+        [...] the gaps, fractions.
+    """
     omega = np.asarray(omega, dtype=np.float64)
     ob = np.asarray(omega_bones, dtype=np.float64)
     return np.min(np.abs(omega[..., None] - ob) / ob, axis=-1)
@@ -47,6 +65,7 @@ class NullResult:
 
     @property
     def median_n_trusted(self) -> float:
+        """Median over draws of the trusted parts."""
         return float(np.median(self.n_trusted))
 
     @property
@@ -70,16 +89,26 @@ class NullResult:
 
     @property
     def median_loglog_r2(self) -> float:
+        """Median over draws of the log-log R^2 of omega against the bones' (NaN draws skipped)."""
         v = self.loglog_r2[np.isfinite(self.loglog_r2)]
         return float(np.median(v)) if v.size else float("nan")
 
     def to_dict(self) -> dict:
+        """The result as a JSON-ready dict (arrays as lists)."""
         return {
             k: (v.tolist() if isinstance(v, np.ndarray) else v) for k, v in asdict(self).items()
         }
 
     @staticmethod
     def from_dict(d: dict) -> "NullResult":
+        """The result that [to_dict][physgs.recovery.null.NullResult.to_dict] wrote.
+
+        Args:
+            d: field name -> value (arrays as lists; the visible-bone scores may be absent or None).
+
+        Returns:
+            The result.
+        """
         opt = {
             k: (np.asarray(d[k], float) if d.get(k) is not None else None)
             for k in ("n_trusted_visible", "median_rel_err_visible")
@@ -114,13 +143,33 @@ def null_control(
     threshold: float = TRUST_THRESHOLD,
     bone_visible: np.ndarray | None = None,
 ) -> NullResult:
-    """Run the untrained null through ``physgs.models.oscillator.integrate`` and the matcher.
+    """Run the untrained null through the trained model's solver and the matcher.
 
-    omega_bones [B] rad/s; bone_theta [B, n_train] rad, the bones' angles over the training
-    window at the training wind; wind [L+F] m/s at the frame rate (training condition, lead-in
-    first); vbar m/s and dt = 1/fps s and substeps exactly as the trained model uses them.
-    gain only scales theta, which correlation ignores. Seeded: same seed, same draws.
-    bone_visible [B] bool: also score each draw on the bones whose own motion is visible.
+    Each draw integrates ``physgs.models.oscillator.integrate`` with drawn omega and zeta =
+    ``zeta_init``; ``gain`` only scales theta, which correlation ignores.
+
+    Args:
+        omega_bones: [B] the bones' natural frequencies, rad/s.
+        bone_theta: [B, n_train] the bones' angles over the training window at the training wind,
+            rad.
+        wind: [L+F] the training condition's observed wind at the frame rate, m/s, lead-in first.
+        n_parts: K, parts per draw.
+        zeta_init: damping ratio of every drawn oscillator (the model's initial value).
+        vbar: the condition's mean wind speed, m/s, as the trained model uses it.
+        dt: seconds per wind sample, 1 / fps.
+        substeps: RK4 substeps per sample, as the trained model uses them.
+        lead_in_frames: L, wind samples before recorded frame 0.
+        n_train: training frames.
+        seed: seeds the draws (same seed, same draws).
+        n_draws: D, draws.
+        gain: the oscillators' force gain, rad / m^2.
+        threshold: |corr| at or above which a match is trusted.
+        bone_visible: [B] bool, bones whose own motion is visible; when given each draw is also
+            scored on them alone.
+
+    Returns:
+        The [`NullResult`][physgs.recovery.null.NullResult]: per-draw scores [D], the draws
+            [D, K] rad/s and the median nearest-bone gap.
     """
     import torch  # here, not at the top: reading a null record needs no torch
 

@@ -101,10 +101,30 @@ def recovery_dict(rec: RecoveryRecord) -> dict:
 
 
 def save_recovery(path, rec: RecoveryRecord) -> None:
+    """Write the recovery record to ``path`` as JSON, atomically.
+
+    Args:
+        path (str | os.PathLike): the ``.json`` file to write.
+        rec: the record.
+    """
     write_json(path, recovery_dict(rec))
 
 
 def load_recovery(path) -> RecoveryRecord:
+    """Read the recovery record that [save_recovery][physgs.recovery.record.save_recovery] wrote.
+
+    Keys a record from before freezing, visibility or the damping scores lacks take their
+    defaults (none frozen, -1 / NaN, None).
+
+    Args:
+        path (str | os.PathLike): the ``.json`` file.
+
+    Returns:
+        The record.
+
+    Raises:
+        IntermediateFileError: the file is missing or unreadable (it names the rule to rerun).
+    """
     d = read_json(path, rule="recovery (tracks_evaluate for the tracks control's)")
     return RecoveryRecord(
         MatchResult.from_dict(d["match"]),
@@ -118,10 +138,27 @@ def load_recovery(path) -> RecoveryRecord:
 
 
 def save_null(path, res: NullResult) -> None:
+    """Write the null control's result to ``path`` as JSON, atomically.
+
+    Args:
+        path (str | os.PathLike): the ``.json`` file to write.
+        res: the result.
+    """
     write_json(path, res.to_dict())
 
 
 def load_null(path) -> NullResult:
+    """Read the null control's result that [save_null][physgs.recovery.record.save_null] wrote.
+
+    Args:
+        path (str | os.PathLike): the ``.json`` file.
+
+    Returns:
+        The result.
+
+    Raises:
+        IntermediateFileError: the file is missing or unreadable (rule ``null_control``).
+    """
     return NullResult.from_dict(read_json(path, rule="null_control"))
 
 

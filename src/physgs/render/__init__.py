@@ -1,8 +1,8 @@
 """Differentiable 3D Gaussian Splatting rasterizer (CPU fast path, PyTorch reference, gsplat).
 
-One entry point, :func:`rasterization`, in the spirit of gsplat's: Gaussians + camera +
-background -> RGB, accumulated alpha and expected depth, differentiable w.r.t. means, quats,
-scales, opacities and colours.
+One entry point, [`rasterization`][physgs.render.rasterization], in the spirit of gsplat's:
+Gaussians + camera + background -> RGB, accumulated alpha and expected depth, differentiable w.r.t.
+means, quats, scales, opacities and colours.
 """
 
 from __future__ import annotations
@@ -116,14 +116,28 @@ def rasterization(
 ) -> RenderOutput:
     """Render N 3D Gaussians into ``camera``.
 
-    means [N, 3] world units; quats [N, 4] (w, x, y, z), need not be unit; scales [N, 3] world
-    units (>= 0, activated); opacities [N] in [0, 1]; colors [N, 3] (any D channels work);
-    background [3] (tensor, array or list; same channels as colors). The image is
-    camera.height x camera.width pixels.
+    Args:
+        means: [N, 3] centres, world units.
+        quats: [N, 4] orientations (w, x, y, z), need not be unit.
+        scales: [N, 3] standard deviations, world units (>= 0, activated).
+        opacities: [N] in [0, 1].
+        colors: [N, 3] in [0, 1] (any D channels work).
+        camera: the camera; the image is camera.height x camera.width px.
+        background (torch.Tensor | np.ndarray | list): [3] (tensor, array or list; same channels as
+            colors).
+        backend: ``"fast"`` (numba CPU kernels with an explicit backward), ``"reference"`` (pure
+            PyTorch autograd), ``"gsplat"`` (CUDA, needs gsplat installed) or ``"auto"`` (gsplat on
+            CUDA when installed, else fast).
+        return_depth: whether to compute the expected depth.
 
-    backend: "fast" (numba CPU kernels with an explicit backward), "reference" (pure PyTorch
-    autograd), "gsplat" (CUDA, needs gsplat installed) or "auto" (gsplat on CUDA when installed,
-    else fast). Returns :class:`RenderOutput` on the device and dtype of ``means``.
+    Returns:
+        A [`RenderOutput`][physgs.render.RenderOutput] on the device and dtype of ``means``.
+
+    Raises:
+        ValueError: an unknown backend, or inputs of the wrong shape, dtype or device, with NaN
+            or inf, negative scales or opacities outside [0, 1].
+        TypeError: an input other than ``background`` is not a tensor.
+        RuntimeError: the gsplat backend is asked for where gsplat is not available.
     """
     if backend not in BACKENDS:
         raise ValueError(f"rasterization: unknown backend {backend!r}; choose one of {BACKENDS}")

@@ -1,11 +1,12 @@
 """Every numerical threshold of the rasterizer, in one place (as gsplat's ``cuda/_constants.py``).
 
-The PyTorch reference (:mod:`physgs.render.project`, :mod:`physgs.render.reference`), the numba
-fast path (:mod:`physgs.render.fast`, :mod:`physgs.render.kernels`) and the gsplat dispatch
-(:mod:`physgs.render.gsplat_backend`) all read these. The numba kernels freeze them as globals
-at compile time and cache the machine code keyed on ``kernels.py`` alone: after editing a value
-here, touch ``kernels.py`` (or delete its ``__pycache__``) so the fast path recompiles; the
-fast-vs-reference tests catch a stale cache.
+The PyTorch reference ([`physgs.render.project`][physgs.render.project],
+[`physgs.render.reference`][physgs.render.reference]), the numba fast path
+([`physgs.render.fast`][physgs.render.fast], [`physgs.render.kernels`][physgs.render.kernels]) and
+the gsplat dispatch ([`physgs.render.gsplat_backend`][physgs.render.gsplat_backend]) all read these.
+The numba kernels freeze them as globals at compile time and cache the machine code keyed on
+``kernels.py`` alone: after editing a value here, touch ``kernels.py`` (or delete its
+``__pycache__``) so the fast path recompiles; the fast-vs-reference tests catch a stale cache.
 
 Not here: the near plane, which is per camera (``Camera.near``, default 0.01 world units, as
 gsplat's ``near_plane``), and the pixel-centre convention (centres at integer + 0.5).

@@ -1,5 +1,5 @@
-"""Fast CPU rasterizer: fused numba projection + tile compositing behind one
-torch.autograd.Function with an explicit backward (kernels in :mod:`physgs.render.kernels`).
+"""Fast CPU rasterizer: fused numba projection + tile compositing behind one torch.autograd.Function
+with an explicit backward (kernels in [`physgs.render.kernels`][physgs.render.kernels]).
 
 Everything between the input tensors and the output images runs in numba or vectorised numpy:
 no Python loop over Gaussians and no small torch ops (whose OpenMP barriers cost more than the
@@ -29,9 +29,18 @@ def _to_torch(x: np.ndarray, like: torch.Tensor) -> torch.Tensor:
 
 
 def camera_arrays(camera: Camera):
-    """(Rc [3, 3], tc [3], intr [4], lims [4]) float64 for the kernels; lims are gsplat's
-    tangent clamps (x-, x+, y-, y+) of the projection Jacobian, from
-    :func:`physgs.render.project.fov_clamp_limits` (the reference path uses the same)."""
+    """The camera as the kernels read it, float64 numpy.
+
+    Args:
+        camera: the pinhole camera.
+
+    Returns:
+        (tuple[np.ndarray, ...]): (Rc, tc, intr, lims), float64: Rc [3, 3] and tc [3] (world
+            units) the world-to-camera rotation and translation; intr [4] (fx, fy, cx, cy) px;
+            lims [4] gsplat's tangent clamps (x-, x+, y-, y+) of the projection Jacobian from
+            [`fov_clamp_limits`][physgs.render.project.fov_clamp_limits] (the reference path uses
+            the same).
+    """
     intr = np.array([camera.fx, camera.fy, camera.cx, camera.cy], dtype=np.float64)
     lims = np.array(fov_clamp_limits(camera), dtype=np.float64)
     return (
@@ -146,13 +155,27 @@ class _FastRasterize(torch.autograd.Function):
 
 
 def work_count(means, quats, scales, opacities, colors, camera, background) -> dict[str, int]:
-    """How much compositing one forward + backward of :func:`rasterize_fast` does (ints):
+    """How much compositing one forward + backward of the fast rasterizer does.
 
-    pairs: pixel-Gaussian pairs composited before transmittance saturates (each costs
-    ``kernels.FLOPS_PER_PAIR`` flops, forward + backward); footprint_pixels: pixels inside the
-    1/255 contours of the tile pairs reached (pairs plus the ones skipped after saturation);
-    rows: pixel rows of those footprints (the forward finds each one's span and two exps);
-    tile_pairs: (tile, Gaussian) pairs binned; gaussians: N.
+    Runs one forward of [`rasterize_fast`][physgs.render.fast.rasterize_fast] (no gradient) and
+    counts what it did.
+
+    Args:
+        means (torch.Tensor): [N, 3] world units.
+        quats (torch.Tensor): [N, 4] (w, x, y, z).
+        scales (torch.Tensor): [N, 3] world units.
+        opacities (torch.Tensor): [N] in [0, 1].
+        colors (torch.Tensor): [N, D] in [0, 1].
+        camera (Camera): the camera.
+        background (torch.Tensor): [D] in [0, 1].
+
+    Returns:
+        The counts by name, ints. ``pairs``, pixel-Gaussian pairs composited before transmittance
+            saturates (each costs ``kernels.FLOPS_PER_PAIR`` flops, forward + backward);
+            ``footprint_pixels``, pixels inside the 1/255 contours of the tile pairs reached (pairs
+            plus the ones skipped after saturation); ``rows``, pixel rows of those footprints (the
+            forward finds each one's span and two exps); ``tile_pairs``, (tile, Gaussian) pairs
+            binned; ``gaussians``, N.
     """
     with torch.no_grad():
         _, state = _forward(means, quats, scales, opacities, colors, background, camera)
@@ -181,12 +204,26 @@ def rasterize_fast(
     background: torch.Tensor,
     return_depth: bool = True,
 ):
-    """Fast CPU backend of :func:`physgs.render.rasterization` (same shapes and units).
+    """Fast CPU backend of [`rasterization`][physgs.render.rasterization] (same shapes and units).
 
-    Returns (rgb [H, W, D], alpha [H, W], depth [H, W] or None). Tensors on another device are
-    copied to the CPU and back. Arithmetic is float64 inside the kernels for any input dtype.
-    Forward only (no autograd node, no state kept for a backward) when autograd is off
-    (torch.no_grad, inference_mode) or no input requires a gradient, as in evaluation.
+    Tensors on another device are copied to the CPU and back. Arithmetic is float64 inside the
+    kernels for any input dtype. Forward only (no autograd node, no state kept for a backward) when
+    autograd is off (torch.no_grad, inference_mode) or no input requires a gradient, as in
+    evaluation.
+
+    Args:
+        means: [N, 3] centres, world units.
+        quats: [N, 4] (w, x, y, z), any norm.
+        scales: [N, 3] world units, activated.
+        opacities: [N] in [0, 1].
+        colors: [N, D] in [0, 1].
+        camera: the camera (the image is camera.height x camera.width px).
+        background: [D] in [0, 1].
+        return_depth: whether to return the expected depth.
+
+    Returns:
+        (tuple[torch.Tensor, ...]): (rgb [H, W, D], alpha [H, W], depth [H, W] world units or
+            None), on the device and dtype of ``means``.
     """
     inputs = (means, quats, scales, opacities, colors, background)
     if torch.is_grad_enabled() and any(x.requires_grad for x in inputs):

@@ -25,7 +25,7 @@ def rasterize_gsplat(
     background: torch.Tensor,
     return_depth: bool = True,
 ):
-    """gsplat backend of :func:`physgs.render.rasterization` (same shapes and units).
+    """gsplat backend of [`rasterization`][physgs.render.rasterization] (same shapes and units).
 
     Returns (rgb [H, W, D], alpha [H, W], depth [H, W] or None) on the CUDA device.
     """

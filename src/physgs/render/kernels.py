@@ -107,7 +107,7 @@ def _row_span(ca, cb, det, ica, thr, mx, dy, lo, hi):  # pragma: no cover - comp
 @nb.njit(cache=True, inline="always")
 def _rows(ca, det, thr, my, lo, hi):  # pragma: no cover - compiled
     """Pixel rows [y0, y1] (clipped to [lo, hi]) that can hold a pixel of the contour
-    ca dx^2 + 2 cb dx dy + cc dy^2 <= thr: |dy| <= sqrt(thr ca / det) (where :func:`_row_span`'s
+    ca dx^2 + 2 cb dx dy + cc dy^2 <= thr: |dy| <= sqrt(thr ca / det) (where ``_row_span``'s
     discriminant is >= 0), widened by ROW_SPAN_TOL px. Tighter than the axis-aligned pixel box,
     which adds a pixel of slack on each side: for the trees' pixel-sized Gaussians it skips about
     half the rows the box holds. Rows it keeps that have no pixel get an empty span."""
@@ -145,10 +145,10 @@ def _rgb(col):  # pragma: no cover - compiled
 
 @nb.njit(cache=True)
 def pixel_boxes(means2d, cov2d, opac, valid, width, height, boxes):  # pragma: no cover
-    """Numba twin of :func:`physgs.render.project.pixel_bounds` (the reference's binning; same
-    formula, constants and clipping), written into boxes [N, 4] int64: (x0, x1, y0, y1)
-    inclusive pixel ranges, x0 > x1 for a Gaussian that touches no pixel. One flat loop instead
-    of some twenty numpy passes over N."""
+    """Numba twin of [`pixel_bounds`][physgs.render.project.pixel_bounds] (the reference's binning;
+    same formula, constants and clipping), written into boxes [N, 4] int64: (x0, x1, y0, y1)
+    inclusive pixel ranges, x0 > x1 for a Gaussian that touches no pixel. One flat loop instead of
+    some twenty numpy passes over N."""
     s = float(BOX_SLACK_PX)
     lo = -(BOX_SLACK_PX + 1.0)
     for i in range(means2d.shape[0]):
@@ -326,13 +326,13 @@ def backward(
     g_depth,
     pair_grad,
 ):  # pragma: no cover - compiled
-    """Explicit backward of :func:`forward`, over the rows the forward recorded (the same
-    pixels, the same exp(-sigma / 2) stepping bit for bit, so both passes make the same alpha
-    tests). g_rgb [H, W, D], g_alpha [H, W], g_depth [H, W] are upstream gradients (float64).
-    Writes pair_grad [P, 7 + D] per (tile, Gaussian) pair:
-    d/d(mx, my, conic a, b, c, opacity, depth, colours). Front-to-back pass: the light behind
-    Gaussian i (later Gaussians plus background) is the total minus the prefix up to i, so no
-    per-pixel list is stored and no division by (1 - alpha) recovers transmittance."""
+    """Explicit backward of [`forward`][physgs.render.kernels.forward], over the rows the forward
+    recorded (the same pixels, the same exp(-sigma / 2) stepping bit for bit, so both passes make
+    the same alpha tests). g_rgb [H, W, D], g_alpha [H, W], g_depth [H, W] are upstream gradients
+    (float64). Writes pair_grad [P, 7 + D] per (tile, Gaussian) pair: d/d(mx, my, conic a, b, c,
+    opacity, depth, colours). Front-to-back pass: the light behind Gaussian i (later Gaussians plus
+    background) is the total minus the prefix up to i, so no per-pixel list is stored and no
+    division by (1 - alpha) recovers transmittance."""
     D = colors.shape[1]
     n_tiles = tile_start.shape[0] - 1
     for t in nb.prange(n_tiles):
@@ -507,7 +507,8 @@ def _mm(A, B, out, ta, tb):  # pragma: no cover - compiled
 def project_forward(
     means, quats, scales, Rc, tc, intr, lims, near, eps2d, means2d, conics, depths, cov2d, valid
 ):  # pragma: no cover - compiled
-    """Fused EWA projection, same maths as :func:`physgs.render.project.project_gaussians`.
+    """Fused EWA projection, same maths as
+    [`project_gaussians`][physgs.render.project.project_gaussians].
 
     means [N, 3], quats [N, 4] wxyz, scales [N, 3] world units; Rc [3, 3], tc [3] world->camera;
     intr (fx, fy, cx, cy) px; lims (x-, x+, y-, y+) tangent clamps; near world units.
@@ -594,9 +595,10 @@ def project_backward(
     v_quats,
     v_scales,
 ):  # pragma: no cover
-    """Explicit backward of :func:`project_forward`: upstream v_means2d [N, 2], v_conics [N, 3],
-    v_depths [N] -> v_means [N, 3], v_quats [N, 4], v_scales [N, 3] (written; zero if culled).
-    Each Gaussian is independent (no accumulation across Gaussians)."""
+    """Explicit backward of [`project_forward`][physgs.render.kernels.project_forward]: upstream
+    v_means2d [N, 2], v_conics [N, 3], v_depths [N] -> v_means [N, 3], v_quats [N, 4], v_scales [N,
+    3] (written; zero if culled). Each Gaussian is independent (no accumulation across
+    Gaussians)."""
     fx, fy = intr[0], intr[1]
     n = means.shape[0]
     # serial: ~150 ns per Gaussian, not worth threads (or their compile time)

@@ -6,7 +6,7 @@ R_q S S^T R_q^T, perspective Jacobian evaluated at x/z, y/z clamped to the image
 principal point, as 3DGS), so Gaussians far off to the side do not blow up, +0.3 px^2 dilation of
 the 2D covariance, conic = its inverse. Culled Gaussians (behind the near plane, degenerate) get a
 mask and finite zero outputs, never NaN: every division uses a clamped denominator, so gradients
-stay finite too. Thresholds live in :mod:`physgs.render.constants`.
+stay finite too. Thresholds live in [`physgs.render.constants`][physgs.render.constants].
 """
 
 from __future__ import annotations
@@ -45,10 +45,16 @@ class Projected:
 
 
 def quat_to_rotmat(quats: torch.Tensor) -> torch.Tensor:
-    """Quaternions [..., 4] (w, x, y, z), normalised here -> rotation matrices [..., 3, 3].
+    """Rotation matrices of quaternions, normalised here.
 
     The package's one torch implementation (``physgs.models.gaussians`` re-exports it; the numba
     kernels have a scalar twin, ``kernels._quat_rotmat``). A zero quaternion gives the identity.
+
+    Args:
+        quats: [..., 4] quaternions (w, x, y, z), any norm.
+
+    Returns:
+        [..., 3, 3] rotation matrices, same dtype and device.
     """
     q = quats / quats.norm(dim=-1, keepdim=True).clamp_min(QUAT_NORM_EPS)
     w, x, y, z = q.unbind(-1)
@@ -69,10 +75,19 @@ def quat_to_rotmat(quats: torch.Tensor) -> torch.Tensor:
 
 
 def fov_clamp_limits(camera: Camera) -> tuple[float, float, float, float]:
-    """Tangent limits (x-, x+, y-, y+) of the Jacobian's evaluation point: x/z is clamped to
-    [-x-, x+] and y/z to [-y-, y+]. Each is the tangent of the image edge on that side plus
-    FOV_CLAMP_MARGIN x tan(half field of view), tan_fovx = 0.5 W / fx (gsplat's ``persp_proj``;
-    1.3 tan(fov / 2) on every side for a centred principal point, as 3DGS's ``computeCov2D``)."""
+    """Tangent limits (x-, x+, y-, y+) of the Jacobian's evaluation point.
+
+    x/z is clamped to [-x-, x+] and y/z to [-y-, y+]. Each is the tangent of the image edge on that
+    side plus FOV_CLAMP_MARGIN x tan(half field of view), tan_fovx = 0.5 W / fx (gsplat's
+    ``persp_proj``; 1.3 tan(fov / 2) on every side for a centred principal point, as 3DGS's
+    ``computeCov2D``).
+
+    Args:
+        camera: the pinhole camera (fx, fy, cx, cy in px; width, height in px).
+
+    Returns:
+        (x-, x+, y-, y+), dimensionless tangents, each > 0.
+    """
     fx, fy, cx, cy = camera.fx, camera.fy, camera.cx, camera.cy
     W, H = camera.width, camera.height
     tan_fovx = 0.5 * W / fx
@@ -86,7 +101,15 @@ def fov_clamp_limits(camera: Camera) -> tuple[float, float, float, float]:
 
 
 def camera_tensors(camera: Camera, like: torch.Tensor) -> tuple[torch.Tensor, torch.Tensor]:
-    """Camera (R [3, 3], t [3]) as tensors with the dtype and device of ``like``."""
+    """The camera's world-to-camera rotation and translation as tensors.
+
+    Args:
+        camera: the camera.
+        like: a tensor whose dtype and device the outputs take.
+
+    Returns:
+        (R [3, 3], t [3] in world units), x_cam = R x_world + t.
+    """
     R = torch.as_tensor(np.asarray(camera.R), dtype=like.dtype, device=like.device)
     t = torch.as_tensor(np.asarray(camera.t), dtype=like.dtype, device=like.device)
     return R, t
@@ -99,9 +122,20 @@ def project_gaussians(
     camera: Camera,
     eps2d: float = EPS2D,
 ) -> Projected:
-    """Project Gaussians (means [N, 3] world units, quats [N, 4] wxyz, scales [N, 3] world units).
+    """Project 3D Gaussians to the image plane (EWA splatting, module docstring).
 
-    Returns a :class:`Projected`; differentiable w.r.t. means, quats and scales.
+    Differentiable w.r.t. means, quats and scales; culled Gaussians get finite zeros.
+
+    Args:
+        means: [N, 3] centres, world units.
+        quats: [N, 4] orientations (w, x, y, z), any norm.
+        scales: [N, 3] standard deviations along the Gaussian's axes, world units.
+        camera: the pinhole camera.
+        eps2d: dilation added to the 2D covariance's diagonal, px^2.
+
+    Returns:
+        A [`Projected`][physgs.render.project.Projected]: means2d [N, 2] px, conics [N, 3]
+            1/px^2, depths [N] world units, cov2d [N, 3] px^2 (detached), valid [N] bool.
     """
     R, t = camera_tensors(camera, means)
     xyz = means @ R.T + t  # [N, 3] camera coordinates
@@ -152,9 +186,19 @@ def pixel_bounds(
     """Conservative pixel boxes outside which a Gaussian's alpha is below ALPHA_MIN.
 
     alpha >= 1/255 needs d^T conic d <= 2 ln(255 o); that ellipse's bounding box has half-widths
-    sqrt(2 ln(255 o) cov_xx), sqrt(2 ln(255 o) cov_yy). Inputs are numpy: means2d [N, 2] px,
-    cov2d [N, 3] px^2, opacities [N], valid [N]. Returns int64 [N, 4] (x0, x1, y0, y1) inclusive
-    pixel index ranges clipped to the image; x0 > x1 marks a Gaussian that touches no pixel.
+    sqrt(2 ln(255 o) cov_xx), sqrt(2 ln(255 o) cov_yy), widened by BOX_SLACK_PX on each side.
+
+    Args:
+        means2d: [N, 2] centres, px.
+        cov2d: [N, 3] 2D covariances (xx, xy, yy), px^2.
+        opacities: [N] in [0, 1].
+        valid: [N] bool, the projection's mask.
+        width: image width, px.
+        height: image height, px.
+
+    Returns:
+        int64 [N, 4] (x0, x1, y0, y1) inclusive pixel index ranges clipped to the image; x0 > x1
+            marks a Gaussian that touches no pixel (invalid, too faint, or off the image).
     """
     n = means2d.shape[0]
     out = np.empty((n, 4), dtype=np.int64)

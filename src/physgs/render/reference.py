@@ -27,12 +27,26 @@ def composite_reference(
     height: int,
     return_depth: bool = True,
 ):
-    """Alpha-composite projected Gaussians front to back.
+    """Alpha-composite projected Gaussians front to back, tile by tile, under autograd.
 
-    means2d [N, 2] px, conics [N, 3] 1/px^2, opacities [N], colors [N, D], depths [N] world units,
-    valid [N] bool, cov2d [N, 3] px^2 (binning only), background [D].
-    Returns (rgb [H, W, D], alpha [H, W], depth [H, W] or None), differentiable w.r.t. means2d,
-    conics, opacities, colors, depths and background.
+    Differentiable w.r.t. means2d, conics, opacities, colors, depths and background.
+
+    Args:
+        means2d: [N, 2] centres, px (pixel centres at integer + 0.5).
+        conics: [N, 3] (a, b, c) of the inverse 2D covariance, 1/px^2.
+        opacities: [N] in [0, 1].
+        colors: [N, D] in [0, 1].
+        depths: [N] camera z, world units.
+        valid: [N] bool, the projection's mask.
+        cov2d: [N, 3] 2D covariances (xx, xy, yy), px^2 (binning only).
+        background: [D] in [0, 1].
+        width: image width W, px.
+        height: image height H, px.
+        return_depth: whether to compute the expected depth.
+
+    Returns:
+        (tuple[torch.Tensor, ...]): (rgb [H, W, D], alpha [H, W], depth [H, W] world units or
+            None), the inputs' dtype.
     """
     D = colors.shape[1]
     boxes = pixel_bounds(

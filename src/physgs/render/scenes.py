@@ -39,13 +39,14 @@ def random_scene(
 def tree_scene(dataset_dir, canonical_cfg: dict | None = None, dtype=torch.float32):
     """A testbed tree's canonical Gaussians at initialisation, seen from its training camera.
 
-    dataset_dir: a testbed folder holding ``observed.npz`` (results/testbed/<tree>);
-    canonical_cfg: ``models.canonical`` of the config (opacity, color, knn, scale_factor; the
-    class defaults when None). Built exactly as every model builds its canonical set
-    (:class:`physgs.models.gaussians.CanonicalGaussians` on ``Observed.canonical_xyz``), so the
-    scene is what the first training iteration renders. Returns the tuple of
-    :func:`random_scene`: (means [N, 3], quats [N, 4], scales [N, 3], opacities [N], colors [N, 3],
-    camera, background [3]) as tensors of ``dtype``, the image the camera's size (pixels).
+    dataset_dir: a testbed folder holding ``observed.npz`` (results/testbed/<tree>); canonical_cfg:
+    ``models.canonical`` of the config (opacity, color, knn, scale_factor; the class defaults when
+    None). Built exactly as every model builds its canonical set
+    ([`CanonicalGaussians`][physgs.models.gaussians.CanonicalGaussians] on
+    ``Observed.canonical_xyz``), so the scene is what the first training iteration renders. Returns
+    the tuple of [`random_scene`][physgs.render.scenes.random_scene]: (means [N, 3], quats [N, 4],
+    scales [N, 3], opacities [N], colors [N, 3], camera, background [3]) as tensors of ``dtype``,
+    the image the camera's size (pixels).
     """
     from physgs.models.gaussians import CanonicalGaussians
     from physgs.testbed.dataset import load_observed

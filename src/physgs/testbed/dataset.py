@@ -124,6 +124,8 @@ def _seed(seed: int, *parts) -> np.random.SeedSequence:
 
 @dataclass(frozen=True)
 class TreeSim:
+    """One simulated tree: skeleton, mesh, true motion and the winds [C, L+F] m/s."""
+
     skeleton: weberpenn.Skeleton
     mesh: TreeMesh
     truth: Truth
@@ -433,7 +435,17 @@ OBSERVED_KEYS = (
 
 
 def load_observed(path: Path | str) -> Observed:
-    """Load and validate ``observed.npz`` (raises DatasetError naming the file and the fix)."""
+    """Load and validate ``observed.npz``.
+
+    Args:
+        path: the file.
+
+    Returns:
+        The [`Observed`][physgs.testbed.dataset.Observed] dataset.
+
+    Raises:
+        DatasetError: the file is missing or invalid (the message names the file and the fix).
+    """
     d = _open(path, OBSERVED_KEYS)
     C, F = len(d["conditions"]), int(d["n_train"]) + int(d["n_tail"])
     L = int(d["lead_in_frames"])
@@ -496,7 +508,17 @@ def load_observed(path: Path | str) -> Observed:
 
 
 def load_truth(path: Path | str) -> Truth:
-    """Load and validate ``truth.npz`` (raises DatasetError naming the file and the fix)."""
+    """Load and validate ``truth.npz``.
+
+    Args:
+        path: the file.
+
+    Returns:
+        The [`Truth`][physgs.testbed.dataset.Truth].
+
+    Raises:
+        DatasetError: the file is missing or invalid (the message names the file and the fix).
+    """
     keys = tuple(Truth.__dataclass_fields__)
     d = _open(path, keys)
     B = len(d["omega"])

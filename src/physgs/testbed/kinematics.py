@@ -11,11 +11,16 @@ import numpy as np
 
 
 def swing_axis(direction_deg: float) -> np.ndarray:
-    """Unit horizontal axis [3] perpendicular to the mean wind.
+    """Unit horizontal axis perpendicular to the mean wind.
 
-    The wind blows along w = (sin d, cos d, 0), d = direction_deg (degrees) measured from the
-    training camera's viewing axis (+y, camera at azimuth 0). The axis is z x w, so a positive
-    angle tilts a bone downwind.
+    The wind blows along w = (sin d, cos d, 0), d measured from the training camera's viewing axis
+    (+y, camera at azimuth 0). The axis is z x w, so a positive angle tilts a bone downwind.
+
+    Args:
+        direction_deg: d, the mean wind's direction, degrees.
+
+    Returns:
+        [3] the unit axis (world).
     """
     d = np.deg2rad(direction_deg)
     w = np.array([np.sin(d), np.cos(d), 0.0])
@@ -95,9 +100,14 @@ def pose_points(
 
 
 def pose_vertices(truth, theta_b: np.ndarray) -> np.ndarray:
-    """Mesh vertices posed by bone angles theta_b [..., B] (rad) -> [..., N, 3] (m).
+    """Mesh vertices posed by bone angles.
 
-    ``truth`` is a :class:`physgs.testbed.dataset.Truth` (or anything with its bone fields).
+    Args:
+        truth (Truth): a [`Truth`][physgs.testbed.dataset.Truth] (or anything with its bone fields).
+        theta_b: [..., B] bone angles, rad.
+
+    Returns:
+        [..., N, 3] vertex positions, m.
     """
     return pose_points(
         truth.rest_vertices,
@@ -111,8 +121,17 @@ def pose_vertices(truth, theta_b: np.ndarray) -> np.ndarray:
 
 
 def pose_gaussians(truth, theta_b: np.ndarray) -> np.ndarray:
-    """The observed Gaussians posed by bone angles theta_b [..., B] (rad) -> [..., N, 3] (m), in
-    Gaussian order (the order of ``canonical_xyz``): ``pose_vertices`` permuted by
-    ``truth.gaussian_vertex``. This is the ground-truth motion of each Gaussian (the true-motion
-    reference moves the canonical Gaussians with it)."""
+    """The observed Gaussians posed by bone angles, in Gaussian order.
+
+    ``pose_vertices`` permuted by ``truth.gaussian_vertex`` (the order of ``canonical_xyz``). This
+    is the ground-truth motion of each Gaussian (the true-motion reference moves the canonical
+    Gaussians with it).
+
+    Args:
+        truth (Truth): the dataset's ground truth.
+        theta_b: [..., B] bone angles, rad.
+
+    Returns:
+        [..., N, 3] Gaussian centres, m.
+    """
     return pose_vertices(truth, theta_b)[..., np.asarray(truth.gaussian_vertex), :]

@@ -36,6 +36,7 @@ class TreeMesh:
     n_leaves: int
 
     def to_trimesh(self) -> "trimesh.Trimesh":  # noqa: F821
+        """The mesh as a ``trimesh.Trimesh`` (vertex colours kept, vertices not merged)."""
         import trimesh  # here: ~1 s of start-up that jobs reading a dataset never need
 
         return trimesh.Trimesh(

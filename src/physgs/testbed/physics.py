@@ -15,10 +15,22 @@ import numpy as np
 def calibrate_omega(
     radius: np.ndarray, length: np.ndarray, band_hz
 ) -> tuple[np.ndarray, float, np.ndarray]:
-    """omega_b = c r_b / L_b^2 (rad/s), one c per tree, centred (geometric mean) on the band.
+    """Natural frequencies from geometry, omega_b = c r_b / L_b^2, one c per tree.
 
-    radius, length [B] (m); band_hz (lo, hi) in Hz. Returns (omega [B] rad/s clamped into the band,
-    c (rad/s * m), clamped [B] bool: bones whose raw c r/L^2 fell outside the band).
+    c centres the bones' frequencies (geometric mean of the extremes) on the band; bones that
+    still fall outside it are clamped into it.
+
+    Args:
+        radius: [B] bone radii, m.
+        length: [B] bone lengths, m.
+        band_hz (tuple[float, float]): (lo, hi), Hz, 0 < lo < hi.
+
+    Returns:
+        (omega [B] rad/s clamped into the band, c in rad/s * m, clamped [B] bool: the bones whose
+            raw c r / L^2 fell outside the band).
+
+    Raises:
+        ValueError: the band is not 0 < lo < hi.
     """
     lo, hi = (2 * np.pi * float(f) for f in band_hz)
     if not 0 < lo < hi:
@@ -32,7 +44,18 @@ def calibrate_omega(
 
 
 def foh_matrices(omega: np.ndarray, zeta: np.ndarray, dt: float):
-    """Exact step matrices for a piecewise-linear input: Phi [B,2,2], G0 [B,2], G1 [B,2]."""
+    """Exact one-step matrices of each oscillator under a piecewise-linear input (Van Loan).
+
+    x_{k+1} = Phi x_k + G0 u_k + G1 (u_{k+1} - u_k) / dt, x = (theta, theta').
+
+    Args:
+        omega: [B] natural frequencies, rad/s.
+        zeta: [B] damping ratios.
+        dt: the step, s.
+
+    Returns:
+        (tuple[np.ndarray, ...]): (Phi [B, 2, 2], G0 [B, 2], G1 [B, 2]), float64.
+    """
     B = len(omega)
     M = np.zeros((B, 4, 4))
     M[:, 0, 1] = 1.0
@@ -49,11 +72,17 @@ def foh_matrices(omega: np.ndarray, zeta: np.ndarray, dt: float):
 def simulate(
     omega: np.ndarray, zeta: np.ndarray, u: np.ndarray, dt: float, x0: np.ndarray | None = None
 ) -> np.ndarray:
-    """Exact response of each oscillator to its forcing.
+    """Exact response of each oscillator to its forcing (first-order hold).
 
-    omega [B] rad/s, zeta [B], u [..., T, B] forcing (rad/s^2) at samples t_k = k dt (dt seconds),
-    linear between samples; x0 [..., B, 2] initial (theta, theta') or rest. Returns theta [..., T, B]
-    (rad), theta[..., k, :] at sample k.
+    Args:
+        omega: [B] natural frequencies, rad/s.
+        zeta: [B] damping ratios (or a scalar).
+        u: [..., T, B] forcing, rad/s^2, at samples t_k = k dt, linear between samples.
+        dt: seconds between samples.
+        x0: [..., B, 2] initial (theta rad, theta' rad/s); None: rest.
+
+    Returns:
+        theta [..., T, B], rad; theta[..., k, :] at sample k.
     """
     omega = np.asarray(omega, float)
     zeta = np.broadcast_to(np.asarray(zeta, float), omega.shape)
@@ -73,11 +102,19 @@ def simulate(
 def periodic_steady_state(
     omega: np.ndarray, zeta: np.ndarray, u_period: np.ndarray, dt: float
 ) -> np.ndarray:
-    """State (theta, theta') [..., B, 2] at sample 0 of the periodic steady state.
+    """State at sample 0 of the periodic steady state (the infinite-past response).
 
-    u_period [..., P+1, B]: one full period of the forcing (sample P equals sample 0). From rest the
-    state after one period is r; the steady state solves x = Phi^P x + r exactly, so a simulation
-    started there carries no start transient at all (the infinite-past response).
+    From rest the state after one period is r; the steady state solves x = Phi^P x + r exactly, so a
+    simulation started there carries no start transient at all.
+
+    Args:
+        omega: [B] natural frequencies, rad/s.
+        zeta: [B] damping ratios (or a scalar).
+        u_period: [..., P+1, B] one full period of the forcing, rad/s^2 (sample P equals sample 0).
+        dt: seconds between samples.
+
+    Returns:
+        [..., B, 2] (theta rad, theta' rad/s).
     """
     P = u_period.shape[-2] - 1
     Phi, _, _ = foh_matrices(
@@ -103,10 +140,28 @@ def _final_state(omega, zeta, u, dt) -> np.ndarray:
 
 
 def drag_forcing(wind: np.ndarray, vbar: np.ndarray) -> np.ndarray:
-    """Unit-gain drag forcing v^2 - vbar^2 (m^2/s^2): wind [C, T] m/s, vbar [C] m/s -> [C, T]."""
+    """Unit-gain drag forcing v^2 - vbar^2.
+
+    Args:
+        wind: [C, T] wind speed per condition, m/s.
+        vbar: [C] each condition's mean speed, m/s.
+
+    Returns:
+        [C, T] forcing, m^2/s^2.
+    """
     return wind**2 - np.asarray(vbar)[:, None] ** 2
 
 
 def lead_in_frames(omega_min: float, zeta: float, lead_in_tau: float, fps: int) -> int:
-    """Frames of lead-in: ceil(lead_in_tau * tau_max * fps), tau_max = 1 / (zeta omega_min) s."""
+    """Frames of lead-in, ceil(lead_in_tau * tau_max * fps) with tau_max = 1 / (zeta omega_min).
+
+    Args:
+        omega_min: the slowest natural frequency, rad/s.
+        zeta: the damping ratio.
+        lead_in_tau: lead-in length in units of the slowest decay time tau_max.
+        fps: frames per second.
+
+    Returns:
+        The lead-in, frames.
+    """
     return int(np.ceil(lead_in_tau / (zeta * omega_min) * fps))

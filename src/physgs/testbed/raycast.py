@@ -16,6 +16,12 @@ class RayBundle:
     """Primary rays of one camera, cached across frames: origins, dirs [H*s*W*s, 3]."""
 
     def __init__(self, camera: Camera, supersample: int):
+        """Cast the camera's primary rays once.
+
+        Args:
+            camera: the camera.
+            supersample: s, rays per pixel side (s x s per pixel).
+        """
         o, d = camera.rays(supersample)
         self.camera, self.s = camera, int(supersample)
         self.origins = o.reshape(-1, 3)

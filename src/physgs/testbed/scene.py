@@ -1,14 +1,14 @@
 """Cameras that frame the tree: every camera on one horizontal orbit (one distance, one height)
 about the vertical line through the centre of the tree's swept extent, looking horizontally.
 
-Framing (``testbed.fill_height``): the swept extent (every posed vertex over every recorded frame
-of every condition) spans exactly ``fill_height`` of the training camera's image height. The field
-of view stays as configured; the camera moves (distance D from the orbit axis, height h). The
-training view is centred vertically where every held-out view allows it; where a held-out view
-would clip (a branch nearer to that camera projects higher), h shifts just enough to keep it in.
-Every camera, training and held-out, must see the whole swept extent at least ``margin_px`` pixels
-inside its border, or :class:`FramingError` names ``testbed.fill_height`` and the largest value
-that fits.
+Framing (``testbed.fill_height``): the swept extent (every posed vertex over every recorded frame of
+every condition) spans exactly ``fill_height`` of the training camera's image height. The field of
+view stays as configured; the camera moves (distance D from the orbit axis, height h). The training
+view is centred vertically where every held-out view allows it; where a held-out view would clip (a
+branch nearer to that camera projects higher), h shifts just enough to keep it in. Every camera,
+training and held-out, must see the whole swept extent at least ``margin_px`` pixels inside its
+border, or [`FramingError`][physgs.testbed.scene.FramingError] names ``testbed.fill_height`` and the
+largest value that fits.
 """
 
 from __future__ import annotations

@@ -165,10 +165,19 @@ def calm_frames(tr: Transient, fps: int) -> tuple[int, int]:
 
 
 def lead_in_frames(omega: np.ndarray, zeta: np.ndarray, lead_in_tau: float, fps: int) -> int:
-    """Lead-in frames from the slowest-decaying bone: ceil(lead_in_tau / min(zeta_b omega_b) fps).
+    """Lead-in frames from the slowest-decaying bone, ceil(lead_in_tau / min(zeta_b omega_b) fps).
 
-    omega [B] rad/s, zeta [B]. For a constant zeta this is exactly
-    ``physics.lead_in_frames(omega.min(), zeta, ...)`` (same operands, same rounding).
+    For a constant zeta this is exactly ``physics.lead_in_frames(omega.min(), zeta, ...)`` (same
+    operands, same rounding).
+
+    Args:
+        omega: [B] natural frequencies, rad/s.
+        zeta: [B] damping ratios.
+        lead_in_tau: lead-in length in units of the slowest decay time 1 / (zeta_b omega_b).
+        fps: frames per second.
+
+    Returns:
+        The lead-in, frames.
     """
     from physgs.testbed import physics  # torch: the workflow imports this module to plan jobs
 

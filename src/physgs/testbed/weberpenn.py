@@ -6,10 +6,11 @@ parent with down-angle and phyllotactic rotation, lengths from the shape ratio, 
 Units: metres and degrees in the preset, metres and radians inside. World frame: z up, the trunk
 base at the origin.
 
-Exact bone counts: the number of stems per level is fixed by the preset (``stems``) and spread
-over the parent stems in proportion to their length (largest remainder, no random splits), so
-bones = sum over armature levels of stems x ceil(curve_res / bone_step). The generator counts the
-bones it actually built and stops with :class:`PresetError` if that differs from ``bones``.
+Exact bone counts: the number of stems per level is fixed by the preset (``stems``) and spread over
+the parent stems in proportion to their length (largest remainder, no random splits), so bones = sum
+over armature levels of stems x ceil(curve_res / bone_step). The generator counts the bones it
+actually built and stops with [`PresetError`][physgs.testbed.weberpenn.PresetError] if that differs
+from ``bones``.
 
 Split clones (``split``) vary per clone as Weber-Penn stems do: ``length_v`` scales each clone's
 length by 1 + U(-length_v, length_v) and ``curve_v_deg`` sets its random bend (default: the trunk
@@ -87,6 +88,7 @@ class Stem:
 
     @property
     def length(self) -> float:
+        """The polyline's length, m."""
         return float(np.linalg.norm(np.diff(self.points, axis=0), axis=1).sum())
 
     def radius_at(self, z: np.ndarray | float) -> np.ndarray:
@@ -112,6 +114,7 @@ class Skeleton:
 
     @property
     def n_bones(self) -> int:
+        """The number of bones, B."""
         return int(self.head.shape[0])
 
 

@@ -199,8 +199,15 @@ def fit_tracks(
 ) -> TrackFit:
     """Fit K oscillators to the tracks of the trained conditions.
 
-    tracks: one ``Tracks`` per trained condition, over the training window's T frames;
-    conditions: their condition indices (into wind); wind [C, L+F] m/s observed (lead-in first).
+    Args:
+        tracks: one ``Tracks`` per trained condition, over the training window's T frames.
+        conditions: their condition indices (into ``wind``).
+        wind: [C, L+F] observed wind, m/s (lead-in first).
+        osc: the oscillators' settings (bounds, substeps, parts).
+        settings: the fit's settings.
+
+    Returns:
+        The [`TrackFit`][physgs.tracks.fit.TrackFit].
     """
     t_start = time.perf_counter()
     if len(tracks) != len(conditions) or not tracks:
@@ -301,8 +308,17 @@ def fit_tracks(
 
 
 def part_theta(fit: TrackFit, osc: Oscillators, wind) -> np.ndarray:
-    """[K, L+F] rad: the fitted parts' angles under one condition's wind [L+F] m/s; parts with no
-    estimate are 0 (the matcher leaves a constant row untrusted)."""
+    """The fitted parts' angles under one condition's wind.
+
+    Args:
+        fit: the track fit.
+        osc: the oscillators' settings the fit used.
+        wind (np.ndarray): [L+F] the condition's observed wind, m/s, lead-in first.
+
+    Returns:
+        [K, L+F] angles, rad; parts with no estimate are 0 (the matcher leaves a constant row
+            untrusted).
+    """
     with torch.no_grad():
         th = osc.theta(torch.as_tensor(fit.omega), torch.as_tensor(fit.zeta), torch.as_tensor(wind))
     th = th.numpy().copy()

@@ -33,9 +33,11 @@ class TracksRecovery:
 
     @property
     def n_no_estimate(self) -> int:
+        """The number of parts without an estimate."""
         return int(self.no_estimate.size)
 
     def to_dict(self) -> dict:
+        """The tracks control's summary: match scores, median zeta, the parts' track counts."""
         m = self.record.match
         return {
             "n_parts": int(m.n_parts),

@@ -1,6 +1,6 @@
 """The tracks control's jobs as the Snakemake rules call them (``workflow/rules/tracks.smk``).
 
-- rule ``track`` calls :func:`physgs.tracks.track.track_condition` (one condition's
+- rule ``track`` calls [`track_condition`][physgs.tracks.track.track_condition] (one condition's
   training-camera video, observed only), whose module imports no torch;
 - ``fit_job``: rule ``fit_tracks``, the oscillators of one configuration fitted to its tracks
   (observed wind only), refusing a K above the tracks it can group, with the key named;

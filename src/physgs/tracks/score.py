@@ -75,6 +75,7 @@ class TrackerScore:
     median_start_px: float
 
     def to_dict(self) -> dict:
+        """The score as a plain dict (field name -> value)."""
         return asdict(self)
 
 

@@ -35,8 +35,15 @@ def condition_indices(spec: str, n_conditions: int) -> list[int]:
 
 
 def parts(cfg: dict, config: str) -> tuple[int, str]:
-    """(K, the config key that sets it) of the tracks control in configuration ``config``:
-    ``models/configs/<config>/K``, or ``tracks/K`` when that overrides it."""
+    """The tracks control's K in configuration ``config``, and the key that sets it.
+
+    Args:
+        cfg: the resolved config.
+        config: a configuration name.
+
+    Returns:
+        (K, the config key): ``models/configs/<config>/K``, or ``tracks/K`` when that overrides it.
+    """
     k = cfg["tracks"]["K"]
     if k == SAME_K:
         return int(cfg["models"]["configs"][config]["K"]), f"models/configs/{config}/K"
@@ -59,9 +66,20 @@ def fields_scored(cfg: dict, config: str, testbed: str) -> list[str]:
 
 
 def fit_job(cfg: dict, config: str, seed: int) -> dict:
-    """The params of one fit: K and its key, the conditions fitted (indices), FitSettings' other
-    fields (lr = ``train.lr.physics``, k-means seed = the training seed) and ours' oscillator
-    settings."""
+    """The params of one track fit.
+
+    Args:
+        cfg: the resolved config.
+        config: a configuration name (one of ``tracks.configs``).
+        seed: the training seed (the k-means seed).
+
+    Returns:
+        K and its key, the conditions fitted (indices), FitSettings' other fields (lr =
+            ``train.lr.physics``) and ours' oscillator settings.
+
+    Raises:
+        ValueError: the configuration is not one of ``tracks.configs``.
+    """
     if config not in cfg["tracks"]["configs"]:
         raise ValueError(
             f"configuration {config!r} is not one of tracks/configs {cfg['tracks']['configs']}"

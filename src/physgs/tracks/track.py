@@ -66,6 +66,12 @@ class TrackSettings:
     lk_eps: float = 0.01
 
     def __post_init__(self):
+        """Check the settings.
+
+        Raises:
+            ValueError: an unknown ``reference``, an even or too small ``win_px``, or a non-positive
+                ``fb_max_px``, ``reseed_every`` or ``max_tracks``.
+        """
         if self.reference not in ("seed", "previous"):
             raise ValueError(
                 f"tracks.reference must be 'seed' or 'previous', got {self.reference!r}"
@@ -79,6 +85,7 @@ class TrackSettings:
             )
 
     def to_dict(self) -> dict:
+        """The settings as a plain dict (field name -> value)."""
         return asdict(self)
 
 
@@ -94,6 +101,7 @@ class Tracks:
 
     @property
     def n_tracks(self) -> int:
+        """The number of tracks, P."""
         return int(self.xy.shape[0])
 
     def length(self) -> np.ndarray:

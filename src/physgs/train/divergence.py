@@ -1,11 +1,12 @@
 """Divergence checks for the training loop: stop a run whose fit has blown up, and say why.
 
-A learning rate far too high does not always give a NaN loss: Adam moves every parameter by
-about the learning rate per step, so at 1e6 a field's Gaussians fly millions of metres away (the
-render shows only background, a finite loss) and ours' bounded oscillators spin chaotically in
-place. :class:`DivergenceGuard` is a pure checker on numpy arrays and floats, built from the
-canonical positions and the initial parameters; the loop feeds it every iteration and turns a
-:class:`Divergence` into a ``TrainingError`` naming the model, the iteration and the setting.
+A learning rate far too high does not always give a NaN loss: Adam moves every parameter by about
+the learning rate per step, so at 1e6 a field's Gaussians fly millions of metres away (the render
+shows only background, a finite loss) and ours' bounded oscillators spin chaotically in place.
+[`DivergenceGuard`][physgs.train.divergence.DivergenceGuard] is a pure checker on numpy arrays and
+floats, built from the canonical positions and the initial parameters; the loop feeds it every
+iteration and turns a [`Divergence`][physgs.train.divergence.Divergence] into a ``TrainingError``
+naming the model, the iteration and the setting.
 
 Three checks, each cheap next to a render:
 

@@ -71,15 +71,32 @@ def train_model(
     Each iteration draws (seeded) one condition from ``conditions`` and one recorded frame
     j < n_train, renders the model at the training camera and steps Adam on
     (1 - w) L1 + w D-SSIM. The first ``warmup`` iterations render the canonical Gaussians only
-    (the shared static warm-up). Raises TrainingError naming the model, the iteration and the
-    likely ``train.lr`` setting if the loss turns NaN or inf, if the fit diverges (non-finite or
-    exploding parameters, Gaussians far outside the scene, a loss far above its warm-up level:
-    ``physgs.train.divergence``), or if the model's forward pass raises (chained).
+    (the shared static warm-up).
 
-    frame_pool: recorded-frame indices (< n_train) to draw from instead of all of them (K
-    selection holds some out). on_iteration: a hook on_iteration(it, model, optimizer) -> dict |
-    None, or a list of them called in order, before each iteration; the dicts they return are
-    merged into the statistics (freezing, the search over omega).
+    Args:
+        model: the model to train (in place).
+        observed (Observed): the testbed's observed dataset.
+        train_cfg: config ``train`` (iterations, warmup, lr, loss weights, ...).
+        conditions: condition indices to draw from.
+        seed: seeds the draws of conditions and frames.
+        name: the name progress and errors use; None: the model's.
+        progress: show a progress bar.
+        frame_pool (np.ndarray | None): recorded-frame indices (< n_train) to draw from instead of
+            all of them (K selection holds some out).
+        on_iteration (Callable | list | None): a hook ``on_iteration(it, model, optimizer) -> dict |
+            None``, or a list of them called in order, before each iteration; the dicts they return
+            are merged into the statistics (freezing, the search over omega).
+
+    Returns:
+        The [`TrainResult`][physgs.train.loop.TrainResult]: the model in eval mode, its statistics
+            and the per-iteration loss log.
+
+    Raises:
+        ValueError: warmup outside [0, iterations), conditions or frame_pool out of range.
+        TrainingError: the loss turns NaN or inf, the fit diverges (non-finite or exploding
+            parameters, Gaussians far outside the scene, a loss far above its warm-up level:
+            ``physgs.train.divergence``), or the model's forward pass raises (chained); it names the
+            model, the iteration and the likely ``train.lr`` setting.
     """
     name = name or model.name
     iterations, warmup = int(train_cfg["iterations"]), int(train_cfg["warmup"])

@@ -55,7 +55,7 @@ def _tile_matrix(tile: int, size: int, sigma: float, dtype, device) -> torch.Ten
 
 def _blur_rows_tiled(z: torch.Tensor, size: int, sigma: float) -> torch.Tensor:
     """Zero-padded 1D Gaussian blur of z [..., H, W] along H, BLUR_TILE output rows at a time:
-    the same sums as the banded matrix of :func:`_blur_matrix`, without its zeros."""
+    the same sums as the banded matrix of ``_blur_matrix``, without its zeros."""
     H, r = z.shape[-2], size // 2
     n_tiles = -(-H // BLUR_TILE)
     zp = F.pad(z, (0, 0, r, n_tiles * BLUR_TILE - H + r))  # [..., tiles*TILE + size-1, W]
@@ -66,9 +66,19 @@ def _blur_rows_tiled(z: torch.Tensor, size: int, sigma: float) -> torch.Tensor:
 
 
 def blur(z: torch.Tensor, size: int = 11, sigma: float = 1.5, tiled: bool | None = None):
-    """Zero-padded separable Gaussian blur of z [..., H, W] (window ``size``, ``sigma`` in
-    pixels), as SSIM's window: banded matmuls, or block-Toeplitz tiles from
-    ``TILED_BLUR_MIN_SIDE`` pixels (``tiled`` forces either)."""
+    """Zero-padded separable Gaussian blur, as SSIM's window.
+
+    Runs as banded matmuls, or as block-Toeplitz tiles from ``TILED_BLUR_MIN_SIDE`` pixels.
+
+    Args:
+        z: [..., H, W] maps.
+        size: window side, px.
+        sigma: the Gaussian's standard deviation, px.
+        tiled: force the tiled (True) or the matmul (False) path; None: by size.
+
+    Returns:
+        (torch.Tensor): [..., H, W] the blurred maps.
+    """
     H, W = z.shape[-2:]
     if tiled is None:
         tiled = min(H, W) >= TILED_BLUR_MIN_SIDE
@@ -81,9 +91,23 @@ def blur(z: torch.Tensor, size: int = 11, sigma: float = 1.5, tiled: bool | None
 
 
 def ssim(a: torch.Tensor, b: torch.Tensor, window: int = 11, sigma: float = 1.5) -> torch.Tensor:
-    """Mean SSIM of images a, b [H, W, C] in [0, 1] (Gaussian 11x11 window, sigma 1.5, zero
-    padding: the 3DGS implementation), differentiable w.r.t. both; the window's separable blur
-    runs as two banded matmuls, or in tiles on large images (:func:`blur`)."""
+    """Mean SSIM of two images (the 3DGS implementation: Gaussian window, zero padding).
+
+    Differentiable w.r.t. both; the window's separable blur runs as two banded matmuls, or in tiles
+    on large images ([`blur`][physgs.train.losses.blur]).
+
+    Args:
+        a: [H, W, C] image in [0, 1].
+        b: [H, W, C] image in [0, 1].
+        window: window side, px.
+        sigma: the window's standard deviation, px.
+
+    Returns:
+        0-d tensor, the mean SSIM over pixels and channels.
+
+    Raises:
+        ValueError: the images are not [H, W, C] of one shape.
+    """
     if a.shape != b.shape or a.ndim != 3:
         raise ValueError(
             f"ssim: images must share shape [H, W, C]; got {tuple(a.shape)}, {tuple(b.shape)}"

@@ -1,9 +1,9 @@
 """Seed every global random source from a job's seed, before its model is built.
 
-A model's initial weights come partly from global state: ``torch.nn.Linear`` draws its weights
-from torch's default generator, whose starting seed differs per process. Calling
-:func:`seed_everything` with the job's seed before building the model makes the same job give
-bitwise-equal weights (and checkpoints) in any process.
+A model's initial weights come partly from global state: ``torch.nn.Linear`` draws its weights from
+torch's default generator, whose starting seed differs per process. Calling
+[`seed_everything`][physgs.train.seeding.seed_everything] with the job's seed before building the
+model makes the same job give bitwise-equal weights (and checkpoints) in any process.
 
 This pins only what reads global state. Library code should still take explicit seeds or
 generators (``np.random.default_rng(seed)``, scikit-learn's ``random_state``): k-means and the
