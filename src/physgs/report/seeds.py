@@ -18,6 +18,14 @@ UNDECIDED = r"$^{\dagger}$"  # .tex mark of a difference whose interval contains
 
 
 def finite(values: Sequence[float]) -> np.ndarray:
+    """The finite values of ``values``, flattened, as float64.
+
+    Args:
+        values (Sequence[float]): per-seed values; NaN and infinity are dropped.
+
+    Returns:
+        np.ndarray: the finite values, ``[n]``.
+    """
     return np.asarray([x for x in np.asarray(values, dtype=np.float64).ravel() if np.isfinite(x)])
 
 

@@ -29,12 +29,23 @@ TRACKS_LABEL = r"\emph{2D tracks}"
 
 @dataclass(frozen=True)
 class Table:
+    """A built table: its name, its numbers and its booktabs LaTeX."""
+
     name: str
     df: pd.DataFrame  # flat, numeric columns at full precision
     tex: str
 
 
 def tree_label(tree: str, bones: int) -> str:
+    """A tree's row label, ``Sparse (22 bones)``.
+
+    Args:
+        tree (str): the tree's name.
+        bones (int): its animated bones.
+
+    Returns:
+        str: the label.
+    """
     return f"{tree.capitalize()} ({bones} bones)"
 
 

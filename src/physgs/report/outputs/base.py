@@ -81,6 +81,14 @@ class Plan:
 
     @classmethod
     def from_config(cls, cfg: dict) -> Plan:
+        """The plan of a resolved config.
+
+        Args:
+            cfg (dict): the resolved config (``physgs.config.load``).
+
+        Returns:
+            Plan: its trees, configurations, seeds and study settings.
+        """
         from physgs.config import study_seeds
         from physgs.tracks.settings import fields_scored
         from physgs.tracks.settings import parts as tracks_k
@@ -135,6 +143,7 @@ class Output:
     in_report: Callable[[Plan], bool] = lambda plan: True
 
     def __post_init__(self):
+        """Refuse an unknown kind or seed scope, naming the output."""
         if self.kind not in ("table", "figure"):
             raise ValueError(f"output {self.name!r}: kind must be table or figure")
         if self.seeds not in SEEDS:
