@@ -3,7 +3,7 @@
     python benchmarks/kselect.py --profile default results/testbed/sparse/observed.npz [...]
 
 Prints one row per candidate K (training + scoring seconds, held-out PSNR, BIC, frozen parts)
-and the total per tree. Budget (issue 6): quick well under a minute per tree; default all three
+and the total per tree. Budget: quick well under a minute per tree; default all three
 trees within about 5 minutes on 2 cores.
 """
 

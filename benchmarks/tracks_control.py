@@ -1,4 +1,4 @@
-"""The 2D-track control (issue 29) on the built testbeds, outside the pipeline (the pipeline's
+"""The 2D-track control on the built testbeds, outside the pipeline (the pipeline's
 rules: workflow/rules/tracks.smk, docs/tracks.md).
 
     python benchmarks/tracks_control.py [--trees sparse,medium,dense] [--K 32] [--seed 0]

@@ -1,4 +1,4 @@
-"""The forcing-free methods' ledger claims (issue 42) follow the direction of their values."""
+"""The forcing-free methods' ledger claims follow the direction of their values."""
 
 from __future__ import annotations
 

@@ -1,4 +1,4 @@
-"""Numerics at the extremes (issue 6): damping, step size, wind, K, precision, degenerate matches.
+"""Numerics at the extremes: damping, step size, wind, K, precision, degenerate matches.
 
 Oracles are independent of the solver: scipy.signal.lsim (exact first-order-hold solution by
 matrix exponential, float64) and closed-form step responses. Bounds are derived in each test.

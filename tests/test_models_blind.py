@@ -1,4 +1,4 @@
-"""Ours with a learned forcing (physgs.models.blind, issue 42): the convolution against ours'
+"""Ours with a learned forcing (physgs.models.blind): the convolution against ours'
 integrator, the forcing's fixed scale, recovery of a known forcing's shape on a small scene,
 no forcing beyond the window, and the wind never read (NaN wind, same model)."""
 

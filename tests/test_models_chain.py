@@ -162,7 +162,7 @@ def test_zero_angles_leave_the_gaussians_exactly_in_place():
 
 def test_registry_variants_train_like_ours_but_stay_out_of_the_tables():
     cfg = quick_models_cfg()
-    # the chained prior is a method of every table (issue 40); the topology variant a study's
+    # the chained prior is a method of every table; the topology variant a study's
     assert "ours_chain" in MODEL_NAMES and "ours_topo" not in MODEL_NAMES
     assert all(m in MODEL_NAMES for m, _ in training_jobs(cfg["configs"]))
     assert spec_of("ours_chain").chain and spec_of("ours_topo").parts == "topology"

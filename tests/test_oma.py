@@ -1,4 +1,4 @@
-"""Output-only modal analysis as a method of the pipeline (issue 42): flow channels against a
+"""Output-only modal analysis as a method of the pipeline: flow channels against a
 known image shift, the mode-to-part rule against constructed shapes, bad settings refused at
 config load naming the key, and the identification reading the frames only (never the wind)."""
 

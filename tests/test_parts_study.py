@@ -1,4 +1,4 @@
-"""The parts study (issue 28): segmentation records, tab_parts, its ledger claims, its config
+"""The parts study: segmentation records, tab_parts, its ledger claims, its config
 check and its place in the job plan."""
 
 from __future__ import annotations

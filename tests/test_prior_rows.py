@@ -1,4 +1,4 @@
-"""The chained prior as a method of every table (issue 40): a model joins the outputs of its
+"""The chained prior as a method of every table: a model joins the outputs of its
 registry role, its recovery rows stand beside ours' against the same null, and its headline
 claims point the right way on constructed tables."""
 

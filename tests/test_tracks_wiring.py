@@ -1,4 +1,4 @@
-"""The 2D-track control as a method of the pipeline (issue 29): its config, its files, its rows in
+"""The 2D-track control as a method of the pipeline: its config, its files, its rows in
 tab_null / tab_damping, tab_tracks, its ledger claims, what its outputs read, and its rules' plan
 (the tracker and the fit never read truth.npz)."""
 

@@ -1,4 +1,4 @@
-# Evaluation (SPEC section 4): every split of one trained model, scored through the rasterizer.
+# Evaluation (the protocol, section 4): every split of one trained model, scored through the rasterizer.
 # Reads the ground truth only for branch-tip trajectories; never feeds anything back to training.
 
 

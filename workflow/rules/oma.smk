@@ -1,4 +1,4 @@
-# Output-only modal analysis (issue 42, docs/blind.md): SSI-cov of the training video's dense flow.
+# Output-only modal analysis (docs/blind.md): SSI-cov of the training video's dense flow.
 # `oma_identify` reads observed.npz's frames only (never the wind); `oma_recovery` and
 # `fig_stabilisation` read the truth (the matcher's bones; the true frequencies drawn).
 

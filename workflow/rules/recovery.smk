@@ -1,4 +1,4 @@
-# Recovery (SPEC section 4): match an oscillator prior's parts to bones by trajectory (ours and the
+# Recovery (the protocol, section 4): match an oscillator prior's parts to bones by trajectory (ours and the
 # parts study's variants), against an untrained null.
 # The null control is keyed by K and seed: configurations sharing a K share one null, and each
 # training seed draws its own (paired with that seed's trained model in tab_null).

@@ -1,4 +1,4 @@
-# The speed-accuracy trade (SPEC section 5): one knob at a time away from the profile's settings,
+# The speed-accuracy trade (the protocol, section 5): one knob at a time away from the profile's settings,
 # ours on one tree, trained by the tables' recipe; `snakemake --cores 2 speed_accuracy`.
 
 

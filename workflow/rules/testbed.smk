@@ -1,4 +1,4 @@
-# The synthetic testbed (SPEC section 1): per tree, the dataset (observed.npz for models,
+# The synthetic testbed (the protocol, section 1): per tree, the dataset (observed.npz for models,
 # truth.npz for evaluation only) and a figure. `snakemake --cores 2 testbed` builds all trees.
 
 

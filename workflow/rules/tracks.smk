@@ -1,4 +1,4 @@
-# The 2D-track control (issue 29, docs/tracks.md): ours' oscillators fitted to point tracks of the
+# The 2D-track control (docs/tracks.md): ours' oscillators fitted to point tracks of the
 # training video instead of to pixels, so the physics and the renderer are told apart. `track` and
 # `fit_tracks` read observed.npz only, like every training rule; `tracks_evaluate` reads the truth
 # (the tracker's error, recovery beside ours' null, motion beyond the window and under unseen wind).

@@ -1,4 +1,4 @@
-"""Evaluation of a reconstruction through a render callback (SPEC section 4).
+"""Evaluation of a reconstruction through a render callback (the protocol, section 4).
 
 Modules: ``metrics`` (PSNR, silhouette centroids), ``splits`` (view / time / transfer splits,
 ``evaluate``), ``trajectories`` (branch-tip paths in pixels), ``adapter`` (render/means callbacks

@@ -1,4 +1,4 @@
-"""Evaluation splits (SPEC section 4): view, time, transfer, plus per-frame curves.
+"""Evaluation splits (the protocol, section 4): view, time, transfer, plus per-frame curves.
 
 The evaluation never sees a model class: it calls a render callback
 ``render_fn(frame_idx, condition, camera) -> (rgb [H, W, 3] float in [0, 1], alpha [H, W])``

@@ -1,6 +1,6 @@
 """How few parts the chained prior needs: the smallest K at which it matches the paper's prior.
 
-"Model only what a scene requires" (issue 28): the chained prior (``ours_chain``) is trained at
+"Model only what a scene requires": the chained prior (``ours_chain``) is trained at
 each smaller K of ``parts_study.k_candidates`` by the one recipe (``physgs.experiments.recipe.fit``,
 the profile's budget, the training frames minus every ``train.holdout_every``-th, as every
 training job of the pipeline), and scored on the held-out training-window frames at the training

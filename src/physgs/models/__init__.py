@@ -1,7 +1,7 @@
 """Models: the canonical Gaussian set and its deformations (static, learned fields, ours), and the
 true-motion reference (truth_motion, the ceiling).
 
-The package's names load on first use (lazy_loader, SPEC 1): the workflow imports the registry's
+The package's names load on first use (lazy_loader: planning imports no torch): the workflow imports the registry's
 model ids to plan jobs, and a dry run should not pay torch's start-up (seconds per Snakemake call)."""
 
 import lazy_loader

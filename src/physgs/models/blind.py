@@ -1,4 +1,4 @@
-"""Ours with a forcing learned from the video instead of the measured wind (issue 42).
+"""Ours with a forcing learned from the video instead of the measured wind.
 
 Every part keeps ours' oscillator (omega_p, zeta_p, gain_p, axis, pivot, rigid rotation); the
 drive gain_p * (v(t)^2 - vbar^2) of the observed wind is replaced by gain_p * f(t), one series

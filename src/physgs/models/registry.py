@@ -59,7 +59,7 @@ MODELS: dict[str, ModelSpec] = {
     "d3dgs": ModelSpec("Deformable-3DGS", "no wind", "d3dgs", False, "field"),
     "d3dgs_wind": ModelSpec("Deformable-3DGS + wind", r"+\,wind", "d3dgs", True, "field"),
     "ours": ModelSpec("Ours", "Ours", "ours", True, "prior"),
-    # this project's prior, not the paper's (issue 28/40): parts cut along the tree, each
+    # this project's prior, not the paper's : parts cut along the tree, each
     # part's transform composed with its parent's, omega searched before the descent
     "ours_chain": ModelSpec(
         "Chained prior (this project)",
@@ -72,16 +72,16 @@ MODELS: dict[str, ModelSpec] = {
     ),
 }
 MODEL_NAMES = tuple(MODELS)
-#: Variants of the oscillator prior (issue 28) studied beside ours in tab_parts only:
+#: Variants of the oscillator prior studied beside ours in tab_parts only:
 #: topology-aware parts (physgs.models.topology) without the chain. Ids of their own, not
 #: options of ``ours``, so one run can train them side by side under one recipe (``job_spec``/
 #: ``fit`` treat every model of family "ours" alike). Kept out of MODELS: every table and the
-#: job plan iterate MODELS (the chained variant graduated there: issue 40).
+#: job plan iterate MODELS (the chained variant is one of them).
 PRIOR_VARIANTS: dict[str, ModelSpec] = {
     "ours_topo": ModelSpec(
         "Ours, topology parts", "topology", "ours", True, "prior", parts="topology"
     ),
-    # issue 42: ours with a learned forcing shared by every part instead of the measured wind
+    # ours with a learned forcing shared by every part instead of the measured wind
     # (physgs.models.blind); trained in `single` only (one window, one forcing)
     "ours_blind": ModelSpec(
         "Ours, learned forcing", "blind", "ours", False, "prior", forcing="learned"

@@ -1,1 +1,1 @@
-"""Output-only modal analysis of the training video (issue 42, docs/blind.md)."""
+"""Output-only modal analysis of the training video (docs/blind.md)."""

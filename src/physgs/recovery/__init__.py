@@ -1,4 +1,4 @@
-"""Parameter recovery against ground truth and null controls (SPEC section 4).
+"""Parameter recovery against ground truth and null controls (the protocol, section 4).
 
 Modules: ``matcher`` (part-to-bone matching by trajectory correlation), ``null`` (untrained
 null control, nearest-bone gap), ``damping`` (zeta_hat, gamma_hat), ``damping_scores`` (zeta_hat

@@ -1,4 +1,4 @@
-"""Match learned parts to ground-truth bones by trajectory correlation (SPEC section 4).
+"""Match learned parts to ground-truth bones by trajectory correlation (the protocol, section 4).
 
 Both a part and a bone solve the same oscillator under the same forcing, so a part that
 recovered its bone reproduces the bone's theta(t); the match reads omega off that bone.
@@ -10,7 +10,7 @@ from dataclasses import asdict, dataclass
 
 import numpy as np
 
-TRUST_THRESHOLD = 0.7  # |corr| at or above which a match is trusted (paper, SPEC)
+TRUST_THRESHOLD = 0.7  # |corr| at or above which a match is trusted (the paper and the protocol)
 
 
 def training_window(theta: np.ndarray, lead_in_frames: int, n_train: int) -> np.ndarray:

@@ -1,4 +1,4 @@
-"""Untrained null control for frequency recovery (SPEC section 4).
+"""Untrained null control for frequency recovery (the protocol, section 4).
 
 Draw omega log-uniformly over the ground-truth range, keep zeta at the model's initial value,
 integrate with the model's own solver under the same observed wind, and push the result

@@ -1,4 +1,4 @@
-"""The ledger's headline claims repeated for a prior other than the paper's (issue 40): the
+"""The ledger's headline claims repeated for a prior other than the paper's: the
 chained prior, or any model of role "prior" the registry adds.
 
 The paper's claims about ours (``physgs.report.claims.measure``) decide its story; each is asked

@@ -1,4 +1,4 @@
-"""Figures (SPEC sections 4-5): fig_temporal, fig_teaser, fig_results, fig_damping and the
+"""Figures (the protocol, section 4-5): fig_temporal, fig_teaser, fig_results, fig_damping and the
 speed-accuracy sweep's fig_speed_accuracy.
 
 Each ``fig_*`` takes collected results as arrays and a list of output paths; the suffix of a

@@ -1,4 +1,4 @@
-"""Figures the source paper states ("Wind on Trees", ../shared/reference/wind-on-trees.tex),
+"""Figures the source paper states ("Wind on Trees", CITATION.cff),
 quoted once here so tables can print them beside what physgs measures."""
 
 #: Section 4, null control: the median nearest-bone gap of each tree (percent).

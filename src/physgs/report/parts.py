@@ -1,4 +1,4 @@
-"""tab_parts and fig_parts: ours' k-means parts beside parts cut along the tree (issue 28).
+"""tab_parts and fig_parts: ours' k-means parts beside parts cut along the tree.
 
 For every tree, training seed and configuration of the parts study (``parts_study`` of the
 config): the paper's prior (``ours``: spatial k-means, independent parts about fixed pivots)

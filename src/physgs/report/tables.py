@@ -1,4 +1,4 @@
-"""Result tables (SPEC section 4; the paper's tab:psnr, tab:null, tab:transfer, tab:margin).
+"""Result tables (the protocol, section 4; the paper's tab:psnr, tab:null, tab:transfer, tab:margin).
 
 Each builder returns a ``Table``: a flat pandas DataFrame (what goes to the .csv, full
 precision) and the booktabs LaTeX shown in the paper (rounded; best per column or row in bold

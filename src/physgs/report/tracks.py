@@ -1,4 +1,4 @@
-"""tab_tracks and fig_tracks: the 2D-track control (issue 29, ``physgs.tracks``, docs/tracks.md).
+"""tab_tracks and fig_tracks: the 2D-track control (``physgs.tracks``, docs/tracks.md).
 
 tab_tracks, per tree, configuration and training seed, from the control's evaluation record
 (``physgs.tracks.run.evaluate_job``): the tracker against the truth-projected vertices (tracks

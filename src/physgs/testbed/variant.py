@@ -1,4 +1,4 @@
-"""Testbed variants (SPEC section 1): which damping the bones get and what the wind does.
+"""Testbed variants (the protocol, section 1): which damping the bones get and what the wind does.
 
 ``faithful`` (the default, the paper's): every bone has ``testbed.zeta``, the wind is the
 unmodified turbulence realisation. ``damping``: each bone's zeta is drawn log-uniformly from

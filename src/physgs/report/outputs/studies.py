@@ -1,4 +1,4 @@
-"""The parts study's outputs (issue 28): tab_parts (every prior's fit, recovery and damping,
+"""The parts study's outputs: tab_parts (every prior's fit, recovery and damping,
 with parts cut by k-means or along the tree), fig_parts (their segmentations) and tab_parts_k
 (the smallest K at which the chained prior matches ours)."""
 
