@@ -208,7 +208,10 @@ def test_speed_accuracy_csv(run):
 
 
 def test_tab_null_plan_trains_ours_only():
-    """`snakemake results/tables/tab_null.tex` must train no baseline: the priors only."""
+    """`snakemake results/tables/tab_null.tex` must train no baseline: the priors only (and the
+    forcing-free priors, whose rows it holds)."""
+    from physgs.models.registry import BLIND_PRIORS
+
     import tempfile
     from pathlib import Path
 
@@ -219,7 +222,7 @@ def test_tab_null_plan_trains_ours_only():
         ).stdout
     trained = re.findall(r"results/models/\w+/seed\d+/(\w+?)_(single|joint32|joint96)\.pt", out)
     assert trained, "the plan trains nothing"
-    assert {m for m, _ in trained} == {"ours", "ours_chain"}
+    assert {m for m, _ in trained} == {"ours", "ours_chain", *BLIND_PRIORS}
     assert "rule evaluate:" not in out
 
 
