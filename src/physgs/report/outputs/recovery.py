@@ -126,51 +126,34 @@ def _tab_null(path, settings, inputs, out):
         }
         for s in seeds
     }
-    tk = settings.get("tracks", {})
-    tracks = {
-        s: {
-            (t, c): (
-                load_recovery(path("tracks_recovery", t, c, s)),
-                load_null(path("null", t, int(tk[c]["K"]), s)),
-            )
-            for t in trees
-            for c in tk
+
+    def paired(kind, *fields, parts):
+        """{seed: {(tree, config): (record of need ``kind``, the null of its K)}}; parts:
+        {config: K}."""
+        return {
+            s: {
+                (t, c): (
+                    load_recovery(path(kind, t, *fields, c, s)),
+                    load_null(path("null", t, int(k), s)),
+                )
+                for t in trees
+                for c, k in parts.items()
+            }
+            for s in seeds
         }
-        for s in seeds
-    }
-    K = {c: int(v["K"]) for c, v in configs.items()}
+
+    tk, oma = settings.get("tracks", {}), settings.get("oma", {})
+    tracks = paired("tracks_recovery", parts={c: v["K"] for c, v in tk.items()})
     methods = {
         tables.OMA: tables.oma_rows(
-            {c: v["label"] for c, v in settings.get("oma", {}).items()},
-            {
-                s: {
-                    (t, c): (
-                        load_recovery(path("oma_recovery", t, c, s)),
-                        load_null(path("null", t, int(v["K"]), s)),
-                    )
-                    for t in trees
-                    for c, v in settings.get("oma", {}).items()
-                }
-                for s in seeds
-            },
+            {c: v["label"] for c, v in oma.items()},
+            paired("oma_recovery", parts={c: v["K"] for c, v in oma.items()}),
         )
     }
     methods.update(
         {
             m: tables.blind_rows(
-                m,
-                mc,
-                {
-                    s: {
-                        (t, c): (
-                            load_recovery(path("prior_recovery", t, m, c, s)),
-                            load_null(path("null", t, K[c], s)),
-                        )
-                        for t in trees
-                        for c in mc
-                    }
-                    for s in seeds
-                },
+                m, mc, paired("prior_recovery", m, parts={c: configs[c]["K"] for c in mc})
             )
             for m, mc in settings.get("blind", {}).items()
         }
