@@ -122,12 +122,19 @@ def test_tab_margin_is_ours_minus_mlp_wind(run):
 def test_tab_null_rows_columns_and_finite_where_defined(run):
     df = _csv(run, "tab_null")
     configs = list(QUICK["models"]["configs"])
-    # ours' rows, the chained prior's, then the 2D-track control's (docs/tracks.md) at its own
-    # K beside its own null
+    from physgs.models.registry import BLIND_PRIORS
+
+    # ours' rows, the chained prior's, then the 2D-track control's (docs/tracks.md) and the
+    # output-only analysis' (docs/blind.md), each at its own K beside its own null, then the
+    # forcing-free priors' (single only)
     assert list(df["method"]) == ["ours"] * len(TREES) * len(configs) + ["ours_chain"] * len(
         TREES
-    ) * len(configs) + ["tracks"] * len(TREES) * len(QUICK["tracks"]["configs"])
+    ) * len(configs) + ["tracks"] * len(TREES) * len(QUICK["tracks"]["configs"]) + ["oma"] * len(
+        TREES
+    ) * len(QUICK["oma"]["configs"]) + list(BLIND_PRIORS) * len(TREES)
     assert (df.loc[df["method"] == "tracks", "K"] == QUICK["tracks"]["K"]).all()
+    assert (df.loc[df["method"] == "oma", "K"] == QUICK["oma"]["K"]).all()
+    assert set(df.loc[df["method"].isin(BLIND_PRIORS), "config"]) == {"single"}
     for col in ("trained_parts_trusted", "null_parts_trusted", "nearest_bone_gap_pct"):
         assert np.isfinite(df[col].to_numpy(float)).all(), col
     # a median over no trusted part is undefined (empty cell), and only then
@@ -208,7 +215,10 @@ def test_speed_accuracy_csv(run):
 
 
 def test_tab_null_plan_trains_ours_only():
-    """`snakemake results/tables/tab_null.tex` must train no baseline: the priors only."""
+    """`snakemake results/tables/tab_null.tex` must train no baseline: the priors only (and the
+    forcing-free priors, whose rows it holds)."""
+    from physgs.models.registry import BLIND_PRIORS
+
     import tempfile
     from pathlib import Path
 
@@ -219,7 +229,7 @@ def test_tab_null_plan_trains_ours_only():
         ).stdout
     trained = re.findall(r"results/models/\w+/seed\d+/(\w+?)_(single|joint32|joint96)\.pt", out)
     assert trained, "the plan trains nothing"
-    assert {m for m, _ in trained} == {"ours", "ours_chain"}
+    assert {m for m, _ in trained} == {"ours", "ours_chain", *BLIND_PRIORS}
     assert "rule evaluate:" not in out
 
 

@@ -115,24 +115,59 @@ def test_table_format_rebuilds_that_table_only(plans):
     assert plan == {"table": 1, "claims": 1, "summary": 1, "all": 1}, plan
 
 
-def test_the_chained_priors_rows_plan_its_own_jobs_only(tmp_path):
+@pytest.fixture(scope="module")
+def fresh_recovery_plan(tmp_path_factory) -> str:
+    """The dry-run plan of tab_null and tab_damping from an empty results folder (default
+    profile, one seed): one dry run that the recovery rows' plan tests share."""
+    from workflow_helpers import workflow_copy
+
+    wd = workflow_copy(tmp_path_factory.mktemp("fresh"))
+    targets = ["results/tables/tab_null.tex", "results/tables/tab_damping.tex"]
+    return snakemake(wd, "-n", "--cores", "2", *targets, "--config", "seeds=[0]").stdout
+
+
+def test_the_chained_priors_rows_plan_its_own_jobs_only(fresh_recovery_plan):
     """tab_null reads the chained prior's recovery in every configuration, tab_damping on both
     testbeds of the damping benchmark's configurations: a fresh plan trains and scores it there,
     and evaluates it in the base configuration only (no table reads a joint evaluation)."""
-    from workflow_helpers import workflow_copy
-
-    wd = workflow_copy(tmp_path)
-    targets = ["results/tables/tab_null.tex", "results/tables/tab_damping.tex"]
-    out = snakemake(wd, "-n", "--cores", "2", *targets, "--config", "seeds=[0]").stdout
-    trained = {c for c in _checkpoints(out) if c.startswith("ours_chain")}
+    out = fresh_recovery_plan
+    trained = {c for c in _checkpoints(out) if c.startswith("ours_chain") and "blind" not in c}
     assert trained == {"ours_chain_single", "ours_chain_joint32", "ours_chain_joint96"}, trained
     outputs = "\n".join(re.findall(r"(?m)^    output: (.*)$", out))
-    scored = set(re.findall(r"results/recovery/(\w+)/seed0/ours_chain_(\w+)\.json", outputs))
+    scored = set(
+        re.findall(r"results/recovery/(\w+)/seed0/ours_chain_((?!blind)\w+)\.json", outputs)
+    )
     trees = ("sparse", "medium", "dense")
     want = {(t, c) for t in trees for c in ("single", "joint32", "joint96")}
     want |= {(f"{t}_damping", c) for t in trees for c in ("single", "joint32")}
     assert scored == want, scored ^ want
     assert not re.search(r"results/eval/\w+/seed0/ours_chain_joint", outputs)
+
+
+def test_the_forcing_free_rows_plan_their_jobs(fresh_recovery_plan):
+    """tab_null and tab_damping read the output-only analysis in each of ``oma.configs`` and the
+    forcing-free priors in ``single`` only, on every tree and on the damping testbeds of the
+    damping benchmark's configurations: a fresh plan identifies, trains and scores them there,
+    with the null of the analysis' own K."""
+    from physgs.models.registry import BLIND_PRIORS
+
+    out = fresh_recovery_plan
+    cfg = physgs.config.load(ROOT / "config" / "trees.yaml", "default")
+    trees, oma = cfg["trees"], cfg["oma"]["configs"]
+    damping = [f"{t}_damping" for t in cfg["damping_benchmark"]["trees"]]
+    dconf = cfg["damping_benchmark"]["configs"]
+    assert oma and damping  # the plan below has something to show
+    outputs = "\n".join(re.findall(r"(?m)^    output: (.*)$", out))
+    scored = set(re.findall(r"results/recovery/(\w+)/seed0/oma_(\w+)\.json", outputs))
+    want = {(t, c) for t in trees for c in oma}
+    want |= {(tb, c) for tb in damping for c in oma if c in dconf}
+    assert scored == want, scored ^ want
+    assert len(re.findall(r"results/oma/\w+/seed0/modes_\w+\.npz", outputs)) == len(want)
+    trained = {c for c in _checkpoints(out) if "blind" in c}
+    assert trained == {f"{m}_single" for m in BLIND_PRIORS}, trained
+    blind = set(re.findall(r"results/recovery/(\w+)/seed0/(ours\w*_blind)_(\w+)\.json", outputs))
+    tbs = [*trees, *(damping if "single" in dconf else [])]
+    assert blind == {(t, m, "single") for t in tbs for m in BLIND_PRIORS}, blind
 
 
 def test_job_params_ignore_key_order():

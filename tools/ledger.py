@@ -32,10 +32,11 @@ def main() -> None:
     cfg = physgs.config.load(args.config, args.profile)
     seeds = args.seeds if args.seeds is not None else cfg["seeds"]
     trees = args.trees or cfg["trees"]
-    needs = build.claims_needs(trees, cfg["models"]["configs"], seeds, True, True)
-    paths = {  # the workflow's layout (common.smk: TABLE, RECOVERY with model ours)
+    needs = build.claims_needs(trees, cfg["models"]["configs"], seeds, True, True, True)
+    paths = {  # the workflow's layout (common.smk: TABLE, RECOVERY)
         "table": "tables/{name}.csv",
         "recovery": "recovery/{tree}/seed{seed}/ours_{config}.json",
+        "prior_recovery": "recovery/{tree}/seed{seed}/{model}_{config}.json",
     }
     inputs = {}
     for need in needs:

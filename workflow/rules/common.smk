@@ -107,6 +107,7 @@ NEED_PATHS = {
     "stats": STATS,
     "table": TABLE.replace("{ext}", "csv"),
     "tracks_recovery": TRACKS_RECOVERY,
+    "oma_recovery": OMA_RECOVERY,
     "tracks_eval": TRACKS_EVAL,
     "tracks_fields": TRACKS_FIELDS,
     "tracks_fit": TRACKS_FIT,

@@ -73,6 +73,7 @@ rule claims:
                     SEEDS,
                     parts=bool(PARTS_MODELS),
                     tracks=bool(TRACKS_CONFIGS),
+                    damping=bool(DAMPING["trees"]),
                 )
             )
         ),

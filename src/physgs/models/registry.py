@@ -98,6 +98,9 @@ PRIOR_VARIANTS: dict[str, ModelSpec] = {
     ),
 }
 PRIOR_VARIANT_NAMES = tuple(PRIOR_VARIANTS)
+#: the forcing-free priors (issue 42, docs/blind.md): trained in ``BLIND_CONFIG`` only (one window,
+#: one forcing), scored in tab_fit, tab_null and tab_damping beside ours
+BLIND_PRIORS = tuple(m for m, s in PRIOR_VARIANTS.items() if s.forcing == "learned")
 #: Reference models: not methods (no recovery, null or method result depends on them), so kept
 #: out of MODELS / MODEL_NAMES. truth_motion moves the canonical Gaussians by the ground-truth
 #: skinning (physgs.models.truth_motion): the ceiling; the only model that reads truth.npz.
@@ -122,6 +125,8 @@ def models_of(*roles: str) -> tuple[str, ...]:
 FIELDS = ("mlp", "d3dgs")  # learned deformation-field architectures
 #: Every model is trained in this configuration; the priors also in every other one of the config.
 BASE_CONFIG = "single"
+#: the one configuration the forcing-free priors (``BLIND_PRIORS``) are trained in
+BLIND_CONFIG = BASE_CONFIG
 FORMAT = "physgs-model-v2"
 #: Ours with K chosen from the data (physgs.experiments.kselect); its K is passed explicitly.
 AUTO_CONFIG = "auto"

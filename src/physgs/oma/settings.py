@@ -23,14 +23,20 @@ def identify_params(cfg: dict, config: str) -> dict:
     }
 
 
+def parts(cfg: dict, config: str) -> int:
+    """The output-only analysis' K in ``config`` (``oma.K``: ``same`` for the configuration's,
+    or an integer): its recovery record's parts and its null's K."""
+    k = cfg["oma"].get("K", "same")
+    return int(cfg["models"]["configs"][config]["K"]) if k == "same" else int(k)
+
+
 def recovery_params(cfg: dict, config: str, seed: int) -> dict:
     """Rule ``oma_recovery``: K (``oma.K``: ``same`` for the configuration's, or an integer),
     the training seed and ours' k-means
     restarts (the cells' parts), and ours' solver settings (the null's, ``null_settings``)."""
     from physgs.recovery.run import null_settings
 
-    k = cfg["oma"].get("K", "same")
-    K = int(cfg["models"]["configs"][config]["K"]) if k == "same" else int(k)
+    K = parts(cfg, config)
     return {
         "K": K,
         "seed": int(seed),

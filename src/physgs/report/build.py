@@ -52,14 +52,17 @@ def claims_needs(
     seeds: Sequence[int],
     parts: bool = False,
     tracks: bool = False,
+    damping: bool = False,
 ) -> list[tuple]:
     """What the claims ledger reads: the tables' CSVs and every prior's recovery (damping) of
     every seed in the joint K=32 configuration (the paper's), or the base configuration when the
     config has none; with ``parts``, tab_parts too (the parts study's hypotheses); with ``tracks``,
-    tab_tracks (the 2D-track control's; its recovery rows are in tab_null)."""
+    tab_tracks (the 2D-track control's; its recovery rows are in tab_null); with ``damping``,
+    tab_damping (the damping benchmark's: the output-only analysis' zeta claims)."""
     c = CLAIMS_CONFIG if CLAIMS_CONFIG in configs else BASE_CONFIG
     extra = [("table", "tab_parts")] if parts else []
     extra += [("table", "tab_tracks")] if tracks else []
+    extra += [("table", "tab_damping")] if damping else []
     return (
         [("table", n) for n in CLAIMS_TABLES]
         + extra
@@ -79,7 +82,7 @@ def claims_frame(inputs: Mapping[str, str], trees: Sequence[str]) -> pd.DataFram
     its claims "undecided: not measured" (a partial run's ledger, ``tools/ledger.py``)."""
     from physgs.report import claims
 
-    names = (*CLAIMS_TABLES, "tab_parts", "tab_tracks")
+    names = (*CLAIMS_TABLES, "tab_parts", "tab_tracks", "tab_damping")
     tabs = {n: pd.read_csv(inputs[key(("table", n))]) for n in names if key(("table", n)) in inputs}
     damping: dict[str, list] = {}
     prior_damping: dict[str, dict[str, list]] = {}

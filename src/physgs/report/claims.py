@@ -582,8 +582,9 @@ def _tracks_claims(
     return out
 
 
-#: methods of tab_null / tab_damping that read no wind (issue 42, docs/blind.md)
-OMA, BLIND = "oma", "ours_blind"
+#: methods of tab_null / tab_damping that read no wind (issue 42, docs/blind.md): the output-only
+#: analysis (its method id, physgs.report.tables.OMA) and ours with a learned forcing
+BLIND = "ours_blind"
 
 
 def _blind_claims(
@@ -599,10 +600,14 @@ def _blind_claims(
     - ``oma_recovers_zeta/<tree>``: output-only minus null median zeta error (points, the
       damping benchmark's testbed) below 0.
     """
+    from physgs.models.registry import BLIND_CONFIG
+    from physgs.report.tables import OMA
+    from physgs.testbed.variant import DAMPING
+
     out: list[tuple[Claim, list[float]]] = []
     if "method" not in null.columns:
         return out
-    c = "single"
+    c = BLIND_CONFIG
 
     def cell(d, tree, method, col):
         r = d[(d["tree"] == tree) & (d["config"] == c) & (d["method"] == method)]
@@ -666,7 +671,10 @@ def _blind_claims(
                         "<",
                         "pp",
                     ),
-                    [cell(d, t, OMA, "trained_minus_null_pp") for d in _per_seed(damping)],
+                    [
+                        cell(d[d["testbed"] == DAMPING], t, OMA, "trained_minus_null_pp")
+                        for d in _per_seed(damping)
+                    ],
                 )
             )
     return out

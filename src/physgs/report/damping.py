@@ -20,10 +20,23 @@ import pandas as pd
 
 from physgs.models.registry import label as model_label
 from physgs.report import seeds as seedstats
-from physgs.report.tables import TRACKS_LABEL, Table, _by_seed, _check, _seeds, _wrap, tree_label
+from physgs.report.tables import (
+    MethodRows,
+    Table,
+    _by_seed,
+    _check,
+    _further,
+    _seeds,
+    _wrap,
+    tree_label,
+)
 from physgs.testbed.variant import DAMPING, FAITHFUL
 
 VARIANTS = (FAITHFUL, DAMPING)
+_TRACKS_NOTE = (
+    r" \emph{2D tracks}: the same oscillators fitted to point tracks of the training "
+    r"video (no renderer), scored on its own matching against its own null draw."
+)
 COLUMNS = (
     "trusted",
     "rel_err_pct",
@@ -46,6 +59,7 @@ def tab_damping(
     tracks: Mapping[int, Mapping[tuple[str, str, str], object]] | None = None,
     tracks_configs: Mapping[str, str] | None = None,
     priors: Mapping[str, Mapping[int, Mapping[tuple[str, str, str], object]]] | None = None,
+    methods: Mapping[str, MethodRows] | None = None,
 ) -> Table:
     """``per_seed[seed][(tree, variant, config)]``: ``RecoveryRecord`` with damping scores and null;
     variant 'faithful' or 'damping'; configs: name -> LaTeX label, in row order. One CSV row per
@@ -58,22 +72,27 @@ def tab_damping(
 
     priors: the other oscillator priors' records, ``priors[model][seed][(tree, variant,
     config)]``, in every configuration of ``configs``; their rows follow ours' of each testbed,
-    column ``method`` the model id."""
+    column ``method`` the model id.
+
+    methods: further methods' rows (method id -> ``MethodRows`` of records per ``(tree,
+    variant, config)``), each in its own configurations, after the tracks control's."""
     seeds = _seeds(per_seed, "tab_damping")
     tracks_configs = dict(tracks_configs or {})
     priors = dict(priors or {})
+    further = _further(tracks, tracks_configs, _TRACKS_NOTE, methods)
     block = [(c, "ours") for c in configs]
     block += [(c, p) for p in priors for c in configs]
-    block += [(c, "tracks") for c in tracks_configs]
+    block += [(c, m) for m, mr in further.items() for c in mr.configs]
     keys = [(t, v, c, m) for t in trees for v in VARIANTS for c, m in block]
     rows = []
     for s in seeds:
         _check([k[:3] for k in keys if k[3] == "ours"], per_seed[s], f"tab_damping (seed {s})")
-        if tracks_configs:
+        for m, mr in further.items():
+            who = "tracks control" if m == "tracks" else m
             _check(
-                [k[:3] for k in keys if k[3] == "tracks"],
-                (tracks or {}).get(s, {}),
-                f"tab_damping (tracks control, seed {s})",
+                [k[:3] for k in keys if k[3] == m],
+                mr.per_seed.get(s, {}),
+                f"tab_damping ({who}, seed {s})",
             )
         for p in priors:
             _check(
@@ -87,7 +106,7 @@ def tab_damping(
             elif method in priors:
                 rec = priors[method][s][(t, v, c)]
             else:
-                rec = tracks[s][(t, v, c)]
+                rec = further[method].per_seed[s][(t, v, c)]
             sc, nl = rec.damping_scores, rec.damping_null
             if sc is None or nl is None:
                 who = {"ours": "", "tracks": " (tracks control)"}.get(method, f" ({method})")
@@ -142,7 +161,7 @@ def tab_damping(
         elif method in priors:
             label = f"{model_label(method)}, {configs[c]}"
         else:
-            label = f"{TRACKS_LABEL}, {tracks_configs[c]}"
+            label = f"{further[method].label}, {further[method].configs[c]}"
         lines.append(
             "    "
             + " & ".join(
@@ -175,12 +194,7 @@ def tab_damping(
         r"exponent $p$ of the fitted decay rate $\hat\gamma=\hat\zeta\hat\omega\propto"
         r"\hat\omega^p$ ($p\approx0$: a frequency-independent rate fitted in place of a "
         r"ratio), the truth's own $p$ on the matched bones in brackets."
-        + (
-            r" \emph{2D tracks}: the same oscillators fitted to point tracks of the training "
-            r"video (no renderer), scored on its own matching against its own null draw."
-            if tracks_configs
-            else ""
-        )
+        + "".join(mr.note for mr in further.values())
         + (
             rf" Mean $\pm$ sd over {len(seeds)} training seeds; differences bold when their 95\% "
             r"interval excludes 0, $^{\dagger}$ when not."

@@ -25,6 +25,11 @@ from physgs.report import seeds as seedstats
 
 #: LaTeX name of the 2D-track control's rows (physgs.report.tracks, docs/tracks.md)
 TRACKS_LABEL = r"\emph{2D tracks}"
+#: method id and LaTeX name of the output-only modal analysis' rows (physgs.oma, docs/blind.md)
+OMA = "oma"
+OMA_LABEL = r"\emph{Output-only (SSI)}"
+#: a .tex cell that a method does not define (a forcing-free prior beyond the window): never 0
+NOT_DEFINED = "n/d"
 
 
 @dataclass(frozen=True)
@@ -34,6 +39,21 @@ class Table:
     name: str
     df: pd.DataFrame  # flat, numeric columns at full precision
     tex: str
+
+
+@dataclass(frozen=True)
+class MethodRows:
+    """A further method's rows in tab_null or tab_damping (beside ours' and the priors').
+
+    label: its LaTeX name; configs: its configurations (name -> LaTeX label, with its own K),
+    in row order; per_seed: ``per_seed[seed][key]``, the table's record of each key (tab_null:
+    ``(tree, config)`` -> (``RecoveryRecord``, the ``NullResult`` of its K); tab_damping:
+    ``(tree, variant, config)`` -> ``RecoveryRecord``); note: its sentence of the caption."""
+
+    label: str
+    configs: Mapping[str, str]
+    per_seed: Mapping[int, Mapping[tuple, object]]
+    note: str = ""
 
 
 def tree_label(tree: str, bones: int) -> str:
@@ -283,7 +303,9 @@ def tab_fit(
     frames), view, time (dB: the evaluation splits), train_s (seconds of training).
     ceiling_frac is (model - static) / (reference - static) on ``fit``, per seed against that
     seed's static pose and ceiling: 1 reaches the true-motion ceiling, 0 is no better than the
-    static pose. The reference row is listed for scale.
+    static pose. The reference row is listed for scale. A split a model does not define (NaN at
+    every seed: a forcing-free prior beyond the window) is an empty CSV cell and ``NOT_DEFINED``
+    in the .tex, never a number.
     """
     seeds = _seeds(per_seed, "tab_fit")
     recs = []
@@ -339,7 +361,10 @@ def tab_fit(
             name,
             *(seedstats.pm(V[c][:, i], fmt) for c in ("fit_psnr_db", "heldout_psnr_db")),
             frac if frac == "--" else frac + r"\%",
-            *(seedstats.pm(V[c][:, i], fmt) for c in ("view_psnr_db", "time_psnr_db")),
+            *(
+                seedstats.pm(V[c][:, i], fmt) if np.isfinite(V[c][:, i]).any() else NOT_DEFINED
+                for c in ("view_psnr_db", "time_psnr_db")
+            ),
             seedstats.pm(V["train_s"][:, i], ".0f"),
         ]
 
@@ -353,6 +378,14 @@ def tab_fit(
         r"(model $-$ static) / "
         r"(true motion $-$ static) on the fit. \emph{View}, \emph{Time}: the evaluation splits. "
         r"In italics the reference: the canonical Gaussians moved by the ground-truth motion."
+        + (
+            f" {NOT_DEFINED}: not defined (a learned forcing has no wind to read beyond the "
+            "window or under another wind)."
+            if any(
+                not np.isfinite(V[c]).any(axis=0).all() for c in ("view_psnr_db", "time_psnr_db")
+            )
+            else ""
+        )
         + (
             rf" Mean $\pm$ sd over {len(seeds)} training seeds."
             if len(seeds) > 1
@@ -373,6 +406,7 @@ def tab_null(
     tracks: Mapping[int, Mapping[tuple[str, str], tuple]] | None = None,
     tracks_configs: Mapping[str, str] | None = None,
     priors: Mapping[str, Mapping[int, Mapping[tuple[str, str], object]]] | None = None,
+    methods: Mapping[str, MethodRows] | None = None,
 ) -> Table:
     """Frequency recovery of the trained model against the untrained null, per tree and config.
 
@@ -392,13 +426,18 @@ def tab_null(
     every configuration of ``configs``, each beside the null of its K (the same draws as ours':
     a null depends on K only); their rows follow ours' of each tree, column ``method`` the
     model id.
+
+    methods: further methods' rows (method id -> ``MethodRows``: (record, null of its K) per
+    ``(tree, config)``), each in its own configurations, after the tracks control's; column
+    ``method`` the id (the output-only analysis: ``OMA``, the forcing-free priors: their ids).
     """
     seeds = _seeds(recovery, "tab_null")
     tracks_configs = dict(tracks_configs or {})
     priors = dict(priors or {})
+    further = _further(tracks, tracks_configs, _NULL_TRACKS_NOTE, methods)
     keys = [(t, c, "ours") for t in trees for c in configs]
     keys += [(t, c, p) for t in trees for p in priors for c in configs]
-    keys += [(t, c, "tracks") for t in trees for c in tracks_configs]
+    keys += [(t, c, m) for t in trees for m, mr in further.items() for c in mr.configs]
     rows = []
     for s in seeds:
         _check(
@@ -411,11 +450,12 @@ def tab_null(
             null.get(s, {}),
             f"tab_null (null control, seed {s})",
         )
-        if tracks_configs:
+        for m, mr in further.items():
+            who = "tracks control" if m == "tracks" else m
             _check(
-                [k[:2] for k in keys if k[2] == "tracks"],
-                (tracks or {}).get(s, {}),
-                f"tab_null (tracks control, seed {s})",
+                [k[:2] for k in keys if k[2] == m],
+                mr.per_seed.get(s, {}),
+                f"tab_null ({who}, seed {s})",
             )
         for p in priors:
             _check(
@@ -429,7 +469,7 @@ def tab_null(
             elif method in priors:
                 rec, nl = priors[method][s][(t, c)], null[s][(t, c)]
             else:
-                rec, nl = tracks[s][(t, c)]
+                rec, nl = further[method].per_seed[s][(t, c)]
             m = rec.match
             if nl.n_parts != m.n_parts:
                 raise ValueError(
@@ -505,7 +545,7 @@ def tab_null(
             if r.method == "ours"
             else f"{label(r.method)}, {configs[r.config]}"
             if r.method in priors
-            else f"{TRACKS_LABEL}, {tracks_configs[r.config]}",
+            else f"{further[r.method].label}, {further[r.method].configs[r.config]}",
             parts("trained_parts_trusted", i, r.K),
             pct("trained_median_rel_err_pct", i),
             seedstats.pm(V["trained_loglog_r2"][:, i], ".3f"),
@@ -530,21 +570,63 @@ def tab_null(
         r"motion moves at least a pixel in the training camera (the CSV also gives the part "
         r"counts)."
         + (
-            r" \emph{2D tracks}: the same oscillators fitted to point tracks of the training "
-            r"video (no renderer), matched and trusted by the same rule, beside the null of its "
-            r"$K$; a part with too few tracks has no estimate and is never trusted."
-            if tracks_configs
-            else ""
-        )
-        + (
             f" {', '.join(label(p) for p in priors)}: the same scoring of its own parts, beside "
             r"the null of its $K$ (a null depends on $K$ only)."
             if priors
             else ""
         )
+        + "".join(mr.note for mr in further.values())
         + _seed_note(len(seeds))
     )
     return Table("tab_null", df, _wrap("\n".join(lines), cap, "tab:null"))
+
+
+_NULL_TRACKS_NOTE = (
+    r" \emph{2D tracks}: the same oscillators fitted to point tracks of the training "
+    r"video (no renderer), matched and trusted by the same rule, beside the null of its "
+    r"$K$; a part with too few tracks has no estimate and is never trusted."
+)
+
+
+def oma_rows(configs: Mapping[str, str], per_seed: Mapping[int, Mapping]) -> MethodRows:
+    """The output-only modal analysis' rows (``physgs.oma``) for tab_null / tab_damping:
+    configs: name -> LaTeX label with its own K; per_seed as ``MethodRows``."""
+    return MethodRows(
+        OMA_LABEL,
+        configs,
+        per_seed,
+        rf" {OMA_LABEL}: modes identified from the training video alone (dense flow, SSI-cov; "
+        r"no wind, no renderer), each assigned to a part by its shape, matched and trusted by "
+        r"the same rule, beside the null of its $K$.",
+    )
+
+
+def blind_rows(model: str, configs: Mapping[str, str], per_seed: Mapping[int, Mapping]):
+    """A forcing-free prior's rows (``registry.BLIND_PRIORS``, physgs.models.blind) for
+    tab_null / tab_damping, labelled from the registry; configs and per_seed as ``oma_rows``."""
+    return MethodRows(
+        label(model),
+        configs,
+        per_seed,
+        f" {label(model)}: the measured wind replaced by a forcing learned from the training "
+        r"video (trained in its configuration only), beside the null of its $K$.",
+    )
+
+
+def _further(
+    tracks: Mapping | None,
+    tracks_configs: Mapping[str, str],
+    tracks_note: str,
+    methods: Mapping[str, MethodRows] | None,
+) -> dict[str, MethodRows]:
+    """The further methods' rows of tab_null / tab_damping in row order: the tracks control's
+    (when it has configurations), then ``methods``'."""
+    methods = dict(methods or {})
+    clash = [m for m in methods if m in ("ours", "tracks")]
+    if clash:
+        raise ValueError(f"further methods {clash}: 'ours' and 'tracks' have their own arguments")
+    tr = {"tracks": MethodRows(TRACKS_LABEL, tracks_configs, tracks or {}, tracks_note)}
+    return {**(tr if tracks_configs else {}), **methods}
 
 
 def _pct(x: float, bold: bool, digits: int = 2) -> str:

@@ -30,6 +30,8 @@ NEED_FIELDS = {
     # the 2D-track control (physgs.tracks): its recovery record (ours' format), its evaluation
     # record, its fit, one condition's tracks, and the observed dataset (fig_tracks' frame)
     "tracks_recovery": ("tree", "config", "seed"),
+    # the output-only modal analysis' recovery record (physgs.oma; ours' format)
+    "oma_recovery": ("tree", "config", "seed"),
     "tracks_eval": ("tree", "config", "seed"),
     "tracks_fields": ("tree", "config", "seed"),  # the learned fields at the tracked points
     "tracks_fit": ("tree", "config", "seed"),
@@ -65,7 +67,9 @@ class Plan:
     tracks: the 2D-track control's configurations -> their K; damping_trees/damping_configs: the
     damping benchmark's; tracks_fields: the (tree, configuration) pairs whose learned fields are
     scored at the tracked points; parts_models/parts_configs: the parts study's variants and
-    configurations ({} without a study); study_seeds/k_candidates: the K match's."""
+    configurations ({} without a study); study_seeds/k_candidates: the K match's; oma: the
+    output-only analysis' configurations -> their K (``oma.configs``); blind: the forcing-free
+    priors trained (``registry.BLIND_PRIORS``, in ``BLIND_CONFIG``; none without it)."""
 
     trees: Sequence[str]
     configs: Mapping[str, dict]
@@ -78,6 +82,8 @@ class Plan:
     parts_configs: Mapping[str, dict] = field(default_factory=dict)
     study_seeds: Sequence[int] = ()
     k_candidates: Sequence[int] = ()
+    oma: Mapping[str, int] = field(default_factory=dict)
+    blind: Sequence[str] = ()
 
     @classmethod
     def from_config(cls, cfg: dict) -> Plan:
@@ -90,6 +96,8 @@ class Plan:
             Plan: its trees, configurations, seeds and study settings.
         """
         from physgs.config import study_seeds
+        from physgs.models.registry import BLIND_CONFIG, BLIND_PRIORS
+        from physgs.oma.settings import parts as oma_k
         from physgs.tracks.settings import fields_scored
         from physgs.tracks.settings import parts as tracks_k
 
@@ -110,6 +118,8 @@ class Plan:
             else {},
             study_seeds=[int(s) for s in study_seeds(cfg)],
             k_candidates=[int(k) for k in cfg["parts_study"]["k_candidates"]],
+            oma={c: oma_k(cfg, c) for c in cfg["oma"]["configs"]},
+            blind=list(BLIND_PRIORS) if BLIND_CONFIG in configs else [],
         )
 
 

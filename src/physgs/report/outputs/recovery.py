@@ -4,7 +4,7 @@ against the untrained null), tab_damping (the damping benchmark), fig_damping an
 
 from __future__ import annotations
 
-from physgs.models.registry import config_label, models_of
+from physgs.models.registry import BLIND_CONFIG, config_label, models_of
 from physgs.recovery.record import load_null, load_recovery
 from physgs.report import kselect
 from physgs.report.outputs.base import Output
@@ -25,6 +25,40 @@ def other_priors() -> tuple[str, ...]:
     """The priors besides ours (the paper's, read through the ``recovery`` need kind): each read
     through ``prior_recovery`` and set beside ours' rows."""
     return tuple(m for m in models_of("prior") if m != "ours")
+
+
+def oma_label(cfg: dict, config: str) -> str:
+    """The LaTeX label of the output-only analysis' configuration ``config`` with its own K."""
+    from physgs.oma.settings import parts as oma_k
+
+    return config_label(config, {**cfg["models"]["configs"][config], "K": oma_k(cfg, config)})
+
+
+def _further_settings(cfg: dict, configs) -> dict:
+    """The forcing-free methods' settings of tab_null / tab_damping in ``configs`` (the table's
+    configurations): oma {config: {K, label}}; blind {model: {config: label}} in
+    ``BLIND_CONFIG`` (``registry.BLIND_PRIORS``, none when the run lacks that configuration)."""
+    from physgs.models.registry import BLIND_PRIORS
+    from physgs.oma.settings import parts as oma_k
+
+    mc = cfg["models"]["configs"]
+    blind = {m: {BLIND_CONFIG: config_label(BLIND_CONFIG, mc[BLIND_CONFIG])} for m in BLIND_PRIORS}
+    return {
+        "oma": {
+            c: {"K": oma_k(cfg, c), "label": oma_label(cfg, c)}
+            for c in cfg["oma"]["configs"]
+            if c in configs
+        },
+        "blind": blind if BLIND_CONFIG in configs else {},
+    }
+
+
+def _further_needs(plan, configs, testbeds, s) -> list[tuple]:
+    """The forcing-free methods' recoveries on ``testbeds`` in ``configs`` (seed ``s``)."""
+    blind = [m for m in plan.blind if BLIND_CONFIG in configs]
+    return [("oma_recovery", tb, c, s) for tb in testbeds for c in plan.oma if c in configs] + [
+        ("prior_recovery", tb, m, BLIND_CONFIG, s) for tb in testbeds for m in blind
+    ]
 
 
 def _configs(cfg: dict) -> dict:
@@ -48,6 +82,7 @@ def _null_needs(plan, seeds):
             for c in plan.configs
         ]
         out += [("tracks_recovery", t, c, s) for t in plan.trees for c in plan.tracks]
+        out += _further_needs(plan, plan.configs, plan.trees, s)
         out += list(
             dict.fromkeys(
                 [
@@ -56,6 +91,7 @@ def _null_needs(plan, seeds):
                     for c in plan.configs
                 ]
                 + [("null", t, int(k), s) for t in plan.trees for k in plan.tracks.values()]
+                + [("null", t, int(k), s) for t in plan.trees for k in plan.oma.values()]
             )
         )
     return out
@@ -70,6 +106,7 @@ def _null_settings(cfg: dict) -> dict:
             c: {"K": tracks_k(cfg, c)[0], "label": tracks_label(cfg, c)}
             for c in cfg["tracks"]["configs"]
         },
+        **_further_settings(cfg, cfg["models"]["configs"]),
     }
 
 
@@ -89,18 +126,38 @@ def _tab_null(path, settings, inputs, out):
         }
         for s in seeds
     }
-    tk = settings.get("tracks", {})
-    tracks = {
-        s: {
-            (t, c): (
-                load_recovery(path("tracks_recovery", t, c, s)),
-                load_null(path("null", t, int(tk[c]["K"]), s)),
-            )
-            for t in trees
-            for c in tk
+
+    def paired(kind, *fields, parts):
+        """{seed: {(tree, config): (record of need ``kind``, the null of its K)}}; parts:
+        {config: K}."""
+        return {
+            s: {
+                (t, c): (
+                    load_recovery(path(kind, t, *fields, c, s)),
+                    load_null(path("null", t, int(k), s)),
+                )
+                for t in trees
+                for c, k in parts.items()
+            }
+            for s in seeds
         }
-        for s in seeds
+
+    tk, oma = settings.get("tracks", {}), settings.get("oma", {})
+    tracks = paired("tracks_recovery", parts={c: v["K"] for c, v in tk.items()})
+    methods = {
+        tables.OMA: tables.oma_rows(
+            {c: v["label"] for c, v in oma.items()},
+            paired("oma_recovery", parts={c: v["K"] for c, v in oma.items()}),
+        )
     }
+    methods.update(
+        {
+            m: tables.blind_rows(
+                m, mc, paired("prior_recovery", m, parts={c: configs[c]["K"] for c in mc})
+            )
+            for m, mc in settings.get("blind", {}).items()
+        }
+    )
     return tables.tab_null(
         rec,
         null,
@@ -121,6 +178,7 @@ def _tab_null(path, settings, inputs, out):
             }
             for m in other_priors()
         },
+        methods={m: mr for m, mr in methods.items() if mr.configs},
     )
 
 
@@ -160,6 +218,16 @@ def _damping_needs(plan, seeds):
             for c in tracks
             for s in seeds
         ]
+        + [
+            x
+            for s in seeds
+            for x in _further_needs(
+                plan,
+                plan.damping_configs,
+                [tb for t in plan.damping_trees for tb in _testbeds(t).values()],
+                int(s),
+            )
+        ]
     )
 
 
@@ -170,52 +238,47 @@ def _damping_settings(cfg: dict) -> dict:
         "tracks_configs": {
             c: tracks_label(cfg, c) for c in configs if c in cfg["tracks"]["configs"]
         },
+        **_further_settings(cfg, configs),
     }
 
 
 def _tab_damping(path, settings, inputs, out):
+    from physgs.report import tables
     from physgs.report.damping import tab_damping
 
-    trees, seeds = settings["trees"], settings["seeds"]
-    rows = {
-        s: {
-            (t, v, c): load_recovery(path("recovery", tb, c, s))
-            for t in trees
-            for v, tb in _testbeds(t).items()
-            for c in settings["configs"]
+    trees, seeds, configs = settings["trees"], settings["seeds"], settings["configs"]
+
+    def records(kind, *fields, configs):
+        """{seed: {(tree, variant, config): record}} of need ``kind`` on each tree's testbeds."""
+        return {
+            s: {
+                (t, v, c): load_recovery(path(kind, tb, *fields, c, s))
+                for t in trees
+                for v, tb in _testbeds(t).items()
+                for c in configs
+            }
+            for s in seeds
         }
-        for s in seeds
-    }
+
     tc = settings.get("tracks_configs", {})
-    tracks = {
-        s: {
-            (t, v, c): load_recovery(path("tracks_recovery", tb, c, s))
-            for t in trees
-            for v, tb in _testbeds(t).items()
-            for c in tc
+    oma = {c: v["label"] for c, v in settings.get("oma", {}).items()}
+    methods = {tables.OMA: tables.oma_rows(oma, records("oma_recovery", configs=oma))}
+    methods.update(
+        {
+            m: tables.blind_rows(m, mc, records("prior_recovery", m, configs=mc))
+            for m, mc in settings.get("blind", {}).items()
         }
-        for s in seeds
-    }
+    )
     return tab_damping(
-        rows,
+        records("recovery", configs=configs),
         trees,
         settings["bones"],
-        settings["configs"],
+        configs,
         digits=settings["digits"],
-        tracks=tracks,
+        tracks=records("tracks_recovery", configs=tc),
         tracks_configs=tc,
-        priors={
-            m: {
-                s: {
-                    (t, v, c): load_recovery(path("prior_recovery", tb, m, c, s))
-                    for t in trees
-                    for v, tb in _testbeds(t).items()
-                    for c in settings["configs"]
-                }
-                for s in seeds
-            }
-            for m in other_priors()
-        },
+        priors={m: records("prior_recovery", m, configs=configs) for m in other_priors()},
+        methods={m: mr for m, mr in methods.items() if mr.configs},
     )
 
 

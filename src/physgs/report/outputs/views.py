@@ -11,7 +11,7 @@ import pandas as pd
 
 from physgs.evaluate.splits import load_eval
 from physgs.experiments.recipe import heldout_split
-from physgs.models.registry import BASE_CONFIG, models_of
+from physgs.models.registry import BASE_CONFIG, BLIND_CONFIG, models_of
 from physgs.report.outputs.base import Output
 
 #: the roles of the methods compared on images, and of the references shown beside them
@@ -96,17 +96,37 @@ def _tab_psnr(path, settings, inputs, out):
     )
 
 
+def _fit_needs(plan, seeds):
+    """tab_fit's: every method's and reference's evaluation and loss log, and the forcing-free
+    priors' (``plan.blind``, trained in ``BLIND_CONFIG``)."""
+    blind = [
+        (k, t, m, BLIND_CONFIG, s)
+        for s in seeds
+        for k in ("eval", "loss")
+        for t in plan.trees
+        for m in plan.blind
+    ]
+    return _evals(("eval", "loss"), METHODS + REFERENCES)(plan, seeds) + blind
+
+
+def _fit_table_settings(cfg: dict) -> dict:
+    from physgs.models.registry import BLIND_PRIORS
+
+    blind = list(BLIND_PRIORS) if BLIND_CONFIG in cfg["models"]["configs"] else []
+    return {**fit_settings(cfg), "blind": blind}
+
+
 def _tab_fit(path, settings, inputs, out):
     from physgs.report import tables
 
     n, every = int(settings["n_train"]), int(settings["holdout_every"])
+    config = {m: BASE_CONFIG for m in models_of(*METHODS, *REFERENCES)}
+    config.update({m: BLIND_CONFIG for m in settings.get("blind", [])})
     rows = {
         s: {
-            (t, m): fit_row(
-                path("eval", t, m, BASE_CONFIG, s), path("loss", t, m, BASE_CONFIG, s), n, every
-            )
+            (t, m): fit_row(path("eval", t, m, c, s), path("loss", t, m, c, s), n, every)
             for t in settings["trees"]
-            for m in models_of(*METHODS, *REFERENCES)
+            for m, c in config.items()
         }
         for s in settings["seeds"]
     }
@@ -114,7 +134,7 @@ def _tab_fit(path, settings, inputs, out):
         rows,
         settings["trees"],
         settings["bones"],
-        models_of(*METHODS),
+        (*models_of(*METHODS), *settings.get("blind", [])),
         models_of(*REFERENCES)[0],
         digits=settings["digits"],
         holdout_every=every,
@@ -163,9 +183,9 @@ TAB_FIT = Output(
     "tab_fit",
     "table",
     METHODS + REFERENCES,
-    _evals(("eval", "loss"), METHODS + REFERENCES),
+    _fit_needs,
     _tab_fit,
-    settings=fit_settings,
+    settings=_fit_table_settings,
 )
 TAB_TRANSFER = Output(
     "tab_transfer",
