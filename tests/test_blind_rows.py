@@ -1,4 +1,4 @@
-"""The forcing-free methods' rows (issue 42): the output-only analysis and the forcing-free
+"""The forcing-free methods' rows: the output-only analysis and the forcing-free
 priors in tab_null and tab_damping, each in its own configurations beside the null of its own
 K, ours' and the other rows left as they were; the forcing-free priors in tab_fit with their
 undefined splits written as not defined; what the outputs read."""

@@ -98,7 +98,7 @@ PRIOR_VARIANTS: dict[str, ModelSpec] = {
     ),
 }
 PRIOR_VARIANT_NAMES = tuple(PRIOR_VARIANTS)
-#: the forcing-free priors (issue 42, docs/blind.md): trained in ``BLIND_CONFIG`` only (one window,
+#: the forcing-free priors (docs/blind.md): trained in ``BLIND_CONFIG`` only (one window,
 #: one forcing), scored in tab_fit, tab_null and tab_damping beside ours
 BLIND_PRIORS = tuple(m for m, s in PRIOR_VARIANTS.items() if s.forcing == "learned")
 #: Reference models: not methods (no recovery, null or method result depends on them), so kept

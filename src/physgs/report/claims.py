@@ -492,7 +492,7 @@ def _parts_claims(df: pd.DataFrame, trees: Sequence[str]) -> list[tuple[Claim, l
 def _tracks_claims(
     null: pd.DataFrame, tracks: pd.DataFrame, trees: Sequence[str]
 ) -> list[tuple[Claim, list[float]]]:
-    """The 2D-track control's claims (issue 29): on the sparse tree it recovers omega better than
+    """The 2D-track control's claims: on the sparse tree it recovers omega better than
     the untrained null and matches ours (tab_null, in the ledger's joint K=32 configuration when
     the control is fitted there, else its first), and on every tree it extrapolates beyond the
     window at least as well as ours' Gaussians at the same tracked points (tab_tracks, the base
@@ -582,7 +582,7 @@ def _tracks_claims(
     return out
 
 
-#: methods of tab_null / tab_damping that read no wind (issue 42, docs/blind.md): the output-only
+#: methods of tab_null / tab_damping that read no wind (docs/blind.md): the output-only
 #: analysis (its method id, physgs.report.tables.OMA) and ours with a learned forcing
 BLIND = "ours_blind"
 
@@ -590,7 +590,7 @@ BLIND = "ours_blind"
 def _blind_claims(
     null: pd.DataFrame, damping: pd.DataFrame | None, trees: Sequence[str]
 ) -> list[tuple[Claim, list[float]]]:
-    """The forcing-free methods' claims (issue 42), in ``single`` (the one configuration both
+    """The forcing-free methods' claims, in ``single`` (the one configuration both
     run in), from tab_null / tab_damping rows whose column ``method`` is ``oma`` or
     ``ours_blind``; a claim whose rows are absent is not added.
 
