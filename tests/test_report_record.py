@@ -75,6 +75,19 @@ def _stamp():
     )
 
 
+def _record(r, out, tables=None, figures=None, summary=None):
+    """write_record over the run ``r`` (every table and figure unless given)."""
+    return record.write_record(
+        out,
+        stamp=_stamp(),
+        summary_md=summary or r / "summary.md",
+        claims_csv=r / "claims.csv",
+        claims_md=r / "claims.md",
+        tables=sorted((r / "tables").glob("*.csv")) if tables is None else tables,
+        figures=sorted((r / "figures").glob("*.png")) if figures is None else figures,
+    )
+
+
 def _parse_md_table(text):
     rows = [ln.strip().strip("|").split("|") for ln in text.strip().splitlines()]
     head, body = [c.strip() for c in rows[0]], rows[2:]
@@ -84,15 +97,7 @@ def _parse_md_table(text):
 def test_write_record_copies_every_table_as_csv_and_markdown_that_agree(tmp_path):
     r, fit, _ = _run(tmp_path)
     out = tmp_path / "record"
-    record.write_record(
-        out,
-        stamp=_stamp(),
-        summary_md=r / "summary.md",
-        claims_csv=r / "claims.csv",
-        claims_md=r / "claims.md",
-        tables=sorted((r / "tables").glob("*.csv")),
-        figures=sorted((r / "figures").glob("*.png")),
-    )
+    _record(r, out)
     assert (out / "tables" / "tab_fit.csv").read_bytes() == (r / "tables/tab_fit.csv").read_bytes()
     head, body = _parse_md_table((out / "tables" / "tab_fit.md").read_text())
     assert head == list(fit.columns)
@@ -118,15 +123,7 @@ def test_write_record_copies_every_table_as_csv_and_markdown_that_agree(tmp_path
 def test_figures_are_web_sized_and_keep_their_aspect(tmp_path):
     r, _, _ = _run(tmp_path)
     out = tmp_path / "record"
-    record.write_record(
-        out,
-        stamp=_stamp(),
-        summary_md=r / "summary.md",
-        claims_csv=r / "claims.csv",
-        claims_md=r / "claims.md",
-        tables=[],
-        figures=sorted((r / "figures").glob("*.png")),
-    )
+    _record(r, out, tables=[])
     with Image.open(out / "figures" / "fig_wide.png") as im:
         assert (im.width, im.height) == (record.FIGURE_WIDTH_PX, 300)
     with Image.open(out / "figures" / "fig_small.png") as im:
@@ -149,24 +146,8 @@ def test_a_missing_input_is_named_and_costs_outlive_a_new_record(tmp_path):
         ),
     )
     with pytest.raises(FileNotFoundError, match="summary.md"):
-        record.write_record(
-            out,
-            stamp=_stamp(),
-            summary_md=r / "nope" / "summary.md",
-            claims_csv=r / "claims.csv",
-            claims_md=r / "claims.md",
-            tables=[],
-            figures=[],
-        )
-    record.write_record(
-        out,
-        stamp=_stamp(),
-        summary_md=r / "summary.md",
-        claims_csv=r / "claims.csv",
-        claims_md=r / "claims.md",
-        tables=[],
-        figures=[],
-    )
+        _record(r, out, tables=[], figures=[], summary=r / "nope" / "summary.md")
+    _record(r, out, tables=[], figures=[])
     assert record.read_costs(out / "costs.csv")["wall_s"].tolist() == [100.0]
 
 

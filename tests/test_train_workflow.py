@@ -94,16 +94,18 @@ def test_tab_damping_plans_ours_on_both_testbeds_of_each_tree():
     """tab_damping (default profile: the quick one builds no damping testbed) trains the priors
     alone (ours and the chained prior), in the benchmark's configurations, per seed, on each tree
     and its <tree>_damping copy, whose dataset is built by the same testbed rule with the damping
-    variant; and ours in the 2D-track control's other configurations on the faithful trees (the
-    control scores every configuration of a tree and seed in one job)."""
+    variant; the forcing-free priors in their one configuration there too; and ours in the 2D-track
+    control's other configurations on the faithful trees (the control scores every configuration
+    of a tree and seed in one job)."""
     from physgs import config as pconfig
-    from physgs.models.registry import models_of
+    from physgs.models.registry import BLIND_CONFIG, BLIND_PRIORS, models_of
 
     cfg = pconfig.load(ROOT / "config" / "trees.yaml", "default")
     db = cfg["damping_benchmark"]
     r = _dry_run("results/tables/tab_damping.tex", profile="default")
     assert r.returncode == 0, r.stderr[-2000:] + r.stdout[-2000:]
-    priors = "|".join(sorted(models_of("prior"), key=len, reverse=True))
+    ids = (*models_of("prior"), *BLIND_PRIORS)
+    priors = "|".join(sorted(ids, key=len, reverse=True))
     trained = set(re.findall(rf"results/models/(\w+)/seed(\d+)/({priors})_(\w+)\.pt", r.stdout))
     want = {
         (tb, str(s), m, c)
@@ -118,6 +120,13 @@ def test_tab_damping_plans_ours_on_both_testbeds_of_each_tree():
         for t in db["trees"]
         for s in cfg["seeds"]
         for c in cfg["tracks"]["configs"]
+    }
+    want |= {  # the forcing-free priors' rows, in their one configuration
+        (tb, str(s), m, BLIND_CONFIG)
+        for t in db["trees"]
+        for tb in (t, f"{t}_damping")
+        for s in cfg["seeds"]
+        for m in BLIND_PRIORS
     }
     assert trained == want
     built = [b for b in _blocks(r.stdout, "testbed_dataset") if "_damping/observed" in b]
