@@ -288,9 +288,11 @@ def cost_lines(costs: pd.DataFrame) -> list[str]:
         if r is None:
             lines.append(f"| `{command}` | not measured | |")
             continue
-        start = "from nothing" if bool(r["from_nothing"]) else "on a finished run"
+        start = ""  # where a run starts from says something only of a workflow's targets
+        if command.startswith("snakemake"):
+            start = " (from nothing)" if bool(r["from_nothing"]) else " (on a finished run)"
         lines.append(
-            f"| `{command}` | {format_duration(float(r['wall_s']))} ({start}) | "
+            f"| `{command}` | {format_duration(float(r['wall_s']))}{start} | "
             f"{r['date']}, commit `{r['commit']}`, {r['cpu']} |"
         )
     return lines
