@@ -31,6 +31,12 @@ def test_figures_write_pdf_and_png(tmp_path):
         )
     }
     FG.fig_damping(d, ["medium"], ["single"], 0.08, [tmp_path / "d.pdf"])
+    chain = {("medium", "single"): d[("medium", "single")]}
+    FG.fig_damping(d, ["medium"], ["single"], 0.08, [tmp_path / "c.png"], {"ours_chain": chain})
+    assert (tmp_path / "c.png").stat().st_size > 1000
+    (tmp_path / "c.png").unlink()
+    with pytest.raises(KeyError, match="of ours_chain for \\(medium, single\\)"):
+        FG.fig_damping(d, ["medium"], ["single"], 0.08, [tmp_path / "x.png"], {"ours_chain": {}})
     for name in ("t.pdf", "t.png", "s.png", "q.png", "d.pdf"):
         assert (tmp_path / name).stat().st_size > 1000
     assert (tmp_path / "t.png").read_bytes()[:4] == b"\x89PNG"

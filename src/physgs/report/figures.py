@@ -260,37 +260,57 @@ def fig_damping(
     configs: Sequence[str],
     zeta_true: float,
     outputs: Sequence[str | Path],
+    priors: Mapping[str, Mapping[tuple[str, str], object]] | None = None,
 ) -> None:
     """Left: zeta_hat per part for each tree and config against the true ratio (line).
     Right: decay rate gamma_hat = zeta_hat * omega_hat (1/s) against omega_hat (rad/s), log-log,
     with the ground-truth line gamma = zeta_true * omega.
 
-    damping[(tree, config)]: ``DampingResult``.
+    Args:
+        damping (Mapping): ours' ``DampingResult`` per ``(tree, config)``.
+        trees (Sequence[str]): the trees, in column order.
+        configs (Sequence[str]): the configurations, in column order.
+        zeta_true (float): the testbed's damping ratio.
+        outputs (Sequence[str | Path]): the files to write (PDF, PNG).
+        priors (Mapping | None): the other priors' ``DampingResult`` per model id and
+            ``(tree, config)``, each drawn beside ours' column (hollow markers on the right).
+
+    Raises:
+        KeyError: naming a ``(tree, config)`` (and model) without a result.
     """
     fig, (a0, a1) = plt.subplots(1, 2, figsize=(10, 3.8))
     tree_colors = dict(zip(trees, ["tab:green", "tab:blue", "tab:red", "tab:purple"]))
     markers = dict(zip(configs, ["o", "s", "^", "D"]))
     pos, labels, allw = 0, [], []
+    sources = {"ours": damping, **(priors or {})}
     for t in trees:
         for c in configs:
-            if (t, c) not in damping:
-                raise KeyError(f"fig_damping: no damping result for ({t}, {c})")
-            d = damping[(t, c)]
-            jitter = np.random.default_rng(pos).uniform(-0.15, 0.15, len(d.zeta))  # display only
-            a0.scatter(pos + jitter, d.zeta, s=6, color=tree_colors[t], alpha=0.5)
-            a0.plot([pos - 0.3, pos + 0.3], [d.median_zeta] * 2, color="k", lw=1.5)
-            labels.append(f"{t} {c}")
-            pos += 1
-            a1.scatter(
-                d.omega,
-                d.gamma,
-                s=8,
-                color=tree_colors[t],
-                marker=markers[c],
-                alpha=0.6,
-                label=f"{t}, {c} (median $\\hat\\zeta$ {d.median_zeta:.3f})",
-            )
-            allw.append(d.omega)
+            for model, results in sources.items():
+                if (t, c) not in results:
+                    who = "" if model == "ours" else f" of {model}"
+                    raise KeyError(f"fig_damping: no damping result{who} for ({t}, {c})")
+                d = results[(t, c)]
+                jitter = np.random.default_rng(pos).uniform(-0.15, 0.15, len(d.zeta))  # display
+                a0.scatter(pos + jitter, d.zeta, s=6, color=tree_colors[t], alpha=0.5)
+                a0.plot([pos - 0.3, pos + 0.3], [d.median_zeta] * 2, color="k", lw=1.5)
+                tag = "" if model == "ours" else f" {label(model).split(' (')[0].lower()}"
+                labels.append(f"{t} {c}{tag}")
+                pos += 1
+                a1.scatter(
+                    d.omega,
+                    d.gamma,
+                    s=8,
+                    marker=markers[c],
+                    alpha=0.6,
+                    # ours filled, the other priors hollow in the same colour
+                    **(
+                        {"color": tree_colors[t]}
+                        if model == "ours"
+                        else {"facecolors": "none", "edgecolors": tree_colors[t]}
+                    ),
+                    label=f"{t}, {c}{tag} (median $\\hat\\zeta$ {d.median_zeta:.3f})",
+                )
+                allw.append(d.omega)
     a0.axhline(zeta_true, color="k", ls="--", lw=0.8, label=f"truth $\\zeta$ = {zeta_true}")
     a0.set_xticks(range(pos))
     a0.set_xticklabels(labels, fontsize=7, rotation=40, ha="right")

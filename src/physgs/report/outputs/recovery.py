@@ -302,16 +302,31 @@ def _fig_damping(path, settings, inputs, out):
     damping = {
         (t, c): load_recovery(path("recovery", t, c, s0)).damping for t in trees for c in configs
     }
-    figures.fig_damping(damping, trees, configs, float(settings["zeta"]), out)
+    priors = {
+        m: {
+            (t, c): load_recovery(path("prior_recovery", t, m, c, s0)).damping
+            for t in trees
+            for c in configs
+        }
+        for m in other_priors()
+    }
+    figures.fig_damping(damping, trees, configs, float(settings["zeta"]), out, priors=priors)
 
 
 FIG_DAMPING = Output(
     "fig_damping",
     "figure",
     ("prior",),
-    lambda plan, seeds: [
-        ("recovery", t, c, s) for s in seeds for t in plan.trees for c in plan.configs
-    ],
+    lambda plan, seeds: (
+        [("recovery", t, c, s) for s in seeds for t in plan.trees for c in plan.configs]
+        + [
+            ("prior_recovery", t, m, c, s)
+            for s in seeds
+            for t in plan.trees
+            for m in other_priors()
+            for c in plan.configs
+        ]
+    ),
     _fig_damping,
     settings=lambda cfg: {**_configs(cfg), "zeta": float(cfg["testbed"]["zeta"])},
     seeds="first",
