@@ -27,6 +27,7 @@ from physgs.report.claims import (
     RATE_EXPONENT,
     Claim,
     _per_seed,
+    damping_offsets,
 )
 from physgs.report.claims import _cell as _value
 
@@ -176,7 +177,7 @@ def prior_claims(
                     "<",
                     "fraction",
                 ),
-                [abs(v["median_zeta"] - v["zeta_true"]) / v["zeta_true"] for v in dmp],
+                damping_offsets(dmp),
             )
         )
         out.append(

@@ -109,7 +109,7 @@ def _cell(x) -> str:
         if not math.isfinite(x):
             return "--"
         return f"{x:.4g}"
-    if x is None or (isinstance(x, float) and math.isnan(x)):
+    if x is None:
         return "--"
     return str(x).replace("|", "\\|")
 
