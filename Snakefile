@@ -50,6 +50,7 @@ RUN = [
     rules.report.input,
     expand(TABLE, name="tab_kselect", ext=("tex", "csv")),
     rules.claims.output,
+    rules.oma.input,  # the stabilisation diagrams (the records are in tab_null / tab_damping)
 ]
 
 

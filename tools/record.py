@@ -61,11 +61,12 @@ def main() -> None:
         print(f"{args.out}: {len(written)} files")
     if not (args.out / "stamp.json").is_file():
         record.write_unrecorded(args.out)
-    (args.out / "found.md").write_text("\n".join(record.found_lines(args.out)))
+    found = record.found_lines(args.out)
+    (args.out / "found.md").write_text("\n".join(found))
     costs = record.cost_lines(record.read_costs(args.out / "costs.csv"))
     (args.out / "costs.md").write_text("\n".join(costs) + "\n")
     text = args.readme.read_text()
-    args.readme.write_text(record.replace_block(text, record.readme_block(args.out)))
+    args.readme.write_text(record.replace_block(text, record.readme_block(found)))
     print(f"{args.readme}: the record block rewritten")
 
 

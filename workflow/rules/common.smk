@@ -42,17 +42,12 @@ PRIORS = ["ours", *PARTS_MODELS]  # every oscillator prior the run trains
 REPORT_PLAN = _build.Plan.from_config(CFG)
 STAMP = _provenance.stamp(CFG)  # not a rerun trigger (see physgs.provenance.Stamp)
 # the 2D-track control (docs/tracks.md): ours' oscillators fitted to point tracks of the training
-# video, in these of ours' configurations, each with its K (tracks/K or the configuration's)
+# video, in these of ours' configurations (each with its K: physgs.tracks.settings.parts)
 TRACKS_CONFIGS = list(CFG["tracks"]["configs"])
-TRACKS_K = {c: _tracks.parts(CFG, c)[0] for c in TRACKS_CONFIGS}
 # on a damping testbed, the control runs in the damping benchmark's configurations only
 TRACKS_DAMPING_CONFIGS = [c for c in DAMPING["configs"] if c in TRACKS_CONFIGS]
-# (tree, configuration) pairs whose learned fields tab_tracks scores at the tracked points
 # output-only modal analysis of the training video (docs/blind.md): the configurations it runs in
 OMA_CONFIGS = list(CFG["oma"]["configs"])
-TRACKS_FIELD_PAIRS = [
-    (t, c) for t in TREES for c in TRACKS_CONFIGS if _tracks.fields_scored(CFG, c, t)
-]
 
 # ---- file layout ------------------------------------------------------------------------------
 # The testbed is one fixed instance per tree (testbed seed CFG["seed"]); every result of a

@@ -70,7 +70,7 @@ rule fig_stabilisation:
         "../scripts/oma_figure.py"
 
 
-# every record and figure of the analysis (not yet in `all`: the tables read them once wired)
+# every record and figure of the analysis (part of `all`; tab_null and tab_damping read the records)
 rule oma:
     input:
         expand(OMA_RECOVERY, tree=TESTBEDS, seed=SEEDS, config=OMA_CONFIGS),

@@ -10,8 +10,10 @@ from physgs.tracks.store import load_fit, load_tracks, save_fit
 sm = snakemake  # noqa: F821 (injected by Snakemake)
 with job(sm) as log:
     observed = load_observed(sm.input.observed)
+    conditions = sorted({c for j in sm.params.jobs for c in j["conditions"]})
+    by_condition = {c: load_tracks(sm.input[f"c{c}"])[0] for c in conditions}  # read once
     for path, j in zip(sm.output.fits, sm.params.jobs, strict=True):
-        tracks = [load_tracks(sm.input[f"c{c}"])[0] for c in j["conditions"]]
+        tracks = [by_condition[c] for c in j["conditions"]]
         fit, osc = fit_job(tracks, observed, j)
         save_fit(path, fit, osc, j["K_key"], j["min_tracks"])
         load_fit(path)  # the file reads back before the job counts as done

@@ -364,19 +364,18 @@ class OscillatorPrior(BaseModel):
             theta0 = theta0 + self.pose_offset
         lab = self.part_labels
         c = self.canonical
-        if self.canonical_pose in ("frame0", "frame0_offset") and self.chain:
+        composed = self.chain and self.canonical_pose in ("frame0", "frame0_offset")
+        if self.canonical_pose != "rest" and not composed:
+            theta = theta - theta0  # one rotation per part: undoing frame 0's is the difference
+        if composed:
             means, quats = chain_deform_from(
                 c.means, c.quats, lab, self.axis, theta, theta0, self.pivot, self.levels
             )
         elif self.chain:
-            if self.canonical_pose != "rest":
-                theta = theta - theta0
             means, quats = chain_deform(
                 c.means, c.quats, lab, self.axis, theta, self.pivot, self.levels
             )
         else:
-            if self.canonical_pose != "rest":  # one rotation: undoing frame 0's is the difference
-                theta = theta - theta0
             means, quats = rotate_parts(c.means, c.quats, lab, self.axis, theta, self.pivot)
         return GaussianState(
             means,

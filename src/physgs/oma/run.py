@@ -181,6 +181,7 @@ def recover_oma(
             float(np.asarray(observed.vbar)[0]),
             dt,
             sub,
+            guard=float(solver["rk4_guard"]),  # the guard the substeps were sized for
         ).numpy()  # [K, L+F]
     th[~est] = 0.0  # no estimate: correlates with nothing, never trusted
     rec = score_recovery(

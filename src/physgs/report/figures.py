@@ -293,7 +293,7 @@ def fig_damping(
                 jitter = np.random.default_rng(pos).uniform(-0.15, 0.15, len(d.zeta))  # display
                 a0.scatter(pos + jitter, d.zeta, s=6, color=tree_colors[t], alpha=0.5)
                 a0.plot([pos - 0.3, pos + 0.3], [d.median_zeta] * 2, color="k", lw=1.5)
-                tag = "" if model == "ours" else f" {label(model).split(' (')[0].lower()}"
+                tag = "" if model == "ours" else f" {spec_of(model).short.lower()}"
                 labels.append(f"{t} {c}{tag}")
                 pos += 1
                 a1.scatter(

@@ -173,11 +173,12 @@ def write_record(
     for p in inputs:
         if not p.is_file():
             raise FileNotFoundError(f"{p}: missing; finish the run first (snakemake --cores 2 all)")
-    out = Path(out_dir)
-    costs = out / "costs.csv"
-    kept = costs.read_bytes() if costs.is_file() else None
+    final = Path(out_dir)
+    kept = (final / "costs.csv").read_bytes() if (final / "costs.csv").is_file() else None
+    out = final.with_name(final.name + ".partial")  # the old record stands until this is whole
     if out.exists():
         shutil.rmtree(out)
+    costs = out / "costs.csv"
     (out / "tables").mkdir(parents=True)
     (out / "figures").mkdir()
     written: list[Path] = []
@@ -232,7 +233,12 @@ def write_record(
             ]
         ),
     )
-    return written
+    old = final.with_name(final.name + ".old")
+    if final.exists():
+        final.rename(old)
+    out.rename(final)
+    shutil.rmtree(old, ignore_errors=True)
+    return [final / p.relative_to(out) for p in written]
 
 
 def write_unrecorded(out_dir: str | Path) -> Path:
@@ -307,14 +313,13 @@ def read_costs(path: str | Path) -> pd.DataFrame:
     return pd.read_csv(p, dtype=text)  # a commit of digits or a command `true` stays text
 
 
-def readme_block(record_dir: str | Path) -> str:
-    """The README's "what it found" and "what it costs" block, from a record folder.
+def readme_block(found: Sequence[str]) -> str:
+    """The README's "what it found" and "what it costs" block around :func:`found_lines`.
 
     Args:
-        record_dir: the record (``docs/record``); where it holds no ledger yet, the block says so.
+        found (Sequence[str]): the lines of :func:`found_lines` of the record.
     """
-    lines = [BEGIN, "", *found_lines(record_dir), END]
-    return "\n".join(lines)
+    return "\n".join([BEGIN, "", *found, END])
 
 
 def found_lines(record_dir: str | Path) -> list[str]:

@@ -769,8 +769,7 @@ def tab_margin(
     fmt = f".{int(digits)}f"
     lines = ["  \\begin{tabular}{l" + "c" * len(cols) + "}", "    \\toprule"]
     for k, p in enumerate(priors):  # the first prior's block under the conditions' heading
-        name = "Ours" if p == "ours" else label(p)
-        what = rf"{name} $-$ (Deformation MLP $+$\,wind)"
+        what = rf"{label(p)} $-$ (Deformation MLP $+$\,wind)"
         if k == 0:
             heads = " & ".join(condition_label(m) for m in conditions)
             lines += [f"    {what} & {heads}" + r" \\", "    \\midrule"]
