@@ -101,7 +101,11 @@ def test_stabilisation_diagram_covers_every_order():
 def test_short_record_or_high_order_stops_naming_the_key():
     with pytest.raises(ValueError, match="oma/ssi/block_rows"):
         check_record(100, 10, SSISettings(block_rows=30, order_max=20))
-    with pytest.raises(ValueError, match="oma/ssi/order_max"):
+    with pytest.raises(ValueError, match="oma/ssi/order_max") as e:
         check_record(1000, 1, SSISettings(block_rows=10, order_max=20))
+    assert (e.value.key, e.value.msg.split()[:2]) == ("oma/ssi/order_max", ["=", "20"])
+    with pytest.raises(ValueError, match="oma/ssi has no channels") as e:
+        check_record(1000, 0, SSISettings())
+    assert e.value.key == "oma/ssi"  # a config check reads the key, not the text
     with pytest.raises(ValueError, match="oma/ssi/block_rows"):
         identify(np.zeros((50, 4)), FS, SSISettings(block_rows=30))

@@ -221,13 +221,12 @@ def oma_is_runnable(cfg: dict) -> Iterator[Problem]:
                 f"'{c}' is not one of models/configs {sorted(cfg['models']['configs'])}: the "
                 "analysis runs in ours' configurations (their winds' videos and K)",
             )
-    from physgs.oma.ssi import SSISettings, check_record
+    from physgs.oma.ssi import RecordError, SSISettings, check_record
 
     try:
         check_record(int(cfg["testbed"]["n_train"]), int(o["components"]), SSISettings(**o["ssi"]))
-    except ValueError as e:
-        key, _, msg = str(e).partition(" ")
-        yield tuple(key.split("/")), f"{msg} (testbed/n_train, oma/components)"
+    except RecordError as e:
+        yield tuple(e.key.split("/")), f"{e.msg} (testbed/n_train, oma/components)"
 
 
 #: The calm must last at least this many periods of the slowest band frequency (band_hz[0]) to

@@ -39,6 +39,16 @@ class SSISettings:
     min_stable: int = 5
 
 
+class RecordError(ValueError):
+    """A record that cannot carry the requested model: ``key`` (a config key path, ``/``-joined)
+    and ``msg`` apart, so a config check can name the key without parsing the text."""
+
+    def __init__(self, key: str, msg: str):
+        """Keep the key and the message; the text is ``"<key> <msg>"``."""
+        super().__init__(f"{key} {msg}")
+        self.key, self.msg = key, msg
+
+
 def check_record(n_samples: int, n_channels: int, s: SSISettings, key: str = "oma/ssi") -> None:
     """Stop before any work when the record cannot carry the requested model.
 
@@ -46,24 +56,30 @@ def check_record(n_samples: int, n_channels: int, s: SSISettings, key: str = "om
     ``n_samples - 2 block_rows`` products; at least as many again as lags), and a model order no
     higher than the Hankel matrix's rank bound ``block_rows * n_channels``. Raises ValueError
     naming the key (``<key>/block_rows`` or ``<key>/order_max``).
+
+    Raises:
+        RecordError: naming the key and what the record lacks.
     """
     if n_channels < 1:
-        raise ValueError(f"{key}: no channels to identify from (0 channels)")
+        raise RecordError(key, "has no channels to identify from (0 channels)")
     if n_samples < 4 * s.block_rows:
-        raise ValueError(
-            f"{key}/block_rows = {s.block_rows} needs a record of at least 4 x {s.block_rows} ="
-            f" {4 * s.block_rows} samples; this one has {n_samples}"
+        raise RecordError(
+            f"{key}/block_rows",
+            f"= {s.block_rows} needs a record of at least 4 x {s.block_rows} ="
+            f" {4 * s.block_rows} samples; this one has {n_samples}",
         )
     if s.order_max > s.block_rows * n_channels:
-        raise ValueError(
-            f"{key}/order_max = {s.order_max} exceeds block_rows x channels ="
+        raise RecordError(
+            f"{key}/order_max",
+            f"= {s.order_max} exceeds block_rows x channels ="
             f" {s.block_rows} x {n_channels} = {s.block_rows * n_channels}, the highest order"
-            " the Hankel matrix can carry"
+            " the Hankel matrix can carry",
         )
     if s.min_stable > s.order_max // s.order_step:
-        raise ValueError(
-            f"{key}/min_stable = {s.min_stable} exceeds the {s.order_max // s.order_step} model"
-            " orders tried (order_max / order_step)"
+        raise RecordError(
+            f"{key}/min_stable",
+            f"= {s.min_stable} exceeds the {s.order_max // s.order_step} model"
+            " orders tried (order_max / order_step)",
         )
 
 
