@@ -32,7 +32,7 @@ class SSISettings:
     block_rows: int = 20
     order_max: int = 40
     order_step: int = 2
-    err_fn: float = 0.02
+    err_fn: float = 0.05
     err_xi: float = 0.2
     err_phi: float = 0.05
     xi_max: float = 0.2
