@@ -25,33 +25,11 @@ from dataclasses import replace
 import numpy as np
 
 import physgs.config
+from physgs.oma.agreement import reproduced_modes
 from physgs.oma.channels import flow_channels, principal_channels
 from physgs.oma.run import OMASettings
 from physgs.oma.ssi import identify
 from physgs.testbed.dataset import load_observed
-
-
-def reproduced(modes: list[tuple[np.ndarray, np.ndarray]]) -> tuple[int, int]:
-    """Modes reproduced in every other record, and modes found, summed over the records.
-
-    Args:
-        modes: per record, (freq_hz [M_r], zeta [M_r]).
-
-    Returns:
-        (reproduced, found).
-    """
-    hit = found = 0
-    for r, (f, z) in enumerate(modes):
-        found += f.size
-        for fi, zi in zip(f, z):
-            ok = True
-            for q, (g, w) in enumerate(modes):
-                if q == r:
-                    continue
-                tol = 0.5 * (zi + w) * 0.5 * (fi + g)  # [M_q] half-power half-bandwidths
-                ok &= bool(np.any(np.abs(g - fi) <= tol))
-            hit += ok
-    return hit, found
 
 
 def main() -> None:
@@ -69,7 +47,9 @@ def main() -> None:
     for tb in args.testbeds:
         obs = load_observed(f"{tb}/observed.npz")
         videos = [obs.frames[c, : obs.n_train] for c in range(obs.frames.shape[0])]
-        chans = [flow_channels(v, obs.background, base.flow, reference=videos[0][0]) for v in videos]
+        chans = [
+            flow_channels(v, obs.background, base.flow, reference=videos[0][0]) for v in videos
+        ]
         ys = [c.y - c.y.mean(axis=0) for c in chans]
         stacked = np.concatenate(ys)
         _, pcs = principal_channels(stacked, min(base.components, *stacked.shape))
@@ -80,12 +60,14 @@ def main() -> None:
                 m = identify(y @ pcs.T, obs.fps, s)
                 keep = (m.freq_hz >= base.omega_hz[0]) & (m.freq_hz <= base.omega_hz[1])
                 per.append((m.freq_hz[keep], m.zeta[keep]))
-            hit, found = reproduced(per)
+            hit, found = reproduced_modes(per)
             totals[e][0] += hit
             totals[e][1] += found
             counts = "/".join(str(f.size) for f, _ in per)
-            print(f"{tb.rstrip('/').split('/')[-1]:<10}{e:>8.3f}{counts:>20}{hit:>12}"
-                  f"{hit / max(found, 1):>8.2f}")
+            print(
+                f"{tb.rstrip('/').split('/')[-1]:<10}{e:>8.3f}{counts:>20}{hit:>12}"
+                f"{hit / max(found, 1):>8.2f}"
+            )
     best = max(grid, key=lambda e: (totals[e][0], totals[e][0] / max(totals[e][1], 1)))
     print("\nall trees: " + ", ".join(f"{e}: {h}/{f}" for e, (h, f) in totals.items()))
     print(f"chosen err_fn: {best}")
