@@ -143,6 +143,7 @@ def test_a_missing_input_is_named_and_costs_outlive_a_new_record(tmp_path):
             commit="c",
             cpu="x",
             from_nothing=True,
+            segments=1,
         ),
     )
     with pytest.raises(FileNotFoundError, match="summary.md"):
@@ -195,6 +196,28 @@ def test_timed_records_a_command_and_passes_a_failure_on(tmp_path):
     )
     assert bad.returncode == 1
     assert record.read_costs(costs)["name"].tolist() == ["tests"]
+
+
+def test_a_resumed_run_records_the_sum_of_its_segments(tmp_path):
+    costs = tmp_path / "costs.csv"
+    cmd = [sys.executable, "tools/timed.py", "--name", "all", "--costs", str(costs)]
+    ok = subprocess.run(
+        [*cmd, "--from-nothing", "--earlier", "3600", "1800", "--", "true"],
+        cwd=ROOT,
+        capture_output=True,
+        text=True,
+    )
+    assert ok.returncode == 0, ok.stderr
+    row = record.read_costs(costs).iloc[0]
+    assert 5400 <= row["wall_s"] < 5430 and row["segments"] == 3
+    line = [ln for ln in record.cost_lines(record.read_costs(costs)) if "cores 2 all`" in ln][0]
+    assert "1 h 30 min" in line and "(from nothing), in 3 segments" in line
+
+
+def test_costs_recorded_before_segments_read_as_one_segment(tmp_path):
+    old = tmp_path / "costs.csv"
+    old.write_text("name,command,wall_s,date,commit,cpu,from_nothing\nall,x,60.0,d,c,u,True\n")
+    assert record.read_costs(old)["segments"].tolist() == [1]
 
 
 def test_readme_and_home_page_say_what_the_record_holds():

@@ -1,12 +1,17 @@
 """Run a command, measure its wall time, and record it as that command's cost.
 
-    python tools/timed.py --name all [--from-nothing] -- snakemake --cores 2 all
+    python tools/timed.py --name all [--from-nothing] [--earlier S ...] -- snakemake --cores 2 all
 
 Runs the command (its output goes through), then sets the row `--name` of
 `docs/record/costs.csv` (`physgs.report.record.record_costs`): the command, its wall time, the
 date, the commit and the machine's CPU. The README's "what each command costs" lines are printed
 from that file (`python tools/record.py --readme-only`). Names the README reads:
 `physgs.report.record.COMMANDS`. A command that fails records nothing and passes its exit code on.
+
+A run interrupted and resumed with the same command (a long pipeline spanning two sessions) is
+one cost: give each earlier segment's wall seconds with `--earlier` (for a Snakemake run, from
+its start to its last finished job in `.snakemake/log/`), and the row records their sum with
+this segment's and the number of segments.
 """
 
 from __future__ import annotations
@@ -27,6 +32,14 @@ def main() -> int:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--name", required=True, choices=[n for n, _ in record.COMMANDS])
     ap.add_argument("--from-nothing", action="store_true", help="results/ was removed first")
+    ap.add_argument(
+        "--earlier",
+        nargs="+",
+        type=float,
+        default=[],
+        metavar="S",
+        help="wall seconds of earlier segments of the same run (resumed with the same command)",
+    )
     ap.add_argument("--costs", default="docs/record/costs.csv", type=Path)
     ap.add_argument("command", nargs=argparse.REMAINDER)
     args = ap.parse_args()
@@ -35,7 +48,7 @@ def main() -> int:
         ap.error("no command given (after --)")
     t0 = time.monotonic()
     rc = subprocess.call(cmd)
-    wall = time.monotonic() - t0
+    wall = time.monotonic() - t0 + sum(args.earlier)
     if rc != 0:
         print(f"{shlex.join(cmd)}: exit {rc}; no cost recorded", file=sys.stderr)
         return rc
@@ -49,6 +62,7 @@ def main() -> int:
             "commit": git_commit(),
             "cpu": machine_cpu(),
             "from_nothing": args.from_nothing,
+            "segments": 1 + len(args.earlier),
         },
     )
     print(f"{args.name}: {record.format_duration(wall)} recorded in {args.costs}")

@@ -45,7 +45,7 @@ COMMANDS: tuple[tuple[str, str], ...] = (
 )
 #: Widest figure in the record, px: the documentation's content column.
 FIGURE_WIDTH_PX = 1200
-COSTS_COLUMNS = ("name", "command", "wall_s", "date", "commit", "cpu", "from_nothing")
+COSTS_COLUMNS = ("name", "command", "wall_s", "date", "commit", "cpu", "from_nothing", "segments")
 BEGIN, END = "<!-- record:begin -->", "<!-- record:end -->"
 
 
@@ -297,6 +297,9 @@ def cost_lines(costs: pd.DataFrame) -> list[str]:
         start = ""  # where a run starts from says something only of a workflow's targets
         if command.startswith("snakemake"):
             start = " (from nothing)" if bool(r["from_nothing"]) else " (on a finished run)"
+        n = int(r["segments"])
+        if n > 1:  # a run resumed after an interruption: its wall time is the segments' sum
+            start += f", in {n} segments"
         lines.append(
             f"| `{command}` | {format_duration(float(r['wall_s']))}{start} | "
             f"{r['date']}, commit `{r['commit']}`, {r['cpu']} |"
@@ -309,8 +312,11 @@ def read_costs(path: str | Path) -> pd.DataFrame:
     p = Path(path)
     if not p.is_file():
         return pd.DataFrame(columns=list(COSTS_COLUMNS))
-    text = {c: str for c in COSTS_COLUMNS if c not in ("wall_s", "from_nothing")}
-    return pd.read_csv(p, dtype=text)  # a commit of digits or a command `true` stays text
+    text = {c: str for c in COSTS_COLUMNS if c not in ("wall_s", "from_nothing", "segments")}
+    df = pd.read_csv(p, dtype=text)  # a commit of digits or a command `true` stays text
+    if "segments" not in df:  # rows recorded before runs could be resumed: one command each
+        df["segments"] = 1
+    return df
 
 
 def readme_block(found: Sequence[str]) -> str:
