@@ -1,18 +1,31 @@
 """What a finished pipeline run cost: job-seconds per stage and seed, and what one more seed adds.
 
     python benchmarks/pipeline_cost.py [--benchmarks results/benchmarks] [--wall-s SECONDS]
+        [--target TARGET ...]
 
 Reads every Snakemake benchmark file of the run (physgs.experiments.cost) and prints job wall
 seconds by stage, per training seed and shared (testbeds), the damping benchmark's share, and,
 given the run's measured wall time (``--wall-s``, e.g. from ``/usr/bin/time``), the wall time one
-more seed would add on the same machine and core count.
+more seed would add on the same machine and core count. With ``--target``, what a run of those
+targets from nothing would cost, from the same run's measured jobs (``snakemake -n --forceall``
+lists the plan; each planned job's benchmark file gives its seconds), scaled to wall time by the
+finished run's own ratio of wall time to job time (``--wall-s``): an estimate for a reader who
+wants one table (``--target results/tables/tab_null.tex``), not a measurement.
 """
 
 from __future__ import annotations
 
 import argparse
+import subprocess
 
-from physgs.experiments.cost import extra_seed_wall_s, read_costs, resources_by_stage, summarise
+from physgs.experiments.cost import (
+    extra_seed_wall_s,
+    plan_cost,
+    plan_jobs,
+    read_costs,
+    resources_by_stage,
+    summarise,
+)
 
 
 def _min(s: float) -> str:
@@ -23,8 +36,12 @@ def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--benchmarks", default="results/benchmarks")
     ap.add_argument("--wall-s", type=float, default=None, help="the run's measured wall seconds")
+    ap.add_argument("--target", nargs="+", default=None, help="Snakemake targets to cost")
     args = ap.parse_args()
     jobs = read_costs(args.benchmarks)
+    if args.target:
+        target_cost(args.target, jobs, args.benchmarks, args.wall_s, summarise(jobs)["total_s"])
+        return
     summary = summarise(jobs)
     seeds = list(summary["per_seed"])
     cols = ["shared", *seeds]
@@ -58,6 +75,30 @@ def main() -> None:
         print(
             f"run wall time {_min(args.wall_s).strip()} min = {args.wall_s / summary['total_s']:.2f} x "
             f"job time; one more seed adds ~{_min(extra).strip()} min of wall time"
+        )
+
+
+def target_cost(targets, jobs, benchmarks, wall_s, run_job_s) -> None:
+    """Print the cost of a run of ``targets`` from nothing, from the finished run's jobs."""
+    dry = subprocess.run(
+        ["snakemake", "-n", "--forceall", *targets], capture_output=True, text=True, check=True
+    ).stdout
+    cost = plan_cost(plan_jobs(dry), jobs, benchmarks)
+    print(f"{' '.join(targets)}: job minutes by rule (measured in the finished run)")
+    for rule, (n, s) in sorted(cost["by_rule"].items(), key=lambda kv: -kv[1][1]):
+        print(f"{rule:<24}{n:>5} jobs{_min(s)} job-min")
+    print(
+        f"{'total':<24}{sum(n for n, _ in cost['by_rule'].values()):>5} jobs{_min(cost['job_s'])}"
+    )
+    light = ", ".join(f"{r} {n}" for r, n in sorted(cost["light"].items()))
+    print(f"jobs without a benchmark (not counted): {light or 'none'}")
+    if cost["unmeasured"]:
+        print(f"planned jobs the run did not measure: {cost['unmeasured']}")
+    if wall_s:
+        est = cost["job_s"] * wall_s / run_job_s
+        print(
+            f"estimated wall time: {_min(est).strip()} min (the run's {wall_s / run_job_s:.2f}"
+            " s of wall per job-second)"
         )
 
 

@@ -2,7 +2,13 @@
 
 import pytest
 
-from physgs.experiments.cost import extra_seed_wall_s, read_costs, summarise
+from physgs.experiments.cost import (
+    extra_seed_wall_s,
+    plan_cost,
+    plan_jobs,
+    read_costs,
+    summarise,
+)
 
 HEADER = "s\th:m:s\tmax_rss\tmax_vms\tmax_uss\tmax_pss\tio_in\tio_out\tmean_load\tcpu_time\n"
 
@@ -90,3 +96,51 @@ def test_resources_by_stage_read_cpu_and_peak_memory(tmp_path):
     }
     assert r["evaluate"]["jobs"] == 1 and r["evaluate"]["wall_max_s"] == 5.0
     assert r["evaluate"]["rss_max_mb"] != r["evaluate"]["rss_max_mb"]  # NaN, not 0
+
+
+DRY_RUN = """
+[Thu Nov 26 05:30:42 2026]
+rule testbed_dataset:
+    output: results/testbed/sparse/observed.npz, results/testbed/sparse/truth.npz
+    log: logs/testbed/sparse.log
+    jobid: 1
+    benchmark: results/benchmarks/testbed/sparse.tsv
+    wildcards: tree=sparse
+
+[Thu Nov 26 05:30:42 2026]
+localrule train:
+    input: results/testbed/sparse/observed.npz
+    benchmark: results/benchmarks/train/sparse/seed0/ours_single.tsv
+    wildcards: tree=sparse, seed=0, model=ours, config=single
+
+rule recovery:
+    output: results/recovery/sparse/seed0/ours_single.json
+
+rule train:
+    benchmark: results/benchmarks/train/dense/seed0/ours_single.tsv
+
+localrule table:
+    output: results/tables/tab_null.tex
+"""
+
+
+def test_a_plan_is_read_job_by_job_with_its_benchmark():
+    assert plan_jobs(DRY_RUN) == [
+        ("testbed_dataset", "results/benchmarks/testbed/sparse.tsv"),
+        ("train", "results/benchmarks/train/sparse/seed0/ours_single.tsv"),
+        ("recovery", None),
+        ("train", "results/benchmarks/train/dense/seed0/ours_single.tsv"),
+        ("table", None),
+    ]
+
+
+def test_a_plan_costs_the_measured_seconds_of_its_jobs(bench):
+    planned = [
+        (r, b.replace("results/benchmarks", str(bench)) if b else None)
+        for r, b in plan_jobs(DRY_RUN)
+    ]
+    cost = plan_cost(planned, read_costs(bench), bench)
+    assert cost["job_s"] == 50.0 + 100.0  # the testbed and the sparse training
+    assert cost["by_rule"] == {"testbed_dataset": (1, 50.0), "train": (1, 100.0)}
+    assert cost["unmeasured"] == {"train": 1}  # the dense training did not run
+    assert cost["light"] == {"recovery": 1, "table": 1}

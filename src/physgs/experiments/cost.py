@@ -187,3 +187,59 @@ def resources_by_stage(jobs: list[JobCost]) -> dict[str, dict]:
             "rss_max_mb": stats([j.max_rss_mb for j in js])[1],
         }
     return out
+
+
+_BENCHMARK_LINE = re.compile(r"^\s*benchmark:\s*(\S+)\s*$")
+_RULE_LINE = re.compile(r"^\s*(?:local)?rule (\w+):\s*$")
+
+
+def plan_jobs(dry_run: str) -> list[tuple[str, str | None]]:
+    """The jobs of a Snakemake dry run's printout (``snakemake -n --forceall TARGET``).
+
+    Args:
+        dry_run: the printout; each job is a ``rule <name>:`` block whose ``benchmark:`` line,
+            if the rule declares one, gives the job's benchmark file.
+
+    Returns:
+        Per job, (rule name, benchmark path as printed, or None for a rule without one).
+    """
+    jobs: list[list] = []
+    for line in dry_run.splitlines():
+        m = _RULE_LINE.match(line)
+        if m:
+            jobs.append([m.group(1), None])
+            continue
+        b = _BENCHMARK_LINE.match(line)
+        if b and jobs:
+            jobs[-1][1] = b.group(1)
+    return [(r, b) for r, b in jobs]
+
+
+def plan_cost(planned: list[tuple[str, str | None]], jobs: list[JobCost], benchmark_dir) -> dict:
+    """What a target's plan would cost, from a finished run's measured jobs.
+
+    Args:
+        planned: the plan's jobs (``plan_jobs``).
+        jobs: the finished run's benchmarked jobs (``read_costs(benchmark_dir)``).
+        benchmark_dir: the folder ``jobs`` were read from (the planned paths start with it).
+
+    Returns:
+        {"job_s": benchmarked job-seconds of the planned jobs that the run measured,
+        "by_rule": {rule: [jobs, job_s]}, "unmeasured": {rule: jobs} (a benchmark the run did
+        not write), "light": {rule: jobs} (rules without a benchmark: tables, recovery)}.
+    """
+    root = Path(benchmark_dir)
+    wall = {j.path: j.wall_s for j in jobs}
+    out: dict = {"job_s": 0.0, "by_rule": {}, "unmeasured": {}, "light": {}}
+    for rule, bench in planned:
+        if bench is None:
+            out["light"][rule] = out["light"].get(rule, 0) + 1
+            continue
+        rel = str(Path(bench).relative_to(root).with_suffix(".tsv"))
+        if rel not in wall:
+            out["unmeasured"][rule] = out["unmeasured"].get(rule, 0) + 1
+            continue
+        n, s = out["by_rule"].get(rule, (0, 0.0))
+        out["by_rule"][rule] = (n + 1, s + wall[rel])
+        out["job_s"] += wall[rel]
+    return out
