@@ -75,7 +75,7 @@ def _stamp():
     )
 
 
-def _record(r, out, tables=None, figures=None, summary=None):
+def _record(r, out, tables=None, figures=None, summary=None, **kw):
     """write_record over the run ``r`` (every table and figure unless given)."""
     return record.write_record(
         out,
@@ -85,7 +85,23 @@ def _record(r, out, tables=None, figures=None, summary=None):
         claims_md=r / "claims.md",
         tables=sorted((r / "tables").glob("*.csv")) if tables is None else tables,
         figures=sorted((r / "figures").glob("*.png")) if figures is None else figures,
+        **kw,
     )
+
+
+def test_the_snakemake_report_is_copied_and_linked_only_when_given(tmp_path):
+    r, _, _ = _run(tmp_path)
+    out = tmp_path / "record"
+    _record(r, out)
+    assert (
+        not (out / "report.html").exists() and "report.html" not in (out / "index.md").read_text()
+    )
+    (r / "report.html").write_text("<html>the run</html>")
+    _record(r, out, report_html=r / "report.html")
+    assert (out / "report.html").read_text() == "<html>the run</html>"
+    assert "[report.html](record/report.html)" in (out / "index.md").read_text()
+    with pytest.raises(FileNotFoundError, match="nope.html"):
+        _record(r, out, report_html=r / "nope.html")
 
 
 def _parse_md_table(text):

@@ -1,6 +1,7 @@
 """The committed record of a finished default-profile run, and the README lines read from it.
 
     python tools/record.py [results] [--out docs/record] [--wall-s S] [--commit REV]
+        [--snakemake-report]
 
 Copies the run's summary, ledger, every table (CSV and Markdown) and every figure (PNG, web
 sized) into `docs/record/` with the run's stamp (`physgs.report.record.write_record`), then
@@ -8,13 +9,16 @@ rewrites the README's block between `<!-- record:begin -->` and `<!-- record:end
 (`physgs.report.record.readme_block`). The run's layout is the workflow's (`results/`:
 `summary.md`, `claims.{csv,md}`, `tables/*.csv`, `figures/*.png`, `benchmarks/`). The wall time
 is the benchmark files' span unless `--wall-s` gives the measured one (`tools/timed.py` measures
-it). `--readme-only` rewrites the README's block from the record already there.
+it). `--snakemake-report` also makes Snakemake's report of the run (`snakemake --report
+<results>/report.html all`) and puts it in the record, linked from its page. `--readme-only`
+rewrites the README's block from the record already there.
 """
 
 from __future__ import annotations
 
 import argparse
 import datetime
+import subprocess
 from pathlib import Path
 
 import pandas as pd
@@ -32,6 +36,7 @@ def main() -> None:
     ap.add_argument("--wall-s", type=float, help="the run's measured wall time, s")
     ap.add_argument("--commit", help="the commit the run was made at (default: git describe)")
     ap.add_argument("--readme-only", action="store_true")
+    ap.add_argument("--snakemake-report", action="store_true", help="add `snakemake --report`")
     args = ap.parse_args()
     if not args.readme_only:
         r = args.results
@@ -49,6 +54,10 @@ def main() -> None:
             wall_s=args.wall_s if args.wall_s is not None else wall_spans(jobs)["run_s"],
             job_min_by_stage={k: sum(v.values()) / 60 for k, v in sorted(by_stage.items())},
         )
+        report = None
+        if args.snakemake_report:
+            report = r / "report.html"
+            subprocess.run(["snakemake", "--report", str(report), "all"], check=True)
         written = record.write_record(
             args.out,
             stamp=stamp,
@@ -57,6 +66,7 @@ def main() -> None:
             claims_md=r / "claims.md",
             tables=sorted((r / "tables").glob("*.csv")),
             figures=sorted((r / "figures").glob("*.png")),
+            report_html=report,
         )
         print(f"{args.out}: {len(written)} files")
     if not (args.out / "stamp.json").is_file():

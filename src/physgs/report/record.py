@@ -151,6 +151,7 @@ def write_record(
     claims_md: str | Path,
     tables: Sequence[str | Path],
     figures: Sequence[str | Path],
+    report_html: str | Path | None = None,
 ) -> list[Path]:
     """Write a run's record into ``out_dir`` (replacing the record there).
 
@@ -162,6 +163,8 @@ def write_record(
         claims_md: the claims ledger as Markdown.
         tables: the run's table CSVs; each becomes ``tables/<name>.csv`` and ``.md``.
         figures: the run's figure PNGs; each becomes ``figures/<name>.png``, web-sized.
+        report_html: Snakemake's report of the same run (``snakemake --report``), copied as
+            ``report.html`` and linked from the record's page; None: no report.
 
     Returns:
         The files written.
@@ -169,7 +172,8 @@ def write_record(
     Raises:
         FileNotFoundError: naming the first input that is missing.
     """
-    inputs = [Path(p) for p in (summary_md, claims_csv, claims_md, *tables, *figures)]
+    extra = [report_html] if report_html is not None else []
+    inputs = [Path(p) for p in (summary_md, claims_csv, claims_md, *tables, *figures, *extra)]
     for p in inputs:
         if not p.is_file():
             raise FileNotFoundError(f"{p}: missing; finish the run first (snakemake --cores 2 all)")
@@ -210,6 +214,15 @@ def write_record(
         written.append(out / "figures" / f.name)
         gallery += [f"### `{f.stem}`", "", f"![{f.stem}](record/figures/{f.name})", ""]
     put("figures.md", "\n".join(gallery))
+    report_line = []
+    if report_html is not None:
+        shutil.copyfile(report_html, out / "report.html")
+        written.append(out / "report.html")
+        report_line = [
+            "The same run as Snakemake's report (every table, figure and job, browsable): "
+            "[report.html](record/report.html).",
+            "",
+        ]
     put(
         "index.md",
         "\n".join(
@@ -218,6 +231,7 @@ def write_record(
                 "",
                 '--8<-- "docs/record/stamp.md"',
                 "",
+                *report_line,
                 '--8<-- "docs/record/summary.md"',
                 "",
                 "## Every table",
