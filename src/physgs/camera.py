@@ -70,11 +70,12 @@ class Camera:
         """World-space rays through the pixel grid.
 
         Args:
-            supersample: s, sub-pixel samples per pixel side: an s x s regular grid inside each pixel.
+            supersample: s, sub-pixel samples per pixel side: an s x s regular grid inside each
+                pixel.
 
         Returns:
-            ``(origins, directions)``: origins [H*s, W*s, 3] (the camera centre, world units) and unit
-                directions [H*s, W*s, 3], row-major (image row = y).
+            ``(origins, directions)``: origins [H*s, W*s, 3] (the camera centre, world units) and
+                unit directions [H*s, W*s, 3], row-major (image row = y).
         """
         s = supersample
         u = (np.arange(self.width * s) + 0.5) / s
@@ -90,8 +91,8 @@ class Camera:
         """Flat arrays for np.savez.
 
         Returns:
-            ``viewmat`` [4, 4], ``intrinsics`` [4] (fx, fy, cx, cy in px), ``size`` [2] (width, height
-                in px) and ``near`` (a 0-d array, world units).
+            ``viewmat`` [4, 4], ``intrinsics`` [4] (fx, fy, cx, cy in px), ``size`` [2] (width,
+                height in px) and ``near`` (a 0-d array, world units).
         """
         return {
             "viewmat": self.viewmat,

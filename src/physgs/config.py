@@ -79,12 +79,13 @@ def partial_schema(node, defs: dict | None = None):
     of the one schema: types, ranges and unknown keys are still refused, missing keys are not.
 
     Args:
-        node (dict | list | Any): a JSON-schema node (dict), a list of nodes, or a leaf value (returned as is).
+        node (dict | list | Any): a JSON-schema node (dict), a list of nodes, or a leaf value
+            (returned as is).
         defs: the root ``$defs`` the ``$ref``s point into (default: ``node``'s own).
 
     Returns:
-        (dict | list | Any): The node rebuilt without ``required`` and ``$defs`` keys, each ``#/$defs/NAME`` reference
-            replaced by the definition merged with the node's other keys.
+        (dict | list | Any): The node rebuilt without ``required`` and ``$defs`` keys, each
+            ``#/$defs/NAME`` reference replaced by the definition merged with the node's other keys.
     """
     if defs is None and isinstance(node, dict):
         defs = node.get("$defs", {})
@@ -188,8 +189,8 @@ def scalar(value):
         value (Any): any value; only a ``str`` is read.
 
     Returns:
-        (Any): An ``int``, ``float``, ``bool`` or ``None`` where the stripped string spells one in YAML
-            1.2's core schema, else ``value`` unchanged.
+        (Any): An ``int``, ``float``, ``bool`` or ``None`` where the stripped string spells one in
+            YAML 1.2's core schema, else ``value`` unchanged.
     """
     if not isinstance(value, str):
         return value
@@ -229,8 +230,8 @@ def read_yaml(path: Path | str):
         path: the YAML file.
 
     Returns:
-        (Any): The file's contents (``yaml.safe_load``) with [`scalars`][physgs.config.scalars] applied;
-            ``None`` for an empty file.
+        (Any): The file's contents (``yaml.safe_load``) with [`scalars`][physgs.config.scalars]
+            applied; ``None`` for an empty file.
     """
     with open(path) as f:
         return scalars(yaml.safe_load(f))

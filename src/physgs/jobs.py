@@ -41,7 +41,8 @@ def output_locks(outputs, lock_dir: Path | str | None = None):
     ``flock``, not the file).
 
     Args:
-        outputs (Iterable[str | Path]): the output paths to lock (made absolute; duplicates locked once).
+        outputs (Iterable[str | Path]): the output paths to lock (made absolute; duplicates locked
+            once).
         lock_dir: where the lock files live (one per output, named by a hash of its path);
             default ``LOCK_DIR``.
 
@@ -91,7 +92,8 @@ def job(sm):
     traceback of a failure there too (not only to the console) before re-raising it.
 
     Args:
-        sm (snakemake.script.Snakemake): the script's ``snakemake`` object (reads ``threads``, ``output`` and ``log[0]``).
+        sm (snakemake.script.Snakemake): the script's ``snakemake`` object (reads ``threads``,
+            ``output`` and ``log[0]``).
 
     Yields:
         (TextIO): The open log file (``sm.log[0]``), where stdout and stderr go for the body.

@@ -38,8 +38,8 @@ class ModelContext:
         """Checkpoint-safe form (tensors and Python scalars only).
 
         Returns:
-            The fields by name: canonical_xyz a float32 tensor [N, 3], view_dir a float64 tensor [3],
-                the rest ints and floats.
+            The fields by name: canonical_xyz a float32 tensor [N, 3], view_dir a float64 tensor
+                [3], the rest ints and floats.
         """
         return {
             "canonical_xyz": torch.tensor(np.asarray(self.canonical_xyz, dtype=np.float32)),

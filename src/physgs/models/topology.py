@@ -217,8 +217,8 @@ def segment_tree(seg: np.ndarray, dist: np.ndarray, pred: np.ndarray, root: int)
         root: index of the root point.
 
     Returns:
-        ``(parent, entry)``: parent [S] int64, -1 for the root's segment; entry [S] entry
-            distances, world units.
+        (tuple[np.ndarray, np.ndarray]): ``(parent, entry)``: parent [S] int64, -1 for the
+            root's segment; entry [S] entry distances, world units.
 
     Raises:
         ValueError: when the ids are not contiguous in [0, S).
