@@ -154,7 +154,7 @@ class BlindOscillatorPrior(OscillatorPrior):
         """theta [K, L + n_train] (rad) under the learned forcing; ``wind`` is ignored.
 
         Args:
-            wind: ignored.
+            wind (Any): ignored.
 
         Returns:
             [K, L + n_train] part angles, rad (frozen parts 0).
@@ -177,7 +177,7 @@ class BlindOscillatorPrior(OscillatorPrior):
             wind: ignored (any [L+F] series, NaN included).
 
         Returns:
-            The Gaussians at the frame (the oscillator prior's deformation).
+            (GaussianState): The Gaussians at the frame (the oscillator prior's deformation).
 
         Raises:
             ForcingNotDefined: the frame lies beyond the training window.

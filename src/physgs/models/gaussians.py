@@ -140,7 +140,7 @@ def rotate_parts(
     angle: torch.Tensor,
     pivot: torch.Tensor,
 ) -> tuple[torch.Tensor, torch.Tensor]:
-    """[`rotate_about_pivot`][physgs.models.gaussians.rotate_about_pivot] with one rotation per part.
+    """One rotation per part: [`rotate_about_pivot`][physgs.models.gaussians.rotate_about_pivot].
 
     The K rotations are built once and gathered (not N times, one per Gaussian): the same numbers
     elementwise, so the result equals ``rotate_about_pivot(means, quats, axis[labels],
