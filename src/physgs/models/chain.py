@@ -24,7 +24,17 @@ from physgs.models.gaussians import axis_angle_quat, quat_multiply, rodrigues_mi
 
 def depth_levels(parent) -> list[tuple[np.ndarray, np.ndarray]]:
     """[(parts [M] int64, their parents [M] int64)] per depth 1, 2, ... for parent [K] (root -1,
-    parent[p] < p); raises ValueError on any other parent array (so no cycle is accepted)."""
+    parent[p] < p); raises ValueError on any other parent array (so no cycle is accepted).
+
+    Args:
+        parent (ArrayLike): [K] each part's parent, -1 for part 0, parent[p] < p.
+
+    Returns:
+        One ``(parts, parents)`` pair per depth from 1 down, each [M] int64.
+
+    Raises:
+        ValueError: for parents not numbered first.
+    """
     from physgs.models.topology import part_depth
 
     parent = np.asarray(parent, dtype=np.int64)
@@ -41,10 +51,18 @@ def chain_transforms(
 ) -> tuple[torch.Tensor, torch.Tensor, torch.Tensor]:
     """World transforms of chained parts at one instant.
 
-    axis [K, 3] unit swing axes; theta [K] own angles (rad); pivot [K, 3] canonical pivots;
-    levels: ``depth_levels(parent)``. Returns (E [K, 3, 3] = world rotation - I, u [K, 3]
-    displacement of each part's pivot by its ancestors, q [K, 4] world rotation quaternions
-    (w, x, y, z)). Differentiable in axis, theta and pivot.
+    Differentiable in axis, theta and pivot.
+
+    Args:
+        axis: [K, 3] unit swing axes.
+        theta: [K] own angles, rad.
+        pivot: [K, 3] canonical pivots, world units.
+        levels (list[tuple[np.ndarray, np.ndarray]]):
+            [`depth_levels`][physgs.models.chain.depth_levels] of the parents.
+
+    Returns:
+        ``(E, u, q)``: E [K, 3, 3] = world rotation - I, u [K, 3] displacement of each part's
+            pivot by its ancestors (world units), q [K, 4] world rotation quaternions (w, x, y, z).
     """
     G = rodrigues_minus_identity(axis, theta)  # [K, 3, 3] own rotation - I
     qo = axis_angle_quat(axis, theta)  # [K, 4] own rotation
@@ -71,9 +89,18 @@ def chain_deform(
 ) -> tuple[torch.Tensor, torch.Tensor]:
     """Move Gaussians by their parts' chained transforms.
 
-    means [N, 3]; quats [N, 4] (w, x, y, z); labels [N] part of each Gaussian; axis [K, 3];
-    theta [K] rad; pivot [K, 3]; levels: ``depth_levels(parent)``. Returns (means [N, 3],
-    quats [N, 4]); exactly the input at theta = 0.
+    Args:
+        means: [N, 3] positions, world units.
+        quats: [N, 4] orientations (w, x, y, z).
+        labels: [N] part of each Gaussian.
+        axis: [K, 3] unit swing axes.
+        theta: [K] own angles, rad.
+        pivot: [K, 3] pivots, world units.
+        levels (list[tuple[np.ndarray, np.ndarray]]):
+            [`depth_levels`][physgs.models.chain.depth_levels] of the parents.
+
+    Returns:
+        ``(means [N, 3], quats [N, 4])``; exactly the input at theta = 0.
     """
     E, u, q = chain_transforms(axis, theta, pivot, levels)
     rel = (means - pivot[labels])[..., None]  # [N, 3, 1]
@@ -95,14 +122,26 @@ def chain_deform_from(
 
     For a canonical set that is the pose at angles theta0 (the recorded frame 0), not the rest
     pose: frame 0's chained transform is undone (its rest pose is T_p(theta0)^-1 of it), then
-    the transform at theta applied. With T_p(x) = c_p + u_p + Rw_p (x - c_p) (``chain_transforms``):
+    the transform at theta applied. With T_p(x) = c_p + u_p + Rw_p (x - c_p)
+    ([`chain_transforms`][physgs.models.chain.chain_transforms]):
 
         T_p(theta) T_p(theta0)^-1 (x) = x + (u_p - u0_p) + (Rw_p Rw0_p^T - I)(x - c_p - u0_p).
 
-    means [N, 3]; quats [N, 4] (w, x, y, z); labels [N]; axis [K, 3]; theta, theta0 [K] rad;
-    pivot [K, 3] (rest-pose pivots); levels: ``depth_levels(parent)``. Returns (means [N, 3],
-    quats [N, 4]); the input (to rounding) at theta = theta0. Differentiable in axis, both angles
-    and pivot.
+    Differentiable in axis, both angles and pivot.
+
+    Args:
+        means: [N, 3] positions posed at theta0, world units.
+        quats: [N, 4] orientations (w, x, y, z).
+        labels: [N] part of each Gaussian.
+        axis: [K, 3] unit swing axes.
+        theta: [K] target own angles, rad.
+        theta0: [K] own angles the input is posed at, rad.
+        pivot: [K, 3] rest-pose pivots, world units.
+        levels (list[tuple[np.ndarray, np.ndarray]]):
+            [`depth_levels`][physgs.models.chain.depth_levels] of the parents.
+
+    Returns:
+        ``(means [N, 3], quats [N, 4])``; the input (to rounding) at theta = theta0.
     """
     E, u, q = chain_transforms(axis, theta, pivot, levels)  # [K, 3, 3], [K, 3], [K, 4]
     E0, u0, q0 = chain_transforms(axis, theta0, pivot, levels)
