@@ -21,12 +21,30 @@ OURS_KEYS = ("omega_hz", "zeta", "omega_init_hz", "zeta_init", "substeps", "rk4_
 
 
 def tracker_settings(cfg: dict) -> dict:
-    """The tracker's settings (``TrackSettings`` fields), the only params of rule ``track``."""
+    """The tracker's settings (``TrackSettings`` fields), the only params of rule ``track``.
+
+    Args:
+        cfg: the resolved config.
+
+    Returns:
+        A copy of ``tracks.tracker``.
+    """
     return dict(cfg["tracks"]["tracker"])
 
 
 def condition_indices(spec: str, n_conditions: int) -> list[int]:
-    """Conditions a configuration fits: 'train' -> [0], 'all' -> every one (as ours trains)."""
+    """Conditions a configuration fits: 'train' -> [0], 'all' -> every one (as ours trains).
+
+    Args:
+        spec: ``'train'`` or ``'all'``.
+        n_conditions: the dataset's condition count.
+
+    Returns:
+        The condition indices.
+
+    Raises:
+        ValueError: for any other ``spec``.
+    """
     if spec == "train":
         return [0]
     if spec == "all":
@@ -55,7 +73,16 @@ def fields_scored(cfg: dict, config: str, testbed: str) -> list[str]:
     configuration ``config`` on ``testbed`` (a tree or a damping variant's id): those the
     pipeline trains there anyway, i.e. in the base configuration on a faithful testbed (the
     fields train in ``single`` only, ``physgs.models.registry.configs_for``, and on the damping
-    benchmark's testbeds only ours and its variants train)."""
+    benchmark's testbeds only ours and its variants train).
+
+    Args:
+        cfg: the resolved config.
+        config: a configuration name.
+        testbed: a testbed id.
+
+    Returns:
+        Model ids from ``tracks.fields``, in its order.
+    """
     from physgs.models.registry import configs_for
     from physgs.testbed.variant import FAITHFUL, parse_id
 
