@@ -53,10 +53,18 @@ def prior_claims(
 ) -> list[tuple[Claim, list[float]]]:
     """The headline claims for ``model`` with their per-seed values.
 
-    tables: the tables' CSVs (tab_psnr, tab_transfer, tab_margin, tab_null; a table not given
-    leaves its claims unmeasured); damping: tree -> per-seed {median_zeta, zeta_true,
-    loglog_exponent} of ``model``'s recovery in ``config`` (trees without it are skipped);
-    config: the configuration of the recovery claims (the ledger's)."""
+    Args:
+        model: a prior's id.
+        tables: the tables' CSVs (tab_psnr, tab_transfer, tab_margin, tab_null; a table not given
+            leaves its claims unmeasured).
+        damping: tree -> per-seed {median_zeta, zeta_true, loglog_exponent} of ``model``'s
+            recovery in ``config`` (trees without it are skipped).
+        trees: the trees.
+        config: the configuration of the recovery claims (the ledger's).
+
+    Returns:
+        ``(claim, per-seed values)`` pairs, ids prefixed by the model's.
+    """
     name = label(model)
     out: list[tuple[Claim, list[float]]] = []
 
