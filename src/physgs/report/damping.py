@@ -88,7 +88,8 @@ def tab_damping(
         The [`Table`][physgs.report.tables.Table].
 
     Raises:
-        ValueError: when a record has no damping scores, or a seed lacks a record.
+        ValueError: when a record has no damping scores.
+        KeyError: when a seed lacks a record.
     """
     seeds = _seeds(per_seed, "tab_damping")
     tracks_configs = dict(tracks_configs or {})
