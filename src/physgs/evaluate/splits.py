@@ -187,7 +187,11 @@ def view_psnr(
         progress: receives a progress line.
 
     Returns:
-        [A, M] PSNR, dB; NaN where the model makes no prediction.
+        [A, M] PSNR, dB.
+
+    Raises:
+        NotDefined: from the callback, where the model makes no prediction (not caught here).
+        ValueError: when a render's size is not the held-out frames'.
     """
     A, M = len(observed.heldout_cameras), len(observed.heldout_frame_idx)
     view = np.empty((A, M))

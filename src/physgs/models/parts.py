@@ -22,7 +22,7 @@ def kmeans_parts(xyz: np.ndarray, k: int, seed: int, n_init: int = 4) -> np.ndar
         [N] int64 labels in [0, k).
 
     Raises:
-        ValueError: for k < 1, k > N, bad positions, or empty parts.
+        ValueError: for k < 1, k > N, or when k-means cannot form k distinct, non-empty parts.
     """
     xyz = np.asarray(xyz, dtype=np.float64)
     n = xyz.shape[0]
