@@ -24,9 +24,7 @@ def trees_have_settings(cfg: dict) -> Iterator[Problem]:
         cfg: The resolved config (profile merged, schema-valid).
 
     Yields:
-        ``(key path, message)`` for each problem found: the key path is a tuple naming the
-            key to change, the message says what is wrong and how to fix it. Nothing when the
-            config passes.
+        ``(key path, message)`` per problem (the module docstring); none when the config passes.
     """
     vertices, presets = cfg["testbed"]["vertices"], cfg["presets"]
     for t in cfg["trees"]:
@@ -51,9 +49,7 @@ def conditions_have_unseen_wind(cfg: dict) -> Iterator[Problem]:
         cfg: The resolved config (profile merged, schema-valid).
 
     Yields:
-        ``(key path, message)`` for each problem found: the key path is a tuple naming the
-            key to change, the message says what is wrong and how to fix it. Nothing when the
-            config passes.
+        ``(key path, message)`` per problem (the module docstring); none when the config passes.
     """
     cond = cfg["testbed"]["conditions"]
     if not math.isclose(float(cond[0]), 1.0, rel_tol=0, abs_tol=1e-12):
@@ -78,9 +74,7 @@ def band_ordered(cfg: dict) -> Iterator[Problem]:
         cfg: The resolved config (profile merged, schema-valid).
 
     Yields:
-        ``(key path, message)`` for each problem found: the key path is a tuple naming the
-            key to change, the message says what is wrong and how to fix it. Nothing when the
-            config passes.
+        ``(key path, message)`` per problem (the module docstring); none when the config passes.
     """
     lo, hi = cfg["testbed"]["band_hz"]
     if not lo < hi:
@@ -106,9 +100,7 @@ def lead_in_fits_wind_period(cfg: dict) -> Iterator[Problem]:
         cfg: The resolved config (profile merged, schema-valid).
 
     Yields:
-        ``(key path, message)`` for each problem found: the key path is a tuple naming the
-            key to change, the message says what is wrong and how to fix it. Nothing when the
-            config passes.
+        ``(key path, message)`` per problem (the module docstring); none when the config passes.
     """
     from physgs.testbed import physics, wind  # the formulas the testbed itself uses
 
@@ -165,9 +157,7 @@ def damping_benchmark_is_runnable(cfg: dict) -> Iterator[Problem]:
         cfg: The resolved config (profile merged, schema-valid).
 
     Yields:
-        ``(key path, message)`` for each problem found: the key path is a tuple naming the
-            key to change, the message says what is wrong and how to fix it. Nothing when the
-            config passes.
+        ``(key path, message)`` per problem (the module docstring); none when the config passes.
     """
     db = cfg.get("damping_benchmark") or {}
     if db.get("trees") and "damping" not in cfg["testbed"]:
@@ -200,9 +190,7 @@ def parts_study_is_runnable(cfg: dict) -> Iterator[Problem]:
         cfg: The resolved config (profile merged, schema-valid).
 
     Yields:
-        ``(key path, message)`` for each problem found: the key path is a tuple naming the
-            key to change, the message says what is wrong and how to fix it. Nothing when the
-            config passes.
+        ``(key path, message)`` per problem (the module docstring); none when the config passes.
     """
     ps = cfg.get("parts_study") or {}
     if not ps.get("models"):
@@ -247,9 +235,7 @@ def tracks_is_runnable(cfg: dict) -> Iterator[Problem]:
         cfg: The resolved config (profile merged, schema-valid).
 
     Yields:
-        ``(key path, message)`` for each problem found: the key path is a tuple naming the
-            key to change, the message says what is wrong and how to fix it. Nothing when the
-            config passes.
+        ``(key path, message)`` per problem (the module docstring); none when the config passes.
     """
     tr = cfg.get("tracks") or {}
     for i, c in enumerate(tr.get("configs", [])):
@@ -278,9 +264,7 @@ def oma_is_runnable(cfg: dict) -> Iterator[Problem]:
         cfg: The resolved config (profile merged, schema-valid).
 
     Yields:
-        ``(key path, message)`` for each problem found: the key path is a tuple naming the
-            key to change, the message says what is wrong and how to fix it. Nothing when the
-            config passes.
+        ``(key path, message)`` per problem (the module docstring); none when the config passes.
     """
     o = cfg.get("oma") or {}
     if not o.get("configs"):
@@ -313,9 +297,7 @@ def damping_range_valid(cfg: dict) -> Iterator[Problem]:
         cfg: The resolved config (profile merged, schema-valid).
 
     Yields:
-        ``(key path, message)`` for each problem found: the key path is a tuple naming the
-            key to change, the message says what is wrong and how to fix it. Nothing when the
-            config passes.
+        ``(key path, message)`` per problem (the module docstring); none when the config passes.
     """
     tb = cfg["testbed"]
     if "damping" not in tb:
@@ -344,9 +326,7 @@ def damping_transient_fits(cfg: dict) -> Iterator[Problem]:
         cfg: The resolved config (profile merged, schema-valid).
 
     Yields:
-        ``(key path, message)`` for each problem found: the key path is a tuple naming the
-            key to change, the message says what is wrong and how to fix it. Nothing when the
-            config passes.
+        ``(key path, message)`` per problem (the module docstring); none when the config passes.
     """
     tb = cfg["testbed"]
     if not _damping_built(cfg) or "damping" not in tb:
@@ -404,9 +384,7 @@ def field_time_scales_valid(cfg: dict) -> Iterator[Problem]:
         cfg: The resolved config (profile merged, schema-valid).
 
     Yields:
-        ``(key path, message)`` for each problem found: the key path is a tuple naming the
-            key to change, the message says what is wrong and how to fix it. Nothing when the
-            config passes.
+        ``(key path, message)`` per problem (the module docstring); none when the config passes.
     """
     from physgs.models.registry import MODELS
     from physgs.models.timescale import WINDOW_TIME
@@ -452,9 +430,7 @@ def study_seeds_in_seeds(cfg: dict) -> Iterator[Problem]:
         cfg: The resolved config (profile merged, schema-valid).
 
     Yields:
-        ``(key path, message)`` for each problem found: the key path is a tuple naming the
-            key to change, the message says what is wrong and how to fix it. Nothing when the
-            config passes.
+        ``(key path, message)`` per problem (the module docstring); none when the config passes.
     """
     v = cfg["speed_accuracy"]["seeds"]
     if isinstance(v, list):
@@ -475,9 +451,7 @@ def warmup_below_iterations(cfg: dict) -> Iterator[Problem]:
         cfg: The resolved config (profile merged, schema-valid).
 
     Yields:
-        ``(key path, message)`` for each problem found: the key path is a tuple naming the
-            key to change, the message says what is wrong and how to fix it. Nothing when the
-            config passes.
+        ``(key path, message)`` per problem (the module docstring); none when the config passes.
     """
     for section, key in ((("train",), "train"), (("models", "kselect"), "models/kselect")):
         node = cfg
@@ -499,9 +473,7 @@ def holdout_leaves_training_frames(cfg: dict) -> Iterator[Problem]:
         cfg: The resolved config (profile merged, schema-valid).
 
     Yields:
-        ``(key path, message)`` for each problem found: the key path is a tuple naming the
-            key to change, the message says what is wrong and how to fix it. Nothing when the
-            config passes.
+        ``(key path, message)`` per problem (the module docstring); none when the config passes.
     """
     every, n = int(cfg["train"]["holdout_every"]), int(cfg["testbed"]["n_train"])
     if every != 0 and not 2 <= every <= n:
@@ -527,9 +499,7 @@ def freeze_inside_deformation_phase(cfg: dict) -> Iterator[Problem]:
         cfg: The resolved config (profile merged, schema-valid).
 
     Yields:
-        ``(key path, message)`` for each problem found: the key path is a tuple naming the
-            key to change, the message says what is wrong and how to fix it. Nothing when the
-            config passes.
+        ``(key path, message)`` per problem (the module docstring); none when the config passes.
     """
     o = cfg["models"]["ours"]
     if float(o["freeze_below_px"]) == 0:
@@ -557,9 +527,7 @@ def omega_search_is_runnable(cfg: dict) -> Iterator[Problem]:
         cfg: The resolved config (profile merged, schema-valid).
 
     Yields:
-        ``(key path, message)`` for each problem found: the key path is a tuple naming the
-            key to change, the message says what is wrong and how to fix it. Nothing when the
-            config passes.
+        ``(key path, message)`` per problem (the module docstring); none when the config passes.
     """
     from physgs.models.omega_search import search_problem
     from physgs.models.registry import MODEL_NAMES, PRIOR_VARIANT_NAMES, is_prior
@@ -591,9 +559,7 @@ def ours_bounds_ordered(cfg: dict) -> Iterator[Problem]:
         cfg: The resolved config (profile merged, schema-valid).
 
     Yields:
-        ``(key path, message)`` for each problem found: the key path is a tuple naming the
-            key to change, the message says what is wrong and how to fix it. Nothing when the
-            config passes.
+        ``(key path, message)`` per problem (the module docstring); none when the config passes.
     """
     o = cfg["models"]["ours"]
     for pair, init in (("omega_hz", "omega_init_hz"), ("zeta", "zeta_init")):
@@ -619,9 +585,7 @@ def configs_have_single(cfg: dict) -> Iterator[Problem]:
         cfg: The resolved config (profile merged, schema-valid).
 
     Yields:
-        ``(key path, message)`` for each problem found: the key path is a tuple naming the
-            key to change, the message says what is wrong and how to fix it. Nothing when the
-            config passes.
+        ``(key path, message)`` per problem (the module docstring); none when the config passes.
     """
     configs = cfg["models"]["configs"]
     if "single" not in configs:
@@ -647,9 +611,7 @@ def k_within_gaussians(cfg: dict) -> Iterator[Problem]:
         cfg: The resolved config (profile merged, schema-valid).
 
     Yields:
-        ``(key path, message)`` for each problem found: the key path is a tuple naming the
-            key to change, the message says what is wrong and how to fix it. Nothing when the
-            config passes.
+        ``(key path, message)`` per problem (the module docstring); none when the config passes.
     """
     vertices = cfg["testbed"]["vertices"]
     counts = {t: int(vertices[t]) for t in cfg["trees"] if t in vertices}
@@ -700,9 +662,7 @@ def presets_reach_bone_counts(cfg: dict) -> Iterator[Problem]:
         cfg: The resolved config (profile merged, schema-valid).
 
     Yields:
-        ``(key path, message)`` for each problem found: the key path is a tuple naming the
-            key to change, the message says what is wrong and how to fix it. Nothing when the
-            config passes.
+        ``(key path, message)`` per problem (the module docstring); none when the config passes.
     """
     from physgs.testbed.weberpenn import PresetError, generate
 
@@ -723,9 +683,7 @@ def sweep_tree_is_listed(cfg: dict) -> Iterator[Problem]:
         cfg: The resolved config (profile merged, schema-valid).
 
     Yields:
-        ``(key path, message)`` for each problem found: the key path is a tuple naming the
-            key to change, the message says what is wrong and how to fix it. Nothing when the
-            config passes.
+        ``(key path, message)`` per problem (the module docstring); none when the config passes.
     """
     tree = cfg["speed_accuracy"]["tree"]
     if tree not in cfg["trees"]:
@@ -743,9 +701,7 @@ def fit_curve_is_runnable(cfg: dict) -> Iterator[Problem]:
         cfg: The resolved config (profile merged, schema-valid).
 
     Yields:
-        ``(key path, message)`` for each problem found: the key path is a tuple naming the
-            key to change, the message says what is wrong and how to fix it. Nothing when the
-            config passes.
+        ``(key path, message)`` per problem (the module docstring); none when the config passes.
     """
     fc = cfg["speed_accuracy"]["fit_curve"]
     if fc["tree"] not in cfg["trees"]:
