@@ -174,7 +174,7 @@ def orbit_camera(
         height_px: image height, px.
 
     Returns:
-        The camera, from [`look_at`][physgs.camera.look_at] with world z up.
+        The camera, from [`physgs.camera.look_at`][] with world z up.
     """
     a = np.deg2rad(azimuth_deg)
     target = np.asarray(target, dtype=np.float64)

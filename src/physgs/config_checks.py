@@ -3,9 +3,9 @@
 Each check takes the resolved config (after the profile merge, already schema-valid) and yields
 ``(key path, message)`` pairs, the message saying what is wrong and how to fix it; the key path is
 the key to change. [`problems`][physgs.config_checks.problems] runs every check in ``CHECKS``;
-``physgs.config`` turns the pairs into one ``ConfigError``. They run when the Snakefile loads, so a
-bad config stops in seconds with nothing written, instead of in the first job that needs the value.
-To add a check, write a function here and append it to ``CHECKS``.
+[`physgs.config`][] turns the pairs into one ``ConfigError``. They run when the Snakefile loads, so
+a bad config stops in seconds with nothing written, instead of in the first job that needs the
+value. To add a check, write a function here and append it to ``CHECKS``.
 """
 
 from __future__ import annotations
@@ -90,10 +90,10 @@ def band_ordered(cfg: dict) -> Iterator[Problem]:
 def lead_in_fits_wind_period(cfg: dict) -> Iterator[Problem]:
     """The record (lead-in + window + tail) is shorter than the periodic wind's period.
 
-    The lead-in is ``physgs.testbed.physics.lead_in_frames`` at the slowest a bone can decay
+    The lead-in is [`physgs.testbed.physics.lead_in_frames`][] at the slowest a bone can decay
     (the band's lower edge: calibration clamps every bone into the band; the lowest zeta:
     testbed/zeta, or for the damping variant the low end of testbed/damping/zeta_range), so this
-    bounds the longest lead-in any tree gets; ``physgs.testbed.dataset.simulate_tree`` refuses
+    bounds the longest lead-in any tree gets; [`physgs.testbed.dataset.simulate_tree`][] refuses
     the same record.
 
     Args:
@@ -258,7 +258,7 @@ def oma_is_runnable(cfg: dict) -> Iterator[Problem]:
     """The training window carries the SSI model the output-only analysis asks for: 4 x
     block_rows samples at least, and an order no higher than block_rows x components (the
     channels SSI reads). Fewer channels than components are only known once the video is seen:
-    the job then stops, naming the key (``physgs.oma.ssi.check_record``).
+    the job then stops, naming the key ([`physgs.oma.ssi.check_record`][]).
 
     Args:
         cfg: The resolved config (profile merged, schema-valid).
@@ -485,7 +485,7 @@ def holdout_leaves_training_frames(cfg: dict) -> Iterator[Problem]:
 
 def _freeze_iteration(ours: dict, iterations: int) -> int:
     """The iteration at which freezing runs, round(freeze_at x iterations), as
-    ``physgs.models.visibility.freeze_schedule`` computes it (that module loads torch)."""
+    [`physgs.models.visibility.freeze_schedule`][] computes it (that module loads torch)."""
     return int(round(float(ours["freeze_at"]) * iterations))
 
 
@@ -493,7 +493,7 @@ def freeze_inside_deformation_phase(cfg: dict) -> Iterator[Problem]:
     """models/ours/freeze_at falls after the warm-up, for train and the K-selection runs alike.
 
     The freezing iteration is round(freeze_at * iterations), as in
-    ``physgs.models.visibility.freeze_schedule``; freezing is off when freeze_below_px is 0.
+    [`physgs.models.visibility.freeze_schedule`][]; freezing is off when freeze_below_px is 0.
 
     Args:
         cfg: The resolved config (profile merged, schema-valid).
@@ -521,7 +521,7 @@ def freeze_inside_deformation_phase(cfg: dict) -> Iterator[Problem]:
 
 def omega_search_is_runnable(cfg: dict) -> Iterator[Problem]:
     """models/omega_search names oscillator priors only, and its bank phase ends after the
-    warm-up and before freezing in the training runs (``physgs.models.omega_search``).
+    warm-up and before freezing in the training runs ([`physgs.models.omega_search`][]).
 
     Args:
         cfg: The resolved config (profile merged, schema-valid).

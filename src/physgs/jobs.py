@@ -86,10 +86,10 @@ def job(sm):
 
     Locks the job's outputs ([`output_locks`][physgs.jobs.output_locks]: a job whose output another
     run is making stops at once), keeps freed memory in the process
-    (``physgs.allocator.retain_freed_memory``), sets torch's and numba's thread counts to the rule's
-    ``threads`` (those imported now, and through OMP_NUM_THREADS / NUMBA_NUM_THREADS those imported
-    later), sends stdout and stderr (progress bars included) to ``sm.log[0]``, and writes the
-    traceback of a failure there too (not only to the console) before re-raising it.
+    ([`physgs.allocator.retain_freed_memory`][]), sets torch's and numba's thread counts to the
+    rule's ``threads`` (those imported now, and through OMP_NUM_THREADS / NUMBA_NUM_THREADS those
+    imported later), sends stdout and stderr (progress bars included) to ``sm.log[0]``, and writes
+    the traceback of a failure there too (not only to the console) before re-raising it.
 
     Args:
         sm (snakemake.script.Snakemake): the script's ``snakemake`` object (reads ``threads``,

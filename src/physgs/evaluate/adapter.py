@@ -1,5 +1,5 @@
 """Callbacks that let the evaluation score any model through the shared interfaces only
-(``model.gaussians_at`` and ``physgs.render.rasterization``), never a model class."""
+(``model.gaussians_at`` and [`physgs.render.rasterization`][]), never a model class."""
 
 from __future__ import annotations
 

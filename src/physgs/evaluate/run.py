@@ -1,7 +1,7 @@
 """Evaluate one trained checkpoint end to end: splits, tip trajectories and qualitative panels.
 
 This is what the Snakemake rule `evaluate` calls; it only joins the pieces of
-``physgs.evaluate`` (scores through the render callback, never through a model class).
+[`physgs.evaluate`][] (scores through the render callback, never through a model class).
 """
 
 from __future__ import annotations

@@ -1,13 +1,13 @@
 """How few parts the chained prior needs: the smallest K at which it matches the paper's prior.
 
-"Model only what a scene requires": the chained prior (``ours_chain``) is trained at
-each smaller K of ``parts_study.k_candidates`` by the one recipe (``physgs.experiments.recipe.fit``,
-the profile's budget, the training frames minus every ``train.holdout_every``-th, as every
-training job of the pipeline), and scored on the held-out training-window frames at the training
-camera and wind. The smallest K whose held-out PSNR lies within ``models.kselect.tie_db`` of the
-k-means prior's at the base configuration's K (``ours`` single, the pipeline's own job, same
-frames held out) is the match; at the base K itself the chained prior is the pipeline's own
-``ours_chain`` single job. Never reads the view, time or transfer splits.
+"Model only what a scene requires": the chained prior (``ours_chain``) is trained at each smaller K
+of ``parts_study.k_candidates`` by the one recipe ([`physgs.experiments.recipe.fit`][], the
+profile's budget, the training frames minus every ``train.holdout_every``-th, as every training job
+of the pipeline), and scored on the held-out training-window frames at the training camera and wind.
+The smallest K whose held-out PSNR lies within ``models.kselect.tie_db`` of the k-means prior's at
+the base configuration's K (``ours`` single, the pipeline's own job, same frames held out) is the
+match; at the base K itself the chained prior is the pipeline's own ``ours_chain`` single job. Never
+reads the view, time or transfer splits.
 """
 
 from __future__ import annotations

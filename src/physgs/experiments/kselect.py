@@ -5,7 +5,7 @@ out every k-th training frame), iterations and warmup (a short training run per 
 tie_db (dB), conditions (which wind conditions the chosen model then trains on).
 
 Both criteria come from the same runs: ours is trained per candidate by the one recipe
-(``physgs.experiments.recipe.fit``: seeding, loop, schedule and freezing as the full run, only
+([`physgs.experiments.recipe.fit`][]: seeding, loop, schedule and freezing as the full run, only
 shorter) on the training frames minus every k-th (frames k-1, 2k-1, ...), and scored through
 the evaluation's render callback.
 - ``heldout``: mean PSNR (dB) over the held-out frames at the training camera and wind; the

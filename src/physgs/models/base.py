@@ -77,7 +77,7 @@ class ModelContext:
 
 
 def context_from_observed(obs, wind: bool = True) -> ModelContext:
-    """ModelContext from a ``physgs.testbed.dataset.Observed`` (training condition = index 0).
+    """ModelContext from a [`physgs.testbed.dataset.Observed`][] (training condition = index 0).
 
     Args:
         obs (Observed): the testbed's [`Observed`][physgs.testbed.dataset.Observed].

@@ -1,5 +1,5 @@
 """Forward kinematics of chained rigid parts: each part rotates about its own pivot and rides on
-its parent (the testbed's own skinning, ``physgs.testbed.kinematics``, with one axis per part).
+its parent (the testbed's own skinning, [`physgs.testbed.kinematics`][], with one axis per part).
 
 Part p's map of canonical space is T_p = T_parent(p) o Rot_p, Rot_p(x) = c_p + R_p (x - c_p)
 the rotation by theta_p about axis a_p through its canonical pivot c_p (a_p and c_p are given
@@ -11,7 +11,7 @@ ancestors. Written as displacements, so that zero angles give exactly zero motio
     E_p = E_q + G_p + E_q G_p,   u_p = u_q + E_q (c_p - c_q),   q = parent(p), G_p = R_p - I,
 
 with E = G and u = 0 at the root. Parts must be numbered parents first (parent[p] < p), as
-``physgs.models.topology`` numbers them; one vectorised step per tree depth.
+[`physgs.models.topology`][] numbers them; one vectorised step per tree depth.
 """
 
 from __future__ import annotations

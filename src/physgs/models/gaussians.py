@@ -19,7 +19,7 @@ from physgs.render.project import quat_to_rotmat  # noqa: F401  (re-exported)
 
 @dataclass(frozen=True)
 class GaussianState:
-    """Gaussians ready for ``physgs.render.rasterization``.
+    """Gaussians ready for [`physgs.render.rasterization`][].
 
     means [N, 3] world units; quats [N, 4] (w, x, y, z); scales [N, 3] world units (> 0);
     opacities [N] in (0, 1); colors [N, 3] in (0, 1).

@@ -18,7 +18,7 @@ resonance only ~zeta wide. The search replaces omega by something the loss is sm
    ``physics_lr_after`` (from the true physics a rate of 5e-2 dephases the response, 1e-3 keeps
    it: docs/parts.md).
 
-Pure functions over arrays here; the prior (``physgs.models.ours``) holds the bank and calls
+Pure functions over arrays here; the prior ([`physgs.models.ours`][]) holds the bank and calls
 ``project_to_oscillators``; ``SearchHook`` is the training loop's hook. torch loads only
 when a response is integrated: the config's checks import ``search_iteration`` to plan.
 """

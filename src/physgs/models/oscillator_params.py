@@ -1,5 +1,5 @@
 """The bounded parameterisation of an oscillator's omega and zeta, shared by every method that fits
-the wind-driven oscillators (ours, and the 2D-track control, ``physgs.tracks.fit``).
+the wind-driven oscillators (ours, and the 2D-track control, [`physgs.tracks.fit`][]).
 
 - omega = exp(log lo + (log hi - log lo) * sigmoid(raw)), rad/s, inside [omega_lo, omega_hi];
 - zeta = zeta_lo + (zeta_hi - zeta_lo) * sigmoid(raw);

@@ -17,16 +17,16 @@ Parameterisation (all bounded or normalised so one Adam rate suits every tree):
 - pivot (world units), initialised at the part's member nearest the base of the tree.
 
 Two options (registry ids ``ours_topo`` and ``ours_chain``; ``ours`` is the paper's):
-- ``segmentation="topology"``: parts cut along the tree (``physgs.models.topology``) instead of
+- ``segmentation="topology"``: parts cut along the tree ([`physgs.models.topology`][]) instead of
   k-means; each part has a parent (``part_parent`` [K], root -1, parents numbered first) and
   its pivot starts at the joint with that parent.
 - ``chain=True`` (topology parts only): each part keeps its own oscillator, but its rigid
-  transform is composed with its ancestors' (``physgs.models.chain``): a branch is carried by
+  transform is composed with its ancestors' ([`physgs.models.chain`][]): a branch is carried by
   its parent. ``part_theta`` stays each part's OWN angle theta_p(t), the quantity the
   oscillator models and recovery compares with each bone's own angle.
 
 The models listed in ``models.omega_search`` (the topology variants) start with a search over
-omega (``physgs.models.omega_search``): until ``until`` x iterations each part's angle is a
+omega ([`physgs.models.omega_search`][]): until ``until`` x iterations each part's angle is a
 linear combination of a fixed bank of oscillators' responses (``bank_weights``), then each part
 is projected onto the single oscillator of a grid that best fits it (``end_bank_phase``) and
 the oscillators take over. After training ``bank_active`` is False: the model is the prior above.
@@ -34,7 +34,7 @@ the oscillators take over. After training ``bank_active`` is False: the model is
 (``CANONICAL_POSES``): ``rest``, each part turned by theta_p(t) as if the canonical set were the
 rest pose; ``frame0``, the pose at recorded frame 0, which it is (the canonical Gaussians sit at
 frame 0's vertices): frame 0's transform is undone before theta(t)'s is applied
-(``physgs.models.chain.chain_deform_from``; for independent parts, a turn by theta_p(t) -
+([`physgs.models.chain.chain_deform_from`][]; for independent parts, a turn by theta_p(t) -
 theta_p(frame 0)), so frame 0 poses the canonical set and the motion cannot displace it;
 ``frame0_angles``, each part turned by theta_p(t) - theta_p(frame 0) (the same as ``frame0`` for
 independent parts, to first order in the angles for chained ones); ``frame0_offset``, as

@@ -291,7 +291,7 @@ def model_settings(models_cfg: dict, model: str) -> dict:
 
 def searches_omega(models_cfg: dict, model: str) -> bool:
     """Whether ``model`` starts with the search over omega (``models.omega_search.models``;
-    ``physgs.models.omega_search``).
+    [`physgs.models.omega_search`][]).
 
     Args:
         models_cfg: the ``models`` config section.

@@ -1,5 +1,5 @@
 """The true-motion reference (the ceiling): the canonical Gaussians moved by the ground-truth
-skinning of the testbed (``physgs.testbed.kinematics``).
+skinning of the testbed ([`physgs.testbed.kinematics`][]).
 
 Every Gaussian is a mesh vertex and follows its bone chain. All bones rotate about one world axis
 (``truth.swing_axis``) through their heads and children move with their parents, so bone b's
@@ -73,7 +73,7 @@ class TrueMotion:
 
     @staticmethod
     def from_truth(truth, observed) -> "TrueMotion":
-        """From a ``physgs.testbed.dataset.Truth`` (or anything with its fields) and the
+        """From a [`physgs.testbed.dataset.Truth`][] (or anything with its fields) and the
         ``Observed`` it belongs to; raises ValueError if they do not belong together.
 
         Args:

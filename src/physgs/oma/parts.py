@@ -1,7 +1,7 @@
 """From identified modes to per-part estimates: the image regions a mode moves, mapped to parts.
 
 Cells are grouped into K parts by k-means on their centres (px), as the 2D-track control groups
-its tracks by their seed positions (``physgs.tracks.fit``). A mode belongs to the part whose
+its tracks by their seed positions ([`physgs.tracks.fit`][]). A mode belongs to the part whose
 cells it moves most: the largest mean squared shape amplitude |phi_c|^2 over the part's
 channels (x and y of each cell), so a large part does not win by its size alone. A part takes,
 of the modes that belong to it, the one it carries the largest share of; a part no mode
@@ -35,7 +35,7 @@ class PartModes:
 
 def cell_parts(cell_xy: np.ndarray, K: int, seed: int, n_init: int) -> np.ndarray:
     """[N] part of each cell: the tracks control's k-means of image positions (px) into K
-    parts (``physgs.tracks.fit.track_parts``: numbered top to bottom, then left to right).
+    parts ([`physgs.tracks.fit.track_parts`][]: numbered top to bottom, then left to right).
 
     Args:
         cell_xy: [N, 2] cell centres, px.

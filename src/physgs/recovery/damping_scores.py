@@ -1,6 +1,6 @@
 """Damping recovery scored part by part against a per-bone truth (the damping testbed variant).
 
-The frequency matcher (``physgs.recovery.matcher``) says which bone each part k reproduces
+The frequency matcher ([`physgs.recovery.matcher`][]) says which bone each part k reproduces
 (``bone[k]``) and whether to trust it (``trusted[k]``); here each trusted part's zeta_hat is read
 against its bone's true zeta:
 

@@ -188,7 +188,7 @@ def restricted(m: MatchResult, bone_mask: np.ndarray) -> tuple[int, float]:
     """The match's scores restricted to the parts matched to the bones in ``bone_mask``.
 
     Used to score recovery only on bones whose own motion is visible in the training camera
-    (``physgs.testbed.stats``).
+    ([`physgs.testbed.stats`][]).
 
     Args:
         m: the match.

@@ -149,7 +149,7 @@ def null_control(
 ) -> NullResult:
     """Run the untrained null through the trained model's solver and the matcher.
 
-    Each draw integrates ``physgs.models.oscillator.integrate`` with drawn omega and zeta =
+    Each draw integrates [`physgs.models.oscillator.integrate`][] with drawn omega and zeta =
     ``zeta_init``; ``gain`` only scales theta, which correlation ignores.
 
     Args:

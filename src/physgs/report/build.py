@@ -1,13 +1,13 @@
 """Collect per-job result files into the tables and figures (what the report rules call).
 
-The library never knows where the workflow keeps its files. Each output (``physgs.report.outputs``)
-declares what it needs as *need tuples* (``needs``): ``("eval" | "traj" | "panels" | "loss", tree,
-model, config, seed)``, ``("recovery", tree, config, seed)``, ``("null", tree, K, seed)``,
-``("kselect", tree, seed)``, ``("stats", tree)``, ``("table", name)`` and the rest of
-``NEED_FIELDS``; seed is a training seed. The workflow maps each tuple to a path
-(``workflow/rules/common.smk``) and hands the builders a mapping ``key(need) -> path``; the
-builders read only those paths. ``settings_for`` gives the narrow settings an output reads, so
-editing one table's format rebuilds that table only.
+The library never knows where the workflow keeps its files. Each output
+([`physgs.report.outputs`][]) declares what it needs as *need tuples* (``needs``): ``("eval" |
+"traj" | "panels" | "loss", tree, model, config, seed)``, ``("recovery", tree, config, seed)``,
+``("null", tree, K, seed)``, ``("kselect", tree, seed)``, ``("stats", tree)``, ``("table", name)``
+and the rest of ``NEED_FIELDS``; seed is a training seed. The workflow maps each tuple to a path
+(``workflow/rules/common.smk``) and hands the builders a mapping ``key(need) -> path``; the builders
+read only those paths. ``settings_for`` gives the narrow settings an output reads, so editing one
+table's format rebuilds that table only.
 """
 
 from __future__ import annotations

@@ -439,7 +439,7 @@ PRIOR_TABLES = ("tab_psnr", "tab_transfer", "tab_margin", "tab_null")
 
 
 def _holds(tables: Mapping[str, pd.DataFrame], model: str, name: str) -> bool:
-    """Whether any of :data:`PRIOR_TABLES` has a row or column of ``model`` (its id, or its
+    """Whether any of ``PRIOR_TABLES`` has a row or column of ``model`` (its id, or its
     label in tab_psnr)."""
     for df in (tables[k] for k in PRIOR_TABLES if k in tables):
         if model in df.columns:

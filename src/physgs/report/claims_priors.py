@@ -1,7 +1,7 @@
 """The ledger's headline claims repeated for a prior other than the paper's: the
 chained prior, or any model of role "prior" the registry adds.
 
-The paper's claims about ours (``physgs.report.claims.measure``) decide its story; each is asked
+The paper's claims about ours ([`physgs.report.claims.measure`][]) decide its story; each is asked
 again of the other prior, on the same tables and thresholds, with ids ``<model>/<claim>/...``:
 above the static pose beyond the window; ahead of the best learned field on every split
 (views, beyond the window, and each unseen wind at training timestamps and beyond); its margin

@@ -8,7 +8,7 @@ exponent p of the fitted decay rate gamma_hat = zeta_hat omega_hat ~ omega_hat^p
 diagnosis is p near 0: a frequency-independent rate fitted in place of a ratio; a recovered
 ratio gives the truth's p, 1 for a constant zeta), each beside the untrained null (zeta drawn
 log-uniformly from the damping range, scored on the same matching; medians over its draws).
-Built from the recovery records (``physgs.recovery.record``, ``damping_scores``/``damping_null``).
+Built from the recovery records ([`physgs.recovery.record`][], ``damping_scores``/``damping_null``).
 """
 
 from __future__ import annotations

@@ -3,7 +3,7 @@
 The profile and config stamp the run was made with, the claims ledger's verdict counts and each
 verdict (``results/claims.csv``), ``tab_fit``'s fraction of the true-motion ceiling's gain per
 tree and model (``results/tables/tab_fit.csv``), and what the run cost: wall time and
-job-minutes by stage from Snakemake's benchmark files (``physgs.experiments.cost``). Nothing here
+job-minutes by stage from Snakemake's benchmark files ([`physgs.experiments.cost`][]). Nothing here
 is typed by hand, so the summary cannot go stale against the run it describes.
 
 Pure: takes paths (and the stamp), returns Markdown; the workflow writes it.

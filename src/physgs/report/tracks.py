@@ -1,7 +1,7 @@
-"""tab_tracks and fig_tracks: the 2D-track control (``physgs.tracks``, docs/tracks.md).
+"""tab_tracks and fig_tracks: the 2D-track control ([`physgs.tracks`][], docs/tracks.md).
 
 tab_tracks, per tree, configuration and training seed, from the control's evaluation record
-(``physgs.tracks.run.evaluate_job``): the tracker against the truth-projected vertices (tracks
+([`physgs.tracks.run.evaluate_job`][]): the tracker against the truth-projected vertices (tracks
 started, share of the frame-0 tracks kept to the window's end, median and 90th-percentile
 position error and displacement error, px), the fit (K, parts with an estimate, fit seconds),
 and the motion errors (px, median over tracks and frames of the displacement error since each

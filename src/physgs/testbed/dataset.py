@@ -7,7 +7,7 @@ stored wind and theta have L lead-in columns first, so column L + j is recorded 
 The ground truth starts at the periodic steady state of the (60 s periodic) wind, i.e. it is the
 response to an infinitely long past; the L = 1.5 tau_max lead-in columns let a model that
 integrates from rest at column 0 reach that steady state before the recorded window opens.
-The damping variant (``physgs.testbed.variant``) keeps that start state and records a gust
+The damping variant ([`physgs.testbed.variant`][]) keeps that start state and records a gust
 dropping to calm inside the training window; its lead-in follows the slowest decay rate,
 min_b zeta_b omega_b.
 

@@ -10,7 +10,7 @@ condition 0, unless said otherwise):
 
 - distinct frequencies: ``distinct_count(omega)``, values equal to a relative 1e-9 count once.
 - nearest-bone gap: for a frequency omega drawn log-uniformly on [min omega_b, max omega_b], the
-  relative distance to the nearest bone, ``physgs.recovery.null.nearest_bone_gap`` (the quantity
+  relative distance to the nearest bone, [`physgs.recovery.null.nearest_bone_gap`][] (the quantity
   the null control reports); its median over the draw is taken on a dense log grid (so it is the
   expectation, not one seed's estimate).
 - swing: each bone's own angle theta_b(t) (not its ancestors'), RMS over the window, degrees.
@@ -290,7 +290,7 @@ def displacement_energy_below(positions: np.ndarray, fps: float, cutoffs_hz) -> 
 
 def time_band_top_hz(bands: int, n_train: int, fps: float) -> float:
     """Highest frequency (Hz) of a Fourier time encoding with ``bands`` bands
-    (``physgs.models.encoding.fourier``: sin(2^k pi t), k < bands) over a training window of
+    ([`physgs.models.encoding.fourier`][]: sin(2^k pi t), k < bands) over a training window of
     n_train frames mapped to t in [0, 1]: 2^(bands-1) / 2 cycles per (n_train - 1) / fps s.
 
     Args:

@@ -8,7 +8,7 @@ then stays exactly at the mean speed for ``calm_s`` seconds (drag forcing v^2 - 
 every bone decays freely with envelope exp(-zeta_b omega_b t)), and the turbulence fades back in.
 
 Times are seconds with t = 0 at recorded frame 0 (frame j at t = j / fps), as in
-``physgs.testbed.dataset``. Everything here is a pure function of the config and arrays.
+[`physgs.testbed.dataset`][]. Everything here is a pure function of the config and arrays.
 """
 
 from __future__ import annotations

@@ -1,10 +1,10 @@
 """Ours' wind-driven oscillators fitted to 2D point tracks instead of to pixels (no renderer).
 
-Tracks (``physgs.tracks.track``) are grouped into K parts by k-means on their seed positions (px).
+Tracks ([`physgs.tracks.track`][]) are grouped into K parts by k-means on their seed positions (px).
 Part p swings by theta_p(t), the response of the *same* oscillator as ours: omega_p and zeta_p
-through ``physgs.models.oscillator_params`` (ours' bounds, initialisation and raw maps), driven by
+through [`physgs.models.oscillator_params`][] (ours' bounds, initialisation and raw maps), driven by
 v(t)^2 - vbar^2 of each condition's observed wind with its lead-in, integrated from rest by
-``physgs.models.oscillator.integrate`` (RK4, ours' substeps), vbar = vbar_ratio * mean(wind).
+[`physgs.models.oscillator.integrate`][] (RK4, ours' substeps), vbar = vbar_ratio * mean(wind).
 
 Image of the motion: track i of part p sits at
 

@@ -1,5 +1,5 @@
 """Recovery of the tracks control's oscillators against the truth file (evaluation only), through
-the same matcher, trusted-part rule and records as ours (``physgs.recovery``)."""
+the same matcher, trusted-part rule and records as ours ([`physgs.recovery`][])."""
 
 from __future__ import annotations
 
@@ -106,7 +106,7 @@ def recover_tracks(
 
 
 def save_tracks_recovery(path, rec: TracksRecovery) -> None:
-    """Ours' recovery record (``physgs.recovery.record.load_recovery`` reads it) plus a
+    """Ours' recovery record ([`physgs.recovery.record.load_recovery`][] reads it) plus a
     ``tracks`` block: the parts with no estimate (too few tracks), each part's track count
     and the minimum, so a part left out of the trusted count is never silently dropped.
 

@@ -7,7 +7,7 @@ editing a tracker setting leaves ours' jobs alone.
 Config: ``tracks`` (``configs``: which of ``models.configs`` the control is fitted in, with their
 conditions and K; ``K``: ``same`` for each configuration's own K, or one integer for every
 configuration; ``iterations``, ``min_track_frames``, ``min_tracks``, ``kmeans_n_init``: the fit;
-``tracker``: ``physgs.tracks.track.TrackSettings``; ``fields``: the learned fields scored at
+``tracker``: [`physgs.tracks.track.TrackSettings`][]; ``fields``: the learned fields scored at
 the tracked points beside ours), ``models.ours`` (the oscillator's bounds,
 initialisation, RK4 substeps and guard) and ``train.lr.physics`` (Adam's rate on omega/zeta).
 """
@@ -72,7 +72,7 @@ def fields_scored(cfg: dict, config: str, testbed: str) -> list[str]:
     """The learned fields of ``tracks.fields`` scored at the tracked points beside ours in
     configuration ``config`` on ``testbed`` (a tree or a damping variant's id): those the
     pipeline trains there anyway, i.e. in the base configuration on a faithful testbed (the
-    fields train in ``single`` only, ``physgs.models.registry.configs_for``, and on the damping
+    fields train in ``single`` only, [`physgs.models.registry.configs_for`][], and on the damping
     benchmark's testbeds only ours and its variants train).
 
     Args:

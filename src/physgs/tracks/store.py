@@ -1,6 +1,6 @@
 """Files of the tracks control: one video's tracks, and one fit with the oscillators it used.
 
-Both are .npz written atomically (``physgs.atomic.save_npz``). A fit file carries the
+Both are .npz written atomically ([`physgs.atomic.save_npz`][]). A fit file carries the
 ``Oscillators`` it was fitted with (bounds, RK4 substeps, frame rate, lead-in, calibration ratio,
 gain, guard), so its evaluation integrates exactly the fitted model without reading the config.
 """

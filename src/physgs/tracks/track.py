@@ -19,7 +19,7 @@ Method:
 - re-seeding: every ``reseed_every`` frames, new seeds are detected in the current frame away
   (``min_distance_px``) from the live tracks, up to ``max_tracks`` live tracks.
 
-Pixel convention: the package's (``physgs.camera``): pixel centres at integer + 0.5. OpenCV puts
+Pixel convention: the package's ([`physgs.camera`][]): pixel centres at integer + 0.5. OpenCV puts
 them at integers, so positions are shifted by +0.5 px on the way out.
 """
 

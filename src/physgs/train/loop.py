@@ -106,8 +106,8 @@ def train_model(
         ValueError: warmup outside [0, iterations), conditions or frame_pool out of range.
         TrainingError: the loss turns NaN or inf, the fit diverges (non-finite or exploding
             parameters, Gaussians far outside the scene, a loss far above its warm-up level:
-            ``physgs.train.divergence``), or the model's forward pass raises (chained); it names the
-            model, the iteration and the likely ``train.lr`` setting.
+            [`physgs.train.divergence`][]), or the model's forward pass raises (chained); it names
+            the model, the iteration and the likely ``train.lr`` setting.
     """
     name = name or model.name
     iterations, warmup = int(train_cfg["iterations"]), int(train_cfg["warmup"])

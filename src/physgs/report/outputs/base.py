@@ -104,7 +104,7 @@ class Plan:
         """The plan of a resolved config.
 
         Args:
-            cfg (dict): the resolved config (``physgs.config.load``).
+            cfg (dict): the resolved config ([`physgs.config.load`][]).
 
         Returns:
             Plan: its trees, configurations, seeds and study settings.
