@@ -29,7 +29,7 @@ def fourier(x: torch.Tensor, bands: int) -> torch.Tensor:
         bands: frequency bands (0: x itself).
 
     Returns:
-        [..., d * (1 + 2 bands)]: x, then the sines of every band, then the cosines.
+        [..., d * (1 + 2 bands)]: x, then per band k its d sines and d cosines.
 
     Raises:
         ValueError: for negative ``bands``.

@@ -113,7 +113,7 @@ class OscillatorBounds:
             raw: [K] unconstrained values.
 
         Returns:
-            [K] omega in (omega_lo, omega_hi), log-uniform in sigmoid(raw), rad/s.
+            [K] omega in (omega_lo, omega_hi), log omega linear in sigmoid(raw), rad/s.
         """
         lo, hi = math.log(self.omega_lo), math.log(self.omega_hi)
         return torch.exp(lo + (hi - lo) * torch.sigmoid(raw))

@@ -277,7 +277,7 @@ class OscillatorPrior(BaseModel):
             wind: [L+F] the condition's observed wind, m/s.
 
         Returns:
-            [K, L+F] theta, rad (float64 as integrated; the bank's angle during the bank phase).
+            [K, L+F] theta, rad, in the dtype of omega (the bank's angle during the bank phase).
                 Without autograd the last result is kept and returned again for the same wind and
                 parameters: callers must not write to it.
 

@@ -124,7 +124,7 @@ class Oscillators:
             wind (ArrayLike): [L+F] the condition's wind, m/s.
 
         Returns:
-            [K, L+F] angles, rad (float64 as integrated), at the shared gain.
+            [K, L+F] angles, rad, in the dtype of omega, at the shared gain.
         """
         g = torch.full_like(omega, self.gain)
         vbar = condition_vbar(self.vbar_ratio, wind)
