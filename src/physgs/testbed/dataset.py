@@ -304,10 +304,11 @@ def build_dataset(tb: dict, preset: dict, *, seed: int, tree: str, progress: boo
         progress: show a progress bar while rendering.
 
     Returns:
-        (tuple[dict, dict]): ``(observed, truth)``, the arrays of
-            [`Observed`][physgs.testbed.dataset.Observed] and of
-            [`Truth`][physgs.testbed.dataset.Truth] as dicts for
-            [`save_dataset`][physgs.testbed.dataset.save_dataset], each with ``format_version``.
+        (tuple[dict, dict]): ``(observed, truth)``: the arrays of ``observed.npz`` and
+            ``truth.npz`` by name, each with ``format_version``, for
+            [`save_dataset`][physgs.testbed.dataset.save_dataset] (read back as
+            [`Observed`][physgs.testbed.dataset.Observed] and
+            [`Truth`][physgs.testbed.dataset.Truth]).
 
     Raises:
         FramingError: when ``testbed.fill_height`` is missing or does not fit every view.
