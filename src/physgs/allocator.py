@@ -25,8 +25,12 @@ TRIM_THRESHOLD_MIB = 256
 
 def retain_freed_memory() -> bool:
     """Fix glibc's mmap and trim thresholds (MMAP_THRESHOLD_MIB, TRIM_THRESHOLD_MIB) for this
-    process. Returns True where glibc took both, False under another C library (macOS, musl),
-    where nothing changes: it only saves page faults, results are the same either way."""
+    process.
+
+    Returns:
+        True where glibc took both, False under another C library (macOS, musl), where nothing
+            changes: it only saves page faults, results are the same either way.
+    """
     name = ctypes.util.find_library("c")
     try:
         libc = ctypes.CDLL(name)

@@ -20,6 +20,9 @@ def current_umask() -> int:
     and restoring it at once (``os.umask`` has no read-only form). That fallback is
     process-global: a thread creating a file between the two calls would get mode 0666 & ~0o077;
     acceptable here (the pipeline writes from one thread), and it never runs on Linux.
+
+    Returns:
+        The mask's bits (e.g. 0o022).
     """
     try:
         with open("/proc/self/status") as f:

@@ -51,7 +51,16 @@ class Camera:
         return -self.R.T @ self.t
 
     def project(self, X: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-        """Project world points X [N, 3] -> (pixels [N, 2], depth [N]) ."""
+        """Project world points X [N, 3] -> (pixels [N, 2], depth [N]) .
+
+        Args:
+            X: [N, 3] world points, world units.
+
+        Returns:
+            ``(uv, z)``: uv [N, 2] pixel coordinates (px, pixel centres at integer + 0.5) and z [N]
+                depth along the optical axis, world units (not clipped at ``near``; z <= 0 gives
+                meaningless pixels).
+        """
         Xc = X @ self.R.T + self.t
         z = Xc[:, 2]
         uv = np.stack([self.fx * Xc[:, 0] / z + self.cx, self.fy * Xc[:, 1] / z + self.cy], axis=1)
@@ -60,8 +69,13 @@ class Camera:
     def rays(self, supersample: int = 1) -> tuple[np.ndarray, np.ndarray]:
         """World-space rays through the pixel grid.
 
-        Returns (origins [H*s, W*s, 3], unit directions [H*s, W*s, 3]), sub-pixel samples on a
-        regular s x s grid inside each pixel, row-major (image row = y).
+        Args:
+            supersample: s, sub-pixel samples per pixel side: an s x s regular grid inside each
+                pixel.
+
+        Returns:
+            ``(origins, directions)``: origins [H*s, W*s, 3] (the camera centre, world units) and
+                unit directions [H*s, W*s, 3], row-major (image row = y).
         """
         s = supersample
         u = (np.arange(self.width * s) + 0.5) / s
@@ -74,7 +88,12 @@ class Camera:
         return o, d_world
 
     def to_dict(self) -> dict[str, np.ndarray]:
-        """Flat arrays for np.savez."""
+        """Flat arrays for np.savez.
+
+        Returns:
+            ``viewmat`` [4, 4], ``intrinsics`` [4] (fx, fy, cx, cy in px), ``size`` [2] (width,
+                height in px) and ``near`` (a 0-d array, world units).
+        """
         return {
             "viewmat": self.viewmat,
             "intrinsics": np.array([self.fx, self.fy, self.cx, self.cy]),
@@ -145,7 +164,17 @@ def orbit_camera(
 ) -> Camera:
     """Camera on a circle about the world z axis; azimuth 0 sits on the -y axis looking toward +y.
 
-    azimuth_deg: degrees, counter-clockwise seen from above. radius, height: world units.
+    Args:
+        azimuth_deg: degrees, counter-clockwise seen from above.
+        radius: distance from the z axis, world units.
+        height: the camera centre's z, world units.
+        target (ArrayLike): [3] the point looked at, world units.
+        fov_deg: vertical field of view, degrees.
+        width: image width, px.
+        height_px: image height, px.
+
+    Returns:
+        The camera, from [`physgs.camera.look_at`][] with world z up.
     """
     a = np.deg2rad(azimuth_deg)
     target = np.asarray(target, dtype=np.float64)

@@ -90,7 +90,15 @@ def parse_sinfo(text: str) -> dict[str, Partition]:
 
 
 def sinfo() -> dict[str, Partition]:
-    """The partitions of the cluster this machine submits to."""
+    """The partitions of the cluster this machine submits to.
+
+    Returns:
+        Partition name -> [`Partition`][physgs.cluster.Partition], from ``sinfo -h -o
+            SINFO_FORMAT``.
+
+    Raises:
+        ClusterRequestError: when ``sinfo`` fails.
+    """
     proc = subprocess.run(
         ["sinfo", "-h", "-o", SINFO_FORMAT], capture_output=True, text=True, check=False
     )

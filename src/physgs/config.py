@@ -49,7 +49,16 @@ class ConfigError(ValueError):
 
 
 def deep_merge(base: dict, override: dict) -> dict:
-    """Return ``base`` with ``override`` merged in recursively (override wins on leaves)."""
+    """Return ``base`` with ``override`` merged in recursively (override wins on leaves).
+
+    Args:
+        base: the mapping merged into (not modified: a deep copy is returned).
+        override: the mapping whose values win; a dict under a key that is a dict in ``base`` too
+            is merged key by key, anything else replaces ``base``'s value.
+
+    Returns:
+        A new dict: ``base`` deep-copied with ``override`` merged in.
+    """
     out = copy.deepcopy(base)
     for k, v in override.items():
         if isinstance(v, dict) and isinstance(out.get(k), dict):
@@ -68,7 +77,15 @@ def partial_schema(node, defs: dict | None = None):
 
     A profile body overrides only the keys it names, so it is checked against this "partial" form
     of the one schema: types, ranges and unknown keys are still refused, missing keys are not.
-    ``defs``: the root ``$defs`` the ``$ref``s point into (default: ``node``'s own).
+
+    Args:
+        node (dict | list | Any): a JSON-schema node (dict), a list of nodes, or a leaf value
+            (returned as is).
+        defs: the root ``$defs`` the ``$ref``s point into (default: ``node``'s own).
+
+    Returns:
+        (dict | list | Any): The node rebuilt without ``required`` and ``$defs`` keys, each
+            ``#/$defs/NAME`` reference replaced by the definition merged with the node's other keys.
     """
     if defs is None and isinstance(node, dict):
         defs = node.get("$defs", {})
@@ -100,7 +117,11 @@ def _schema() -> dict:
 
 
 def schema() -> dict:
-    """The schema in use (a copy): the packaged file with the profile bodies' partial schema."""
+    """The schema in use (a copy): the packaged file with the profile bodies' partial schema.
+
+    Returns:
+        A deep copy of the schema dict, so a caller's edits do not reach the cached one.
+    """
     return copy.deepcopy(_schema())
 
 
@@ -162,7 +183,15 @@ def scalar(value):
     """A string read as YAML 1.2's core schema and Python read it (anything else unchanged):
     '1e-3' -> 0.001, '3' -> 3, '.nan' -> nan, 'true' -> True, 'null' -> None, 'single' ->
     'single'. PyYAML follows YAML 1.1, where ``1e-3`` (no dot) is a string, and Snakemake hands a
-    ``--config`` value's nested scalars over as strings (YAML's BaseLoader)."""
+    ``--config`` value's nested scalars over as strings (YAML's BaseLoader).
+
+    Args:
+        value (Any): any value; only a ``str`` is read.
+
+    Returns:
+        (Any): An ``int``, ``float``, ``bool`` or ``None`` where the stripped string spells one in
+            YAML 1.2's core schema, else ``value`` unchanged.
+    """
     if not isinstance(value, str):
         return value
     v = value.strip()
@@ -177,7 +206,15 @@ def scalar(value):
 
 def scalars(value):
     """``value`` with [`scalar`][physgs.config.scalar] applied to every string at every depth (keys
-    unchanged)."""
+    unchanged).
+
+    Args:
+        value (Any): a dict, list, tuple or scalar (tuples come back as lists).
+
+    Returns:
+        (Any): The same structure rebuilt with every string leaf passed through
+            [`scalar`][physgs.config.scalar].
+    """
     if isinstance(value, dict):
         return {k: scalars(v) for k, v in value.items()}
     if isinstance(value, (list, tuple)):
@@ -187,7 +224,15 @@ def scalars(value):
 
 def read_yaml(path: Path | str):
     """A config file's contents, numbers read as YAML 1.2 reads them
-    ([`scalars`][physgs.config.scalars])."""
+    ([`scalars`][physgs.config.scalars]).
+
+    Args:
+        path: the YAML file.
+
+    Returns:
+        (Any): The file's contents (``yaml.safe_load``) with [`scalars`][physgs.config.scalars]
+            applied; ``None`` for an empty file.
+    """
     with open(path) as f:
         return scalars(yaml.safe_load(f))
 
@@ -376,9 +421,16 @@ def validate(
     """Validate ``cfg`` (raw, with ``profiles``, or resolved) against the packaged schema and
     refuse NaN and infinity wherever they stand.
 
-    Raise ConfigError naming every offending key path, where its value came from and the fix; an
-    unknown key gets the nearest valid one. ``raw``: the raw config ``cfg`` was resolved from, to
-    say which values a profile set; ``layers``: the command-line sources over ``source``.
+    Args:
+        cfg: the config to check.
+        raw: the raw config ``cfg`` was resolved from, to say which values a profile set;
+            None when ``cfg`` is itself the raw config.
+        source: the file named in messages as where the values came from.
+        layers: the command-line sources over ``source``, each ``(name, values)``.
+
+    Raises:
+        ConfigError: naming every offending key path, where its value came from and the fix; an
+            unknown key gets the nearest valid one. Also when ``cfg`` is not a mapping.
     """
     if not isinstance(cfg, dict):
         raise ConfigError(
@@ -405,7 +457,17 @@ def check(
     source: str = DEFAULT_SOURCE,
     layers: list[Layer] = (),
 ) -> None:
-    """Run the cross-key checks (``physgs.config_checks.CHECKS``) on a resolved config."""
+    """Run the cross-key checks (``physgs.config_checks.CHECKS``) on a resolved config.
+
+    Args:
+        cfg: the resolved config.
+        raw: the raw config it was resolved from, to attribute a value to its profile.
+        source: the file named in messages as where the values came from.
+        layers: the command-line sources over ``source``, each ``(name, values)``.
+
+    Raises:
+        ConfigError: naming every problem's key path, its source and the fix.
+    """
     profile = cfg.get("profile")
     lines = [
         _line(tuple(path), msg, _attribute(tuple(path), raw, profile, list(layers), source), source)
@@ -419,7 +481,19 @@ def check(
 
 
 def resolve(cfg: dict, profile: str | None = None) -> dict:
-    """Merge the chosen profile over the base config and return the resolved config."""
+    """Merge the chosen profile over the base config and return the resolved config.
+
+    Args:
+        cfg: the raw config, with its ``profiles`` section.
+        profile: the profile to apply; None: ``cfg['profile']``, else ``default``.
+
+    Returns:
+        The base config without ``profiles``, the profile's body deep-merged over it, and
+            ``profile`` set to the chosen name.
+
+    Raises:
+        ConfigError: for a profile that ``profiles`` does not hold (with the nearest name).
+    """
     profile = profile or cfg.get("profile", "default")
     profiles = cfg.get("profiles") or {}
     if profile not in profiles:
@@ -446,17 +520,28 @@ def load_workflow_config(
     """The one way in: validate a raw config, resolve its profile, put the command line over it,
     validate and check the result.
 
-    config: the raw config (what Snakemake's ``config`` holds: ``config/trees.yaml`` with any
-    ``--configfile`` and ``--config`` merged in); profile: overrides ``config['profile']``;
-    configfiles: the ``--configfile`` paths (Snakemake's ``workflow.config_settings.configfiles``),
-    read again here as YAML 1.2; command_line: the ``--config KEY=VALUE`` pairs (Snakemake's
-    ``workflow.config_settings.config``). Whatever these set, at any depth, beats the profile's
-    value (``--config 'tracks={configs: [single]}'`` fits single only under any profile), except in
-    a ``--configfile`` that holds a ``profiles`` section: such a file is a config of its own
+    Whatever ``configfiles`` and ``command_line`` set, at any depth, beats the profile's value
+    (``--config 'tracks={configs: [single]}'`` fits single only under any profile), except in a
+    ``--configfile`` that holds a ``profiles`` section: such a file is a config of its own
     (``--configfile config/trees.yaml`` is the base again), merged under the profile. Every number
     is read as YAML 1.2 reads it ([`scalars`][physgs.config.scalars]), and a problem names the
-    source that holds the bad value. Returns the resolved config; raises ConfigError before anything
-    runs.
+    source that holds the bad value.
+
+    Args:
+        config: the raw config (what Snakemake's ``config`` holds: ``config/trees.yaml`` with any
+            ``--configfile`` and ``--config`` merged in).
+        profile: overrides ``config['profile']``.
+        source: the file named in messages as where the values came from.
+        command_line: the ``--config KEY=VALUE`` pairs (Snakemake's
+            ``workflow.config_settings.config``).
+        configfiles (Iterable[str | Path]): the ``--configfile`` paths (Snakemake's
+            ``workflow.config_settings.configfiles``), read again here as YAML 1.2.
+
+    Returns:
+        The resolved config.
+
+    Raises:
+        ConfigError: before anything runs, naming every bad key and its source.
     """
     layers: list[Layer] = [(f"--configfile {p}", read_yaml(p) or {}) for p in configfiles]
     if command_line:
@@ -498,7 +583,19 @@ def apply_overrides(cfg: dict, assignments: list[str]) -> dict:
     """A resolved config with ``KEY.PATH=VALUE`` overrides (a script's ``--set``) applied, then
     validated against the schema and the cross-key checks exactly as the config is: an unknown key,
     a value of the wrong type or a NaN is refused with the key and its ``--set`` named, before any
-    work. VALUE is read as YAML 1.2 and Python read it (``1e-3`` is a number)."""
+    work. VALUE is read as YAML 1.2 and Python read it (``1e-3`` is a number).
+
+    Args:
+        cfg: a resolved config (not modified: a deep copy is returned).
+        assignments: ``KEY.PATH=VALUE`` strings, dots between keys.
+
+    Returns:
+        The overridden, validated config.
+
+    Raises:
+        ConfigError: for an assignment without ``=`` or a key, a path through a key that is not a
+            section, or a result the schema or the cross-key checks refuse.
+    """
     out = copy.deepcopy(cfg)
     layers: list[Layer] = []
     for a in assignments:
@@ -523,7 +620,14 @@ def apply_overrides(cfg: dict, assignments: list[str]) -> dict:
 def study_seeds(cfg: dict) -> list[int]:
     """The training seeds the studies of the trade (speed-accuracy sweep, fit curve) run at:
     ``speed_accuracy.seeds`` of a resolved config ('first' = the first of ``seeds``, 'all' =
-    every one, or a list from ``seeds``, which the config checks enforce)."""
+    every one, or a list from ``seeds``, which the config checks enforce).
+
+    Args:
+        cfg: a resolved config.
+
+    Returns:
+        The seeds, in the order of ``seeds`` for 'first' and 'all', else in the listed order.
+    """
     seeds = [int(s) for s in cfg["seeds"]]
     v = cfg["speed_accuracy"]["seeds"]
     if v == "first":

@@ -3,9 +3,9 @@
 Each check takes the resolved config (after the profile merge, already schema-valid) and yields
 ``(key path, message)`` pairs, the message saying what is wrong and how to fix it; the key path is
 the key to change. [`problems`][physgs.config_checks.problems] runs every check in ``CHECKS``;
-``physgs.config`` turns the pairs into one ``ConfigError``. They run when the Snakefile loads, so a
-bad config stops in seconds with nothing written, instead of in the first job that needs the value.
-To add a check, write a function here and append it to ``CHECKS``.
+[`physgs.config`][] turns the pairs into one ``ConfigError``. They run when the Snakefile loads, so
+a bad config stops in seconds with nothing written, instead of in the first job that needs the
+value. To add a check, write a function here and append it to ``CHECKS``.
 """
 
 from __future__ import annotations
@@ -18,7 +18,14 @@ Check = Callable[[dict], Iterator[Problem]]
 
 
 def trees_have_settings(cfg: dict) -> Iterator[Problem]:
-    """Every tree in ``trees`` has a preset and a vertex count."""
+    """Every tree in ``trees`` has a preset and a vertex count.
+
+    Args:
+        cfg: The resolved config (profile merged, schema-valid).
+
+    Yields:
+        ``(key path, message)`` per problem (the module docstring); none when the config passes.
+    """
     vertices, presets = cfg["testbed"]["vertices"], cfg["presets"]
     for t in cfg["trees"]:
         if t not in vertices:
@@ -36,7 +43,14 @@ def trees_have_settings(cfg: dict) -> Iterator[Problem]:
 
 
 def conditions_have_unseen_wind(cfg: dict) -> Iterator[Problem]:
-    """conditions[0] is the training wind (1.0) and at least one unseen condition follows."""
+    """conditions[0] is the training wind (1.0) and at least one unseen condition follows.
+
+    Args:
+        cfg: The resolved config (profile merged, schema-valid).
+
+    Yields:
+        ``(key path, message)`` per problem (the module docstring); none when the config passes.
+    """
     cond = cfg["testbed"]["conditions"]
     if not math.isclose(float(cond[0]), 1.0, rel_tol=0, abs_tol=1e-12):
         yield (
@@ -54,7 +68,14 @@ def conditions_have_unseen_wind(cfg: dict) -> Iterator[Problem]:
 
 
 def band_ordered(cfg: dict) -> Iterator[Problem]:
-    """testbed/band_hz and the wind band are (low, high)."""
+    """testbed/band_hz and the wind band are (low, high).
+
+    Args:
+        cfg: The resolved config (profile merged, schema-valid).
+
+    Yields:
+        ``(key path, message)`` per problem (the module docstring); none when the config passes.
+    """
     lo, hi = cfg["testbed"]["band_hz"]
     if not lo < hi:
         yield (("testbed", "band_hz"), f"[{lo}, {hi}] Hz must be [low, high] with low < high")
@@ -69,11 +90,17 @@ def band_ordered(cfg: dict) -> Iterator[Problem]:
 def lead_in_fits_wind_period(cfg: dict) -> Iterator[Problem]:
     """The record (lead-in + window + tail) is shorter than the periodic wind's period.
 
-    The lead-in is ``physgs.testbed.physics.lead_in_frames`` at the slowest a bone can decay
+    The lead-in is [`physgs.testbed.physics.lead_in_frames`][] at the slowest a bone can decay
     (the band's lower edge: calibration clamps every bone into the band; the lowest zeta:
     testbed/zeta, or for the damping variant the low end of testbed/damping/zeta_range), so this
-    bounds the longest lead-in any tree gets; ``physgs.testbed.dataset.simulate_tree`` refuses
+    bounds the longest lead-in any tree gets; [`physgs.testbed.dataset.simulate_tree`][] refuses
     the same record.
+
+    Args:
+        cfg: The resolved config (profile merged, schema-valid).
+
+    Yields:
+        ``(key path, message)`` per problem (the module docstring); none when the config passes.
     """
     from physgs.testbed import physics, wind  # the formulas the testbed itself uses
 
@@ -124,7 +151,14 @@ def _damping_built(cfg: dict) -> bool:
 
 def damping_benchmark_is_runnable(cfg: dict) -> Iterator[Problem]:
     """The damping benchmark's trees are built faithfully too (tab_damping compares the two) and
-    its configurations are ours' configurations."""
+    its configurations are ours' configurations.
+
+    Args:
+        cfg: The resolved config (profile merged, schema-valid).
+
+    Yields:
+        ``(key path, message)`` per problem (the module docstring); none when the config passes.
+    """
     db = cfg.get("damping_benchmark") or {}
     if db.get("trees") and "damping" not in cfg["testbed"]:
         yield (
@@ -150,7 +184,14 @@ def damping_benchmark_is_runnable(cfg: dict) -> Iterator[Problem]:
 def parts_study_is_runnable(cfg: dict) -> Iterator[Problem]:
     """The parts study's configurations are ours' configurations, and, where the damping
     benchmark builds testbeds, among its configurations too (tab_parts sets each variant's damping
-    error beside ours' on the same configuration)."""
+    error beside ours' on the same configuration).
+
+    Args:
+        cfg: The resolved config (profile merged, schema-valid).
+
+    Yields:
+        ``(key path, message)`` per problem (the module docstring); none when the config passes.
+    """
     ps = cfg.get("parts_study") or {}
     if not ps.get("models"):
         return
@@ -188,7 +229,14 @@ def parts_study_is_runnable(cfg: dict) -> Iterator[Problem]:
 def tracks_is_runnable(cfg: dict) -> Iterator[Problem]:
     """The tracks control is fitted in configurations of ours (their conditions and K), and its
     shortest fitted track fits in the training window. (Whether K exceeds the tracks kept is only
-    known once the video is tracked: the fit job refuses it, naming the key.)"""
+    known once the video is tracked: the fit job refuses it, naming the key.)
+
+    Args:
+        cfg: The resolved config (profile merged, schema-valid).
+
+    Yields:
+        ``(key path, message)`` per problem (the module docstring); none when the config passes.
+    """
     tr = cfg.get("tracks") or {}
     for i, c in enumerate(tr.get("configs", [])):
         if c not in cfg["models"]["configs"]:
@@ -210,7 +258,14 @@ def oma_is_runnable(cfg: dict) -> Iterator[Problem]:
     """The training window carries the SSI model the output-only analysis asks for: 4 x
     block_rows samples at least, and an order no higher than block_rows x components (the
     channels SSI reads). Fewer channels than components are only known once the video is seen:
-    the job then stops, naming the key (``physgs.oma.ssi.check_record``)."""
+    the job then stops, naming the key ([`physgs.oma.ssi.check_record`][]).
+
+    Args:
+        cfg: The resolved config (profile merged, schema-valid).
+
+    Yields:
+        ``(key path, message)`` per problem (the module docstring); none when the config passes.
+    """
     o = cfg.get("oma") or {}
     if not o.get("configs"):
         return
@@ -236,7 +291,14 @@ MIN_CALM_PERIODS = 1.0
 
 def damping_range_valid(cfg: dict) -> Iterator[Problem]:
     """testbed/damping/zeta_range is (low, high) with 0 < low < high <= 1 (checked whatever the
-    variant: it is a typo either way; a constant zeta is the faithful variant's testbed/zeta)."""
+    variant: it is a typo either way; a constant zeta is the faithful variant's testbed/zeta).
+
+    Args:
+        cfg: The resolved config (profile merged, schema-valid).
+
+    Yields:
+        ``(key path, message)`` per problem (the module docstring); none when the config passes.
+    """
     tb = cfg["testbed"]
     if "damping" not in tb:
         return
@@ -258,7 +320,14 @@ def damping_range_valid(cfg: dict) -> Iterator[Problem]:
 def damping_transient_fits(cfg: dict) -> Iterator[Problem]:
     """For the damping variant: the gust and the calm (testbed/damping/transient, seconds from
     recorded frame 0) lie inside the training window [0, n_train / fps], and the calm lasts at
-    least MIN_CALM_PERIODS periods of band_hz[0], so every bone's free decay is recorded."""
+    least MIN_CALM_PERIODS periods of band_hz[0], so every bone's free decay is recorded.
+
+    Args:
+        cfg: The resolved config (profile merged, schema-valid).
+
+    Yields:
+        ``(key path, message)`` per problem (the module docstring); none when the config passes.
+    """
     tb = cfg["testbed"]
     if not _damping_built(cfg) or "damping" not in tb:
         return  # damping_benchmark_is_runnable reports a missing block
@@ -309,7 +378,14 @@ def damping_transient_fits(cfg: dict) -> Iterator[Problem]:
 def field_time_scales_valid(cfg: dict) -> Iterator[Problem]:
     """Each learned field names its time encoding's top band: a positive frequency (Hz) no higher
     than half the frame rate (a band above Nyquist aliases between frames), or "window"
-    (physgs.models.timescale), for exactly the model ids of its architecture."""
+    (physgs.models.timescale), for exactly the model ids of its architecture.
+
+    Args:
+        cfg: The resolved config (profile merged, schema-valid).
+
+    Yields:
+        ``(key path, message)`` per problem (the module docstring); none when the config passes.
+    """
     from physgs.models.registry import MODELS
     from physgs.models.timescale import WINDOW_TIME
 
@@ -348,7 +424,14 @@ def field_time_scales_valid(cfg: dict) -> Iterator[Problem]:
 
 
 def study_seeds_in_seeds(cfg: dict) -> Iterator[Problem]:
-    """The studies' seeds (speed_accuracy/seeds) are training seeds of the run."""
+    """The studies' seeds (speed_accuracy/seeds) are training seeds of the run.
+
+    Args:
+        cfg: The resolved config (profile merged, schema-valid).
+
+    Yields:
+        ``(key path, message)`` per problem (the module docstring); none when the config passes.
+    """
     v = cfg["speed_accuracy"]["seeds"]
     if isinstance(v, list):
         extra = [s for s in v if int(s) not in {int(x) for x in cfg["seeds"]}]
@@ -362,7 +445,14 @@ def study_seeds_in_seeds(cfg: dict) -> Iterator[Problem]:
 
 
 def warmup_below_iterations(cfg: dict) -> Iterator[Problem]:
-    """The static warm-up ends before training does (train and the K-selection runs)."""
+    """The static warm-up ends before training does (train and the K-selection runs).
+
+    Args:
+        cfg: The resolved config (profile merged, schema-valid).
+
+    Yields:
+        ``(key path, message)`` per problem (the module docstring); none when the config passes.
+    """
     for section, key in ((("train",), "train"), (("models", "kselect"), "models/kselect")):
         node = cfg
         for k in section:
@@ -377,7 +467,14 @@ def warmup_below_iterations(cfg: dict) -> Iterator[Problem]:
 
 
 def holdout_leaves_training_frames(cfg: dict) -> Iterator[Problem]:
-    """Held-out training frames (train.holdout_every) leave most of the window to train on."""
+    """Held-out training frames (train.holdout_every) leave most of the window to train on.
+
+    Args:
+        cfg: The resolved config (profile merged, schema-valid).
+
+    Yields:
+        ``(key path, message)`` per problem (the module docstring); none when the config passes.
+    """
     every, n = int(cfg["train"]["holdout_every"]), int(cfg["testbed"]["n_train"])
     if every != 0 and not 2 <= every <= n:
         yield (
@@ -388,7 +485,7 @@ def holdout_leaves_training_frames(cfg: dict) -> Iterator[Problem]:
 
 def _freeze_iteration(ours: dict, iterations: int) -> int:
     """The iteration at which freezing runs, round(freeze_at x iterations), as
-    ``physgs.models.visibility.freeze_schedule`` computes it (that module loads torch)."""
+    [`physgs.models.visibility.freeze_schedule`][] computes it (that module loads torch)."""
     return int(round(float(ours["freeze_at"]) * iterations))
 
 
@@ -396,7 +493,13 @@ def freeze_inside_deformation_phase(cfg: dict) -> Iterator[Problem]:
     """models/ours/freeze_at falls after the warm-up, for train and the K-selection runs alike.
 
     The freezing iteration is round(freeze_at * iterations), as in
-    ``physgs.models.visibility.freeze_schedule``; freezing is off when freeze_below_px is 0.
+    [`physgs.models.visibility.freeze_schedule`][]; freezing is off when freeze_below_px is 0.
+
+    Args:
+        cfg: The resolved config (profile merged, schema-valid).
+
+    Yields:
+        ``(key path, message)`` per problem (the module docstring); none when the config passes.
     """
     o = cfg["models"]["ours"]
     if float(o["freeze_below_px"]) == 0:
@@ -418,7 +521,14 @@ def freeze_inside_deformation_phase(cfg: dict) -> Iterator[Problem]:
 
 def omega_search_is_runnable(cfg: dict) -> Iterator[Problem]:
     """models/omega_search names oscillator priors only, and its bank phase ends after the
-    warm-up and before freezing in the training runs (``physgs.models.omega_search``)."""
+    warm-up and before freezing in the training runs ([`physgs.models.omega_search`][]).
+
+    Args:
+        cfg: The resolved config (profile merged, schema-valid).
+
+    Yields:
+        ``(key path, message)`` per problem (the module docstring); none when the config passes.
+    """
     from physgs.models.omega_search import search_problem
     from physgs.models.registry import MODEL_NAMES, PRIOR_VARIANT_NAMES, is_prior
 
@@ -443,7 +553,14 @@ def omega_search_is_runnable(cfg: dict) -> Iterator[Problem]:
 
 
 def ours_bounds_ordered(cfg: dict) -> Iterator[Problem]:
-    """omega_hz and zeta are (low, high) with the initial values strictly inside."""
+    """omega_hz and zeta are (low, high) with the initial values strictly inside.
+
+    Args:
+        cfg: The resolved config (profile merged, schema-valid).
+
+    Yields:
+        ``(key path, message)`` per problem (the module docstring); none when the config passes.
+    """
     o = cfg["models"]["ours"]
     for pair, init in (("omega_hz", "omega_init_hz"), ("zeta", "zeta_init")):
         lo, hi = (float(v) for v in o[pair])
@@ -462,7 +579,14 @@ def ours_bounds_ordered(cfg: dict) -> Iterator[Problem]:
 
 
 def configs_have_single(cfg: dict) -> Iterator[Problem]:
-    """models/configs holds `single` (every model trains in it) and not the reserved `auto`."""
+    """models/configs holds `single` (every model trains in it) and not the reserved `auto`.
+
+    Args:
+        cfg: The resolved config (profile merged, schema-valid).
+
+    Yields:
+        ``(key path, message)`` per problem (the module docstring); none when the config passes.
+    """
     configs = cfg["models"]["configs"]
     if "single" not in configs:
         yield (
@@ -482,6 +606,12 @@ def k_within_gaussians(cfg: dict) -> Iterator[Problem]:
 
     The Gaussian count is the tree's target vertex count (testbed/vertices): the smallest among
     the trees for what runs on every tree, the sweep tree's for the sweep.
+
+    Args:
+        cfg: The resolved config (profile merged, schema-valid).
+
+    Yields:
+        ``(key path, message)`` per problem (the module docstring); none when the config passes.
     """
     vertices = cfg["testbed"]["vertices"]
     counts = {t: int(vertices[t]) for t in cfg["trees"] if t in vertices}
@@ -526,7 +656,14 @@ def k_within_gaussians(cfg: dict) -> Iterator[Problem]:
 
 def presets_reach_bone_counts(cfg: dict) -> Iterator[Problem]:
     """Every listed tree's preset builds its exact bone count (clone variation included). The
-    skeleton alone is built (well under a second for all three trees), not the mesh or frames."""
+    skeleton alone is built (well under a second for all three trees), not the mesh or frames.
+
+    Args:
+        cfg: The resolved config (profile merged, schema-valid).
+
+    Yields:
+        ``(key path, message)`` per problem (the module docstring); none when the config passes.
+    """
     from physgs.testbed.weberpenn import PresetError, generate
 
     for tree in cfg["trees"]:
@@ -540,7 +677,14 @@ def presets_reach_bone_counts(cfg: dict) -> Iterator[Problem]:
 
 
 def sweep_tree_is_listed(cfg: dict) -> Iterator[Problem]:
-    """The speed-accuracy sweep runs on a tree the pipeline builds."""
+    """The speed-accuracy sweep runs on a tree the pipeline builds.
+
+    Args:
+        cfg: The resolved config (profile merged, schema-valid).
+
+    Yields:
+        ``(key path, message)`` per problem (the module docstring); none when the config passes.
+    """
     tree = cfg["speed_accuracy"]["tree"]
     if tree not in cfg["trees"]:
         yield (
@@ -551,7 +695,14 @@ def sweep_tree_is_listed(cfg: dict) -> Iterator[Problem]:
 
 def fit_curve_is_runnable(cfg: dict) -> Iterator[Problem]:
     """The fit curve's tree is built by the pipeline (its profile-budget point is the pipeline's
-    own job) and its budgets give at least three points with the profile's."""
+    own job) and its budgets give at least three points with the profile's.
+
+    Args:
+        cfg: The resolved config (profile merged, schema-valid).
+
+    Yields:
+        ``(key path, message)`` per problem (the module docstring); none when the config passes.
+    """
     fc = cfg["speed_accuracy"]["fit_curve"]
     if fc["tree"] not in cfg["trees"]:
         yield (

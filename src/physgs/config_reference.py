@@ -52,7 +52,15 @@ def _resolve(node: Mapping, schema: Mapping) -> Mapping:
 
 
 def type_words(node: Mapping, schema: Mapping) -> str:
-    """A schema node's type in words: ``integer ≥ 1``, ``one of: rest, frame0``, ``list of ...``."""
+    """A schema node's type in words: ``integer ≥ 1``, ``one of: rest, frame0``, ``list of ...``.
+
+    Args:
+        node: a schema node (a ``$ref`` is resolved against ``schema``).
+        schema: the root schema, whose ``$defs`` the references point into.
+
+    Returns:
+        The words for the config reference's *type* column.
+    """
     node = _resolve(node, schema)
     if "enum" in node:
         return "one of: " + ", ".join(map(str, node["enum"]))
@@ -73,6 +81,13 @@ def type_words(node: Mapping, schema: Mapping) -> str:
 
 def rows(schema: Mapping) -> Iterator[Row]:
     """Every key of the schema, depth first in the schema's order.
+
+    Args:
+        schema: the config schema, annotated (``description``, ``x-reruns``).
+
+    Yields:
+        A [`Row`][physgs.config_reference.Row] per key (path, type in words, description, the jobs
+            an edit reruns), then the rows of one tree preset under ``presets.<tree>``.
 
     Raises:
         ValueError: naming every key without a ``description``.
@@ -138,6 +153,9 @@ def reference(schema: Mapping, config: Mapping) -> str:
     Args:
         schema: the config schema (``physgs/schemas/config.schema.yaml``), annotated.
         config: ``config/trees.yaml`` as read, its ``profiles`` included.
+
+    Returns:
+        The page's Markdown text, ending in a newline.
     """
     profiles = config.get("profiles", {}) or {}
     out = [

@@ -23,7 +23,16 @@ class IntermediateFileError(ValueError):
 
 
 def refuse(path: str | Path, what: str, rule: str) -> IntermediateFileError:
-    """Remove the unreadable ``path`` and say so: the error to raise (``what``: what is wrong)."""
+    """Remove the unreadable ``path`` and say so: the error to raise.
+
+    Args:
+        path: the intermediate file (removed if present).
+        what: what is wrong with it (the message's predicate, e.g. "is corrupt").
+        rule: the workflow rule that writes it.
+
+    Returns:
+        The error, naming the file, the fault and the rule; the caller raises it.
+    """
     path = Path(path)
     path.unlink(missing_ok=True)
     return IntermediateFileError(

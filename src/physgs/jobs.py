@@ -34,10 +34,24 @@ class OutputLockedError(RuntimeError):
 
 @contextlib.contextmanager
 def output_locks(outputs, lock_dir: Path | str | None = None):
-    """Hold an exclusive lock on each of ``outputs`` (paths) for the body; raise
-    OutputLockedError at once if another process holds one (no waiting: that process is doing
-    this work). The lock files record the holder's pid, host and start time, and stay (empty of
-    meaning once released: a lock is the ``flock``, not the file). lock_dir: default LOCK_DIR."""
+    """Hold an exclusive lock on each of ``outputs`` for the body.
+
+    No waiting: another process that holds one is doing this work. The lock files record the
+    holder's pid, host and start time, and stay (empty of meaning once released: a lock is the
+    ``flock``, not the file).
+
+    Args:
+        outputs (Iterable[str | Path]): the output paths to lock (made absolute; duplicates locked
+            once).
+        lock_dir: where the lock files live (one per output, named by a hash of its path);
+            default ``LOCK_DIR``.
+
+    Yields:
+        (None): the body runs while the locks are held; they are released on exit.
+
+    Raises:
+        OutputLockedError: at once if another process holds one of the locks.
+    """
     lock_dir = Path(LOCK_DIR if lock_dir is None else lock_dir)
     lock_dir.mkdir(parents=True, exist_ok=True)
     held = []
@@ -72,10 +86,21 @@ def job(sm):
 
     Locks the job's outputs ([`output_locks`][physgs.jobs.output_locks]: a job whose output another
     run is making stops at once), keeps freed memory in the process
-    (``physgs.allocator.retain_freed_memory``), sets torch's and numba's thread counts to the rule's
-    ``threads`` (those imported now, and through OMP_NUM_THREADS / NUMBA_NUM_THREADS those imported
-    later), sends stdout and stderr (progress bars included) to ``sm.log[0]``, and writes the
-    traceback of a failure there too (not only to the console) before re-raising it.
+    ([`physgs.allocator.retain_freed_memory`][]), sets torch's and numba's thread counts to the
+    rule's ``threads`` (those imported now, and through OMP_NUM_THREADS / NUMBA_NUM_THREADS those
+    imported later), sends stdout and stderr (progress bars included) to ``sm.log[0]``, and writes
+    the traceback of a failure there too (not only to the console) before re-raising it.
+
+    Args:
+        sm (snakemake.script.Snakemake): the script's ``snakemake`` object (reads ``threads``,
+            ``output`` and ``log[0]``).
+
+    Yields:
+        (TextIO): The open log file (``sm.log[0]``), where stdout and stderr go for the body.
+
+    Raises:
+        OutputLockedError: when another run is making one of the outputs now. Any exception of
+            the body is re-raised after its traceback is written to the log.
     """
     threads = max(1, int(getattr(sm, "threads", 1)))
     retain_freed_memory()  # no page faults of fresh memory every training iteration

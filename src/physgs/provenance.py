@@ -13,7 +13,11 @@ from pathlib import Path
 
 
 def package_version() -> str:
-    """physgs' installed version ('unknown' when run from a tree that is not installed)."""
+    """physgs' installed version ('unknown' when run from a tree that is not installed).
+
+    Returns:
+        The version string of the installed distribution, or ``'unknown'``.
+    """
     try:
         return version("physgs")
     except PackageNotFoundError:
@@ -47,7 +51,11 @@ class Stamp:
     physgs_version: str
 
     def to_dict(self) -> dict:
-        """The stamp as a plain dict (profile, config_hash, physgs_version)."""
+        """The stamp as a plain dict (profile, config_hash, physgs_version).
+
+        Returns:
+            A new dict of the dataclass fields.
+        """
         return asdict(self)
 
 
@@ -69,6 +77,9 @@ def machine_cpu(cpuinfo: str | Path = "/proc/cpuinfo") -> str:
 
     Args:
         cpuinfo: the kernel's CPU description (Linux); elsewhere ``platform.processor()``.
+
+    Returns:
+        ``'<model> (<flags>)'``, the flags among ``avx512_bf16`` and ``amx_bf16`` or ``no bf16``.
     """
     info = Path(cpuinfo).read_text() if Path(cpuinfo).is_file() else ""
     model = next(
@@ -79,7 +90,14 @@ def machine_cpu(cpuinfo: str | Path = "/proc/cpuinfo") -> str:
 
 
 def git_commit(cwd: str | Path = ".") -> str:
-    """``git describe --always --dirty`` of ``cwd``, or ``unknown`` outside a checkout."""
+    """``git describe --always --dirty`` of ``cwd``, or ``unknown`` outside a checkout.
+
+    Args:
+        cwd: the directory git runs in.
+
+    Returns:
+        The description (e.g. ``77c3389-dirty``), or ``'unknown'`` when git prints nothing.
+    """
     out = subprocess.run(
         ["git", "describe", "--always", "--dirty"], capture_output=True, text=True, cwd=cwd
     )

@@ -2,7 +2,7 @@
 
 Modules: ``metrics`` (PSNR, silhouette centroids), ``splits`` (view / time / transfer splits,
 ``evaluate``), ``trajectories`` (branch-tip paths in pixels), ``adapter`` (render/means callbacks
-from a model via the shared interfaces); safe writes live in ``physgs.atomic``.
+from a model via the shared interfaces); safe writes live in [`physgs.atomic`][].
 
 The names load on first use (lazy_loader): the report jobs read evaluation records with
 ``splits.load_eval`` and should not pay torch's start-up for it.

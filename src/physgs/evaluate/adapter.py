@@ -1,5 +1,5 @@
 """Callbacks that let the evaluation score any model through the shared interfaces only
-(``model.gaussians_at`` and ``physgs.render.rasterization``), never a model class."""
+(``model.gaussians_at`` and [`physgs.render.rasterization`][]), never a model class."""
 
 from __future__ import annotations
 
@@ -10,8 +10,18 @@ import torch
 def model_render_fn(model, observed, *, backend: str = "auto"):
     """render_fn(frame_idx, condition, camera) -> (rgb [H, W, 3] in [0, 1], alpha [H, W]) numpy.
 
-    model: any module with ``gaussians_at(frame_idx, wind [L+F])``; observed: ``Observed``
-    (its wind per condition and background colour). Runs without autograd.
+    Runs without autograd; the last deformed frame is kept, so one deformation serves every camera
+    (and, for a model blind to the wind, every condition).
+
+    Args:
+        model (BaseModel): any module with ``gaussians_at(frame_idx, wind [L+F])`` and
+            ``defined(frame_idx, condition)``.
+        observed (Observed): the dataset (its wind per condition and background colour).
+        backend: the rasterizer backend (see [`rasterization`][physgs.render.rasterization]).
+
+    Returns:
+        (Callable): The callback, float64 arrays; it raises
+            [`NotDefined`][physgs.evaluate.splits.NotDefined] where the model makes no prediction.
     """
     from physgs.render import rasterization
 
@@ -53,7 +63,15 @@ def model_render_fn(model, observed, *, backend: str = "auto"):
 
 
 def model_means_fn(model, observed):
-    """means_fn(frame_idx, condition) -> Gaussian means [N, 3] numpy (world units)."""
+    """means_fn(frame_idx, condition) -> Gaussian means [N, 3] numpy (world units).
+
+    Args:
+        model (BaseModel): the trained model.
+        observed (Observed): the dataset (its wind per condition).
+
+    Returns:
+        (Callable): ``means_fn``; NaN means [N, 3] where the model makes no prediction.
+    """
     winds = [torch.as_tensor(w, dtype=torch.float32) for w in observed.wind]
 
     def means_fn(frame_idx: int, condition: int) -> np.ndarray:

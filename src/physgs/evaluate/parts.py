@@ -24,12 +24,30 @@ class Purity:
 
 
 def gaussian_bone(truth) -> np.ndarray:
-    """[N] bone of each observed Gaussian (in ``canonical_xyz`` order), from truth.npz."""
+    """[N] bone of each observed Gaussian (in ``canonical_xyz`` order), from truth.npz.
+
+    Args:
+        truth (Truth): the dataset's ground truth (``vertex_bone``, ``gaussian_vertex``).
+
+    Returns:
+        [N] bone ids.
+    """
     return np.asarray(truth.vertex_bone)[np.asarray(truth.gaussian_vertex)]
 
 
 def part_purity(labels: np.ndarray, bone: np.ndarray) -> Purity:
-    """Purity of parts ``labels`` [N] (ids in [0, K), every part non-empty) against ``bone`` [N]."""
+    """Purity of parts ``labels`` [N] (ids in [0, K), every part non-empty) against ``bone`` [N].
+
+    Args:
+        labels: [N] part ids in [0, K).
+        bone: [N] bone ids.
+
+    Returns:
+        The [`Purity`][physgs.evaluate.parts.Purity] per part and overall.
+
+    Raises:
+        ValueError: for shapes that are not one [N], or an empty part.
+    """
     labels = np.asarray(labels, dtype=np.int64)
     bone = np.asarray(bone, dtype=np.int64)
     if labels.shape != bone.shape or labels.ndim != 1 or labels.size == 0:
@@ -49,12 +67,20 @@ def part_purity(labels: np.ndarray, bone: np.ndarray) -> Purity:
 def segmentation_record(models, bone: np.ndarray) -> dict[str, np.ndarray]:
     """Arrays of one tree's parts record: each trained prior's segmentation and its purity.
 
-    models: {model id: trained oscillator prior} (their ``part_labels`` [N], ``pivot`` [K, 3]
-    world units, ``part_parent`` [K] for topology parts, all on the same canonical Gaussians);
-    bone [N]: each Gaussian's bone (``gaussian_bone``). Keys: ``models`` [M] ids, ``xyz`` [N, 3]
-    canonical positions, ``bone`` [N], and per model ``<id>/labels`` [N], ``<id>/parent`` [K]
-    (-1 where a part has no parent: every part of k-means), ``<id>/pivots`` [K, 3],
-    ``<id>/purity`` [K], ``<id>/majority_bone`` [K], ``<id>/size`` [K], ``<id>/overall`` [].
+    Args:
+        models (Mapping[str, OscillatorPrior]): model id -> trained oscillator prior (their
+            ``part_labels`` [N], ``pivot`` [K, 3] world units, ``part_parent`` [K] for topology
+            parts, all on the same canonical Gaussians).
+        bone: [N] each Gaussian's bone ([`gaussian_bone`][physgs.evaluate.parts.gaussian_bone]).
+
+    Returns:
+        ``models`` [M] ids, ``xyz`` [N, 3] canonical positions, ``bone`` [N], and per model
+            ``<id>/labels`` [N], ``<id>/parent`` [K] (-1 where a part has no parent: every part of
+            k-means), ``<id>/pivots`` [K, 3], ``<id>/purity`` [K], ``<id>/majority_bone`` [K],
+            ``<id>/size`` [K], ``<id>/overall`` [].
+
+    Raises:
+        ValueError: when a model's labels do not cover the N Gaussians.
     """
     bone = np.asarray(bone, dtype=np.int64)
     out: dict[str, np.ndarray] = {"models": np.asarray(list(models), dtype=str), "bone": bone}
@@ -79,7 +105,13 @@ def segmentation_record(models, bone: np.ndarray) -> dict[str, np.ndarray]:
 
 
 def save_segmentations(path, record: dict[str, np.ndarray]) -> None:
-    """Write a ``segmentation_record`` atomically as .npz."""
+    """Write a ``segmentation_record`` atomically as .npz.
+
+    Args:
+        path (str | Path): the ``.npz`` to write.
+        record: the arrays of
+            [`segmentation_record`][physgs.evaluate.parts.segmentation_record].
+    """
     from physgs.atomic import atomic_path
 
     with atomic_path(path) as tmp, open(tmp, "wb") as f:
@@ -87,7 +119,17 @@ def save_segmentations(path, record: dict[str, np.ndarray]) -> None:
 
 
 def load_segmentations(path) -> dict[str, np.ndarray]:
-    """The arrays of a parts record written by ``save_segmentations``."""
+    """The arrays of a parts record written by ``save_segmentations``.
+
+    Args:
+        path (str | Path): the ``.npz``.
+
+    Returns:
+        The arrays by key.
+
+    Raises:
+        IntermediateFileError: when the file is missing or corrupt (rule ``parts_segmentation``).
+    """
     from physgs.intermediate import read_npz
 
     return read_npz(path, (), rule="parts_segmentation")

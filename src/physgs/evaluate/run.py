@@ -1,7 +1,7 @@
 """Evaluate one trained checkpoint end to end: splits, tip trajectories and qualitative panels.
 
 This is what the Snakemake rule `evaluate` calls; it only joins the pieces of
-``physgs.evaluate`` (scores through the render callback, never through a model class).
+[`physgs.evaluate`][] (scores through the render callback, never through a model class).
 """
 
 from __future__ import annotations
@@ -18,10 +18,16 @@ from physgs.evaluate.trajectories import tip_trajectories
 def panel_choice(observed) -> dict[str, tuple[int, int, int]]:
     """The qualitative panels of fig_results: split -> (frame_idx, condition, camera index).
 
-    camera index -1 is the training camera, otherwise a held-out azimuth. Fixed choices so every
-    model shows the same frame: the middle of the tail (unseen time), the held-out azimuth
-    nearest +30 degrees in the middle of the window (unseen view), and the weakest unseen wind in
-    the middle of the tail (unseen wind, where replay cannot help).
+    Fixed choices so every model shows the same frame: the middle of the tail (unseen time), the
+    held-out azimuth nearest +30 degrees in the middle of the window (unseen view), and the
+    weakest unseen wind in the middle of the tail (unseen wind, where replay cannot help).
+
+    Args:
+        observed (Observed): the dataset.
+
+    Returns:
+        ``time``, ``view`` and ``wind`` -> ``(frame_idx, condition, camera)``; camera -1 is the
+            training camera, otherwise a held-out azimuth's index.
     """
     mid_tail = int(observed.n_train + observed.n_tail // 2)
     az = np.asarray(observed.heldout_azimuths_deg, dtype=np.float64)
@@ -35,7 +41,16 @@ def panel_choice(observed) -> dict[str, tuple[int, int, int]]:
 
 
 def render_panels(render_fn, observed) -> dict[str, np.ndarray]:
-    """Renders and ground truth of the fig_results panels; arrays keyed '<split>_pred/_gt/_psnr'."""
+    """Renders and ground truth of the fig_results panels; arrays keyed '<split>_pred/_gt/_psnr'.
+
+    Args:
+        render_fn (RenderFn): the model's render callback.
+        observed (Observed): the dataset.
+
+    Returns:
+        Per split ``<split>_pred`` and ``<split>_gt`` [H, W, 3] uint8 and ``<split>_psnr`` (dB, a
+            0-d array; NaN with a blank render where the model makes no prediction).
+    """
     out = {}
     for split, (j, c, a) in panel_choice(observed).items():
         if a < 0:
@@ -60,7 +75,18 @@ def training_camera_scores(
     model, observed, frames, *, condition: int = 0, backend: str = "auto"
 ) -> tuple[np.ndarray, np.ndarray]:
     """(MSE [M], PSNR dB [M]) of ``model`` at the training camera, per recorded frame in
-    ``frames`` [M] of ``condition``, through the same render callback as the evaluation."""
+    ``frames`` [M] of ``condition``, through the same render callback as the evaluation.
+
+    Args:
+        model (BaseModel): the trained model.
+        observed (Observed): the dataset.
+        frames (ArrayLike): [M] recorded-frame indices.
+        condition: the wind condition's index.
+        backend: the rasterizer backend.
+
+    Returns:
+        ``(mse [M], psnr [M])``: MSE of images in [0, 1], PSNR in dB.
+    """
     render_fn = model_render_fn(model, observed, backend=backend)
     mse, score = [], []
     for j in np.asarray(frames, dtype=np.int64):
@@ -73,7 +99,15 @@ def training_camera_scores(
 
 def undefined_splits(model, observed) -> set[str]:
     """The summary keys (``EvalResult.summary``) holding a frame the model does not predict
-    (``model.defined``): a learned forcing has none beyond its window or under another wind."""
+    (``model.defined``): a learned forcing has none beyond its window or under another wind.
+
+    Args:
+        model (BaseModel): the trained model.
+        observed (Observed): the dataset.
+
+    Returns:
+        Keys among ``time``, ``view``, ``train_c{c}``, ``beyond_c{c}``, ``centroid_c{c}``.
+    """
     n, C = int(observed.n_train), len(observed.conditions)
     out = set()
     if not model.defined(n, 0):
@@ -102,9 +136,23 @@ def evaluate_checkpoint(
 ) -> dict[str, float]:
     """Score ``model`` on every split and write three files atomically.
 
-    eval_path: ``EvalResult`` npz (per-frame PSNR in dB, centroid errors in pixels);
-    traj_path: branch-tip trajectories (pixels) at the training wind; panels_path: the
-    qualitative renders. Returns the split means (``EvalResult.summary()``).
+    Args:
+        model (BaseModel): the trained model.
+        observed (Observed): the dataset.
+        truth (Truth): its ground truth (for the tip trajectories).
+        eval_path (str | Path): [`EvalResult`][physgs.evaluate.splits.EvalResult] npz (per-frame
+            PSNR in dB, centroid errors in pixels).
+        traj_path (str | Path): branch-tip trajectories (pixels) at the training wind.
+        panels_path (str | Path): the qualitative renders.
+        backend: the rasterizer backend.
+        progress (Callable[[str], None] | None): receives progress lines.
+
+    Returns:
+        The split means ([`EvalResult.summary`][physgs.evaluate.splits.EvalResult.summary]).
+
+    Raises:
+        FloatingPointError: when a split the model predicts scores non-finite (a corrupt
+            checkpoint); nothing is written then.
     """
     render_fn = model_render_fn(model, observed, backend=backend)
     res = evaluate(render_fn, observed, progress=progress)

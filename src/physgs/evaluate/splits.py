@@ -68,7 +68,11 @@ class EvalResult:
     # --- split means (what the tables show) ---------------------------------------------
     def summary(self) -> dict[str, float]:
         """Mean PSNR per split (dB): view, time, and train/beyond for every condition c as
-        ``train_c{c}`` / ``beyond_c{c}``; mean centroid errors as ``centroid_c{c}`` (px)."""
+        ``train_c{c}`` / ``beyond_c{c}``; mean centroid errors as ``centroid_c{c}`` (px).
+
+        Returns:
+            Split name -> mean.
+        """
         out = {"view": float(self.view_psnr.mean()), "time": float(self.time_psnr.mean())}
         for c in range(len(self.conditions)):
             out[f"train_c{c}"] = float(self.train_timestamps_psnr[c].mean())
@@ -77,7 +81,11 @@ class EvalResult:
         return out
 
     def save(self, path) -> None:
-        """Write as .npz atomically."""
+        """Write as .npz atomically.
+
+        Args:
+            path (str | Path): the ``.npz`` to write.
+        """
         save_npz(path, **{f.name: np.asarray(getattr(self, f.name)) for f in fields(self)})
 
 
@@ -171,7 +179,20 @@ def view_psnr(
     render_fn: RenderFn, observed, *, progress: Callable[[str], None] | None = None
 ) -> np.ndarray:
     """The view split: PSNR (dB) [A, M] of the held-out azimuths x held-out frames (training
-    condition, inside the window) of ``observed``, through the render callback."""
+    condition, inside the window) of ``observed``, through the render callback.
+
+    Args:
+        render_fn: the model's render callback.
+        observed (Observed): the dataset.
+        progress: receives a progress line.
+
+    Returns:
+        [A, M] PSNR, dB.
+
+    Raises:
+        NotDefined: from the callback, where the model makes no prediction (not caught here).
+        ValueError: when a render's size is not the held-out frames'.
+    """
     A, M = len(observed.heldout_cameras), len(observed.heldout_frame_idx)
     view = np.empty((A, M))
     if progress:

@@ -29,7 +29,11 @@ class Trajectories:
     n_train: int
 
     def error_px(self) -> np.ndarray:
-        """[P, F] pixel distance between predicted and ground-truth tips."""
+        """[P, F] pixel distance between predicted and ground-truth tips.
+
+        Returns:
+            [P, F] distances, px.
+        """
         return np.linalg.norm(self.pred_px - self.gt_px, axis=-1)
 
     def save(self, path) -> None:
@@ -71,8 +75,22 @@ def gt_tip_positions(
     """Ground-truth world positions [P, F, 3] of vertices ``tips`` at recorded frames 0..F-1.
 
     Recorded frame j uses bone angles ``truth.theta[condition, lead_in_frames + j]`` (rad) posed
-    by forward kinematics ``pose_fn(truth, theta_b [B]) -> [N, 3]`` (default
-    ``physgs.testbed.kinematics.pose_vertices``).
+    by forward kinematics.
+
+    Args:
+        truth (Truth): the dataset's ground truth.
+        tips: [P] mesh vertex indices.
+        condition: the wind condition's index.
+        lead_in_frames: lead-in frames L.
+        n_frames: F, the recorded frames.
+        pose_fn: ``pose_fn(truth, theta_b [B]) -> [N, 3]`` (default
+            [`pose_vertices`][physgs.testbed.kinematics.pose_vertices]).
+
+    Returns:
+        [P, F, 3] positions, m.
+
+    Raises:
+        ValueError: when the truth holds fewer than L + F samples.
     """
     if pose_fn is None:
         # imported here so the metric code loads without the testbed package
@@ -100,10 +118,21 @@ def tip_trajectories(
 ) -> Trajectories:
     """Ground-truth and predicted branch-tip paths in pixels at the training camera.
 
-    means_fn(frame_idx, condition) -> [N, 3] numpy Gaussian means of the model, in Gaussian order
-    (one Gaussian per mesh vertex, in the seeded random order of ``canonical_xyz``). tips: mesh
-    vertex indices [P] (default ``truth.tip_vertices``); the Gaussian of vertex v is
-    ``truth.vertex_gaussian[v]``. Covers all F = n_train + n_tail recorded frames.
+    The Gaussian of vertex v is ``truth.vertex_gaussian[v]`` (one Gaussian per mesh vertex, in the
+    seeded random order of ``canonical_xyz``). Covers all F = n_train + n_tail recorded frames.
+
+    Args:
+        means_fn: ``means_fn(frame_idx, condition) -> [N, 3]`` numpy Gaussian means of the
+            model, in Gaussian order.
+        truth (Truth): the dataset's ground truth.
+        observed (Observed): the dataset (training camera, frame counts).
+        condition: the wind condition's index.
+        tips: [P] mesh vertex indices (default ``truth.tip_vertices``).
+        pose_fn: forward kinematics for the ground truth (see
+            [`gt_tip_positions`][physgs.evaluate.trajectories.gt_tip_positions]).
+
+    Returns:
+        The [`Trajectories`][physgs.evaluate.trajectories.Trajectories], px.
     """
     tips = np.asarray(truth.tip_vertices if tips is None else tips, dtype=np.int64)
     gauss = np.asarray(truth.vertex_gaussian, dtype=np.int64)[tips]  # the tips' Gaussians

@@ -63,8 +63,18 @@ def _number(x) -> float:
 
 
 def read_costs(benchmark_dir) -> list[JobCost]:
-    """Every ``*.tsv`` under ``benchmark_dir`` as a JobCost. Raises FileNotFoundError if the folder
-    is missing and ValueError naming the file if one has no ``s`` column or no data row."""
+    """Every ``*.tsv`` under ``benchmark_dir`` as a JobCost.
+
+    Args:
+        benchmark_dir (str | Path): the run's benchmark folder (searched recursively).
+
+    Returns:
+        One [`JobCost`][physgs.experiments.cost.JobCost] per file.
+
+    Raises:
+        FileNotFoundError: if the folder is missing or holds no ``*.tsv``.
+        ValueError: naming the file if one has no ``s`` column or no data row.
+    """
     root = Path(benchmark_dir)
     if not root.is_dir():
         raise FileNotFoundError(f"{root}: no benchmark folder (run the pipeline first)")
@@ -99,9 +109,14 @@ def read_costs(benchmark_dir) -> list[JobCost]:
 def summarise(jobs: list[JobCost]) -> dict:
     """Job-seconds (wall) by stage and seed, shared (seed None) and damping-benchmark totals.
 
-    Returns {"by_stage": {stage: {seed or "shared": s}}, "per_seed": {seed: s},
-    "shared_s": s, "damping_s": s, "damping_per_seed": {seed: s}, "total_s": s}; seconds are job
-    wall seconds summed (on c cores a perfectly packed run takes total_s / c)."""
+    Args:
+        jobs: the benchmarked jobs.
+
+    Returns:
+        ``{"by_stage": {stage: {seed or "shared": s}}, "per_seed": {seed: s}, "shared_s": s,
+            "damping_s": s, "damping_per_seed": {seed: s}, "total_s": s}``; seconds are job wall
+            seconds summed (on c cores a perfectly packed run takes total_s / c).
+    """
     by_stage: dict[str, dict] = {}
     per_seed: dict[int, float] = {}
     damping_per_seed: dict[int, float] = {}
@@ -131,8 +146,18 @@ def summarise(jobs: list[JobCost]) -> dict:
 def extra_seed_wall_s(summary: dict, *, run_wall_s: float) -> float:
     """Wall seconds one more seed adds to a run like the measured one: the mean per-seed
     job-seconds scaled by the run's own ratio of wall time to job-seconds (which carries the
-    core count, the packing of jobs and the unbenchmarked light jobs). Raises ValueError without
-    a seed or with a non-positive wall time."""
+    core count, the packing of jobs and the unbenchmarked light jobs).
+
+    Args:
+        summary: [`summarise`][physgs.experiments.cost.summarise] of the run's jobs.
+        run_wall_s: the run's measured wall time, s.
+
+    Returns:
+        The extra wall time, s.
+
+    Raises:
+        ValueError: without a per-seed job or with a non-positive wall time.
+    """
     if not summary["per_seed"]:
         raise ValueError("no per-seed jobs: nothing to scale")
     if not run_wall_s > 0:
@@ -145,8 +170,19 @@ def wall_spans(jobs: list[JobCost]) -> dict:
     """Elapsed wall seconds from the first job's start to the last job's end, for the whole run
     and per stage (stages overlap: jobs of different stages run side by side).
 
-    Returns {"run_s": s, "by_stage": {stage: s}}. Read from the benchmark files' times, so a run
-    resumed after a pause counts the pause, and a stage rerun later spans both runs."""
+    Read from the benchmark files' times, so a run resumed after a pause counts the pause, and a
+    stage rerun later spans both runs.
+
+    Args:
+        jobs: the jobs, as [`read_costs`][physgs.experiments.cost.read_costs] reads them (with end
+            times).
+
+    Returns:
+        ``{"run_s": s, "by_stage": {stage: s}}``.
+
+    Raises:
+        ValueError: without jobs, or for a job without an end time.
+    """
     if not jobs:
         raise ValueError("no jobs: nothing to span")
     if any(j.end != j.end for j in jobs):  # NaN: a JobCost built without its end time
@@ -164,7 +200,14 @@ def wall_spans(jobs: list[JobCost]) -> dict:
 def resources_by_stage(jobs: list[JobCost]) -> dict[str, dict]:
     """What each stage's jobs used, to size a cluster's requests from measurement: per stage
     {jobs, wall_mean_s, wall_max_s, cpu_mean_s, cpu_max_s, rss_max_mb} (NaN-free maxima and
-    means over the jobs that report the quantity; NaN when none does)."""
+    means over the jobs that report the quantity; NaN when none does).
+
+    Args:
+        jobs: the benchmarked jobs.
+
+    Returns:
+        Stage -> its statistics, stages sorted by name; seconds and MB.
+    """
     import math
 
     def stats(xs):

@@ -33,19 +33,40 @@ COLUMNS = ("seed", "model", "iterations", "is_profile", "fit", "heldout", "time"
 
 
 def budgets(cfg: dict) -> list[int]:
-    """Every budget on the curve, ascending: the listed ones and the profile's own."""
+    """Every budget on the curve, ascending: the listed ones and the profile's own.
+
+    Args:
+        cfg: the resolved config.
+
+    Returns:
+        Training iterations, ascending, without repeats.
+    """
     fc = cfg["speed_accuracy"]["fit_curve"]
     return sorted({*map(int, fc["iterations"]), int(cfg["train"]["iterations"])})
 
 
 def extra_budgets(cfg: dict) -> list[int]:
-    """The budgets that need a training job of their own (all but the profile's)."""
+    """The budgets that need a training job of their own (all but the profile's).
+
+    Args:
+        cfg: the resolved config.
+
+    Returns:
+        Training iterations, ascending.
+    """
     return [b for b in budgets(cfg) if b != int(cfg["train"]["iterations"])]
 
 
 def window_models(cfg: dict) -> list[str]:
     """The fit curve's fields whose chosen time encoding is not the window convention: each gets
-    a ``<model>@window`` diagnostic point at the profile's budget."""
+    a ``<model>@window`` diagnostic point at the profile's budget.
+
+    Args:
+        cfg: the resolved config.
+
+    Returns:
+        Model ids, in the fit curve's order.
+    """
     out = []
     for m in cfg["speed_accuracy"]["fit_curve"]["models"]:
         family = MODELS[m].family
@@ -57,9 +78,22 @@ def window_models(cfg: dict) -> list[str]:
 def point_job(
     cfg: dict, model: str, iterations: int, seed: int | None = None, window_time: bool = False
 ) -> dict:
-    """The training job (``recipe.job_spec``) of ``model`` at ``iterations`` with training seed
-    ``seed`` (default ``cfg['seed']``), as a sorted dict; ``window_time``: a field with the
-    window-normalised time encoding instead of its chosen one (the diagnostic series)."""
+    """The training job ([`job_spec`][physgs.experiments.recipe.job_spec]) of ``model`` at a budget.
+
+    Args:
+        cfg: the resolved config (the fit curve's tree is read from it).
+        model: a model id.
+        iterations: the training budget (the warm-up keeps its fraction).
+        seed: the training seed (default ``cfg['seed']``).
+        window_time: a field with the window-normalised time encoding instead of its chosen one
+            (the diagnostic series).
+
+    Returns:
+        The job as a sorted dict.
+
+    Raises:
+        ValueError: for ``window_time`` on a model that is not a field.
+    """
     tree = cfg["speed_accuracy"]["fit_curve"]["tree"]
     pcfg = with_knob(cfg, tree, "iterations", iterations)
     if window_time:
@@ -76,11 +110,18 @@ def point_job(
 def run_point(job: Mapping, observed, *, progress: bool = False, series: str | None = None) -> dict:
     """Train ``job`` on ``observed`` and score it; a flat record (dB, seconds).
 
-    series: the record's ``model`` (default the job's model id; ``<model>@window`` for the
-    window-time diagnostic).
+    Args:
+        job: the training job's dict.
+        observed (Observed): the dataset.
+        progress: show a progress bar.
+        series: the record's ``model`` (default the job's model id; ``<model>@window`` for the
+            window-time diagnostic).
 
-    fit / heldout: mean PSNR over the trained / held-out training-window frames; time: over the
-    tail frames; all at the training camera and wind. train_s: wall time of the training.
+    Returns:
+        ``model``, ``seed``, ``iterations``, ``fit`` / ``heldout`` (mean PSNR over the trained /
+            held-out training-window frames, dB; heldout NaN without held-out frames), ``time``
+            (over the tail frames, dB), all at the training camera and wind, and ``train_s`` (wall
+            time of the training, s).
     """
     from physgs.evaluate.run import training_camera_scores  # torch: only when training
 
@@ -123,9 +164,21 @@ def collect(
 ) -> pd.DataFrame:
     """One row per (seed, model, budget), sorted.
 
-    points: ``run_point`` records (each names its seed); profile_rows: seed -> model -> the
-    pipeline's own row at the profile's budget (``report.build.fit_row``: fit, heldout, time,
-    train_s), references included.
+    Args:
+        points: [`run_point`][physgs.experiments.fit_curve.run_point] records (each names its
+            seed).
+        profile_rows: seed -> model -> the pipeline's own row at the profile's budget
+            ([`fit_row`][physgs.report.build.fit_row]: fit, heldout, time, train_s), references
+            included.
+        profile_iterations: the profile's budget.
+        tree: the fit curve's tree (a column).
+
+    Returns:
+        The ``COLUMNS`` table, sorted by model, iterations and seed; ``is_profile`` marks the
+            pipeline's rows.
+
+    Raises:
+        ValueError: when a point repeats a (seed, model) at the profile's budget.
     """
     keep = ("model", "iterations", "fit", "heldout", "time", "train_s")
     rows = [
@@ -160,7 +213,16 @@ def ceiling_fraction(
     df: pd.DataFrame, static: str = "static", ceiling: str = "truth_motion"
 ) -> pd.Series:
     """(fit - static) / (ceiling - static) per row, against the same seed's profile-budget static
-    and ceiling rows (the fraction of the achievable in-window gain); NaN without them."""
+    and ceiling rows (the fraction of the achievable in-window gain); NaN without them.
+
+    Args:
+        df: [`collect`][physgs.experiments.fit_curve.collect]'s table.
+        static: the static model's id.
+        ceiling: the ceiling's id.
+
+    Returns:
+        The fractions, indexed like ``df``.
+    """
     prof = df[df["is_profile"]].set_index(["seed", "model"])["fit"]
     out = pd.Series(np.nan, index=df.index)
     for seed, g in df.groupby("seed"):

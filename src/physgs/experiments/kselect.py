@@ -5,7 +5,7 @@ out every k-th training frame), iterations and warmup (a short training run per 
 tie_db (dB), conditions (which wind conditions the chosen model then trains on).
 
 Both criteria come from the same runs: ours is trained per candidate by the one recipe
-(``physgs.experiments.recipe.fit``: seeding, loop, schedule and freezing as the full run, only
+([`physgs.experiments.recipe.fit`][]: seeding, loop, schedule and freezing as the full run, only
 shorter) on the training frames minus every k-th (frames k-1, 2k-1, ...), and scored through
 the evaluation's render callback.
 - ``heldout``: mean PSNR (dB) over the held-out frames at the training camera and wind; the
@@ -33,14 +33,38 @@ PARAMS_PER_PART = 8  # omega, zeta, gain, swing axis (2), pivot (3)
 
 
 def bic(mse: float, n: int, k_parts: int) -> float:
-    """n log(MSE) + p log n with p = 8 K (see module docstring); lower is better."""
+    """n log(MSE) + p log n with p = 8 K (see module docstring); lower is better.
+
+    Args:
+        mse: mean squared error of the scored pixels (> 0).
+        n: number of scored values (> 0).
+        k_parts: K.
+
+    Returns:
+        The BIC.
+
+    Raises:
+        ValueError: unless mse > 0 and n > 0.
+    """
     if not (mse > 0 and n > 0):
         raise ValueError(f"bic needs mse > 0 and n > 0, got {mse}, {n}")
     return float(n * np.log(mse) + PARAMS_PER_PART * k_parts * np.log(n))
 
 
 def choose_heldout(candidates, heldout_psnr, tie_db: float) -> int:
-    """Smallest K whose held-out PSNR (dB) is within ``tie_db`` of the best."""
+    """Smallest K whose held-out PSNR (dB) is within ``tie_db`` of the best.
+
+    Args:
+        candidates (ArrayLike): [n] K values.
+        heldout_psnr (ArrayLike): [n] held-out PSNR per candidate, dB.
+        tie_db: the tolerance, dB.
+
+    Returns:
+        The chosen K.
+
+    Raises:
+        ValueError: when every PSNR is non-finite.
+    """
     ks, p = np.asarray(candidates), np.asarray(heldout_psnr, dtype=np.float64)
     if not np.isfinite(p).any():
         raise ValueError("every K candidate gave a non-finite held-out PSNR; training diverged")
@@ -49,7 +73,15 @@ def choose_heldout(candidates, heldout_psnr, tie_db: float) -> int:
 
 
 def choose_bic(candidates, bics) -> int:
-    """K with the lowest BIC (ties: the smaller K)."""
+    """K with the lowest BIC (ties: the smaller K).
+
+    Args:
+        candidates (ArrayLike): [n] K values.
+        bics (ArrayLike): [n] BIC per candidate.
+
+    Returns:
+        The chosen K.
+    """
     ks, b = np.asarray(candidates), np.asarray(bics, dtype=np.float64)
     best = np.nanmin(b)
     return int(ks[b == best].min())
@@ -78,7 +110,11 @@ class KSelection:
     chosen_k: int
 
     def to_dict(self) -> dict:
-        """The selection as a plain JSON-serialisable dict (field name -> value)."""
+        """The selection as a plain JSON-serialisable dict (field name -> value).
+
+        Returns:
+            Field name -> value.
+        """
         return asdict(self)
 
     @staticmethod
@@ -145,10 +181,23 @@ def _check_cfg(ks: dict, n_gaussians: int) -> list[int]:
 def select_k(observed, job: Job | dict, kselect: dict, *, progress: bool = False) -> KSelection:
     """Train ours once per candidate K on the non-held-out frames and score both criteria.
 
-    observed: ``Observed``; job: ours' training job (``recipe.job_spec``: settings, train,
-    seed; its K and configuration are replaced per candidate); kselect: the
-    ``models.kselect`` section. Each candidate is trained by ``recipe.fit`` (freezing
-    included) with the section's shorter schedule. Deterministic for the job's seed.
+    Each candidate is trained by [`fit`][physgs.experiments.recipe.fit] (freezing included) with
+    the section's shorter schedule. Deterministic for the job's seed.
+
+    Args:
+        observed (Observed): the dataset.
+        job: ours' training job ([`job_spec`][physgs.experiments.recipe.job_spec]: settings,
+            train, seed; its K and configuration are replaced per candidate).
+        kselect: the ``models.kselect`` section.
+        progress: show progress bars.
+
+    Returns:
+        The [`KSelection`][physgs.experiments.kselect.KSelection]: every candidate's scores and
+            the K each criterion chooses.
+
+    Raises:
+        ValueError: for candidates above the Gaussian count or an unknown method, or when every
+            held-out PSNR is non-finite.
     """
     from physgs.evaluate.run import training_camera_scores  # torch: only when training
 
@@ -188,6 +237,15 @@ def select_k(observed, job: Job | dict, kselect: dict, *, progress: bool = False
 
 
 def auto_job(job: Job | dict, sel: KSelection, conditions: str) -> dict:
-    """Ours' training job with the chosen K (configuration 'auto'), as ``recipe.job_spec``."""
+    """Ours' training job with the chosen K (configuration 'auto'), as ``recipe.job_spec``.
+
+    Args:
+        job: ours' training job.
+        sel: the selection.
+        conditions: the configuration's conditions (``'train'`` or ``'all'``).
+
+    Returns:
+        The job's dict with K, configuration and conditions replaced.
+    """
     job = Job.from_dict(job) if isinstance(job, dict) else job
     return job.replace(K=int(sel.chosen_k), config=AUTO_CONFIG, conditions=conditions).to_dict()

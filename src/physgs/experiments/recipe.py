@@ -27,7 +27,14 @@ if TYPE_CHECKING:
 
 def canonical(x):
     """``x`` with every dict's keys sorted (recursively): a stable repr, so Snakemake's params
-    check sees a job as changed only when a value changes, never when keys are reordered."""
+    check sees a job as changed only when a value changes, never when keys are reordered.
+
+    Args:
+        x (Any): a dict, list, tuple or leaf.
+
+    Returns:
+        (Any): The same structure (tuples as lists).
+    """
     if isinstance(x, dict):
         return {k: canonical(x[k]) for k in sorted(x)}
     if isinstance(x, (list, tuple)):
@@ -62,6 +69,9 @@ class Job:
         """The job as a plain dict, keys sorted at every level.
 
         See [canonical][physgs.experiments.recipe.canonical].
+
+        Returns:
+            The job's fields as nested plain values.
         """
         return canonical(asdict(self))
 
@@ -128,7 +138,18 @@ def job_spec(cfg: dict, model: str, config: str, seed: int | None = None) -> dic
 
 def heldout_split(n_train: int, every: int) -> tuple[np.ndarray, np.ndarray]:
     """(training frames, held-out frames): indices in [0, n_train), every ``every``-th held out
-    (frames every-1, 2 every-1, ...), so frame 0 and the window's start stay in training."""
+    (frames every-1, 2 every-1, ...), so frame 0 and the window's start stay in training.
+
+    Args:
+        n_train: training-window length, frames.
+        every: the holdout period, in [2, n_train].
+
+    Returns:
+        ``(trained, held)`` frame indices, int arrays.
+
+    Raises:
+        ValueError: for ``every`` outside [2, n_train].
+    """
     if not 2 <= every <= n_train:
         raise ValueError(
             f"every (train.holdout_every, models.kselect.every) must lie in "
@@ -217,7 +238,19 @@ def fit(
 
 def training_hooks(observed, job: Job, conditions: list[int]) -> list:
     """The ``on_iteration`` hooks of ``job``'s training, in order: freezing invisible parts
-    (oscillator priors, unless off) and the search over omega (the models it lists)."""
+    (oscillator priors, unless off) and the search over omega (the models it lists).
+
+    Args:
+        observed (Observed): the dataset.
+        job: the training job.
+        conditions: the trained conditions' indices.
+
+    Returns:
+        The hooks (none that are off).
+
+    Raises:
+        ValueError: for a freezing iteration or a search end outside the deformation phase.
+    """
     from physgs.models.omega_search import omega_search_callback
     from physgs.models.registry import searches_omega
     from physgs.models.visibility import freeze_callback
@@ -239,7 +272,16 @@ def check_precision_supported(settings: dict, families: tuple[str, ...] = ("mlp"
     """Raise RuntimeError if any of ``families`` asks for ``precision: bfloat16`` in the models
     settings ``settings`` and this CPU has no native bf16 (autocast would emulate it, ~48x
     slower than float32: a default run would take days), naming the key and the way out. torch
-    is imported only when some family asks for bf16, so planning a float32 run stays light."""
+    is imported only when some family asks for bf16, so planning a float32 run stays light.
+
+    Args:
+        settings: the ``models`` settings.
+        families: the field families checked.
+
+    Raises:
+        RuntimeError: naming the key and the way out when bf16 is asked for without native
+            support.
+    """
     asked = [
         f for f in families if (settings.get(f) or {}).get("precision", "float32") == "bfloat16"
     ]

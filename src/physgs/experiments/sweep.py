@@ -29,7 +29,16 @@ BASE = "base"
 
 
 def knob_value(cfg: dict, tree: str, knob: str) -> int:
-    """The resolved config's current value of ``knob`` for ``tree``."""
+    """The resolved config's current value of ``knob`` for ``tree``.
+
+    Args:
+        cfg: the resolved config.
+        tree: the sweep's tree.
+        knob: one of ``KNOBS``.
+
+    Returns:
+        The value.
+    """
     return {
         "resolution": lambda: cfg["testbed"]["resolution"],
         "vertices": lambda: cfg["testbed"]["vertices"][tree],
@@ -40,7 +49,20 @@ def knob_value(cfg: dict, tree: str, knob: str) -> int:
 
 
 def with_knob(cfg: dict, tree: str, knob: str, value: int) -> dict:
-    """A copy of the resolved config with one knob set; the static warm-up keeps its fraction."""
+    """A copy of the resolved config with one knob set; the static warm-up keeps its fraction.
+
+    Args:
+        cfg: the resolved config (not modified).
+        tree: the sweep's tree.
+        knob: one of ``KNOBS``.
+        value: the knob's value.
+
+    Returns:
+        The new config.
+
+    Raises:
+        ValueError: for an unknown knob.
+    """
     if knob not in KNOBS:
         raise ValueError(f"unknown speed-accuracy knob '{knob}'; choose one of {KNOBS}")
     out = copy.deepcopy(cfg)
@@ -64,6 +86,12 @@ def sweep_points(cfg: dict) -> list[str]:
     """Point names '<knob>-<value>' of the sweep, plus 'base' (every knob at the profile's value).
 
     A listed value equal to the profile's own is the base point, so it is run once.
+
+    Args:
+        cfg: the resolved config.
+
+    Returns:
+        ``'base'`` then the other points, knobs in ``KNOBS`` order.
     """
     sa = cfg["speed_accuracy"]
     tree = sa["tree"]
@@ -100,11 +128,22 @@ def parse_point(name: str) -> tuple[str | None, int | None]:
 def point_settings(
     cfg: dict, name: str, seed: int | None = None, testbed_seeds: bool = False
 ) -> dict:
-    """What sweep point ``name`` reads, as a sorted plain dict (the workflow's params): its knob
-    values, ours' training job at those values (``recipe.job_spec``, the tables' recipe, with
-    training seed ``seed``, default ``cfg['seed']``) and, for a knob that changes the testbed,
-    the testbed settings to rebuild it with (testbed seed ``cfg['seed']``, or ``seed`` when
-    ``testbed_seeds``: each seed then has its own tree instance)."""
+    """What sweep point ``name`` reads, as a sorted plain dict (the workflow's params).
+
+    Its knob values, ours' training job at those values
+    ([`job_spec`][physgs.experiments.recipe.job_spec], the tables' recipe) and, for a knob that
+    changes the testbed, the testbed settings to rebuild it with.
+
+    Args:
+        cfg: the resolved config.
+        name: the point's name (``'base'`` or ``'<knob>-<value>'``).
+        seed: the training seed (default ``cfg['seed']``).
+        testbed_seeds: build a changed testbed with ``seed`` instead of ``cfg['seed']``: each
+            seed then has its own tree instance.
+
+    Returns:
+        ``point``, ``knob``, ``tree``, ``values``, ``job`` and, for a testbed knob, ``testbed``.
+    """
     tree = cfg["speed_accuracy"]["tree"]
     knob, value = parse_point(name)
     pcfg = cfg if knob is None else with_knob(cfg, tree, knob, value)
@@ -128,9 +167,21 @@ def point_settings(
 def run_point(point: dict, observed_path, truth_path, *, progress: bool = False) -> dict:
     """Train and score one sweep point; returns a flat record (seconds, dB, fractions).
 
-    point: ``point_settings``; observed_path/truth_path: the tree's pipeline dataset, reused
-    unless the knob changes the testbed. Ours is trained by ``recipe.fit``, freezing included,
-    so each point is the model the tables report at those settings.
+    Ours is trained by [`fit`][physgs.experiments.recipe.fit], freezing included, so each point is
+    the model the tables report at those settings.
+
+    Args:
+        point: [`point_settings`][physgs.experiments.sweep.point_settings].
+        observed_path (str | Path): the tree's pipeline dataset, reused unless the knob changes
+            the testbed (then rebuilt in a temporary folder).
+        truth_path (str | Path): its truth file.
+        progress: show progress bars.
+
+    Returns:
+        The point's name, knob, tree, seed and knob values, with ``testbed_s``, ``train_s``,
+            ``eval_s``, ``wall_s`` (s), ``psnr_time`` (dB, the tail at the training camera),
+            ``rel_err`` (median relative frequency error, fraction), ``trusted``, ``parts`` and
+            ``frozen`` counts.
     """
     from physgs.evaluate.run import training_camera_scores  # torch: only when training
 
@@ -177,7 +228,19 @@ def run_point(point: dict, observed_path, truth_path, *, progress: bool = False)
 
 def collect(records: Sequence[dict]) -> pd.DataFrame:
     """One row per (seed, knob, value), the base point of each seed repeated under every knob it
-    anchors; records of one seed or several (each record names its ``seed``: ``run_point``)."""
+    anchors.
+
+    Args:
+        records: [`run_point`][physgs.experiments.sweep.run_point] records of one seed or several
+            (each names its ``seed``).
+
+    Returns:
+        Rows sorted by knob, value and seed: seed, knob, value, is_base, the timings, scores,
+            counts, tree and every knob's value.
+
+    Raises:
+        ValueError: for a record without a seed, or a seed without exactly one base point.
+    """
     by_seed: dict[int, list[dict]] = {}
     for r in records:
         if "seed" not in r:
@@ -227,7 +290,16 @@ def collect(records: Sequence[dict]) -> pd.DataFrame:
 def null_level(nulls: Sequence) -> dict:
     """The untrained null's chance level for the recovery panel, from ``NullResult`` s (one per
     seed): the median over every draw of each draw's median relative error, and the central 95%
-    of those draws (fractions). A sweep point inside the band is indistinguishable from chance."""
+    of those draws (fractions). A sweep point inside the band is indistinguishable from chance.
+
+    Args:
+        nulls (Sequence[NullResult]): one [`NullResult`][physgs.recovery.null.NullResult] per
+            seed, at one K.
+
+    Returns:
+        ``median``, ``low`` and ``high`` (fractions), ``draws`` and ``K`` (no ``K`` when no draw
+            is finite: the values are then NaN).
+    """
     v = np.concatenate([np.asarray(n.median_rel_err, float) for n in nulls])
     v = v[np.isfinite(v)]
     if not v.size:

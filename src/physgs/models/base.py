@@ -35,7 +35,12 @@ class ModelContext:
     vbar_ratio: float = 1.0
 
     def to_dict(self) -> dict:
-        """Checkpoint-safe form (tensors and Python scalars only)."""
+        """Checkpoint-safe form (tensors and Python scalars only).
+
+        Returns:
+            The fields by name: canonical_xyz a float32 tensor [N, 3], view_dir a float64 tensor
+                [3], the rest ints and floats.
+        """
         return {
             "canonical_xyz": torch.tensor(np.asarray(self.canonical_xyz, dtype=np.float32)),
             "fps": int(self.fps),
@@ -72,10 +77,20 @@ class ModelContext:
 
 
 def context_from_observed(obs, wind: bool = True) -> ModelContext:
-    """ModelContext from a ``physgs.testbed.dataset.Observed`` (training condition = index 0).
+    """ModelContext from a [`physgs.testbed.dataset.Observed`][] (training condition = index 0).
 
-    wind=False: a model that never reads the wind (``ModelSpec.wind``): the wind statistics are
-    NaN and the observed wind is not looked at (it may be NaN itself).
+    Args:
+        obs (Observed): the testbed's [`Observed`][physgs.testbed.dataset.Observed].
+        wind: False for a model that never reads the wind (``ModelSpec.wind``): the wind
+            statistics are NaN and the observed wind is not looked at (it may be NaN itself).
+
+    Returns:
+        The [`ModelContext`][physgs.models.base.ModelContext]: canonical positions, frame counts,
+            the training wind's mean and std (m/s) and its forcing's std (m^2/s^2), the training
+            camera's viewing direction [3].
+
+    Raises:
+        ValueError: when ``wind`` and the training wind is constant or not finite.
     """
     w = np.asarray(obs.wind[0], dtype=np.float64) if wind else np.full(2, np.nan)  # [L+F] m/s
     std = float(w.std())
@@ -129,7 +144,14 @@ class BaseModel(nn.Module):
         self.extent = float(0.5 * np.linalg.norm(hi - lo))
 
     def t_norm(self, frame_idx: int) -> float:
-        """Normalised time: 0 at recorded frame 0, 1 at the last training frame."""
+        """Normalised time: 0 at recorded frame 0, 1 at the last training frame.
+
+        Args:
+            frame_idx: recorded frame, 0-based.
+
+        Returns:
+            ``frame_idx / (n_train - 1)`` (above 1 beyond the window).
+        """
         return frame_idx / (self.n_train - 1)
 
     def _check(self, frame_idx: int, wind: torch.Tensor) -> None:
@@ -151,15 +173,38 @@ class BaseModel(nn.Module):
 
     def defined(self, frame_idx: int, condition: int) -> bool:
         """Whether the model predicts recorded frame ``frame_idx`` under condition ``condition``
-        (every model but a prior with a learned forcing predicts everything)."""
+        (every model but a prior with a learned forcing predicts everything).
+
+        Args:
+            frame_idx: recorded frame, 0-based.
+            condition: wind condition index.
+
+        Returns:
+            True here; overridden where a model predicts only some frames.
+        """
         return True
 
     def canonical_state(self) -> GaussianState:
-        """The undeformed canonical Gaussians (used by the shared static warm-up)."""
+        """The undeformed canonical Gaussians (used by the shared static warm-up).
+
+        Returns:
+            The canonical set's [`GaussianState`][physgs.models.gaussians.GaussianState].
+        """
         return self.canonical.state()
 
     def gaussians_at(self, frame_idx: int, wind: torch.Tensor) -> GaussianState:
-        """Gaussians at recorded frame ``frame_idx`` under the observed wind [L+F] (m/s)."""
+        """Gaussians at recorded frame ``frame_idx`` under the observed wind [L+F] (m/s).
+
+        Args:
+            frame_idx: recorded frame, 0-based.
+            wind: [L+F] the condition's observed wind, m/s, lead-in included.
+
+        Returns:
+            The deformed [`GaussianState`][physgs.models.gaussians.GaussianState].
+
+        Raises:
+            ValueError: when the frame or the wind does not fit the model (the model's own check).
+        """
         wind = torch.as_tensor(wind, dtype=torch.float32)
         self._check(int(frame_idx), wind)
         return self.deform(int(frame_idx), wind)
@@ -179,7 +224,12 @@ class BaseModel(nn.Module):
     def param_groups(self, lr: dict) -> list[dict]:
         """Adam parameter groups; the canonical set uses the same rates in every model.
 
-        lr: config train.lr (means and pivot rates are multiplied by the scene extent).
+        Args:
+            lr: config ``train.lr`` (means and pivot rates are multiplied by the scene extent).
+
+        Returns:
+            The canonical set's groups (means, quats, scales, opacities, colors) followed by
+                [`deformation_param_groups`][physgs.models.base.BaseModel.deformation_param_groups].
         """
         c = self.canonical
         groups = [
@@ -204,10 +254,18 @@ class BaseModel(nn.Module):
 
     def bounded_positions(self) -> dict[str, np.ndarray]:
         """Where each bounded physical parameter sits between its bounds: name -> [n] in [0, 1]
-        (0: the lower bound, 1: the upper). Models without bounded parameters: empty."""
+        (0: the lower bound, 1: the upper). Models without bounded parameters: empty.
+
+        Returns:
+            Empty here; a model with bounded parameters overrides it.
+        """
         return {}
 
     def scale_settings(self) -> dict[str, list[tuple[str, float]]]:
         """Config settings besides a group's rate that scale what the group's parameters do now:
-        parameter group -> [(dotted config key, value)]; named when that group is suspect."""
+        parameter group -> [(dotted config key, value)]; named when that group is suspect.
+
+        Returns:
+            Empty here; a model whose groups scale with other settings overrides it.
+        """
         return {}

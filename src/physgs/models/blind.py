@@ -42,7 +42,19 @@ class ForcingNotDefined(NotDefined, ValueError):
 
 
 def harmonics(n_samples: int, fps: float, forcing_hz: float) -> np.ndarray:
-    """[J] frequencies (Hz) j / S, j = 1..J, up to ``forcing_hz`` (S = n_samples / fps)."""
+    """[J] frequencies (Hz) j / S, j = 1..J, up to ``forcing_hz`` (S = n_samples / fps).
+
+    Args:
+        n_samples: samples of the span (lead-in plus training window).
+        fps: frame rate, frames/s.
+        forcing_hz: the highest harmonic allowed, Hz.
+
+    Returns:
+        [J] frequencies, Hz.
+
+    Raises:
+        ValueError: when ``forcing_hz`` is below the lowest harmonic 1 / S.
+    """
     span = n_samples / float(fps)
     J = int(math.floor(forcing_hz * span))
     if J < 1:
@@ -54,7 +66,15 @@ def harmonics(n_samples: int, fps: float, forcing_hz: float) -> np.ndarray:
 
 
 def forcing_series(coef: torch.Tensor, basis: torch.Tensor) -> torch.Tensor:
-    """Unit-RMS, zero-mean f [N] from coefficients [2J] over the basis [2J, N]."""
+    """Unit-RMS, zero-mean f [N] from coefficients [2J] over the basis [2J, N].
+
+    Args:
+        coef: [2J] coefficients.
+        basis: [2J, N] the cosine and sine basis.
+
+    Returns:
+        [N] the forcing, zero mean and unit RMS.
+    """
     f = coef @ basis  # [N]
     f = f - f.mean()
     return f / torch.sqrt((f * f).mean() + 1e-24)
@@ -66,6 +86,14 @@ def causal_convolve(r0: torch.Tensor, h: torch.Tensor, f: torch.Tensor) -> torch
     The integrator's forcing is linear between samples, so a unit sample s >= 1 is a hat over
     [s - 1, s + 1] whose response is h [K, N] shifted by s (h[t] = the response to a unit
     sample 1, read at t + 1), while sample 0 is half a hat, with response r0 [K, N].
+
+    Args:
+        r0: [K, N] the response to a unit sample 0, rad.
+        h: [K, N] the response to a unit sample 1, read one step later, rad.
+        f: [N] the forcing samples.
+
+    Returns:
+        [K, N] theta, rad.
     """
     N = f.shape[-1]
     n = 2 * N
@@ -115,11 +143,22 @@ class BlindOscillatorPrior(OscillatorPrior):
         self.register_buffer("unit0", torch.tensor(unit[1:]), persistent=False)
 
     def forcing(self) -> torch.Tensor:
-        """f [L + n_train], unit RMS, over the lead-in and the training window."""
+        """f [L + n_train], unit RMS, over the lead-in and the training window.
+
+        Returns:
+            [L + n_train] the learned forcing, dimensionless.
+        """
         return forcing_series(self.forcing_coef, self.forcing_basis)
 
     def part_theta(self, wind=None) -> torch.Tensor:
-        """theta [K, L + n_train] (rad) under the learned forcing; ``wind`` is ignored."""
+        """theta [K, L + n_train] (rad) under the learned forcing; ``wind`` is ignored.
+
+        Args:
+            wind (Any): ignored.
+
+        Returns:
+            [K, L + n_train] part angles, rad (frozen parts 0).
+        """
         om, ze, g = self.omega.double(), self.zeta.double(), self.gain.double()
         r0, r1 = (
             integrate_forcing(om, ze, g, u, self.dt, self.substeps, guard=self.guard)
@@ -137,6 +176,9 @@ class BlindOscillatorPrior(OscillatorPrior):
             frame_idx: recorded frame, 0 .. n_train - 1.
             wind: ignored (any [L+F] series, NaN included).
 
+        Returns:
+            (GaussianState): The Gaussians at the frame (the oscillator prior's deformation).
+
         Raises:
             ForcingNotDefined: the frame lies beyond the training window.
         """
@@ -148,7 +190,15 @@ class BlindOscillatorPrior(OscillatorPrior):
         return super().deform(frame_idx, wind)
 
     def defined(self, frame_idx: int, condition: int) -> bool:
-        """Only the training window of the training condition (the forcing's span)."""
+        """Only the training window of the training condition (the forcing's span).
+
+        Args:
+            frame_idx: recorded frame, 0-based.
+            condition: wind condition index.
+
+        Returns:
+            True for condition 0 and 0 <= frame_idx < n_train.
+        """
         return int(condition) == 0 and 0 <= int(frame_idx) < self.n_train
 
     def _check(self, frame_idx: int, wind: torch.Tensor) -> None:  # the wind is not read

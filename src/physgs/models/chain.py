@@ -1,5 +1,5 @@
 """Forward kinematics of chained rigid parts: each part rotates about its own pivot and rides on
-its parent (the testbed's own skinning, ``physgs.testbed.kinematics``, with one axis per part).
+its parent (the testbed's own skinning, [`physgs.testbed.kinematics`][], with one axis per part).
 
 Part p's map of canonical space is T_p = T_parent(p) o Rot_p, Rot_p(x) = c_p + R_p (x - c_p)
 the rotation by theta_p about axis a_p through its canonical pivot c_p (a_p and c_p are given
@@ -11,7 +11,7 @@ ancestors. Written as displacements, so that zero angles give exactly zero motio
     E_p = E_q + G_p + E_q G_p,   u_p = u_q + E_q (c_p - c_q),   q = parent(p), G_p = R_p - I,
 
 with E = G and u = 0 at the root. Parts must be numbered parents first (parent[p] < p), as
-``physgs.models.topology`` numbers them; one vectorised step per tree depth.
+[`physgs.models.topology`][] numbers them; one vectorised step per tree depth.
 """
 
 from __future__ import annotations
@@ -24,7 +24,17 @@ from physgs.models.gaussians import axis_angle_quat, quat_multiply, rodrigues_mi
 
 def depth_levels(parent) -> list[tuple[np.ndarray, np.ndarray]]:
     """[(parts [M] int64, their parents [M] int64)] per depth 1, 2, ... for parent [K] (root -1,
-    parent[p] < p); raises ValueError on any other parent array (so no cycle is accepted)."""
+    parent[p] < p); raises ValueError on any other parent array (so no cycle is accepted).
+
+    Args:
+        parent (ArrayLike): [K] each part's parent, -1 for part 0, parent[p] < p.
+
+    Returns:
+        One ``(parts, parents)`` pair per depth from 1 down, each [M] int64.
+
+    Raises:
+        ValueError: for parents not numbered first.
+    """
     from physgs.models.topology import part_depth
 
     parent = np.asarray(parent, dtype=np.int64)
@@ -41,10 +51,18 @@ def chain_transforms(
 ) -> tuple[torch.Tensor, torch.Tensor, torch.Tensor]:
     """World transforms of chained parts at one instant.
 
-    axis [K, 3] unit swing axes; theta [K] own angles (rad); pivot [K, 3] canonical pivots;
-    levels: ``depth_levels(parent)``. Returns (E [K, 3, 3] = world rotation - I, u [K, 3]
-    displacement of each part's pivot by its ancestors, q [K, 4] world rotation quaternions
-    (w, x, y, z)). Differentiable in axis, theta and pivot.
+    Differentiable in axis, theta and pivot.
+
+    Args:
+        axis: [K, 3] unit swing axes.
+        theta: [K] own angles, rad.
+        pivot: [K, 3] canonical pivots, world units.
+        levels (list[tuple[np.ndarray, np.ndarray]]):
+            [`depth_levels`][physgs.models.chain.depth_levels] of the parents.
+
+    Returns:
+        ``(E, u, q)``: E [K, 3, 3] = world rotation - I, u [K, 3] displacement of each part's
+            pivot by its ancestors (world units), q [K, 4] world rotation quaternions (w, x, y, z).
     """
     G = rodrigues_minus_identity(axis, theta)  # [K, 3, 3] own rotation - I
     qo = axis_angle_quat(axis, theta)  # [K, 4] own rotation
@@ -71,9 +89,18 @@ def chain_deform(
 ) -> tuple[torch.Tensor, torch.Tensor]:
     """Move Gaussians by their parts' chained transforms.
 
-    means [N, 3]; quats [N, 4] (w, x, y, z); labels [N] part of each Gaussian; axis [K, 3];
-    theta [K] rad; pivot [K, 3]; levels: ``depth_levels(parent)``. Returns (means [N, 3],
-    quats [N, 4]); exactly the input at theta = 0.
+    Args:
+        means: [N, 3] positions, world units.
+        quats: [N, 4] orientations (w, x, y, z).
+        labels: [N] part of each Gaussian.
+        axis: [K, 3] unit swing axes.
+        theta: [K] own angles, rad.
+        pivot: [K, 3] pivots, world units.
+        levels (list[tuple[np.ndarray, np.ndarray]]):
+            [`depth_levels`][physgs.models.chain.depth_levels] of the parents.
+
+    Returns:
+        ``(means [N, 3], quats [N, 4])``; exactly the input at theta = 0.
     """
     E, u, q = chain_transforms(axis, theta, pivot, levels)
     rel = (means - pivot[labels])[..., None]  # [N, 3, 1]
@@ -95,14 +122,26 @@ def chain_deform_from(
 
     For a canonical set that is the pose at angles theta0 (the recorded frame 0), not the rest
     pose: frame 0's chained transform is undone (its rest pose is T_p(theta0)^-1 of it), then
-    the transform at theta applied. With T_p(x) = c_p + u_p + Rw_p (x - c_p) (``chain_transforms``):
+    the transform at theta applied. With T_p(x) = c_p + u_p + Rw_p (x - c_p)
+    ([`chain_transforms`][physgs.models.chain.chain_transforms]):
 
         T_p(theta) T_p(theta0)^-1 (x) = x + (u_p - u0_p) + (Rw_p Rw0_p^T - I)(x - c_p - u0_p).
 
-    means [N, 3]; quats [N, 4] (w, x, y, z); labels [N]; axis [K, 3]; theta, theta0 [K] rad;
-    pivot [K, 3] (rest-pose pivots); levels: ``depth_levels(parent)``. Returns (means [N, 3],
-    quats [N, 4]); the input (to rounding) at theta = theta0. Differentiable in axis, both angles
-    and pivot.
+    Differentiable in axis, both angles and pivot.
+
+    Args:
+        means: [N, 3] positions posed at theta0, world units.
+        quats: [N, 4] orientations (w, x, y, z).
+        labels: [N] part of each Gaussian.
+        axis: [K, 3] unit swing axes.
+        theta: [K] target own angles, rad.
+        theta0: [K] own angles the input is posed at, rad.
+        pivot: [K, 3] rest-pose pivots, world units.
+        levels (list[tuple[np.ndarray, np.ndarray]]):
+            [`depth_levels`][physgs.models.chain.depth_levels] of the parents.
+
+    Returns:
+        ``(means [N, 3], quats [N, 4])``; the input (to rounding) at theta = theta0.
     """
     E, u, q = chain_transforms(axis, theta, pivot, levels)  # [K, 3, 3], [K, 3], [K, 4]
     E0, u0, q0 = chain_transforms(axis, theta0, pivot, levels)

@@ -8,14 +8,31 @@ import torch
 
 
 def fourier_dim(d: int, bands: int) -> int:
-    """Width of ``fourier(x [.., d], bands)``: the input plus a sine and cosine per band."""
+    """Width of ``fourier(x [.., d], bands)``: the input plus a sine and cosine per band.
+
+    Args:
+        d: the input's width.
+        bands: frequency bands.
+
+    Returns:
+        d * (1 + 2 bands).
+    """
     return d * (1 + 2 * bands)
 
 
 def fourier(x: torch.Tensor, bands: int) -> torch.Tensor:
     """[x, sin(2^k pi x), cos(2^k pi x) for k < bands] of x [..., d] -> [..., d * (1 + 2 bands)].
 
-    x is expected in roughly [-1, 1] (normalised position) or [0, 1+] (normalised time).
+    Args:
+        x: [..., d] inputs, expected in roughly [-1, 1] (normalised position) or [0, 1+]
+            (normalised time).
+        bands: frequency bands (0: x itself).
+
+    Returns:
+        [..., d * (1 + 2 bands)]: x, then per band k its d sines and d cosines.
+
+    Raises:
+        ValueError: for negative ``bands``.
     """
     if bands < 0:
         raise ValueError(f"fourier: bands must be >= 0, got {bands}")

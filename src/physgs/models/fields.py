@@ -33,7 +33,11 @@ PRECISIONS = ("float32", "bfloat16")  # models.<mlp|d3dgs>.precision
 
 def native_bf16() -> bool:
     """Whether this CPU runs bf16 matmuls natively (oneDNN's own probe: AVX-512 BF16 or AMX
-    class hardware). Without it autocast emulates them, ~48x slower than float32."""
+    class hardware). Without it autocast emulates them, ~48x slower than float32.
+
+    Returns:
+        True where oneDNN reports native bf16 support.
+    """
     return bool(
         torch.backends.mkldnn.is_available() and torch.ops.mkldnn._is_mkldnn_bf16_supported()
     )
@@ -183,7 +187,19 @@ class FieldModel(BaseModel):
         self.field = DeformationField(in_dim, depth, width, skip, heads, precision)
 
     def features(self, frame_idx: int, wind: torch.Tensor) -> torch.Tensor:
-        """Field input [N, in_dim] at recorded frame ``frame_idx``."""
+        """Field input [N, in_dim] at recorded frame ``frame_idx``.
+
+        Args:
+            frame_idx: recorded frame, 0-based.
+            wind: [L+F] the condition's observed wind, m/s (read by wind-driven fields only).
+
+        Returns:
+            [N, in_dim]: Fourier features of the normalised position, of the scaled normalised time,
+                and (wind-driven fields) the standardised wind window.
+
+        Raises:
+            ValueError: when the wind window reaches outside the wind series.
+        """
         xn = (self.canonical.means.detach() - self.xyz_center) / self.xyz_half  # [N, 3]
         n = xn.shape[0]
         t = torch.tensor([self.time_scale * self.t_norm(frame_idx)], dtype=xn.dtype)

@@ -19,7 +19,7 @@ from physgs.render.project import quat_to_rotmat  # noqa: F401  (re-exported)
 
 @dataclass(frozen=True)
 class GaussianState:
-    """Gaussians ready for ``physgs.render.rasterization``.
+    """Gaussians ready for [`physgs.render.rasterization`][].
 
     means [N, 3] world units; quats [N, 4] (w, x, y, z); scales [N, 3] world units (> 0);
     opacities [N] in (0, 1); colors [N, 3] in (0, 1).
@@ -33,7 +33,15 @@ class GaussianState:
 
 
 def quat_multiply(a: torch.Tensor, b: torch.Tensor) -> torch.Tensor:
-    """Hamilton product a * b of quaternions [..., 4] (w, x, y, z); rotation b first, then a."""
+    """Hamilton product a * b of quaternions [..., 4] (w, x, y, z); rotation b first, then a.
+
+    Args:
+        a: [..., 4] quaternions (w, x, y, z).
+        b: [..., 4] quaternions, broadcast against ``a``.
+
+    Returns:
+        [..., 4] the products (unit when both are unit).
+    """
     aw, ax, ay, az = a.unbind(-1)
     bw, bx, by, bz = b.unbind(-1)
     return torch.stack(
@@ -48,7 +56,15 @@ def quat_multiply(a: torch.Tensor, b: torch.Tensor) -> torch.Tensor:
 
 
 def axis_angle_quat(axis: torch.Tensor, angle: torch.Tensor) -> torch.Tensor:
-    """Unit quaternions [..., 4] for rotations by ``angle`` [...] rad about unit ``axis`` [..., 3]."""
+    """Unit quaternions [..., 4] for rotations by ``angle`` [...] rad about unit ``axis`` [..., 3].
+
+    Args:
+        axis: [..., 3] unit axes.
+        angle: [...] angles, rad.
+
+    Returns:
+        [..., 4] quaternions (w, x, y, z).
+    """
     half = 0.5 * angle
     return torch.cat([torch.cos(half)[..., None], torch.sin(half)[..., None] * axis], dim=-1)
 
@@ -57,6 +73,13 @@ def rodrigues_minus_identity(axis: torch.Tensor, angle: torch.Tensor) -> torch.T
     """R - I [..., 3, 3] for rotations by ``angle`` [...] rad about unit ``axis`` [..., 3].
 
     Kept apart from I so that a zero angle gives exactly zero (and small angles lose no digits).
+
+    Args:
+        axis: [..., 3] unit axes.
+        angle: [...] angles, rad.
+
+    Returns:
+        [..., 3, 3] R - I.
     """
     x, y, z = axis.unbind(-1)
     zero = torch.zeros_like(x)
@@ -67,7 +90,15 @@ def rodrigues_minus_identity(axis: torch.Tensor, angle: torch.Tensor) -> torch.T
 
 
 def rodrigues(axis: torch.Tensor, angle: torch.Tensor) -> torch.Tensor:
-    """Rotation matrices [..., 3, 3] by ``angle`` [...] rad about unit ``axis`` [..., 3]."""
+    """Rotation matrices [..., 3, 3] by ``angle`` [...] rad about unit ``axis`` [..., 3].
+
+    Args:
+        axis: [..., 3] unit axes.
+        angle: [...] angles, rad.
+
+    Returns:
+        [..., 3, 3] rotation matrices.
+    """
     return torch.eye(3, dtype=axis.dtype, device=axis.device) + rodrigues_minus_identity(
         axis, angle
     )
@@ -82,9 +113,17 @@ def rotate_about_pivot(
 ) -> tuple[torch.Tensor, torch.Tensor]:
     """Rigidly rotate Gaussians: positions about ``pivot`` and orientations alike.
 
-    means [N, 3]; quats [N, 4]; axis [N, 3] unit; angle [N] rad; pivot [N, 3] (per Gaussian,
-    e.g. gathered from its part). Returns (means [N, 3], quats [N, 4]). Rotating the orientation
-    too keeps an elongated Gaussian aligned with the branch it sits on.
+    Rotating the orientation too keeps an elongated Gaussian aligned with the branch it sits on.
+
+    Args:
+        means: [N, 3] positions, world units.
+        quats: [N, 4] orientations (w, x, y, z).
+        axis: [N, 3] unit rotation axes.
+        angle: [N] angles, rad.
+        pivot: [N, 3] pivot per Gaussian (e.g. gathered from its part), world units.
+
+    Returns:
+        ``(means, quats)``: [N, 3] and [N, 4]; exactly the inputs' means at angle 0.
     """
     RmI = rodrigues_minus_identity(axis, angle)  # [N, 3, 3]
     # x' = p + R (x - p) = x + (R - I)(x - p): exactly x at angle 0.
@@ -101,11 +140,23 @@ def rotate_parts(
     angle: torch.Tensor,
     pivot: torch.Tensor,
 ) -> tuple[torch.Tensor, torch.Tensor]:
-    """``rotate_about_pivot`` with one rotation per part: means [N, 3]; quats [N, 4]; labels [N]
-    part of each Gaussian; axis [K, 3] unit; angle [K] rad; pivot [K, 3]. The K rotations are
-    built once and gathered (not N times, one per Gaussian): the same numbers elementwise, so the
-    result equals ``rotate_about_pivot(means, quats, axis[labels], angle[labels],
-    pivot[labels])`` exactly, at a K/N share of the rotation cost."""
+    """One rotation per part: [`rotate_about_pivot`][physgs.models.gaussians.rotate_about_pivot].
+
+    The K rotations are built once and gathered (not N times, one per Gaussian): the same numbers
+    elementwise, so the result equals ``rotate_about_pivot(means, quats, axis[labels],
+    angle[labels], pivot[labels])`` exactly, at a K/N share of the rotation cost.
+
+    Args:
+        means: [N, 3] positions, world units.
+        quats: [N, 4] orientations (w, x, y, z).
+        labels: [N] part of each Gaussian, in [0, K).
+        axis: [K, 3] unit rotation axes.
+        angle: [K] angles, rad.
+        pivot: [K, 3] pivots, world units.
+
+    Returns:
+        ``(means, quats)``: [N, 3] and [N, 4].
+    """
     RmI = rodrigues_minus_identity(axis, angle)  # [K, 3, 3]
     q = axis_angle_quat(axis, angle)  # [K, 4]
     new_means = means + (RmI[labels] @ (means - pivot[labels])[..., None])[..., 0]
@@ -117,6 +168,16 @@ def nearest_neighbour_scale(xyz: np.ndarray, k: int = 3) -> np.ndarray:
 
     Coincident points (distance 0) get the smallest positive spacing in the set, so every
     Gaussian has a drawable size.
+
+    Args:
+        xyz: [N, 3] positions, world units, N >= 2.
+        k: neighbours averaged (at most N - 1).
+
+    Returns:
+        [N] scales, world units, all positive.
+
+    Raises:
+        ValueError: for positions that are not [N >= 2, 3], not finite, or all coincident.
     """
     xyz = np.asarray(xyz, dtype=np.float64)
     if xyz.ndim != 2 or xyz.shape[1] != 3 or xyz.shape[0] < 2:
@@ -189,7 +250,12 @@ class CanonicalGaussians(nn.Module):
         return self.means.shape[0]
 
     def state(self) -> GaussianState:
-        """Activated canonical Gaussians."""
+        """Activated canonical Gaussians.
+
+        Returns:
+            The [`GaussianState`][physgs.models.gaussians.GaussianState]: means and quats as stored,
+                scales exp(log_scales), opacities and colours through a sigmoid.
+        """
         return GaussianState(
             self.means,
             self.quats,

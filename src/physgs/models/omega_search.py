@@ -18,7 +18,7 @@ resonance only ~zeta wide. The search replaces omega by something the loss is sm
    ``physics_lr_after`` (from the true physics a rate of 5e-2 dephases the response, 1e-3 keeps
    it: docs/parts.md).
 
-Pure functions over arrays here; the prior (``physgs.models.ours``) holds the bank and calls
+Pure functions over arrays here; the prior ([`physgs.models.ours`][]) holds the bank and calls
 ``project_to_oscillators``; ``SearchHook`` is the training loop's hook. torch loads only
 when a response is integrated: the config's checks import ``search_iteration`` to plan.
 """
@@ -74,16 +74,37 @@ class OmegaSearch:
 
 
 def log_grid(lo: float, hi: float, n: int) -> np.ndarray:
-    """n values log-spaced over [lo, hi] (both > 0), float64; for n = 1 their geometric mean."""
+    """n values log-spaced over [lo, hi] (both > 0), float64; for n = 1 their geometric mean.
+
+    Args:
+        lo: the lower end (> 0).
+        hi: the upper end (> 0).
+        n: number of values.
+
+    Returns:
+        [n] values.
+    """
     if n == 1:
         return np.array([np.sqrt(lo * hi)])
     return np.exp(np.linspace(np.log(lo), np.log(hi), n))
 
 
 def unit_responses(omega, zeta, wind, vbar: float, dt: float, substeps: int) -> np.ndarray:
-    """Responses at unit gain [G, T] (rad per unit of m^2/s^2 forcing) of G oscillators, omega [G]
-    rad/s, zeta [G], to the forcing v^2 - vbar^2 of wind [T] m/s sampled every dt seconds
-    (``physgs.models.oscillator.integrate``, from rest at sample 0)."""
+    """Responses at unit gain of G oscillators to the forcing v^2 - vbar^2 of a wind.
+
+    Integrated by [`integrate`][physgs.models.oscillator.integrate], from rest at sample 0.
+
+    Args:
+        omega (ArrayLike): [G] natural frequencies, rad/s.
+        zeta (ArrayLike): [G] damping ratios.
+        wind (ArrayLike): [T] wind speed, m/s.
+        vbar: the mean speed subtracted, m/s.
+        dt: the sample interval, s.
+        substeps: RK4 substeps per sample.
+
+    Returns:
+        [G, T] responses, rad per unit of m^2/s^2 forcing.
+    """
     import torch
 
     from physgs.models.oscillator import integrate
@@ -100,11 +121,21 @@ def project_to_oscillators(
 ) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
     """The single oscillator that best fits each part's angle, by least squares over a grid.
 
-    theta [K, S]: each part's angle (rad) at S samples; responses [G, S]: the grid's unit-gain
-    responses at the same samples; omega [G] rad/s and zeta [G]: the grid. For every part and
-    grid point the gain is the least-squares one, <theta, r> / <r, r>; the grid point left with
-    the smallest residual wins. Returns (omega [K], zeta [K], gain [K] in rad per m^2/s^2,
-    explained [K]: 1 - residual / |theta|^2, 0 for a part whose angle is zero).
+    For every part and grid point the gain is the least-squares one, <theta, r> / <r, r>; the grid
+    point left with the smallest residual wins.
+
+    Args:
+        theta: [K, S] each part's angle, rad, at S samples.
+        responses: [G, S] the grid's unit-gain responses at the same samples.
+        omega: [G] the grid's natural frequencies, rad/s.
+        zeta: [G] the grid's damping ratios.
+
+    Returns:
+        ``(omega [K], zeta [K], gain [K] in rad per m^2/s^2, explained [K])``, explained = 1 -
+            residual / |theta|^2, 0 for a part whose angle is zero.
+
+    Raises:
+        ValueError: when the shapes do not share S, or a grid response is identically zero.
     """
     theta = np.asarray(theta, dtype=np.float64)
     responses = np.asarray(responses, dtype=np.float64)
@@ -130,7 +161,17 @@ def project_to_oscillators(
 def search_problem(until: float, iterations: int, warmup: int, freeze_at: int | None) -> str | None:
     """Why ``until`` cannot end the bank phase in a run of ``iterations`` with ``warmup``
     (iterations) and freezing at iteration ``freeze_at`` (None: off), or None if it can: the
-    phase must end after the warm-up and before freezing (freezing reads the oscillators)."""
+    phase must end after the warm-up and before freezing (freezing reads the oscillators).
+
+    Args:
+        until: fraction of ``iterations`` at which the bank phase ends.
+        iterations: training iterations.
+        warmup: static warm-up iterations.
+        freeze_at: the freezing iteration, or None when freezing is off.
+
+    Returns:
+        The reason, or None.
+    """
     it = int(round(until * iterations))
     end = iterations if freeze_at is None else freeze_at
     if warmup < it < end:
@@ -144,7 +185,19 @@ def search_problem(until: float, iterations: int, warmup: int, freeze_at: int | 
 
 def search_iteration(search: OmegaSearch, train_cfg: dict, freeze_at: int | None) -> int:
     """The iteration at which the bank phase ends, round(until x train.iterations); raises
-    ValueError naming ``models.omega_search.until`` where ``search_problem`` finds one."""
+    ValueError naming ``models.omega_search.until`` where ``search_problem`` finds one.
+
+    Args:
+        search: the search settings.
+        train_cfg: the ``train`` config section (iterations, warmup).
+        freeze_at: the freezing iteration, or None.
+
+    Returns:
+        The iteration.
+
+    Raises:
+        ValueError: where [`search_problem`][physgs.models.omega_search.search_problem] finds one.
+    """
     iterations, warmup = int(train_cfg["iterations"]), int(train_cfg["warmup"])
     why = search_problem(search.until, iterations, warmup, freeze_at)
     if why is not None:
@@ -155,7 +208,21 @@ def search_iteration(search: OmegaSearch, train_cfg: dict, freeze_at: int | None
 def omega_search_callback(observed, models_cfg: dict, train_cfg: dict, conditions: list[int]):
     """The ``SearchHook`` of one training run: it ends the prior's bank phase once, fitting the
     trained conditions' winds over the training window (recorded frames 0 .. n_train - 1; the
-    held-out training frames lie inside it, and their images are never read)."""
+    held-out training frames lie inside it, and their images are never read).
+
+    Args:
+        observed (Observed): the dataset (winds [C, L+F] m/s, lead-in, n_train).
+        models_cfg: the ``models`` config section.
+        train_cfg: the ``train`` config section.
+        conditions: the trained conditions' indices.
+
+    Returns:
+        (SearchHook): The hook, firing at the iteration of
+            [`search_iteration`][physgs.models.omega_search.search_iteration].
+
+    Raises:
+        ValueError: when the phase cannot end between the warm-up and freezing.
+    """
     from physgs.models.visibility import freeze_schedule
 
     search = OmegaSearch.from_config(models_cfg["omega_search"])

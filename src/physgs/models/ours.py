@@ -17,16 +17,16 @@ Parameterisation (all bounded or normalised so one Adam rate suits every tree):
 - pivot (world units), initialised at the part's member nearest the base of the tree.
 
 Two options (registry ids ``ours_topo`` and ``ours_chain``; ``ours`` is the paper's):
-- ``segmentation="topology"``: parts cut along the tree (``physgs.models.topology``) instead of
+- ``segmentation="topology"``: parts cut along the tree ([`physgs.models.topology`][]) instead of
   k-means; each part has a parent (``part_parent`` [K], root -1, parents numbered first) and
   its pivot starts at the joint with that parent.
 - ``chain=True`` (topology parts only): each part keeps its own oscillator, but its rigid
-  transform is composed with its ancestors' (``physgs.models.chain``): a branch is carried by
+  transform is composed with its ancestors' ([`physgs.models.chain`][]): a branch is carried by
   its parent. ``part_theta`` stays each part's OWN angle theta_p(t), the quantity the
   oscillator models and recovery compares with each bone's own angle.
 
 The models listed in ``models.omega_search`` (the topology variants) start with a search over
-omega (``physgs.models.omega_search``): until ``until`` x iterations each part's angle is a
+omega ([`physgs.models.omega_search`][]): until ``until`` x iterations each part's angle is a
 linear combination of a fixed bank of oscillators' responses (``bank_weights``), then each part
 is projected onto the single oscillator of a grid that best fits it (``end_bank_phase``) and
 the oscillators take over. After training ``bank_active`` is False: the model is the prior above.
@@ -34,7 +34,7 @@ the oscillators take over. After training ``bank_active`` is False: the model is
 (``CANONICAL_POSES``): ``rest``, each part turned by theta_p(t) as if the canonical set were the
 rest pose; ``frame0``, the pose at recorded frame 0, which it is (the canonical Gaussians sit at
 frame 0's vertices): frame 0's transform is undone before theta(t)'s is applied
-(``physgs.models.chain.chain_deform_from``; for independent parts, a turn by theta_p(t) -
+([`physgs.models.chain.chain_deform_from`][]; for independent parts, a turn by theta_p(t) -
 theta_p(frame 0)), so frame 0 poses the canonical set and the motion cannot displace it;
 ``frame0_angles``, each part turned by theta_p(t) - theta_p(frame 0) (the same as ``frame0`` for
 independent parts, to first order in the angles for chained ones); ``frame0_offset``, as
@@ -75,8 +75,18 @@ CANONICAL_POSES = ("rest", "frame0", "frame0_angles", "frame0_offset")
 def prior_substeps(omega_hz, zeta, substeps: int, dt: float, guard: float = STABILITY_GUARD) -> int:
     """RK4 substeps per wind sample for the prior's bounds: the configured count, raised until
     every (omega, zeta) the bounds allow passes the guard. The fastest rate is at the top of both
-    bounds (above zeta = 1 it exceeds omega). omega_hz: [lo, hi] Hz; zeta: [lo, hi]; dt: seconds.
-    The null control integrates with this same step."""
+    bounds (above zeta = 1 it exceeds omega). The null control integrates with this same step.
+
+    Args:
+        omega_hz (Sequence[float]): ``[lo, hi]`` natural-frequency bounds, Hz.
+        zeta (Sequence[float]): ``[lo, hi]`` damping-ratio bounds.
+        substeps: the configured substeps per sample.
+        dt: the wind's sample interval, s.
+        guard: the largest stable rate x step allowed.
+
+    Returns:
+        The substep count, at least ``substeps``.
+    """
     hi = 2 * math.pi * float(omega_hz[1])
     rate = float(fastest_rate(hi, float(zeta[1])))
     return max(int(substeps), required_substeps(rate, dt, guard))
@@ -219,7 +229,14 @@ class OscillatorPrior(BaseModel):
         self._theta_memo = None  # (versions, wind [L+F], theta [K, L+F]): part_theta, no autograd
 
     def freeze_parts(self, mask) -> None:
-        """Freeze the parts in ``mask`` [K] bool (added to those already frozen)."""
+        """Freeze the parts in ``mask`` [K] bool (added to those already frozen).
+
+        Args:
+            mask (ArrayLike): [K] bool, True for a part to freeze.
+
+        Raises:
+            ValueError: when the mask is not [K].
+        """
         mask = torch.as_tensor(np.asarray(mask, dtype=bool))
         if mask.shape != (self.K,):
             raise ValueError(f"freeze mask must be [K = {self.K}], got shape {tuple(mask.shape)}")
@@ -255,6 +272,17 @@ class OscillatorPrior(BaseModel):
 
         vbar, the condition's mean speed, is the record's mean times the calibration ratio frozen
         from the training condition (``ModelContext.vbar_ratio``). Frozen parts have theta = 0.
+
+        Args:
+            wind: [L+F] the condition's observed wind, m/s.
+
+        Returns:
+            [K, L+F] theta, rad, in the dtype of omega (the bank's angle during the bank phase).
+                Without autograd the last result is kept and returned again for the same wind and
+                parameters: callers must not write to it.
+
+        Raises:
+            ValueError: when ``wind`` is not one-dimensional.
         """
         wind = torch.as_tensor(wind, dtype=torch.float64)
         if wind.ndim != 1:
@@ -292,10 +320,20 @@ class OscillatorPrior(BaseModel):
     def end_bank_phase(self, windows) -> dict:
         """Project each part's bank angle onto one oscillator and hand over to the oscillators.
 
-        windows: [(wind [L+F] m/s, slice of the samples fitted)] of the trained conditions. Sets
-        omega, zeta (grid of ``search.grid`` over the bounds) and gain by least squares
-        (``project_to_oscillators``); the bank is switched off. Returns statistics (the median
-        share of each part's angle energy the oscillator explains, the omega quartiles in Hz).
+        Sets omega, zeta (grid of ``search.grid`` over the bounds) and gain by least squares
+        ([`project_to_oscillators`][physgs.models.omega_search.project_to_oscillators]); the bank is
+        switched off.
+
+        Args:
+            windows (list[tuple[ArrayLike, slice]]): ``(wind [L+F] m/s, slice of the samples
+                fitted)`` of the trained conditions.
+
+        Returns:
+            ``omega_search_explained_median`` (the median share of each part's angle energy the
+                oscillator explains) and ``omega_search_hz_quartiles`` (omega's quartiles, Hz).
+
+        Raises:
+            RuntimeError: when the prior has no bank phase running.
         """
         if self.search is None or not bool(self.bank_active):
             raise RuntimeError("end_bank_phase: this prior has no bank phase running")
@@ -387,7 +425,11 @@ class OscillatorPrior(BaseModel):
 
     def bounded_positions(self) -> dict[str, np.ndarray]:
         """sigmoid of omega_raw and zeta_raw (their place between the bounds) of the parts that
-        are not frozen (a frozen part's parameters take no updates)."""
+        are not frozen (a frozen part's parameters take no updates).
+
+        Returns:
+            ``omega`` and ``zeta``: [n] each, in [0, 1], over the n parts not frozen.
+        """
         live = ~self.frozen.cpu().numpy()
         with torch.no_grad():
             return {
@@ -397,7 +439,12 @@ class OscillatorPrior(BaseModel):
 
     def scale_settings(self) -> dict[str, list[tuple[str, float]]]:
         """With the search, the physics group's bank weights act through bank_scale, and the
-        hand-over sets the gains from them."""
+        hand-over sets the gains from them.
+
+        Returns:
+            ``{"physics": [("models.omega_search.bank_scale", value)]}`` with the search, else
+                empty.
+        """
         if self.search is not None:
             return {"physics": [("models.omega_search.bank_scale", float(self.search.bank_scale))]}
         return {}

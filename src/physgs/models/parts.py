@@ -8,9 +8,21 @@ import numpy as np
 
 
 def kmeans_parts(xyz: np.ndarray, k: int, seed: int, n_init: int = 4) -> np.ndarray:
-    """Hard-assign N points [N, 3] to k parts; labels [N] int64, deterministic for ``seed``.
+    """Hard-assign N points [N, 3] to k parts, deterministic for ``seed``.
 
     Parts are numbered by ascending centroid height (z), then x, so part 0 sits lowest.
+
+    Args:
+        xyz: [N, 3] positions, world units.
+        k: number of parts.
+        seed: the k-means seed.
+        n_init: k-means restarts.
+
+    Returns:
+        [N] int64 labels in [0, k).
+
+    Raises:
+        ValueError: for k < 1, k > N, or when k-means cannot form k distinct, non-empty parts.
     """
     xyz = np.asarray(xyz, dtype=np.float64)
     n = xyz.shape[0]

@@ -115,7 +115,17 @@ REFERENCE_NAMES = tuple(REFERENCES)
 def models_of(*roles: str) -> tuple[str, ...]:
     """The ids of the methods (``MODELS``) and references of the given roles (``ROLES``), in
     registry order (methods first): what a table reads when it reads those roles (the study
-    variants, ``PRIOR_VARIANTS``, are not among them)."""
+    variants, ``PRIOR_VARIANTS``, are not among them).
+
+    Args:
+        *roles: role names from ``ROLES``.
+
+    Returns:
+        The model ids whose role is among ``roles``.
+
+    Raises:
+        ValueError: for a role not in ``ROLES``.
+    """
     bad = [r for r in roles if r not in ROLES]
     if bad:
         raise ValueError(f"unknown model role(s) {bad}; choose from {ROLES}")
@@ -133,12 +143,29 @@ AUTO_CONFIG = "auto"
 
 
 def is_reference(model: str) -> bool:
-    """Whether ``model`` is a reference id (``REFERENCES``), not a method."""
+    """Whether ``model`` is a reference id (``REFERENCES``), not a method.
+
+    Args:
+        model: a model id.
+
+    Returns:
+        True for a reference id.
+    """
     return model in REFERENCES
 
 
 def spec_of(model: str) -> ModelSpec:
-    """The ModelSpec of a method, prior variant or reference id (ValueError naming the ids)."""
+    """The ModelSpec of a method, prior variant or reference id (ValueError naming the ids).
+
+    Args:
+        model: a method, prior variant or reference id.
+
+    Returns:
+        Its [`ModelSpec`][physgs.models.registry.ModelSpec].
+
+    Raises:
+        ValueError: for an unknown id, naming the valid ones.
+    """
     spec = MODELS.get(model) or PRIOR_VARIANTS.get(model) or REFERENCES.get(model)
     if spec is None:
         raise ValueError(
@@ -150,18 +177,44 @@ def spec_of(model: str) -> ModelSpec:
 
 def is_prior(model: str) -> bool:
     """Whether ``model`` is an oscillator prior (``ours`` or one of PRIOR_VARIANTS): trained in
-    every configuration, with K parts, part freezing and recovery."""
+    every configuration, with K parts, part freezing and recovery.
+
+    Args:
+        model: a model id.
+
+    Returns:
+        True for an oscillator prior.
+
+    Raises:
+        ValueError: for an unknown id.
+    """
     return spec_of(model).family == "ours"
 
 
 def label(model: str) -> str:
-    """Table/legend label of a model id (method or reference)."""
+    """Table/legend label of a model id (method or reference).
+
+    Args:
+        model: a model id.
+
+    Returns:
+        Its label, or ``model`` itself for an unknown id.
+    """
     spec = MODELS.get(model) or PRIOR_VARIANTS.get(model) or REFERENCES.get(model)
     return spec.label if spec is not None else model
 
 
 def config_label(name: str, spec: dict, tex: bool = True) -> str:
-    """'single ($K{=}32$)' / 'joint ($K{=}96$)': derived from the configuration's conditions and K."""
+    """'single ($K{=}32$)' / 'joint ($K{=}96$)': derived from the configuration's conditions and K.
+
+    Args:
+        name: the configuration's name (unused: the label is derived from ``spec``).
+        spec: the configuration (``conditions`` and ``K``).
+        tex: LaTeX math for K (tables) or plain text.
+
+    Returns:
+        The label.
+    """
     kind = "single" if spec["conditions"] == "train" else "joint"
     return rf"{kind} ($K{{=}}{int(spec['K'])}$)" if tex else f"{kind} (K={int(spec['K'])})"
 
@@ -171,7 +224,16 @@ def configs_for(model: str, configs) -> tuple[str, ...]:
     its wind-driven variants) every configuration; a prior with a learned forcing `single`
     only (one training window, one forcing).
 
-    configs: the names of the config's ``models.configs`` (the one source of configurations).
+    Args:
+        model: a model id.
+        configs (Iterable[str]): the names of the config's ``models.configs`` (the one source of
+            configurations).
+
+    Returns:
+        The configuration names, in ``configs``' order.
+
+    Raises:
+        ValueError: for an unknown id.
     """
     if is_prior(model) and spec_of(model).forcing == "wind":
         return tuple(configs)
@@ -180,13 +242,33 @@ def configs_for(model: str, configs) -> tuple[str, ...]:
 
 def training_jobs(configs) -> list[tuple[str, str]]:
     """All (model, configuration) pairs trained per tree, for the config's ``models.configs``
-    (methods only: references have their own workflow rule)."""
+    (methods only: references have their own workflow rule).
+
+    Args:
+        configs (Iterable[str]): the names of ``models.configs``.
+
+    Returns:
+        ``(model, configuration)`` pairs, models in ``MODEL_NAMES`` order.
+    """
     return [(m, c) for m in MODEL_NAMES for c in configs_for(m, configs)]
 
 
 def model_settings(models_cfg: dict, model: str) -> dict:
     """The part of the ``models`` config section that ``model`` reads (and nothing else), so a
-    workflow job is out of date only when one of its own settings changes."""
+    workflow job is out of date only when one of its own settings changes.
+
+    Args:
+        models_cfg: the ``models`` config section.
+        model: a model id.
+
+    Returns:
+        ``canonical`` and, as the model needs them, its family's section (its own
+            ``time_top_hz`` only), ``topology``, ``blind``, ``omega_search`` (its own entry) and
+            ``wind_window``.
+
+    Raises:
+        ValueError: for an unknown id.
+    """
     spec = spec_of(model)
     out = {"canonical": models_cfg["canonical"]}
     if spec.family in REFERENCES:  # the canonical set only: the motion comes from truth.npz
@@ -209,14 +291,29 @@ def model_settings(models_cfg: dict, model: str) -> dict:
 
 def searches_omega(models_cfg: dict, model: str) -> bool:
     """Whether ``model`` starts with the search over omega (``models.omega_search.models``;
-    ``physgs.models.omega_search``)."""
+    [`physgs.models.omega_search`][]).
+
+    Args:
+        models_cfg: the ``models`` config section.
+        model: a model id.
+
+    Returns:
+        True when ``model`` is listed there.
+    """
     return model in (models_cfg.get("omega_search") or {}).get("models", ())
 
 
 def canonical_pose_of(topology_cfg: dict) -> str:
     """``models.topology.canonical_pose`` of a (possibly older) topology section: checkpoints
     written before the key existed carry ``from_frame0`` (true: ``frame0_angles``) or neither
-    (``rest``)."""
+    (``rest``).
+
+    Args:
+        topology_cfg: a ``models.topology`` section.
+
+    Returns:
+        ``'rest'``, ``'frame0_angles'`` or the section's own value.
+    """
     if "canonical_pose" in topology_cfg:
         return str(topology_cfg["canonical_pose"])
     return "frame0_angles" if topology_cfg.get("from_frame0", False) else "rest"
@@ -236,13 +333,33 @@ def build_model(
 ) -> BaseModel:
     """A freshly initialised model.
 
-    name: one of MODEL_NAMES or REFERENCE_NAMES; observed: a testbed ``Observed`` or a
-    ModelContext; cfg: the ``models`` config section, or ``model_settings`` of it; config:
-    training configuration name; K: number of parts of ours (default:
-    ``cfg['configs'][config]['K']``); seed: k-means seed (ours); labels: precomputed part labels
-    [N] and parent: precomputed part parents [K] (topology variants; used when loading); truth: references only, and required by them: the dataset's
-    ``Truth`` (``load_truth`` of truth.npz; ``observed`` must then be the ``Observed``), or the
-    ``TrueMotion`` a checkpoint stores. A method given a truth raises (methods never read it).
+    A method given a truth raises (methods never read it).
+
+    Args:
+        name: one of MODEL_NAMES, PRIOR_VARIANT_NAMES or REFERENCE_NAMES.
+        observed (Observed | ModelContext): a testbed
+            [`Observed`][physgs.testbed.dataset.Observed] or a
+            [`ModelContext`][physgs.models.base.ModelContext].
+        cfg: the ``models`` config section, or
+            [`model_settings`][physgs.models.registry.model_settings] of it.
+        config: training configuration name.
+        K: number of parts of ours (default: ``cfg['configs'][config]['K']``).
+        seed: k-means seed (ours).
+        labels: precomputed part labels [N] (used when loading).
+        parent: precomputed part parents [K] (topology variants; used when loading).
+        truth (Truth | TrueMotion | None): references only, and required by them: the dataset's
+            [`Truth`][physgs.testbed.dataset.Truth] (``load_truth`` of truth.npz; ``observed``
+            must then be the ``Observed``), or the ``TrueMotion`` a checkpoint stores.
+
+    Returns:
+        The model, untrained: a truth-motion reference, the static model, a field model or an
+            oscillator prior (blind for a learned forcing).
+
+    Raises:
+        ValueError: for a model not trained in ``config``, a method given a truth, a reference
+            without one (or built from truth.npz with a ModelContext), a configuration ours does
+            not have when K is not given, or a learned-forcing prior listed for the search over
+            omega.
     """
     from physgs.models.base import ModelContext, context_from_observed
     from physgs.models.fields import FieldModel
@@ -366,8 +483,17 @@ def save_checkpoint(
 ) -> None:
     """Write the checkpoint atomically (temporary file in the same folder, then rename).
 
-    models_cfg: the settings the model was built from (``model_settings`` or the whole
-    ``models`` section); ours' K is read off the model, so any configuration name reloads.
+    Args:
+        path (str | Path): the ``.pt`` file.
+        model: the trained model.
+        name: its model id.
+        config: its training configuration name.
+        seed: its training seed.
+        models_cfg: the settings the model was built from
+            ([`model_settings`][physgs.models.registry.model_settings] or the whole ``models``
+            section); ours' K is read off the model, so any configuration name reloads.
+        train_cfg: the ``train`` config section it was trained with.
+        stats: the training statistics.
     """
     import torch
 
@@ -390,7 +516,18 @@ def save_checkpoint(
 
 
 def read_checkpoint(path) -> dict:
-    """The raw checkpoint dict; clear errors for a missing or corrupt file."""
+    """The raw checkpoint dict; clear errors for a missing or corrupt file.
+
+    Args:
+        path (str | Path): the ``.pt`` file.
+
+    Returns:
+        The checkpoint's dict (loaded on the CPU, ``weights_only``).
+
+    Raises:
+        FileNotFoundError: when there is no file.
+        ValueError: when it does not unpickle or is not a checkpoint of this format.
+    """
     import torch
 
     path = Path(path)
@@ -413,6 +550,16 @@ def load_checkpoint(path) -> BaseModel:
     """Rebuild the trained model (eval mode) from a checkpoint written by save_checkpoint.
 
     The returned model also carries ``checkpoint_info`` (name, config, seed, stats, cfgs).
+
+    Args:
+        path (str | Path): the ``.pt`` file.
+
+    Returns:
+        The model in eval mode, its state loaded strictly.
+
+    Raises:
+        FileNotFoundError: when there is no file.
+        ValueError: for a corrupt checkpoint.
     """
     from physgs.models.base import ModelContext
     from physgs.models.truth_motion import TrueMotion

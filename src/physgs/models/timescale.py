@@ -19,8 +19,19 @@ WINDOW_TIME = "window"
 def top_band_hz(bands: int, time_scale: float, window_s: float) -> float:
     """Frequency (Hz) of the highest time band when ``fourier`` encodes ``time_scale * t_norm``.
 
-    t_norm = t / window_s runs 0..1 over the training window (window_s seconds); band k is
-    sin(2^k pi x), i.e. 2^(k-1) cycles per unit of x.
+    t_norm = t / window_s runs 0..1 over the training window; band k is sin(2^k pi x), i.e.
+    2^(k-1) cycles per unit of x.
+
+    Args:
+        bands: time bands (>= 1).
+        time_scale: the factor on t_norm.
+        window_s: the training window's length, s.
+
+    Returns:
+        The top band's frequency, Hz.
+
+    Raises:
+        ValueError: for ``bands`` < 1.
     """
     if bands < 1:
         raise ValueError(f"top_band_hz: a time encoding with {bands} bands has no top band")
@@ -30,10 +41,20 @@ def top_band_hz(bands: int, time_scale: float, window_s: float) -> float:
 def time_scale_for(top_hz: float | str, bands: int, window_s: float) -> float:
     """Factor on t_norm before the encoding that puts the top time band at ``top_hz`` (Hz).
 
-    top_hz: a positive frequency in Hz, or ``WINDOW_TIME`` (factor 1: Deformable-3DGS's window-
-    normalised time); bands: time bands (0 bands: factor 1, nothing is encoded); window_s: the
-    training window's length t_norm is normalised by (seconds). The top band's frequency reads
-    the same whatever the frame rate or window, which a bare factor would not.
+    The top band's frequency reads the same whatever the frame rate or window, which a bare
+    factor would not.
+
+    Args:
+        top_hz: a positive frequency in Hz, or ``WINDOW_TIME`` (factor 1: Deformable-3DGS's
+            window-normalised time).
+        bands: time bands (0 bands: factor 1, nothing is encoded).
+        window_s: the training window's length t_norm is normalised by, s.
+
+    Returns:
+        The factor (dimensionless).
+
+    Raises:
+        ValueError: for a ``top_hz`` that is neither positive nor ``WINDOW_TIME``.
     """
     if top_hz == WINDOW_TIME or bands == 0:
         return 1.0

@@ -90,6 +90,16 @@ def neighbour_graph(xyz: np.ndarray, knn: int = KNN):
     """Symmetric kNN graph (scipy CSR [N, N]); edge weight = Euclidean length (world units).
 
     Coincident points get a tiny positive weight, so a stored edge is never read as absent.
+
+    Args:
+        xyz: [N, 3] positions, world units.
+        knn: neighbours per point, in [1, N - 1].
+
+    Returns:
+        (scipy.sparse.csr_matrix): [N, N] symmetric edge lengths, world units.
+
+    Raises:
+        ValueError: for ``knn`` outside [1, N - 1] or positions that are not [N, 3] and finite.
     """
     import scipy.sparse
     import scipy.spatial
@@ -108,7 +118,15 @@ def neighbour_graph(xyz: np.ndarray, knn: int = KNN):
 def join_components(xyz: np.ndarray, graph, root: int):
     """The graph with every component joined to the root's by the rule of the module docstring.
 
-    Returns (graph CSR [N, N], joins: list of (i, j, length) edges added, i in the main part).
+    Args:
+        xyz: [N, 3] positions, world units.
+        graph (scipy.sparse.csr_matrix): [N, N] symmetric kNN graph, edge lengths in world units.
+        root: index of the root point.
+
+    Returns:
+        (tuple[scipy.sparse.csr_matrix, list]): ``(graph, joins)``: the connected graph CSR
+            [N, N] and the ``(i, j, length)`` edges added, i in the main part (the input graph
+            and no joins when it is connected already).
     """
     import scipy.sparse
     import scipy.sparse.csgraph as csgraph
@@ -142,7 +160,19 @@ def join_components(xyz: np.ndarray, graph, root: int):
 
 
 def geodesic_from_root(graph, root: int) -> tuple[np.ndarray, np.ndarray]:
-    """(distance [N] world units, predecessor [N] int, -9999 at the root) along a connected graph."""
+    """(distance [N] world units, predecessor [N] int, -9999 at the root) along a connected graph.
+
+    Args:
+        graph (scipy.sparse.csr_matrix): [N, N] connected graph, edge lengths in world units.
+        root: index of the root point.
+
+    Returns:
+        ``(distance, predecessor)``: distance [N] world units, predecessor [N] int (-9999 at the
+            root).
+
+    Raises:
+        ValueError: when a point is unreachable (the graph is not connected).
+    """
     import scipy.sparse.csgraph as csgraph
 
     dist, pred = csgraph.dijkstra(graph, directed=False, indices=root, return_predecessors=True)
@@ -155,6 +185,14 @@ def slab_segments(graph, dist: np.ndarray, n_bins: int) -> np.ndarray:
     """Segment id [N] per point: connected pieces of each of ``n_bins`` equal geodesic slabs.
 
     Ids are arbitrary (not ordered); see ``segment_tree`` for the parent links.
+
+    Args:
+        graph (scipy.sparse.csr_matrix): [N, N] connected graph.
+        dist: [N] geodesic distance from the root, world units.
+        n_bins: number of slabs over [0, max dist].
+
+    Returns:
+        [N] int64 segment ids.
     """
     import scipy.sparse.csgraph as csgraph
 
@@ -172,8 +210,19 @@ def slab_segments(graph, dist: np.ndarray, n_bins: int) -> np.ndarray:
 def segment_tree(seg: np.ndarray, dist: np.ndarray, pred: np.ndarray, root: int):
     """Parent of each segment: the segment of the geodesic predecessor of its entry point.
 
-    seg [N] segment ids in [0, S); returns (parent [S] int64, -1 for the root's segment;
-    entry [S] entry distances). Raises if any link does not point strictly nearer the root.
+    Args:
+        seg: [N] segment ids in [0, S).
+        dist: [N] geodesic distance from the root, world units.
+        pred: [N] geodesic predecessor of each point.
+        root: index of the root point.
+
+    Returns:
+        (tuple[np.ndarray, np.ndarray]): ``(parent, entry)``: parent [S] int64, -1 for the
+            root's segment; entry [S] entry distances, world units.
+
+    Raises:
+        ValueError: when the ids are not contiguous in [0, S).
+        AssertionError: if any link does not point strictly nearer the root.
     """
     S = int(seg.max()) + 1
     order = np.lexsort((np.arange(len(dist)), dist))  # nearest the root first, ties by index
@@ -199,8 +248,13 @@ def merge_to_k(seg: np.ndarray, parent: np.ndarray, k: int) -> np.ndarray:
     parent has no other child merges into it (ties: the lowest id); only when none is left, the
     smallest of all; if the root is the smallest, its smallest child merges into it.
 
-    seg [N] ids in [0, S); parent [S] (-1 root). Returns seg [N] with merged ids (the
-    parent's id survives; not renumbered).
+    Args:
+        seg: [N] segment ids in [0, S).
+        parent: [S] each segment's parent, -1 for the root.
+        k: the number of segments to keep.
+
+    Returns:
+        [N] merged ids (the parent's id survives; not renumbered).
     """
     seg = seg.copy()
     parent = parent.copy()
@@ -226,7 +280,18 @@ def pivots_of(xyz, graph, labels, parent, root_fraction: float = 0.1) -> np.ndar
     """[K, 3] pivots: mean midpoint of the edges joining each part to its parent; the root's,
     the centroid of its Gaussians in the lowest ``root_fraction`` of its height (whole rings at
     the trunk's base: a fraction of the points nearest the root would take a one-sided patch of
-    the base ring, off the axis)."""
+    the base ring, off the axis).
+
+    Args:
+        xyz (np.ndarray): [N, 3] positions, world units.
+        graph (scipy.sparse.csr_matrix): [N, N] the neighbour graph.
+        labels (np.ndarray): [N] part of each point, in [0, K), parents numbered first.
+        parent (np.ndarray): [K] each part's parent, -1 for part 0.
+        root_fraction: share of the root part's height whose points give its pivot.
+
+    Returns:
+        [K, 3] pivots, world units.
+    """
     K = len(parent)
     coo = graph.tocoo()
     a, b = labels[coo.row], labels[coo.col]
@@ -244,7 +309,16 @@ def pivots_of(xyz, graph, labels, parent, root_fraction: float = 0.1) -> np.ndar
 def topology_parts(xyz: np.ndarray, k: int, knn: int = KNN) -> TopologyParts:
     """K topology-aware parts of the canonical positions xyz [N, 3] (see the module docstring).
 
-    Raises ValueError if K < 1, or if fewer than K parts can be cut (naming the maximum).
+    Args:
+        xyz: [N, 3] canonical positions, world units.
+        k: number of parts K.
+        knn: neighbours per point of the graph.
+
+    Returns:
+        The [`TopologyParts`][physgs.models.topology.TopologyParts], parents numbered first.
+
+    Raises:
+        ValueError: if K < 1, or if fewer than K parts can be cut (naming the maximum).
     """
     xyz = _check_xyz(xyz)
     n = xyz.shape[0]
@@ -285,7 +359,17 @@ def topology_parts(xyz: np.ndarray, k: int, knn: int = KNN) -> TopologyParts:
 
 
 def part_depth(parent: np.ndarray) -> np.ndarray:
-    """Depth [K] of each part (root 0) for parents numbered first (parent[p] < p)."""
+    """Depth [K] of each part (root 0) for parents numbered first (parent[p] < p).
+
+    Args:
+        parent: [K] each part's parent, -1 for part 0.
+
+    Returns:
+        [K] int64 depths.
+
+    Raises:
+        ValueError: when parents are not numbered first (parent[0] = -1, 0 <= parent[p] < p).
+    """
     parent = np.asarray(parent, dtype=np.int64)
     K = len(parent)
     if K == 0 or parent[0] != -1 or np.any(parent[1:] < 0) or np.any(parent[1:] >= np.arange(1, K)):

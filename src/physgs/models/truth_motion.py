@@ -1,5 +1,5 @@
 """The true-motion reference (the ceiling): the canonical Gaussians moved by the ground-truth
-skinning of the testbed (``physgs.testbed.kinematics``).
+skinning of the testbed ([`physgs.testbed.kinematics`][]).
 
 Every Gaussian is a mesh vertex and follows its bone chain. All bones rotate about one world axis
 (``truth.swing_axis``) through their heads and children move with their parents, so bone b's
@@ -73,8 +73,16 @@ class TrueMotion:
 
     @staticmethod
     def from_truth(truth, observed) -> "TrueMotion":
-        """From a ``physgs.testbed.dataset.Truth`` (or anything with its fields) and the
-        ``Observed`` it belongs to; raises ValueError if they do not belong together."""
+        """From a [`physgs.testbed.dataset.Truth`][] (or anything with its fields) and the
+        ``Observed`` it belongs to; raises ValueError if they do not belong together.
+
+        Args:
+            truth (Truth): the dataset's ground truth.
+            observed (Observed): the matching observed dataset.
+
+        Returns:
+            The motion at the recorded frames, float64, in Gaussian order.
+        """
         wind = np.asarray(observed.wind, dtype=np.float32)  # [C, L+F]
         L = int(observed.lead_in_frames)
         theta = np.asarray(truth.theta, dtype=np.float64)  # [C, L+F, B]
@@ -118,7 +126,18 @@ class TrueMotion:
 
     @staticmethod
     def from_state_dict(sd: dict, prefix: str = "") -> "TrueMotion":
-        """The motion a checkpoint's state dict stores (no truth.npz needed)."""
+        """The motion a checkpoint's state dict stores (no truth.npz needed).
+
+        Args:
+            sd: the state dict.
+            prefix: the keys' prefix (the module's name in a larger state dict).
+
+        Returns:
+            The motion, as numpy arrays.
+
+        Raises:
+            ValueError: when a buffer is missing.
+        """
         missing = [k for k in BUFFERS if prefix + k not in sd]
         if missing:
             raise ValueError(f"truth_motion checkpoint lacks {missing}; delete it and retrain")
@@ -185,7 +204,17 @@ class TruthMotionModel(BaseModel):
         return int(self.theta.shape[0])
 
     def condition_of(self, wind: torch.Tensor) -> int:
-        """The recorded condition whose observed wind [L+F] this is (ValueError if none)."""
+        """The recorded condition whose observed wind [L+F] this is (ValueError if none).
+
+        Args:
+            wind: [L+F] an observed wind, m/s.
+
+        Returns:
+            The condition's index.
+
+        Raises:
+            ValueError: when the shape differs or no recorded wind lies within ``WIND_MATCH_TOL``.
+        """
         w = torch.as_tensor(wind, dtype=torch.float32, device=self.winds.device)
         if w.shape != self.winds.shape[1:]:
             raise ValueError(
@@ -204,7 +233,15 @@ class TruthMotionModel(BaseModel):
 
     def bone_motion(self, frame_idx: int, condition: int) -> tuple[torch.Tensor, torch.Tensor]:
         """(dPhi [B] rad, dHead [B, 3] m): each bone's rotation angle about the swing axis and
-        head displacement from the canonical pose to (condition, recorded frame_idx); float64."""
+        head displacement from the canonical pose to (condition, recorded frame_idx); float64.
+
+        Args:
+            frame_idx: recorded frame, 0-based.
+            condition: wind condition index.
+
+        Returns:
+            ``(dPhi, dHead)``: [B] rad and [B, 3] m, float64.
+        """
         return self._dphi[condition, frame_idx], self._dhead[condition, frame_idx]
 
     def deform(self, frame_idx: int, wind: torch.Tensor) -> GaussianState:

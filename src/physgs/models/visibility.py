@@ -37,11 +37,22 @@ def part_image_swing(
 ) -> np.ndarray:
     """[K] largest image displacement (pixels, training camera) of each part's Gaussians.
 
-    model: an oscillator prior (``part_theta``, ``part_labels`` [N], ``axis`` [K, 3],
-    ``pivot`` [K, 3], ``K``); observed: ``Observed`` (wind [C, L+F] m/s, train_camera,
-    n_train, lead_in_frames); frames: recorded-frame indices (default: the training window);
-    probe_rad: if given, every part is rotated by +-probe_rad (rad) instead of its theta(t).
     Frozen parts swing 0 under their own theta.
+
+    Args:
+        model (OscillatorPrior): an oscillator prior (``part_theta``, ``part_labels`` [N], ``axis``
+            [K, 3], ``pivot`` [K, 3], ``K``).
+        observed (Observed): the dataset (wind [C, L+F] m/s, train_camera, n_train,
+            lead_in_frames).
+        condition: the wind condition whose theta is used.
+        frames (ArrayLike | None): recorded-frame indices (default: the training window).
+        probe_rad: if given, every part is rotated by +-probe_rad (rad) instead of its theta(t).
+
+    Returns:
+        [K] swing, px.
+
+    Raises:
+        ValueError: for a ``probe_rad`` that is not > 0.
     """
     cam = observed.train_camera
     lab = model.part_labels.cpu().numpy()
@@ -112,8 +123,21 @@ def freeze_invisible(
 
     Also clears the Adam first moments of the frozen rows in ``optimizer`` (if given): their
     gradients are exactly zero from now on (theta = 0), so with a zero first moment Adam's step
-    is exactly zero and the parameters stay put. Returns statistics for the training record:
-    frozen_parts (count), part_swing_px [K].
+    is exactly zero and the parameters stay put.
+
+    Args:
+        model (OscillatorPrior): the prior being trained.
+        observed (Observed): the dataset.
+        threshold_px: the swing below which a part freezes, px.
+        optimizer (torch.optim.Adam | None): the training optimizer.
+        probe_rad: see [`part_image_swing`][physgs.models.visibility.part_image_swing].
+
+    Returns:
+        Statistics for the training record: ``frozen_parts`` (count, all frozen so far),
+            ``part_swing_px`` [K].
+
+    Raises:
+        ValueError: for a negative threshold.
     """
     if not threshold_px >= 0:
         raise ValueError(f"models.ours.freeze_below_px must be >= 0 pixels, got {threshold_px}")
@@ -132,9 +156,18 @@ def freeze_invisible(
 def freeze_schedule(models_cfg: dict, train_cfg: dict) -> int | None:
     """Iteration at which ours freezes invisible parts, or None when freezing is off.
 
-    Reads models.ours.freeze_below_px (pixels; 0 = off) and freeze_at (fraction of
-    train.iterations). The iteration must fall after the static warm-up, when theta has had
-    time to grow; otherwise a clear error names the fix.
+    The iteration must fall after the static warm-up, when theta has had time to grow.
+
+    Args:
+        models_cfg: the ``models`` section (reads ``ours.freeze_below_px``, pixels, 0 = off, and
+            ``ours.freeze_at``, a fraction of train.iterations).
+        train_cfg: the ``train`` section (iterations, warmup).
+
+    Returns:
+        round(freeze_at x iterations), or None.
+
+    Raises:
+        ValueError: naming the fix when the iteration falls outside (warmup, iterations).
     """
     o = models_cfg["ours"]
     thr, at = float(o["freeze_below_px"]), float(o["freeze_at"])
@@ -152,7 +185,22 @@ def freeze_schedule(models_cfg: dict, train_cfg: dict) -> int | None:
 
 
 def freeze_callback(observed, models_cfg: dict, train_cfg: dict):
-    """``on_iteration`` callback for ``train_model`` that freezes invisible parts once, or None."""
+    """``on_iteration`` callback for ``train_model`` that freezes invisible parts once, or None.
+
+    Args:
+        observed (Observed): the dataset.
+        models_cfg: the ``models`` config section.
+        train_cfg: the ``train`` config section.
+
+    Returns:
+        (Callable | None): ``on_iteration(it, model, optimizer)``, returning at the freezing
+            iteration ``frozen_at``, ``freeze_below_px`` and
+            [`freeze_invisible`][physgs.models.visibility.freeze_invisible]'s statistics (None at
+            every other); None when freezing is off.
+
+    Raises:
+        ValueError: from [`freeze_schedule`][physgs.models.visibility.freeze_schedule].
+    """
     at = freeze_schedule(models_cfg, train_cfg)
     if at is None:
         return None

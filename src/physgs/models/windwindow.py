@@ -11,7 +11,19 @@ import torch
 
 
 def window_step(seconds: float, n_values: int, fps: int) -> int:
-    """Frames between window samples, e.g. 6 s at 24 fps in 48 values -> 3. Must be a whole number."""
+    """Frames between window samples, e.g. 6 s at 24 fps in 48 values -> 3. Must be a whole number.
+
+    Args:
+        seconds: the window's length, s.
+        n_values: samples in the window.
+        fps: frame rate, frames/s.
+
+    Returns:
+        The step, frames.
+
+    Raises:
+        ValueError: unless seconds * fps / n_values is a positive integer.
+    """
     frames = seconds * fps
     step = frames / n_values
     if n_values < 1 or abs(step - round(step)) > 1e-9 or round(step) < 1:
@@ -27,7 +39,19 @@ def window_columns(frame_idx: int, lead_in: int, n_values: int, step: int) -> np
     """Wind columns [n_values] of the window ending at recorded frame ``frame_idx`` (oldest first).
 
     The last column is lead_in + frame_idx (the wind at t itself); earlier ones go back ``step``
-    frames each. Raises if the window reaches before the first recorded wind sample.
+    frames each.
+
+    Args:
+        frame_idx: recorded frame, 0-based.
+        lead_in: lead-in frames L before recorded frame 0.
+        n_values: samples in the window.
+        step: frames between samples.
+
+    Returns:
+        [n_values] int column indices into a wind [L+F].
+
+    Raises:
+        ValueError: if the window reaches before the first recorded wind sample.
     """
     end = lead_in + int(frame_idx)
     cols = end - step * np.arange(n_values - 1, -1, -1)
@@ -51,8 +75,21 @@ def wind_window(
 ) -> torch.Tensor:
     """Standardised raw-speed history [n_values] ending at frame ``frame_idx``.
 
-    wind [L+F] m/s of one condition; mean, std: m/s, the TRAINING condition's statistics (so a
-    weaker wind stays weaker after standardisation).
+    Args:
+        wind: [L+F] one condition's observed wind, m/s.
+        frame_idx: recorded frame, 0-based.
+        lead_in: lead-in frames L.
+        mean: the TRAINING condition's mean speed, m/s (so a weaker wind stays weaker after
+            standardisation).
+        std: the training condition's speed std, m/s.
+        n_values: samples in the window.
+        step: frames between samples.
+
+    Returns:
+        [n_values] (wind - mean) / std, oldest first.
+
+    Raises:
+        ValueError: when the window reaches before the series or beyond it.
     """
     cols = window_columns(frame_idx, lead_in, n_values, step)
     if cols[-1] >= wind.shape[-1]:

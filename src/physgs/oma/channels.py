@@ -20,7 +20,7 @@ import numpy as np
 class FlowSettings:
     """cell_px: cell side (px); min_fg: the fewest foreground share of a cell's pixels in the
     first frame for it to be a channel; fg_tol, fg_dilate_px: the tracker's foreground test
-    (``physgs.tracks.track.foreground``); levels, winsize, iterations, poly_n, poly_sigma:
+    ([`physgs.tracks.track.foreground`][]); levels, winsize, iterations, poly_n, poly_sigma:
     OpenCV's Farneback settings (pyramid levels, averaging window px, iterations per level,
     polynomial neighbourhood px and its Gaussian sigma). Values and their reasons: docs/blind.md.
     """

@@ -9,8 +9,17 @@ from physgs.atomic import atomic_path
 
 def stabilisation_figure(path, ident, omega_bones, title: str = "") -> None:
     """Poles (frequency Hz against model order; filled: stable) with the identified modes as
-    vertical lines, and the true bone frequencies (rad/s, ``omega_bones`` [B]) as ticks in a
-    strip below. The truth is drawn, never used to select anything."""
+    vertical lines, and the true bone frequencies as ticks in a strip below.
+
+    The truth is drawn, never used to select anything.
+
+    Args:
+        path (str | Path): the PNG to write.
+        ident (Identification): the identification
+            ([`Identification`][physgs.oma.run.Identification]), its stabilisation diagram included.
+        omega_bones (ArrayLike): [B] true bone frequencies, rad/s.
+        title: the figure's title.
+    """
     import matplotlib
 
     matplotlib.use("Agg")

@@ -1,7 +1,7 @@
 """From identified modes to per-part estimates: the image regions a mode moves, mapped to parts.
 
 Cells are grouped into K parts by k-means on their centres (px), as the 2D-track control groups
-its tracks by their seed positions (``physgs.tracks.fit``). A mode belongs to the part whose
+its tracks by their seed positions ([`physgs.tracks.fit`][]). A mode belongs to the part whose
 cells it moves most: the largest mean squared shape amplitude |phi_c|^2 over the part's
 channels (x and y of each cell), so a large part does not win by its size alone. A part takes,
 of the modes that belong to it, the one it carries the largest share of; a part no mode
@@ -35,7 +35,20 @@ class PartModes:
 
 def cell_parts(cell_xy: np.ndarray, K: int, seed: int, n_init: int) -> np.ndarray:
     """[N] part of each cell: the tracks control's k-means of image positions (px) into K
-    parts (``physgs.tracks.fit.track_parts``: numbered top to bottom, then left to right)."""
+    parts ([`physgs.tracks.fit.track_parts`][]: numbered top to bottom, then left to right).
+
+    Args:
+        cell_xy: [N, 2] cell centres, px.
+        K: number of parts.
+        seed: the k-means seed.
+        n_init: k-means restarts.
+
+    Returns:
+        [N] int64 part ids.
+
+    Raises:
+        ValueError: when K exceeds the cells.
+    """
     from physgs.tracks.fit import track_parts
 
     n = int(np.asarray(cell_xy).shape[0])
@@ -54,8 +67,17 @@ def assign_modes(
 ) -> PartModes:
     """Each mode to the part it moves most, each part to its strongest mode.
 
-    freq_hz [M], zeta [M], shape [M, C] (over the cell channels), channel_cell [C],
-    part_of_cell [N] in [0, K).
+    Args:
+        freq_hz: [M] mode frequencies, Hz.
+        zeta: [M] mode damping ratios.
+        shape: [M, C] complex mode shapes over the cell channels.
+        channel_cell: [C] the cell of each channel.
+        part_of_cell: [N] part of each cell, in [0, K).
+        K: number of parts.
+
+    Returns:
+        The [`PartModes`][physgs.oma.parts.PartModes]: omega (rad/s) and zeta per part, NaN where
+            a part has no mode.
     """
     shape = np.asarray(shape)
     M = int(np.asarray(freq_hz).size)

@@ -63,10 +63,21 @@ class Identification:
 def identify_video(
     videos: list[np.ndarray], background, fps: float, s: OMASettings
 ) -> Identification:
-    """Flow channels of each video's window frames [T, H, W, 3] uint8 (the first video's cells
-    for all), the principal components of all records together, SSI-cov over the records
-    (``identify_records``), and the modes inside ours' bounds, their shapes mapped back over
-    the cell channels."""
+    """Flow channels of each video's window frames (the first video's cells for all), the principal
+    components of all records together, SSI-cov over the records
+    ([`identify_records`][physgs.oma.ssi.identify_records]), and the modes inside ours' bounds,
+    their shapes mapped back over the cell channels.
+
+    Args:
+        videos: one [T, H, W, 3] uint8 array per record (the training window's frames).
+        background (ArrayLike): [3] the background colour (the foreground mask's reference).
+        fps: frame rate, frames/s.
+        s: the analysis' settings.
+
+    Returns:
+        The [`Identification`][physgs.oma.run.Identification]: the first video's channels, the
+            modes in ``s.omega_hz`` (Hz), and the wall time, s.
+    """
     import time
 
     t0 = time.perf_counter()
@@ -136,7 +147,20 @@ def load_identification(path) -> Identification:
 
 
 def part_modes(ident: Identification, K: int, seed: int, n_init: int) -> PartModes:
-    """The cells' K parts (k-means, training seed) and each part's mode."""
+    """The cells' K parts (k-means, training seed) and each part's mode.
+
+    Args:
+        ident: the identification.
+        K: number of parts.
+        seed: the training seed (k-means).
+        n_init: k-means restarts.
+
+    Returns:
+        The [`PartModes`][physgs.oma.parts.PartModes].
+
+    Raises:
+        ValueError: when K exceeds the foreground cells.
+    """
     parts = cell_parts(ident.channels.cell_xy, K, seed, n_init)
     m = ident.modes
     return assign_modes(m.freq_hz, m.zeta, m.shape, ident.channels.channel_cell, parts, K)
@@ -152,9 +176,25 @@ def recover_oma(
 ):
     """Ours' recovery record for the parts' modal estimates (evaluation: reads wind and truth).
 
-    solver: ours' settings (``physgs.recovery.run.null_settings``: omega_hz, zeta, zeta_init,
-    substeps, rk4_guard); a part without a mode keeps ours' initial values and theta = 0.
-    Returns (RecoveryRecord, the ``oma`` block of the record).
+    A part without a mode keeps ours' initial values and theta = 0.
+
+    Args:
+        pm: the parts' modes.
+        observed (Observed): the dataset (training wind, vbar, fps, frame counts).
+        truth (Truth): its ground truth.
+        solver: ours' settings ([`null_settings`][physgs.recovery.run.null_settings]: omega_hz,
+            zeta, zeta_init, substeps, rk4_guard).
+        bone_visible (np.ndarray | None): [B] bool; restricts the scores to visible bones.
+        damping: settings of the damping scores (``zeta_range``, ``seed``); None: none.
+
+    Returns:
+        (tuple[RecoveryRecord, dict]): ``(record, block)``: the
+            [`RecoveryRecord`][physgs.recovery.record.RecoveryRecord] and the record's ``oma``
+            block (part and mode counts, the parts without an estimate, each mode's part, the
+            median zeta).
+
+    Raises:
+        RuntimeError: if a part without a mode were matched as trusted.
     """
     import torch
 
@@ -205,7 +245,13 @@ def recover_oma(
 
 
 def save_oma_recovery(path, rec, block: dict) -> None:
-    """Ours' recovery record (``load_recovery`` reads it) plus an ``oma`` block."""
+    """Ours' recovery record (``load_recovery`` reads it) plus an ``oma`` block.
+
+    Args:
+        path (str | Path): the JSON to write.
+        rec (RecoveryRecord): the record.
+        block: the ``oma`` block.
+    """
     from physgs.recovery.record import recovery_dict
 
     write_json(path, {**recovery_dict(rec), "oma": block})

@@ -9,7 +9,15 @@ from __future__ import annotations
 def identify_params(cfg: dict, config: str) -> dict:
     """Rule ``oma_identify``: the conditions of ``config`` (``models.configs``: train -> [0],
     all -> every wind's video, one record each), the flow, components and SSI settings, and
-    ours' omega bounds (a mode outside them is dropped). Nothing about the wind."""
+    ours' omega bounds (a mode outside them is dropped). Nothing about the wind.
+
+    Args:
+        cfg: the resolved config.
+        config: a configuration name of ``models.configs``.
+
+    Returns:
+        ``conditions``, ``flow``, ``components``, ``ssi`` and ``omega_hz`` (Hz).
+    """
     from physgs.tracks.settings import condition_indices
 
     o = cfg["oma"]
@@ -25,7 +33,15 @@ def identify_params(cfg: dict, config: str) -> dict:
 
 def parts(cfg: dict, config: str) -> int:
     """The output-only analysis' K in ``config`` (``oma.K``: ``same`` for the configuration's,
-    or an integer): its recovery record's parts and its null's K."""
+    or an integer): its recovery record's parts and its null's K.
+
+    Args:
+        cfg: the resolved config.
+        config: a configuration name.
+
+    Returns:
+        K.
+    """
     k = cfg["oma"].get("K", "same")
     return int(cfg["models"]["configs"][config]["K"]) if k == "same" else int(k)
 
@@ -33,7 +49,16 @@ def parts(cfg: dict, config: str) -> int:
 def recovery_params(cfg: dict, config: str, seed: int) -> dict:
     """Rule ``oma_recovery``: K (``oma.K``: ``same`` for the configuration's, or an integer),
     the training seed and ours' k-means
-    restarts (the cells' parts), and ours' solver settings (the null's, ``null_settings``)."""
+    restarts (the cells' parts), and ours' solver settings (the null's, ``null_settings``).
+
+    Args:
+        cfg: the resolved config.
+        config: a configuration name.
+        seed: the training seed.
+
+    Returns:
+        ``K``, ``seed``, ``kmeans_n_init`` and ``solver``.
+    """
     from physgs.recovery.run import null_settings
 
     K = parts(cfg, config)

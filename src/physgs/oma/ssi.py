@@ -57,6 +57,12 @@ def check_record(n_samples: int, n_channels: int, s: SSISettings, key: str = "om
     higher than the Hankel matrix's rank bound ``block_rows * n_channels``. Raises ValueError
     naming the key (``<key>/block_rows`` or ``<key>/order_max``).
 
+    Args:
+        n_samples: samples per channel in the record.
+        n_channels: channels SSI reads.
+        s: the SSI settings.
+        key: the config section named in the error.
+
     Raises:
         RecordError: naming the key and what the record lacks.
     """
@@ -130,11 +136,20 @@ def group_stable_poles(
 ) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
     """Cluster stable poles along frequency into modes.
 
-    freq, xi [P, O]; phi [P, O, C]; stable [P, O] bool. Poles sorted by frequency are cut where
-    two neighbours differ by more than ``err_fn`` (relative); a cluster is a mode when it holds
-    stable poles of at least ``min_stable`` distinct orders. Its frequency and damping are the
-    medians over its poles, its shape the pole of the highest order nearest its frequency.
-    Returns (freq_hz [M], zeta [M], shape [M, C], n_stable [M], freq_spread [M]).
+    Poles sorted by frequency are cut where two neighbours differ by more than ``err_fn``
+    (relative); a cluster is a mode when it holds stable poles of at least ``min_stable`` distinct
+    orders. Its frequency and damping are the medians over its poles, its shape the pole of the
+    highest order nearest its frequency.
+
+    Args:
+        freq: [P, O] pole frequencies, Hz.
+        xi: [P, O] pole damping ratios.
+        phi: [P, O, C] pole shapes.
+        stable: [P, O] bool.
+        s: the SSI settings (``err_fn``, ``min_stable``).
+
+    Returns:
+        ``(freq_hz [M], zeta [M], shape [M, C], n_stable [M], freq_spread [M])``.
     """
     p_idx, o_idx = np.nonzero(stable & np.isfinite(freq))
     order = np.argsort(freq[p_idx, o_idx])
@@ -170,7 +185,16 @@ def group_stable_poles(
 
 
 def identify(y: np.ndarray, fs: float, s: SSISettings) -> Modes:
-    """SSI-cov of one record (``identify_records`` of ``[y]``)."""
+    """SSI-cov of one record (``identify_records`` of ``[y]``).
+
+    Args:
+        y: [T, C] the record's channels.
+        fs: sampling rate, Hz.
+        s: the SSI settings.
+
+    Returns:
+        The [`Modes`][physgs.oma.ssi.Modes].
+    """
     return identify_records([y], fs, s)
 
 

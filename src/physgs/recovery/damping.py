@@ -31,7 +31,11 @@ class DampingResult:
     zeta_true: float
 
     def to_dict(self) -> dict:
-        """The result as a JSON-ready dict (arrays as lists)."""
+        """The result as a JSON-ready dict (arrays as lists).
+
+        Returns:
+            Field name -> value, arrays as lists.
+        """
         return {
             k: (v.tolist() if isinstance(v, np.ndarray) else v) for k, v in asdict(self).items()
         }

@@ -1,6 +1,6 @@
 """Damping recovery scored part by part against a per-bone truth (the damping testbed variant).
 
-The frequency matcher (``physgs.recovery.matcher``) says which bone each part k reproduces
+The frequency matcher ([`physgs.recovery.matcher`][]) says which bone each part k reproduces
 (``bone[k]``) and whether to trust it (``trusted[k]``); here each trusted part's zeta_hat is read
 against its bone's true zeta:
 
@@ -55,7 +55,11 @@ class DampingScores:
     gamma_exponent_true: float
 
     def to_dict(self) -> dict:
-        """The scores as a plain dict (field name -> value)."""
+        """The scores as a plain dict (field name -> value).
+
+        Returns:
+            Field name -> value.
+        """
         return asdict(self)
 
     @staticmethod
@@ -85,9 +89,18 @@ def _positive(name: str, x) -> np.ndarray:
 
 
 def loglog_exponent(omega: np.ndarray, gamma: np.ndarray) -> float:
-    """Least-squares slope p of log gamma = p log omega + c; omega [n] rad/s, gamma [n] 1/s.
+    """Least-squares slope p of log gamma = p log omega + c.
 
-    NaN with fewer than MIN_FIT_PARTS values or no spread in omega (the slope is undefined).
+    Args:
+        omega: [n] natural frequencies, rad/s (> 0).
+        gamma: [n] decay rates, 1/s (> 0).
+
+    Returns:
+        p, or NaN with fewer than MIN_FIT_PARTS values or no spread in omega (the slope is
+            undefined).
+
+    Raises:
+        ValueError: for values that are not finite and positive.
     """
     x, y = np.log(_positive("omega", omega)), np.log(_positive("gamma", gamma))
     if x.size < MIN_FIT_PARTS or np.ptp(x) == 0:
@@ -98,7 +111,18 @@ def loglog_exponent(omega: np.ndarray, gamma: np.ndarray) -> float:
 
 def log_correlation(zeta_hat: np.ndarray, zeta_true: np.ndarray) -> float:
     """Pearson r of log zeta_hat with log zeta_true, both [n]: NaN for n < MIN_CORR_PARTS,
-    0 when either side is constant (no evidence of ranking, never 0/0)."""
+    0 when either side is constant (no evidence of ranking, never 0/0).
+
+    Args:
+        zeta_hat: [n] estimated damping ratios (> 0).
+        zeta_true: [n] true damping ratios (> 0).
+
+    Returns:
+        r in [-1, 1], NaN or 0 as said.
+
+    Raises:
+        ValueError: for values that are not finite and positive.
+    """
     x, y = np.log(_positive("zeta_hat", zeta_hat)), np.log(_positive("zeta_true", zeta_true))
     if x.size < MIN_CORR_PARTS:
         return float("nan")
@@ -154,7 +178,17 @@ def damping_scores(
 def score_match(
     match, zeta_hat: np.ndarray, zeta_bones: np.ndarray, omega_bones: np.ndarray
 ) -> DampingScores:
-    """``damping_scores`` of a ``MatchResult`` (its bones, trusted parts and omega_hat)."""
+    """``damping_scores`` of a ``MatchResult`` (its bones, trusted parts and omega_hat).
+
+    Args:
+        match (MatchResult): the parts' match to bones.
+        zeta_hat: [K] estimated damping ratios.
+        zeta_bones: [B] true damping ratios.
+        omega_bones: [B] true natural frequencies, rad/s.
+
+    Returns:
+        The [`DampingScores`][physgs.recovery.damping_scores.DampingScores] of the trusted parts.
+    """
     return damping_scores(
         match.bone, match.trusted, zeta_hat, match.omega_hat, zeta_bones, omega_bones
     )
@@ -166,7 +200,20 @@ def score_match(
 
 def draw_null_zetas(zeta_range, n_parts: int, n_draws: int, seed: int) -> np.ndarray:
     """[n_draws, n_parts] damping ratios, log-uniform on zeta_range = (lo, hi), seeded (its own
-    stream NULL_STREAM beside the seed, so it shares no draws with the frequency null)."""
+    stream NULL_STREAM beside the seed, so it shares no draws with the frequency null).
+
+    Args:
+        zeta_range (Sequence[float]): ``(lo, hi)``, 0 < lo <= hi.
+        n_parts: ratios per draw.
+        n_draws: draws.
+        seed: the seed (with NULL_STREAM).
+
+    Returns:
+        [n_draws, n_parts] damping ratios.
+
+    Raises:
+        ValueError: unless 0 < lo <= hi.
+    """
     lo, hi = (float(z) for z in zeta_range)
     if not 0 < lo <= hi:
         raise ValueError(f"zeta_range {list(zeta_range)} must satisfy 0 < lo <= hi")
@@ -207,7 +254,11 @@ class DampingNull:
         return self._median(self.gamma_exponent)
 
     def to_dict(self) -> dict:
-        """The null as a JSON-ready dict (arrays as lists)."""
+        """The null as a JSON-ready dict (arrays as lists).
+
+        Returns:
+            Field name -> value, arrays as lists.
+        """
         return {
             k: (v.tolist() if isinstance(v, np.ndarray) else v) for k, v in asdict(self).items()
         }

@@ -106,7 +106,11 @@ class MatchResult:
     loglog_r2: float
 
     def to_dict(self) -> dict:
-        """The result as a JSON-ready dict (arrays as lists)."""
+        """The result as a JSON-ready dict (arrays as lists).
+
+        Returns:
+            Field name -> value, arrays as lists.
+        """
         return {
             k: (v.tolist() if isinstance(v, np.ndarray) else v) for k, v in asdict(self).items()
         }
@@ -184,7 +188,7 @@ def restricted(m: MatchResult, bone_mask: np.ndarray) -> tuple[int, float]:
     """The match's scores restricted to the parts matched to the bones in ``bone_mask``.
 
     Used to score recovery only on bones whose own motion is visible in the training camera
-    (``physgs.testbed.stats``).
+    ([`physgs.testbed.stats`][]).
 
     Args:
         m: the match.

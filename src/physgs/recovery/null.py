@@ -94,7 +94,11 @@ class NullResult:
         return float(np.median(v)) if v.size else float("nan")
 
     def to_dict(self) -> dict:
-        """The result as a JSON-ready dict (arrays as lists)."""
+        """The result as a JSON-ready dict (arrays as lists).
+
+        Returns:
+            Field name -> value, arrays as lists.
+        """
         return {
             k: (v.tolist() if isinstance(v, np.ndarray) else v) for k, v in asdict(self).items()
         }
@@ -145,7 +149,7 @@ def null_control(
 ) -> NullResult:
     """Run the untrained null through the trained model's solver and the matcher.
 
-    Each draw integrates ``physgs.models.oscillator.integrate`` with drawn omega and zeta =
+    Each draw integrates [`physgs.models.oscillator.integrate`][] with drawn omega and zeta =
     ``zeta_init``; ``gain`` only scales theta, which correlation ignores.
 
     Args:

@@ -36,13 +36,29 @@ class RecoveryRecord:
     damping_null: DampingNull | None = None
 
     def with_visibility(self, bone_visible: np.ndarray) -> "RecoveryRecord":
-        """This record with the scores restricted to visible bones (``bone_visible`` [B] bool)."""
+        """This record with the scores restricted to visible bones (``bone_visible`` [B] bool).
+
+        Args:
+            bone_visible: [B] bool, True for a visible bone.
+
+        Returns:
+            A copy with ``n_trusted_visible`` and ``median_rel_err_visible`` set.
+        """
         n, med = restricted(self.match, bone_visible)
         return dataclasses.replace(self, n_trusted_visible=n, median_rel_err_visible=med)
 
 
 def bone_window(truth, lead_in_frames: int, n_train: int) -> np.ndarray:
-    """[B, n_train] ground-truth bone angles (rad) over the training window at the training wind."""
+    """[B, n_train] ground-truth bone angles (rad) over the training window at the training wind.
+
+    Args:
+        truth (Truth): the dataset's ground truth.
+        lead_in_frames: lead-in frames L.
+        n_train: training-window length, frames.
+
+    Returns:
+        [B, n_train] angles, rad.
+    """
     theta = np.asarray(truth.theta)[0]  # [L+F, B]
     return training_window(theta.T, lead_in_frames, n_train)
 
@@ -57,9 +73,20 @@ def score_recovery(
 ) -> RecoveryRecord:
     """Match parts to bones and summarise damping.
 
-    part_theta [K, L+F]: the model's part angles (rad) under the training wind, lead-in first
-    (``model.part_theta(wind)``); omega_hat [K] rad/s, zeta_hat [K]; truth: a ``Truth``.
     Damping is summarised over all parts (the paper's median zeta_hat is over all parts).
+
+    Args:
+        part_theta: [K, L+F] the model's part angles (rad) under the training wind, lead-in first
+            (``model.part_theta(wind)``).
+        omega_hat: [K] estimated natural frequencies, rad/s.
+        zeta_hat: [K] estimated damping ratios.
+        truth (Truth): the dataset's ground truth.
+        lead_in_frames: lead-in frames L.
+        n_train: training-window length, frames.
+
+    Returns:
+        The [`RecoveryRecord`][physgs.recovery.record.RecoveryRecord]: the match over the training
+            window and the damping summary.
     """
     part = training_window(part_theta, lead_in_frames, n_train)
     m = match_parts(part, bone_window(truth, lead_in_frames, n_train), omega_hat, truth.omega)
@@ -70,7 +97,18 @@ def score_recovery(
 def with_damping_scores(rec: RecoveryRecord, zeta_hat, truth, damping: dict) -> RecoveryRecord:
     """``rec`` with each trusted part's zeta scored against its bone's true zeta and against
     the untrained null drawn log-uniformly from ``damping['zeta_range']`` with seed
-    ``damping['seed']`` (``physgs.recovery.damping_scores``; tab_damping). zeta_hat [K]."""
+    ``damping['seed']`` ([`physgs.recovery.damping_scores`][physgs.recovery.damping_scores];
+    tab_damping).
+
+    Args:
+        rec: the record (its match is used).
+        zeta_hat (ArrayLike): [K] estimated damping ratios.
+        truth (Truth): the dataset's ground truth (``zeta``, ``omega``).
+        damping: ``zeta_range`` and ``seed`` of the null.
+
+    Returns:
+        A copy with ``damping_scores`` and ``damping_null`` set.
+    """
     from physgs.recovery.damping_scores import damping_null, score_match
 
     zb, ob = np.asarray(truth.zeta, np.float64), np.asarray(truth.omega, np.float64)
@@ -86,7 +124,15 @@ def with_damping_scores(rec: RecoveryRecord, zeta_hat, truth, damping: dict) -> 
 
 def recovery_dict(rec: RecoveryRecord) -> dict:
     """The JSON object ``save_recovery`` writes (``load_recovery`` ignores any other key, so a
-    method may add its own block beside these)."""
+    method may add its own block beside these).
+
+    Args:
+        rec: the record.
+
+    Returns:
+        ``match``, ``damping``, ``n_frozen``, ``n_trusted_visible``, ``median_rel_err_visible``,
+            ``damping_scores`` and ``damping_null`` (None where not scored).
+    """
     return {
         "match": rec.match.to_dict(),
         "damping": rec.damping.to_dict(),
@@ -177,7 +223,20 @@ def run_null(
 
     Uses the training condition's observed wind (lead-in first), dt = 1 / fps, and the
     condition's mean speed ``observed.vbar[0]``, as the oscillator prior does; bones over the
-    training window at the training wind. zeta_init and substeps: the model's config values.
+    training window at the training wind.
+
+    Args:
+        truth (Truth): the dataset's ground truth.
+        observed (Observed): the dataset.
+        n_parts: K, parts per draw.
+        zeta_init: the model's initial damping ratio (config value).
+        substeps: RK4 substeps per wind sample (the model's).
+        seed: the null's seed.
+        n_draws: draws (default ``N_DRAWS``).
+        bone_visible: [B] bool; also score the draws on visible bones.
+
+    Returns:
+        The [`NullResult`][physgs.recovery.null.NullResult].
     """
     from physgs.recovery.null import N_DRAWS, null_control
 

@@ -20,11 +20,25 @@ def recover_model(
 ) -> RecoveryRecord:
     """Match the trained parts to bones (training wind, training window) and summarise damping.
 
-    model: a trained ``ours`` model (``part_theta``, ``omega`` rad/s, ``zeta``); bone_visible
-    [B] bool (``physgs.testbed.stats``): also score the parts matched to visible bones.
-    damping: {zeta_range, seed} to also score each trusted part's zeta against its bone's true
-    zeta and against the untrained null drawn log-uniformly from zeta_range with that seed
-    (``physgs.recovery.damping_scores``; tab_damping).
+    Args:
+        model (OscillatorPrior): a trained ``ours`` model (``part_theta``, ``omega`` rad/s,
+            ``zeta``).
+        observed (Observed): the dataset.
+        truth (Truth): its ground truth.
+        bone_visible (np.ndarray | None): [B] bool
+            ([`physgs.testbed.stats`][physgs.testbed.stats]): also score the parts matched to
+            visible bones.
+        damping: ``{zeta_range, seed}`` to also score each trusted part's zeta against its bone's
+            true zeta and against the untrained null drawn log-uniformly from zeta_range with
+            that seed ([`physgs.recovery.damping_scores`][physgs.recovery.damping_scores];
+            tab_damping).
+
+    Returns:
+        The [`RecoveryRecord`][physgs.recovery.record.RecoveryRecord], ``n_frozen`` set.
+
+    Raises:
+        TypeError: for a model without ``part_theta``.
+        RuntimeError: if a frozen part were matched as trusted.
     """
     import torch
 
@@ -54,10 +68,20 @@ def recover_model(
 
 
 def null_settings(cfg: dict, K: int, seed: int | None = None) -> dict:
-    """What the null control for K parts reads from the resolved config: ours' solver settings
-    (omega and zeta bounds, zeta_init, substeps, RK4 guard) and the seed (a training seed: each
-    seed draws its own null, paired with that seed's model; default ``cfg['seed']``). Keyed by K,
-    not by configuration, so configurations sharing a K share one null."""
+    """What the null control for K parts reads from the resolved config.
+
+    Keyed by K, not by configuration, so configurations sharing a K share one null.
+
+    Args:
+        cfg: the resolved config.
+        K: number of parts.
+        seed: a training seed (each seed draws its own null, paired with that seed's model);
+            default ``cfg['seed']``.
+
+    Returns:
+        ``K``, ours' solver settings (``omega_hz`` bounds in Hz, ``zeta`` bounds, ``zeta_init``,
+            ``substeps``, ``rk4_guard``) and ``seed``.
+    """
     o = cfg["models"]["ours"]
     return {
         "K": int(K),
@@ -73,7 +97,18 @@ def null_settings(cfg: dict, K: int, seed: int | None = None) -> dict:
 def null_control(observed, truth, settings: dict, bone_visible=None) -> NullResult:
     """The untrained null for ``settings['K']`` parts (``null_settings``), through the solver
     settings ours uses: substeps are raised exactly as the model raises them, so the null
-    integrates with the trained model's step."""
+    integrates with the trained model's step.
+
+    Args:
+        observed (Observed): the dataset.
+        truth (Truth): its ground truth.
+        settings: [`null_settings`][physgs.recovery.run.null_settings] (``rk4_guard`` defaults
+            to ``STABILITY_GUARD``).
+        bone_visible (np.ndarray | None): [B] bool; also score the draws on visible bones.
+
+    Returns:
+        The [`NullResult`][physgs.recovery.null.NullResult].
+    """
     from physgs.models.oscillator import STABILITY_GUARD
     from physgs.models.ours import prior_substeps
     from physgs.recovery.record import run_null

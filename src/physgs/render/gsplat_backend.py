@@ -27,7 +27,20 @@ def rasterize_gsplat(
 ):
     """gsplat backend of [`rasterization`][physgs.render.rasterization] (same shapes and units).
 
-    Returns (rgb [H, W, D], alpha [H, W], depth [H, W] or None) on the CUDA device.
+    Args:
+        means: [N, 3] centres, world units.
+        quats: [N, 4] orientations (w, x, y, z).
+        scales: [N, 3] standard deviations, world units.
+        opacities: [N] in [0, 1].
+        colors: [N, D] in [0, 1].
+        camera: the camera; the image is camera.height x camera.width px.
+        background: [D] background colour.
+        return_depth: whether to compute the expected depth.
+
+    Returns:
+        (tuple[torch.Tensor, torch.Tensor, torch.Tensor | None]): ``(rgb [H, W, D], alpha [H, W],
+            depth [H, W] or None)`` on the CUDA device, in the dtype of ``means`` (gsplat computes
+            in float32).
     """
     import gsplat
 

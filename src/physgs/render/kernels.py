@@ -43,11 +43,21 @@ FLOPS_PER_PAIR_BACKWARD = 59
 def bin_tiles(boxes, order, tile, tiles_x, tiles_y):  # pragma: no cover - compiled
     """Tile lists of depth-sorted Gaussians.
 
-    boxes [N, 4] int64 (x0, x1, y0, y1) inclusive pixel ranges; order [M] Gaussian ids sorted
-    front to back, only ones whose box is non-empty. Returns (tile_start [T + 1], pair_gid [P],
-    row_start [P + 1]): tile t holds pair_gid[tile_start[t]:tile_start[t + 1]], in depth order;
-    pair k may record up to row_start[k + 1] - row_start[k] pixel rows (its box's rows inside
-    the tile) in the forward's row buffers, which the backward reads back.
+    Tile t holds pair_gid[tile_start[t]:tile_start[t + 1]], in depth order; pair k may record up to
+    row_start[k + 1] - row_start[k] pixel rows (its box's rows inside the tile) in the forward's row
+    buffers, which the backward reads back.
+
+    Args:
+        boxes (np.ndarray): [N, 4] int64 (x0, x1, y0, y1) inclusive pixel ranges.
+        order (np.ndarray): [M] int64 Gaussian ids sorted front to back, only ones whose box is
+            non-empty.
+        tile (int): tile side, px.
+        tiles_x (int): tiles per image row.
+        tiles_y (int): tiles per image column.
+
+    Returns:
+        (tuple[np.ndarray, np.ndarray, np.ndarray]): ``(tile_start [T + 1], pair_gid [P],
+            row_start [P + 1])``, T = tiles_x x tiles_y, P (tile, Gaussian) pairs.
     """
     n_tiles = tiles_x * tiles_y
     start = np.zeros(n_tiles + 1, np.int64)
@@ -146,9 +156,20 @@ def _rgb(col):  # pragma: no cover - compiled
 @nb.njit(cache=True)
 def pixel_boxes(means2d, cov2d, opac, valid, width, height, boxes):  # pragma: no cover
     """Numba twin of [`pixel_bounds`][physgs.render.project.pixel_bounds] (the reference's binning;
-    same formula, constants and clipping), written into boxes [N, 4] int64: (x0, x1, y0, y1)
-    inclusive pixel ranges, x0 > x1 for a Gaussian that touches no pixel. One flat loop instead of
-    some twenty numpy passes over N."""
+    same formula, constants and clipping).
+
+    One flat loop instead of some twenty numpy passes over N.
+
+    Args:
+        means2d (np.ndarray): [N, 2] projected centres, px.
+        cov2d (np.ndarray): [N, 3] 2D covariances (a, b, c), px^2.
+        opac (np.ndarray): [N] opacities.
+        valid (np.ndarray): [N] bool, False for culled Gaussians.
+        width (int): image width, px.
+        height (int): image height, px.
+        boxes (np.ndarray): [N, 4] int64, written: (x0, x1, y0, y1) inclusive pixel ranges, x0 > x1
+            for a Gaussian that touches no pixel.
+    """
     s = float(BOX_SLACK_PX)
     lo = -(BOX_SLACK_PX + 1.0)
     for i in range(means2d.shape[0]):
@@ -201,13 +222,39 @@ def forward(
     row_gauss,
     n_rows,
 ):  # pragma: no cover - compiled
-    """Composite front to back. Inputs: means2d [N, 2] px, conics [N, 3], opac [N],
-    colors [N, D], depths [N], bg [D], boxes [N, 4], tile lists and row offsets from bin_tiles.
-    Writes out_rgb [H, W, D], out_alpha [H, W], out_depth [H, W] and float64 totals for the
-    backward: acc_c [H, W, D] = sum c a T, acc_d [H, W] = sum z a T, t_final [H, W];
-    n_contrib [H, W] counts the Gaussians composited at each pixel; and the rows it composited, so the backward need not find them again: pair k's rows are
-    row_start[k] + [0, n_rows[k]), each row_pix (y, x0, x1) int64 [R, 3] pixels with
-    row_gauss (exp(-sigma / 2) at x0, its step ratio) [R, 2]."""
+    """Composite front to back.
+
+    Writes the image and float64 totals for the backward, and the rows it composited, so the
+    backward need not find them again: pair k's rows are row_start[k] + [0, n_rows[k]).
+
+    Args:
+        means2d (np.ndarray): [N, 2] projected centres, px.
+        conics (np.ndarray): [N, 3] inverse 2D covariances, px^-2.
+        opac (np.ndarray): [N] opacities.
+        colors (np.ndarray): [N, D] colours.
+        depths (np.ndarray): [N] camera-space depths, world units.
+        bg (np.ndarray): [D] background colour.
+        boxes (np.ndarray): [N, 4] pixel boxes from
+            [`pixel_boxes`][physgs.render.kernels.pixel_boxes].
+        tile_start (np.ndarray): [T + 1] from [`bin_tiles`][physgs.render.kernels.bin_tiles].
+        pair_gid (np.ndarray): [P] from ``bin_tiles``.
+        row_start (np.ndarray): [P + 1] from ``bin_tiles``.
+        tile (int): tile side, px.
+        tiles_x (int): tiles per image row.
+        width (int): image width W, px.
+        height (int): image height H, px.
+        out_rgb (np.ndarray): [H, W, D], written.
+        out_alpha (np.ndarray): [H, W], written.
+        out_depth (np.ndarray): [H, W] expected depth sum z a T, written.
+        acc_c (np.ndarray): [H, W, D] = sum c a T, written.
+        acc_d (np.ndarray): [H, W] = sum z a T, written.
+        t_final (np.ndarray): [H, W] final transmittance, written.
+        n_contrib (np.ndarray): [H, W] int64, the Gaussians composited at each pixel, written.
+        row_pix (np.ndarray): [R, 3] (y, x0, x1) pixels per recorded row (int32 as
+            [`physgs.render.fast`][physgs.render.fast] allocates it), written.
+        row_gauss (np.ndarray): [R, 2] (exp(-sigma / 2) at x0, its step ratio) per row, written.
+        n_rows (np.ndarray): [P] int64 rows recorded per pair, written.
+    """
     D = colors.shape[1]
     n_tiles = tile_start.shape[0] - 1
     for t in nb.prange(n_tiles):
@@ -328,11 +375,39 @@ def backward(
 ):  # pragma: no cover - compiled
     """Explicit backward of [`forward`][physgs.render.kernels.forward], over the rows the forward
     recorded (the same pixels, the same exp(-sigma / 2) stepping bit for bit, so both passes make
-    the same alpha tests). g_rgb [H, W, D], g_alpha [H, W], g_depth [H, W] are upstream gradients
-    (float64). Writes pair_grad [P, 7 + D] per (tile, Gaussian) pair: d/d(mx, my, conic a, b, c,
-    opacity, depth, colours). Front-to-back pass: the light behind Gaussian i (later Gaussians plus
-    background) is the total minus the prefix up to i, so no per-pixel list is stored and no
-    division by (1 - alpha) recovers transmittance."""
+    the same alpha tests).
+
+    Front-to-back pass: the light behind Gaussian i (later Gaussians plus background) is the total
+    minus the prefix up to i, so no per-pixel list is stored and no division by (1 - alpha)
+    recovers transmittance.
+
+    Args:
+        means2d (np.ndarray): [N, 2] as in the forward.
+        conics (np.ndarray): [N, 3] as in the forward.
+        opac (np.ndarray): [N] as in the forward.
+        colors (np.ndarray): [N, D] as in the forward.
+        depths (np.ndarray): [N] as in the forward.
+        bg (np.ndarray): [D] as in the forward.
+        boxes (np.ndarray): [N, 4] as in the forward.
+        tile_start (np.ndarray): [T + 1] as in the forward.
+        pair_gid (np.ndarray): [P] as in the forward.
+        row_start (np.ndarray): [P + 1] as in the forward.
+        tile (int): tile side, px.
+        tiles_x (int): tiles per image row.
+        width (int): image width W, px.
+        height (int): image height H, px.
+        acc_c (np.ndarray): [H, W, D] the forward's totals.
+        acc_d (np.ndarray): [H, W] the forward's totals.
+        t_final (np.ndarray): [H, W] the forward's final transmittance.
+        row_pix (np.ndarray): [R, 3] the forward's recorded rows.
+        row_gauss (np.ndarray): [R, 2] the forward's recorded rows.
+        n_rows (np.ndarray): [P] the forward's row counts.
+        g_rgb (np.ndarray): [H, W, D] upstream gradient, float64.
+        g_alpha (np.ndarray): [H, W] upstream gradient, float64.
+        g_depth (np.ndarray): [H, W] upstream gradient, float64.
+        pair_grad (np.ndarray): [P, 7 + D], written per (tile, Gaussian) pair: d/d(mx, my, conic
+            a, b, c, opacity, depth, colours).
+    """
     D = colors.shape[1]
     n_tiles = tile_start.shape[0] - 1
     for t in nb.prange(n_tiles):
@@ -465,7 +540,16 @@ def backward(
 
 @nb.njit(cache=True)
 def reduce_pairs(pair_gid, pair_grad, n):  # pragma: no cover - compiled
-    """Sum pair_grad [P, C] into per-Gaussian rows [n, C] in pair order (deterministic)."""
+    """Sum pair_grad [P, C] into per-Gaussian rows [n, C] in pair order (deterministic).
+
+    Args:
+        pair_gid (np.ndarray): [P] the Gaussian of each pair.
+        pair_grad (np.ndarray): [P, C] per-pair gradients.
+        n (int): the number of Gaussians.
+
+    Returns:
+        (np.ndarray): [n, C] float64 sums.
+    """
     out = np.zeros((n, pair_grad.shape[1]))
     for k in range(pair_gid.shape[0]):
         g = pair_gid[k]
@@ -510,10 +594,23 @@ def project_forward(
     """Fused EWA projection, same maths as
     [`project_gaussians`][physgs.render.project.project_gaussians].
 
-    means [N, 3], quats [N, 4] wxyz, scales [N, 3] world units; Rc [3, 3], tc [3] world->camera;
-    intr (fx, fy, cx, cy) px; lims (x-, x+, y-, y+) tangent clamps; near world units.
-    Writes means2d [N, 2] px, conics [N, 3], depths [N], cov2d [N, 3] px^2, valid [N];
-    culled Gaussians get zeros.
+    Culled Gaussians get zeros.
+
+    Args:
+        means (np.ndarray): [N, 3] centres, world units.
+        quats (np.ndarray): [N, 4] orientations (w, x, y, z).
+        scales (np.ndarray): [N, 3] standard deviations, world units.
+        Rc (np.ndarray): [3, 3] world-to-camera rotation.
+        tc (np.ndarray): [3] world-to-camera translation, world units.
+        intr (np.ndarray): [4] (fx, fy, cx, cy), px.
+        lims (np.ndarray): [4] (x-, x+, y-, y+) tangent clamps.
+        near (float): near-plane depth, world units.
+        eps2d (float): dilation added to the 2D covariance's diagonal, px^2.
+        means2d (np.ndarray): [N, 2] px, written.
+        conics (np.ndarray): [N, 3] px^-2, written.
+        depths (np.ndarray): [N] world units, written.
+        cov2d (np.ndarray): [N, 3] px^2, written.
+        valid (np.ndarray): [N] bool, written.
     """
     fx, fy, cx, cy = intr[0], intr[1], intr[2], intr[3]
     n = means.shape[0]
@@ -595,10 +692,28 @@ def project_backward(
     v_quats,
     v_scales,
 ):  # pragma: no cover
-    """Explicit backward of [`project_forward`][physgs.render.kernels.project_forward]: upstream
-    v_means2d [N, 2], v_conics [N, 3], v_depths [N] -> v_means [N, 3], v_quats [N, 4], v_scales [N,
-    3] (written; zero if culled). Each Gaussian is independent (no accumulation across
-    Gaussians)."""
+    """Explicit backward of [`project_forward`][physgs.render.kernels.project_forward].
+
+    Each Gaussian is independent (no accumulation across Gaussians).
+
+    Args:
+        means (np.ndarray): [N, 3] as in the forward.
+        quats (np.ndarray): [N, 4] as in the forward.
+        scales (np.ndarray): [N, 3] as in the forward.
+        Rc (np.ndarray): [3, 3] as in the forward.
+        tc (np.ndarray): [3] as in the forward.
+        intr (np.ndarray): [4] as in the forward.
+        lims (np.ndarray): [4] as in the forward.
+        near (float): as in the forward.
+        eps2d (float): as in the forward.
+        valid (np.ndarray): [N] the forward's culling.
+        v_means2d (np.ndarray): [N, 2] upstream gradient.
+        v_conics (np.ndarray): [N, 3] upstream gradient.
+        v_depths (np.ndarray): [N] upstream gradient.
+        v_means (np.ndarray): [N, 3], written (zero if culled).
+        v_quats (np.ndarray): [N, 4], written (zero if culled).
+        v_scales (np.ndarray): [N, 3], written (zero if culled).
+    """
     fx, fy = intr[0], intr[1]
     n = means.shape[0]
     # serial: ~150 ns per Gaussian, not worth threads (or their compile time)

@@ -47,7 +47,7 @@ class Projected:
 def quat_to_rotmat(quats: torch.Tensor) -> torch.Tensor:
     """Rotation matrices of quaternions, normalised here.
 
-    The package's one torch implementation (``physgs.models.gaussians`` re-exports it; the numba
+    The package's one torch implementation ([`physgs.models.gaussians`][] re-exports it; the numba
     kernels have a scalar twin, ``kernels._quat_rotmat``). A zero quaternion gives the identity.
 
     Args:

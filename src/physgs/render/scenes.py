@@ -18,8 +18,20 @@ def random_scene(
 
     Scales follow the mean nearest-neighbour spacing (0.6 x (4/3 pi / n)^(1/3), times a random
     0.5-1.5 anisotropy per axis), random rotations, opacities uniform in ``opacity_range``,
-    colours uniform in [0, 1]. Returns (means [n, 3], quats [n, 4], scales [n, 3],
-    opacities [n], colors [n, 3], camera, background [3]) as tensors of ``dtype``.
+    colours uniform in [0, 1].
+
+    Args:
+        n: number of Gaussians.
+        width: image width, px.
+        height: image height, px.
+        seed: the generator's seed.
+        dtype (torch.dtype): the tensors' dtype.
+        opacity_range (tuple[float, float]): ``(lo, hi)`` of the opacities.
+
+    Returns:
+        (tuple): ``(means [n, 3], quats [n, 4], scales [n, 3], opacities [n], colors [n, 3],
+            camera, background [3])``, tensors of ``dtype`` and a
+            [`Camera`][physgs.camera.Camera].
     """
     rng = np.random.default_rng(seed)
     d = rng.normal(size=(n, 3))
@@ -39,14 +51,21 @@ def random_scene(
 def tree_scene(dataset_dir, canonical_cfg: dict | None = None, dtype=torch.float32):
     """A testbed tree's canonical Gaussians at initialisation, seen from its training camera.
 
-    dataset_dir: a testbed folder holding ``observed.npz`` (results/testbed/<tree>); canonical_cfg:
-    ``models.canonical`` of the config (opacity, color, knn, scale_factor; the class defaults when
-    None). Built exactly as every model builds its canonical set
+    Built exactly as every model builds its canonical set
     ([`CanonicalGaussians`][physgs.models.gaussians.CanonicalGaussians] on
-    ``Observed.canonical_xyz``), so the scene is what the first training iteration renders. Returns
-    the tuple of [`random_scene`][physgs.render.scenes.random_scene]: (means [N, 3], quats [N, 4],
-    scales [N, 3], opacities [N], colors [N, 3], camera, background [3]) as tensors of ``dtype``,
-    the image the camera's size (pixels).
+    ``Observed.canonical_xyz``), so the scene is what the first training iteration renders.
+
+    Args:
+        dataset_dir (str | Path): a testbed folder holding ``observed.npz``
+            (results/testbed/<tree>).
+        canonical_cfg: ``models.canonical`` of the config (opacity, color, knn, scale_factor; the
+            class defaults when None).
+        dtype (torch.dtype): the tensors' dtype.
+
+    Returns:
+        (tuple): The tuple of [`random_scene`][physgs.render.scenes.random_scene]: ``(means
+            [N, 3], quats [N, 4], scales [N, 3], opacities [N], colors [N, 3], camera, background
+            [3])``, the image the camera's size (pixels).
     """
     from physgs.models.gaussians import CanonicalGaussians
     from physgs.testbed.dataset import load_observed

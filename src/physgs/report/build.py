@@ -1,13 +1,13 @@
 """Collect per-job result files into the tables and figures (what the report rules call).
 
-The library never knows where the workflow keeps its files. Each output (``physgs.report.outputs``)
-declares what it needs as *need tuples* (``needs``): ``("eval" | "traj" | "panels" | "loss", tree,
-model, config, seed)``, ``("recovery", tree, config, seed)``, ``("null", tree, K, seed)``,
-``("kselect", tree, seed)``, ``("stats", tree)``, ``("table", name)`` and the rest of
-``NEED_FIELDS``; seed is a training seed. The workflow maps each tuple to a path
-(``workflow/rules/common.smk``) and hands the builders a mapping ``key(need) -> path``; the
-builders read only those paths. ``settings_for`` gives the narrow settings an output reads, so
-editing one table's format rebuilds that table only.
+The library never knows where the workflow keeps its files. Each output
+([`physgs.report.outputs`][]) declares what it needs as *need tuples* (``needs``): ``("eval" |
+"traj" | "panels" | "loss", tree, model, config, seed)``, ``("recovery", tree, config, seed)``,
+``("null", tree, K, seed)``, ``("kselect", tree, seed)``, ``("stats", tree)``, ``("table", name)``
+and the rest of ``NEED_FIELDS``; seed is a training seed. The workflow maps each tuple to a path
+(``workflow/rules/common.smk``) and hands the builders a mapping ``key(need) -> path``; the builders
+read only those paths. ``settings_for`` gives the narrow settings an output reads, so editing one
+table's format rebuilds that table only.
 """
 
 from __future__ import annotations
@@ -42,7 +42,18 @@ def _output(name: str):
 
 def in_report(name: str, plan: Plan) -> bool:
     """Whether the ``report`` target builds output ``name`` in this plan (the rest: ``all``
-    builds tab_kselect, ``studies`` tab_parts_k; a study or control not run builds nothing)."""
+    builds tab_kselect, ``studies`` tab_parts_k; a study or control not run builds nothing).
+
+    Args:
+        name: an output's name.
+        plan: the run's plan.
+
+    Returns:
+        True when ``report`` builds it.
+
+    Raises:
+        ValueError: for an unknown output.
+    """
     return _output(name).in_report(plan)
 
 
@@ -54,11 +65,22 @@ def claims_needs(
     tracks: bool = False,
     damping: bool = False,
 ) -> list[tuple]:
-    """What the claims ledger reads: the tables' CSVs and every prior's recovery (damping) of
-    every seed in the joint K=32 configuration (the paper's), or the base configuration when the
-    config has none; with ``parts``, tab_parts too (the parts study's hypotheses); with ``tracks``,
-    tab_tracks (the 2D-track control's; its recovery rows are in tab_null); with ``damping``,
-    tab_damping (the damping benchmark's: the output-only analysis' zeta claims)."""
+    """What the claims ledger reads.
+
+    The tables' CSVs and every prior's recovery (damping) of every seed in the joint K=32
+    configuration (the paper's), or the base configuration when the config has none.
+
+    Args:
+        trees: the trees.
+        configs: ``models.configs``.
+        seeds: the training seeds.
+        parts: add tab_parts (the parts study's hypotheses).
+        tracks: add tab_tracks (the 2D-track control's; its recovery rows are in tab_null).
+        damping: add tab_damping (the damping benchmark's: the output-only analysis' zeta claims).
+
+    Returns:
+        Need tuples (module docstring).
+    """
     c = CLAIMS_CONFIG if CLAIMS_CONFIG in configs else BASE_CONFIG
     extra = [("table", "tab_parts")] if parts else []
     extra += [("table", "tab_tracks")] if tracks else []
@@ -77,9 +99,19 @@ def claims_needs(
 
 
 def claims_frame(inputs: Mapping[str, str], trees: Sequence[str]) -> pd.DataFrame:
-    """The claims ledger (``physgs.report.claims``) from the files in ``inputs`` (need key ->
-    path, ``claims_needs``). The rule gives every table; a table left out of ``inputs`` leaves
-    its claims "undecided: not measured" (a partial run's ledger, ``tools/ledger.py``)."""
+    """The claims ledger ([`physgs.report.claims`][physgs.report.claims]) from the files in
+    ``inputs``.
+
+    The rule gives every table; a table left out of ``inputs`` leaves its claims "undecided: not
+    measured" (a partial run's ledger, ``tools/ledger.py``).
+
+    Args:
+        inputs: need key -> path ([`claims_needs`][physgs.report.build.claims_needs]).
+        trees: the trees.
+
+    Returns:
+        The ledger, one row per claim.
+    """
     from physgs.report import claims
 
     names = (*CLAIMS_TABLES, "tab_parts", "tab_tracks", "tab_damping")
@@ -103,8 +135,19 @@ def claims_frame(inputs: Mapping[str, str], trees: Sequence[str]) -> pd.DataFram
 
 
 def make_claims(inputs: Mapping[str, str], trees: Sequence[str], md_path, csv_path, stamp=None):
-    """Build the claims ledger from the files in ``inputs`` (``claims_frame``) and write
-    results/claims.md and .csv; returns the ledger."""
+    """Build the claims ledger from the files in ``inputs``
+    ([`claims_frame`][physgs.report.build.claims_frame]) and write results/claims.md and .csv.
+
+    Args:
+        inputs: need key -> path.
+        trees: the trees.
+        md_path (str | Path): the Markdown ledger to write.
+        csv_path (str | Path): the CSV ledger to write.
+        stamp (Stamp | None): written into every CSV row and the Markdown.
+
+    Returns:
+        (pd.DataFrame): The ledger (without the stamp's columns).
+    """
     from physgs.atomic import atomic_path, write_text
     from physgs.report import claims
 
@@ -131,6 +174,16 @@ def needs(name: str, plan: Plan) -> list[tuple]:
 
     The outputs that show one training seed (a figure of images, trajectories or a scatter)
     read the first seed only; tab_parts_k reads the studies' seeds; tab_testbed none.
+
+    Args:
+        name: an output's name.
+        plan: the run's plan.
+
+    Returns:
+        The need tuples.
+
+    Raises:
+        ValueError: for an unknown output, or a plan without seeds for an output that reads them.
     """
     o = _output(name)
     if o.seeds in ("all", "first") and not plan.seeds:
@@ -139,9 +192,21 @@ def needs(name: str, plan: Plan) -> list[tuple]:
 
 
 def settings_for(name: str, cfg: dict) -> dict:
-    """The settings output ``name`` reads from the resolved config (and nothing more): its
-    trees with their bones, its training seeds, a table's digits, and its own
-    (``Output.settings``)."""
+    """The settings output ``name`` reads from the resolved config (and nothing more).
+
+    Its trees with their bones, its training seeds, a table's digits, and its own
+    (``Output.settings``).
+
+    Args:
+        name: an output's name.
+        cfg: the resolved config.
+
+    Returns:
+        The settings (the rule's params).
+
+    Raises:
+        ValueError: for an unknown output.
+    """
     from physgs.config import study_seeds
 
     o = _output(name)
@@ -160,9 +225,23 @@ def settings_for(name: str, cfg: dict) -> dict:
 def make_table(
     name: str, inputs: Mapping[str, str], settings: dict, tex_path, csv_path, stamp=None
 ) -> Table:
-    """Build table ``name`` from the files in ``inputs`` (need key -> path) and write its .tex
-    and .csv. settings: ``settings_for(name, cfg)``; stamp: a ``physgs.provenance.Stamp``
-    written into every CSV row (profile, config hash, package version)."""
+    """Build table ``name`` from the files in ``inputs`` and write its .tex and .csv.
+
+    Args:
+        name: a table's name.
+        inputs: need key -> path.
+        settings: [`settings_for`][physgs.report.build.settings_for] of the table.
+        tex_path (str | Path): the .tex to write.
+        csv_path (str | Path): the .csv to write.
+        stamp (Stamp | None): a [`Stamp`][physgs.provenance.Stamp] written into every CSV row
+            (profile, config hash, package version).
+
+    Returns:
+        The [`Table`][physgs.report.tables.Table].
+
+    Raises:
+        ValueError: for a name that is not a table.
+    """
     from physgs.report import tables
 
     o = _output(name)
@@ -178,8 +257,17 @@ def make_table(
 def make_figure(
     name: str, inputs: Mapping[str, str], settings: dict, outputs: Sequence[str]
 ) -> None:
-    """Build figure ``name`` from the files in ``inputs`` (need key -> path), written to every
-    path in ``outputs``. settings: ``settings_for(name, cfg)``."""
+    """Build figure ``name`` from the files in ``inputs``, written to every path in ``outputs``.
+
+    Args:
+        name: a figure's name.
+        inputs: need key -> path.
+        settings: [`settings_for`][physgs.report.build.settings_for] of the figure.
+        outputs: the paths to write.
+
+    Raises:
+        ValueError: for a name that is not a figure.
+    """
     o = _output(name)
     if o.kind != "figure":
         raise ValueError(f"unknown figure '{name}'; choose one of {FIGURES}")

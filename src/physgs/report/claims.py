@@ -92,7 +92,16 @@ class Claim:
 
 
 def verdict(claim: Claim, values: Sequence[float]) -> str:
-    """'holds', 'fails', 'undecided' or 'undecided: one seed' (see the module docstring)."""
+    """'holds', 'fails', 'undecided' or 'undecided: one seed' (see the module docstring).
+
+    Args:
+        claim: the claim (threshold, side, whether it needs seed variance).
+        values: its per-seed values (NaN: not measured for that seed).
+
+    Returns:
+        The verdict; ``'undecided: not measured'`` without a finite value, and the one-seed
+            verdict says on which side the point estimate lies.
+    """
     m, _, lo, hi = interval(values)
     if not np.isfinite(m):
         return "undecided: not measured"
@@ -141,10 +150,7 @@ def measure(
     trees: Sequence[str],
     prior_damping: Mapping[str, Mapping[str, Sequence[Mapping[str, float]]]] | None = None,
 ) -> list[tuple[Claim, list[float]]]:
-    """Every claim with its per-seed values, from the tables' CSVs (tab_psnr, tab_transfer,
-    tab_margin, tab_null, tab_testbed and, when given, tab_fit, tab_parts and tab_tracks) and
-    ours' damping summaries (tree -> median_zeta, loglog_exponent, zeta_true, for the joint K=32
-    configuration).
+    """Every claim with its per-seed values, from the tables' CSVs and ours' damping summaries.
 
     A partial run gives a partial ledger: a claim whose table is not in ``tables`` is listed with
     no values (verdict "undecided: not measured"), except the per-wind rows of tab_transfer,
@@ -152,8 +158,19 @@ def measure(
     when their tables are given). A damping claim is listed for each tree in ``damping``.
 
     The headline claims are then asked again of every other prior of the registry (role
-    "prior", ``physgs.report.claims_priors``), with its damping from ``prior_damping`` (model
-    -> tree -> per-seed summaries, as ``damping``)."""
+    "prior", [`physgs.report.claims_priors`][physgs.report.claims_priors]).
+
+    Args:
+        tables: table name -> its CSV (tab_psnr, tab_transfer, tab_margin, tab_null, tab_testbed
+            and, when given, tab_fit, tab_parts and tab_tracks).
+        damping: tree -> ours' damping summary (median_zeta, loglog_exponent, zeta_true), for the
+            joint K=32 configuration.
+        trees: the trees.
+        prior_damping: model -> tree -> per-seed summaries, as ``damping``, of the other priors.
+
+    Returns:
+        ``(claim, per-seed values)`` pairs, in the ledger's order.
+    """
     from physgs.models.registry import label, models_of
     from physgs.report.claims_priors import prior_claims
 
@@ -422,7 +439,7 @@ PRIOR_TABLES = ("tab_psnr", "tab_transfer", "tab_margin", "tab_null")
 
 
 def _holds(tables: Mapping[str, pd.DataFrame], model: str, name: str) -> bool:
-    """Whether any of :data:`PRIOR_TABLES` has a row or column of ``model`` (its id, or its
+    """Whether any of ``PRIOR_TABLES`` has a row or column of ``model`` (its id, or its
     label in tab_psnr)."""
     for df in (tables[k] for k in PRIOR_TABLES if k in tables):
         if model in df.columns:
@@ -695,7 +712,14 @@ def _blind_claims(
 
 def ledger(measured: Sequence[tuple[Claim, list[float]]]) -> pd.DataFrame:
     """One row per claim: the claim, the paper's figure, the measured mean, sd, 95% interval and
-    number of seeds, the threshold and side, the verdict and where it comes from."""
+    number of seeds, the threshold and side, the verdict and where it comes from.
+
+    Args:
+        measured: [`measure`][physgs.report.claims.measure]'s pairs.
+
+    Returns:
+        The ledger, one row per claim.
+    """
     rows = []
     for c, values in measured:
         m, sd, lo, hi = interval(values)
@@ -719,7 +743,15 @@ def ledger(measured: Sequence[tuple[Claim, list[float]]]) -> pd.DataFrame:
 
 
 def ledger_markdown(df: pd.DataFrame, stamp: Mapping[str, str] | None = None) -> str:
-    """The ledger as a Markdown page (results/claims.md)."""
+    """The ledger as a Markdown page (results/claims.md).
+
+    Args:
+        df: the [`ledger`][physgs.report.claims.ledger].
+        stamp: the run's stamp fields, printed under the title; None: none.
+
+    Returns:
+        The page's Markdown, ending in a newline.
+    """
     counts = df["verdict"].str.split(":").str[0].value_counts().to_dict()
     lines = [
         "# Claims ledger",

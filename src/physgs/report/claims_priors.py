@@ -1,7 +1,7 @@
 """The ledger's headline claims repeated for a prior other than the paper's: the
 chained prior, or any model of role "prior" the registry adds.
 
-The paper's claims about ours (``physgs.report.claims.measure``) decide its story; each is asked
+The paper's claims about ours ([`physgs.report.claims.measure`][]) decide its story; each is asked
 again of the other prior, on the same tables and thresholds, with ids ``<model>/<claim>/...``:
 above the static pose beyond the window; ahead of the best learned field on every split
 (views, beyond the window, and each unseen wind at training timestamps and beyond); its margin
@@ -53,10 +53,18 @@ def prior_claims(
 ) -> list[tuple[Claim, list[float]]]:
     """The headline claims for ``model`` with their per-seed values.
 
-    tables: the tables' CSVs (tab_psnr, tab_transfer, tab_margin, tab_null; a table not given
-    leaves its claims unmeasured); damping: tree -> per-seed {median_zeta, zeta_true,
-    loglog_exponent} of ``model``'s recovery in ``config`` (trees without it are skipped);
-    config: the configuration of the recovery claims (the ledger's)."""
+    Args:
+        model: a prior's id.
+        tables: the tables' CSVs (tab_psnr, tab_transfer, tab_margin, tab_null; a table not given
+            leaves its claims unmeasured).
+        damping: tree -> per-seed {median_zeta, zeta_true, loglog_exponent} of ``model``'s
+            recovery in ``config`` (trees without it are skipped).
+        trees: the trees.
+        config: the configuration of the recovery claims (the ledger's).
+
+    Returns:
+        ``(claim, per-seed values)`` pairs, ids prefixed by the model's.
+    """
     name = label(model)
     out: list[tuple[Claim, list[float]]] = []
 

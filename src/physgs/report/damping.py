@@ -8,7 +8,7 @@ exponent p of the fitted decay rate gamma_hat = zeta_hat omega_hat ~ omega_hat^p
 diagnosis is p near 0: a frequency-independent rate fitted in place of a ratio; a recovered
 ratio gives the truth's p, 1 for a constant zeta), each beside the untrained null (zeta drawn
 log-uniformly from the damping range, scored on the same matching; medians over its draws).
-Built from the recovery records (``physgs.recovery.record``, ``damping_scores``/``damping_null``).
+Built from the recovery records ([`physgs.recovery.record`][], ``damping_scores``/``damping_null``).
 """
 
 from __future__ import annotations
@@ -61,21 +61,36 @@ def tab_damping(
     priors: Mapping[str, Mapping[int, Mapping[tuple[str, str, str], object]]] | None = None,
     methods: Mapping[str, MethodRows] | None = None,
 ) -> Table:
-    """``per_seed[seed][(tree, variant, config)]``: ``RecoveryRecord`` with damping scores and null;
-    variant 'faithful' or 'damping'; configs: name -> LaTeX label, in row order. One CSV row per
-    seed, tree, variant and configuration; the .tex gives mean +- sd over seeds and the paired
-    trained - null difference with its 95% interval.
+    """Damping recovery per seed, tree, variant and configuration, beside the null.
 
-    tracks: the 2D-track control's records the same way (``physgs.tracks``, with damping scores),
-    for the configurations of ``tracks_configs`` (name -> LaTeX label); they follow ours' rows of
-    each testbed, column ``method`` 'tracks' (ours' rows: 'ours').
+    One CSV row per seed, tree, variant and configuration; the .tex gives mean +- sd over seeds
+    and the paired trained - null difference with its 95% interval.
 
-    priors: the other oscillator priors' records, ``priors[model][seed][(tree, variant,
-    config)]``, in every configuration of ``configs``; their rows follow ours' of each testbed,
-    column ``method`` the model id.
+    Args:
+        per_seed: ``per_seed[seed][(tree, variant, config)]``: ``RecoveryRecord`` with damping
+            scores and null; variant 'faithful' or 'damping'.
+        trees: the trees.
+        bones: tree -> its bone count.
+        configs: name -> LaTeX label, in row order.
+        digits: decimals shown in the .tex.
+        tracks: the 2D-track control's records the same way ([`physgs.tracks`][physgs.tracks],
+            with damping scores), for the configurations of ``tracks_configs``; they follow ours'
+            rows of each testbed, column ``method`` 'tracks' (ours' rows: 'ours').
+        tracks_configs: name -> LaTeX label of the tracks control's configurations.
+        priors: the other oscillator priors' records, ``priors[model][seed][(tree, variant,
+            config)]``, in every configuration of ``configs``; their rows follow ours' of each
+            testbed, column ``method`` the model id.
+        methods: further methods' rows (method id ->
+            [`MethodRows`][physgs.report.tables.MethodRows] of records per ``(tree, variant,
+            config)``), each in its own configurations, after the tracks control's.
 
-    methods: further methods' rows (method id -> ``MethodRows`` of records per ``(tree,
-    variant, config)``), each in its own configurations, after the tracks control's."""
+    Returns:
+        The [`Table`][physgs.report.tables.Table].
+
+    Raises:
+        ValueError: when a record has no damping scores.
+        KeyError: when a seed lacks a record.
+    """
     seeds = _seeds(per_seed, "tab_damping")
     tracks_configs = dict(tracks_configs or {})
     priors = dict(priors or {})

@@ -40,7 +40,16 @@ WINDOW, TAIL = "0.6", "tab:blue"
 
 
 def save_figure(fig, outputs: Sequence[str | Path], dpi: int = 200) -> None:
-    """Save ``fig`` to every path in ``outputs`` (format from the suffix), atomically; closes it."""
+    """Save ``fig`` to every path in ``outputs`` (format from the suffix), atomically; closes it.
+
+    Args:
+        fig (matplotlib.figure.Figure): the figure (closed afterwards, also on error).
+        outputs: the paths, each ``.pdf`` or ``.png``.
+        dpi: resolution of a PNG, dots per inch.
+
+    Raises:
+        ValueError: for another suffix.
+    """
     try:
         for out in outputs:
             suffix = Path(out).suffix.lstrip(".")
@@ -57,7 +66,20 @@ def best_baseline(
     key: str = "time",
     exclude: Sequence[str] = ("static", "ours"),
 ) -> str:
-    """The learned baseline with the highest ``summary[key]`` (dB) among summaries[model]."""
+    """The learned baseline with the highest ``summary[key]`` (dB) among summaries[model].
+
+    Args:
+        summaries: model -> its split means
+            ([`EvalResult.summary`][physgs.evaluate.splits.EvalResult.summary]).
+        key: the split compared.
+        exclude: models that are not candidates.
+
+    Returns:
+        The model id.
+
+    Raises:
+        ValueError: when no candidate is left.
+    """
     cands = {m: s[key] for m, s in summaries.items() if m not in exclude}
     if not cands:
         raise ValueError("best_baseline: no baseline among the given models")
@@ -65,7 +87,15 @@ def best_baseline(
 
 
 def representative_frame(psnr_ours: np.ndarray, psnr_base: np.ndarray) -> int:
-    """Index of the frame whose ours-minus-baseline PSNR gap is closest to the split's mean gap."""
+    """Index of the frame whose ours-minus-baseline PSNR gap is closest to the split's mean gap.
+
+    Args:
+        psnr_ours: [F] ours' per-frame PSNR, dB.
+        psnr_base: [F] the baseline's, dB.
+
+    Returns:
+        The frame's index into the arrays.
+    """
     gap = np.asarray(psnr_ours, float) - np.asarray(psnr_base, float)
     return int(np.argmin(np.abs(gap - gap.mean())))
 
@@ -80,11 +110,20 @@ def fig_temporal(
 ) -> None:
     """Per-frame PSNR (dB) at the training camera and wind, one panel per tree.
 
-    curves[(tree, model)]: [S, F] PSNR over recorded frames 1..F, one row per training seed
-    (or [F] for one seed); the mean over seeds is drawn, with a band from the lowest to the
-    highest seed when there are several. The window boundary (after frame n_train) is marked
-    and the tail shaded. A reference present in ``curves`` (the true-motion ceiling) is drawn as
-    a thin black dotted line.
+    The mean over seeds is drawn, with a band from the lowest to the highest seed when there are
+    several. The window boundary (after frame n_train) is marked and the tail shaded. A reference
+    present in ``curves`` (the true-motion ceiling) is drawn as a thin black dotted line.
+
+    Args:
+        curves: ``curves[(tree, model)]``: [S, F] PSNR (dB) over recorded frames 1..F, one row per
+            training seed (or [F] for one seed).
+        trees: the trees, one panel each.
+        n_train: training-window length, frames.
+        outputs: the paths to write.
+        models: the models drawn.
+
+    Raises:
+        KeyError: when a (tree, model) has no curve.
     """
     fig, axes = plt.subplots(
         1, len(trees), figsize=(4.2 * len(trees), 3.2), squeeze=False, sharey=False
@@ -139,10 +178,16 @@ def fig_teaser(
 ) -> None:
     """Branch-tip paths through the window (grey) and tail (blue), and canopy-centroid error.
 
-    trajectories[model]: ``Trajectories`` at the training wind (e.g. ours and the best
-    baseline; the ground truth is taken from the first). centroid_err[model]: [C, F] pixels.
-    tip: which tip to draw (default: the one the ground truth moves most). unseen: index of
-    the unseen condition shown in the last panel.
+    Args:
+        trajectories: ``trajectories[model]``:
+            [`Trajectories`][physgs.evaluate.trajectories.Trajectories] at the training wind (e.g.
+            ours and the best baseline; the ground truth is taken from the first).
+        centroid_err: ``centroid_err[model]``: [C, F] canopy-centroid error, px.
+        conditions: the mean-speed multipliers of the C conditions.
+        outputs: the paths to write.
+        tip: which tip to draw (default: the one the ground truth moves most).
+        unseen: index of the unseen condition shown in the last panel.
+        title: the figure's title.
     """
     models = list(trajectories)
     first = trajectories[models[0]]
@@ -211,9 +256,19 @@ def fig_results(
 ) -> None:
     """Qualitative grid: one row per (tree, split) label, one column per model (or 'gt').
 
-    images[(row, column)] = (rgb [H, W, 3] in [0, 1] or uint8, PSNR in dB or None for the
-    ground truth). PSNR is printed on each panel, green on ours where it is best in its row
-    and orange on a baseline that beats ours.
+    PSNR is printed on each panel, green on ours where it is best in its row and orange on a
+    baseline that beats ours.
+
+    Args:
+        rows: the row labels.
+        columns: the column labels (model ids or ``'gt'``).
+        images: ``images[(row, column)]`` = (rgb [H, W, 3] in [0, 1] or uint8, PSNR in dB or None
+            for the ground truth).
+        outputs: the paths to write.
+        ours: ours' column.
+
+    Raises:
+        KeyError: when a panel has no image.
     """
     fig, axes = plt.subplots(
         len(rows), len(columns), figsize=(1.7 * len(columns), 1.8 * len(rows)), squeeze=False
@@ -350,10 +405,16 @@ def fig_speed_accuracy(
 ) -> None:
     """Two panels against wall time (s): PSNR on the time split (dB) and recovery error (%).
 
-    df: ``experiments.sweep.collect`` (one row per seed, knob and value). One line per knob
-    through its values (labelled, mean over seeds; error bars: sd over seeds on both axes), the
-    base point starred. null: ``sweep.null_level``; the untrained null's median and the central
-    95% of its draws are drawn on the recovery panel, so a point inside the band reads as chance.
+    One line per knob through its values (labelled, mean over seeds; error bars: sd over seeds on
+    both axes), the base point starred.
+
+    Args:
+        df: [`sweep.collect`][physgs.experiments.sweep.collect] (one row per seed, knob and
+            value).
+        outputs: the paths to write.
+        null: [`null_level`][physgs.experiments.sweep.null_level]; the untrained null's median and
+            the central 95% of its draws are drawn on the recovery panel, so a point inside the
+            band reads as chance.
     """
     n_seeds = df["seed"].nunique()
     m = _seed_mean(
@@ -422,14 +483,19 @@ def fig_speed_accuracy(
 
 
 def fig_fit_curve(df: pd.DataFrame, outputs: Sequence[str | Path]) -> None:
-    """The fit curve (``physgs.experiments.fit_curve``): three panels, one line per model.
+    """The fit curve ([`physgs.experiments.fit_curve`][physgs.experiments.fit_curve]): three panels,
+    one line per model.
 
     In-window fit PSNR (dB, trained frames) and time-split PSNR (dB, the tail) against training
-    iterations, and the fit against training wall time (s). df: ``experiments.fit_curve.collect``
-    (one row per seed, model and budget): points are means over seeds, error bars the sd. The
-    static pose and the true-motion ceiling at the profile's budget are horizontal lines; the
-    profile's budget is starred. A ``<field>@window`` series (the field with Deformable-3DGS's
-    window-normalised time) is drawn as open diamonds in its field's colour.
+    iterations, and the fit against training wall time (s). Points are means over seeds, error
+    bars the sd. The static pose and the true-motion ceiling at the profile's budget are
+    horizontal lines; the profile's budget is starred. A ``<field>@window`` series (the field with
+    Deformable-3DGS's window-normalised time) is drawn as open diamonds in its field's colour.
+
+    Args:
+        df: [`fit_curve.collect`][physgs.experiments.fit_curve.collect] (one row per seed, model
+            and budget).
+        outputs: the paths to write.
     """
     panels = (
         ("iterations", "fit", "training iterations (log)", "PSNR, trained frames (dB)"),

@@ -24,9 +24,22 @@ def tab_kselect(
     method: str,
     digits: int = 2,
 ) -> Table:
-    """``per_seed[seed][(tree, config)]``: K, time_psnr (dB), median_rel_err (fraction), trusted,
-    frozen, k_heldout, k_bic. One LaTeX row per tree and configuration: K as chosen by each seed
-    (slash-separated when the seeds disagree), the rest mean +- sd over seeds."""
+    """The K selection per tree and configuration.
+
+    One LaTeX row per tree and configuration: K as chosen by each seed (slash-separated when the
+    seeds disagree), the rest mean +- sd over seeds.
+
+    Args:
+        per_seed: ``per_seed[seed][(tree, config)]``: K, time_psnr (dB), median_rel_err
+            (fraction), trusted, frozen, k_heldout, k_bic.
+        trees: the trees.
+        bones: tree -> its bone count.
+        method: the selection method used (``models.kselect.method``).
+        digits: decimals shown in the .tex.
+
+    Returns:
+        The [`Table`][physgs.report.tables.Table].
+    """
     seeds = _seeds(per_seed, "tab_kselect")
     recs = []
     for s in seeds:

@@ -47,10 +47,26 @@ def row(
     damping_recovery=None,
     purity: float = float("nan"),
 ) -> dict[str, float]:
-    """One tab_parts row. fit: ``physgs.report.build.fit_row`` of the model (dB, seconds);
-    static_fit, ceiling_fit: the same seed's static pose and true-motion fit (dB); recovery: the
-    model's ``RecoveryRecord`` on the faithful testbed, null: the ``NullResult`` of its K;
-    damping_recovery: its record on the damping testbed (with damping scores), or None."""
+    """One tab_parts row.
+
+    Args:
+        fit: [`fit_row`][physgs.report.build.fit_row] of the model (dB, seconds).
+        static_fit: the same seed's static pose's fit, dB.
+        ceiling_fit: the same seed's true-motion fit, dB.
+        recovery (RecoveryRecord): the model's record on the faithful testbed.
+        null (NullResult): the null of its K.
+        damping_recovery (RecoveryRecord | None): its record on the damping testbed (with damping
+            scores), or None.
+        purity: the segmentation's overall purity (fraction).
+
+    Returns:
+        The row: purity, fit, ceiling fraction, view and time PSNR (dB), trusted parts, omega and
+            zeta errors against their nulls (%; zeta NaN without ``damping_recovery``), training
+            seconds.
+
+    Raises:
+        ValueError: when ``damping_recovery`` has no damping scores.
+    """
     from physgs.evaluate.metrics import ceiling_fraction
 
     out = {
@@ -86,10 +102,24 @@ def tab_parts(
     configs: Mapping[str, str],
     digits: int = 2,
 ) -> Table:
-    """``per_seed[seed][(tree, model, config)]``: a ``row``; models: ids in row order (``ours``
-    first); configs: name -> LaTeX label. One CSV row per seed, tree, model and configuration;
-    the .tex gives mean +- sd over seeds and, per variant, the paired difference of its fit
-    fraction from ours' (percentage points, 95% interval)."""
+    """The parts study per tree, model and configuration.
+
+    One CSV row per seed, tree, model and configuration; the .tex gives mean +- sd over seeds and,
+    per variant, the paired difference of its fit fraction from ours' (percentage points, 95%
+    interval).
+
+    Args:
+        per_seed: ``per_seed[seed][(tree, model, config)]``: a
+            [`row`][physgs.report.parts.row].
+        trees: the trees.
+        bones: tree -> its bone count.
+        models: ids in row order (``ours`` first).
+        configs: name -> LaTeX label.
+        digits: decimals shown in the .tex.
+
+    Returns:
+        The [`Table`][physgs.report.tables.Table].
+    """
     seeds = _seeds(per_seed, "tab_parts")
     keys = [(t, m, c) for t in trees for c in configs for m in models]
     recs = []
@@ -195,11 +225,19 @@ def fig_parts(
     outputs: Sequence[str],
     title: str = "",
 ) -> None:
-    """One row per tree, one panel per model of its parts record (``physgs.evaluate.parts``):
-    the canonical Gaussians seen from the side (x right, z up, world units), coloured by part,
-    each part's pivot as a black dot and, for parts with a parent, a line from its pivot to the
-    parent's; the panel title gives the segmentation's purity. Written to every path of
-    ``outputs`` (pdf, png)."""
+    """One row per tree, one panel per model of its parts record.
+
+    The canonical Gaussians seen from the side (x right, z up, world units), coloured by part, each
+    part's pivot as a black dot and, for parts with a parent, a line from its pivot to the
+    parent's; the panel title gives the segmentation's purity.
+
+    Args:
+        records: tree -> its parts record
+            ([`segmentation_record`][physgs.evaluate.parts.segmentation_record]).
+        trees: the trees, one row each.
+        outputs: the paths to write (pdf, png).
+        title: the figure's title.
+    """
     import matplotlib
 
     matplotlib.use("Agg")
@@ -248,12 +286,25 @@ def tab_parts_k(
     tie_db: float,
     digits: int = 2,
 ) -> Table:
-    """The smallest K at which the chained prior matches ours (``physgs.experiments.kmatch``).
+    """The smallest K at which the chained prior matches ours
+    ([`physgs.experiments.kmatch`][physgs.experiments.kmatch]).
 
-    ``per_seed[seed][tree]``: {"ours": held-out dB of ours at ``base_k``, "chain": {K: held-out
-    dB of the chained prior}} (``base_k`` among the chain's K). One CSV row per seed, tree and
-    (model, K), with that seed's matched K (NaN where none matches) on every row of the tree; the
-    .tex gives mean +- sd over seeds and the matched K of each seed."""
+    One CSV row per seed, tree and (model, K), with that seed's matched K (NaN where none
+    matches) on every row of the tree; the .tex gives mean +- sd over seeds and the matched K of
+    each seed.
+
+    Args:
+        per_seed: ``per_seed[seed][tree]``: {"ours": held-out dB of ours at ``base_k``, "chain":
+            {K: held-out dB of the chained prior}} (``base_k`` among the chain's K).
+        trees: the trees.
+        bones: tree -> its bone count.
+        base_k: ours' K.
+        tie_db: the tolerance of a match, dB.
+        digits: decimals shown in the .tex.
+
+    Returns:
+        The [`Table`][physgs.report.tables.Table].
+    """
     from physgs.experiments.kmatch import matched_k
 
     seeds = _seeds(per_seed, "tab_parts_k")

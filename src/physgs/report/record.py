@@ -5,7 +5,8 @@ profile, config hash, seeds, the machine's CPU, wall time and job-minutes by sta
 ``summary.md``, the claims ledger, every table as CSV and as a Markdown table, and the figures as
 PNG sized for the web. The Results page includes the record's files (never a copy of their
 numbers), and the README's "what it found" and "what it costs" lines are printed from the record
-by :func:`readme_block`, so neither can disagree with the run they describe.
+by [`readme_block`][physgs.report.record.readme_block], so neither can disagree with the run they
+describe.
 
 What each command costs is measured by ``tools/timed.py`` (one row per command in
 ``costs.csv``, the command's last measured wall time on this machine's CPU).
@@ -76,7 +77,12 @@ class Stamp:
     job_min_by_stage: dict[str, float] = field(default_factory=dict)
 
     def markdown(self) -> str:
-        """The stamp as a short Markdown list."""
+        """The stamp as a short Markdown list.
+
+        Returns:
+            Four bullet lines (run, commit and date, machine, wall time and job-minutes by stage)
+                and a blank line.
+        """
         stages = ", ".join(f"{k} {v:.1f}" for k, v in self.job_min_by_stage.items())
         total = sum(self.job_min_by_stage.values())
         return "\n".join(
@@ -93,7 +99,14 @@ class Stamp:
 
 
 def format_duration(seconds: float) -> str:
-    """``3 h 8 min``, ``29 min 9 s`` or ``42 s``; ``--`` for a missing value."""
+    """``3 h 8 min``, ``29 min 9 s`` or ``42 s``; ``--`` for a missing value.
+
+    Args:
+        seconds: a duration, s (NaN or inf: missing).
+
+    Returns:
+        The duration in words, rounded to the second.
+    """
     if not math.isfinite(seconds):
         return "--"
     s = round(seconds)
@@ -115,7 +128,14 @@ def _cell(x) -> str:
 
 
 def markdown_table(df: pd.DataFrame) -> str:
-    """A DataFrame as a Markdown table; floats to 4 significant digits, NaN as ``--``."""
+    """A DataFrame as a Markdown table; floats to 4 significant digits, NaN as ``--``.
+
+    Args:
+        df: the table (its index is dropped).
+
+    Returns:
+        The table's lines, ending in a newline.
+    """
     lines = ["| " + " | ".join(map(str, df.columns)) + " |", "|" + "---|" * len(df.columns)]
     for row in df.itertuples(index=False):
         lines.append("| " + " | ".join(_cell(x) for x in row) + " |")
@@ -124,7 +144,14 @@ def markdown_table(df: pd.DataFrame) -> str:
 
 def demote(markdown: str) -> str:
     """Every Markdown heading one level down (``# x`` -> ``## x``), so that an included page sits
-    under the including page's title."""
+    under the including page's title.
+
+    Args:
+        markdown: the page's text.
+
+    Returns:
+        The text, headings one ``#`` deeper.
+    """
     return "\n".join(
         "#" + ln if ln.startswith("#") and ln.lstrip("#").startswith(" ") else ln
         for ln in markdown.split("\n")
@@ -132,7 +159,7 @@ def demote(markdown: str) -> str:
 
 
 def _png_for_web(src: Path, dst: Path) -> None:
-    """Copy a PNG, downscaled to :data:`FIGURE_WIDTH_PX` wide if wider."""
+    """Copy a PNG, downscaled to ``FIGURE_WIDTH_PX`` wide if wider."""
     from PIL import Image
 
     with Image.open(src) as im:
@@ -256,7 +283,14 @@ def write_record(
 
 
 def write_unrecorded(out_dir: str | Path) -> Path:
-    """``index.md`` of a record folder that holds no run yet, saying how to make one."""
+    """``index.md`` of a record folder that holds no run yet, saying how to make one.
+
+    Args:
+        out_dir: the record folder (made if missing).
+
+    Returns:
+        The path of the ``index.md`` written.
+    """
     out = Path(out_dir)
     out.mkdir(parents=True, exist_ok=True)
     (out / "index.md").write_text(
@@ -267,11 +301,14 @@ def write_unrecorded(out_dir: str | Path) -> Path:
 
 
 def headline_lines(claims: pd.DataFrame) -> list[str]:
-    """What the run found, in a few lines: the ledger's counts, then each :data:`HEADLINE`
+    """What the run found, in a few lines: the ledger's counts, then each ``HEADLINE``
     family's verdict per cell with its measured value and 95% interval.
 
     Args:
         claims: the ledger (``claims.csv``: id, measured, ci_low, ci_high, unit, verdict).
+
+    Returns:
+        The Markdown lines.
     """
     kind = claims["verdict"].astype(str).str.split(":").str[0]
     counts = kind.value_counts()
@@ -299,8 +336,15 @@ def headline_lines(claims: pd.DataFrame) -> list[str]:
 
 
 def cost_lines(costs: pd.DataFrame) -> list[str]:
-    """What each of :data:`COMMANDS` costs on 2 cores, from ``costs.csv``; ``not measured``
-    where the record has no row for it."""
+    """What each of ``COMMANDS`` costs on 2 cores, from ``costs.csv``; ``not measured``
+    where the record has no row for it.
+
+    Args:
+        costs: ``costs.csv`` as [`read_costs`][physgs.report.record.read_costs] reads it.
+
+    Returns:
+        The lines of a Markdown table: command, wall time on 2 cores, when and where measured.
+    """
     lines = ["| command | wall time on 2 cores | measured on |", "|---|---|---|"]
     by_name = {r["name"]: r for _, r in costs.iterrows()} if len(costs) else {}
     for name, command in COMMANDS:
@@ -322,7 +366,14 @@ def cost_lines(costs: pd.DataFrame) -> list[str]:
 
 
 def read_costs(path: str | Path) -> pd.DataFrame:
-    """``costs.csv`` of a record, or an empty frame with its columns where there is none."""
+    """``costs.csv`` of a record, or an empty frame with its columns where there is none.
+
+    Args:
+        path: the ``costs.csv``.
+
+    Returns:
+        Its rows (``COSTS_COLUMNS``), text columns read as text.
+    """
     p = Path(path)
     if not p.is_file():
         return pd.DataFrame(columns=list(COSTS_COLUMNS))
@@ -334,16 +385,29 @@ def read_costs(path: str | Path) -> pd.DataFrame:
 
 
 def readme_block(found: Sequence[str]) -> str:
-    """The README's "what it found" and "what it costs" block around :func:`found_lines`.
+    """The README's "what it found" and "what it costs" block around
+    [`found_lines`][physgs.report.record.found_lines].
 
     Args:
-        found (Sequence[str]): the lines of :func:`found_lines` of the record.
+        found (Sequence[str]): the lines of [`found_lines`][physgs.report.record.found_lines]
+            of the record.
+
+    Returns:
+        The block between the ``BEGIN`` and ``END`` markers.
     """
     return "\n".join([BEGIN, "", *found, END])
 
 
 def found_lines(record_dir: str | Path) -> list[str]:
-    """The lines of :func:`readme_block` without its markers: what the home page includes."""
+    """The lines of [`readme_block`][physgs.report.record.readme_block] without its markers: what
+    the home page includes.
+
+    Args:
+        record_dir: the record folder (``claims.csv``, ``stamp.json``, ``costs.csv``).
+
+    Returns:
+        The Markdown lines, ending in a blank one.
+    """
     record = Path(record_dir)
     lines = ["**What the last full run found** (its record: `docs/record/`):", ""]
     if (record / "claims.csv").is_file():
@@ -365,7 +429,14 @@ def found_lines(record_dir: str | Path) -> list[str]:
 
 
 def replace_block(text: str, block: str) -> str:
-    """``text`` with the part between :data:`BEGIN` and :data:`END` replaced by ``block``.
+    """``text`` with the part between ``BEGIN`` and ``END`` replaced by ``block``.
+
+    Args:
+        text: the page's text.
+        block: the new block, markers included.
+
+    Returns:
+        The new text.
 
     Raises:
         ValueError: when the markers are missing or out of order.
@@ -377,7 +448,12 @@ def replace_block(text: str, block: str) -> str:
 
 
 def record_costs(path: str | Path, row: Mapping[str, object]) -> None:
-    """Set the row of ``row['name']`` in ``costs.csv`` (the command's last measured cost)."""
+    """Set the row of ``row['name']`` in ``costs.csv`` (the command's last measured cost).
+
+    Args:
+        path: the ``costs.csv`` (made if missing).
+        row: the command's measurement, keyed by ``COSTS_COLUMNS``.
+    """
     df = read_costs(path)
     df = df[df["name"] != row["name"]]
     df = pd.concat([df, pd.DataFrame([{k: row[k] for k in COSTS_COLUMNS}])], ignore_index=True)

@@ -31,7 +31,15 @@ def finite(values: Sequence[float]) -> np.ndarray:
 
 def interval(values: Sequence[float], level: float = LEVEL) -> tuple[float, float, float, float]:
     """(mean, sd, low, high) over seeds, NaNs dropped; the interval is Student's t on the mean
-    (sd and bounds NaN with one value, all NaN with none)."""
+    (sd and bounds NaN with one value, all NaN with none).
+
+    Args:
+        values: per-seed values.
+        level: the interval's coverage.
+
+    Returns:
+        ``(mean, sd, low, high)``.
+    """
     v = finite(values)
     if v.size == 0:
         return (np.nan,) * 4
@@ -47,13 +55,32 @@ def interval(values: Sequence[float], level: float = LEVEL) -> tuple[float, floa
 
 def decided(values: Sequence[float], level: float = LEVEL) -> bool:
     """Whether the interval of the mean excludes 0 (False with fewer than two seeds, or when the
-    differences are all exactly 0)."""
+    differences are all exactly 0).
+
+    Args:
+        values: per-seed values (e.g. paired differences).
+        level: the interval's coverage.
+
+    Returns:
+        True when decided.
+    """
     _, _, lo, hi = interval(values, level)
     return bool(np.isfinite(lo) and (lo > 0 or hi < 0))
 
 
 def paired(a: Sequence[float], b: Sequence[float]) -> np.ndarray:
-    """Per-seed differences a - b [S] (a, b [S] in the same seed order)."""
+    """Per-seed differences a - b [S] (a, b [S] in the same seed order).
+
+    Args:
+        a: [S] values.
+        b: [S] values.
+
+    Returns:
+        [S] differences.
+
+    Raises:
+        ValueError: when the shapes differ.
+    """
     a, b = np.asarray(a, dtype=np.float64), np.asarray(b, dtype=np.float64)
     if a.shape != b.shape:
         raise ValueError(
@@ -64,7 +91,16 @@ def paired(a: Sequence[float], b: Sequence[float]) -> np.ndarray:
 
 def decided_best(values: np.ndarray, higher: bool = True, level: float = LEVEL) -> int | None:
     """Column of values [S, M] (seeds x candidates) whose mean is best, when its paired
-    difference to the runner-up is decided; None otherwise (ties, one seed, all NaN)."""
+    difference to the runner-up is decided; None otherwise (ties, one seed, all NaN).
+
+    Args:
+        values: [S, M] per-seed values of M candidates.
+        higher: True when higher is better.
+        level: the interval's coverage.
+
+    Returns:
+        The best column's index, or None.
+    """
     v = np.asarray(values, dtype=np.float64)
     means = np.array([np.nanmean(c) if np.isfinite(c).any() else np.nan for c in v.T])
     if np.isfinite(means).sum() < 2:
@@ -77,7 +113,16 @@ def decided_best(values: np.ndarray, higher: bool = True, level: float = LEVEL) 
 
 
 def pm(values: Sequence[float], fmt: str, bold: bool = False) -> str:
-    """.tex cell 'mean $\\pm$ sd' (just the mean with one seed, '--' with none)."""
+    """.tex cell 'mean $\\pm$ sd' (just the mean with one seed, '--' with none).
+
+    Args:
+        values: per-seed values.
+        fmt: the number format (e.g. ``'.2f'``).
+        bold: wrap the cell in ``\textbf``.
+
+    Returns:
+        The cell's LaTeX.
+    """
     m, sd, _, _ = interval(values)
     if not np.isfinite(m):
         return "--"
@@ -87,7 +132,15 @@ def pm(values: Sequence[float], fmt: str, bold: bool = False) -> str:
 
 def difference(values: Sequence[float], fmt: str) -> str:
     """.tex cell of a paired difference: '$+1.23$ [0.80, 1.66]', bold when decided, marked
-    with a dagger when not (the interval contains 0, or one seed gives none)."""
+    with a dagger when not (the interval contains 0, or one seed gives none).
+
+    Args:
+        values: per-seed paired differences.
+        fmt: the number format (e.g. ``'.2f'``).
+
+    Returns:
+        The cell's LaTeX (``'--'`` without a finite value).
+    """
     m, _, lo, hi = interval(values)
     if not np.isfinite(m):
         return "--"

@@ -3,7 +3,7 @@
 The profile and config stamp the run was made with, the claims ledger's verdict counts and each
 verdict (``results/claims.csv``), ``tab_fit``'s fraction of the true-motion ceiling's gain per
 tree and model (``results/tables/tab_fit.csv``), and what the run cost: wall time and
-job-minutes by stage from Snakemake's benchmark files (``physgs.experiments.cost``). Nothing here
+job-minutes by stage from Snakemake's benchmark files ([`physgs.experiments.cost`][]). Nothing here
 is typed by hand, so the summary cannot go stale against the run it describes.
 
 Pure: takes paths (and the stamp), returns Markdown; the workflow writes it.
@@ -45,7 +45,17 @@ def _stale(stamp: Mapping[str, str], df: pd.DataFrame, name: str) -> list[str]:
 
 
 def claims_section(claims: pd.DataFrame) -> list[str]:
-    """Verdict counts and one line per claim (verdict, measured value with its interval)."""
+    """Verdict counts and one line per claim (verdict, measured value with its interval).
+
+    Args:
+        claims: the ledger (``claims.csv``).
+
+    Returns:
+        The section's Markdown lines, ending in a blank one.
+
+    Raises:
+        ValueError: for a verdict not in ``VERDICTS``.
+    """
     kind = claims["verdict"].astype(str).str.split(":").str[0]
     bad = sorted(set(kind) - set(VERDICTS))
     if bad:
@@ -74,7 +84,14 @@ def claims_section(claims: pd.DataFrame) -> list[str]:
 def prior_lines(claims: pd.DataFrame) -> list[str]:
     """One line per prior other than ours with ``<model>/ahead_of_fields/...`` claims: on how
     many splits and trees it beats every learned field (the claim holds: its paired 95% interval
-    above 0), and which."""
+    above 0), and which.
+
+    Args:
+        claims: the ledger.
+
+    Returns:
+        Two lines per prior (the sentence and a blank one).
+    """
     ids = claims["id"].astype(str)
     ahead = claims[ids.str.contains(f"/{AHEAD}/", regex=False)]
     lines = []
@@ -93,7 +110,14 @@ def prior_lines(claims: pd.DataFrame) -> list[str]:
 
 def fit_section(tab_fit: pd.DataFrame) -> list[str]:
     """Fraction of the ceiling's in-window gain per model (rows) and tree (columns), in percent:
-    the mean over seeds, with its 95% interval when there are two seeds or more."""
+    the mean over seeds, with its 95% interval when there are two seeds or more.
+
+    Args:
+        tab_fit: ``tab_fit.csv`` (ceiling_frac per seed, model and tree).
+
+    Returns:
+        The section's Markdown lines, ending in a blank one.
+    """
     trees = list(dict.fromkeys(tab_fit["tree"]))
     models = list(dict.fromkeys(tab_fit.loc[~tab_fit["reference"].astype(bool), "model"]))
     seeds = sorted(tab_fit["seed"].unique())
@@ -127,7 +151,17 @@ def fit_section(tab_fit: pd.DataFrame) -> list[str]:
 
 def cost_section(benchmark_dir) -> list[str]:
     """Wall time of the run and of each stage (first job start to last job end) and
-    job-minutes by stage, shared and per seed, from the benchmark files."""
+    job-minutes by stage, shared and per seed, from the benchmark files.
+
+    Args:
+        benchmark_dir (str | Path): the run's benchmark folder.
+
+    Returns:
+        The section's Markdown lines, ending in a blank one.
+
+    Raises:
+        FileNotFoundError: when the folder is missing or holds no benchmark file.
+    """
     jobs = read_costs(benchmark_dir)
     s, spans = summarise(jobs), wall_spans(jobs)
     seeds = list(s["per_seed"])
@@ -158,7 +192,20 @@ def cost_section(benchmark_dir) -> list[str]:
 
 def run_summary(stamp: Mapping[str, str], claims_csv, tab_fit_csv, benchmark_dir) -> str:
     """results/summary.md of a finished run, from its claims ledger, its ``tab_fit`` and its
-    benchmark folder. Raises FileNotFoundError naming a missing file or folder."""
+    benchmark folder.
+
+    Args:
+        stamp: the run's stamp fields.
+        claims_csv (str | Path): the claims ledger's CSV.
+        tab_fit_csv (str | Path): ``tab_fit``'s CSV.
+        benchmark_dir (str | Path): the benchmark folder.
+
+    Returns:
+        The page's Markdown.
+
+    Raises:
+        FileNotFoundError: naming a missing file or folder.
+    """
     for p in (claims_csv, tab_fit_csv):
         if not Path(p).is_file():
             raise FileNotFoundError(f"{p}: missing (run `snakemake --cores 2 all` first)")

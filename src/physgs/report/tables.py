@@ -70,7 +70,15 @@ def tree_label(tree: str, bones: int) -> str:
 
 
 def condition_label(mult: float, tex: bool = True) -> str:
-    """Mean-speed multiplier -> '$v_0$' / '$0.84v_0$' (tex) or 'v0' / '0.84v0'."""
+    """Mean-speed multiplier -> '$v_0$' / '$0.84v_0$' (tex) or 'v0' / '0.84v0'.
+
+    Args:
+        mult: the multiplier of the training mean speed v0.
+        tex: LaTeX (tables) or plain text.
+
+    Returns:
+        The label.
+    """
     if np.isclose(mult, 1.0):
         return "$v_0$" if tex else "v0"
     return f"${mult:.2f}v_0$" if tex else f"{mult:.2f}v0"
@@ -184,12 +192,23 @@ def tab_psnr(
 ) -> Table:
     """PSNR (dB) on the view and time splits, one row per model, two columns per tree.
 
-    ``per_seed[seed][(tree, model)]``: ``EvalResult.summary()`` of the model trained ``single`` with
-    that training seed. Below the models: references (the true-motion ceiling; never bold) and
-    two paired differences, ours - static and ours - the best learned field (per seed, the
-    learned field with the highest PSNR in that column), for every prior among ``models`` (role
-    "prior" in the registry: ours, then the chained prior). The best method per column is bold
-    when its paired difference to the runner-up is decided; digits: decimals shown in the .tex.
+    Below the models: references (the true-motion ceiling; never bold) and two paired
+    differences, ours - static and ours - the best learned field (per seed, the learned field with
+    the highest PSNR in that column), for every prior among ``models`` (role "prior" in the
+    registry: ours, then the chained prior). The best method per column is bold when its paired
+    difference to the runner-up is decided.
+
+    Args:
+        per_seed: ``per_seed[seed][(tree, model)]``: ``EvalResult.summary()`` of the model trained
+            ``single`` with that training seed.
+        trees: the trees, in column order.
+        bones: tree -> its bone count (in the header).
+        models: the methods, in row order.
+        digits: decimals shown in the .tex.
+        references: the reference rows.
+
+    Returns:
+        The [`Table`][physgs.report.tables.Table].
     """
     fmt = f".{int(digits)}f"
     seeds = _seeds(per_seed, "tab_psnr")
@@ -298,14 +317,27 @@ def tab_fit(
 ) -> Table:
     """How much of the achievable fit each model reaches, per tree and model.
 
-    ``per_seed[seed][(tree, model)]``: fit (dB: mean PSNR over the trained training-window frames at
-    the training camera and wind), heldout (dB: the same over the held-out training-window
-    frames), view, time (dB: the evaluation splits), train_s (seconds of training).
     ceiling_frac is (model - static) / (reference - static) on ``fit``, per seed against that
     seed's static pose and ceiling: 1 reaches the true-motion ceiling, 0 is no better than the
     static pose. The reference row is listed for scale. A split a model does not define (NaN at
     every seed: a forcing-free prior beyond the window) is an empty CSV cell and ``NOT_DEFINED``
     in the .tex, never a number.
+
+    Args:
+        per_seed: ``per_seed[seed][(tree, model)]``: fit (dB: mean PSNR over the trained
+            training-window frames at the training camera and wind), heldout (dB: the same over
+            the held-out training-window frames), view, time (dB: the evaluation splits), train_s
+            (seconds of training).
+        trees: the trees.
+        bones: tree -> its bone count.
+        models: the models, in row order.
+        reference: the ceiling's id.
+        digits: decimals shown in the .tex.
+        static: the static model's id.
+        holdout_every: train.holdout_every (the caption says which frames were held out).
+
+    Returns:
+        The [`Table`][physgs.report.tables.Table].
     """
     seeds = _seeds(per_seed, "tab_fit")
     recs = []
@@ -410,26 +442,39 @@ def tab_null(
 ) -> Table:
     """Frequency recovery of the trained model against the untrained null, per tree and config.
 
-    ``recovery[seed][(tree, config)]``: ``RecoveryRecord`` of that seed's model;
-    ``null[seed][(tree, config)]``: ``NullResult`` drawn with that seed and the model's K; configs: configuration name
-    -> its LaTeX label (``registry.config_label``), in row order. Columns: parts trusted, median
-    relative error (%), log-log R^2 for trained and null (null entries are medians over draws),
-    trained - null (percentage points, paired per seed: negative means the trained model beats
-    chance), and the median nearest-bone gap (%).
+    Columns: parts trusted, median relative error (%), log-log R^2 for trained and null (null
+    entries are medians over draws), trained - null (percentage points, paired per seed: negative
+    means the trained model beats chance), and the median nearest-bone gap (%).
 
-    tracks: the 2D-track control's rows (``physgs.tracks``), ``tracks[seed][(tree, config)]`` =
-    (its ``RecoveryRecord``, the ``NullResult`` of its K), for the configurations of
-    ``tracks_configs`` (name -> LaTeX label, in row order); they follow ours' rows of each tree,
-    column ``method`` 'tracks' (ours' rows: 'ours').
+    Args:
+        recovery: ``recovery[seed][(tree, config)]``: ``RecoveryRecord`` of that seed's model.
+        null: ``null[seed][(tree, config)]``: ``NullResult`` drawn with that seed and the model's
+            K.
+        trees: the trees.
+        bones: tree -> its bone count.
+        configs: configuration name -> its LaTeX label
+            ([`config_label`][physgs.models.registry.config_label]), in row order.
+        digits: decimals shown in the .tex.
+        tracks: the 2D-track control's rows ([`physgs.tracks`][physgs.tracks]),
+            ``tracks[seed][(tree, config)]`` = (its ``RecoveryRecord``, the ``NullResult`` of its
+            K), for the configurations of ``tracks_configs``; they follow ours' rows of each tree,
+            column ``method`` 'tracks' (ours' rows: 'ours').
+        tracks_configs: name -> LaTeX label of the tracks control's configurations, in row order.
+        priors: the other oscillator priors' records, ``priors[model][seed][(tree, config)]``, in
+            every configuration of ``configs``, each beside the null of its K (the same draws as
+            ours': a null depends on K only); their rows follow ours' of each tree, column
+            ``method`` the model id.
+        methods: further methods' rows (method id ->
+            [`MethodRows`][physgs.report.tables.MethodRows]: (record, null of its K) per ``(tree,
+            config)``), each in its own configurations, after the tracks control's; column
+            ``method`` the id (the output-only analysis: ``OMA``, the forcing-free priors: their
+            ids).
 
-    priors: the other oscillator priors' records, ``priors[model][seed][(tree, config)]``, in
-    every configuration of ``configs``, each beside the null of its K (the same draws as ours':
-    a null depends on K only); their rows follow ours' of each tree, column ``method`` the
-    model id.
+    Returns:
+        The [`Table`][physgs.report.tables.Table].
 
-    methods: further methods' rows (method id -> ``MethodRows``: (record, null of its K) per
-    ``(tree, config)``), each in its own configurations, after the tracks control's; column
-    ``method`` the id (the output-only analysis: ``OMA``, the forcing-free priors: their ids).
+    Raises:
+        ValueError: when a null's K differs from its model's.
     """
     seeds = _seeds(recovery, "tab_null")
     tracks_configs = dict(tracks_configs or {})
@@ -589,8 +634,15 @@ _NULL_TRACKS_NOTE = (
 
 
 def oma_rows(configs: Mapping[str, str], per_seed: Mapping[int, Mapping]) -> MethodRows:
-    """The output-only modal analysis' rows (``physgs.oma``) for tab_null / tab_damping:
-    configs: name -> LaTeX label with its own K; per_seed as ``MethodRows``."""
+    """The output-only modal analysis' rows ([`physgs.oma`][physgs.oma]) for tab_null / tab_damping.
+
+    Args:
+        configs: name -> LaTeX label with its own K.
+        per_seed: as in [`MethodRows`][physgs.report.tables.MethodRows].
+
+    Returns:
+        The rows, with their caption sentence.
+    """
     return MethodRows(
         OMA_LABEL,
         configs,
@@ -602,8 +654,18 @@ def oma_rows(configs: Mapping[str, str], per_seed: Mapping[int, Mapping]) -> Met
 
 
 def blind_rows(model: str, configs: Mapping[str, str], per_seed: Mapping[int, Mapping]):
-    """A forcing-free prior's rows (``registry.BLIND_PRIORS``, physgs.models.blind) for
-    tab_null / tab_damping, labelled from the registry; configs and per_seed as ``oma_rows``."""
+    """A forcing-free prior's rows (``registry.BLIND_PRIORS``,
+    [`physgs.models.blind`][physgs.models.blind]) for tab_null / tab_damping, labelled from the
+    registry.
+
+    Args:
+        model: the prior's id.
+        configs: name -> LaTeX label with its own K.
+        per_seed: as in [`MethodRows`][physgs.report.tables.MethodRows].
+
+    Returns:
+        (MethodRows): The rows, with their caption sentence.
+    """
     return MethodRows(
         label(model),
         configs,
@@ -648,9 +710,19 @@ def tab_transfer(
 ) -> Table:
     """Zero-shot transfer PSNR (dB) on the unseen conditions (index >= 1), all models ``single``.
 
-    ``per_seed[seed][(tree, model)]``: ``EvalResult.summary()``. Rows: split (training timestamps /
-    beyond the window) x tree x unseen condition; columns: models. The best per row is bold when
-    its paired difference to the runner-up is decided.
+    Rows: split (training timestamps / beyond the window) x tree x unseen condition; columns:
+    models. The best per row is bold when its paired difference to the runner-up is decided.
+
+    Args:
+        per_seed: ``per_seed[seed][(tree, model)]``: ``EvalResult.summary()``.
+        trees: the trees.
+        bones: tree -> its bone count.
+        conditions: the mean-speed multipliers, the training one first.
+        models: the methods, in column order.
+        digits: decimals shown in the .tex.
+
+    Returns:
+        The [`Table`][physgs.report.tables.Table].
     """
     seeds = _seeds(per_seed, "tab_transfer")
     rows = []
@@ -746,9 +818,23 @@ def tab_margin(
     digits: int = 2,
 ) -> Table:
     """Each prior minus Deformation MLP + wind, PSNR (dB) at training timestamps, per tree and
-    condition (including the training condition), paired per seed. Positive: the prior ahead.
-    A margin is bold when its 95% interval excludes 0, marked undecided when not. One block of
-    rows per prior of ``priors`` (column ``model``: its id), in that order."""
+    condition (including the training condition), paired per seed.
+
+    Positive: the prior ahead. A margin is bold when its 95% interval excludes 0, marked undecided
+    when not. One block of rows per prior of ``priors`` (column ``model``: its id), in that order.
+
+    Args:
+        per_seed: ``per_seed[seed][(tree, model)]``: ``EvalResult.summary()``.
+        trees: the trees.
+        bones: tree -> its bone count.
+        conditions: the mean-speed multipliers, the training one first.
+        priors: the priors, in block order.
+        baseline: the model subtracted.
+        digits: decimals shown in the .tex.
+
+    Returns:
+        The [`Table`][physgs.report.tables.Table].
+    """
     seeds = _seeds(per_seed, "tab_margin")
     rows = []
     for s in seeds:
@@ -802,8 +888,12 @@ def tab_margin(
 def write_table(table: Table, tex_path: str | Path, csv_path: str | Path, stamp=None) -> None:
     """Write the table's .tex and .csv, each atomically (temp file then rename).
 
-    stamp: a ``physgs.provenance.Stamp``; its fields become the CSV's last columns (one value
-    per row) and a comment line of the .tex.
+    Args:
+        table: the table.
+        tex_path: the .tex to write.
+        csv_path: the .csv to write.
+        stamp (Stamp | None): a [`Stamp`][physgs.provenance.Stamp]; its fields become the CSV's
+            last columns (one value per row) and a comment line of the .tex.
     """
     df, tex = table.df, table.tex
     if stamp is not None:
@@ -816,13 +906,23 @@ def write_table(table: Table, tex_path: str | Path, csv_path: str | Path, stamp=
 
 # --------------------------------------------------------------------------------------------
 def tab_testbed(stats: Mapping[str, Mapping], trees: Sequence[str], digits: int = 2) -> Table:
-    """The testbed's statistics per tree (``physgs.testbed.stats.testbed_stats``), beside the
-    paper's figures where it gives them (``physgs.report.paper``).
+    """The testbed's statistics per tree
+    ([`testbed_stats`][physgs.testbed.stats.testbed_stats]), beside the paper's figures where it
+    gives them ([`physgs.report.paper`][physgs.report.paper]).
 
     Columns: bones; distinct natural frequencies; f min / median / max (Hz) and span; bones
     clamped into the band; median nearest-bone gap (%); median per-bone swing (degrees); how
     visible each bone's own motion is in the training camera (median pixels, % under 1 px);
     the training frame's height filled by the swept tree and pixels covered (%).
+
+    Args:
+        stats: tree -> its statistics (as [`load_stats`][physgs.testbed.stats.load_stats] reads
+            them).
+        trees: the trees, in row order.
+        digits: decimals shown in the .tex.
+
+    Returns:
+        The [`Table`][physgs.report.tables.Table].
     """
     from physgs.report import paper
 

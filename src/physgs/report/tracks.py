@@ -1,7 +1,7 @@
-"""tab_tracks and fig_tracks: the 2D-track control (``physgs.tracks``, docs/tracks.md).
+"""tab_tracks and fig_tracks: the 2D-track control ([`physgs.tracks`][], docs/tracks.md).
 
 tab_tracks, per tree, configuration and training seed, from the control's evaluation record
-(``physgs.tracks.run.evaluate_job``): the tracker against the truth-projected vertices (tracks
+([`physgs.tracks.run.evaluate_job`][]): the tracker against the truth-projected vertices (tracks
 started, share of the frame-0 tracks kept to the window's end, median and 90th-percentile
 position error and displacement error, px), the fit (K, parts with an estimate, fit seconds),
 and the motion errors (px, median over tracks and frames of the displacement error since each
@@ -49,21 +49,39 @@ TRACKER_COLUMNS = (
 
 
 def case_label(case: str, conditions: Sequence[float]) -> str:
-    """CSV column stem of a motion case: 'tail', or 'wind_<mult>v0' for case 'wind<c>'."""
+    """CSV column stem of a motion case: 'tail', or 'wind_<mult>v0' for case 'wind<c>'.
+
+    Args:
+        case: ``'tail'`` or ``'wind<c>'``.
+        conditions: the testbed's mean-speed multipliers.
+
+    Returns:
+        The column stem.
+    """
     if case == "tail":
         return "tail"
     return "wind_" + condition_label(float(conditions[int(case[4:])]), tex=False)
 
 
 def row(scores: Mapping, conditions: Sequence[float]) -> dict[str, float]:
-    """One tab_tracks row from an evaluation record (``evaluate_job``'s scores, plus
-    ``ours_train_s``: ours' training seconds in the same configuration, NaN when absent);
-    conditions: the testbed's mean-speed multipliers (the first is the training wind). Motion
-    columns
-    ``<case>_px`` (the control), ``<case>_ours_px`` (ours' Gaussians at the same points; NaN when
-    not scored), ``<case>_field_<id>_px`` (each learned field scored, at the same points),
-    ``<case>_best_field_px`` (the lowest of them; NaN when none was scored),
-    ``<case>_static_px`` (motionless)."""
+    """One tab_tracks row from an evaluation record.
+
+    Motion columns ``<case>_px`` (the control), ``<case>_ours_px`` (ours' Gaussians at the same
+    points; NaN when not scored), ``<case>_field_<id>_px`` (each learned field scored, at the
+    same points), ``<case>_best_field_px`` (the lowest of them; NaN when none was scored),
+    ``<case>_static_px`` (motionless).
+
+    Args:
+        scores: [`evaluate_job`][physgs.tracks.run.evaluate_job]'s scores, plus ``ours_train_s``:
+            ours' training seconds in the same configuration, NaN when absent.
+        conditions: the testbed's mean-speed multipliers (the first is the training wind).
+
+    Returns:
+        The row, px and seconds.
+
+    Raises:
+        KeyError: when the record lacks a motion case.
+    """
     tr, fit = scores["tracker"], scores["fit"]
     out = {
         "n_tracks": float(tr["n_tracks"]),
@@ -105,10 +123,23 @@ def tab_tracks(
     conditions: Sequence[float],
     digits: int = 2,
 ) -> Table:
-    """``per_seed[seed][(tree, config)]``: an evaluation record (``evaluate_job``'s scores);
-    configs: name -> {"label": LaTeX, "conditions": 'train' | 'all'}, in row order; conditions:
-    the testbed's multipliers. One CSV row per seed, tree and configuration; the .tex gives the
-    mean +- sd over seeds (one seed: the value)."""
+    """The 2D-track control per tree and configuration.
+
+    One CSV row per seed, tree and configuration; the .tex gives the mean +- sd over seeds (one
+    seed: the value).
+
+    Args:
+        per_seed: ``per_seed[seed][(tree, config)]``: an evaluation record
+            ([`evaluate_job`][physgs.tracks.run.evaluate_job]'s scores).
+        trees: the trees.
+        bones: tree -> its bone count.
+        configs: name -> {"label": LaTeX, "conditions": 'train' | 'all'}, in row order.
+        conditions: the testbed's multipliers.
+        digits: decimals shown in the .tex.
+
+    Returns:
+        The [`Table`][physgs.report.tables.Table].
+    """
     seeds = _seeds(per_seed, "tab_tracks")
     keys = [(t, c) for t in trees for c in configs]
     recs = []
@@ -219,11 +250,20 @@ def fig_tracks(
     outputs: Sequence[str],
     title: str = "",
 ) -> None:
-    """One panel per tree: ``frames[tree]`` [H, W, 3] uint8 (the training camera's frame 0) under
-    the paths of ``tracks[tree]`` (``physgs.tracks.track.Tracks`` of that video; pixel centres at
-    integer + 0.5, so a path is drawn at xy - 0.5 in imshow's coordinates), each coloured by
-    ``labels[tree]`` [P] (its part; -1 or None: grey, not fitted or in a part without an
-    estimate), its seed position a dot. Written to every path of ``outputs`` (pdf, png)."""
+    """One panel per tree: the training camera's frame 0 under the tracks' paths.
+
+    Pixel centres are at integer + 0.5, so a path is drawn at xy - 0.5 in imshow's coordinates;
+    each path's seed position is a dot.
+
+    Args:
+        frames: ``frames[tree]``: [H, W, 3] uint8, the training camera's frame 0.
+        tracks: ``tracks[tree]``: [`Tracks`][physgs.tracks.track.Tracks] of that video.
+        labels: ``labels[tree]``: [P] each track's part (-1 or None: grey, not fitted or in a part
+            without an estimate).
+        trees: the trees, one panel each.
+        outputs: the paths to write (pdf, png).
+        title: the figure's title.
+    """
     import matplotlib
 
     matplotlib.use("Agg")

@@ -7,7 +7,7 @@ stored wind and theta have L lead-in columns first, so column L + j is recorded 
 The ground truth starts at the periodic steady state of the (60 s periodic) wind, i.e. it is the
 response to an infinitely long past; the L = 1.5 tau_max lead-in columns let a model that
 integrates from rest at column 0 reach that steady state before the recorded window opens.
-The damping variant (``physgs.testbed.variant``) keeps that start state and records a gust
+The damping variant ([`physgs.testbed.variant`][]) keeps that start state and records a gust
 dropping to calm inside the training window; its lead-in follows the slowest decay rate,
 min_b zeta_b omega_b.
 
@@ -136,9 +136,26 @@ class TreeSim:
 def simulate_tree(tb: dict, preset: dict, *, seed: int, tree: str) -> TreeSim:
     """Geometry, physics and wind for one tree (everything but the frames).
 
-    tb: the resolved ``testbed`` config section; preset: ``presets.<tree>``. ``tb["variant"]``
-    (``physgs.testbed.variant``; default faithful) chooses a constant zeta and the unmodified
-    wind, or per-bone zeta and a gust dropping to calm inside the training window.
+    ``tb["variant"]`` ([`physgs.testbed.variant`][physgs.testbed.variant]; default faithful)
+    chooses a constant zeta and the unmodified wind, or per-bone zeta and a gust dropping to calm
+    inside the training window.
+
+    Args:
+        tb: the resolved ``testbed`` config section.
+        preset: ``presets.<tree>``.
+        seed: the run's seed.
+        tree: the tree's name (seeds its streams).
+
+    Returns:
+        The [`TreeSim`][physgs.testbed.dataset.TreeSim]: skeleton, mesh, truth and winds [C, L+F]
+            (m/s).
+
+    Raises:
+        WindError: when the record is not shorter than the wind's period (or the period is not a
+            whole number of frames), the wind speed reaches 0, or the transient starts before
+            recorded frame 0.
+        PresetError: for an inconsistent preset.
+        MeshBudgetError: when the vertex budget cannot hold the tubes.
     """
     skel = weberpenn.generate(preset, seed=seed, name=tree)
     leaves = preset.get("leaves") or {}
@@ -260,7 +277,15 @@ def simulate_tree(tb: dict, preset: dict, *, seed: int, tree: str) -> TreeSim:
 
 def swept_points(truth: Truth, chunk: int = 25) -> np.ndarray:
     """Vertices [K, 3] (m) of the convex hull of every posed vertex over every recorded frame of
-    every condition (lead-in excluded): the tree's swept extent, as the framing needs it."""
+    every condition (lead-in excluded): the tree's swept extent, as the framing needs it.
+
+    Args:
+        truth: the tree's ground truth.
+        chunk: frames posed at a time (bounds memory, not the result).
+
+    Returns:
+        [K, 3] hull vertices, m.
+    """
     L = truth.lead_in_frames
     th = truth.theta[:, L:].reshape(-1, truth.theta.shape[-1])
     return scene.convex_hull_points(
@@ -269,7 +294,26 @@ def swept_points(truth: Truth, chunk: int = 25) -> np.ndarray:
 
 
 def build_dataset(tb: dict, preset: dict, *, seed: int, tree: str, progress: bool = True):
-    """Simulate and render one tree. Returns (observed arrays dict, truth arrays dict)."""
+    """Simulate and render one tree.
+
+    Args:
+        tb: the resolved ``testbed`` config section.
+        preset: ``presets.<tree>``.
+        seed: the run's seed.
+        tree: the tree's name.
+        progress: show a progress bar while rendering.
+
+    Returns:
+        (tuple[dict, dict]): ``(observed, truth)``: the arrays of ``observed.npz`` and
+            ``truth.npz`` by name, each with ``format_version``, for
+            [`save_dataset`][physgs.testbed.dataset.save_dataset] (read back as
+            [`Observed`][physgs.testbed.dataset.Observed] and
+            [`Truth`][physgs.testbed.dataset.Truth]).
+
+    Raises:
+        FramingError: when ``testbed.fill_height`` is missing or does not fit every view.
+        WindError: see [`simulate_tree`][physgs.testbed.dataset.simulate_tree].
+    """
     sim = simulate_tree(tb, preset, seed=seed, tree=tree)
     tr = sim.truth
     L, fps = tr.lead_in_frames, tr.fps
@@ -355,7 +399,14 @@ def build_dataset(tb: dict, preset: dict, *, seed: int, tree: str, progress: boo
 
 
 def save_dataset(observed: dict, truth: dict, observed_path, truth_path) -> None:
-    """Write both files; neither appears unless both were written completely."""
+    """Write both files; neither appears unless both were written completely.
+
+    Args:
+        observed: the observed arrays (``np.savez_compressed`` keywords).
+        truth: the truth arrays.
+        observed_path (str | Path): the observed ``.npz``.
+        truth_path (str | Path): the truth ``.npz``.
+    """
     parts = []
     try:
         for arrays, p in ((observed, Path(observed_path)), (truth, Path(truth_path))):

@@ -21,9 +21,17 @@ def testbed_figure(
 ) -> Path:
     """Write the figure to ``path`` (PNG, via a temporary file) and return the path.
 
-    stats: ``physgs.testbed.stats.testbed_stats`` of the tree; when given, the skeleton is
-    coloured by how visible each bone's own motion is (pixels) beside its frequency, and the
-    headline statistics are printed under the title.
+    Args:
+        obs: the tree's observed dataset.
+        truth: its ground truth.
+        tree: the tree's name (in the title).
+        path: the PNG to write.
+        stats: [`testbed_stats`][physgs.testbed.stats.testbed_stats] of the tree; when given, the
+            skeleton is coloured by how visible each bone's own motion is (pixels) beside its
+            frequency, and the headline statistics are printed under the title.
+
+    Returns:
+        ``path`` as a ``Path``.
     """
     f_hz = truth.omega / (2 * np.pi)
     fig = plt.figure(figsize=(12, 6.2))

@@ -28,14 +28,33 @@ def swing_axis(direction_deg: float) -> np.ndarray:
 
 
 def rotate(v: np.ndarray, axis: np.ndarray, angle: np.ndarray) -> np.ndarray:
-    """Rotate vectors v [..., 3] about unit axis [3] by angle [...] (rad), Rodrigues."""
+    """Rotate vectors v [..., 3] about unit axis [3] by angle [...] (rad), Rodrigues.
+
+    Args:
+        v: [..., 3] vectors.
+        axis: [3] unit rotation axis.
+        angle: [...] angles, rad (broadcast against v's leading axes).
+
+    Returns:
+        [..., 3] the rotated vectors.
+    """
     c, s = np.cos(angle)[..., None], np.sin(angle)[..., None]
     K = np.array([[0.0, -axis[2], axis[1]], [axis[2], 0.0, -axis[0]], [-axis[1], axis[0], 0.0]])
     return v * c + (v @ K.T) * s + axis * (v @ axis)[..., None] * (1.0 - c)  # v @ K.T = axis x v
 
 
 def bone_depth(parent: np.ndarray) -> np.ndarray:
-    """Depth [B] of each bone in its tree (root = 0); raises on a cycle or a bad parent index."""
+    """Depth [B] of each bone in its tree (root = 0); raises on a cycle or a bad parent index.
+
+    Args:
+        parent: [B] each bone's parent index, -1 for a root.
+
+    Returns:
+        [B] int depths.
+
+    Raises:
+        ValueError: when ``parent`` is not a forest (a cycle or an index out of range).
+    """
     B = len(parent)
     depth = np.full(B, -1)
     for b in range(B):
@@ -53,7 +72,18 @@ def bone_depth(parent: np.ndarray) -> np.ndarray:
 
 
 def cumulative_angle(parent: np.ndarray, theta: np.ndarray) -> np.ndarray:
-    """World rotation angle of each bone, the sum of theta along its chain: [..., B] (rad)."""
+    """World rotation angle of each bone, the sum of theta along its chain: [..., B] (rad).
+
+    Args:
+        parent: [B] each bone's parent index, -1 for a root.
+        theta: [..., B] each bone's own angle, rad.
+
+    Returns:
+        [..., B] cumulative angles, rad (a new array).
+
+    Raises:
+        ValueError: when ``parent`` is not a forest.
+    """
     depth = bone_depth(parent)
     Theta = np.array(theta, dtype=np.float64)
     for d in range(1, depth.max() + 1):
@@ -67,7 +97,19 @@ def pose_bones(
 ):
     """Posed bones for angles theta [..., B] (rad).
 
-    Returns (Theta [..., B] cumulative angle, heads [..., B, 3], tails [..., B, 3]) in metres.
+    Args:
+        head: [B, 3] rest bone heads, m.
+        tail: [B, 3] rest bone tails, m.
+        parent: [B] each bone's parent index, -1 for a root.
+        axis: [3] the unit swing axis every bone rotates about.
+        theta: [..., B] each bone's own angle, rad.
+
+    Returns:
+        (tuple[np.ndarray, np.ndarray, np.ndarray]): ``(Theta, heads, tails)``: Theta [..., B]
+            cumulative angle (rad), heads [..., B, 3] and tails [..., B, 3] in metres.
+
+    Raises:
+        ValueError: when ``parent`` is not a forest.
     """
     theta = np.asarray(theta, dtype=np.float64)
     depth = bone_depth(parent)
@@ -94,7 +136,20 @@ def pose_points(
     axis: np.ndarray,
     theta: np.ndarray,
 ) -> np.ndarray:
-    """Rigidly skinned points [N, 3] (rest pose, m) posed by theta [..., B] -> [..., N, 3]."""
+    """Rigidly skinned points [N, 3] (rest pose, m) posed by theta [..., B] -> [..., N, 3].
+
+    Args:
+        points: [N, 3] rest positions, m.
+        point_bone: [N] each point's bone.
+        head: [B, 3] rest bone heads, m.
+        tail: [B, 3] rest bone tails, m.
+        parent: [B] each bone's parent index, -1 for a root.
+        axis: [3] the unit swing axis.
+        theta: [..., B] each bone's own angle, rad.
+
+    Returns:
+        [..., N, 3] posed positions, m.
+    """
     Theta, H, _ = pose_bones(head, tail, parent, axis, theta)
     return H[..., point_bone, :] + rotate(points - head[point_bone], axis, Theta[..., point_bone])
 

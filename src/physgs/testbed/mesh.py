@@ -36,7 +36,11 @@ class TreeMesh:
     n_leaves: int
 
     def to_trimesh(self) -> "trimesh.Trimesh":  # noqa: F821
-        """The mesh as a ``trimesh.Trimesh`` (vertex colours kept, vertices not merged)."""
+        """The mesh as a ``trimesh.Trimesh`` (vertex colours kept, vertices not merged).
+
+        Returns:
+            A new ``trimesh.Trimesh`` over the same vertices [N, 3] (m) and faces [M, 3].
+        """
         import trimesh  # here: ~1 s of start-up that jobs reading a dataset never need
 
         return trimesh.Trimesh(
@@ -45,13 +49,33 @@ class TreeMesh:
 
 
 def tube_vertex_count(stems: tuple[Stem, ...], sides: int, rings_per_segment: int) -> int:
-    """Vertices of all capped tubes: per stem (segments * rings + 1) rings of `sides`, + 2 caps."""
+    """Vertices of all capped tubes: per stem (segments * rings + 1) rings of `sides`, + 2 caps.
+
+    Args:
+        stems: the skeleton's stems (their polylines' segment counts are used).
+        sides: vertices per ring.
+        rings_per_segment: rings per polyline segment.
+
+    Returns:
+        The vertex count of all tubes, caps included.
+    """
     return sum((len(s.points) - 1) * rings_per_segment * sides + sides + 2 for s in stems)
 
 
 def choose_resolution(stems, target_tube: int) -> tuple[int, int]:
     """(sides, rings_per_segment) whose tube count is the largest not above target_tube,
-    preferring rounder tubes (more sides) on ties within 2%."""
+    preferring rounder tubes (more sides) on ties within 2%.
+
+    Args:
+        stems (tuple[Stem, ...]): the skeleton's stems.
+        target_tube: the tube vertex budget.
+
+    Returns:
+        ``(sides, rings_per_segment)``, each in [3, 16] and [1, 16].
+
+    Raises:
+        MeshBudgetError: when even 3 sides and 1 ring per segment exceed ``target_tube``.
+    """
     best = None
     for sides in range(3, 17):
         for rings in range(1, 17):
@@ -101,8 +125,21 @@ def build_mesh(
 ) -> TreeMesh:
     """Mesh a skeleton near ``target_vertices`` vertices.
 
-    leaf_fraction: share of the vertex budget given to leaf quads (0 = no leaves) on the deepest
-    stem level; leaf_scale: leaf side (m). Colours vary mildly per vertex (seeded).
+    Colours vary mildly per vertex (seeded).
+
+    Args:
+        skeleton: the tree's bones and stems.
+        target_vertices: the vertex budget (tubes and leaves together).
+        leaf_fraction: share of the vertex budget given to leaf quads (0 = no leaves) on the
+            deepest stem level.
+        leaf_scale: leaf side, m (varied by a factor in [0.8, 1.2]).
+        seed_seq: seeds the colours and leaf placement.
+
+    Returns:
+        The [`TreeMesh`][physgs.testbed.mesh.TreeMesh]: capped tubes, then four vertices per leaf.
+
+    Raises:
+        MeshBudgetError: when the budget cannot hold the tubes.
     """
     rng = np.random.default_rng(seed_seq)
     stems = skeleton.stems

@@ -40,9 +40,23 @@ def render_mesh(
 ):
     """Render a triangle mesh.
 
-    vertices [N, 3] (m), faces [M, 3], face_colors [M, 3] in [0, 1], background [3].
-    Returns (rgb [H, W, 3] float32 in [0, 1], alpha [H, W] float32 = covered fraction of each pixel).
     Shading: colour * (ambient + (1 - ambient) |n . l|), two-sided (leaves are single quads).
+
+    Args:
+        vertices: [N, 3] posed vertices, m.
+        faces: [M, 3] vertex indices.
+        face_colors: [M, 3] in [0, 1].
+        rays: the camera's primary rays.
+        background (ArrayLike): [3] colour in [0, 1].
+        ambient: the ambient share of the shading.
+        light_dir: [3] unit light direction.
+
+    Returns:
+        (tuple[np.ndarray, np.ndarray]): ``(rgb, alpha)``: rgb [H, W, 3] float32 in [0, 1], alpha
+            [H, W] float32 = covered fraction of each pixel.
+
+    Raises:
+        RuntimeError: when Embree ray casting is not installed.
     """
     if not trimesh.ray.has_embree:
         raise RuntimeError("Embree ray casting unavailable: pip install embreex")
@@ -64,5 +78,12 @@ def render_mesh(
 
 
 def to_uint8(rgb: np.ndarray) -> np.ndarray:
-    """[..., 3] float in [0, 1] -> uint8 (rounded)."""
+    """[..., 3] float in [0, 1] -> uint8 (rounded).
+
+    Args:
+        rgb: [..., 3] floats in [0, 1] (clipped).
+
+    Returns:
+        [..., 3] uint8.
+    """
     return np.clip(np.rint(rgb * 255.0), 0, 255).astype(np.uint8)

@@ -27,6 +27,12 @@ def convex_hull_points(chunks) -> np.ndarray:
 
     Every framing constraint (in front of a camera, inside its image) is a half-space in world
     coordinates, so it holds for a point set exactly when it holds for its hull's vertices.
+
+    Args:
+        chunks (Iterable[ArrayLike]): point sets of shape [..., 3], hulled one after another.
+
+    Returns:
+        [K, 3] hull vertices (all points where the set is flat or too small for a hull).
     """
     from scipy.spatial import ConvexHull, QhullError
 
@@ -54,7 +60,19 @@ def orbit_cameras(
 ) -> list[Camera]:
     """Square cameras at ``distance`` (m) from the vertical line through centre_xy [2] (m), at
     ``height`` (m), looking horizontally at it. Azimuth 0 sits on -y looking along +y; azimuths in
-    degrees, counter-clockwise seen from above."""
+    degrees, counter-clockwise seen from above.
+
+    Args:
+        centre_xy (ArrayLike): [2] the orbit axis' (x, y), m.
+        distance: horizontal distance from the axis, m.
+        height: camera height (z), m.
+        azimuths_deg (Iterable[float]): the cameras' azimuths, degrees.
+        fov_deg: field of view, degrees.
+        resolution: image side, px.
+
+    Returns:
+        One [`Camera`][physgs.camera.Camera] per azimuth.
+    """
     c = np.asarray(centre_xy, dtype=np.float64)
     cams = []
     for a in azimuths_deg:
@@ -100,15 +118,29 @@ def frame_cameras(
     fill_height: float,
     margin_px: float = 0.5,
 ) -> list[Camera]:
-    """Orbit cameras (one per azimuth, degrees; the first is the training camera, which is framed).
+    """Orbit cameras (one per azimuth; the first is the training camera, which is framed).
 
-    points [K, 3] (m): the swept extent, every posed vertex over the whole recording (or the
-    vertices of its convex hull). The orbit's axis is the vertical line through the centre of the
-    points' horizontal bounding box. Distance D and height h are chosen so that, in the first
-    camera, the points span exactly ``fill_height`` of the image height (field of view fixed),
-    centred vertically unless a held-out view needs h shifted (see the module docstring).
-    Raises FramingError, naming ``testbed.fill_height`` and the largest value that fits, if any
-    camera then sees a point closer than ``margin_px`` pixels to its image border (or behind it).
+    The orbit's axis is the vertical line through the centre of the points' horizontal bounding
+    box. Distance D and height h are chosen so that, in the first camera, the points span exactly
+    ``fill_height`` of the image height (field of view fixed), centred vertically unless a held-out
+    view needs h shifted (see the module docstring).
+
+    Args:
+        points: [K, 3] the swept extent, m: every posed vertex over the whole recording (or the
+            vertices of its convex hull).
+        azimuths_deg (Iterable[float]): the cameras' azimuths, degrees.
+        fov_deg: field of view, degrees.
+        resolution: image side, px.
+        fill_height: fraction in (0, 1) of the training image's height the points span.
+        margin_px: the smallest distance a point may keep from an image border, px.
+
+    Returns:
+        One [`Camera`][physgs.camera.Camera] per azimuth.
+
+    Raises:
+        FramingError: for ``fill_height`` outside (0, 1), or when a camera sees a point closer than
+            ``margin_px`` to its border (or behind it); the message names ``testbed.fill_height``
+            and the largest value that fits.
     """
     pts = np.asarray(points, dtype=np.float64).reshape(-1, 3)
     az = [float(a) for a in azimuths_deg]

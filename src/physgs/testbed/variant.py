@@ -8,7 +8,7 @@ then stays exactly at the mean speed for ``calm_s`` seconds (drag forcing v^2 - 
 every bone decays freely with envelope exp(-zeta_b omega_b t)), and the turbulence fades back in.
 
 Times are seconds with t = 0 at recorded frame 0 (frame j at t = j / fps), as in
-``physgs.testbed.dataset``. Everything here is a pure function of the config and arrays.
+[`physgs.testbed.dataset`][]. Everything here is a pure function of the config and arrays.
 """
 
 from __future__ import annotations
@@ -27,20 +27,44 @@ DAMPING_SUFFIX = "_damping"
 
 
 def damping_id(tree: str) -> str:
-    """The testbed id of ``tree``'s damping variant ('medium' -> 'medium_damping')."""
+    """The testbed id of ``tree``'s damping variant ('medium' -> 'medium_damping').
+
+    Args:
+        tree: the tree's name.
+
+    Returns:
+        The damping variant's testbed id.
+    """
     return tree + DAMPING_SUFFIX
 
 
 def parse_id(testbed: str) -> tuple[str, str]:
     """(tree, variant) of a testbed id: 'medium_damping' -> ('medium', 'damping'), 'medium' ->
-    ('medium', 'faithful'). The damping copy shares the tree's geometry, frequencies and wind."""
+    ('medium', 'faithful'). The damping copy shares the tree's geometry, frequencies and wind.
+
+    Args:
+        testbed: a testbed id.
+
+    Returns:
+        ``(tree, variant)``, variant ``'damping'`` or ``'faithful'``.
+    """
     if testbed.endswith(DAMPING_SUFFIX):
         return testbed[: -len(DAMPING_SUFFIX)], DAMPING
     return testbed, FAITHFUL
 
 
 def variant_of(tb: dict) -> str:
-    """The variant a ``testbed`` config section asks for (``faithful`` when it names none)."""
+    """The variant a ``testbed`` config section asks for (``faithful`` when it names none).
+
+    Args:
+        tb: the ``testbed`` config section.
+
+    Returns:
+        ``'faithful'`` or ``'damping'``.
+
+    Raises:
+        ValueError: for a ``variant`` that is not one of ``VARIANTS``.
+    """
     v = tb.get("variant", FAITHFUL)
     if v not in VARIANTS:
         raise ValueError(f"testbed.variant '{v}' is not one of {VARIANTS}; fix config/trees.yaml")
@@ -50,7 +74,18 @@ def variant_of(tb: dict) -> str:
 def effective_settings(tb: dict) -> dict:
     """The ``testbed`` section with only what changes the dataset: for the faithful variant the
     ``variant`` and ``damping`` keys are dropped (they change nothing in it), so a job keyed on
-    these settings is not rebuilt when the damping block is edited or first added."""
+    these settings is not rebuilt when the damping block is edited or first added.
+
+    Args:
+        tb: the ``testbed`` config section.
+
+    Returns:
+        A shallow copy of the section, without ``variant`` and ``damping`` for the faithful
+            variant.
+
+    Raises:
+        ValueError: for an unknown variant (from [`variant_of`][physgs.testbed.variant.variant_of]).
+    """
     if variant_of(tb) == FAITHFUL:
         return {k: v for k, v in tb.items() if k not in ("variant", "damping")}
     return dict(tb)
@@ -61,7 +96,19 @@ def effective_settings(tb: dict) -> dict:
 
 
 def draw_zeta(zeta_range, n_bones: int, seed_seq: np.random.SeedSequence) -> np.ndarray:
-    """[n_bones] damping ratios, log-uniform on [lo, hi] = zeta_range, 0 < lo <= hi <= 1, seeded."""
+    """[n_bones] damping ratios, log-uniform on [lo, hi] = zeta_range, 0 < lo <= hi <= 1, seeded.
+
+    Args:
+        zeta_range (Sequence[float]): ``(lo, hi)``, the damping ratios' range.
+        n_bones: number of ratios to draw.
+        seed_seq: seeds the generator (one uniform draw per bone).
+
+    Returns:
+        [n_bones] damping ratios (dimensionless).
+
+    Raises:
+        ValueError: unless 0 < lo <= hi <= 1.
+    """
     lo, hi = (float(z) for z in zeta_range)
     if not 0 < lo <= hi <= 1:
         raise ValueError(
@@ -74,7 +121,19 @@ def draw_zeta(zeta_range, n_bones: int, seed_seq: np.random.SeedSequence) -> np.
 
 def bone_zeta(tb: dict, n_bones: int, seed_seq: np.random.SeedSequence) -> np.ndarray:
     """[n_bones] damping ratio of every bone: ``testbed.zeta`` for all (faithful) or drawn from
-    ``testbed.damping.zeta_range`` with ``seed_seq`` (damping; the faithful variant ignores it)."""
+    ``testbed.damping.zeta_range`` with ``seed_seq`` (damping; the faithful variant ignores it).
+
+    Args:
+        tb: the ``testbed`` config section.
+        n_bones: number of bones.
+        seed_seq: seeds the draw of the damping variant.
+
+    Returns:
+        [n_bones] damping ratios (dimensionless).
+
+    Raises:
+        ValueError: for an unknown variant or a bad ``zeta_range``.
+    """
     if variant_of(tb) == FAITHFUL:
         return np.full(n_bones, float(tb["zeta"]))
     return draw_zeta(tb["damping"]["zeta_range"], n_bones, seed_seq)
@@ -108,7 +167,17 @@ class Transient:
 
 
 def transient_of(tb: dict) -> Transient | None:
-    """The transient a ``testbed`` section asks for (None for the faithful variant)."""
+    """The transient a ``testbed`` section asks for (None for the faithful variant).
+
+    Args:
+        tb: the ``testbed`` config section (reads ``damping.transient`` for the damping variant).
+
+    Returns:
+        The [`Transient`][physgs.testbed.variant.Transient], or None.
+
+    Raises:
+        ValueError: for an unknown variant.
+    """
     if variant_of(tb) == FAITHFUL:
         return None
     t = tb["damping"]["transient"]
@@ -128,7 +197,15 @@ def _rise(x: np.ndarray) -> np.ndarray:
 
 def turbulence_weight(t: np.ndarray, tr: Transient) -> np.ndarray:
     """[T] weight of the turbulence at times t [T] (s): 1, fading to exactly 0 over the gust,
-    0 through the calm, fading back to 1 over ramp_s."""
+    0 through the calm, fading back to 1 over ramp_s.
+
+    Args:
+        t: [T] times, s from recorded frame 0.
+        tr: the gust and calm.
+
+    Returns:
+        [T] weights in [0, 1].
+    """
     t = np.asarray(t, dtype=np.float64)
     down = 1.0 - _rise((t - (tr.start_s - tr.gust_s)) / tr.gust_s)
     end = tr.start_s + tr.calm_s
@@ -138,7 +215,15 @@ def turbulence_weight(t: np.ndarray, tr: Transient) -> np.ndarray:
 
 def gust_shape(t: np.ndarray, tr: Transient) -> np.ndarray:
     """[T] Hann bump sin^2(pi (t - t0) / gust_s) on [t0, t0 + gust_s], t0 = start_s - gust_s;
-    0 elsewhere (it is back to exactly 0 when the calm begins)."""
+    0 elsewhere (it is back to exactly 0 when the calm begins).
+
+    Args:
+        t: [T] times, s from recorded frame 0.
+        tr: the gust and calm.
+
+    Returns:
+        [T] bump values in [0, 1].
+    """
     x = (np.asarray(t, dtype=np.float64) - (tr.start_s - tr.gust_s)) / tr.gust_s
     return np.where((x > 0) & (x < 1), np.sin(np.pi * np.clip(x, 0.0, 1.0)) ** 2, 0.0)
 
@@ -146,9 +231,17 @@ def gust_shape(t: np.ndarray, tr: Transient) -> np.ndarray:
 def shape_wind(v: np.ndarray, t: np.ndarray, v0: float, tr: Transient) -> np.ndarray:
     """The wind with the transient: v0 + w(t) (v - v0) + gust_gain v0 gust(t), m/s [T].
 
-    v [T] m/s the unmodified speed at times t [T] s; v0 m/s its mean. Exactly v0 through the
-    calm (w = gust = 0 there), so the drag forcing v^2 - v0^2 is exactly 0; never below
-    min(v, v0), so a positive wind stays positive; v itself outside the transient.
+    Exactly v0 through the calm (w = gust = 0 there), so the drag forcing v^2 - v0^2 is exactly 0;
+    never below min(v, v0), so a positive wind stays positive; v itself outside the transient.
+
+    Args:
+        v: [T] the unmodified wind speed, m/s.
+        t: [T] its times, s from recorded frame 0.
+        v0: the mean speed, m/s.
+        tr: the gust and calm.
+
+    Returns:
+        [T] the shaped wind speed, m/s (bit-identical to ``v`` where untouched).
     """
     v = np.asarray(v, dtype=np.float64)
     w, g = turbulence_weight(t, tr), gust_shape(t, tr)
@@ -158,7 +251,15 @@ def shape_wind(v: np.ndarray, t: np.ndarray, v0: float, tr: Transient) -> np.nda
 
 def calm_frames(tr: Transient, fps: int) -> tuple[int, int]:
     """(j0, j1): recorded frames j0 <= j < j1 lie inside the calm; between consecutive ones the
-    forcing is exactly zero (the simulator holds the forcing linear between frames)."""
+    forcing is exactly zero (the simulator holds the forcing linear between frames).
+
+    Args:
+        tr: the gust and calm.
+        fps: frame rate, frames/s.
+
+    Returns:
+        ``(j0, j1)``, recorded-frame indices; a calm edge on a frame counts as inside.
+    """
     t0, t1 = tr.calm_window_s
     eps = 1e-9  # a calm edge on a frame counts as inside
     return int(math.ceil(t0 * fps - eps)), int(math.floor(t1 * fps + eps)) + 1

@@ -47,7 +47,18 @@ SHAPES = (
 
 
 def shape_ratio(shape: str, r: float) -> float:
-    """Weber-Penn shape ratio for relative position r in [0, 1] (1 = base of the crown)."""
+    """Weber-Penn shape ratio for relative position r in [0, 1] (1 = base of the crown).
+
+    Args:
+        shape: one of ``SHAPES``.
+        r: relative position, clipped to [0, 1].
+
+    Returns:
+        The ratio (a length factor).
+
+    Raises:
+        PresetError: for an unknown shape.
+    """
     r = min(max(r, 0.0), 1.0)
     if shape == "conical":
         return 0.2 + 0.8 * r
@@ -92,7 +103,14 @@ class Stem:
         return float(np.linalg.norm(np.diff(self.points, axis=0), axis=1).sum())
 
     def radius_at(self, z: np.ndarray | float) -> np.ndarray:
-        """Radius (m) at relative arc position z in [0, 1]."""
+        """Radius (m) at relative arc position z in [0, 1].
+
+        Args:
+            z: relative arc position(s), 0 at the base, 1 at the tip.
+
+        Returns:
+            The radius, m, the shape of ``z``.
+        """
         return self.radius * (1.0 - self.taper * np.asarray(z, dtype=np.float64))
 
 
@@ -172,15 +190,34 @@ def _stable_id(name: str) -> int:
 
 
 def bones_per_stem(curve_res: int, bone_step: int) -> int:
-    """Bones on one armature stem: ceil(curve_res / bone_step)."""
+    """Bones on one armature stem: ceil(curve_res / bone_step).
+
+    Args:
+        curve_res: the stem's polyline segments.
+        bone_step: segments per bone.
+
+    Returns:
+        The bone count.
+    """
     return -(-int(curve_res) // int(bone_step))
 
 
 def generate(preset: dict, *, seed: int, name: str) -> Skeleton:
     """Build a tree from a preset (a ``presets.<name>`` entry of config/trees.yaml).
 
-    Deterministic for (seed, name). Raises PresetError naming the cause and the fix when the
-    preset is inconsistent or its declared ``bones`` count is not what the geometry yields.
+    Deterministic for (seed, name).
+
+    Args:
+        preset: the ``presets.<name>`` mapping (levels, armature_levels, scale, shape, split, ...).
+        seed: the run's seed.
+        name: the tree's name (it and ``seed`` seed the generator; named in errors).
+
+    Returns:
+        The [`Skeleton`][physgs.testbed.weberpenn.Skeleton]: bones in metres, and their stems.
+
+    Raises:
+        PresetError: naming the cause and the fix when the preset is inconsistent or its declared
+            ``bones`` count is not what the geometry yields.
     """
     rng = np.random.default_rng(np.random.SeedSequence([int(seed), _stable_id(name), 1]))
     levels = preset["levels"]

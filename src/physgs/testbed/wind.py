@@ -29,7 +29,14 @@ class WindField:
     ti: float
 
     def speed(self, t: np.ndarray) -> np.ndarray:
-        """Wind speed (m/s) at times t [T] (s) -> [T]; unit-variance turbulence scaled by v0*ti."""
+        """Wind speed (m/s) at times t [T] (s) -> [T]; unit-variance turbulence scaled by v0*ti.
+
+        Args:
+            t: [T] times, s.
+
+        Returns:
+            [T] wind speed, m/s.
+        """
         t = np.asarray(t, dtype=np.float64)
         K = len(self.freqs)
         s = np.zeros_like(t)
@@ -50,7 +57,20 @@ def make_wind(
 ) -> WindField:
     """A flat-spectrum realisation on the grid f = k / period_s inside [f_lo_hz, f_hi_hz].
 
-    period_s (s) must exceed the whole record (lead-in included) so the record never repeats.
+    Args:
+        v0: mean wind speed, m/s.
+        turbulence_intensity: the speed's standard deviation over its mean.
+        f_lo_hz: the band's lower edge, Hz.
+        f_hi_hz: the band's upper edge, Hz.
+        seed_seq: seeds the phases.
+        period_s: the realisation's period, s; must exceed the whole record (lead-in included)
+            so the record never repeats.
+
+    Returns:
+        The [`WindField`][physgs.testbed.wind.WindField]: frequencies on the grid, uniform phases.
+
+    Raises:
+        WindError: for an empty band.
     """
     if not 0 < f_lo_hz < f_hi_hz:
         raise WindError(

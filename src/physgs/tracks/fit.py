@@ -1,10 +1,10 @@
 """Ours' wind-driven oscillators fitted to 2D point tracks instead of to pixels (no renderer).
 
-Tracks (``physgs.tracks.track``) are grouped into K parts by k-means on their seed positions (px).
+Tracks ([`physgs.tracks.track`][]) are grouped into K parts by k-means on their seed positions (px).
 Part p swings by theta_p(t), the response of the *same* oscillator as ours: omega_p and zeta_p
-through ``physgs.models.oscillator_params`` (ours' bounds, initialisation and raw maps), driven by
+through [`physgs.models.oscillator_params`][] (ours' bounds, initialisation and raw maps), driven by
 v(t)^2 - vbar^2 of each condition's observed wind with its lead-in, integrated from rest by
-``physgs.models.oscillator.integrate`` (RK4, ours' substeps), vbar = vbar_ratio * mean(wind).
+[`physgs.models.oscillator.integrate`][] (RK4, ours' substeps), vbar = vbar_ratio * mean(wind).
 
 Image of the motion: track i of part p sits at
 
@@ -86,7 +86,19 @@ class Oscillators:
     @staticmethod
     def from_config(ours_cfg: dict, observed) -> Oscillators:
         """From ``models.ours`` (omega_hz, zeta, omega_init_hz, zeta_init, substeps, rk4_guard)
-        and an ``Observed`` (training condition = index 0)."""
+        and an ``Observed`` (training condition = index 0).
+
+        Args:
+            ours_cfg: the ``models.ours`` section.
+            observed (Observed): the dataset (fps, lead-in, training wind and vbar).
+
+        Returns:
+            The oscillators' settings, substeps raised as ours raises them
+                ([`prior_substeps`][physgs.models.ours.prior_substeps]).
+
+        Raises:
+            ValueError: for inconsistent bounds.
+        """
         b = OscillatorBounds.from_config(
             ours_cfg["omega_hz"], ours_cfg["zeta"], ours_cfg["omega_init_hz"], ours_cfg["zeta_init"]
         )
@@ -104,7 +116,16 @@ class Oscillators:
         )
 
     def theta(self, omega, zeta, wind) -> torch.Tensor:
-        """[K, L+F] rad under one condition's wind [L+F] m/s (lead-in first), from rest."""
+        """[K, L+F] rad under one condition's wind [L+F] m/s (lead-in first), from rest.
+
+        Args:
+            omega (torch.Tensor): [K] natural frequencies, rad/s.
+            zeta (torch.Tensor): [K] damping ratios.
+            wind (ArrayLike): [L+F] the condition's wind, m/s.
+
+        Returns:
+            [K, L+F] angles, rad, in the dtype of omega, at the shared gain.
+        """
         g = torch.full_like(omega, self.gain)
         vbar = condition_vbar(self.vbar_ratio, wind)
         return integrate(
@@ -114,7 +135,20 @@ class Oscillators:
 
 def track_parts(seed_xy: np.ndarray, K: int, seed: int, n_init: int = 4) -> np.ndarray:
     """[P] int labels in [0, K): k-means on the tracks' seed positions seed_xy [P, 2] px.
-    Deterministic for ``seed``; parts numbered bottom of the image first (largest y), then x."""
+    Deterministic for ``seed``; parts numbered bottom of the image first (largest y), then x.
+
+    Args:
+        seed_xy: [P, 2] the tracks' seed positions, px.
+        K: number of parts.
+        seed: the k-means seed.
+        n_init: k-means restarts.
+
+    Returns:
+        [P] int64 labels.
+
+    Raises:
+        ValueError: for K < 1 or K above the number of tracks.
+    """
     seed_xy = np.asarray(seed_xy, np.float64)
     if K < 1:
         raise ValueError(f"models.configs K must be >= 1 for the tracks control, got {K}")
@@ -329,7 +363,18 @@ def part_theta(fit: TrackFit, osc: Oscillators, wind) -> np.ndarray:
 def predict_tracks(fit: TrackFit, osc: Oscillators, entry: int, wind, frames) -> np.ndarray:
     """[P, F, 2] px: the tracks of fitted condition ``fit.conditions[entry]`` predicted at recorded
     frames [F] under a condition's wind [L+F] (its own, or another for transfer); NaN rows for
-    tracks that were not fitted."""
+    tracks that were not fitted.
+
+    Args:
+        fit: the fit.
+        osc: its oscillators.
+        entry: the index into ``fit.conditions`` whose tracks are predicted.
+        wind (ArrayLike): [L+F] the wind to predict under, m/s.
+        frames (ArrayLike): [F] recorded-frame indices.
+
+    Returns:
+        [P, F, 2] predicted positions, px.
+    """
     th = part_theta(fit, osc, wind)[:, osc.lead_in + np.asarray(frames)]  # [K, F]
     lab = fit.labels[entry]
     out = fit.c[entry][:, None, :] + fit.d[entry][:, None, :] * th[np.maximum(lab, 0)][..., None]

@@ -1,5 +1,5 @@
 """Recovery of the tracks control's oscillators against the truth file (evaluation only), through
-the same matcher, trusted-part rule and records as ours (``physgs.recovery``)."""
+the same matcher, trusted-part rule and records as ours ([`physgs.recovery`][])."""
 
 from __future__ import annotations
 
@@ -37,7 +37,12 @@ class TracksRecovery:
         return int(self.no_estimate.size)
 
     def to_dict(self) -> dict:
-        """The tracks control's summary: match scores, median zeta, the parts' track counts."""
+        """The tracks control's summary: match scores, median zeta, the parts' track counts.
+
+        Returns:
+            ``n_parts``, ``n_trusted``, ``median_rel_err``, ``loglog_r2``, ``median_zeta``,
+                ``n_no_estimate``, ``no_estimate``, ``n_tracks_per_part`` and ``min_tracks``.
+        """
         m = self.record.match
         return {
             "n_parts": int(m.n_parts),
@@ -63,11 +68,25 @@ def recover_tracks(
 ) -> TracksRecovery:
     """Match the fitted parts to bones under the training wind over the training window.
 
-    bone_visible [B] bool: also score the parts matched to visible bones (as ours' recovery);
-    damping: {zeta_range, seed} to also score each trusted part's zeta against its bone's and
-    against the untrained draw from zeta_range (``physgs.recovery.damping_scores``, tab_damping),
-    exactly as ``physgs.recovery.run.recover_model`` does for ours; min_tracks: the fewest
-    tracks a part needed (recorded beside each part's count).
+    Args:
+        fit: the fit.
+        osc: its oscillators.
+        observed (Observed): the dataset.
+        truth (Truth): its ground truth.
+        bone_visible (np.ndarray | None): [B] bool: also score the parts matched to visible bones
+            (as ours' recovery).
+        damping: ``{zeta_range, seed}`` to also score each trusted part's zeta against its bone's
+            and against the untrained draw from zeta_range
+            ([`physgs.recovery.damping_scores`][physgs.recovery.damping_scores], tab_damping),
+            exactly as [`recover_model`][physgs.recovery.run.recover_model] does for ours.
+        min_tracks: the fewest tracks a part needed (recorded beside each part's count).
+
+    Returns:
+        The [`TracksRecovery`][physgs.tracks.recover.TracksRecovery]: the record, the parts
+            without an estimate and the median zeta of those with one.
+
+    Raises:
+        RuntimeError: if a part without an estimate were matched as trusted.
     """
     th = part_theta(fit, osc, np.asarray(observed.wind[0], np.float64))  # [K, L+F]
     rec = score_recovery(
@@ -87,14 +106,29 @@ def recover_tracks(
 
 
 def save_tracks_recovery(path, rec: TracksRecovery) -> None:
-    """Ours' recovery record (``physgs.recovery.record.load_recovery`` reads it) plus a
+    """Ours' recovery record ([`physgs.recovery.record.load_recovery`][] reads it) plus a
     ``tracks`` block: the parts with no estimate (too few tracks), each part's track count
-    and the minimum, so a part left out of the trusted count is never silently dropped."""
+    and the minimum, so a part left out of the trusted count is never silently dropped.
+
+    Args:
+        path (str | Path): the JSON to write.
+        rec: the tracks control's recovery.
+    """
     write_json(path, {**recovery_dict(rec.record), "tracks": rec.to_dict()})
 
 
 def load_tracks_block(path) -> dict:
-    """The ``tracks`` block of a record written by ``save_tracks_recovery``."""
+    """The ``tracks`` block of a record written by ``save_tracks_recovery``.
+
+    Args:
+        path (str | Path): the JSON record.
+
+    Returns:
+        The block's dict.
+
+    Raises:
+        IntermediateFileError: when the file is missing, corrupt or lacks the block.
+    """
     from physgs.intermediate import read_json
 
     return read_json(path, ("tracks",), rule="tracks_evaluate")["tracks"]

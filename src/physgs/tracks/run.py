@@ -19,11 +19,21 @@ from physgs.tracks.track import Tracks
 
 
 def fit_job(tracks: list[Tracks], observed, job: dict) -> tuple[TrackFit, Oscillators]:
-    """Fit the oscillators of one configuration. tracks: one per condition of
-    ``job["conditions"]``, in that order; job: ``physgs.tracks.settings.fit_job``.
+    """Fit the oscillators of one configuration.
 
-    Raises ValueError naming ``job["K_key"]`` when K exceeds the tracks long enough to fit
-    (>= min_track_frames frames), which is only known once the video is tracked."""
+    Args:
+        tracks: one per condition of ``job["conditions"]``, in that order.
+        observed (Observed): the dataset.
+        job: [`fit_job`][physgs.tracks.settings.fit_job] of the settings.
+
+    Returns:
+        ``(fit, oscillators)``.
+
+    Raises:
+        ValueError: naming ``job["K_key"]`` when K exceeds the tracks long enough to fit
+            (>= min_track_frames frames), which is only known once the video is tracked; also when
+            the track files do not match the conditions.
+    """
     if len(tracks) != len(job["conditions"]):
         raise ValueError(
             f"fit_job: {len(tracks)} track files for conditions {job['conditions']}; the rule "
@@ -63,7 +73,14 @@ def fit_job(tracks: list[Tracks], observed, job: dict) -> tuple[TrackFit, Oscill
 
 def motion_cases(observed) -> list[tuple[str, int, np.ndarray]]:
     """(name, condition, recorded frames) scored for motion: "tail" (the training wind's frames
-    n_train..F-1, beyond the window) and "wind<c>" (condition c >= 1's window frames)."""
+    n_train..F-1, beyond the window) and "wind<c>" (condition c >= 1's window frames).
+
+    Args:
+        observed (Observed): the dataset.
+
+    Returns:
+        ``(name, condition, frames)`` per case, frames an int array.
+    """
     T = int(observed.n_train)
     F = T + int(observed.n_tail)
     out = [("tail", 0, np.arange(T, F))]
@@ -79,8 +96,20 @@ def _fitted(fit: TrackFit) -> np.ndarray:
 
 def models_at_tracks(models: dict, fit: TrackFit, tracks0: Tracks, observed, truth) -> dict:
     """Each trained Gaussian model's prediction of the fitted tracked points, scored as the
-    control's: {case (``motion_cases``): {name: motion_errors}}, each model's displacement measured
-    since each track's seed frame. models: name -> model (``gaussians_at``)."""
+    control's, each model's displacement measured since each track's seed frame.
+
+    Args:
+        models: name -> trained model (``gaussians_at``).
+        fit: the tracks control's fit.
+        tracks0: the tracks of condition 0.
+        observed (Observed): the dataset.
+        truth (Truth): its ground truth.
+
+    Returns:
+        ``{case: {name: motion_errors}}``, cases from
+            [`motion_cases`][physgs.tracks.run.motion_cases], errors from
+            [`motion_errors`][physgs.tracks.score.motion_errors].
+    """
     from physgs.evaluate.adapter import model_means_fn
     from physgs.tracks.score import associate, model_point_tracks, motion_errors
 
@@ -114,13 +143,29 @@ def evaluate_job(
     min_tracks: int = -1,
     ours=None,
 ) -> tuple[TracksRecovery, dict]:
-    """Score one fit against the truth. tracks0: the tracks of condition 0 (the fit's first
-    entry); ours: ours' trained model in the same configuration (None: not scored).
+    """Score one fit against the truth.
 
-    Returns (recovery, scores): scores = {"tracker": ``TrackerScore`` dict of tracks0,
-    "fit": {K, seconds, loop_seconds, rms_px, n_fitted}, and per motion case (``motion_cases``)
-    {"tracks": motion_errors of the control, "ours": the same of ours' Gaussians at the same
-    tracked points (``models_at_tracks``)}}.
+    Args:
+        fit: the fit.
+        osc: its oscillators.
+        tracks0: the tracks of condition 0 (the fit's first entry).
+        observed (Observed): the dataset.
+        truth (Truth): its ground truth.
+        bone_visible (np.ndarray | None): [B] bool; also score the parts matched to visible bones.
+        damping: ``{zeta_range, seed}`` to score the damping too.
+        min_tracks: the fewest tracks a part needed.
+        ours (OscillatorPrior | None): ours' trained model in the same configuration (None: not
+            scored).
+
+    Returns:
+        ``(recovery, scores)``: scores = {"tracker": ``TrackerScore`` dict of tracks0, "fit": {K,
+            seconds, loop_seconds, rms_px, n_fitted, n_estimated}, and per motion case
+            ([`motion_cases`][physgs.tracks.run.motion_cases]) {"tracks": motion_errors of the
+            control, "ours": the same of ours' Gaussians at the same tracked points
+            ([`models_at_tracks`][physgs.tracks.run.models_at_tracks])}}.
+
+    Raises:
+        ValueError: when the fit's first condition is not the training one.
     """
     from physgs.tracks.score import motion_errors, score_tracker
 

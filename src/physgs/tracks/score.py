@@ -22,7 +22,17 @@ ASSOC_RADIUS_PX = 1.0
 
 def project_vertices(truth, camera, condition: int, frames: np.ndarray) -> np.ndarray:
     """[F, N, 2] px: every mesh vertex (mesh order) projected by ``camera`` at recorded frames
-    ``frames`` [F] of ``condition`` (true bone angles ``truth.theta[condition, L + j]``)."""
+    ``frames`` [F] of ``condition`` (true bone angles ``truth.theta[condition, L + j]``).
+
+    Args:
+        truth (Truth): the dataset's ground truth.
+        camera (Camera): the camera.
+        condition: the wind condition's index.
+        frames: [F] recorded-frame indices.
+
+    Returns:
+        [F, N, 2] pixel positions.
+    """
     L = int(truth.lead_in_frames)
     V = kinematics.pose_vertices(truth, truth.theta[condition, L + np.asarray(frames)])  # [F, N, 3]
     F, N = V.shape[:2]
@@ -31,7 +41,17 @@ def project_vertices(truth, camera, condition: int, frames: np.ndarray) -> np.nd
 
 
 def associate(truth, camera, tracks: Tracks, condition: int) -> np.ndarray:
-    """[P] mesh vertex index of each track (see the module docstring), at its seed frame."""
+    """[P] mesh vertex index of each track (see the module docstring), at its seed frame.
+
+    Args:
+        truth (Truth): the dataset's ground truth.
+        camera (Camera): the camera the tracks were made in.
+        tracks: the tracks.
+        condition: the wind condition's index of their video.
+
+    Returns:
+        [P] int64 vertex indices.
+    """
     L = int(truth.lead_in_frames)
     out = np.empty(tracks.n_tracks, np.int64)
     first = tracks.first_xy()  # [P, 2]
@@ -47,7 +67,18 @@ def associate(truth, camera, tracks: Tracks, condition: int) -> np.ndarray:
 
 
 def truth_tracks(truth, camera, vertices: np.ndarray, condition: int, frames) -> np.ndarray:
-    """[P, F, 2] px: vertices [P] (mesh order) projected at recorded frames [F] of condition."""
+    """[P, F, 2] px: vertices [P] (mesh order) projected at recorded frames [F] of condition.
+
+    Args:
+        truth (Truth): the dataset's ground truth.
+        camera (Camera): the camera.
+        vertices: [P] mesh vertex indices.
+        condition: the wind condition's index.
+        frames (ArrayLike): [F] recorded-frame indices.
+
+    Returns:
+        [P, F, 2] pixel positions.
+    """
     uv = project_vertices(truth, camera, condition, frames)  # [F, N, 2]
     return np.transpose(uv[:, np.asarray(vertices)], (1, 0, 2))
 
@@ -75,18 +106,40 @@ class TrackerScore:
     median_start_px: float
 
     def to_dict(self) -> dict:
-        """The score as a plain dict (field name -> value)."""
+        """The score as a plain dict (field name -> value).
+
+        Returns:
+            Field name -> value.
+        """
         return asdict(self)
 
 
 def track_errors(tracks: Tracks, gt: np.ndarray) -> np.ndarray:
-    """[P, T] px distance between tracks and their truth gt [P, T, 2]; NaN where not valid."""
+    """[P, T] px distance between tracks and their truth gt [P, T, 2]; NaN where not valid.
+
+    Args:
+        tracks: the tracks, xy [P, T, 2] px.
+        gt: [P, T, 2] their true paths, px.
+
+    Returns:
+        [P, T] errors, px.
+    """
     e = np.linalg.norm(tracks.xy - gt, axis=-1)
     return np.where(tracks.valid, e, np.nan)
 
 
 def score_tracker(tracks: Tracks, truth, camera, condition: int = 0) -> TrackerScore:
-    """Score tracks [P, T] of ``condition``'s training-camera video over its T frames."""
+    """Score tracks [P, T] of ``condition``'s training-camera video over its T frames.
+
+    Args:
+        tracks: the tracks of the video.
+        truth (Truth): the dataset's ground truth.
+        camera (Camera): the training camera.
+        condition: the video's wind condition.
+
+    Returns:
+        The [`TrackerScore`][physgs.tracks.score.TrackerScore] (NaN scores without tracks).
+    """
     T = tracks.xy.shape[1]
     if tracks.n_tracks == 0:
         nan = float("nan")
@@ -124,19 +177,29 @@ def motion_errors(
     fit_condition: int = 0,
     seed_xy: np.ndarray | None = None,
 ) -> dict:
-    """Pixel errors of predicted tracks pred [P, F, 2] (rows NaN for unfitted tracks) of the
-    tracks ``tracks`` (seeded in the video of ``fit_condition``) at recorded ``frames`` [F] of
-    ``condition``, against their associated vertices' true paths.
+    """Pixel errors of predicted tracks at recorded frames, against their associated vertices'
+    true paths.
 
-    Returns {"median_px": raw position error, "motion_median_px": error after removing each
-    track's association offset (track minus vertex at its seed frame, measured once in the fitted
-    video: the vertex is not the tracked point), "static_median_px": the same for a motionless
-    prediction at each track's mean tracked position (the no-physics baseline), "n_tracks"}.
+    Args:
+        pred: [P, F, 2] predicted positions, px (rows NaN for unfitted tracks).
+        tracks: the tracks (seeded in the video of ``fit_condition``).
+        truth (Truth): the dataset's ground truth.
+        camera (Camera): the training camera.
+        condition: the wind condition of ``frames``.
+        frames (ArrayLike): [F] recorded-frame indices.
+        fit_condition: the condition whose video the tracks come from.
+        seed_xy: [P, 2] px, the position the offset is measured from, in place of the tracked one
+            at each seed frame: a model scored at the tracked points
+            ([`model_point_tracks`][physgs.tracks.score.model_point_tracks]) passes its own
+            position at the seed frame, so its motion error is, like the tracks control's, the
+            error of its displacement since the seed frame.
 
-    seed_xy [P, 2] px: the position the offset is measured from, in place of the tracked one at
-    each seed frame: a model scored at the tracked points (``model_point_tracks``) passes its own
-    position at the seed frame, so its motion error is, like the tracks control's, the error of
-    its displacement since the seed frame.
+    Returns:
+        ``{"median_px": raw position error, "motion_median_px": error after removing each
+            track's association offset (track minus vertex at its seed frame, measured once in
+            the fitted video: the vertex is not the tracked point), "static_median_px": the same
+            for a motionless prediction at each track's mean tracked position (the no-physics
+            baseline), "n_tracks"}``; NaN errors and 0 tracks when no row is fitted.
     """
     ok = np.isfinite(pred).all(axis=(1, 2))
     if not ok.any():
@@ -169,11 +232,23 @@ def motion_errors(
 def model_point_tracks(
     means_fn, truth, camera, vertices: np.ndarray, condition: int, frames
 ) -> np.ndarray:
-    """[P, F, 2] px: a Gaussian model's prediction at mesh vertices ``vertices`` [P] (the
-    tracked points' vertices, ``associate``): the projection by ``camera`` of each vertex's
-    Gaussian (``truth.vertex_gaussian``: the observed Gaussians are stored in a random order)
-    at recorded ``frames`` [F] of ``condition``. means_fn(frame, condition) -> [N, 3] world
-    (``physgs.evaluate.adapter.model_means_fn``)."""
+    """A Gaussian model's prediction at the tracked points' mesh vertices.
+
+    The projection by ``camera`` of each vertex's Gaussian (``truth.vertex_gaussian``: the observed
+    Gaussians are stored in a random order) at recorded ``frames`` of ``condition``.
+
+    Args:
+        means_fn (Callable): ``means_fn(frame, condition) -> [N, 3]`` world units
+            ([`model_means_fn`][physgs.evaluate.adapter.model_means_fn]).
+        truth (Truth): the dataset's ground truth.
+        camera (Camera): the camera.
+        vertices: [P] mesh vertex indices ([`associate`][physgs.tracks.score.associate]).
+        condition: the wind condition's index.
+        frames (ArrayLike): [F] recorded-frame indices.
+
+    Returns:
+        [P, F, 2] pixel positions.
+    """
     gauss = np.asarray(truth.vertex_gaussian, np.int64)[np.asarray(vertices, np.int64)]
     frames = np.asarray(frames, np.int64)
     xyz = np.stack([np.asarray(means_fn(int(j), condition))[gauss] for j in frames], axis=1)

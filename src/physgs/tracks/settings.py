@@ -7,7 +7,7 @@ editing a tracker setting leaves ours' jobs alone.
 Config: ``tracks`` (``configs``: which of ``models.configs`` the control is fitted in, with their
 conditions and K; ``K``: ``same`` for each configuration's own K, or one integer for every
 configuration; ``iterations``, ``min_track_frames``, ``min_tracks``, ``kmeans_n_init``: the fit;
-``tracker``: ``physgs.tracks.track.TrackSettings``; ``fields``: the learned fields scored at
+``tracker``: [`physgs.tracks.track.TrackSettings`][]; ``fields``: the learned fields scored at
 the tracked points beside ours), ``models.ours`` (the oscillator's bounds,
 initialisation, RK4 substeps and guard) and ``train.lr.physics`` (Adam's rate on omega/zeta).
 """
@@ -21,12 +21,30 @@ OURS_KEYS = ("omega_hz", "zeta", "omega_init_hz", "zeta_init", "substeps", "rk4_
 
 
 def tracker_settings(cfg: dict) -> dict:
-    """The tracker's settings (``TrackSettings`` fields), the only params of rule ``track``."""
+    """The tracker's settings (``TrackSettings`` fields), the only params of rule ``track``.
+
+    Args:
+        cfg: the resolved config.
+
+    Returns:
+        A copy of ``tracks.tracker``.
+    """
     return dict(cfg["tracks"]["tracker"])
 
 
 def condition_indices(spec: str, n_conditions: int) -> list[int]:
-    """Conditions a configuration fits: 'train' -> [0], 'all' -> every one (as ours trains)."""
+    """Conditions a configuration fits: 'train' -> [0], 'all' -> every one (as ours trains).
+
+    Args:
+        spec: ``'train'`` or ``'all'``.
+        n_conditions: the dataset's condition count.
+
+    Returns:
+        The condition indices.
+
+    Raises:
+        ValueError: for any other ``spec``.
+    """
     if spec == "train":
         return [0]
     if spec == "all":
@@ -54,8 +72,17 @@ def fields_scored(cfg: dict, config: str, testbed: str) -> list[str]:
     """The learned fields of ``tracks.fields`` scored at the tracked points beside ours in
     configuration ``config`` on ``testbed`` (a tree or a damping variant's id): those the
     pipeline trains there anyway, i.e. in the base configuration on a faithful testbed (the
-    fields train in ``single`` only, ``physgs.models.registry.configs_for``, and on the damping
-    benchmark's testbeds only ours and its variants train)."""
+    fields train in ``single`` only, [`physgs.models.registry.configs_for`][], and on the damping
+    benchmark's testbeds only ours and its variants train).
+
+    Args:
+        cfg: the resolved config.
+        config: a configuration name.
+        testbed: a testbed id.
+
+    Returns:
+        Model ids from ``tracks.fields``, in its order.
+    """
     from physgs.models.registry import configs_for
     from physgs.testbed.variant import FAITHFUL, parse_id
 

@@ -1,6 +1,6 @@
 """Files of the tracks control: one video's tracks, and one fit with the oscillators it used.
 
-Both are .npz written atomically (``physgs.atomic.save_npz``). A fit file carries the
+Both are .npz written atomically ([`physgs.atomic.save_npz`][]). A fit file carries the
 ``Oscillators`` it was fitted with (bounds, RK4 substeps, frame rate, lead-in, calibration ratio,
 gain, guard), so its evaluation integrates exactly the fitted model without reading the config.
 """
@@ -26,7 +26,13 @@ TRACKS_RULE, FIT_RULE = "track", "fit_tracks"
 
 
 def save_tracks(path, tracks: Tracks, condition: int) -> None:
-    """Tracks of condition ``condition``'s training-camera video (``Tracks`` fields, px)."""
+    """Tracks of condition ``condition``'s training-camera video (``Tracks`` fields, px).
+
+    Args:
+        path (str | Path): the ``.npz`` to write.
+        tracks: the tracks.
+        condition: the wind condition's index.
+    """
     save_npz(
         path,
         xy=tracks.xy,
@@ -37,7 +43,17 @@ def save_tracks(path, tracks: Tracks, condition: int) -> None:
 
 
 def load_tracks(path) -> tuple[Tracks, int]:
-    """(Tracks, condition index) from ``save_tracks``."""
+    """(Tracks, condition index) from ``save_tracks``.
+
+    Args:
+        path (str | Path): the ``.npz``.
+
+    Returns:
+        ``(tracks, condition)``.
+
+    Raises:
+        IntermediateFileError: when the file is missing, corrupt or inconsistent (it is removed).
+    """
     d = read_npz(path, ("xy", "valid", "start", "condition"), rule=TRACKS_RULE)
     xy, valid, start = d["xy"], d["valid"], d["start"]
     P = xy.shape[0] if xy.ndim == 3 else -1
@@ -53,8 +69,15 @@ def load_tracks(path) -> tuple[Tracks, int]:
 
 
 def save_fit(path, fit: TrackFit, osc: Oscillators, K_key: str, min_tracks: int) -> None:
-    """A fit and its oscillators. K_key: the config key that set K (named by the evaluation);
-    min_tracks: the fewest tracks a part needed for an estimate."""
+    """A fit and its oscillators.
+
+    Args:
+        path (str | Path): the ``.npz`` to write.
+        fit: the fit.
+        osc: its oscillators.
+        K_key: the config key that set K (named by the evaluation).
+        min_tracks: the fewest tracks a part needed for an estimate.
+    """
     arrays = {
         "omega": fit.omega,
         "zeta": fit.zeta,
@@ -82,7 +105,17 @@ def save_fit(path, fit: TrackFit, osc: Oscillators, K_key: str, min_tracks: int)
 
 
 def load_fit(path) -> tuple[TrackFit, Oscillators, dict]:
-    """(TrackFit, Oscillators, {"K_key", "min_tracks"}) from ``save_fit``."""
+    """(TrackFit, Oscillators, {"K_key", "min_tracks"}) from ``save_fit``.
+
+    Args:
+        path (str | Path): the ``.npz``.
+
+    Returns:
+        ``(fit, oscillators, {"K_key", "min_tracks"})``.
+
+    Raises:
+        IntermediateFileError: when the file is missing, corrupt or lacks an entry (it is removed).
+    """
     from physgs.models.oscillator_params import OscillatorBounds
     from physgs.tracks.fit import Oscillators, TrackFit
 

@@ -19,7 +19,7 @@ Method:
 - re-seeding: every ``reseed_every`` frames, new seeds are detected in the current frame away
   (``min_distance_px``) from the live tracks, up to ``max_tracks`` live tracks.
 
-Pixel convention: the package's (``physgs.camera``): pixel centres at integer + 0.5. OpenCV puts
+Pixel convention: the package's ([`physgs.camera`][]): pixel centres at integer + 0.5. OpenCV puts
 them at integers, so positions are shifted by +0.5 px on the way out.
 """
 
@@ -85,7 +85,11 @@ class TrackSettings:
             )
 
     def to_dict(self) -> dict:
-        """The settings as a plain dict (field name -> value)."""
+        """The settings as a plain dict (field name -> value).
+
+        Returns:
+            Field name -> value.
+        """
         return asdict(self)
 
 
@@ -105,16 +109,34 @@ class Tracks:
         return int(self.xy.shape[0])
 
     def length(self) -> np.ndarray:
-        """[P] frames each track is valid on."""
+        """[P] frames each track is valid on.
+
+        Returns:
+            [P] int counts.
+        """
         return self.valid.sum(axis=1)
 
     def first_xy(self) -> np.ndarray:
-        """[P, 2] px, each track's position at its seed frame."""
+        """[P, 2] px, each track's position at its seed frame.
+
+        Returns:
+            [P, 2] positions, px.
+        """
         return self.xy[np.arange(self.n_tracks), self.start]
 
 
 def to_gray(frames: np.ndarray) -> np.ndarray:
-    """[T, H, W, 3] uint8 RGB -> [T, H, W] uint8 luminance (OpenCV's weights)."""
+    """[T, H, W, 3] uint8 RGB -> [T, H, W] uint8 luminance (OpenCV's weights).
+
+    Args:
+        frames: [T, H, W, 3] uint8 RGB.
+
+    Returns:
+        [T, H, W] uint8.
+
+    Raises:
+        ValueError: for another shape or dtype.
+    """
     import cv2
 
     frames = np.asarray(frames)
@@ -125,7 +147,17 @@ def to_gray(frames: np.ndarray) -> np.ndarray:
 
 def foreground(frames: np.ndarray, background, tol: int, dilate_px: int) -> np.ndarray:
     """[T, H, W] bool: pixels of frames [T, H, W, 3] uint8 more than ``tol`` grey levels away from
-    the background colour ([3] in [0, 1]) in some channel, dilated by ``dilate_px`` px."""
+    the background colour ([3] in [0, 1]) in some channel, dilated by ``dilate_px`` px.
+
+    Args:
+        frames: [T, H, W, 3] uint8.
+        background (ArrayLike): [3] background colour in [0, 1].
+        tol: grey levels (0..255) a foreground pixel differs by.
+        dilate_px: dilation radius, px (0: none).
+
+    Returns:
+        [T, H, W] bool mask.
+    """
     import cv2
 
     bg = np.round(np.asarray(background, dtype=np.float64) * 255.0).astype(np.int16)
@@ -159,8 +191,17 @@ def _seeds(gray, fg, live_xy, s: TrackSettings, n_max: int) -> np.ndarray:
 
 def track_video(frames: np.ndarray, background, settings: TrackSettings | None = None) -> Tracks:
     """Track points through frames [T, H, W, 3] uint8 (one condition, training camera) over a
-    background of colour ``background`` ([3] in [0, 1]). Deterministic (no random state).
-    Returns Tracks with P the number of tracks ever started."""
+    background of colour ``background``. Deterministic (no random state).
+
+    Args:
+        frames: [T, H, W, 3] uint8.
+        background (ArrayLike): [3] background colour in [0, 1].
+        settings: the tracker's settings (default ``TrackSettings()``).
+
+    Returns:
+        The [`Tracks`][physgs.tracks.track.Tracks], P the number of tracks ever started (0 when
+            nothing is tracked).
+    """
     import cv2
 
     s = settings or TrackSettings()
@@ -231,7 +272,19 @@ def track_video(frames: np.ndarray, background, settings: TrackSettings | None =
 
 def track_condition(observed, condition: int, settings: dict) -> Tracks:
     """Tracks of condition ``condition``'s training-camera video over the training window
-    (frames 0..n_train-1: what a method may train on). settings: ``TrackSettings`` fields."""
+    (frames 0..n_train-1: what a method may train on).
+
+    Args:
+        observed (Observed): the dataset.
+        condition: the wind condition's index.
+        settings: [`TrackSettings`][physgs.tracks.track.TrackSettings] fields.
+
+    Returns:
+        The [`Tracks`][physgs.tracks.track.Tracks].
+
+    Raises:
+        ValueError: for a condition the dataset does not have.
+    """
     if not 0 <= condition < len(observed.conditions):
         raise ValueError(f"condition {condition} is not one of the {len(observed.conditions)}")
     frames = np.asarray(observed.frames[condition, : int(observed.n_train)])

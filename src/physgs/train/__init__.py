@@ -1,6 +1,6 @@
 """Training: one loop for every model (Adam, L1 + D-SSIM, shared warm-up and schedule).
 
-The recipe that seeds, builds and trains a job is ``physgs.experiments.recipe``."""
+The recipe that seeds, builds and trains a job is [`physgs.experiments.recipe`][]."""
 
 from physgs.train.loop import (
     TrainingError,

@@ -90,8 +90,14 @@ class Divergence:
 def pinned(positions: Mapping[str, np.ndarray], group: str = "physics") -> Divergence | None:
     """A Divergence when every bounded parameter sits on a bound (within PIN_TOL), else None.
 
-    positions: name -> [n] places between the bounds, 0..1 (``BaseModel.bounded_positions``);
-    group: the parameter group (``train.lr`` key) that trains them.
+    Args:
+        positions: name -> [n] places between the bounds, 0..1
+            ([`bounded_positions`][physgs.models.base.BaseModel.bounded_positions]).
+        group: the parameter group (``train.lr`` key) that trains them.
+
+    Returns:
+        The [`Divergence`][physgs.train.divergence.Divergence] naming ``group``, or None (also
+            when there is no bounded parameter).
     """
     arrays = {k: np.asarray(v, np.float64).ravel() for k, v in positions.items()}
     n = sum(a.size for a in arrays.values())
@@ -134,8 +140,22 @@ class DivergenceGuard:
     def build(
         cls, canonical_xyz, params: Mapping[str, object], group: Mapping[str, str], warmup: int
     ) -> "DivergenceGuard":
-        """Guard from the canonical positions [N, 3] (world units), the initial parameters
-        (name -> array, or its largest |value|), each parameter's group, and the warm-up length."""
+        """Guard from the canonical positions, the initial parameters, their groups and the warm-up.
+
+        Args:
+            canonical_xyz (ArrayLike): [N, 3] canonical positions, world units (their box's centre
+                and half-diagonal set the scene's centre and extent).
+            params: name -> array, or its largest |value| (the initial scale, at least 1).
+            group: each parameter's group (``train.lr`` key).
+            warmup: static warm-up iterations.
+
+        Returns:
+            The guard.
+
+        Raises:
+            ValueError: for positions that are not finite [N > 0, 3], or a parameter without a
+                group.
+        """
         xyz = np.asarray(canonical_xyz, dtype=np.float64)
         if xyz.ndim != 2 or xyz.shape[1] != 3 or xyz.shape[0] == 0 or not np.isfinite(xyz).all():
             raise ValueError(
@@ -154,14 +174,25 @@ class DivergenceGuard:
 
     def growth(self) -> dict[str, float]:
         """Group -> largest |value| / initial scale over its parameters at the last check_params
-        (empty before the first)."""
+        (empty before the first).
+
+        Returns:
+            A copy of the growth ratios by group.
+        """
         return dict(self._growth)
 
     def suspects(self, groups) -> tuple[str, ...]:
         """``groups`` (those present) ordered by growth at the last check_params, largest first,
         leaving out those grown less than SUSPECT_SHARE of the largest (a group that did not
         move is no suspect next to one that did). While no group has grown past SUSPECT_GROWN,
-        growth says nothing: all of them, in the order given."""
+        growth says nothing: all of them, in the order given.
+
+        Args:
+            groups (Iterable[str]): candidate groups (duplicates and absent groups dropped).
+
+        Returns:
+            The suspect groups, most grown first.
+        """
         present = [g for g in dict.fromkeys(groups) if g in set(self.group.values())]
         top = max((self._growth.get(g, 0.0) for g in present), default=0.0)
         if top <= SUSPECT_GROWN:
@@ -170,18 +201,36 @@ class DivergenceGuard:
         return tuple(g for g in ranked if self._growth.get(g, 0.0) >= SUSPECT_SHARE * top)
 
     def deformation_groups(self) -> tuple[str, ...]:
-        """The groups that deform the canonical set (none for the static model)."""
+        """The groups that deform the canonical set (none for the static model).
+
+        Returns:
+            The guard's groups that are not in ``CANONICAL_GROUPS``, in first-seen order.
+        """
         return tuple(g for g in dict.fromkeys(self.group.values()) if g not in CANONICAL_GROUPS)
 
     def deformation_suspects(self) -> tuple[str, ...]:
-        """The deformation groups by growth, or, for a model without any, the canonical ones."""
+        """The deformation groups by growth, or, for a model without any, the canonical ones.
+
+        Returns:
+            The suspect groups, most grown first.
+        """
         return self.suspects(self.deformation_groups() or CANONICAL_GROUPS)
 
     # -- checks ----------------------------------------------------------------------------------
 
     def check_params(self, params: Mapping[str, object]) -> Divergence | None:
         """Parameters (name -> array, or its largest |value|) after an optimiser step: a
-        non-finite value, or one grown past PARAM_GROWTH x its initial scale, diverged."""
+        non-finite value, or one grown past PARAM_GROWTH x its initial scale, diverged.
+
+        Args:
+            params: name -> array, or its largest |value|; every name must be one the guard was
+                built with.
+
+        Returns:
+            The [`Divergence`][physgs.train.divergence.Divergence] (every group over the limit, the
+                worst first), or None. Records each group's growth for
+                [`suspects`][physgs.train.divergence.DivergenceGuard.suspects].
+        """
         worst, worst_ratio = None, 0.0
         growth: dict[str, float] = {}
         for name, v in params.items():
@@ -211,7 +260,16 @@ class DivergenceGuard:
         )
 
     def check_means(self, means) -> Divergence | None:
-        """Gaussian positions [N, 3] (world units) about to be rendered."""
+        """Gaussian positions [N, 3] (world units) about to be rendered.
+
+        Args:
+            means (ArrayLike): [N, 3] Gaussian positions, world units.
+
+        Returns:
+            A [`Divergence`][physgs.train.divergence.Divergence] when a mean is not finite or more
+                than BOUNDS_FRACTION of them lie over BOUNDS_FACTOR x the extent from the centre,
+                else None.
+        """
         x = np.asarray(means)
         lo, hi = x.min(0), x.max(0)
         if not (np.isfinite(lo).all() and np.isfinite(hi).all()):
@@ -237,7 +295,17 @@ class DivergenceGuard:
         )
 
     def check_loss(self, it: int, loss: float) -> Divergence | None:
-        """The loss of iteration ``it`` (0-based, called once per iteration in order)."""
+        """The loss of iteration ``it`` (0-based, called once per iteration in order).
+
+        Args:
+            it: the iteration, 0-based.
+            loss: its loss.
+
+        Returns:
+            A [`Divergence`][physgs.train.divergence.Divergence] when the loss's recent median
+                exceeds LOSS_RATIO x its warm-up level (checked from LOSS_GRACE iterations after the
+                warm-up), else None.
+        """
         loss = float(loss)
         if it < self.warmup:
             self._warm.append(loss)

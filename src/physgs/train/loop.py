@@ -46,7 +46,18 @@ class TrainResult:
 
 
 def condition_indices(spec: str, n_conditions: int) -> list[int]:
-    """Wind conditions a configuration trains on: 'train' -> [0], 'all' -> every condition."""
+    """Wind conditions a configuration trains on: 'train' -> [0], 'all' -> every condition.
+
+    Args:
+        spec: ``'train'`` or ``'all'`` (a configuration's ``conditions``).
+        n_conditions: the dataset's condition count.
+
+    Returns:
+        The condition indices.
+
+    Raises:
+        ValueError: for any other ``spec``.
+    """
     if spec == "train":
         return [0]
     if spec == "all":
@@ -95,8 +106,8 @@ def train_model(
         ValueError: warmup outside [0, iterations), conditions or frame_pool out of range.
         TrainingError: the loss turns NaN or inf, the fit diverges (non-finite or exploding
             parameters, Gaussians far outside the scene, a loss far above its warm-up level:
-            ``physgs.train.divergence``), or the model's forward pass raises (chained); it names the
-            model, the iteration and the likely ``train.lr`` setting.
+            [`physgs.train.divergence`][]), or the model's forward pass raises (chained); it names
+            the model, the iteration and the likely ``train.lr`` setting.
     """
     name = name or model.name
     iterations, warmup = int(train_cfg["iterations"]), int(train_cfg["warmup"])
@@ -332,7 +343,12 @@ def _likely(groups, lr_cfg: dict, growth=None, scales=None, reach=None) -> str:
 
 
 def write_loss_log(path, log: list[dict]) -> None:
-    """Write the loss log as CSV atomically (temporary file, then rename)."""
+    """Write the loss log as CSV atomically (temporary file, then rename).
+
+    Args:
+        path (str | Path): the CSV to write.
+        log: one dict per logged iteration, keyed by ``LOG_FIELDS``.
+    """
     with atomic_path(path) as tmp, open(tmp, "w", newline="") as f:
         w = csv.DictWriter(f, fieldnames=LOG_FIELDS)
         w.writeheader()

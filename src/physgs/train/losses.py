@@ -133,7 +133,16 @@ def ssim(a: torch.Tensor, b: torch.Tensor, window: int = 11, sigma: float = 1.5)
 
 
 def photometric_loss(render: torch.Tensor, target: torch.Tensor, ssim_weight: float = 0.2):
-    """(loss, l1, dssim) for images [H, W, 3] in [0, 1]; loss = (1-w) L1 + w (1 - SSIM)."""
+    """(loss, l1, dssim) for images [H, W, 3] in [0, 1]; loss = (1-w) L1 + w (1 - SSIM).
+
+    Args:
+        render: [H, W, 3] the rendered image, in [0, 1].
+        target: [H, W, 3] the recorded image, in [0, 1].
+        ssim_weight: w, the D-SSIM share.
+
+    Returns:
+        (tuple[torch.Tensor, torch.Tensor, torch.Tensor]): ``(loss, l1, dssim)``, scalar tensors.
+    """
     l1 = (render - target).abs().mean()
     dssim = 1.0 - ssim(render, target)
     return (1.0 - ssim_weight) * l1 + ssim_weight * dssim, l1, dssim

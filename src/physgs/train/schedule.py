@@ -12,6 +12,16 @@ def lr_factor(group: str, it: int, iterations: int, warmup: int, final_ratio: fl
 
     Canonical means decay over the whole run; deformation groups (deform, physics, pivot) from
     the end of the static warm-up, so they get the same schedule whatever the warm-up length.
+
+    Args:
+        group: the parameter group (``train.lr`` key); groups outside ``DECAYING`` keep 1.
+        it: the iteration, 0-based.
+        iterations: training iterations.
+        warmup: static warm-up iterations.
+        final_ratio: the factor reached at the last iteration.
+
+    Returns:
+        final_ratio ** progress, progress in [0, 1] over the group's span.
     """
     if group not in DECAYING:
         return 1.0

@@ -22,8 +22,14 @@ def seed_everything(seed: int) -> None:
     """Seed torch's default generator (CPU and every CUDA device), numpy's legacy global
     generator (``np.random.seed``) and Python's ``random`` from ``seed``.
 
-    seed: a non-negative integer (the job's seed). Raises ValueError otherwise. numpy's legacy
-    seed must fit in 32 bits, so it gets ``seed mod 2**32``; torch and ``random`` get ``seed``.
+    numpy's legacy seed must fit in 32 bits, so it gets ``seed mod 2**32``; torch and ``random``
+    get ``seed``.
+
+    Args:
+        seed: a non-negative integer (the job's seed).
+
+    Raises:
+        ValueError: for anything else (a bool or negative number included).
     """
     if isinstance(seed, bool) or not isinstance(seed, (int, np.integer)) or seed < 0:
         raise ValueError(f"seed_everything: seed must be a non-negative integer, got {seed!r}")

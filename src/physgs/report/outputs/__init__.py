@@ -44,7 +44,14 @@ OUTPUTS: dict[str, Output] = {
 
 
 def reading(role: str) -> tuple[str, ...]:
-    """The outputs that read the models of ``role`` (what a new model of that role joins)."""
+    """The outputs that read the models of ``role`` (what a new model of that role joins).
+
+    Args:
+        role: a model role (``ROLES``).
+
+    Returns:
+        Output names, in ``OUTPUTS`` order.
+    """
     return tuple(n for n, o in OUTPUTS.items() if role in o.roles)
 
 

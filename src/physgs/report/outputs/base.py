@@ -41,12 +41,26 @@ NEED_FIELDS = {
 
 
 def key(need: tuple) -> str:
-    """The name of a need in the inputs mapping: its parts joined by '/'."""
+    """The name of a need in the inputs mapping: its parts joined by '/'.
+
+    Args:
+        need: a need tuple (kind, then its parts).
+
+    Returns:
+        The key.
+    """
     return "/".join(str(p) for p in need)
 
 
 def reader(inputs: Mapping[str, str]) -> Callable[..., str]:
-    """``path(*need)``: the file of a need in ``inputs`` (KeyError naming it when absent)."""
+    """``path(*need)``: the file of a need in ``inputs`` (KeyError naming it when absent).
+
+    Args:
+        inputs: need key -> path (the rule's inputs).
+
+    Returns:
+        The ``path`` function; it raises ``KeyError`` naming a need without a file.
+    """
 
     def path(*need) -> str:
         k = key(need)
@@ -90,7 +104,7 @@ class Plan:
         """The plan of a resolved config.
 
         Args:
-            cfg (dict): the resolved config (``physgs.config.load``).
+            cfg (dict): the resolved config ([`physgs.config.load`][]).
 
         Returns:
             Plan: its trees, configurations, seeds and study settings.

@@ -14,7 +14,15 @@ KSELECT_ROWS = tuple(c for c, _ in kselect.ROWS)
 
 
 def tracks_label(cfg: dict, config: str) -> str:
-    """The LaTeX label of the 2D-track control's configuration ``config`` with its own K."""
+    """The LaTeX label of the 2D-track control's configuration ``config`` with its own K.
+
+    Args:
+        cfg: the resolved config.
+        config: a configuration name.
+
+    Returns:
+        The label ([`config_label`][physgs.models.registry.config_label]).
+    """
     from physgs.tracks.settings import parts as tracks_k
 
     spec = {**cfg["models"]["configs"][config], "K": tracks_k(cfg, config)[0]}
@@ -23,12 +31,24 @@ def tracks_label(cfg: dict, config: str) -> str:
 
 def other_priors() -> tuple[str, ...]:
     """The priors besides ours (the paper's, read through the ``recovery`` need kind): each read
-    through ``prior_recovery`` and set beside ours' rows."""
+    through ``prior_recovery`` and set beside ours' rows.
+
+    Returns:
+        Prior ids in registry order, ``ours`` left out.
+    """
     return tuple(m for m in models_of("prior") if m != "ours")
 
 
 def oma_label(cfg: dict, config: str) -> str:
-    """The LaTeX label of the output-only analysis' configuration ``config`` with its own K."""
+    """The LaTeX label of the output-only analysis' configuration ``config`` with its own K.
+
+    Args:
+        cfg: the resolved config.
+        config: a configuration name.
+
+    Returns:
+        The label ([`config_label`][physgs.models.registry.config_label]).
+    """
     from physgs.oma.settings import parts as oma_k
 
     return config_label(config, {**cfg["models"]["configs"][config], "K": oma_k(cfg, config)})

@@ -41,7 +41,18 @@ def _conditions(cfg: dict) -> dict:
 
 
 def summaries(path, trees, models, seeds) -> dict:
-    """{seed: {(tree, model): summary}} of the models trained in the base configuration."""
+    """{seed: {(tree, model): summary}} of the models trained in the base configuration.
+
+    Args:
+        path (Callable[..., str]): the need -> file function of
+            [`reader`][physgs.report.outputs.base.reader].
+        trees (Sequence[str]): the trees.
+        models (Sequence[str]): the models.
+        seeds (Sequence[int]): the training seeds.
+
+    Returns:
+        ``{seed: {(tree, model): summary}}``, each summary split -> mean (dB; centroid errors px).
+    """
     return {
         s: {
             (t, m): load_eval(path("eval", t, m, BASE_CONFIG, s)).summary()
@@ -55,7 +66,17 @@ def summaries(path, trees, models, seeds) -> dict:
 def fit_row(eval_path, loss_path, n_train: int, holdout_every: int) -> dict:
     """One tab_fit row from a model's evaluation and loss log: fit and held-out-frame PSNR (dB,
     training camera and wind, frames < n_train), view and time PSNR (dB), training seconds
-    (NaN without a loss log)."""
+    (NaN without a loss log).
+
+    Args:
+        eval_path (str | Path): the model's evaluation ``.npz``.
+        loss_path (str | Path | None): its loss log CSV (its last ``seconds``), or None.
+        n_train: training-window length, frames.
+        holdout_every: the held-out stride (0: no held-out frames, ``heldout`` NaN).
+
+    Returns:
+        ``fit``, ``heldout``, ``view``, ``time`` (dB) and ``train_s`` (s).
+    """
     ev = load_eval(eval_path)
     cam = np.asarray(ev.camera_psnr[0, :n_train], dtype=np.float64)  # [n_train] dB
     if holdout_every:
@@ -74,7 +95,14 @@ def fit_row(eval_path, loss_path, n_train: int, holdout_every: int) -> dict:
 
 
 def fit_settings(cfg: dict) -> dict:
-    """What ``fit_row`` reads: the training window's length and its held-out stride."""
+    """What ``fit_row`` reads: the training window's length and its held-out stride.
+
+    Args:
+        cfg: the resolved config.
+
+    Returns:
+        ``n_train`` and ``holdout_every``.
+    """
     return {
         "n_train": int(cfg["testbed"]["n_train"]),
         "holdout_every": int(cfg["train"]["holdout_every"]),
@@ -209,7 +237,14 @@ TAB_MARGIN = Output(
 
 # ---- figures -------------------------------------------------------------------------------
 def teaser_tree(trees: Sequence[str]) -> str:
-    """The tree the teaser shows: medium if built (the paper's clearest case), else the last."""
+    """The tree the teaser shows: medium if built (the paper's clearest case), else the last.
+
+    Args:
+        trees: the trees built.
+
+    Returns:
+        The tree's name.
+    """
     return "medium" if "medium" in trees else trees[-1]
 
 
