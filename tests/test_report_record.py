@@ -187,6 +187,29 @@ def test_headline_counts_the_verdicts_and_gives_each_story_claim_its_interval():
     assert "sparse **fails** (+1.27 [+0.56, +1.97] x)" in lines[2]
 
 
+def test_a_headline_family_of_another_prior_is_found_by_its_id_prefix():
+    claims = pd.DataFrame(
+        {
+            "id": [
+                "ours_chain/above_static_beyond/dense",
+                "ours_chain_blind/above_static_beyond/dense",  # another model: not the family
+                "anemometer_needed/sparse",
+            ],
+            "measured": [2.0, 9.0, 23.5],
+            "ci_low": [1.0, 8.0, -15.0],
+            "ci_high": [3.0, 10.0, 62.0],
+            "unit": ["dB", "dB", "points"],
+            "verdict": ["holds", "holds", "undecided: interval spans 0"],
+        }
+    )
+    lines = record.headline_lines(claims)
+    chain = [ln for ln in lines if ln.startswith("- The chained prior")]
+    assert len(chain) == 1 and "dense **holds** (+2 [+1, +3] dB)" in chain[0]
+    assert "+9" not in chain[0]
+    wind = [ln for ln in lines if ln.startswith("- Without the anemometer")]
+    assert len(wind) == 1 and "sparse **undecided** (+23.5 [-15, +62] points)" in wind[0]
+
+
 def test_costs_say_not_measured_rather_than_guess():
     lines = record.cost_lines(record.read_costs("/nonexistent/costs.csv"))
     assert len(lines) == 2 + len(record.COMMANDS)
