@@ -19,7 +19,7 @@ from __future__ import annotations
 from dataclasses import dataclass
 from pathlib import Path
 
-from typing import TYPE_CHECKING
+from typing import TYPE_CHECKING, Iterable
 
 import numpy as np
 
@@ -142,12 +142,13 @@ FORMAT = "physgs-model-v2"
 AUTO_CONFIG = "auto"
 
 
-def blind_priors(configs) -> tuple[str, ...]:
+def blind_priors(configs: Iterable[str]) -> tuple[str, ...]:
     """The forcing-free priors (``BLIND_PRIORS``) trained with the configurations ``configs``:
     all of them when ``BLIND_CONFIG`` is among them, none otherwise.
 
     Args:
-        configs: configuration names (a run's ``models.configs``, or a table's own).
+        configs (Iterable[str]): configuration names (a run's ``models.configs``, or a
+            table's own).
 
     Returns:
         tuple[str, ...]: their ids, in registry order.
