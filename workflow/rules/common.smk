@@ -93,7 +93,6 @@ NEED_PATHS = {
     "traj": TRAJ,
     "panels": PANELS,
     "loss": LOSS,
-    "recovery": RECOVERY.replace("{model}", "ours"),
     "prior_recovery": RECOVERY,
     "parts": PARTS_RECORD,
     "kmatch": KMATCH,
