@@ -14,7 +14,7 @@ import pandas as pd
 
 from physgs.models.registry import spec_of
 from physgs.report import seeds as seedstats
-from physgs.report.tables import Table, _by_seed, _first, _seeds, _tree_blocks, _wrap
+from physgs.report.tables import Table, _by_seed, _check, _first, _seeds, _tree_blocks, _wrap
 
 ROWS = (("single", "fixed $K$"), ("auto", "chosen $K$"))
 #: the per-seed values averaged in the .tex (K is shown as each seed chose it)
@@ -71,6 +71,9 @@ def tab_kselect(
     seeds = _seeds(per_seed, "tab_kselect")
     recs = []
     for s in seeds:
+        _check(
+            [(t, m, c) for t in trees for m in models for c, _ in ROWS], per_seed[s], "tab_kselect"
+        )
         for t in trees:
             for m in models:
                 fixed_s = float(per_seed[s][(t, m, "single")]["train_s"])
