@@ -23,7 +23,8 @@ NEED_FIELDS = {
     "parts": ("tree", "seed"),  # the priors' segmentations (physgs.evaluate.parts)
     "kmatch": ("tree", "K", "seed"),  # the chained prior at a smaller K (experiments.kmatch)
     "null": ("tree", "K", "seed"),
-    "kselect": ("tree", "seed"),
+    "kselect": ("tree", "seed"),  # ours' K selection
+    "prior_kselect": ("tree", "model", "seed"),  # another prior's (models.kselect.priors)
     "stats": ("tree",),
     "table": ("name",),
     # the 2D-track control (physgs.tracks): its recovery record (ours' format), its evaluation
@@ -82,7 +83,9 @@ class Plan:
     scored at the tracked points; parts_models/parts_configs: the parts study's variants and
     configurations ({} without a study); study_seeds/k_candidates: the K match's; oma: the
     output-only analysis' configurations -> their K (``oma.configs``); blind: the forcing-free
-    priors trained (``registry.blind_priors``: in ``BLIND_CONFIG``, none without it)."""
+    priors trained (``registry.blind_priors``: in ``BLIND_CONFIG``, none without it);
+    kselect_priors: the priors besides ours whose K is chosen from the data
+    (``models.kselect.priors``)."""
 
     trees: Sequence[str]
     configs: Mapping[str, dict]
@@ -97,6 +100,7 @@ class Plan:
     k_candidates: Sequence[int] = ()
     oma: Mapping[str, int] = field(default_factory=dict)
     blind: Sequence[str] = ()
+    kselect_priors: Sequence[str] = ()
 
     @classmethod
     def from_config(cls, cfg: dict) -> Plan:
@@ -109,6 +113,7 @@ class Plan:
             Plan: its trees, configurations, seeds and study settings.
         """
         from physgs.config import study_seeds
+        from physgs.experiments.kselect import selected_models
         from physgs.models.registry import blind_priors
         from physgs.oma.settings import parts as oma_k
         from physgs.tracks.settings import fields_scored
@@ -133,6 +138,7 @@ class Plan:
             k_candidates=[int(k) for k in cfg["parts_study"]["k_candidates"]],
             oma={c: oma_k(cfg, c) for c in cfg["oma"]["configs"]},
             blind=list(blind_priors(configs)),
+            kselect_priors=list(selected_models(cfg["models"]["kselect"])[1:]),
         )
 
 

@@ -4,6 +4,7 @@ against the untrained null), tab_damping (the damping benchmark), fig_damping an
 
 from __future__ import annotations
 
+from physgs.experiments.kselect import BASE_MODEL, selected_models
 from physgs.models.registry import BLIND_CONFIG, blind_priors, config_label, models_of
 from physgs.recovery.record import load_null, load_recovery
 from physgs.report import kselect
@@ -283,20 +284,33 @@ FIG_DAMPING = Output(
 
 
 # ---- tab_kselect ---------------------------------------------------------------------------
+def _kselect_models(plan) -> list[str]:
+    """The priors whose K is chosen: ours, then the plan's others (``models.kselect.priors``)."""
+    return [BASE_MODEL, *plan.kselect_priors]
+
+
+def _selection_need(t: str, m: str, s: int) -> tuple:
+    """The need of prior ``m``'s K selection on tree ``t`` (ours' has its own kind)."""
+    return ("kselect", t, s) if m == BASE_MODEL else ("prior_kselect", t, m, s)
+
+
 def _kselect_needs(plan, seeds):
+    """Per seed, tree and prior: its K selection, and the evaluation, recovery and loss log
+    (training seconds) of its fixed-K and chosen-K models."""
     out = []
     for s in seeds:
         for t in plan.trees:
-            out.append(("kselect", t, s))
-            out += [
-                x
-                for c in KSELECT_ROWS
-                for x in (("eval", t, "ours", c, s), ("prior_recovery", t, "ours", c, s))
-            ]
+            for m in _kselect_models(plan):
+                out.append(_selection_need(t, m, s))
+                for c in KSELECT_ROWS:
+                    rec = ("prior_recovery", t, m, c, s)
+                    out += [("eval", t, m, c, s), rec, ("loss", t, m, c, s)]
     return out
 
 
 def _tab_kselect(path, settings, inputs, out):
+    import pandas as pd
+
     from physgs.evaluate.splits import load_eval
     from physgs.experiments.kselect import load_selection
 
@@ -304,21 +318,31 @@ def _tab_kselect(path, settings, inputs, out):
     for s in settings["seeds"]:
         rows[s] = {}
         for t in settings["trees"]:
-            sel = load_selection(path("kselect", t, s))
-            for c in KSELECT_ROWS:
-                ev = load_eval(path("eval", t, "ours", c, s)).summary()
-                rec = load_recovery(path("prior_recovery", t, "ours", c, s))
-                rows[s][(t, c)] = {
-                    "K": rec.match.n_parts,
-                    "time_psnr": ev["time"],
-                    "median_rel_err": rec.match.median_rel_err,
-                    "trusted": rec.match.n_trusted,
-                    "frozen": rec.n_frozen,
-                    "k_heldout": sel.k_heldout,
-                    "k_bic": sel.k_bic,
-                }
+            for m in settings["models"]:
+                sel = load_selection(path(*_selection_need(t, m, s)))
+                for c in KSELECT_ROWS:
+                    ev = load_eval(path("eval", t, m, c, s)).summary()
+                    rec = load_recovery(path("prior_recovery", t, m, c, s))
+                    loss = pd.read_csv(path("loss", t, m, c, s))
+                    rows[s][(t, m, c)] = {
+                        "K": rec.match.n_parts,
+                        "view_psnr": ev["view"],
+                        "time_psnr": ev["time"],
+                        "median_rel_err": rec.match.median_rel_err,
+                        "trusted": rec.match.n_trusted,
+                        "frozen": rec.n_frozen,
+                        "k_heldout": sel.k_heldout,
+                        "k_bic": sel.k_bic,
+                        "train_s": float(loss["seconds"].iloc[-1]),
+                        "select_s": float(sum(sel.wall_s)),
+                    }
     return kselect.tab_kselect(
-        rows, settings["trees"], settings["bones"], settings["method"], digits=settings["digits"]
+        rows,
+        settings["trees"],
+        settings["bones"],
+        settings["method"],
+        models=settings["models"],
+        digits=settings["digits"],
     )
 
 
@@ -327,6 +351,9 @@ TAB_KSELECT = Output(
     "table",
     _kselect_needs,
     _tab_kselect,
-    settings=lambda cfg: {"method": cfg["models"]["kselect"]["method"]},
+    settings=lambda cfg: {
+        "method": cfg["models"]["kselect"]["method"],
+        "models": list(selected_models(cfg["models"]["kselect"])),
+    },
     in_report=lambda plan: False,  # `all` builds it (Snakefile): K selection costs trainings
 )
