@@ -225,5 +225,5 @@ def test_tab_kselect_reads_the_chains_selection_and_models():
         assert ("eval", "sparse", "ours_chain", c, 3) in got
         assert ("prior_recovery", "sparse", "ours_chain", c, 3) in got
         assert ("loss", "sparse", "ours_chain", c, 3) in got
-        assert ("recovery", "sparse", c, 3) in got  # ours' own kind, as before
+        assert ("prior_recovery", "sparse", "ours", c, 3) in got  # ours through every prior's kind
     assert not any(n[0] == "prior_kselect" for n in needs("tab_kselect", Plan(["sparse"], {}, [3])))
