@@ -69,3 +69,53 @@ def test_no_rows_no_claims():
     df = _null([2.0], [3.0], [2.0], [4.0])
     df = df[df["method"] == "ours"]
     assert claims._blind_claims(df, None, ["sparse"]) == []
+
+
+def test_every_blind_prior_is_paired_with_a_prior_that_reads_the_wind():
+    from physgs.models.registry import BLIND_PRIORS, MODELS, spec_of
+
+    assert {m: spec_of(m).blind_of for m in BLIND_PRIORS} == {
+        "ours_blind": "ours",
+        "ours_chain_blind": "ours_chain",
+    }
+    for m in BLIND_PRIORS:
+        wind = MODELS[spec_of(m).blind_of]
+        assert wind.role == "prior" and wind.forcing == "wind", m
+
+
+def test_each_blind_prior_gets_its_anemometer_claim_against_its_counterpart():
+    """tab_null rows of two winds' priors and their forcing-free variants: each variant's
+    claim is its error minus its own counterpart's, ours' under the old id, the chain's under
+    its prefix (claims_priors' convention)."""
+    err = {  # median omega error (%) per seed
+        "ours": [2.0, 2.2, 2.4],
+        "ours_chain": [1.0, 1.1, 1.2],
+        "ours_blind": [3.0, 3.3, 3.6],
+        "ours_chain_blind": [0.5, 0.6, 0.7],
+    }
+    null = pd.DataFrame(
+        [
+            dict(
+                seed=s,
+                tree="sparse",
+                config="single",
+                method=m,
+                trained_median_rel_err_pct=v[s],
+                null_median_rel_err_pct=5.0,
+            )
+            for s in range(3)
+            for m, v in err.items()
+        ]
+    )
+    got = {c.id: (c, v) for c, v in claims._blind_claims(null, None, ["sparse"])}
+    ours, v_ours = got["anemometer_needed/sparse"]
+    chain, v_chain = got["ours_chain/anemometer_needed/sparse"]
+    # by hand: 3.0 - 2.0, 3.3 - 2.2, 3.6 - 2.4; 0.5 - 1.0, 0.6 - 1.1, 0.7 - 1.2
+    assert v_ours == pytest.approx([1.0, 1.1, 1.2])
+    assert v_chain == pytest.approx([-0.5, -0.5, -0.5])
+    assert claims.verdict(ours, v_ours) == "holds"
+    assert claims.verdict(chain, v_chain) == "fails"
+    assert "ours_chain_blind - ours_chain" in chain.source and "ours_blind - ours" in ours.source
+    # a blind prior without its rows in the table has no claim
+    alone = claims._blind_claims(null[null.method != "ours_chain_blind"], None, ["sparse"])
+    assert [c.id for c, _ in alone] == ["anemometer_needed/sparse"]

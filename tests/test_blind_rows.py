@@ -14,7 +14,7 @@ from physgs.report import build
 from physgs.report import tables as T
 from physgs.report.damping import tab_damping
 from test_report_damping import _record as damping_record
-from test_report_tables import BONES, null, record
+from test_report_tables import BONES, null, paired, record
 
 SEEDS = (0, 1, 2)
 CONFIGS = {"single": "single", "joint32": "joint32"}
@@ -38,23 +38,18 @@ def _methods(oma_null=0.10):
     blind = {s: {("sparse", "single"): (record(1, 0.06), null(0.0456))} for s in SEEDS}
     return {
         T.OMA: T.oma_rows({"single": "single (K=2)", "joint32": "joint (K=2)"}, oma),
-        "ours_blind": T.blind_rows("ours_blind", {"single": "single"}, blind),
+        "ours_blind": T.prior_rows("ours_blind", {"single": "single"}, blind),
     }
 
 
 def _tab_null(methods=None):
     rec, nl, tracks, chain = _null_inputs()
-    return T.tab_null(
-        rec,
-        nl,
-        ["sparse"],
-        BONES,
-        CONFIGS,
-        tracks=tracks,
-        tracks_configs={"single": "single"},
-        priors={"ours_chain": chain},
-        methods=methods,
-    )
+    priors = {
+        m: T.prior_rows(m, CONFIGS, paired(d, nl), T.NULL_PRIOR_NOTE)
+        for m, d in (("ours", rec), ("ours_chain", chain))
+    }
+    rows = {**priors, T.TRACKS: T.tracks_rows({"single": "single"}, tracks, T.NULL_TRACKS_NOTE)}
+    return T.tab_null({**rows, **(methods or {})}, ["sparse"], BONES)
 
 
 def test_tab_null_adds_the_forcing_free_rows_with_their_own_null():
@@ -96,8 +91,6 @@ def test_tab_null_refuses_a_method_row_without_its_record_or_with_another_k():
             for s, v in methods[T.OMA].per_seed.items()}  # fmt: skip
     with pytest.raises(ValueError, match="K=2"):
         _tab_null({T.OMA: dataclasses.replace(methods[T.OMA], per_seed=rec2)})
-    with pytest.raises(ValueError, match="tracks"):
-        _tab_null({"tracks": methods[T.OMA]})
 
 
 def test_tab_damping_adds_the_forcing_free_rows_with_their_own_scores():
@@ -117,10 +110,11 @@ def test_tab_damping_adds_the_forcing_free_rows_with_their_own_scores():
              for s in SEEDS}  # fmt: skip
     methods = {
         T.OMA: T.oma_rows({"single": "single"}, oma),
-        "ours_blind": T.blind_rows("ours_blind", {"single": "single"}, blind),
+        "ours_blind": T.prior_rows("ours_blind", {"single": "single"}, blind),
     }
-    before = tab_damping(ours, ["sparse"], {"sparse": 22}, CONFIGS)
-    tab = tab_damping(ours, ["sparse"], {"sparse": 22}, CONFIGS, methods=methods)
+    mine = {"ours": T.prior_rows("ours", CONFIGS, ours)}
+    before = tab_damping(mine, ["sparse"], {"sparse": 22})
+    tab = tab_damping({**mine, **methods}, ["sparse"], {"sparse": 22})
     d = tab.df[(tab.df.seed == 0) & (tab.df.testbed == "damping")]
     assert list(d.method) == ["ours", "ours", "oma", "ours_blind"]
     np.testing.assert_allclose(tab.df[tab.df.method == "oma"].rel_err_pct, 50.0, atol=1e-9)

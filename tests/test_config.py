@@ -282,6 +282,22 @@ def _set(path, value, profile=None):
             "models/kselect/candidates/1",
         ),
         (_set(("speed_accuracy", "knobs", "K"), [8, 3000]), "default", "speed_accuracy/knobs/K/1"),
+        # a prior's own K selection: its candidates, its schedule, and only a wind-driven prior
+        (
+            _set(("models", "kselect", "priors", "ours_chain", "candidates"), [4, 401], "quick"),
+            "quick",
+            "models/kselect/priors/ours_chain/candidates/1",
+        ),
+        (
+            _set(("models", "kselect", "priors", "ours_chain", "warmup"), 400),
+            "default",
+            "models/kselect/priors/ours_chain/warmup",
+        ),
+        (
+            _set(("models", "kselect", "priors", "ours_blind"), {"candidates": [4]}),
+            "default",
+            "models/kselect/priors/ours_blind",
+        ),
         (
             lambda c: (
                 _set(("models", "configs", "single", "K"), 100)(c),

@@ -32,7 +32,13 @@ def test_every_key_of_the_config_file_has_a_row():
     def keys(node, prefix):
         for k, v in node.items():
             yield f"{prefix}{k}"
-            if isinstance(v, dict) and k not in ("profiles", "presets", "configs", "time_top_hz"):
+            if isinstance(v, dict) and k not in (
+                "profiles",
+                "presets",
+                "configs",
+                "time_top_hz",
+                "priors",
+            ):
                 yield from keys(v, f"{prefix}{k}.")
 
     assert not set(keys(cfg, "")) - paths

@@ -11,9 +11,8 @@ from physgs.report import build
 from physgs.report import claims as C
 from physgs.report import tables as T
 from physgs.report.claims_priors import prior_claims
-from physgs.report.outputs import OUTPUTS, reading
 from physgs.report.summary import prior_lines
-from test_report_tables import BONES, record, null
+from test_report_tables import BONES, null, paired, record
 
 CONFIGS = {"single": {"K": 32}, "joint32": {"K": 32}, "joint96": {"K": 96}}
 PLAN = build.Plan(
@@ -36,13 +35,17 @@ def test_the_chained_prior_is_a_prior_trained_in_every_configuration():
         models_of("blind")
 
 
-def test_the_outputs_of_a_role_read_each_of_its_models():
-    assert {"tab_psnr", "tab_transfer", "tab_margin", "tab_null", "tab_damping", "tab_fit"} <= set(
-        reading("prior")
-    )
+def test_every_output_that_reads_ours_reads_every_prior():
+    """ours is one prior among the registry's: no output reads it by a need kind of its own."""
+    from physgs.report.outputs import NEED_FIELDS
+
+    assert "recovery" not in NEED_FIELDS  # ours' records are read as every prior's
     for name in ("tab_psnr", "tab_transfer", "tab_margin", "fig_temporal", "fig_results"):
         got = {n[2] for n in build.needs(name, PLAN) if n[0] == "eval"}
         assert {"ours", "ours_chain"} <= got, name
+    for name in ("tab_null", "tab_damping", "fig_damping"):
+        got = {n[2] for n in build.needs(name, PLAN) if n[0] == "prior_recovery"}
+        assert got == {"ours", "ours_chain"}, name
     assert ("loss", "sparse", "ours_chain", "single", 1) in build.needs("tab_fit", PLAN)
     assert ("traj", "sparse", "ours_chain", "single", 0) in build.needs("fig_teaser", PLAN)
 
@@ -62,20 +65,21 @@ def test_recovery_outputs_read_the_chained_prior_in_every_configuration_and_test
     assert ("prior_recovery", "sparse", "ours_chain", "joint32", 1) in ledger
 
 
-def test_every_output_declares_its_roles_from_the_registry():
-    from physgs.models.registry import ROLES
-
-    for name, o in OUTPUTS.items():
-        assert set(o.roles) <= set(ROLES), name
-
-
 # --- its rows ----------------------------------------------------------------------------------
+def _priors(ours, chain, nl, configs):
+    """tab_null's methods: ours and the chained prior, each beside the null of its K."""
+    return {
+        m: T.prior_rows(m, configs, paired(per_seed, nl), T.NULL_PRIOR_NOTE)
+        for m, per_seed in (("ours", ours), ("ours_chain", chain))
+    }
+
+
 def test_tab_null_sets_each_prior_beside_the_null_of_its_k():
     configs = {"single": "single", "joint96": "joint96"}
     rec = {s: {("sparse", c): record(3, 0.03) for c in configs} for s in (0, 1, 2)}
     chain = {s: {("sparse", c): record(4, 0.010 + 0.001 * s) for c in configs} for s in (0, 1, 2)}
     nl = {s: {("sparse", c): null(0.0456) for c in configs} for s in (0, 1, 2)}
-    tab = T.tab_null(rec, nl, ["sparse"], BONES, configs, priors={"ours_chain": chain})
+    tab = T.tab_null(_priors(rec, chain, nl, configs), ["sparse"], BONES)
     df = tab.df[tab.df.seed == 1]
     assert list(df.method) == ["ours", "ours", "ours_chain", "ours_chain"]
     mine = df[df.method == "ours_chain"]
@@ -84,7 +88,50 @@ def test_tab_null_sets_each_prior_beside_the_null_of_its_k():
     np.testing.assert_allclose(df[df.method == "ours"].trained_median_rel_err_pct, [3.0, 3.0])
     assert f"{label('ours_chain')}, joint96" in tab.tex
     with pytest.raises(KeyError, match="ours_chain"):
-        T.tab_null(rec, nl, ["sparse"], BONES, configs, priors={"ours_chain": {0: {}}})
+        T.tab_null(_priors(rec, {0: {}}, nl, configs), ["sparse"], BONES)
+
+
+def test_a_prior_added_to_the_registry_gets_tab_null_rows_through_its_entry_alone(
+    tmp_path, monkeypatch
+):
+    """A new model of role "prior" (its registry entry, nothing else) is read and scored by
+    tab_null beside ours, against the null of its K."""
+    from physgs.models import registry
+    from physgs.recovery.record import save_null, save_recovery
+    from physgs.report.outputs import key
+
+    spec = registry.ModelSpec("A new prior", "New", "ours", True, "prior")
+    monkeypatch.setitem(registry.MODELS, "ours_new", spec)
+    cfg = {
+        "trees": ["sparse"],
+        "presets": {"sparse": {"bones": 22}},
+        "seeds": [0, 1],
+        "report": {"tab_null": {"digits": 2}},
+        "models": {"configs": {"joint32": {"K": 4, "conditions": "all"}}},
+        "tracks": {"configs": []},
+        "oma": {"configs": []},
+    }
+    plan = build.Plan(["sparse"], cfg["models"]["configs"], [0, 1])
+    err = {"ours": 0.03, "ours_chain": 0.02, "ours_new": 0.012}  # each prior's median error
+    inputs = {}
+    for need in build.needs("tab_null", plan):
+        path = tmp_path / (key(need).replace("/", "_") + ".json")
+        if need[0] == "null":
+            save_null(path, null(0.0456))
+        else:
+            assert need[0] == "prior_recovery", need
+            save_recovery(path, record(3, err[need[2]]))
+        inputs[key(need)] = str(path)
+    assert {k.split("/")[2] for k in inputs if k.startswith("prior_recovery")} == set(err)
+    settings = build.settings_for("tab_null", cfg)
+    tab = build.make_table("tab_null", inputs, settings, tmp_path / "n.tex", tmp_path / "n.csv")
+    df = tab.df[tab.df.seed == 1]
+    assert list(df.method) == ["ours", "ours_chain", "ours_new"]
+    new = df[df.method == "ours_new"]
+    # trained 1.2 %, the null of its K 4.56 %: by hand
+    np.testing.assert_allclose(new.trained_median_rel_err_pct, 1.2)
+    np.testing.assert_allclose(new.trained_minus_null_pp, 1.2 - 4.56)
+    assert "A new prior, joint ($K{=}4$)" in tab.tex
 
 
 # --- its claims --------------------------------------------------------------------------------
@@ -103,7 +150,7 @@ def _tables(ahead: float, seeds=(0, 1, 2)):
             psnr.append(
                 {
                     "seed": s,
-                    "model": C.LABELS.get(m) or label(m),
+                    "model": label(m),
                     "sparse_view": base + jitter,
                     "sparse_time": base + jitter,
                 }
@@ -210,7 +257,11 @@ def test_tab_damping_sets_each_prior_beside_ours_on_both_testbeds():
     ours = {s: {k: _damped(zb * 1.1, s) for k in keys} for s in (0, 1)}
     chain = {s: {k: _damped(zb * 1.02, s) for k in keys} for s in (0, 1)}
     configs = {"a": "A", "b": "B"}
-    tab = tab_damping(ours, ["sparse"], {"sparse": 22}, configs, priors={"ours_chain": chain})
+
+    def methods(chain):
+        return {m: T.prior_rows(m, configs, d) for m, d in (("ours", ours), ("ours_chain", chain))}
+
+    tab = tab_damping(methods(chain), ["sparse"], {"sparse": 22})
     df = tab.df
     assert list(df[df.seed == 0].method) == ["ours", "ours", "ours_chain", "ours_chain"] * 2
     # |1.1 zeta - zeta| / zeta = 10 %, |1.02 zeta - zeta| / zeta = 2 %: by hand
@@ -218,4 +269,4 @@ def test_tab_damping_sets_each_prior_beside_ours_on_both_testbeds():
     np.testing.assert_allclose(df[df.method == "ours_chain"].rel_err_pct, 2.0)
     assert f"{label('ours_chain')}, B" in tab.tex and r"\multirow{8}{*}" in tab.tex
     with pytest.raises(KeyError, match="ours_chain"):
-        tab_damping(ours, ["sparse"], {"sparse": 22}, configs, priors={"ours_chain": {0: {}}})
+        tab_damping(methods({0: {}}), ["sparse"], {"sparse": 22})

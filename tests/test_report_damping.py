@@ -11,9 +11,14 @@ from physgs.recovery.damping_scores import DampingNull, DampingScores, damping_n
 from physgs.recovery.matcher import MatchResult
 from physgs.recovery.record import RecoveryRecord, load_recovery, save_recovery
 from physgs.report.damping import tab_damping
-from physgs.report.tables import write_table
+from physgs.report.tables import prior_rows, write_table
 
 CONFIGS = {"single": "single", "joint32": "joint"}
+
+
+def ours(per_seed, configs=CONFIGS):
+    """tab_damping's methods holding ours' rows alone."""
+    return {"ours": prior_rows("ours", configs, per_seed)}
 
 
 def _record(zeta_hat, zeta_bones, seed):
@@ -49,7 +54,7 @@ def _data(n_seeds):
 
 def test_rows_are_per_seed_and_match_the_scores(tmp_path):
     data = _data(3)
-    tab = tab_damping(data, ["sparse"], {"sparse": 22}, CONFIGS)
+    tab = tab_damping(ours(data), ["sparse"], {"sparse": 22})
     assert len(tab.df) == 3 * 2 * 2 and list(tab.df.seed.unique()) == [0, 1, 2]
     d = tab.df[(tab.df.testbed == "damping") & (tab.df.config == "single")]
     np.testing.assert_allclose(d.rel_err_pct, [2.0, 4.0, 6.0], atol=1e-9)
@@ -75,7 +80,7 @@ def test_a_record_without_damping_scores_is_named():
         data[0][("sparse", "damping", "joint32")], damping_scores=None
     )
     with pytest.raises(ValueError, match="sparse/damping/joint32"):
-        tab_damping(data, ["sparse"], {"sparse": 22}, CONFIGS)
+        tab_damping(ours(data), ["sparse"], {"sparse": 22})
 
 
 def test_recovery_record_round_trips_its_damping_scores(tmp_path):

@@ -30,13 +30,17 @@ def test_figures_write_pdf_and_png(tmp_path):
             np.array([2.0, 4.0, 8.0]), np.array([0.2, 0.1, 0.05]), 0.08
         )
     }
-    FG.fig_damping(d, ["medium"], ["single"], 0.08, [tmp_path / "d.pdf"])
+    FG.fig_damping({"ours": d}, ["medium"], ["single"], 0.08, [tmp_path / "d.pdf"])
     chain = {("medium", "single"): d[("medium", "single")]}
-    FG.fig_damping(d, ["medium"], ["single"], 0.08, [tmp_path / "c.png"], {"ours_chain": chain})
+    FG.fig_damping(
+        {"ours": d, "ours_chain": chain}, ["medium"], ["single"], 0.08, [tmp_path / "c.png"]
+    )
     assert (tmp_path / "c.png").stat().st_size > 1000
     (tmp_path / "c.png").unlink()
     with pytest.raises(KeyError, match="of ours_chain for \\(medium, single\\)"):
-        FG.fig_damping(d, ["medium"], ["single"], 0.08, [tmp_path / "x.png"], {"ours_chain": {}})
+        FG.fig_damping(
+            {"ours": d, "ours_chain": {}}, ["medium"], ["single"], 0.08, [tmp_path / "x.png"]
+        )
     for name in ("t.pdf", "t.png", "s.png", "q.png", "d.pdf"):
         assert (tmp_path / name).stat().st_size > 1000
     assert (tmp_path / "t.png").read_bytes()[:4] == b"\x89PNG"

@@ -8,6 +8,7 @@ import numpy as np
 import pytest
 
 from physgs.experiments.cost import read_costs, wall_spans
+from physgs.models.registry import label
 from physgs.report import claims as C
 from physgs.report import tables as T
 from physgs.report.summary import run_summary
@@ -116,12 +117,12 @@ def test_fit_fractions_per_tree_and_model(run):
     lines = text.splitlines()
     assert "| model | sparse | medium |" in lines
     for m, f in FRAC.items():
-        row = next(line for line in lines if line.startswith(f"| {C.LABELS[m]} |"))
+        row = next(line for line in lines if line.startswith(f"| {label(m)} |"))
         cells = [c.strip() for c in row.strip("|").split("|")][1:]
         assert len(cells) == 2
         for c in cells:  # two seeds with the same fraction: an interval of zero width
             assert c == f"{100 * f:.0f}% [{100 * f:.0f}, {100 * f:.0f}]"
-    assert f"| {C.LABELS['static']} | 0% [0, 0] | 0% [0, 0] |" in lines
+    assert f"| {label('static')} | 0% [0, 0] | 0% [0, 0] |" in lines
     assert "True motion" not in text and "truth_motion" not in text  # the reference is the scale
 
 
@@ -152,7 +153,7 @@ def test_one_seed_has_no_interval(tmp_path):
         STAMP, tmp_path / "claims.csv", tmp_path / "tab_fit.csv", write_benchmarks(tmp_path / "b")
     )
     assert "one seed, no interval" in text
-    assert f"| {C.LABELS['ours']} | 75% | 75% |" in text
+    assert f"| {label('ours')} | 75% | 75% |" in text
 
 
 def test_a_file_from_another_config_is_flagged(tmp_path):

@@ -228,6 +228,16 @@ def null(med):
     )
 
 
+def paired(rec, nl):
+    """tab_null's per-seed (record, null of its K) of per-seed records and nulls."""
+    return {s: {k: (r, nl[s][k]) for k, r in d.items()} for s, d in rec.items()}
+
+
+def ours(rec, nl, configs):
+    """tab_null's methods holding ours' rows alone."""
+    return {"ours": T.prior_rows("ours", configs, paired(rec, nl))}
+
+
 def test_tab_null_per_seed_difference_and_nan_cells(tmp_path):
     cfg = {"single": "single ($K{=}32$)"}
     rec = {
@@ -241,7 +251,7 @@ def test_tab_null_per_seed_difference_and_nan_cells(tmp_path):
         s: {("sparse", "single"): null(0.0456 + 0.002 * s), ("medium", "single"): null(0.0177)}
         for s in range(3)
     }
-    tab = T.tab_null(rec, nl, TREES, BONES, configs=cfg)
+    tab = T.tab_null(ours(rec, nl, cfg), TREES, BONES)
     sp = tab.df[tab.df.tree == "sparse"]
     np.testing.assert_allclose(sp.trained_median_rel_err_pct, [1.8, 1.9, 2.0])
     np.testing.assert_allclose(sp.null_median_rel_err_pct, [4.56, 4.76, 4.96])
@@ -257,7 +267,7 @@ def test_tab_null_per_seed_difference_and_nan_cells(tmp_path):
     assert np.isnan(csv[csv.tree == "medium"].trained_median_rel_err_pct).all()
     assert "--" in tab.tex  # the medium model has no trusted part
     with pytest.raises(KeyError, match="dense"):
-        T.tab_null(rec, nl, ["sparse", "dense"], BONES, configs=cfg)
+        T.tab_null(ours(rec, nl, cfg), ["sparse", "dense"], BONES)
 
 
 def test_tab_null_refuses_a_null_with_another_k():
@@ -267,7 +277,7 @@ def test_tab_null_refuses_a_null_with_another_k():
         np.array([4]), np.array([0.04]), np.array([0.9]), np.ones((1, 8)), 8, 0.004, 0
     )
     with pytest.raises(ValueError, match="K=8"):
-        T.tab_null(rec, {0: {("sparse", "single"): other}}, ["sparse"], BONES, configs=cfg)
+        T.tab_null(ours(rec, {0: {("sparse", "single"): other}}, cfg), ["sparse"], BONES)
 
 
 def test_missing_model_names_the_cause():

@@ -236,18 +236,20 @@ def test_tab_kselect_rows_and_undefined_entries():
     from physgs.report.build import Plan, needs
     from physgs.report.kselect import tab_kselect
 
+    common = dict(view_psnr=22.0, k_heldout=16, k_bic=64)
     rows = {
-        ("sparse", "single"): dict(
-            K=32, time_psnr=25.0, median_rel_err=0.05, trusted=10, frozen=3, k_heldout=16, k_bic=64
+        ("sparse", "ours", "single"): dict(
+            K=32, time_psnr=25.0, median_rel_err=0.05, trusted=10, frozen=3, train_s=600.0, **common
         ),
-        ("sparse", "auto"): dict(
+        ("sparse", "ours", "auto"): dict(
             K=16,
             time_psnr=25.5,
             median_rel_err=float("nan"),
             trusted=0,
             frozen=16,
-            k_heldout=16,
-            k_bic=64,
+            train_s=500.0,
+            select_s=250.0,
+            **common,
         ),
     }
     t = tab_kselect({0: rows}, ["sparse"], {"sparse": 22}, "heldout")
@@ -256,7 +258,7 @@ def test_tab_kselect_rows_and_undefined_entries():
     assert ("kselect", "sparse", 3) in needs("tab_kselect", Plan(["sparse"], {}, [3]))
     # a second seed that chose another K: both choices shown, the rest averaged
     rows1 = {k: dict(v) for k, v in rows.items()}
-    rows1[("sparse", "auto")].update(K=64, time_psnr=26.5)
+    rows1[("sparse", "ours", "auto")].update(K=64, time_psnr=26.5)
     t2 = tab_kselect({0: rows, 1: rows1}, ["sparse"], {"sparse": 22}, "heldout")
     assert t2.df["seed"].tolist() == [0, 0, 1, 1] and "16/64" in t2.tex
     assert "26.00 $\\pm$ 0.71" in t2.tex

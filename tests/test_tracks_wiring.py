@@ -21,11 +21,12 @@ from physgs.recovery.null import NullResult
 from physgs.recovery.record import RecoveryRecord, load_recovery
 from physgs.report import build, claims
 from physgs.report import tables as T
-from physgs.report.damping import tab_damping
+from physgs.report.damping import TRACKS_NOTE, tab_damping
 from physgs.report.tracks import tab_tracks
 from physgs.tracks import settings as tsettings
 from oracles import quick_config
 from test_config import _refused
+from test_report_tables import ours as ours_rows
 from workflow_helpers import ROOT
 
 BONES = {"sparse": 22, "medium": 224}
@@ -240,9 +241,11 @@ def test_tab_null_adds_the_tracks_rows_after_ours_and_leaves_ours_rows_as_they_w
         s: {(t, "joint32"): (_record(0.03 + 0.002 * s, K=2), _null(0.06, K=2)) for t in BONES}
         for s in (0, 1)
     }
-    plain = T.tab_null(rec, nl, list(BONES), BONES, cfg).df
+    plain = T.tab_null(ours_rows(rec, nl, cfg), list(BONES), BONES).df
     both = T.tab_null(
-        rec, nl, list(BONES), BONES, cfg, tracks=tracks, tracks_configs={"joint32": "j2"}
+        {**ours_rows(rec, nl, cfg), "tracks": T.tracks_rows({"joint32": "j2"}, tracks, "")},
+        list(BONES),
+        BONES,
     )
     df = both.df
     ours = df[df.method == "ours"].drop(columns="method").reset_index(drop=True)
@@ -265,13 +268,12 @@ def test_tab_null_adds_the_tracks_rows_after_ours_and_leaves_ours_rows_as_they_w
     bad = {0: {(t, "joint32"): (_record(0.03, K=2), _null(0.06, K=4)) for t in BONES}}
     with pytest.raises(ValueError, match="K=4 but the model has K=2"):
         T.tab_null(
-            {0: rec[0]},
-            {0: nl[0]},
+            {
+                **ours_rows({0: rec[0]}, {0: nl[0]}, cfg),
+                "tracks": T.tracks_rows({"joint32": "j"}, bad, ""),
+            },
             list(BONES),
             BONES,
-            cfg,
-            tracks=bad,
-            tracks_configs={"joint32": "j"},
         )
 
 
@@ -297,14 +299,11 @@ def test_tab_damping_adds_the_tracks_rows_with_their_own_scores():
         s: {("sparse", v, "a"): _damped(zb * 1.5, s) for v in ("faithful", "damping")}
         for s in (0, 1)
     }
-    tab = tab_damping(
-        ours,
-        ["sparse"],
-        {"sparse": 22},
-        {"a": "A", "b": "B"},
-        tracks=mine,
-        tracks_configs={"a": "A"},
-    )
+    methods = {
+        "ours": T.prior_rows("ours", {"a": "A", "b": "B"}, ours),
+        "tracks": T.tracks_rows({"a": "A"}, mine, TRACKS_NOTE),
+    }
+    tab = tab_damping(methods, ["sparse"], {"sparse": 22})
     df = tab.df
     assert len(df) == 2 * 2 * 3 and set(df.method) == {"ours", "tracks"}
     np.testing.assert_allclose(df[df.method == "ours"].rel_err_pct, 10.0)
@@ -317,7 +316,9 @@ def test_tab_damping_adds_the_tracks_rows_with_their_own_scores():
     }
     with pytest.raises(ValueError, match="tracks control"):
         tab_damping(
-            ours, ["sparse"], {"sparse": 22}, {"a": "A"}, tracks=none, tracks_configs={"a": "A"}
+            {**methods, "tracks": T.tracks_rows({"a": "A"}, none, TRACKS_NOTE)},
+            ["sparse"],
+            {"sparse": 22},
         )
 
 

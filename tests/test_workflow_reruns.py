@@ -28,6 +28,12 @@ EDITS = {
     "table_digits": {"report": {"tab_psnr": {"digits": 3}}},
     "freeze_at": {"models": {"ours": {"freeze_at": 0.6}}},
     "kselect_tie": {"models": {"kselect": {"tie_db": 0.2}}},
+    # the chained prior's own candidates (the quick profile sets them, so the edit goes there)
+    "kselect_chain": {
+        "profiles": {
+            "quick": {"models": {"kselect": {"priors": {"ours_chain": {"candidates": [4]}}}}}
+        }
+    },
     "tracks_iterations": {"tracks": {"iterations": 200}},
 }
 
@@ -104,6 +110,7 @@ def test_mlp_width_and_search_retrain_their_own_models_only(plans):
         "ours_chain_single",
         "ours_chain_joint32",
         "ours_chain_joint96",
+        "ours_chain_auto",  # its K selection trains it with the search too
     }, trained
     assert _counts(out).get("kmatch_point"), _counts(out)
 
@@ -203,11 +210,19 @@ def test_freeze_at_retrains_ours_and_no_baseline(plans):
     assert trained and all(t.startswith("ours_") for t in trained), trained
 
 
-def test_kselect_tie_retrains_only_the_auto_model(plans):
+def test_kselect_tie_retrains_only_the_auto_models(plans):
     out = plans["kselect_tie"]
     plan = _counts(out)
-    assert plan.get("kselect") and "train" not in plan and "speed_accuracy_point" not in plan, plan
-    assert _checkpoints(out) == {"ours_auto"}
+    assert plan.get("kselect") and plan.get("kselect_prior"), plan
+    assert "train" not in plan and "speed_accuracy_point" not in plan, plan
+    assert _checkpoints(out) == {"ours_auto", "ours_chain_auto"}
+
+
+def test_the_chains_own_kselect_keys_leave_ours_selection_alone(plans):
+    out = plans["kselect_chain"]
+    plan = _counts(out)
+    assert plan.get("kselect_prior") == 1 and "kselect" not in plan and "train" not in plan, plan
+    assert _checkpoints(out) == {"ours_chain_auto"}
 
 
 def test_tracks_fit_settings_refit_the_tracks_control_only(plans):

@@ -35,7 +35,6 @@ def main() -> None:
     needs = build.claims_needs(trees, cfg["models"]["configs"], seeds, True, True, True)
     paths = {  # the workflow's layout (common.smk: TABLE, RECOVERY)
         "table": "tables/{name}.csv",
-        "recovery": "recovery/{tree}/seed{seed}/ours_{config}.json",
         "prior_recovery": "recovery/{tree}/seed{seed}/{model}_{config}.json",
     }
     inputs = {}

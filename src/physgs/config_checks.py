@@ -444,6 +444,28 @@ def study_seeds_in_seeds(cfg: dict) -> Iterator[Problem]:
             )
 
 
+def _kselect_runs(cfg: dict, *own_keys: str) -> Iterator[tuple[str, tuple, dict]]:
+    """(model, config path, settings) of every K selection's short runs: ours' (the section's
+    own keys) and each prior's under models/kselect/priors (its keys over the section's); with
+    ``own_keys``, a prior's only where its entry sets one of them (else a problem with them is
+    ours', reported once under ours' key)."""
+    from physgs.experiments.kselect import selected_models, settings_for
+
+    ks = cfg["models"]["kselect"]
+    for m in selected_models(ks):
+        where = ("models", "kselect") if m == "ours" else ("models", "kselect", "priors", m)
+        if m == "ours" or not own_keys or set(own_keys) & set(ks["priors"][m]):
+            yield m, where, settings_for(ks, m)
+
+
+def _schedules(cfg: dict) -> Iterator[tuple[tuple, str, dict]]:
+    """(config path, its name in messages, iterations/warmup node) of train and of every K
+    selection's short runs."""
+    yield ("train",), "train", cfg["train"]
+    for _, where, node in _kselect_runs(cfg, "iterations", "warmup"):
+        yield where, "/".join(where), node
+
+
 def warmup_below_iterations(cfg: dict) -> Iterator[Problem]:
     """The static warm-up ends before training does (train and the K-selection runs).
 
@@ -453,10 +475,7 @@ def warmup_below_iterations(cfg: dict) -> Iterator[Problem]:
     Yields:
         ``(key path, message)`` per problem (the module docstring); none when the config passes.
     """
-    for section, key in ((("train",), "train"), (("models", "kselect"), "models/kselect")):
-        node = cfg
-        for k in section:
-            node = node[k]
+    for section, key, node in _schedules(cfg):
         it, warm = int(node["iterations"]), int(node["warmup"])
         if not 0 <= warm < it:
             yield (
@@ -505,7 +524,7 @@ def freeze_inside_deformation_phase(cfg: dict) -> Iterator[Problem]:
     if float(o["freeze_below_px"]) == 0:
         return
     at = float(o["freeze_at"])
-    for node, key in ((cfg["train"], "train"), (cfg["models"]["kselect"], "models/kselect")):
+    for _, key, node in _schedules(cfg):
         it, warm = int(node["iterations"]), int(node["warmup"])
         if not 0 <= warm < it:
             continue  # warmup_below_iterations reports it
@@ -550,6 +569,53 @@ def omega_search_is_runnable(cfg: dict) -> Iterator[Problem]:
     why = search_problem(float(osr["until"]), it, warm, frz)
     if why is not None:
         yield (("models", "omega_search", "until"), why)
+
+
+def kselect_priors_are_runnable(cfg: dict) -> Iterator[Problem]:
+    """models/kselect/priors names wind-driven priors, and their short runs fit the search.
+
+    The priors listed must be wind-driven oscillator priors of the methods besides ours
+    (trained in every configuration: ``<prior>_auto`` joins its rows), and the short runs of a
+    prior that searches omega leave room for the search's bank phase (after the warm-up, before
+    freezing): never adjusted, the key is named.
+
+    Args:
+        cfg: The resolved config (profile merged, schema-valid).
+
+    Yields:
+        ``(key path, message)`` per problem; none when the config passes.
+    """
+    from physgs.models.omega_search import search_problem
+    from physgs.models.registry import MODELS, is_prior, searches_omega, spec_of
+
+    valid = [m for m in MODELS if m != "ours" and is_prior(m) and spec_of(m).forcing == "wind"]
+    own = cfg["models"]["kselect"].get("priors") or {}
+    for m in own:
+        if m not in valid:
+            yield (
+                ("models", "kselect", "priors", m),
+                f"{m!r} is not a wind-driven oscillator prior besides ours (ours' K is "
+                f"chosen by the section's own keys); valid: {valid}",
+            )
+    o, osr = cfg["models"]["ours"], cfg["models"].get("omega_search")
+    for m, where, ks in _kselect_runs(cfg):
+        if m not in valid or not searches_omega(cfg["models"], m):
+            continue
+        it, warm = int(ks["iterations"]), int(ks["warmup"])
+        if not 0 <= warm < it:
+            continue  # warmup_below_iterations reports it
+        frz = None if float(o["freeze_below_px"]) == 0 else _freeze_iteration(o, it)
+        why = search_problem(float(osr["until"]), it, warm, frz)
+        if why is not None:
+            key = "/".join(where)
+            shared = [k for k in ("iterations", "warmup") if k not in own.get(m, {})]
+            note = f"; {' and '.join(shared)} from models/kselect" if shared else ""
+            yield (
+                where + ("iterations",),
+                f"{m} searches omega in its K-selection runs (iterations = {it}, warmup = "
+                f"{warm}{note}), and models/omega_search/until = {why}; set "
+                f"{key}/iterations higher or {key}/warmup lower",
+            )
 
 
 def ours_bounds_ordered(cfg: dict) -> Iterator[Problem]:
@@ -626,12 +692,13 @@ def k_within_gaussians(cfg: dict) -> Iterator[Problem]:
                 ("models", "configs", name, "K"),
                 f"K = {c['K']} parts exceeds {fix}; lower K or raise the vertex count",
             )
-    for i, k in enumerate(cfg["models"]["kselect"]["candidates"]):
-        if int(k) > smallest:
-            yield (
-                ("models", "kselect", "candidates", i),
-                f"K = {k} exceeds {fix}; drop it from the candidates or raise the vertex count",
-            )
+    for _, where, ks in _kselect_runs(cfg, "candidates"):
+        for i, k in enumerate(ks["candidates"]):
+            if int(k) > smallest:
+                yield (
+                    (*where, "candidates", i),
+                    f"K = {k} exceeds {fix}; drop it from the candidates or raise the vertex count",
+                )
     sa = cfg["speed_accuracy"]
     tree = sa["tree"]
     if tree in vertices:
@@ -731,6 +798,7 @@ CHECKS: list[Check] = [
     freeze_inside_deformation_phase,
     ours_bounds_ordered,
     omega_search_is_runnable,
+    kselect_priors_are_runnable,
     configs_have_single,
     k_within_gaussians,
     sweep_tree_is_listed,

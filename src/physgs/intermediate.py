@@ -12,7 +12,7 @@ from __future__ import annotations
 
 import json
 import zipfile
-from collections.abc import Iterable
+from collections.abc import Callable, Iterable
 from pathlib import Path
 
 import numpy as np
@@ -47,6 +47,42 @@ def _missing(path: Path, rule: str) -> IntermediateFileError:
     )
 
 
+def load_npz(
+    path: str | Path, keys: Iterable[str], error: Callable[[str, str], Exception]
+) -> dict[str, np.ndarray]:
+    """The arrays of an ``.npz`` of plain arrays (no pickled objects), every one of ``keys``
+    present; what the caller raises when it is not is ``error``'s (``read_npz``: an
+    intermediate file's; ``physgs.testbed.dataset``: a dataset's).
+
+    Args:
+        path: the file.
+        keys: names the file must hold (it may hold more).
+        error: ``error(problem, detail)`` -> the exception to raise: problem "missing" (detail
+            ""), "corrupt" (detail: the exception's type and message) or "lacks" (detail: the
+            absent keys).
+
+    Returns:
+        name -> array, for every array in the file.
+
+    Raises:
+        Exception: ``error``'s; a ``PermissionError`` as it is (not the file's fault).
+    """
+    path = Path(path)
+    if not path.is_file():
+        raise error("missing", "")
+    try:
+        with np.load(path, allow_pickle=False) as z:
+            d = {k: z[k] for k in z.files}
+    except PermissionError:
+        raise  # not the file's fault: keep it
+    except (zipfile.BadZipFile, ValueError, OSError, EOFError, KeyError) as e:
+        raise error("corrupt", f"{type(e).__name__}: {e}") from None
+    absent = [k for k in keys if k not in d]
+    if absent:
+        raise error("lacks", str(absent))
+    return d
+
+
 def read_npz(path: str | Path, keys: Iterable[str], *, rule: str) -> dict[str, np.ndarray]:
     """The arrays of an intermediate ``.npz`` (no pickled objects), every one of ``keys`` present.
 
@@ -62,20 +98,17 @@ def read_npz(path: str | Path, keys: Iterable[str], *, rule: str) -> dict[str, n
         IntermediateFileError: the file is missing, or is not a readable ``.npz`` of plain arrays
             holding ``keys`` (then it is removed first, so the next run rebuilds it).
     """
-    path = Path(path)
-    if not path.is_file():
-        raise _missing(path, rule)
-    try:
-        with np.load(path, allow_pickle=False) as z:
-            d = {k: z[k] for k in z.files}
-    except PermissionError:
-        raise  # not the file's fault: keep it
-    except (zipfile.BadZipFile, ValueError, OSError, EOFError, KeyError) as e:
-        raise refuse(path, f"is corrupt ({type(e).__name__}: {e})", rule) from None
-    absent = [k for k in keys if k not in d]
-    if absent:
-        raise refuse(path, f"lacks {absent} (another version, or not this rule's file)", rule)
-    return d
+
+    def error(problem: str, detail: str) -> IntermediateFileError:
+        if problem == "missing":
+            return _missing(Path(path), rule)
+        what = {
+            "corrupt": f"is corrupt ({detail})",
+            "lacks": f"lacks {detail} (another version, or not this rule's file)",
+        }[problem]
+        return refuse(path, what, rule)
+
+    return load_npz(path, keys, error)
 
 
 def read_json(path: str | Path, keys: Iterable[str] = (), *, rule: str) -> dict:

@@ -48,6 +48,9 @@ TRACKS_CONFIGS = list(CFG["tracks"]["configs"])
 TRACKS_DAMPING_CONFIGS = [c for c in DAMPING["configs"] if c in TRACKS_CONFIGS]
 # output-only modal analysis of the training video (docs/blind.md): the configurations it runs in
 OMA_CONFIGS = list(CFG["oma"]["configs"])
+# the priors besides ours whose K is chosen from the data (models/kselect/priors), each trained
+# as <prior>_auto by the rules of ours' (kselect.smk)
+KSELECT_PRIORS = list(_kselect.selected_models(CFG["models"]["kselect"])[1:])
 
 # ---- file layout ------------------------------------------------------------------------------
 # The testbed is one fixed instance per tree (testbed seed CFG["seed"]); every result of a
@@ -68,6 +71,7 @@ PARTS_RECORD = "results/parts/{tree}/seed{seed}.npz"  # the priors' segmentation
 KMATCH = "results/parts/{tree}/seed{seed}_chain_K{K}.json"  # the chained prior at a smaller K
 NULL = "results/recovery/{tree}/seed{seed}/null_K{K}.json"
 KSELECT = "results/kselect/{tree}/seed{seed}.json"
+PRIOR_KSELECT = "results/kselect/{tree}/seed{seed}/{model}.json"  # a prior's besides ours'
 SWEEP_POINT = "results/speed_accuracy/seed{seed}/{point}.json"
 FIT_POINT = "results/fit_curve/{tree}/seed{seed}/{model}_it{iterations}.json"
 # a field trained with the window-normalised time encoding (the fit curve's diagnostic series)
@@ -93,12 +97,12 @@ NEED_PATHS = {
     "traj": TRAJ,
     "panels": PANELS,
     "loss": LOSS,
-    "recovery": RECOVERY.replace("{model}", "ours"),
     "prior_recovery": RECOVERY,
     "parts": PARTS_RECORD,
     "kmatch": KMATCH,
     "null": NULL,
     "kselect": KSELECT,
+    "prior_kselect": PRIOR_KSELECT,
     "stats": STATS,
     "table": TABLE.replace("{ext}", "csv"),
     "tracks_recovery": TRACKS_RECOVERY,
@@ -189,12 +193,20 @@ def train_params(wildcards):
 
 
 def kselect_params(wildcards):
+    """The prior's base training job and its K-selection settings (ours' without {model})."""
+    model = getattr(wildcards, "model", _kselect.BASE_MODEL)
     return _canonical(
         {
-            "job": _job_spec(CFG, "ours", _models.BASE_CONFIG, seed=int(wildcards.seed)),
-            "kselect": CFG["models"]["kselect"],
+            "job": _job_spec(CFG, model, _models.BASE_CONFIG, seed=int(wildcards.seed)),
+            "kselect": _kselect.settings_for(CFG["models"]["kselect"], model),
         }
     )
+
+
+def kselect_runtime(model):
+    """Minutes of one K selection: about 1 s per iteration per candidate, generous for a cluster."""
+    ks = _kselect.settings_for(CFG["models"]["kselect"], model)
+    return 10 + len(ks["candidates"]) * ks["iterations"] // 60
 
 
 def null_params(wildcards):

@@ -2,7 +2,11 @@
 
 Config ``models.kselect``: candidates (K values), method (``heldout`` or ``bic``), every (hold
 out every k-th training frame), iterations and warmup (a short training run per candidate),
-tie_db (dB), conditions (which wind conditions the chosen model then trains on).
+tie_db (dB), conditions (which wind conditions the chosen model then trains on). Ours' K is
+always chosen (trained as ``ours_auto``); each prior under ``priors`` (prior -> its own
+candidates, iterations and warmup, the rest shared) is chosen the same way and trained as
+``<prior>_auto``: the chained prior's search over omega needs its bank phase after the
+warm-up, so its short runs are longer than ours' (``settings_for``).
 
 Both criteria come from the same runs: ours is trained per candidate by the one recipe
 ([`physgs.experiments.recipe.fit`][]: seeding, loop, schedule and freezing as the full run, only
@@ -30,6 +34,63 @@ from physgs.models.registry import AUTO_CONFIG
 
 METHODS = ("heldout", "bic")
 PARAMS_PER_PART = 8  # omega, zeta, gain, swing axis (2), pivot (3)
+#: the prior whose K the section's own keys choose (an entry of its own under ``priors`` is refused)
+BASE_MODEL = "ours"
+#: what a prior's entry under ``models.kselect.priors`` may set: its candidates and its short
+#: runs' schedule (the criterion, held-out frames and conditions stay shared, so the choices
+#: compare)
+OWN_KEYS = ("candidates", "iterations", "warmup")
+
+
+def selected_models(kselect: dict) -> tuple[str, ...]:
+    """The priors whose K is chosen from the data: ours, then those under ``priors``.
+
+    Args:
+        kselect: the ``models.kselect`` config section.
+
+    Returns:
+        Their registry ids, ours first, then in the section's order.
+    """
+    return (BASE_MODEL, *(kselect.get("priors") or {}))
+
+
+def section_key(model: str) -> str:
+    """The config key holding a model's own K-selection settings (for messages).
+
+    Args:
+        model: a registry id among ``selected_models``.
+
+    Returns:
+        ``models/kselect`` for ours, ``models/kselect/priors/<model>`` for another prior.
+    """
+    return "models/kselect" if model == BASE_MODEL else f"models/kselect/priors/{model}"
+
+
+def settings_for(kselect: dict, model: str) -> dict:
+    """The K-selection settings of ``model``: the section's keys, with the model's own entry
+    under ``priors`` over them (ours: the section's keys alone, exactly as before priors had
+    entries, so ours' selection reruns on its own keys only).
+
+    Args:
+        kselect: the ``models.kselect`` config section.
+        model: a registry id among ``selected_models(kselect)``.
+
+    Returns:
+        candidates, method, every, iterations, warmup, tie_db, conditions of its selection.
+
+    Raises:
+        ValueError: ``model`` has no K selection, naming the ones that have.
+    """
+    shared = {k: v for k, v in kselect.items() if k != "priors"}
+    if model == BASE_MODEL:
+        return shared
+    own = (kselect.get("priors") or {}).get(model)
+    if own is None:
+        raise ValueError(
+            f"{model!r} has no K selection; models/kselect/priors lists "
+            f"{list(selected_models(kselect)[1:])} (ours is always chosen)"
+        )
+    return {**shared, **own}
 
 
 def bic(mse: float, n: int, k_parts: int) -> float:
@@ -162,33 +223,31 @@ def load_selection(path) -> KSelection:
         raise refuse(path, f"is not a K selection ({type(e).__name__}: {e})", "kselect") from None
 
 
-def _check_cfg(ks: dict, n_gaussians: int) -> list[int]:
+def _check_cfg(ks: dict, n_gaussians: int, where: str = "models/kselect") -> list[int]:
     cands = sorted({int(k) for k in ks["candidates"]})
     if not cands or cands[0] < 1:
-        raise ValueError(
-            f"models.kselect.candidates must be positive integers, got {ks['candidates']}"
-        )
+        raise ValueError(f"{where}/candidates must be positive integers, got {ks['candidates']}")
     if cands[-1] > n_gaussians:
         raise ValueError(
-            f"models.kselect.candidates: K = {cands[-1]} exceeds the {n_gaussians} "
+            f"{where}/candidates: K = {cands[-1]} exceeds the {n_gaussians} "
             "Gaussians of this tree; drop it from the candidates"
         )
     if ks["method"] not in METHODS:
-        raise ValueError(f"models.kselect.method must be one of {METHODS}, got {ks['method']!r}")
+        raise ValueError(f"models/kselect/method must be one of {METHODS}, got {ks['method']!r}")
     return cands
 
 
 def select_k(observed, job: Job | dict, kselect: dict, *, progress: bool = False) -> KSelection:
-    """Train ours once per candidate K on the non-held-out frames and score both criteria.
+    """Train a prior once per candidate K on the non-held-out frames and score both criteria.
 
-    Each candidate is trained by [`fit`][physgs.experiments.recipe.fit] (freezing included) with
-    the section's shorter schedule. Deterministic for the job's seed.
+    Each candidate is trained by [`fit`][physgs.experiments.recipe.fit] (freezing and the search
+    over omega included) with the shorter schedule. Deterministic for the job's seed.
 
     Args:
         observed (Observed): the dataset.
-        job: ours' training job ([`job_spec`][physgs.experiments.recipe.job_spec]: settings,
-            train, seed; its K and configuration are replaced per candidate).
-        kselect: the ``models.kselect`` section.
+        job: the prior's training job ([`job_spec`][physgs.experiments.recipe.job_spec]: model,
+            settings, train, seed; its K and configuration are replaced per candidate).
+        kselect: its K-selection settings ([`settings_for`][physgs.experiments.kselect.settings_for]).
         progress: show progress bars.
 
     Returns:
@@ -203,7 +262,7 @@ def select_k(observed, job: Job | dict, kselect: dict, *, progress: bool = False
 
     job = Job.from_dict(job) if isinstance(job, dict) else job
     ks = kselect
-    cands = _check_cfg(ks, int(np.asarray(observed.canonical_xyz).shape[0]))
+    cands = _check_cfg(ks, int(np.asarray(observed.canonical_xyz).shape[0]), section_key(job.model))
     train_idx, held = heldout_split(int(observed.n_train), int(ks["every"]))
     tcfg = dict(job.train, iterations=int(ks["iterations"]), warmup=int(ks["warmup"]))
     scored_train = train_idx[:: max(1, train_idx.size // held.size)][: held.size]
@@ -213,7 +272,7 @@ def select_k(observed, job: Job | dict, kselect: dict, *, progress: bool = False
     for K in cands:
         t0 = time.perf_counter()
         cand = job.replace(K=int(K), config=AUTO_CONFIG, conditions="train", train=tcfg)
-        res = fit(observed, cand, frame_pool=train_idx, progress=progress, name=f"ours_K{K}")
+        res = fit(observed, cand, frame_pool=train_idx, progress=progress, name=f"{job.model}_K{K}")
         _, p_held = training_camera_scores(res.model, observed, held, backend=backend)
         mse_tr, _ = training_camera_scores(res.model, observed, scored_train, backend=backend)
         rows["heldout_psnr"].append(float(np.mean(p_held)))
@@ -237,10 +296,10 @@ def select_k(observed, job: Job | dict, kselect: dict, *, progress: bool = False
 
 
 def auto_job(job: Job | dict, sel: KSelection, conditions: str) -> dict:
-    """Ours' training job with the chosen K (configuration 'auto'), as ``recipe.job_spec``.
+    """A prior's training job with the chosen K (configuration 'auto'), as ``recipe.job_spec``.
 
     Args:
-        job: ours' training job.
+        job: the prior's training job.
         sel: the selection.
         conditions: the configuration's conditions (``'train'`` or ``'all'``).
 

@@ -19,7 +19,7 @@ from __future__ import annotations
 from dataclasses import dataclass
 from pathlib import Path
 
-from typing import TYPE_CHECKING
+from typing import TYPE_CHECKING, Iterable
 
 import numpy as np
 
@@ -41,6 +41,9 @@ class ModelSpec:
     parts: str = "kmeans"  # oscillator priors: how parts are cut ("kmeans" or "topology")
     chain: bool = False  # oscillator priors: each part's transform composed with its parent's
     forcing: str = "wind"  # oscillator priors: "wind" (measured) or "learned" (physgs.models.blind)
+    # a forcing-free prior: the prior of ``MODELS`` whose measured wind it replaces (the
+    # ledger's anemometer claim compares the two)
+    blind_of: str | None = None
 
 
 #: The roles a model plays in the comparison. A report output (``physgs.report.outputs``) declares
@@ -84,7 +87,13 @@ PRIOR_VARIANTS: dict[str, ModelSpec] = {
     # ours with a learned forcing shared by every part instead of the measured wind
     # (physgs.models.blind); trained in `single` only (one window, one forcing)
     "ours_blind": ModelSpec(
-        "Ours, learned forcing", "blind", "ours", False, "prior", forcing="learned"
+        "Ours, learned forcing",
+        "blind",
+        "ours",
+        False,
+        "prior",
+        forcing="learned",
+        blind_of="ours",
     ),
     "ours_chain_blind": ModelSpec(
         "Ours, chained topology parts, learned forcing",
@@ -95,6 +104,7 @@ PRIOR_VARIANTS: dict[str, ModelSpec] = {
         parts="topology",
         chain=True,
         forcing="learned",
+        blind_of="ours_chain",
     ),
 }
 PRIOR_VARIANT_NAMES = tuple(PRIOR_VARIANTS)
@@ -140,6 +150,20 @@ BLIND_CONFIG = BASE_CONFIG
 FORMAT = "physgs-model-v2"
 #: Ours with K chosen from the data (physgs.experiments.kselect); its K is passed explicitly.
 AUTO_CONFIG = "auto"
+
+
+def blind_priors(configs: Iterable[str]) -> tuple[str, ...]:
+    """The forcing-free priors (``BLIND_PRIORS``) trained with the configurations ``configs``:
+    all of them when ``BLIND_CONFIG`` is among them, none otherwise.
+
+    Args:
+        configs (Iterable[str]): configuration names (a run's ``models.configs``, or a
+            table's own).
+
+    Returns:
+        tuple[str, ...]: their ids, in registry order.
+    """
+    return BLIND_PRIORS if BLIND_CONFIG in configs else ()
 
 
 def is_reference(model: str) -> bool:

@@ -1,13 +1,13 @@
 """Collect per-job result files into the tables and figures (what the report rules call).
 
-The library never knows where the workflow keeps its files. Each output
-([`physgs.report.outputs`][]) declares what it needs as *need tuples* (``needs``): ``("eval" |
-"traj" | "panels" | "loss", tree, model, config, seed)``, ``("recovery", tree, config, seed)``,
-``("null", tree, K, seed)``, ``("kselect", tree, seed)``, ``("stats", tree)``, ``("table", name)``
-and the rest of ``NEED_FIELDS``; seed is a training seed. The workflow maps each tuple to a path
-(``workflow/rules/common.smk``) and hands the builders a mapping ``key(need) -> path``; the builders
-read only those paths. ``settings_for`` gives the narrow settings an output reads, so editing one
-table's format rebuilds that table only.
+The library never knows where the workflow keeps its files. Each output (``physgs.report.outputs``)
+declares what it needs as *need tuples* (``needs``): ``("eval" | "traj" | "panels" | "loss", tree,
+model, config, seed)``, ``("prior_recovery", tree, model, config, seed)``, ``("null", tree, K, seed)``,
+``("kselect", tree, seed)``, ``("stats", tree)``, ``("table", name)`` and the rest of
+``NEED_FIELDS``; seed is a training seed. The workflow maps each tuple to a path
+(``workflow/rules/common.smk``) and hands the builders a mapping ``key(need) -> path``; the
+builders read only those paths. ``settings_for`` gives the narrow settings an output reads, so
+editing one table's format rebuilds that table only.
 """
 
 from __future__ import annotations
@@ -16,10 +16,9 @@ from typing import TYPE_CHECKING, Mapping, Sequence
 
 import pandas as pd
 
-from physgs.models.registry import BASE_CONFIG
+from physgs.models.registry import BASE_CONFIG, models_of
 from physgs.recovery.record import load_recovery
 from physgs.report.outputs import NEED_FIELDS, OUTPUTS, Plan, key, reader
-from physgs.report.outputs.recovery import other_priors
 from physgs.report.outputs.views import fit_row
 
 if TYPE_CHECKING:
@@ -67,8 +66,8 @@ def claims_needs(
 ) -> list[tuple]:
     """What the claims ledger reads.
 
-    The tables' CSVs and every prior's recovery (damping) of every seed in the joint K=32
-    configuration (the paper's), or the base configuration when the config has none.
+    The tables' CSVs and every prior's recovery (damping; ours first) of every seed in the joint
+    K=32 configuration (the paper's), or the base configuration when the config has none.
 
     Args:
         trees: the trees.
@@ -88,10 +87,9 @@ def claims_needs(
     return (
         [("table", n) for n in CLAIMS_TABLES]
         + extra
-        + [("recovery", t, c, int(s)) for t in trees for s in seeds]
         + [
             ("prior_recovery", t, m, c, int(s))
-            for m in other_priors()
+            for m in models_of("prior")
             for t in trees
             for s in seeds
         ]
@@ -116,22 +114,21 @@ def claims_frame(inputs: Mapping[str, str], trees: Sequence[str]) -> pd.DataFram
 
     names = (*CLAIMS_TABLES, "tab_parts", "tab_tracks", "tab_damping")
     tabs = {n: pd.read_csv(inputs[key(("table", n))]) for n in names if key(("table", n)) in inputs}
-    damping: dict[str, list] = {}
-    prior_damping: dict[str, dict[str, list]] = {}
-    for k, p in sorted(inputs.items()):  # recovery/<tree>/<config>/<seed>: one entry per seed
-        kind, tree, *rest = k.split("/")  # prior_recovery/<tree>/<model>/<config>/<seed>
-        if kind not in ("recovery", "prior_recovery"):
+    damping: dict[str, dict[str, list]] = {}  # model -> tree -> one summary per seed
+    for k, p in sorted(inputs.items()):  # prior_recovery/<tree>/<model>/<config>/<seed>
+        kind, tree, *rest = k.split("/")
+        if kind != "prior_recovery":
             continue
         d = load_recovery(p).damping
-        into = damping if kind == "recovery" else prior_damping.setdefault(rest[0], {})
-        into.setdefault(tree, []).append(
+        damping.setdefault(rest[0], {}).setdefault(tree, []).append(
             {
                 "median_zeta": d.median_zeta,
                 "zeta_true": d.zeta_true,
                 "loglog_exponent": d.loglog_exponent,
             }
         )
-    return claims.ledger(claims.measure(tabs, damping, trees, prior_damping))
+    ours = damping.pop("ours", {})  # the paper's claims; the other priors' are asked again
+    return claims.ledger(claims.measure(tabs, ours, trees, damping))
 
 
 def make_claims(inputs: Mapping[str, str], trees: Sequence[str], md_path, csv_path, stamp=None):

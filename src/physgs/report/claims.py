@@ -19,18 +19,10 @@ from typing import Callable, Mapping, Sequence
 
 import numpy as np
 import pandas as pd
+from physgs.models.registry import label, models_of
 from physgs.report import paper
 from physgs.report.seeds import interval
 
-LEARNED = ("mlp", "mlp_wind", "d3dgs", "d3dgs_wind")
-LABELS = {
-    "static": "Static pose",
-    "mlp": "Deformation MLP",
-    "mlp_wind": "Deformation MLP + wind",
-    "d3dgs": "Deformable-3DGS",
-    "d3dgs_wind": "Deformable-3DGS + wind",
-    "ours": "Ours",
-}
 #: The paper's own figures for each tree (tables 1-4 and section 4).
 PAPER_PSNR = {  # tab:psnr, (view, time)
     "sparse": {
@@ -128,7 +120,7 @@ def _per_seed(df: pd.DataFrame) -> list[pd.DataFrame]:
 
 
 def _psnr(df, tree, model, split):
-    return float(df.loc[df["model"] == LABELS[model], f"{tree}_{split}"].iloc[0])
+    return float(df.loc[df["model"] == label(model), f"{tree}_{split}"].iloc[0])
 
 
 def damping_offsets(summaries: Sequence[Mapping[str, float]]) -> list[float]:
@@ -171,9 +163,9 @@ def measure(
     Returns:
         ``(claim, per-seed values)`` pairs, in the ledger's order.
     """
-    from physgs.models.registry import label, models_of
     from physgs.report.claims_priors import prior_claims
 
+    learned = models_of("field")
     # the other priors the run's tables hold (a run made before one joined them lists none)
     others = [m for m in models_of("prior") if m != "ours" and _holds(tables, m, label(m))]
     out: list[tuple[Claim, list[float]]] = []
@@ -187,7 +179,7 @@ def measure(
     for t in trees:
         pp = PAPER_PSNR.get(t, {})
         if pp:
-            base_time = max(pp[m][1] - pp["static"][1] for m in LEARNED)
+            base_time = max(pp[m][1] - pp["static"][1] for m in learned)
         add(
             Claim(
                 f"baselines_below_static_beyond/{t}",
@@ -200,7 +192,7 @@ def measure(
             ),
             "tab_psnr",
             lambda d, t=t: (
-                max(_psnr(d, t, m, "time") for m in LEARNED) - _psnr(d, t, "static", "time")
+                max(_psnr(d, t, m, "time") for m in learned) - _psnr(d, t, "static", "time")
             ),
         )
         add(
@@ -220,7 +212,7 @@ def measure(
             Claim(
                 f"ours_behind_on_views/{t}",
                 f"{t}: ours is behind the best learned field on held-out views",
-                f"{pp['ours'][0] - max(pp[m][0] for m in LEARNED):+.2f} dB" if pp else "--",
+                f"{pp['ours'][0] - max(pp[m][0] for m in learned):+.2f} dB" if pp else "--",
                 "tab_psnr, view column: ours - max over learned fields",
                 0.0,
                 "<",
@@ -228,7 +220,7 @@ def measure(
             ),
             "tab_psnr",
             lambda d, t=t: (
-                _psnr(d, t, "ours", "view") - max(_psnr(d, t, m, "view") for m in LEARNED)
+                _psnr(d, t, "ours", "view") - max(_psnr(d, t, m, "view") for m in learned)
             ),
         )
 
@@ -347,11 +339,11 @@ def measure(
 
     # the premise of every comparison: the fields fit their window
     for t in trees:
-        for m in (*LEARNED, "ours", *others):
+        for m in (*learned, "ours", *others):
             add(
                 Claim(
                     f"fits_window/{t}/{m}",
-                    f"{t}: {LABELS.get(m) or label(m)} fits its training window (reaches {FIT_BAR:.0%} of "
+                    f"{t}: {label(m)} fits its training window (reaches {FIT_BAR:.0%} of "
                     "the true-motion ceiling's in-window gain over static)",
                     "the fields 'fit the training window well'",
                     "tab_fit: (fit - static) / (ceiling - static) on the trained frames",
@@ -383,7 +375,7 @@ def measure(
                 "dB",
             ),
             "tab_transfer",
-            lambda d, cell=cell: float(cell(d)["ours"] - max(cell(d)[m] for m in LEARNED)),
+            lambda d, cell=cell: float(cell(d)["ours"] - max(cell(d)[m] for m in learned)),
         )
         add(
             Claim(
@@ -396,7 +388,7 @@ def measure(
                 "dB",
             ),
             "tab_transfer",
-            lambda d, cell=cell: float(max(cell(d)[m] for m in LEARNED) - cell(d)["static"]),
+            lambda d, cell=cell: float(max(cell(d)[m] for m in learned) - cell(d)["static"]),
         )
 
     if "tab_parts" in tables:
@@ -612,25 +604,22 @@ def _tracks_claims(
     return out
 
 
-#: methods of tab_null / tab_damping that read no wind (docs/blind.md): the output-only
-#: analysis (its method id, physgs.report.tables.OMA) and ours with a learned forcing
-BLIND = "ours_blind"
-
-
 def _blind_claims(
     null: pd.DataFrame, damping: pd.DataFrame | None, trees: Sequence[str]
 ) -> list[tuple[Claim, list[float]]]:
     """The forcing-free methods' claims, in ``single`` (the one configuration both
-    run in), from tab_null / tab_damping rows whose column ``method`` is ``oma`` or
-    ``ours_blind``; a claim whose rows are absent is not added.
+    run in), from tab_null / tab_damping rows whose column ``method`` is ``oma`` or a
+    forcing-free prior's (``registry.BLIND_PRIORS``); a claim whose rows are absent is not added.
 
-    - ``anemometer_needed/<tree>``: ours with a learned forcing minus ours (median omega error,
-      points) above 0: the measured wind helps recovery;
+    - ``anemometer_needed/<tree>``: for each forcing-free prior, it minus the prior whose
+      measured wind it replaces (``ModelSpec.blind_of``; median omega error, points) above 0:
+      the measured wind helps recovery (ids ``<prior>/anemometer_needed/<tree>`` for a prior
+      other than ours, as ``claims_priors``');
     - ``oma_beats_null/sparse``: null / output-only median omega error above 1;
     - ``oma_recovers_zeta/<tree>``: output-only minus null median zeta error (points, the
       damping benchmark's testbed) below 0.
     """
-    from physgs.models.registry import BLIND_CONFIG
+    from physgs.models.registry import BLIND_CONFIG, BLIND_PRIORS, spec_of
     from physgs.report.tables import OMA
     from physgs.testbed.variant import DAMPING
 
@@ -644,23 +633,27 @@ def _blind_claims(
         return float(r.iloc[0][col]) if len(r) else float("nan")
 
     have = set(null["method"])
-    for t in trees:
-        if BLIND in have and (null["tree"] == t).any():
+    for blind in (m for m in BLIND_PRIORS if m in have):
+        wind = spec_of(blind).blind_of
+        who, prefix = ("ours", "") if wind == "ours" else (f"the {label(wind)}", f"{wind}/")
+        for t in trees:
+            if not (null["tree"] == t).any():
+                continue
             out.append(
                 (
                     Claim(
-                        f"anemometer_needed/{t}",
-                        f"{t}: without the measured wind (a learned forcing) ours recovers "
+                        f"{prefix}anemometer_needed/{t}",
+                        f"{t}: without the measured wind (a learned forcing) {who} recovers "
                         "omega worse",
                         "the paper's closing limit: 'real footage needs an anemometer'",
-                        f"tab_null, {c}: ours_blind - ours median rel. error (points)",
+                        f"tab_null, {c}: {blind} - {wind} median rel. error (points)",
                         0.0,
                         ">",
                         "pp",
                     ),
                     [
-                        cell(d, t, BLIND, "trained_median_rel_err_pct")
-                        - cell(d, t, "ours", "trained_median_rel_err_pct")
+                        cell(d, t, blind, "trained_median_rel_err_pct")
+                        - cell(d, t, wind, "trained_median_rel_err_pct")
                         for d in _per_seed(null)
                     ],
                 )

@@ -18,11 +18,9 @@ from typing import Callable, Mapping, Sequence
 import numpy as np
 import pandas as pd
 
-from physgs.models.registry import label
+from physgs.models.registry import label, models_of
 from physgs.report.claims import (
     DAMPING_OFF,
-    LABELS,
-    LEARNED,
     NULL_MATCH_PP,
     RATE_EXPONENT,
     Claim,
@@ -36,8 +34,7 @@ AHEAD = "ahead_of_fields"
 
 
 def _psnr(d: pd.DataFrame, tree: str, model: str, split: str) -> float:
-    name = LABELS.get(model) or label(model)
-    return _value(d, d["model"] == name, f"{tree}_{split}")
+    return _value(d, d["model"] == label(model), f"{tree}_{split}")
 
 
 def _col(d: pd.DataFrame, mask, model: str) -> float:
@@ -96,7 +93,7 @@ def prior_claims(
                 f"tab_psnr, {split} column: prior - max over learned fields",
                 "tab_psnr",
                 lambda d, t=t, sp=split: (
-                    _psnr(d, t, model, sp) - max(_psnr(d, t, m, sp) for m in LEARNED)
+                    _psnr(d, t, model, sp) - max(_psnr(d, t, m, sp) for m in models_of("field"))
                 ),
             )
 
@@ -114,7 +111,7 @@ def prior_claims(
                 f"tab_transfer ({sp}): prior - max learned",
                 "tab_transfer",
                 lambda d, cell=cell: (
-                    _col(d, cell(d), model) - max(_col(d, cell(d), m) for m in LEARNED)
+                    _col(d, cell(d), model) - max(_col(d, cell(d), m) for m in models_of("field"))
                 ),
             )
 

@@ -18,22 +18,22 @@ from typing import Mapping, Sequence
 import numpy as np
 import pandas as pd
 
-from physgs.models.registry import label as model_label
 from physgs.report import seeds as seedstats
 from physgs.report.tables import (
     MethodRows,
     Table,
     _by_seed,
     _check,
-    _further,
     _seeds,
+    _who,
     _wrap,
     tree_label,
 )
 from physgs.testbed.variant import DAMPING, FAITHFUL
 
 VARIANTS = (FAITHFUL, DAMPING)
-_TRACKS_NOTE = (
+#: tab_damping's caption sentence for the 2D-track control (``tables.tracks_rows``)
+TRACKS_NOTE = (
     r" \emph{2D tracks}: the same oscillators fitted to point tracks of the training "
     r"video (no renderer), scored on its own matching against its own null draw."
 )
@@ -51,38 +51,25 @@ COLUMNS = (
 
 
 def tab_damping(
-    per_seed: Mapping[int, Mapping[tuple[str, str, str], object]],
+    methods: Mapping[str, MethodRows],
     trees: Sequence[str],
     bones: Mapping[str, int],
-    configs: Mapping[str, str],
     digits: int = 2,
-    tracks: Mapping[int, Mapping[tuple[str, str, str], object]] | None = None,
-    tracks_configs: Mapping[str, str] | None = None,
-    priors: Mapping[str, Mapping[int, Mapping[tuple[str, str, str], object]]] | None = None,
-    methods: Mapping[str, MethodRows] | None = None,
 ) -> Table:
-    """Damping recovery per seed, tree, variant and configuration, beside the null.
+    """Damping recovery per seed, tree, variant, method and configuration, beside the null.
 
-    One CSV row per seed, tree, variant and configuration; the .tex gives mean +- sd over seeds
-    and the paired trained - null difference with its 95% interval.
+    One CSV row per seed, tree, variant, method and configuration (column ``method`` the id);
+    the .tex gives mean +- sd over seeds and the paired trained - null difference with its 95%
+    interval.
 
     Args:
-        per_seed: ``per_seed[seed][(tree, variant, config)]``: ``RecoveryRecord`` with damping
+        methods: method id -> its [`MethodRows`][physgs.report.tables.MethodRows], in row order
+            (ours first, as tab_null's; a method with no configurations has no rows):
+            ``per_seed[seed][(tree, variant, config)]`` = its ``RecoveryRecord`` with damping
             scores and null; variant 'faithful' or 'damping'.
         trees: the trees.
         bones: tree -> its bone count.
-        configs: name -> LaTeX label, in row order.
         digits: decimals shown in the .tex.
-        tracks: the 2D-track control's records the same way ([`physgs.tracks`][physgs.tracks],
-            with damping scores), for the configurations of ``tracks_configs``; they follow ours'
-            rows of each testbed, column ``method`` 'tracks' (ours' rows: 'ours').
-        tracks_configs: name -> LaTeX label of the tracks control's configurations.
-        priors: the other oscillator priors' records, ``priors[model][seed][(tree, variant,
-            config)]``, in every configuration of ``configs``; their rows follow ours' of each
-            testbed, column ``method`` the model id.
-        methods: further methods' rows (method id ->
-            [`MethodRows`][physgs.report.tables.MethodRows] of records per ``(tree, variant,
-            config)``), each in its own configurations, after the tracks control's.
 
     Returns:
         The [`Table`][physgs.report.tables.Table].
@@ -91,40 +78,23 @@ def tab_damping(
         ValueError: when a record has no damping scores.
         KeyError: when a seed lacks a record.
     """
-    seeds = _seeds(per_seed, "tab_damping")
-    tracks_configs = dict(tracks_configs or {})
-    priors = dict(priors or {})
-    further = _further(tracks, tracks_configs, _TRACKS_NOTE, methods)
-    block = [(c, "ours") for c in configs]
-    block += [(c, p) for p in priors for c in configs]
-    block += [(c, m) for m, mr in further.items() for c in mr.configs]
+    methods = {m: mr for m, mr in methods.items() if mr.configs}
+    seeds = _seeds(next(iter(methods.values())).per_seed if methods else {}, "tab_damping")
+    block = [(c, m) for m, mr in methods.items() for c in mr.configs]
     keys = [(t, v, c, m) for t in trees for v in VARIANTS for c, m in block]
     rows = []
     for s in seeds:
-        _check([k[:3] for k in keys if k[3] == "ours"], per_seed[s], f"tab_damping (seed {s})")
-        for m, mr in further.items():
-            who = "tracks control" if m == "tracks" else m
+        for m, mr in methods.items():
             _check(
                 [k[:3] for k in keys if k[3] == m],
                 mr.per_seed.get(s, {}),
-                f"tab_damping ({who}, seed {s})",
-            )
-        for p in priors:
-            _check(
-                [k[:3] for k in keys if k[3] == p],
-                priors[p].get(s, {}),
-                f"tab_damping ({p}, seed {s})",
+                f"tab_damping ({_who(m)}, seed {s})",
             )
         for t, v, c, method in keys:
-            if method == "ours":
-                rec = per_seed[s][(t, v, c)]
-            elif method in priors:
-                rec = priors[method][s][(t, v, c)]
-            else:
-                rec = further[method].per_seed[s][(t, v, c)]
+            rec = methods[method].per_seed[s][(t, v, c)]
             sc, nl = rec.damping_scores, rec.damping_null
             if sc is None or nl is None:
-                who = {"ours": "", "tracks": " (tracks control)"}.get(method, f" ({method})")
+                who = "" if method == "ours" else f" ({_who(method)})"
                 raise ValueError(
                     f"tab_damping: the recovery of {t}/{v}/{c}{who} (seed {s}) has no "
                     "damping scores; re-run its recovery rule with damping params"
@@ -171,19 +141,13 @@ def tab_damping(
         )
         p = seedstats.pm(V["gamma_exponent"][:, i], ".2f")
         p_true = np.nanmean(V["gamma_exponent_true"][:, i])
-        if method == "ours":
-            label = configs[c]
-        elif method in priors:
-            label = f"{model_label(method)}, {configs[c]}"
-        else:
-            label = f"{further[method].label}, {further[method].configs[c]}"
         lines.append(
             "    "
             + " & ".join(
                 [
                     head,
                     v if i % len(block) == 0 else "",
-                    label,
+                    methods[method].row_label(c),
                     seedstats.pm(V["trusted"][:, i], ".1f"),  # a mean count: one decimal
                     pct(seedstats.pm(V["rel_err_pct"][:, i], ".0f")),
                     pct(seedstats.pm(V["null_rel_err_pct"][:, i], ".0f")),
@@ -209,7 +173,7 @@ def tab_damping(
         r"exponent $p$ of the fitted decay rate $\hat\gamma=\hat\zeta\hat\omega\propto"
         r"\hat\omega^p$ ($p\approx0$: a frequency-independent rate fitted in place of a "
         r"ratio), the truth's own $p$ on the matched bones in brackets."
-        + "".join(mr.note for mr in further.values())
+        + "".join(mr.note for mr in methods.values())
         + (
             rf" Mean $\pm$ sd over {len(seeds)} training seeds; differences bold when their 95\% "
             r"interval excludes 0, $^{\dagger}$ when not."

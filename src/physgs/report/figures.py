@@ -310,25 +310,24 @@ def fig_results(
 
 # --------------------------------------------------------------------------------------------
 def fig_damping(
-    damping: Mapping[tuple[str, str], object],
+    damping: Mapping[str, Mapping[tuple[str, str], object]],
     trees: Sequence[str],
     configs: Sequence[str],
     zeta_true: float,
     outputs: Sequence[str | Path],
-    priors: Mapping[str, Mapping[tuple[str, str], object]] | None = None,
 ) -> None:
     """Left: zeta_hat per part for each tree and config against the true ratio (line).
     Right: decay rate gamma_hat = zeta_hat * omega_hat (1/s) against omega_hat (rad/s), log-log,
     with the ground-truth line gamma = zeta_true * omega.
 
     Args:
-        damping (Mapping): ours' ``DampingResult`` per ``(tree, config)``.
+        damping (Mapping): each prior's ``DampingResult`` per ``(tree, config)``, by model id in
+            drawing order: ours' (filled markers), then the others' beside it (hollow markers
+            on the right).
         trees (Sequence[str]): the trees, in column order.
         configs (Sequence[str]): the configurations, in column order.
         zeta_true (float): the testbed's damping ratio.
         outputs (Sequence[str | Path]): the files to write (PDF, PNG).
-        priors (Mapping | None): the other priors' ``DampingResult`` per model id and
-            ``(tree, config)``, each drawn beside ours' column (hollow markers on the right).
 
     Raises:
         KeyError: naming a ``(tree, config)`` (and model) without a result.
@@ -337,10 +336,9 @@ def fig_damping(
     tree_colors = dict(zip(trees, ["tab:green", "tab:blue", "tab:red", "tab:purple"]))
     markers = dict(zip(configs, ["o", "s", "^", "D"]))
     pos, labels, allw = 0, [], []
-    sources = {"ours": damping, **(priors or {})}
     for t in trees:
         for c in configs:
-            for model, results in sources.items():
+            for model, results in damping.items():
                 if (t, c) not in results:
                     who = "" if model == "ours" else f" of {model}"
                     raise KeyError(f"fig_damping: no damping result{who} for ({t}, {c})")

@@ -1,7 +1,8 @@
-"""tab_kselect: ours with fixed K (`single`) beside ours with K chosen from the data (`auto`).
+"""tab_kselect: each prior with fixed K (`single`) beside the same prior with K chosen from the
+data (`auto`): ours, and every prior under ``models.kselect.priors`` (the chained prior).
 
-Built by ``physgs.report.build.make_table('tab_kselect', ...)`` from each tree's K selection
-and the evaluation and recovery of ``ours_single`` and ``ours_auto``.
+Built by ``physgs.report.build.make_table('tab_kselect', ...)`` from each tree's K selections
+and the evaluation, recovery and loss log of ``<prior>_single`` and ``<prior>_auto``.
 """
 
 from __future__ import annotations
@@ -11,91 +12,152 @@ from typing import Mapping, Sequence
 import numpy as np
 import pandas as pd
 
+from physgs.models.registry import spec_of
 from physgs.report import seeds as seedstats
-from physgs.report.tables import Table, _by_seed, _first, _seeds, _tree_blocks, _wrap
+from physgs.report.tables import Table, _by_seed, _check, _first, _seeds, _tree_blocks, _wrap
 
 ROWS = (("single", "fixed $K$"), ("auto", "chosen $K$"))
+#: the per-seed values averaged in the .tex (K is shown as each seed chose it)
+_AVERAGED = (
+    "K",
+    "view_psnr_db",
+    "time_psnr_db",
+    "median_rel_err_pct",
+    "parts_trusted",
+    "parts_frozen",
+    "train_s",
+    "select_s",
+    "cost_x",
+)
+
+
+def row_label(model: str, config: str) -> str:
+    """A row's LaTeX label: the registry's short name and the row kind.
+
+    Args:
+        model: the prior's registry id.
+        config: the row kind (``single``: fixed K, ``auto``: chosen K).
+
+    Returns:
+        'Ours, fixed $K$' / 'Chained, chosen $K$'.
+    """
+    return f"{spec_of(model).short}, {dict(ROWS)[config]}"
+
+
+def cost_ratio(train_s: float, select_s: float, fixed_train_s: float) -> float:
+    """What K from the data costs against the fixed K.
+
+    Args:
+        train_s: training of the chosen-K model, s.
+        select_s: the selection's runs, s.
+        fixed_train_s: training of the fixed-K model, s.
+
+    Returns:
+        (train_s + select_s) / fixed_train_s.
+    """
+    return (train_s + select_s) / fixed_train_s
 
 
 def tab_kselect(
-    per_seed: Mapping[int, Mapping[tuple[str, str], dict]],
+    per_seed: Mapping[int, Mapping[tuple[str, str, str], dict]],
     trees: Sequence[str],
     bones: Mapping[str, int],
     method: str,
+    models: Sequence[str] = ("ours",),
     digits: int = 2,
 ) -> Table:
-    """The K selection per tree and configuration.
-
-    One LaTeX row per tree and configuration: K as chosen by each seed (slash-separated when the
-    seeds disagree), the rest mean +- sd over seeds.
+    """One LaTeX row per tree, prior and configuration (fixed, then chosen K).
 
     Args:
-        per_seed: ``per_seed[seed][(tree, config)]``: K, time_psnr (dB), median_rel_err
-            (fraction), trusted, frozen, k_heldout, k_bic.
-        trees: the trees.
-        bones: tree -> its bone count.
-        method: the selection method used (``models.kselect.method``).
-        digits: decimals shown in the .tex.
+        per_seed: ``per_seed[seed][(tree, model, config)]`` with config ``single`` or
+            ``auto``: K, view_psnr and time_psnr (dB), median_rel_err (fraction), trusted,
+            frozen, k_heldout, k_bic (of the model's selection), train_s (seconds of the
+            model's training), and for ``auto`` select_s (seconds of the selection's runs).
+        trees: the tree names, in row order.
+        bones: tree -> bone count (its label).
+        method: the criterion that chose K (``models.kselect.method``).
+        models: the priors, in row order (ours first).
+        digits: decimals of the PSNR and error cells.
 
     Returns:
-        The [`Table`][physgs.report.tables.Table].
+        The table: K as each seed chose it (slash-separated when the seeds disagree), the
+            rest mean +- sd over seeds; the CSV also holds each seed's cost against the fixed
+            K, ``cost_x`` = (train_s + select_s) / train_s of the fixed-K row.
     """
     seeds = _seeds(per_seed, "tab_kselect")
     recs = []
     for s in seeds:
+        _check(
+            [(t, m, c) for t in trees for m in models for c, _ in ROWS], per_seed[s], "tab_kselect"
+        )
         for t in trees:
-            for c, _ in ROWS:
-                r = per_seed[s][(t, c)]
-                recs.append(
-                    {
-                        "seed": s,
-                        "tree": t,
-                        "bones": bones[t],
-                        "config": c,
-                        "K": int(r["K"]),
-                        "time_psnr_db": r["time_psnr"],
-                        "median_rel_err_pct": 100 * r["median_rel_err"],
-                        "parts_trusted": int(r["trusted"]),
-                        "parts_frozen": int(r["frozen"]),
-                        "k_heldout": r["k_heldout"],
-                        "k_bic": r["k_bic"],
-                    }
-                )
+            for m in models:
+                fixed_s = float(per_seed[s][(t, m, "single")]["train_s"])
+                for c, _ in ROWS:
+                    r = per_seed[s][(t, m, c)]
+                    select_s = float(r["select_s"]) if c == "auto" else np.nan
+                    recs.append(
+                        {
+                            "seed": s,
+                            "tree": t,
+                            "bones": bones[t],
+                            "model": m,
+                            "config": c,
+                            "K": int(r["K"]),
+                            "view_psnr_db": r["view_psnr"],
+                            "time_psnr_db": r["time_psnr"],
+                            "median_rel_err_pct": 100 * r["median_rel_err"],
+                            "parts_trusted": int(r["trusted"]),
+                            "parts_frozen": int(r["frozen"]),
+                            "k_heldout": r["k_heldout"],
+                            "k_bic": r["k_bic"],
+                            "train_s": float(r["train_s"]),
+                            "select_s": select_s,
+                            "cost_x": cost_ratio(float(r["train_s"]), select_s, fixed_s)
+                            if c == "auto"
+                            else np.nan,
+                        }
+                    )
     df = pd.DataFrame(recs)
     first = _first(df)
     first["_i"] = np.arange(len(first))
-    V = {
-        c: _by_seed(df, c, len(seeds))
-        for c in ("K", "time_psnr_db", "median_rel_err_pct", "parts_trusted", "parts_frozen")
-    }
+    V = {c: _by_seed(df, c, len(seeds)) for c in _AVERAGED}
     fmt = f".{digits}f"
 
     def cells(r):
         i = r._i
         ks = "/".join(str(k) for k in dict.fromkeys(V["K"][:, i].astype(int)))
         err = seedstats.pm(V["median_rel_err_pct"][:, i], fmt)
+        cost = seedstats.pm(V["cost_x"][:, i], ".2g")
         return [
-            dict(ROWS)[r.config],
+            row_label(r.model, r.config),
             ks,
+            seedstats.pm(V["view_psnr_db"][:, i], fmt),
             seedstats.pm(V["time_psnr_db"][:, i], fmt),
             err if err == "--" else err + r"\%",
             f"{seedstats.pm(V['parts_trusted'][:, i], '.3g')}/{ks}",
             seedstats.pm(V["parts_frozen"][:, i], ".3g"),
+            seedstats.pm(V["train_s"][:, i], ".0f"),
+            seedstats.pm(V["select_s"][:, i], ".0f"),
+            cost if cost == "--" else cost + r"$\times$",
         ]
 
     lines = [
-        "  \\begin{tabular}{llccccc}",
+        "  \\begin{tabular}{llcccccccccc}",
         "    \\toprule",
-        r"    Tree & Model & $K$ & PSNR time & Med.\ rel.\ err. & Trusted & Frozen \\",
+        r"    Tree & Model & $K$ & PSNR views & PSNR time & Med.\ rel.\ err. & Trusted & Frozen"
+        r" & Train (s) & Select (s) & Cost \\",
         "    \\midrule",
     ]
     lines += _tree_blocks(first, trees, cells)
     lines += ["    \\bottomrule", "  \\end{tabular}", ""]
     cap = (
-        rf"Ours with fixed $K$ against $K$ chosen from the data (method: {method}; the "
-        r"CSV also lists the choice by held-out frames and by BIC). PSNR (dB) on the time split; "
+        rf"Each prior with fixed $K$ against $K$ chosen from the data (method: {method}, on "
+        r"held-out training-window frames; the CSV also lists the choice by held-out frames and "
+        r"by BIC). PSNR (dB) on the held-out views and on the time split (beyond the window); "
         r"median relative frequency error over trusted parts; Frozen: parts whose swing stayed "
-        r"under a pixel."
+        r"under a pixel. Train: seconds of the model's training; Select: seconds of the "
+        r"selection's short runs; Cost: (train + select) over the fixed-$K$ training."
         + (
             rf" Mean $\pm$ sd over {len(seeds)} training seeds; $K$ as each "
             r"seed chose it."

@@ -19,7 +19,7 @@ import pandas as pd
 
 from physgs.experiments.cost import read_costs, summarise, wall_spans
 from physgs.models.registry import label
-from physgs.report.claims import FIT_BAR, LABELS
+from physgs.report.claims import FIT_BAR
 from physgs.report.claims_priors import AHEAD
 from physgs.report.seeds import interval
 
@@ -145,7 +145,7 @@ def fit_section(tab_fit: pd.DataFrame) -> list[str]:
             if np.isfinite(lo):
                 cell += f" [{lo:.0f}, {hi:.0f}]"
             cells.append(cell)
-        lines.append(f"| {LABELS.get(m) or label(m)} | " + " | ".join(cells) + " |")
+        lines.append(f"| {label(m)} | " + " | ".join(cells) + " |")
     return lines + [""]
 
 

@@ -43,10 +43,13 @@ class Table:
 
 @dataclass(frozen=True)
 class MethodRows:
-    """A further method's rows in tab_null or tab_damping (beside ours' and the priors').
+    """One method's rows in tab_null or tab_damping: every prior (ours first), the 2D-track
+    control, the output-only analysis each give one (``prior_rows``, ``tracks_rows``,
+    ``oma_rows``).
 
-    label: its LaTeX name; configs: its configurations (name -> LaTeX label, with its own K),
-    in row order; per_seed: ``per_seed[seed][key]``, the table's record of each key (tab_null:
+    label: its LaTeX name ("" for ours, the paper's prior: its rows are labelled by their
+    configuration alone); configs: its configurations (name -> LaTeX label, with its own K), in
+    row order; per_seed: ``per_seed[seed][key]``, the table's record of each key (tab_null:
     ``(tree, config)`` -> (``RecoveryRecord``, the ``NullResult`` of its K); tab_damping:
     ``(tree, variant, config)`` -> ``RecoveryRecord``); note: its sentence of the caption."""
 
@@ -54,6 +57,17 @@ class MethodRows:
     configs: Mapping[str, str]
     per_seed: Mapping[int, Mapping[tuple, object]]
     note: str = ""
+
+    def row_label(self, config: str) -> str:
+        """The LaTeX label of its row in a configuration.
+
+        Args:
+            config: the configuration's name (a key of ``configs``).
+
+        Returns:
+            '<label>, <config label>' (ours': the configuration's label alone).
+        """
+        return f"{self.label}, {self.configs[config]}" if self.label else self.configs[config]
 
 
 def tree_label(tree: str, bones: int) -> str:
@@ -429,92 +443,44 @@ def tab_fit(
 
 # --------------------------------------------------------------------------------------------
 def tab_null(
-    recovery: Mapping[int, Mapping[tuple[str, str], object]],
-    null: Mapping[int, Mapping[tuple[str, str], object]],
+    methods: Mapping[str, MethodRows],
     trees: Sequence[str],
     bones: Mapping[str, int],
-    configs: Mapping[str, str],
     digits: int = 2,
-    tracks: Mapping[int, Mapping[tuple[str, str], tuple]] | None = None,
-    tracks_configs: Mapping[str, str] | None = None,
-    priors: Mapping[str, Mapping[int, Mapping[tuple[str, str], object]]] | None = None,
-    methods: Mapping[str, MethodRows] | None = None,
 ) -> Table:
-    """Frequency recovery of the trained model against the untrained null, per tree and config.
+    """Frequency recovery of each method against the untrained null, per tree and config.
 
-    Columns: parts trusted, median relative error (%), log-log R^2 for trained and null (null
-    entries are medians over draws), trained - null (percentage points, paired per seed: negative
-    means the trained model beats chance), and the median nearest-bone gap (%).
+    Each tree's rows: every method's in turn, each in its configurations; column ``method`` the
+    id. Columns: parts trusted, median relative error (%), log-log R^2 for trained and null
+    (null entries are medians over draws), trained - null (percentage points, paired per seed:
+    negative means the trained model beats chance), and the median nearest-bone gap (%).
 
     Args:
-        recovery: ``recovery[seed][(tree, config)]``: ``RecoveryRecord`` of that seed's model.
-        null: ``null[seed][(tree, config)]``: ``NullResult`` drawn with that seed and the model's
-            K.
+        methods: method id -> its [`MethodRows`][physgs.report.tables.MethodRows], in row order
+            (ours first, then the other priors, the 2D-track control, the output-only analysis,
+            the forcing-free priors; a method with no configurations has no rows):
+            ``per_seed[seed][(tree, config)]`` = (its ``RecoveryRecord``, the ``NullResult``
+            drawn with that seed and the method's K).
         trees: the trees.
         bones: tree -> its bone count.
-        configs: configuration name -> its LaTeX label
-            ([`config_label`][physgs.models.registry.config_label]), in row order.
         digits: decimals shown in the .tex.
-        tracks: the 2D-track control's rows ([`physgs.tracks`][physgs.tracks]),
-            ``tracks[seed][(tree, config)]`` = (its ``RecoveryRecord``, the ``NullResult`` of its
-            K), for the configurations of ``tracks_configs``; they follow ours' rows of each tree,
-            column ``method`` 'tracks' (ours' rows: 'ours').
-        tracks_configs: name -> LaTeX label of the tracks control's configurations, in row order.
-        priors: the other oscillator priors' records, ``priors[model][seed][(tree, config)]``, in
-            every configuration of ``configs``, each beside the null of its K (the same draws as
-            ours': a null depends on K only); their rows follow ours' of each tree, column
-            ``method`` the model id.
-        methods: further methods' rows (method id ->
-            [`MethodRows`][physgs.report.tables.MethodRows]: (record, null of its K) per ``(tree,
-            config)``), each in its own configurations, after the tracks control's; column
-            ``method`` the id (the output-only analysis: ``OMA``, the forcing-free priors: their
-            ids).
 
     Returns:
         The [`Table`][physgs.report.tables.Table].
-
-    Raises:
-        ValueError: when a null's K differs from its model's.
     """
-    seeds = _seeds(recovery, "tab_null")
-    tracks_configs = dict(tracks_configs or {})
-    priors = dict(priors or {})
-    further = _further(tracks, tracks_configs, _NULL_TRACKS_NOTE, methods)
-    keys = [(t, c, "ours") for t in trees for c in configs]
-    keys += [(t, c, p) for t in trees for p in priors for c in configs]
-    keys += [(t, c, m) for t in trees for m, mr in further.items() for c in mr.configs]
+    methods = {m: mr for m, mr in methods.items() if mr.configs}
+    seeds = _seeds(next(iter(methods.values())).per_seed if methods else {}, "tab_null")
+    keys = [(t, c, m) for t in trees for m, mr in methods.items() for c in mr.configs]
     rows = []
     for s in seeds:
-        _check(
-            [k[:2] for k in keys if k[2] == "ours"],
-            recovery.get(s, {}),
-            f"tab_null (trained recovery, seed {s})",
-        )
-        _check(
-            [k[:2] for k in keys if k[2] == "ours"],
-            null.get(s, {}),
-            f"tab_null (null control, seed {s})",
-        )
-        for m, mr in further.items():
-            who = "tracks control" if m == "tracks" else m
+        for m, mr in methods.items():
             _check(
                 [k[:2] for k in keys if k[2] == m],
                 mr.per_seed.get(s, {}),
-                f"tab_null ({who}, seed {s})",
-            )
-        for p in priors:
-            _check(
-                [k[:2] for k in keys if k[2] == p],
-                priors[p].get(s, {}),
-                f"tab_null ({p}, seed {s})",
+                f"tab_null ({_who(m)}, seed {s})",
             )
         for t, c, method in keys:
-            if method == "ours":
-                rec, nl = recovery[s][(t, c)], null[s][(t, c)]
-            elif method in priors:
-                rec, nl = priors[method][s][(t, c)], null[s][(t, c)]
-            else:
-                rec, nl = further[method].per_seed[s][(t, c)]
+            rec, nl = methods[method].per_seed[s][(t, c)]
             m = rec.match
             if nl.n_parts != m.n_parts:
                 raise ValueError(
@@ -544,18 +510,7 @@ def tab_null(
                     "null_median_rel_err_visible_pct": 100 * nl.median_median_rel_err_visible,
                 }
             )
-    df = pd.DataFrame(rows)
-    # each tree's rows together (ours', the other priors', the tracks control's), the same
-    # order every seed
-    order = {
-        (t, c, m): i for i, (t, c, m) in enumerate(sorted(keys, key=lambda k: trees.index(k[0])))
-    }
-    df = (
-        df.assign(_o=[order[(t, c, m)] for t, c, m in zip(df.tree, df.config, df.method)])
-        .sort_values(["seed", "_o"], kind="stable")
-        .drop(columns="_o")
-        .reset_index(drop=True)
-    )
+    df = pd.DataFrame(rows)  # each seed's block: each tree's rows together, in ``keys`` order
     first = _first(df)
     first["_i"] = np.arange(len(first))
     V = {
@@ -586,11 +541,7 @@ def tab_null(
     def cells(r):
         i = r._i
         return [
-            configs[r.config]
-            if r.method == "ours"
-            else f"{label(r.method)}, {configs[r.config]}"
-            if r.method in priors
-            else f"{further[r.method].label}, {further[r.method].configs[r.config]}",
+            methods[r.method].row_label(r.config),
             parts("trained_parts_trusted", i, r.K),
             pct("trained_median_rel_err_pct", i),
             seedstats.pm(V["trained_loglog_r2"][:, i], ".3f"),
@@ -613,20 +564,70 @@ def tab_null(
         r"paired per seed (negative: the trained model beats chance); Gap: median nearest-bone "
         r"gap. Visible bones: the median errors restricted to parts matched to bones whose own "
         r"motion moves at least a pixel in the training camera (the CSV also gives the part "
-        r"counts)."
-        + (
-            f" {', '.join(label(p) for p in priors)}: the same scoring of its own parts, beside "
-            r"the null of its $K$ (a null depends on $K$ only)."
-            if priors
-            else ""
-        )
-        + "".join(mr.note for mr in further.values())
-        + _seed_note(len(seeds))
+        r"counts)." + "".join(mr.note for mr in methods.values()) + _seed_note(len(seeds))
     )
     return Table("tab_null", df, _wrap("\n".join(lines), cap, "tab:null"))
 
 
-_NULL_TRACKS_NOTE = (
+def _who(method: str) -> str:
+    """A method's name in tab_null / tab_damping's errors."""
+    return "tracks control" if method == TRACKS else method
+
+
+def prior_rows(
+    model: str, configs: Mapping[str, str], per_seed: Mapping[int, Mapping], note: str = ""
+) -> MethodRows:
+    """An oscillator prior's rows for tab_null / tab_damping, labelled from the registry.
+
+    Ours' (the paper's) are labelled by their configuration alone and carry no caption sentence;
+    a forcing-free prior's carry the sentence saying its forcing is learned; any other's the
+    sentence '<label>: <note>' (none without ``note``).
+
+    Args:
+        model: a registry model of role "prior", or a forcing-free prior
+            (``registry.BLIND_PRIORS``).
+        configs: name -> LaTeX label, as in [`MethodRows`][physgs.report.tables.MethodRows].
+        per_seed: its records, as in ``MethodRows``.
+        note: the table's word on the priors beside ours.
+
+    Returns:
+        The rows.
+    """
+    if model == "ours":
+        return MethodRows("", configs, per_seed)
+    name = label(model)
+    if spec_of(model).forcing == "learned":
+        note = (
+            "the measured wind replaced by a forcing learned from the training video (trained "
+            r"in its configuration only), beside the null of its $K$."
+        )
+    return MethodRows(name, configs, per_seed, f" {name}: {note}" if note else "")
+
+
+#: tab_null's word on a prior beside ours (``prior_rows``)
+NULL_PRIOR_NOTE = (
+    r"the same scoring of its own parts, beside the null of its $K$ (a null depends on $K$ only)."
+)
+#: the method id of the 2D-track control's rows
+TRACKS = "tracks"
+
+
+def tracks_rows(configs: Mapping[str, str], per_seed: Mapping[int, Mapping], note: str):
+    """The 2D-track control's rows ([`physgs.tracks`][physgs.tracks]) for tab_null / tab_damping.
+
+    Args:
+        configs: name -> LaTeX label with its own K.
+        per_seed: its records, as in [`MethodRows`][physgs.report.tables.MethodRows].
+        note: the table's sentence for it (``NULL_TRACKS_NOTE``,
+            ``physgs.report.damping.TRACKS_NOTE``).
+
+    Returns:
+        The rows.
+    """
+    return MethodRows(TRACKS_LABEL, configs, per_seed, note)
+
+
+NULL_TRACKS_NOTE = (
     r" \emph{2D tracks}: the same oscillators fitted to point tracks of the training "
     r"video (no renderer), matched and trusted by the same rule, beside the null of its "
     r"$K$; a part with too few tracks has no estimate and is never trusted."
@@ -651,44 +652,6 @@ def oma_rows(configs: Mapping[str, str], per_seed: Mapping[int, Mapping]) -> Met
         r"no wind, no renderer), each assigned to a part by its shape, matched and trusted by "
         r"the same rule, beside the null of its $K$.",
     )
-
-
-def blind_rows(model: str, configs: Mapping[str, str], per_seed: Mapping[int, Mapping]):
-    """A forcing-free prior's rows (``registry.BLIND_PRIORS``,
-    [`physgs.models.blind`][physgs.models.blind]) for tab_null / tab_damping, labelled from the
-    registry.
-
-    Args:
-        model: the prior's id.
-        configs: name -> LaTeX label with its own K.
-        per_seed: as in [`MethodRows`][physgs.report.tables.MethodRows].
-
-    Returns:
-        (MethodRows): The rows, with their caption sentence.
-    """
-    return MethodRows(
-        label(model),
-        configs,
-        per_seed,
-        f" {label(model)}: the measured wind replaced by a forcing learned from the training "
-        r"video (trained in its configuration only), beside the null of its $K$.",
-    )
-
-
-def _further(
-    tracks: Mapping | None,
-    tracks_configs: Mapping[str, str],
-    tracks_note: str,
-    methods: Mapping[str, MethodRows] | None,
-) -> dict[str, MethodRows]:
-    """The further methods' rows of tab_null / tab_damping in row order: the tracks control's
-    (when it has configurations), then ``methods``'."""
-    methods = dict(methods or {})
-    clash = [m for m in methods if m in ("ours", "tracks")]
-    if clash:
-        raise ValueError(f"further methods {clash}: 'ours' and 'tracks' have their own arguments")
-    tr = {"tracks": MethodRows(TRACKS_LABEL, tracks_configs, tracks or {}, tracks_note)}
-    return {**(tr if tracks_configs else {}), **methods}
 
 
 def _pct(x: float, bold: bool, digits: int = 2) -> str:

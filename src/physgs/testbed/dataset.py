@@ -22,7 +22,6 @@ Gaussian ``vertex_gaussian[v]``. Everything indexed by mesh vertex (``vertex_bon
 from __future__ import annotations
 
 import os
-import zipfile
 import zlib
 from dataclasses import dataclass
 from pathlib import Path
@@ -31,6 +30,7 @@ import numpy as np
 from tqdm import tqdm
 
 from physgs.camera import Camera
+from physgs.intermediate import load_npz
 from physgs.testbed import kinematics, physics, scene, variant, weberpenn, wind as windmod
 from physgs.testbed.mesh import TreeMesh, build_mesh
 
@@ -425,26 +425,20 @@ def save_dataset(observed: dict, truth: dict, observed_path, truth_path) -> None
 
 def _open(path: Path | str, required: tuple[str, ...]) -> dict:
     path = Path(path)
-    if not path.is_file():
-        raise DatasetError(
-            f"dataset file {path} does not exist; build it with "
-            "`snakemake --cores 2 testbed` (or the matching results/testbed target)"
-        )
-    try:
-        with np.load(path, allow_pickle=False) as z:
-            missing = [k for k in required if k not in z.files]
-            if missing:
-                raise DatasetError(
-                    f"dataset file {path} lacks {missing}: it is from another "
-                    f"version or incomplete; {REBUILD}"
-                )
-            d = {k: z[k] for k in z.files}
-    except DatasetError:
-        raise
-    except (zipfile.BadZipFile, ValueError, OSError, EOFError, KeyError) as e:
-        raise DatasetError(
-            f"dataset file {path} is corrupt ({type(e).__name__}: {e}); {REBUILD}"
-        ) from None
+
+    def error(problem: str, detail: str) -> DatasetError:
+        if problem == "missing":
+            return DatasetError(
+                f"dataset file {path} does not exist; build it with "
+                "`snakemake --cores 2 testbed` (or the matching results/testbed target)"
+            )
+        what = {
+            "corrupt": f"is corrupt ({detail})",
+            "lacks": f"lacks {detail}: it is from another version or incomplete",
+        }[problem]
+        return DatasetError(f"dataset file {path} {what}; {REBUILD}")
+
+    d = load_npz(path, required, error)
     if int(d.get("format_version", -1)) != FORMAT_VERSION:
         raise DatasetError(
             f"dataset file {path} has format_version {d.get('format_version')}, "

@@ -1,6 +1,6 @@
-"""The report's tables and figures, each declared once (``Output``): the registry roles it
-reads, its needs, its settings and its builder. ``OUTPUTS`` lists them in build order; a model
-joins every output that reads its role through its registry entry
+"""The report's tables and figures, each declared once (``Output``): its needs, its settings
+and its builder. ``OUTPUTS`` lists them in build order; a model joins every output that reads
+the models of its role (``physgs.models.registry.models_of``) through its registry entry
 (``physgs.models.registry.MODELS``), and a new output is one ``Output`` added here."""
 
 from physgs.report.outputs.base import NEED_FIELDS, Output, Plan, key, reader
@@ -43,16 +43,4 @@ OUTPUTS: dict[str, Output] = {
 }
 
 
-def reading(role: str) -> tuple[str, ...]:
-    """The outputs that read the models of ``role`` (what a new model of that role joins).
-
-    Args:
-        role: a model role (``ROLES``).
-
-    Returns:
-        Output names, in ``OUTPUTS`` order.
-    """
-    return tuple(n for n, o in OUTPUTS.items() if role in o.roles)
-
-
-__all__ = ["NEED_FIELDS", "OUTPUTS", "Output", "Plan", "key", "reader", "reading"]
+__all__ = ["NEED_FIELDS", "OUTPUTS", "Output", "Plan", "key", "reader"]

@@ -1,7 +1,7 @@
 """What every report output declares, and what the run plans (the shared vocabulary).
 
-An output (a table or a figure) is one ``Output``: the registry roles whose models it reads
-(``physgs.models.registry.ROLES``), the result files it reads as *need tuples* (``needs``), the
+An output (a table or a figure) is one ``Output``: the result files it reads as *need tuples*
+(``needs``: the models of the registry roles it shows, ``physgs.models.registry.models_of``), the
 settings it reads from the resolved config (``settings``) and how it builds itself (``build``).
 A need tuple is ``(kind, *fields)`` with the fields of ``NEED_FIELDS[kind]``; the workflow maps
 each to a path (``workflow/rules/common.smk``) and hands the builder a mapping ``key(need) ->
@@ -19,12 +19,12 @@ NEED_FIELDS = {
     "traj": ("tree", "model", "config", "seed"),
     "panels": ("tree", "model", "config", "seed"),
     "loss": ("tree", "model", "config", "seed"),
-    "recovery": ("tree", "config", "seed"),  # ours'
-    "prior_recovery": ("tree", "model", "config", "seed"),  # any oscillator prior's
+    "prior_recovery": ("tree", "model", "config", "seed"),  # any oscillator prior's, ours too
     "parts": ("tree", "seed"),  # the priors' segmentations (physgs.evaluate.parts)
     "kmatch": ("tree", "K", "seed"),  # the chained prior at a smaller K (experiments.kmatch)
     "null": ("tree", "K", "seed"),
-    "kselect": ("tree", "seed"),
+    "kselect": ("tree", "seed"),  # ours' K selection
+    "prior_kselect": ("tree", "model", "seed"),  # another prior's (models.kselect.priors)
     "stats": ("tree",),
     "table": ("name",),
     # the 2D-track control (physgs.tracks): its recovery record (ours' format), its evaluation
@@ -83,7 +83,9 @@ class Plan:
     scored at the tracked points; parts_models/parts_configs: the parts study's variants and
     configurations ({} without a study); study_seeds/k_candidates: the K match's; oma: the
     output-only analysis' configurations -> their K (``oma.configs``); blind: the forcing-free
-    priors trained (``registry.BLIND_PRIORS``, in ``BLIND_CONFIG``; none without it)."""
+    priors trained (``registry.blind_priors``: in ``BLIND_CONFIG``, none without it);
+    kselect_priors: the priors besides ours whose K is chosen from the data
+    (``models.kselect.priors``)."""
 
     trees: Sequence[str]
     configs: Mapping[str, dict]
@@ -98,6 +100,7 @@ class Plan:
     k_candidates: Sequence[int] = ()
     oma: Mapping[str, int] = field(default_factory=dict)
     blind: Sequence[str] = ()
+    kselect_priors: Sequence[str] = ()
 
     @classmethod
     def from_config(cls, cfg: dict) -> Plan:
@@ -110,7 +113,8 @@ class Plan:
             Plan: its trees, configurations, seeds and study settings.
         """
         from physgs.config import study_seeds
-        from physgs.models.registry import BLIND_CONFIG, BLIND_PRIORS
+        from physgs.experiments.kselect import selected_models
+        from physgs.models.registry import blind_priors
         from physgs.oma.settings import parts as oma_k
         from physgs.tracks.settings import fields_scored
         from physgs.tracks.settings import parts as tracks_k
@@ -133,7 +137,8 @@ class Plan:
             study_seeds=[int(s) for s in study_seeds(cfg)],
             k_candidates=[int(k) for k in cfg["parts_study"]["k_candidates"]],
             oma={c: oma_k(cfg, c) for c in cfg["oma"]["configs"]},
-            blind=list(BLIND_PRIORS) if BLIND_CONFIG in configs else [],
+            blind=list(blind_priors(configs)),
+            kselect_priors=list(selected_models(cfg["models"]["kselect"])[1:]),
         )
 
 
@@ -147,9 +152,8 @@ class Output:
     """One table or figure of the report.
 
     name: its file name (results/tables/<name>.* or results/figures/<name>.*); kind: "table" or
-    "figure"; roles: the registry roles whose models it reads (documentation and
-    ``outputs.reading``; its ``needs`` and ``build`` take the models from them); seeds: which
-    training seeds it reads (``SEEDS``); trees: the config key of its trees ("trees", or
+    "figure"; seeds: which training seeds it reads (``SEEDS``); trees: the config key of its
+    trees ("trees", or
     "damping_benchmark" for the damping benchmark's); needs(plan, seeds): its need tuples for
     those seeds; settings(cfg): the settings it reads beyond the common ones (trees, bones,
     seeds, digits); build(path, settings, inputs, out): writes a figure to ``out`` (its paths)
@@ -158,7 +162,6 @@ class Output:
 
     name: str
     kind: str
-    roles: tuple[str, ...]
     needs: Callable[[Plan, Sequence[int]], list[tuple]]
     build: Callable[..., Any]
     settings: Callable[[dict], dict] = lambda cfg: {}

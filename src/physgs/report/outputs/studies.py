@@ -96,7 +96,6 @@ def _tab_parts(path, settings, inputs, out):
 TAB_PARTS = Output(
     "tab_parts",
     "table",
-    ("prior", "control", "reference"),
     _parts_needs,
     _tab_parts,
     settings=_parts_settings,
@@ -117,7 +116,6 @@ def _fig_parts(path, settings, inputs, out):
 FIG_PARTS = Output(
     "fig_parts",
     "figure",
-    ("prior",),
     lambda plan, seeds: [("parts", t, int(seeds[0])) for t in plan.trees],
     _fig_parts,
     settings=lambda cfg: {"models": [BASELINE_PRIOR, *cfg["parts_study"]["models"]]},
@@ -180,7 +178,6 @@ def _tab_parts_k(path, settings, inputs, out):
 TAB_PARTS_K = Output(
     "tab_parts_k",
     "table",
-    ("prior",),
     _kmatch_needs,
     _tab_parts_k,
     settings=_kmatch_settings,

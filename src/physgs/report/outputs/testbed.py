@@ -18,7 +18,6 @@ def _tab_testbed(path, settings, inputs, out):
 TAB_TESTBED = Output(
     "tab_testbed",
     "table",
-    (),
     lambda plan, seeds: [("stats", t) for t in plan.trees],
     _tab_testbed,
     seeds="none",

@@ -69,7 +69,6 @@ def _tab_tracks(path, settings, inputs, out):
 TAB_TRACKS = Output(
     "tab_tracks",
     "table",
-    ("prior", "field"),
     _tab_tracks_needs,
     _tab_tracks,
     settings=_tab_tracks_settings,
@@ -111,7 +110,6 @@ def _fig_tracks(path, settings, inputs, out):
 FIG_TRACKS = Output(
     "fig_tracks",
     "figure",
-    (),
     _fig_tracks_needs,
     _fig_tracks,
     settings=lambda cfg: {"configs": list(cfg["tracks"]["configs"])},

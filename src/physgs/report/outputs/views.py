@@ -11,7 +11,7 @@ import pandas as pd
 
 from physgs.evaluate.splits import load_eval
 from physgs.experiments.recipe import heldout_split
-from physgs.models.registry import BASE_CONFIG, BLIND_CONFIG, models_of
+from physgs.models.registry import BASE_CONFIG, BLIND_CONFIG, blind_priors, models_of
 from physgs.report.outputs.base import Output
 
 #: the roles of the methods compared on images, and of the references shown beside them
@@ -138,10 +138,7 @@ def _fit_needs(plan, seeds):
 
 
 def _fit_table_settings(cfg: dict) -> dict:
-    from physgs.models.registry import BLIND_PRIORS
-
-    blind = list(BLIND_PRIORS) if BLIND_CONFIG in cfg["models"]["configs"] else []
-    return {**fit_settings(cfg), "blind": blind}
+    return {**fit_settings(cfg), "blind": list(blind_priors(cfg["models"]["configs"]))}
 
 
 def _tab_fit(path, settings, inputs, out):
@@ -203,14 +200,12 @@ def _tab_margin(path, settings, inputs, out):
 TAB_PSNR = Output(
     "tab_psnr",
     "table",
-    METHODS + REFERENCES,
     _evals(("eval",), METHODS + REFERENCES),
     _tab_psnr,
 )
 TAB_FIT = Output(
     "tab_fit",
     "table",
-    METHODS + REFERENCES,
     _fit_needs,
     _tab_fit,
     settings=_fit_table_settings,
@@ -218,7 +213,6 @@ TAB_FIT = Output(
 TAB_TRANSFER = Output(
     "tab_transfer",
     "table",
-    METHODS,
     _evals(("eval",), METHODS),
     _tab_transfer,
     settings=_conditions,
@@ -226,7 +220,6 @@ TAB_TRANSFER = Output(
 TAB_MARGIN = Output(
     "tab_margin",
     "table",
-    ("field", "prior"),
     lambda plan, seeds: [
         ("eval", t, m, BASE_CONFIG, s) for s in seeds for t in plan.trees for m in _margin_models()
     ],
@@ -299,7 +292,6 @@ def _fig_results(path, settings, inputs, out):
 FIG_TEMPORAL = Output(
     "fig_temporal",
     "figure",
-    METHODS + REFERENCES,
     _evals(("eval",), METHODS + REFERENCES),
     _fig_temporal,
     settings=lambda cfg: {"n_train": int(cfg["testbed"]["n_train"])},
@@ -307,7 +299,6 @@ FIG_TEMPORAL = Output(
 FIG_TEASER = Output(
     "fig_teaser",
     "figure",
-    METHODS,
     _evals(("eval", "traj"), METHODS),
     _fig_teaser,
     settings=_conditions,
@@ -316,7 +307,6 @@ FIG_TEASER = Output(
 FIG_RESULTS = Output(
     "fig_results",
     "figure",
-    METHODS,
     _evals(("eval", "panels"), METHODS),
     _fig_results,
     settings=_conditions,
