@@ -258,7 +258,9 @@ def plan_jobs(dry_run: str) -> list[tuple[str, str | None]]:
     return [(r, b) for r, b in jobs]
 
 
-def plan_cost(planned: list[tuple[str, str | None]], jobs: list[JobCost], benchmark_dir) -> dict:
+def plan_cost(
+    planned: list[tuple[str, str | None]], jobs: list[JobCost], benchmark_dir: str | Path
+) -> dict:
     """What a target's plan would cost, from a finished run's measured jobs.
 
     Args:

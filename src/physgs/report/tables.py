@@ -612,7 +612,9 @@ NULL_PRIOR_NOTE = (
 TRACKS = "tracks"
 
 
-def tracks_rows(configs: Mapping[str, str], per_seed: Mapping[int, Mapping], note: str):
+def tracks_rows(
+    configs: Mapping[str, str], per_seed: Mapping[int, Mapping], note: str
+) -> MethodRows:
     """The 2D-track control's rows ([`physgs.tracks`][physgs.tracks]) for tab_null / tab_damping.
 
     Args:
