@@ -22,12 +22,9 @@ import argparse
 import logging
 from dataclasses import replace
 
-import numpy as np
-
 import physgs.config
 from physgs.oma.agreement import reproduced_modes
-from physgs.oma.channels import flow_channels, principal_channels
-from physgs.oma.run import OMASettings
+from physgs.oma.run import OMASettings, in_bounds, projected_records
 from physgs.oma.ssi import identify
 from physgs.testbed.dataset import load_observed
 
@@ -47,18 +44,13 @@ def main() -> None:
     for tb in args.testbeds:
         obs = load_observed(f"{tb}/observed.npz")
         videos = [obs.frames[c, : obs.n_train] for c in range(obs.frames.shape[0])]
-        chans = [
-            flow_channels(v, obs.background, base.flow, reference=videos[0][0]) for v in videos
-        ]
-        ys = [c.y - c.y.mean(axis=0) for c in chans]
-        stacked = np.concatenate(ys)
-        _, pcs = principal_channels(stacked, min(base.components, *stacked.shape))
+        rec = projected_records(videos, obs.background, base)
         for e in grid:
             s = replace(base.ssi, err_fn=e)
             per = []
-            for y in ys:
-                m = identify(y @ pcs.T, obs.fps, s)
-                keep = (m.freq_hz >= base.omega_hz[0]) & (m.freq_hz <= base.omega_hz[1])
+            for y in rec.projected:
+                m = identify(y, obs.fps, s)
+                keep = in_bounds(m, base.omega_hz)
                 per.append((m.freq_hz[keep], m.zeta[keep]))
             hit, found = reproduced_modes(per)
             totals[e][0] += hit

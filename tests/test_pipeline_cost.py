@@ -99,6 +99,15 @@ def test_resources_by_stage_read_cpu_and_peak_memory(tmp_path):
 
 
 DRY_RUN = """
+Job stats:
+job                count
+---------------  -------
+testbed_dataset        1
+train                  2
+recovery               1
+table                  1
+total                  5
+
 [Thu Nov 26 05:30:42 2026]
 rule testbed_dataset:
     output: results/testbed/sparse/observed.npz, results/testbed/sparse/truth.npz
@@ -132,6 +141,15 @@ def test_a_plan_is_read_job_by_job_with_its_benchmark():
         ("train", "results/benchmarks/train/dense/seed0/ours_single.tsv"),
         ("table", None),
     ]
+
+
+def test_a_printout_whose_jobs_do_not_add_up_to_its_stats_is_refused():
+    with pytest.raises(ValueError, match="job-stats table"):
+        plan_jobs(DRY_RUN.replace("train                  2", "train                  3"))
+    with pytest.raises(ValueError, match="says nothing"):
+        plan_jobs(DRY_RUN.split("[Thu", 1)[1])  # no stats table
+    with pytest.raises(ValueError, match="job blocks read"):
+        plan_jobs(DRY_RUN.replace("rule recovery:", "rule recovery (group x):"))
 
 
 def test_a_plan_costs_the_measured_seconds_of_its_jobs(bench):

@@ -234,6 +234,24 @@ def resources_by_stage(jobs: list[JobCost]) -> dict[str, dict]:
 
 _BENCHMARK_LINE = re.compile(r"^\s*benchmark:\s*(\S+)\s*$")
 _RULE_LINE = re.compile(r"^\s*(?:local)?rule (\w+):\s*$")
+_STATS_ROW = re.compile(r"^(\w+)\s+(\d+)\s*$")
+
+
+def _job_stats(dry_run: str) -> dict[str, int]:
+    """The job-stats table a dry run prints before its jobs ({rule: count}, without ``total``)."""
+    lines = dry_run.splitlines()
+    head = next((i for i, ln in enumerate(lines) if ln.split() == ["job", "count"]), None)
+    if head is None:
+        return {}
+    out: dict[str, int] = {}
+    for ln in lines[head + 1 :]:
+        m = _STATS_ROW.match(ln.strip())
+        if ln.startswith("-"):
+            continue
+        if not m or m.group(1) == "total":
+            break
+        out[m.group(1)] = int(m.group(2))
+    return out
 
 
 def plan_jobs(dry_run: str) -> list[tuple[str, str | None]]:
@@ -245,6 +263,10 @@ def plan_jobs(dry_run: str) -> list[tuple[str, str | None]]:
 
     Returns:
         Per job, (rule name, benchmark path as printed, or None for a rule without one).
+
+    Raises:
+        ValueError: the printout has no job-stats table, or its jobs do not add up to it (a
+            change of Snakemake's print format must not pass as a cheaper plan).
     """
     jobs: list[list] = []
     for line in dry_run.splitlines():
@@ -255,6 +277,15 @@ def plan_jobs(dry_run: str) -> list[tuple[str, str | None]]:
         b = _BENCHMARK_LINE.match(line)
         if b and jobs:
             jobs[-1][1] = b.group(1)
+    stats = _job_stats(dry_run)
+    counted: dict[str, int] = {}
+    for r, _ in jobs:
+        counted[r] = counted.get(r, 0) + 1
+    if not stats or counted != stats:
+        raise ValueError(
+            "could not read the dry run's jobs: its job-stats table says "
+            f"{stats or 'nothing'}, the job blocks read {counted}"
+        )
     return [(r, b) for r, b in jobs]
 
 

@@ -60,13 +60,54 @@ class Identification:
     seconds: float  # wall time of flow + SSI
 
 
+@dataclass(frozen=True)
+class Records:
+    """The records SSI reads: each video's cell channels projected on the principal components of
+    all records together."""
+
+    channels: Channels  # the first video's (its cells serve every record)
+    projected: list[np.ndarray]  # one [T, P] per video
+    load: np.ndarray  # [P, C] the principal components over the cell channels
+
+
+def projected_records(videos: list[np.ndarray], background, s: OMASettings) -> Records:
+    """Flow channels of each video's window frames (the first video's cells for all), centred, and
+    their projection on the principal components of all records together.
+
+    Args:
+        videos: one [T, H, W, 3] uint8 array per record (the training window's frames).
+        background (ArrayLike): [3] the background colour (the foreground mask's reference).
+        s: the analysis' settings (``flow``, ``components``).
+
+    Returns:
+        The [`Records`][physgs.oma.run.Records].
+    """
+    chans = [flow_channels(v, background, s.flow, reference=videos[0][0]) for v in videos]
+    ys = [c.y - c.y.mean(axis=0) for c in chans]
+    stacked = np.concatenate(ys)  # [sum T, C]
+    _, load = principal_channels(stacked, min(s.components, *stacked.shape))
+    return Records(chans[0], [y @ load.T for y in ys], load)
+
+
+def in_bounds(m: Modes, omega_hz: tuple[float, float]) -> np.ndarray:
+    """Which modes lie inside ours' frequency bounds.
+
+    Args:
+        m: identified modes.
+        omega_hz: ours' bounds (lo, hi), Hz.
+
+    Returns:
+        [M] bool.
+    """
+    return (m.freq_hz >= omega_hz[0]) & (m.freq_hz <= omega_hz[1])
+
+
 def identify_video(
     videos: list[np.ndarray], background, fps: float, s: OMASettings
 ) -> Identification:
-    """Flow channels of each video's window frames (the first video's cells for all), the principal
-    components of all records together, SSI-cov over the records
-    ([`identify_records`][physgs.oma.ssi.identify_records]), and the modes inside ours' bounds,
-    their shapes mapped back over the cell channels.
+    """The records of every video ([`projected_records`][physgs.oma.run.projected_records]),
+    SSI-cov over them together ([`identify_records`][physgs.oma.ssi.identify_records]), and the
+    modes inside ours' bounds, their shapes mapped back over the cell channels.
 
     Args:
         videos: one [T, H, W, 3] uint8 array per record (the training window's frames).
@@ -81,17 +122,14 @@ def identify_video(
     import time
 
     t0 = time.perf_counter()
-    chans = [flow_channels(v, background, s.flow, reference=videos[0][0]) for v in videos]
-    ys = [c.y - c.y.mean(axis=0) for c in chans]
-    stacked = np.concatenate(ys)  # [sum T, C]
-    _, load = principal_channels(stacked, min(s.components, *stacked.shape))
-    m = identify_records([y @ load.T for y in ys], fps, s.ssi)
-    keep = (m.freq_hz >= s.omega_hz[0]) & (m.freq_hz <= s.omega_hz[1])
-    shape = m.shape[keep] @ load  # [M, C] over the cell channels
+    rec = projected_records(videos, background, s)
+    m = identify_records(rec.projected, fps, s.ssi)
+    keep = in_bounds(m, s.omega_hz)
+    shape = m.shape[keep] @ rec.load  # [M, C] over the cell channels
     modes = Modes(
         m.freq_hz[keep], m.zeta[keep], shape, m.n_stable[keep], m.freq_spread[keep], m.stab
     )
-    return Identification(chans[0], modes, time.perf_counter() - t0)
+    return Identification(rec.channels, modes, time.perf_counter() - t0)
 
 
 def save_identification(path, ident: Identification, s: OMASettings) -> None:

@@ -14,35 +14,19 @@ from physgs.report.outputs.base import Output
 KSELECT_ROWS = tuple(c for c, _ in kselect.ROWS)
 
 
-def tracks_label(cfg: dict, config: str) -> str:
-    """The LaTeX label of the 2D-track control's configuration ``config`` with its own K.
+def label_with_k(cfg: dict, config: str, K: int) -> str:
+    """The LaTeX label of configuration ``config`` for a method that sets its own K (the 2D-track
+    control, the output-only analysis).
 
     Args:
         cfg: the resolved config.
         config: a configuration name.
+        K: the method's number of parts in that configuration.
 
     Returns:
         The label ([`config_label`][physgs.models.registry.config_label]).
     """
-    from physgs.tracks.settings import parts as tracks_k
-
-    spec = {**cfg["models"]["configs"][config], "K": tracks_k(cfg, config)[0]}
-    return config_label(config, spec)
-
-
-def oma_label(cfg: dict, config: str) -> str:
-    """The LaTeX label of the output-only analysis' configuration ``config`` with its own K.
-
-    Args:
-        cfg: the resolved config.
-        config: a configuration name.
-
-    Returns:
-        The label ([`config_label`][physgs.models.registry.config_label]).
-    """
-    from physgs.oma.settings import parts as oma_k
-
-    return config_label(config, {**cfg["models"]["configs"][config], "K": oma_k(cfg, config)})
+    return config_label(config, {**cfg["models"]["configs"][config], "K": K})
 
 
 def _method_settings(cfg: dict, configs) -> dict:
@@ -56,7 +40,7 @@ def _method_settings(cfg: dict, configs) -> dict:
     return {
         "priors": {m: {c: config_label(c, mc[c]) for c in configs} for m in models_of("prior")},
         "oma": {
-            c: {"K": oma_k(cfg, c), "label": oma_label(cfg, c)}
+            c: {"K": (k := oma_k(cfg, c)), "label": label_with_k(cfg, c, k)}
             for c in cfg["oma"]["configs"]
             if c in configs
         },
@@ -149,7 +133,7 @@ def _tracks_settings(cfg: dict, configs) -> dict:
 
     return {
         "tracks": {
-            c: {"K": tracks_k(cfg, c)[0], "label": tracks_label(cfg, c)}
+            c: {"K": (k := tracks_k(cfg, c)[0]), "label": label_with_k(cfg, c, k)}
             for c in configs
             if c in cfg["tracks"]["configs"]
         }

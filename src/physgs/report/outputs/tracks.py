@@ -8,7 +8,7 @@ import pandas as pd
 
 from physgs.intermediate import read_json
 from physgs.report.outputs.base import Output, key
-from physgs.report.outputs.recovery import tracks_label
+from physgs.report.outputs.recovery import label_with_k
 
 
 def _controlled(plan) -> bool:
@@ -29,10 +29,12 @@ def _tab_tracks_needs(plan, seeds):
 
 
 def _tab_tracks_settings(cfg: dict) -> dict:
+    from physgs.tracks.settings import parts as tracks_k
+
     return {
         "configs": {
             c: {
-                "label": tracks_label(cfg, c),
+                "label": label_with_k(cfg, c, tracks_k(cfg, c)[0]),
                 "conditions": cfg["models"]["configs"][c]["conditions"],
             }
             for c in cfg["tracks"]["configs"]
