@@ -147,7 +147,8 @@ def test_a_printout_whose_jobs_do_not_add_up_to_its_stats_is_refused():
     with pytest.raises(ValueError, match="job-stats table"):
         plan_jobs(DRY_RUN.replace("train                  2", "train                  3"))
     with pytest.raises(ValueError, match="says nothing"):
-        plan_jobs(DRY_RUN.split("[Thu", 1)[1])  # no stats table
+        plan_jobs(DRY_RUN.split("[Thu", 1)[1])  # job blocks without a stats table
+    assert plan_jobs("Building DAG of jobs...\nNothing to be done.\n") == []
     with pytest.raises(ValueError, match="job blocks read"):
         plan_jobs(DRY_RUN.replace("rule recovery:", "rule recovery (group x):"))
 

@@ -278,6 +278,8 @@ def plan_jobs(dry_run: str) -> list[tuple[str, str | None]]:
         if b and jobs:
             jobs[-1][1] = b.group(1)
     stats = _job_stats(dry_run)
+    if not jobs and not stats:  # "Nothing to be done": an empty plan, not an unread one
+        return []
     counted: dict[str, int] = {}
     for r, _ in jobs:
         counted[r] = counted.get(r, 0) + 1
