@@ -12,6 +12,11 @@
 # user's default account), accounting through slurmdbd on MariaDB (sacct works; per-job CPU time
 # and MaxRSS are gathered every second, so the plugin's --slurm-efficiency-report has numbers;
 # job comments are stored, the plugin puts the rule name there).
+# MessageTimeout=2 (Slurm's default is 10): the SLURM executor plugin runs `scontrol show config`
+# whenever Snakemake starts, every command and every dry run; once these packages are installed and
+# the daemons are down (after tools/slurm_down.sh, or a reboot) scontrol retries the controller for
+# MessageTimeout - 1 seconds, so each `snakemake` call slept 9 s; now 1 s. Round trips to this
+# one-node controller take milliseconds.
 # Exit status: 0 booted (sinfo shows the node idle or busy); 2 cannot boot here (not root, no
 # apt-get and no slurm): the message says why; 1 a daemon did not come up (its log is named).
 set -euo pipefail
@@ -100,6 +105,7 @@ JobAcctGatherType=jobacct_gather/linux
 JobAcctGatherFrequency=task=1
 JobCompType=jobcomp/none
 MinJobAge=600
+MessageTimeout=2
 NodeName=$host CPUs=$cpus RealMemory=$mem State=UNKNOWN
 PartitionName=$PARTITION Nodes=$host Default=YES MaxTime=INFINITE State=UP
 CONF
