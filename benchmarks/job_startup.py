@@ -1,0 +1,87 @@
+"""A workflow job's start-up: the CPU seconds its script's imports cost before it reads a file.
+
+    python benchmarks/job_startup.py [--scripts train,evaluate,recovery] [--reps 3]
+
+For each script of `workflow/scripts/` (or those named), runs its top-level imports (the
+`import` / `from ... import` statements of the file, read with `ast`) in a fresh Python process,
+`--reps` times, and prints the least CPU time (user + system of the child). Then the costs a job
+pays on first use, beyond its imports, each in a fresh process: torch's first optimiser
+(`torch.optim.Optimizer` imports `torch._dynamo` when it is built), scikit-learn's k-means
+(imported where ours cuts its parts) and the renderer's numba kernels (compiled once, then loaded
+from numba's cache). A job's start-up is its script's imports plus the first uses it reaches: a
+training builds an optimiser, ours' training also runs k-means, and every job that renders loads
+the kernels. `python -X importtime -c "<imports>"` says which module costs what.
+"""
+
+from __future__ import annotations
+
+import argparse
+import ast
+import resource
+import subprocess
+import sys
+from pathlib import Path
+
+SCRIPTS = Path(__file__).resolve().parents[1] / "workflow" / "scripts"
+
+#: First-use costs beyond a script's imports: (name, setup code not timed apart, code).
+FIRST_USE = (
+    ("torch (import)", "", "import torch"),
+    (
+        "+ first optimiser (torch._dynamo)",
+        "import torch",
+        "torch.optim.Adam([torch.zeros(1, requires_grad=True)])",
+    ),
+    ("+ scikit-learn k-means", "import torch", "from sklearn.cluster import KMeans"),
+    (
+        "+ renderer kernels (numba cache)",
+        "import torch",
+        "import physgs.render.fast as f, physgs.render.kernels as k",
+    ),
+)
+
+
+def script_imports(path: Path) -> str:
+    """The top-level import statements of a script, as source lines."""
+    tree = ast.parse(path.read_text())
+    return "\n".join(
+        ast.unparse(n) for n in tree.body if isinstance(n, (ast.Import, ast.ImportFrom))
+    )
+
+
+def child_cpu(code: str) -> float:
+    """CPU seconds (user + system) of ``python -c code`` in a fresh process."""
+    before = resource.getrusage(resource.RUSAGE_CHILDREN)
+    subprocess.run([sys.executable, "-c", code], check=True)
+    after = resource.getrusage(resource.RUSAGE_CHILDREN)
+    return (after.ru_utime - before.ru_utime) + (after.ru_stime - before.ru_stime)
+
+
+def least(code: str, reps: int) -> float:
+    return min(child_cpu(code) for _ in range(reps))
+
+
+def main() -> None:
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("--scripts", default="", help="comma-separated script names (default: all)")
+    ap.add_argument("--reps", type=int, default=3, help="fresh processes per row (least kept)")
+    args = ap.parse_args()
+    names = [s for s in args.scripts.split(",") if s] or sorted(
+        p.stem for p in SCRIPTS.glob("*.py")
+    )
+    bare = least("pass", args.reps)
+    print(f"CPU s of a fresh process (least of {args.reps}); python alone: {bare:.2f}")
+    print(f"{'script':<24} {'imports':>8}")
+    for name in names:
+        print(f"{name:<24} {least(script_imports(SCRIPTS / f'{name}.py'), args.reps):>8.2f}")
+    print(f"\n{'first use':<36} {'CPU s':>6}")
+    base = {"": bare}
+    for label, setup, code in FIRST_USE:
+        if setup not in base:
+            base[setup] = least(setup, args.reps)
+        total = least(f"{setup}\n{code}", args.reps)
+        print(f"{label:<36} {total - base[setup]:>6.2f}")
+
+
+if __name__ == "__main__":
+    main()
