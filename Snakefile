@@ -4,8 +4,12 @@ from snakemake.utils import min_version
 
 import physgs.config
 import physgs.experiments.recipe
+import physgs.scheduling
 
 min_version("9.0")
+# Snakemake's loop adds a re-evaluation timer chain per finished job, and a long run's loop then
+# takes most of a core from the jobs: keep one pending timer (physgs.scheduling)
+physgs.scheduling.install()
 
 
 configfile: "config/trees.yaml"

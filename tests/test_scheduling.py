@@ -1,0 +1,130 @@
+"""physgs.scheduling: Snakemake's scheduling loop keeps one pending re-evaluation timer."""
+
+from __future__ import annotations
+
+import re
+import subprocess
+import sys
+import threading
+import time
+
+import pytest
+
+from physgs.scheduling import single_reevaluation_timer
+
+
+def fake_scheduler_cls():
+    """A class with Snakemake 9.27's method: each call arms a timer that releases _open_jobs."""
+
+    class Loop:
+        def __init__(self):
+            self._open_jobs = threading.Semaphore(0)
+
+        def _schedule_reevalutation(self, delay):
+            threading.Timer(delay, lambda: self._open_jobs.release()).start()
+
+    return Loop
+
+
+def releases(sem: threading.Semaphore) -> int:
+    n = 0
+    while sem.acquire(blocking=False):
+        n += 1
+    return n
+
+
+def test_unpatched_loop_arms_one_timer_per_call():
+    """The upstream behaviour the patch removes: n calls, n wake-ups (the chains' seed)."""
+    loop = fake_scheduler_cls()()
+    for _ in range(20):
+        loop._schedule_reevalutation(0.05)
+    time.sleep(0.3)
+    assert releases(loop._open_jobs) == 20
+
+
+def test_many_requests_one_wakeup():
+    cls = fake_scheduler_cls()
+    single_reevaluation_timer(cls)
+    loop = cls()
+    for _ in range(20):
+        loop._schedule_reevalutation(0.05)
+    time.sleep(0.3)
+    assert releases(loop._open_jobs) == 1
+    # after it fired, the next request arms a new one (a pass always leaves a wake-up pending)
+    loop._schedule_reevalutation(0.05)
+    time.sleep(0.3)
+    assert releases(loop._open_jobs) == 1
+
+
+def test_earlier_request_replaces_later_one():
+    cls = fake_scheduler_cls()
+    single_reevaluation_timer(cls)
+    loop = cls()
+    loop._schedule_reevalutation(30.0)  # e.g. a queue-input wait
+    t0 = time.monotonic()
+    loop._schedule_reevalutation(0.05)  # the rate limiter's timespan
+    assert loop._open_jobs.acquire(timeout=5.0)
+    assert time.monotonic() - t0 < 2.0
+    time.sleep(0.2)
+    assert releases(loop._open_jobs) == 0  # the 30-s timer was cancelled, not left behind
+
+
+def test_instances_keep_their_own_timer():
+    cls = fake_scheduler_cls()
+    single_reevaluation_timer(cls)
+    a, b = cls(), cls()
+    a._schedule_reevalutation(0.05)
+    b._schedule_reevalutation(0.05)
+    time.sleep(0.3)
+    assert (releases(a._open_jobs), releases(b._open_jobs)) == (1, 1)
+
+
+def test_installing_twice_keeps_one_wrapper():
+    cls = fake_scheduler_cls()
+    single_reevaluation_timer(cls)
+    method = cls._schedule_reevalutation
+    single_reevaluation_timer(cls)
+    assert cls._schedule_reevalutation is method
+
+
+def test_a_loop_without_the_method_stops_with_a_message():
+    with pytest.raises(RuntimeError, match="_schedule_reevalutation"):
+        single_reevaluation_timer(type("OtherLoop", (), {}))
+
+
+SNAKEFILE = """
+import threading
+{install}
+rule all:
+    input: expand("out/{{i}}.txt", i=range(40))
+rule one:
+    output: "out/{{i}}.txt"
+    shell: "sleep 0.05 && touch {{output}}"
+onsuccess:
+    print("THREADS", threading.active_count())
+"""
+
+
+def run_threads(tmp_path, install: bool) -> int:
+    d = tmp_path / ("patched" if install else "upstream")
+    d.mkdir()
+    code = "import physgs.scheduling\nphysgs.scheduling.install()" if install else ""
+    (d / "Snakefile").write_text(SNAKEFILE.format(install=code))
+    out = subprocess.run(
+        [sys.executable, "-m", "snakemake", "--cores", "2", "--workflow-profile", "none"],
+        cwd=d,
+        capture_output=True,
+        text=True,
+        timeout=120,
+    )
+    assert out.returncode == 0, out.stderr[-2000:]
+    return int(re.search(r"THREADS (\d+)", out.stdout + out.stderr).group(1))
+
+
+def test_snakemake_run_ends_with_one_timer_not_one_per_job(tmp_path):
+    """Snakemake's own loop, 40 jobs: upstream leaves a timer chain per finished job alive at
+    the end of the run; with the patch the loop holds at most one."""
+    upstream = run_threads(tmp_path, install=False)
+    patched = run_threads(tmp_path, install=True)
+    assert upstream >= 20, upstream
+    assert patched <= 4, patched
