@@ -70,6 +70,10 @@ def main() -> None:
             f"{stage:<16}{r['jobs']:>6}{r['wall_mean_s']:>11.0f} /{r['wall_max_s']:>6.0f}"
             f"{r['cpu_mean_s']:>12.0f} /{r['cpu_max_s']:>6.0f}{r['rss_max_mb']:>13.0f}"
         )
+    print(
+        "(CPU and peak RSS are Snakemake's samples, taken every 30 s after a job's first 15 s: "
+        "lower bounds that miss up to a job's last 30 s; wall s is exact)"
+    )
     if args.wall_s:
         extra = extra_seed_wall_s(summary, run_wall_s=args.wall_s)
         print(

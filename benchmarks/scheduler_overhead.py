@@ -1,7 +1,7 @@
 """What Snakemake's own process costs while it runs a workflow's jobs, by its job-rate setting.
 
     python benchmarks/scheduler_overhead.py [--jobs 300] [--job-s 0.5] [--cores 2]
-        [--timespans 100/1s,1000/10s]
+        [--timespans 100/1s,1000/10s] [--loops upstream,single]
 
 Snakemake 9 (9.27.1 here) re-runs its scheduling loop on a timer whenever a job-rate limit is set,
 and `--max-jobs-per-timespan` defaults to `100/1s`, so a limit is always set. Each pass schedules
@@ -15,6 +15,10 @@ the jobs' shells), its wall time and the jobs' ideal wall time (jobs x job_s / c
 limit's count is kept far above any rate the pipeline reaches, so the setting changes only how
 often the loop wakes; the price of a longer timespan is that the process waits up to one
 timespan for its last timers when the run ends.
+
+Each setting runs with Snakemake's loop as released ('upstream') and with the loop the
+workflow installs (:mod:`physgs.scheduling`, 'single': one pending re-evaluation timer, a
+daemon thread, so no wait at exit either).
 """
 
 from __future__ import annotations
@@ -27,6 +31,7 @@ import time
 from pathlib import Path
 
 SNAKEFILE = """
+{install}
 N = {jobs}
 rule all:
     input: expand("out/{{i}}.txt", i=range(N))
@@ -36,10 +41,16 @@ rule one:
 """
 
 
-def run_once(jobs: int, job_s: float, cores: int, timespan: str) -> tuple[float, float]:
+#: the Snakefile's first lines for each loop
+LOOPS = {"upstream": "", "single": "import physgs.scheduling\nphysgs.scheduling.install()"}
+
+
+def run_once(jobs: int, job_s: float, cores: int, timespan: str, loop: str) -> tuple[float, float]:
     """Run the throwaway workflow once; (CPU seconds of Snakemake and its children, wall s)."""
     with tempfile.TemporaryDirectory() as d:
-        Path(d, "Snakefile").write_text(SNAKEFILE.format(jobs=jobs, job_s=job_s))
+        Path(d, "Snakefile").write_text(
+            SNAKEFILE.format(install=LOOPS[loop], jobs=jobs, job_s=job_s)
+        )
         before = resource.getrusage(resource.RUSAGE_CHILDREN)
         t0 = time.monotonic()
         subprocess.run(
@@ -59,13 +70,15 @@ def main() -> None:
     ap.add_argument("--job-s", type=float, default=0.5)
     ap.add_argument("--cores", type=int, default=2)
     ap.add_argument("--timespans", default="100/1s,1000/10s")
+    ap.add_argument("--loops", default="upstream,single", help=f"among {', '.join(LOOPS)}")
     args = ap.parse_args()
     ideal = args.jobs * args.job_s / args.cores
     print(f"{args.jobs} jobs of {args.job_s} s on {args.cores} cores: ideal wall {ideal:.0f} s")
-    print(f"{'max-jobs-per-timespan':>22}{'CPU s':>9}{'wall s':>9}{'wall - ideal':>14}")
-    for ts in args.timespans.split(","):
-        cpu, wall = run_once(args.jobs, args.job_s, args.cores, ts)
-        print(f"{ts:>22}{cpu:>9.1f}{wall:>9.1f}{wall - ideal:>14.1f}")
+    print(f"{'loop':>9}{'max-jobs-per-timespan':>22}{'CPU s':>9}{'wall s':>9}{'wall - ideal':>14}")
+    for loop in args.loops.split(","):
+        for ts in args.timespans.split(","):
+            cpu, wall = run_once(args.jobs, args.job_s, args.cores, ts, loop)
+            print(f"{loop:>9}{ts:>22}{cpu:>9.1f}{wall:>9.1f}{wall - ideal:>14.1f}")
 
 
 if __name__ == "__main__":

@@ -28,7 +28,12 @@ class JobCost:
     seed), ``damping`` (part of the damping benchmark), wall seconds, its path, and when it ended
     (``end``: the benchmark file's modification time, seconds since the epoch; Snakemake writes
     it as the job finishes, so the job ran from ``end - wall_s`` to ``end``), its CPU seconds and
-    peak resident memory (NaN where the file has no such column or Snakemake wrote '-')."""
+    peak resident memory (NaN where the file has no such column or Snakemake wrote '-').
+
+    ``cpu_s`` and ``max_rss_mb`` are sampled: Snakemake 9.27 reads the job's processes every
+    0.5 s for its first ~15 s and then every 30 s, and keeps the last reading, so a job's last
+    (up to 30) seconds are missing from ``cpu_s`` (a lower bound; a 90-s training at full speed
+    reads ~75) and a late peak from ``max_rss_mb``. ``wall_s`` is exact."""
 
     stage: str
     seed: int | None
