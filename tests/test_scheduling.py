@@ -90,8 +90,17 @@ def test_installing_twice_keeps_one_wrapper():
 
 
 def test_a_loop_without_the_method_stops_with_a_message():
-    with pytest.raises(RuntimeError, match="_schedule_reevalutation"):
+    with pytest.raises(RuntimeError, match="has no _schedule_reevalutation"):
         single_reevaluation_timer(type("OtherLoop", (), {}))
+
+
+def test_a_method_that_no_longer_arms_the_timer_stops_with_a_message():
+    class OtherLoop:
+        def _schedule_reevalutation(self, delay):
+            self._wake_at = delay  # another mechanism: replacing it would change what it does
+
+    with pytest.raises(RuntimeError, match="no longer arms a timer"):
+        single_reevaluation_timer(OtherLoop)
 
 
 SNAKEFILE = """

@@ -16,12 +16,14 @@ is already pending; an earlier request replaces the pending one. The timer is a 
 so a finished run exits at once instead of waiting out the last timespan.
 
 The Snakefile installs it when the workflow loads (Snakemake imports the Snakefile in the
-process that runs the loop). A Snakemake without the method stops the workflow with a message
-rather than running the unpatched loop silently.
+process that runs the loop). A Snakemake whose method is missing, or no longer arms a timer that
+releases ``_open_jobs`` (what the replacement does), stops the workflow with a message rather
+than running either loop silently.
 """
 
 from __future__ import annotations
 
+import inspect
 import threading
 import time
 
@@ -38,18 +40,28 @@ def single_reevaluation_timer(scheduler_cls: type) -> None:
             ``self._open_jobs``).
 
     Raises:
-        RuntimeError: the class has no ``_schedule_reevalutation`` (a Snakemake whose loop
-            this was not written for).
+        RuntimeError: the class has no ``_schedule_reevalutation``, or its body does not release
+            ``_open_jobs`` from a timer (a Snakemake whose loop this was not written for).
     """
-    if not hasattr(scheduler_cls, "_schedule_reevalutation"):
-        raise RuntimeError(
-            f"{scheduler_cls.__module__}.{scheduler_cls.__name__} has no "
-            "_schedule_reevalutation: physgs.scheduling was written for Snakemake 9.27's "
-            "scheduling loop; check its timers before running this Snakemake "
-            "(benchmarks/scheduler_overhead.py)"
-        )
+    where = f"{scheduler_cls.__module__}.{scheduler_cls.__name__}"
+    hint = (
+        "physgs.scheduling was written for Snakemake 9.27's scheduling loop; check its timers "
+        "before running this Snakemake (benchmarks/scheduler_overhead.py)"
+    )
     if getattr(scheduler_cls, _MARK, False):
         return
+    method = getattr(scheduler_cls, "_schedule_reevalutation", None)
+    if method is None:
+        raise RuntimeError(f"{where} has no _schedule_reevalutation: {hint}")
+    try:
+        body = inspect.getsource(method)
+    except (OSError, TypeError) as e:
+        raise RuntimeError(f"{where}._schedule_reevalutation has no readable source: {hint}") from e
+    if "Timer(" not in body or "_open_jobs.release()" not in body:
+        raise RuntimeError(
+            f"{where}._schedule_reevalutation no longer arms a timer that releases _open_jobs: "
+            f"{hint}"
+        )
     lock = threading.Lock()
 
     def _schedule_reevalutation(self, delay: float) -> None:
