@@ -10,8 +10,9 @@ full default-profile run the Snakemake process held 391 timer threads and used 7
 near the end (``benchmarks/scheduler_overhead.py``), on a machine whose two cores the jobs need.
 
 The loop needs only one pending wake-up: the rate limiter's (after a timespan, to admit jobs the
-limit held back), while finished jobs wake it themselves. :func:`single_reevaluation_timer`
-replaces the method on the class so that a request is dropped when a timer that fires no later
+limit held back), while finished jobs wake it themselves.
+[`single_reevaluation_timer`][physgs.scheduling.single_reevaluation_timer] replaces the method on
+the class so that a request is dropped when a timer that fires no later
 is already pending; an earlier request replaces the pending one. The timer is a daemon thread,
 so a finished run exits at once instead of waiting out the last timespan.
 
@@ -89,7 +90,8 @@ def single_reevaluation_timer(scheduler_cls: type) -> None:
 
 
 def install() -> None:
-    """Install :func:`single_reevaluation_timer` on Snakemake's ``JobScheduler``."""
+    """Install [`single_reevaluation_timer`][physgs.scheduling.single_reevaluation_timer] on
+    Snakemake's ``JobScheduler``."""
     from snakemake.scheduling.job_scheduler import JobScheduler
 
     single_reevaluation_timer(JobScheduler)
