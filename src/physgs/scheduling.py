@@ -44,13 +44,13 @@ def single_reevaluation_timer(scheduler_cls: type) -> None:
         RuntimeError: the class has no ``_schedule_reevalutation``, or its body does not release
             ``_open_jobs`` from a timer (a Snakemake whose loop this was not written for).
     """
+    if getattr(scheduler_cls, _MARK, False):
+        return
     where = f"{scheduler_cls.__module__}.{scheduler_cls.__name__}"
     hint = (
         "physgs.scheduling was written for Snakemake 9.27's scheduling loop; check its timers "
         "before running this Snakemake (benchmarks/scheduler_overhead.py)"
     )
-    if getattr(scheduler_cls, _MARK, False):
-        return
     method = getattr(scheduler_cls, "_schedule_reevalutation", None)
     if method is None:
         raise RuntimeError(f"{where} has no _schedule_reevalutation: {hint}")
