@@ -7,6 +7,8 @@ import functools
 import torch
 import torch.nn.functional as F
 
+from physgs.train.fused_loss import SSIM_C1, SSIM_C2, fused_photometric_loss
+
 #: Image side (pixels) from which SSIM's blur runs in block-Toeplitz tiles rather than as one
 #: banded [n, n] matmul per side: the banded matmul does O(n) work per output pixel, the tiles
 #: O(TILE + window). Measured (benchmarks/ssim_blur.py) forward + backward of the 15 blurred maps,
@@ -127,13 +129,36 @@ def ssim(a: torch.Tensor, b: torch.Tensor, window: int = 11, sigma: float = 1.5)
     sxx = bxx - mx * mx
     syy = byy - my * my
     sxy = bxy - mx * my
-    c1, c2 = 0.01**2, 0.03**2
+    c1, c2 = SSIM_C1, SSIM_C2
     m = ((2 * mx * my + c1) * (2 * sxy + c2)) / ((mx * mx + my * my + c1) * (sxx + syy + c2))
     return m.mean()
 
 
 def photometric_loss(render: torch.Tensor, target: torch.Tensor, ssim_weight: float = 0.2):
     """(loss, l1, dssim) for images [H, W, 3] in [0, 1]; loss = (1-w) L1 + w (1 - SSIM).
+
+    On the CPU with a target that needs no gradient (training), the loss and its gradient come
+    from one numba pass in float64
+    ([`fused_photometric_loss`][physgs.train.fused_loss.fused_photometric_loss], half the time
+    of the torch ops); otherwise from the torch ops below (differentiable w.r.t. both images,
+    on any device, in the images' dtype). The two agree to float64 rounding on float64 images.
+
+    Args:
+        render: [H, W, 3] the rendered image, in [0, 1].
+        target: [H, W, 3] the recorded image, in [0, 1].
+        ssim_weight: w, the D-SSIM share.
+
+    Returns:
+        (tuple[torch.Tensor, torch.Tensor, torch.Tensor]): ``(loss, l1, dssim)``, scalar tensors.
+    """
+    if render.device.type == "cpu" and target.device.type == "cpu" and not target.requires_grad:
+        return fused_photometric_loss(render, target, ssim_weight)
+    return photometric_loss_torch(render, target, ssim_weight)
+
+
+def photometric_loss_torch(render: torch.Tensor, target: torch.Tensor, ssim_weight: float = 0.2):
+    """[`photometric_loss`][physgs.train.losses.photometric_loss] as torch ops: differentiable
+    w.r.t. both images, on any device (the fused path's reference in the tests).
 
     Args:
         render: [H, W, 3] the rendered image, in [0, 1].
