@@ -150,11 +150,12 @@ class BlindOscillatorPrior(OscillatorPrior):
         """
         return forcing_series(self.forcing_coef, self.forcing_basis)
 
-    def part_theta(self, wind=None) -> torch.Tensor:
+    def part_theta(self, wind=None, upto: int | None = None) -> torch.Tensor:
         """theta [K, L + n_train] (rad) under the learned forcing; ``wind`` is ignored.
 
         Args:
             wind (Any): ignored.
+            upto: ignored: the whole window is computed (a convolution, not a march in time).
 
         Returns:
             [K, L + n_train] part angles, rad (frozen parts 0).

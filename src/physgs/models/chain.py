@@ -19,6 +19,7 @@ from __future__ import annotations
 import numpy as np
 import torch
 
+from physgs.models.part_transform import transform_parts
 from physgs.models.gaussians import axis_angle_quat, quat_multiply, rodrigues_minus_identity
 
 
@@ -103,9 +104,7 @@ def chain_deform(
         ``(means [N, 3], quats [N, 4])``; exactly the input at theta = 0.
     """
     E, u, q = chain_transforms(axis, theta, pivot, levels)
-    rel = (means - pivot[labels])[..., None]  # [N, 3, 1]
-    new_means = means + u[labels] + (E[labels] @ rel)[..., 0]
-    return new_means, quat_multiply(q[labels], quats)
+    return transform_parts(means, quats, labels, E, pivot, u, q)
 
 
 def chain_deform_from(
@@ -148,6 +147,4 @@ def chain_deform_from(
     # Rw Rw0^T - I = E + E0^T + E E0^T, kept apart from I as chain_transforms keeps E
     M = E + E0.transpose(-1, -2) + E @ E0.transpose(-1, -2)  # [K, 3, 3]
     q0_inv = q0 * torch.tensor([1.0, -1.0, -1.0, -1.0], dtype=q0.dtype, device=q0.device)
-    rel = (means - pivot[labels] - u0[labels])[..., None]  # [N, 3, 1]
-    new_means = means + (u - u0)[labels] + (M[labels] @ rel)[..., 0]
-    return new_means, quat_multiply(quat_multiply(q, q0_inv)[labels], quats)
+    return transform_parts(means, quats, labels, M, pivot + u0, u - u0, quat_multiply(q, q0_inv))

@@ -142,9 +142,10 @@ def rotate_parts(
 ) -> tuple[torch.Tensor, torch.Tensor]:
     """One rotation per part: [`rotate_about_pivot`][physgs.models.gaussians.rotate_about_pivot].
 
-    The K rotations are built once and gathered (not N times, one per Gaussian): the same numbers
-    elementwise, so the result equals ``rotate_about_pivot(means, quats, axis[labels],
-    angle[labels], pivot[labels])`` exactly, at a K/N share of the rotation cost.
+    The K rotations are built once and applied per Gaussian by
+    [`transform_parts`][physgs.models.part_transform.transform_parts] (not built N times, one per
+    Gaussian): the result equals ``rotate_about_pivot(means, quats, axis[labels], angle[labels],
+    pivot[labels])`` to rounding, at a K/N share of the rotation cost.
 
     Args:
         means: [N, 3] positions, world units.
@@ -157,10 +158,11 @@ def rotate_parts(
     Returns:
         ``(means, quats)``: [N, 3] and [N, 4].
     """
+    from physgs.models.part_transform import transform_parts
+
     RmI = rodrigues_minus_identity(axis, angle)  # [K, 3, 3]
     q = axis_angle_quat(axis, angle)  # [K, 4]
-    new_means = means + (RmI[labels] @ (means - pivot[labels])[..., None])[..., 0]
-    return new_means, quat_multiply(q[labels], quats)
+    return transform_parts(means, quats, labels, RmI, pivot, torch.zeros_like(pivot), q)
 
 
 def nearest_neighbour_scale(xyz: np.ndarray, k: int = 3) -> np.ndarray:

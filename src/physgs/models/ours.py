@@ -267,7 +267,7 @@ class OscillatorPrior(BaseModel):
         """[K, 3] unit swing axes (world)."""
         return self.axis_raw / self.axis_raw.norm(dim=-1, keepdim=True)
 
-    def part_theta(self, wind: torch.Tensor) -> torch.Tensor:
+    def part_theta(self, wind: torch.Tensor, upto: int | None = None) -> torch.Tensor:
         """Swing angles theta [K, L+F] (rad) under one condition's observed wind [L+F] (m/s).
 
         vbar, the condition's mean speed, is the record's mean times the calibration ratio frozen
@@ -275,9 +275,14 @@ class OscillatorPrior(BaseModel):
 
         Args:
             wind: [L+F] the condition's observed wind, m/s.
+            upto: with autograd, integrate only samples [0, upto): the oscillators start from
+                rest at sample 0 and are causal, so these are the full series' first ``upto``
+                columns (a training iteration needs one frame, not the whole record). None (and
+                always without autograd): the whole record.
 
         Returns:
-            [K, L+F] theta, rad, in the dtype of omega (the bank's angle during the bank phase).
+            [K, L+F] theta, rad, in the dtype of omega (the bank's angle during the bank phase);
+                [K, upto] when ``upto`` is given with autograd on.
                 Without autograd the last result is kept and returned again for the same wind and
                 parameters: callers must not write to it.
 
@@ -288,7 +293,7 @@ class OscillatorPrior(BaseModel):
         if wind.ndim != 1:
             raise ValueError(f"part_theta: wind must be [L+F], got shape {tuple(wind.shape)}")
         if torch.is_grad_enabled():
-            return self._integrate_theta(wind)
+            return self._integrate_theta(wind, upto)
         # Without autograd (evaluation, recovery) every frame of a series asks for the same
         # series: keep the last one, keyed by the wind's values and the versions of everything
         # theta reads, so an in-place edit of a parameter or of the frozen mask (or a new tensor,
@@ -371,13 +376,20 @@ class OscillatorPrior(BaseModel):
             "omega_search_hz_quartiles": [float(h) for h in hz],
         }
 
-    def _integrate_theta(self, wind: torch.Tensor) -> torch.Tensor:
+    def _integrate_theta(self, wind: torch.Tensor, upto: int | None = None) -> torch.Tensor:
         if self.search is not None and bool(self.bank_active):
-            return self.bank_weights @ self._bank_responses(wind)  # [K, L+F]
-        vbar = condition_vbar(self.vbar_ratio, wind)
+            return self.bank_weights @ self._bank_responses(wind)[:, :upto]  # [K, upto]
+        vbar = condition_vbar(self.vbar_ratio, wind)  # of the whole record, whatever upto
         theta = integrate(
-            self.omega, self.zeta, self.gain, wind, vbar, self.dt, self.substeps, guard=self.guard
-        )  # [K, L+F]
+            self.omega,
+            self.zeta,
+            self.gain,
+            wind[:upto],
+            vbar,
+            self.dt,
+            self.substeps,
+            guard=self.guard,
+        )  # [K, upto]
         if not bool(self.frozen.any()):
             return theta
         # where(), not a product: frozen rows get exactly zero gradient, so with their Adam
@@ -395,7 +407,7 @@ class OscillatorPrior(BaseModel):
             The deformed Gaussians (positions and orientations rotated; scales, opacities, colours
                 those of the canonical set).
         """
-        theta_all = self.part_theta(wind)  # [K, L+F]
+        theta_all = self.part_theta(wind, upto=self.lead_in + frame_idx + 1)  # [K, >= that]
         theta = theta_all[:, self.lead_in + frame_idx]  # [K]
         theta0 = theta_all[:, self.lead_in]  # [K] at recorded frame 0
         if self.canonical_pose == "frame0_offset":

@@ -135,7 +135,8 @@ def train_model(
     groups = model.param_groups(train_cfg["lr"])
     for g in groups:
         g["base_lr"] = g["lr"]
-    opt = torch.optim.Adam(groups, eps=1e-15)
+    # fused: one kernel per step for all groups, about half the per-op (foreach) step's time
+    opt = torch.optim.Adam(groups, eps=1e-15, fused=True)
     lr_cfg = train_cfg["lr"]
     group_of = {id(p): g["name"] for g in groups for p in g["params"]}
     named = [(n, p) for n, p in model.named_parameters() if id(p) in group_of]
