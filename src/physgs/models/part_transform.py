@@ -153,9 +153,30 @@ class _PartTransform(torch.autograd.Function):
         )
 
 
-def transform_parts_torch(means, quats, labels, M, c, t, Q):
+def transform_parts_torch(
+    means: torch.Tensor,
+    quats: torch.Tensor,
+    labels: torch.Tensor,
+    M: torch.Tensor,
+    c: torch.Tensor,
+    t: torch.Tensor,
+    Q: torch.Tensor,
+) -> tuple[torch.Tensor, torch.Tensor]:
     """[`transform_parts`][physgs.models.part_transform.transform_parts] as torch ops (any
-    device; the fused path's reference in the tests). Same arguments and returns."""
+    device, autograd through every op; the fused path's reference in the tests).
+
+    Args:
+        means: [N, 3] positions, world units.
+        quats: [N, 4] orientations (w, x, y, z).
+        labels: [N] int, the part of each Gaussian, in [0, K).
+        M: [K, 3, 3] each part's rotation minus the identity.
+        c: [K, 3] the centre each part rotates about, world units.
+        t: [K, 3] each part's translation after the rotation, world units.
+        Q: [K, 4] each part's rotation as a quaternion (w, x, y, z).
+
+    Returns:
+        ``(means [N, 3], quats [N, 4])``.
+    """
     from physgs.models.gaussians import quat_multiply
 
     rel = (means - c[labels])[..., None]  # [N, 3, 1]
