@@ -249,7 +249,7 @@ class SearchHook:
         Args:
             it (int): the training iteration.
             model (OscillatorPrior): the prior being trained.
-            optimizer (torch.optim.Optimizer): its optimiser (groups named as in ``param_groups``).
+            optimizer (physgs.train.adam.FusedAdam): its optimiser (groups named as in ``param_groups``).
 
         Returns:
             The statistics to log at ``at``, else None.

@@ -129,7 +129,7 @@ def freeze_invisible(
         model (OscillatorPrior): the prior being trained.
         observed (Observed): the dataset.
         threshold_px: the swing below which a part freezes, px.
-        optimizer (torch.optim.Adam | None): the training optimizer.
+        optimizer (physgs.train.adam.FusedAdam | None): the training optimizer.
         probe_rad: see [`part_image_swing`][physgs.models.visibility.part_image_swing].
 
     Returns:

@@ -40,6 +40,7 @@ from physgs.models.oscillator import STABILITY_GUARD, integrate
 from physgs.models.oscillator_params import OscillatorBounds, condition_vbar
 from physgs.models.ours import prior_substeps
 from physgs.tracks.track import Tracks
+from physgs.train.adam import FusedAdam
 from physgs.train.divergence import pinned
 
 #: tracks shorter than this many frames (1 s at 24 fps: a third of the slowest 0.35 Hz period,
@@ -268,7 +269,7 @@ def fit_tracks(
     b = osc.bounds
     om_raw = torch.full((s.K,), b.omega_raw_init(), dtype=torch.float64, requires_grad=True)
     ze_raw = torch.full((s.K,), b.zeta_raw_init(), dtype=torch.float64, requires_grad=True)
-    opt = torch.optim.Adam([om_raw, ze_raw], lr=s.lr)
+    opt = FusedAdam([{"params": [om_raw, ze_raw], "lr": s.lr}])  # no torch.optim: see train.adam
     n_obs = sum(float(w.sum()) for w in ws) * 2
     if n_obs == 0:  # the parts do not depend on min_tracks: their largest count is what works
         frames = _largest_min_frames(tracks, s)
