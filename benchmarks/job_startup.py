@@ -5,12 +5,14 @@
 For each script of `workflow/scripts/` (or those named), runs its top-level imports (the
 `import` / `from ... import` statements of the file, read with `ast`) in a fresh Python process,
 `--reps` times, and prints the least CPU time (user + system of the child). Then the costs a job
-pays on first use, beyond its imports, each in a fresh process: torch's first optimiser
-(`torch.optim.Optimizer` imports `torch._dynamo` when it is built), scikit-learn's k-means
-(imported where ours cuts its parts) and the renderer's numba kernels (loaded from numba's cache
-at the first render, forward and backward; the imports that render needs are timed apart). A
-job's start-up is its script's imports plus the first uses it reaches: a training builds an
-optimiser, ours' training also runs k-means, and every job that renders loads the kernels.
+pays on first use, beyond its imports, each in a fresh process: the training's first optimiser
+step (`physgs.train.adam.FusedAdam`; beside it, what `torch.optim.Adam` would cost: building any
+`torch.optim.Optimizer` imports `torch._dynamo`), scikit-learn's k-means (imported where ours
+cuts its parts), the renderer's numba kernels (loaded from numba's cache at the first render,
+forward and backward; the imports that render needs are timed apart) and the loss's and the
+part transform's kernels. A job's start-up is its script's imports plus the first uses it
+reaches: a training steps an optimiser, ours' training also runs k-means, and every job that
+renders loads the kernels.
 `python -X importtime -c "<imports>"` says which module costs what.
 """
 
@@ -29,9 +31,27 @@ SCRIPTS = Path(__file__).resolve().parents[1] / "workflow" / "scripts"
 FIRST_USE = (
     ("torch (import)", "", "import torch"),
     (
-        "+ first optimiser (torch._dynamo)",
+        "+ first optimiser step (FusedAdam)",
+        "import torch\nfrom physgs.train.adam import FusedAdam",
+        "p = torch.zeros(1, requires_grad=True)\np.grad = torch.ones(1)\n"
+        "FusedAdam([{'params': [p], 'lr': 0.1}]).step()",
+    ),
+    (
+        "  (torch.optim.Adam: torch._dynamo)",
         "import torch",
         "torch.optim.Adam([torch.zeros(1, requires_grad=True)])",
+    ),
+    (
+        "+ loss and part-transform kernels",
+        "import torch\nfrom physgs.train.losses import photometric_loss\n"
+        "from physgs.models.gaussians import rotate_parts",
+        "x = torch.rand(8, 8, 3, requires_grad=True)\n"
+        "photometric_loss(x, torch.rand(8, 8, 3))[0].backward()\n"
+        "m = torch.zeros(2, 3, requires_grad=True)\n"
+        "q = torch.tensor([[1.0, 0, 0, 0]] * 2, requires_grad=True)\n"
+        "a = torch.tensor([[0.0, 0, 1]])\n"
+        "out = rotate_parts(m, q, torch.zeros(2, dtype=torch.long), a, torch.ones(1), a)\n"
+        "(out[0].sum() + out[1].sum()).backward()",
     ),
     ("+ scikit-learn k-means", "import torch", "from sklearn.cluster import KMeans"),
     ("+ renderer kernels (numba cache)", "import torch", "render_once()"),
