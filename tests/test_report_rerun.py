@@ -1,0 +1,46 @@
+"""compare_seeded on small tables whose spreads and changes are known by construction."""
+
+import math
+
+import pandas as pd
+import pytest
+
+from physgs.report.rerun import compare_seeded
+
+
+def _old():
+    return pd.DataFrame(
+        {
+            "seed": [0, 1, 2, 0, 1, 2],
+            "tree": ["a"] * 3 + ["b"] * 3,
+            "err": [1.0, 2.0, 4.0, 10.0, 10.0, 10.0],  # spreads: a 3.0, b 0.0
+            "n": [5, 5, 6, 7, 7, 7],
+            "label": ["x"] * 6,
+        }
+    )
+
+
+def test_cells_sorted_into_identical_within_and_beyond():
+    new = _old().copy()
+    new.loc[0, "err"] = 3.9  # a, seed 0: moved 2.9 <= 3.0
+    new.loc[1, "err"] = 5.5  # a, seed 1: moved 3.5 > 3.0
+    new.loc[3, "err"] = 10.5  # b: any move exceeds a zero spread
+    new.loc[4, "n"] = math.nan  # a NaN in one run only
+    r = compare_seeded(_old(), new, ["seed", "tree"])
+    assert (r.rows, r.cells) == (6, 12)
+    assert (r.identical, r.within, len(r.beyond)) == (8, 1, 3)
+    moved = {(ch.key["tree"], ch.key["seed"], ch.column) for ch in r.beyond}
+    assert moved == {("a", 1, "err"), ("b", 0, "err"), ("b", 1, "n")}
+    assert r.beyond[-1].column == "err" and r.beyond[-1].spread == 3.0  # finite ratio last
+
+
+def test_unmatched_rows_and_bad_keys():
+    new = _old().iloc[1:]
+    r = compare_seeded(_old(), new, ["seed", "tree"])
+    assert r.only_old == [(0, "a")] and r.only_new == [] and r.rows == 5
+    with pytest.raises(ValueError, match="seed column"):
+        compare_seeded(_old(), _old(), ["tree"])
+    with pytest.raises(ValueError, match="repeats keys"):
+        compare_seeded(_old(), _old(), ["seed", "label"])
+    with pytest.raises(ValueError, match="lacks key"):
+        compare_seeded(_old(), _old().drop(columns="tree"), ["seed", "tree"])
