@@ -284,3 +284,21 @@ def test_part_theta_without_autograd_reuses_its_series_until_a_parameter_changes
     with torch.enable_grad():
         c = model.part_theta(w)
     assert c.requires_grad and torch.equal(c.detach(), model._integrate_theta(w).detach())
+
+
+def test_ours_training_frame_integrates_only_up_to_it_bit_for_bit():
+    # Oracle: the whole record's theta, computed without autograd (the memo path): the oscillators
+    # start from rest and are causal, so the first columns are the same numbers.
+    from physgs.models.ours import OscillatorPrior
+
+    ctx, _ = model_context(50, seed=0, lead_in=10)
+    m = build_model("ours", ctx, quick_models_cfg(), config="single")
+    assert isinstance(m, OscillatorPrior)
+    wind = torch.as_tensor(np.random.default_rng(0).uniform(4, 8, 60), dtype=torch.float64)
+    with torch.no_grad():
+        m.gain_raw.add_(0.5)
+        full = m.part_theta(wind).clone()
+    for upto in (11, 33, 60):
+        part = m.part_theta(wind, upto=upto)
+        assert part.shape == (full.shape[0], upto)
+        assert torch.equal(part.detach(), full[:, :upto])

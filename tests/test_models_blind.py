@@ -181,3 +181,22 @@ def test_undefined_splits_are_the_ones_outside_the_window_and_wind():
         "centroid_c1",
     }
     assert undefined_splits(SimpleNamespace(defined=lambda j, c: True), obs) == set()
+
+
+def test_a_training_frame_needs_only_the_window_up_to_it():
+    # Oracle: the whole window's theta, computed without autograd; the training path (autograd
+    # on, upto = lead-in + frame + 1) integrates and convolves only that much.
+    m = _model(seed=3)
+    with torch.no_grad():
+        m.gain_raw.add_(torch.randn(m.gain_raw.shape, generator=torch.Generator().manual_seed(0)))
+        full = m.part_theta().clone()  # [K, L + n_train]
+    for frame in (0, 37, N_TRAIN - 1):
+        upto = LEAD + frame + 1
+        part = m.part_theta(upto=upto)
+        assert part.shape == (2, upto) and part.requires_grad
+        np.testing.assert_allclose(part.detach().numpy(), full[:, :upto].numpy(), atol=1e-12)
+    # and the deformation of a frame is the same either way
+    s = m.deform(37, torch.zeros(LEAD + N_TRAIN))
+    with torch.no_grad():
+        s0 = m.deform(37, torch.zeros(LEAD + N_TRAIN))
+    np.testing.assert_allclose(s.means.detach().numpy(), s0.means.numpy(), atol=1e-6)

@@ -155,17 +155,24 @@ class BlindOscillatorPrior(OscillatorPrior):
 
         Args:
             wind (Any): ignored.
-            upto: ignored: the whole window is computed (a convolution, not a march in time).
+            upto: with autograd, only samples [0, upto) (at most L + n_train): the responses and
+                the convolution are causal, so these are the whole series' first ``upto``
+                columns to rounding (a training iteration needs one frame). None (and always
+                without autograd): the whole window.
 
         Returns:
-            [K, L + n_train] part angles, rad (frozen parts 0).
+            [K, L + n_train] part angles, rad (frozen parts 0); [K, upto] when ``upto`` is given
+                with autograd on.
         """
+        m = self.n_samples
+        if upto is not None and torch.is_grad_enabled():
+            m = max(1, min(int(upto), m))
         om, ze, g = self.omega.double(), self.zeta.double(), self.gain.double()
         r0, r1 = (
             integrate_forcing(om, ze, g, u, self.dt, self.substeps, guard=self.guard)
-            for u in (self.unit0, self.unit1)
-        )  # [K, N] the response to a unit sample 0, [K, N + 1] to a unit sample 1
-        theta = causal_convolve(r0, r1[:, 1:], self.forcing()).to(self.omega_raw.dtype)
+            for u in (self.unit0[:m], self.unit1[: m + 1])
+        )  # [K, m] the response to a unit sample 0, [K, m + 1] to a unit sample 1
+        theta = causal_convolve(r0, r1[:, 1:], self.forcing()[:m]).to(self.omega_raw.dtype)
         if bool(self.frozen.any()):
             theta = torch.where(self.frozen[:, None], torch.zeros_like(theta), theta)
         return theta
