@@ -7,7 +7,7 @@ import torch
 from scipy.ndimage import correlate1d
 
 from physgs.train.fused_loss import fused_photometric_loss, gauss_window, loss_terms
-from physgs.train.losses import photometric_loss, photometric_loss_torch
+from physgs.train.losses import photometric_loss, _photometric_loss_torch
 
 
 def _images(shape, seed):
@@ -40,7 +40,7 @@ def test_values_and_gradients_equal_the_torch_ops_in_float64(shape):
     a, b = _images(shape, 1)
     weights = (1.0, 0.3, -0.7)  # a mix of the three outputs, so each one's backward is checked
     grads = []
-    for f in (fused_photometric_loss, photometric_loss_torch):
+    for f in (fused_photometric_loss, _photometric_loss_torch):
         out = f(a, b, 0.2)
         sum(w * o for w, o in zip(weights, out)).backward()
         grads.append(a.grad.clone())
@@ -72,7 +72,7 @@ def test_float32_images_are_computed_in_float64():
     assert loss.dtype == torch.float32 and a32.grad.dtype == torch.float32
     # the reference on the same (float32-rounded) pixels, in float64
     a64 = a32.detach().double().requires_grad_(True)
-    ref = photometric_loss_torch(a64, b32.double(), 0.2)
+    ref = _photometric_loss_torch(a64, b32.double(), 0.2)
     ref[0].backward()
     # the kernel's own float64 results, before the one rounding to the render's dtype
     grads = [np.empty(a32.shape, np.float32) for _ in range(3)]

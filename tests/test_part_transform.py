@@ -3,7 +3,7 @@
 import pytest
 import torch
 
-from physgs.models.part_transform import transform_parts, transform_parts_torch
+from physgs.models.part_transform import transform_parts, _transform_parts_torch
 
 
 def _inputs(N, K, dtype, seed=0):
@@ -21,7 +21,7 @@ def test_values_and_gradients_equal_the_torch_ops():
     w = torch.randn(300, 7, generator=torch.Generator().manual_seed(1), dtype=torch.float64)
     grads = []
     outs = []
-    for f in (transform_parts, transform_parts_torch):
+    for f in (transform_parts, _transform_parts_torch):
         m, q = f(*x)
         outs.append((m.detach(), q.detach()))
         loss = (torch.cat([m, q], 1) * w).sum()
@@ -44,7 +44,7 @@ def test_float32_in_float32_out_within_rounding():
     x = _inputs(200, 5, torch.float32, seed=3)
     m, q = transform_parts(*x)
     assert m.dtype == q.dtype == torch.float32
-    ref = transform_parts_torch(*[v.detach().double() if v.is_floating_point() else v for v in x])
+    ref = _transform_parts_torch(*[v.detach().double() if v.is_floating_point() else v for v in x])
     torch.testing.assert_close(m.double(), ref[0], rtol=0, atol=1e-5)
     torch.testing.assert_close(q.double(), ref[1], rtol=0, atol=1e-5)
     (m.sum() + q.sum()).backward()

@@ -23,6 +23,12 @@ import numpy as np
 import torch
 
 
+@nb.njit(cache=True, inline="always")
+def _row4(a, i):  # pragma: no cover - compiled
+    """Row i of a [*, 4] array as four float64 scalars."""
+    return float(a[i, 0]), float(a[i, 1]), float(a[i, 2]), float(a[i, 3])
+
+
 @nb.njit(cache=True)
 def _forward(means, quats, labels, M, c, t, Q, out_means, out_quats):  # pragma: no cover
     for i in range(means.shape[0]):
@@ -34,13 +40,8 @@ def _forward(means, quats, labels, M, c, t, Q, out_means, out_quats):  # pragma:
             out_means[i, a] = (
                 float(means[i, a]) + t[k, a] + (M[k, a, 0] * r0 + M[k, a, 1] * r1 + M[k, a, 2] * r2)
             )
-        aw, ax, ay, az = float(Q[k, 0]), float(Q[k, 1]), float(Q[k, 2]), float(Q[k, 3])
-        bw, bx, by, bz = (
-            float(quats[i, 0]),
-            float(quats[i, 1]),
-            float(quats[i, 2]),
-            float(quats[i, 3]),
-        )
+        aw, ax, ay, az = _row4(Q, k)
+        bw, bx, by, bz = _row4(quats, i)
         out_quats[i, 0] = aw * bw - ax * bx - ay * by - az * bz
         out_quats[i, 1] = aw * bx + ax * bw + ay * bz - az * by
         out_quats[i, 2] = aw * by - ax * bz + ay * bw + az * bx
@@ -73,19 +74,9 @@ def _backward(
         g_t[k, 0] += g0
         g_t[k, 1] += g1
         g_t[k, 2] += g2
-        aw, ax, ay, az = float(Q[k, 0]), float(Q[k, 1]), float(Q[k, 2]), float(Q[k, 3])
-        bw, bx, by, bz = (
-            float(quats[i, 0]),
-            float(quats[i, 1]),
-            float(quats[i, 2]),
-            float(quats[i, 3]),
-        )
-        hw, hx, hy, hz = (
-            float(g_nq[i, 0]),
-            float(g_nq[i, 1]),
-            float(g_nq[i, 2]),
-            float(g_nq[i, 3]),
-        )
+        aw, ax, ay, az = _row4(Q, k)
+        bw, bx, by, bz = _row4(quats, i)
+        hw, hx, hy, hz = _row4(g_nq, i)
         # the product is bilinear: transpose its matrix in b (for quats), then in a (for Q)
         g_quats[i, 0] = aw * hw + ax * hx + ay * hy + az * hz
         g_quats[i, 1] = -ax * hw + aw * hx + az * hy - ay * hz
@@ -153,30 +144,9 @@ class _PartTransform(torch.autograd.Function):
         )
 
 
-def transform_parts_torch(
-    means: torch.Tensor,
-    quats: torch.Tensor,
-    labels: torch.Tensor,
-    M: torch.Tensor,
-    c: torch.Tensor,
-    t: torch.Tensor,
-    Q: torch.Tensor,
-) -> tuple[torch.Tensor, torch.Tensor]:
-    """[`transform_parts`][physgs.models.part_transform.transform_parts] as torch ops (any
-    device, autograd through every op; the fused path's reference in the tests).
-
-    Args:
-        means: [N, 3] positions, world units.
-        quats: [N, 4] orientations (w, x, y, z).
-        labels: [N] int, the part of each Gaussian, in [0, K).
-        M: [K, 3, 3] each part's rotation minus the identity.
-        c: [K, 3] the centre each part rotates about, world units.
-        t: [K, 3] each part's translation after the rotation, world units.
-        Q: [K, 4] each part's rotation as a quaternion (w, x, y, z).
-
-    Returns:
-        ``(means [N, 3], quats [N, 4])``.
-    """
+def _transform_parts_torch(means, quats, labels, M, c, t, Q):
+    """[`transform_parts`][physgs.models.part_transform.transform_parts] as torch ops, on any
+    device with autograd through every op (the fused pass's reference in the tests)."""
     from physgs.models.gaussians import quat_multiply
 
     rel = (means - c[labels])[..., None]  # [N, 3, 1]
@@ -196,8 +166,7 @@ def transform_parts(
     """Move each Gaussian by its part's transform: means + t + M (means - c), Q * quats.
 
     One numba pass forward and one backward on the CPU (differentiable w.r.t. every tensor but
-    ``labels``); the torch ops of
-    [`transform_parts_torch`][physgs.models.part_transform.transform_parts_torch] elsewhere.
+    ``labels``); the same sums as torch ops on other devices.
 
     Args:
         means: [N, 3] positions, world units.
@@ -236,5 +205,5 @@ def transform_parts(
             f"[{int(labels.min())}, {int(labels.max())}]"
         )
     if means.device.type != "cpu":
-        return transform_parts_torch(means, quats, labels, M, c, t, Q)
+        return _transform_parts_torch(means, quats, labels, M, c, t, Q)
     return _PartTransform.apply(means, quats, labels, M, c, t, Q)

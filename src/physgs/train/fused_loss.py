@@ -72,6 +72,15 @@ def _blur_plane(src, g, tmp, dst):  # pragma: no cover - compiled
 
 
 @nb.njit(cache=True)
+def _blur_product(a, b, g, prod, tmp, dst):  # pragma: no cover - compiled
+    """dst = the blur of a * b (all [H, W]); prod and tmp are scratch."""
+    for i in range(a.shape[0]):
+        for j in range(a.shape[1]):
+            prod[i, j] = a[i, j] * b[i, j]
+    _blur_plane(prod, g, tmp, dst)
+
+
+@nb.njit(cache=True)
 def loss_terms(render, target, g, w, grad_loss, grad_l1, grad_ssim):  # pragma: no cover
     """L1, mean SSIM and the gradients w.r.t. the render of the L1, SSIM and the loss.
 
@@ -91,20 +100,25 @@ def loss_terms(render, target, g, w, grad_loss, grad_l1, grad_ssim):  # pragma: 
     """
     H, W, C = render.shape
     inv_n = 1.0 / (C * H * W)
-    xc = np.empty((H, W))
-    yc = np.empty((H, W))
-    prod = np.empty((H, W))
-    tmp = np.empty((H, W))
-    mx = np.empty((H, W))
-    my = np.empty((H, W))
-    bxx = np.empty((H, W))
-    byy = np.empty((H, W))
-    bxy = np.empty((H, W))
-    g_mx = np.empty((H, W))
-    g_bxx = np.empty((H, W))
-    g_bxy = np.empty((H, W))
+    planes = np.empty((13, H, W))  # float64 scratch, one [H, W] plane each
+    xc, yc, prod, tmp, mx, my, bxx = (
+        planes[0],
+        planes[1],
+        planes[2],
+        planes[3],
+        planes[4],
+        planes[5],
+        planes[6],
+    )
+    byy, bxy, g_mx, g_bxx, g_bxy, gl1 = (
+        planes[7],
+        planes[8],
+        planes[9],
+        planes[10],
+        planes[11],
+        planes[12],
+    )
     m_row = np.empty(W)
-    gl1 = np.empty((H, W))
     l1 = 0.0
     total = 0.0
     for c in range(C):
@@ -114,18 +128,9 @@ def loss_terms(render, target, g, w, grad_loss, grad_l1, grad_ssim):  # pragma: 
                 yc[i, j] = target[i, j, c]
         _blur_plane(xc, g, tmp, mx)
         _blur_plane(yc, g, tmp, my)
-        for i in range(H):
-            for j in range(W):
-                prod[i, j] = xc[i, j] * xc[i, j]
-        _blur_plane(prod, g, tmp, bxx)
-        for i in range(H):
-            for j in range(W):
-                prod[i, j] = yc[i, j] * yc[i, j]
-        _blur_plane(prod, g, tmp, byy)
-        for i in range(H):
-            for j in range(W):
-                prod[i, j] = xc[i, j] * yc[i, j]
-        _blur_plane(prod, g, tmp, bxy)
+        _blur_product(xc, xc, g, prod, tmp, bxx)
+        _blur_product(yc, yc, g, prod, tmp, byy)
+        _blur_product(xc, yc, g, prod, tmp, bxy)
         for i in range(H):
             # row views: the loop below has no reduction and vectorises
             a_, b_, xx, yy, xy = mx[i], my[i], bxx[i], byy[i], bxy[i]

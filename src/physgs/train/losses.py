@@ -153,21 +153,12 @@ def photometric_loss(render: torch.Tensor, target: torch.Tensor, ssim_weight: fl
     """
     if render.device.type == "cpu" and target.device.type == "cpu" and not target.requires_grad:
         return fused_photometric_loss(render, target, ssim_weight)
-    return photometric_loss_torch(render, target, ssim_weight)
+    return _photometric_loss_torch(render, target, ssim_weight)
 
 
-def photometric_loss_torch(render: torch.Tensor, target: torch.Tensor, ssim_weight: float = 0.2):
+def _photometric_loss_torch(render: torch.Tensor, target: torch.Tensor, ssim_weight: float = 0.2):
     """[`photometric_loss`][physgs.train.losses.photometric_loss] as torch ops: differentiable
-    w.r.t. both images, on any device (the fused path's reference in the tests).
-
-    Args:
-        render: [H, W, 3] the rendered image, in [0, 1].
-        target: [H, W, 3] the recorded image, in [0, 1].
-        ssim_weight: w, the D-SSIM share.
-
-    Returns:
-        (tuple[torch.Tensor, torch.Tensor, torch.Tensor]): ``(loss, l1, dssim)``, scalar tensors.
-    """
+    w.r.t. both images, on any device (the fused pass's reference in the tests)."""
     l1 = (render - target).abs().mean()
     dssim = 1.0 - ssim(render, target)
     return (1.0 - ssim_weight) * l1 + ssim_weight * dssim, l1, dssim
