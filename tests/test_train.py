@@ -224,3 +224,27 @@ def test_ssim_on_large_images_takes_the_tiles_with_the_same_value(monkeypatch):
     assert calls and min(a.shape[:2]) >= losses.TILED_BLUR_MIN_SIDE
     monkeypatch.setattr(losses, "TILED_BLUR_MIN_SIDE", 10**6)
     assert tiled == pytest.approx(float(losses.ssim(a, b)), abs=1e-13)
+
+
+def test_a_training_job_never_imports_torch_dynamo(tmp_path):
+    # torch.optim's optimisers import torch._dynamo (and sympy) when built: ~1 CPU-s of every
+    # job's start-up. A fresh process trains ours and an MLP field as a job does and must not.
+    import subprocess
+    import sys
+    from pathlib import Path
+
+    code = f"""
+import sys
+sys.path.insert(0, {str(Path(__file__).parent)!r})
+from conftest import swaying_dataset
+from oracles import quick_train_cfg
+from physgs.experiments import job_spec, train_and_save
+data = swaying_dataset()
+cfg = quick_train_cfg(4, 1)
+for name in ("ours", "mlp"):
+    train_and_save(data, job_spec(cfg, name, "single"), checkpoint_path={str(tmp_path)!r} + f"/{{name}}.pt",
+                   loss_path={str(tmp_path)!r} + f"/{{name}}.csv", progress=False)
+print("dynamo" if "torch._dynamo" in sys.modules else "clean")
+"""
+    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True)
+    assert out.stdout.strip().splitlines()[-1] == "clean"
