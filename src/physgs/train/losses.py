@@ -7,7 +7,7 @@ import functools
 import torch
 import torch.nn.functional as F
 
-from physgs.train.fused_loss import SSIM_C1, SSIM_C2, fused_photometric_loss
+from physgs.train.fused_loss import SSIM_C1, SSIM_C2, fused_photometric_loss, gauss_window
 
 #: Image side (pixels) from which SSIM's blur runs in block-Toeplitz tiles rather than as one
 #: banded [n, n] matmul per side: the banded matmul does O(n) work per output pixel, the tiles
@@ -21,10 +21,9 @@ BLUR_TILE = 32
 
 
 def _gauss_1d(size: int, sigma: float, dtype) -> torch.Tensor:
-    """Normalised 1D Gaussian window [size] (sums to 1); the 2D window is its outer product."""
-    x = torch.arange(size, dtype=dtype) - (size - 1) / 2
-    g = torch.exp(-(x**2) / (2 * sigma**2))
-    return g / g.sum()
+    """Normalised 1D Gaussian window [size] (sums to 1); the 2D window is its outer product (the
+    fused pass's window, one definition)."""
+    return torch.as_tensor(gauss_window(size, sigma), dtype=dtype)
 
 
 @functools.lru_cache(maxsize=16)
