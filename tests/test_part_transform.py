@@ -64,3 +64,14 @@ def test_bad_labels_and_shapes_are_refused():
         transform_parts(means, quats, labels + 3, M, c, t, Q)
     with pytest.raises(ValueError, match="expected means"):
         transform_parts(means, quats, labels, M, c, t[:2], Q)
+
+
+def test_an_in_place_edit_before_the_backward_is_refused():
+    means, quats, labels, M, c, t, Q = _inputs(10, 2, torch.float64)
+    leaf = means.detach().clone().requires_grad_(True)
+    moved = leaf * 1.0  # a non-leaf input, as a model's activated tensors are
+    m, q = transform_parts(moved, quats, labels, M, c, t, Q)
+    with torch.no_grad():
+        moved.add_(1.0)
+    with pytest.raises(RuntimeError, match="modified by an inplace operation"):
+        (m.sum() + q.sum()).backward()

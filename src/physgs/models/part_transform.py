@@ -108,18 +108,19 @@ class _PartTransform(torch.autograd.Function):
         m = means.detach().cpu().numpy()
         q = quats.detach().cpu().numpy()
         lab = np.ascontiguousarray(labels.detach().cpu().numpy(), dtype=np.int64)
-        parts = tuple(_np64(x) for x in (M, c, t, Q))
         out_m = np.empty(m.shape, m.dtype)
         out_q = np.empty(q.shape, q.dtype)
-        _forward(m, q, lab, *parts, out_m, out_q)
-        ctx.state = (m, q, lab, parts)
-        ctx.likes = (means, quats, M, c, t, Q)
+        _forward(m, q, lab, *(_np64(x) for x in (M, c, t, Q)), out_m, out_q)
+        # saved as tensors: autograd then refuses a backward after an in-place edit of any
+        ctx.save_for_backward(means, quats, labels, M, c, t, Q)
         return torch.from_numpy(out_m).to(means.device), torch.from_numpy(out_q).to(quats.device)
 
     @staticmethod
     def backward(ctx, g_means, g_quats):
-        m, q, lab, (M, c, _, Q) = ctx.state
-        like_m, like_q, like_M, like_c, like_t, like_Q = ctx.likes
+        means, quats, labels, M, c, t, Q = ctx.saved_tensors
+        m, q = means.detach().cpu().numpy(), quats.detach().cpu().numpy()
+        lab = np.ascontiguousarray(labels.cpu().numpy(), dtype=np.int64)
+        M64, c64, Q64 = _np64(M), _np64(c), _np64(Q)
         g_nm = np.zeros(m.shape) if g_means is None else g_means.detach().cpu().numpy()  # [N, 3]
         g_nq = np.zeros(q.shape) if g_quats is None else g_quats.detach().cpu().numpy()
         K = M.shape[0]
@@ -131,16 +132,13 @@ class _PartTransform(torch.autograd.Function):
             np.empty((K, 3)),
             np.empty((K, 4)),
         )
-        _backward(m, q, lab, M, c, Q, np.ascontiguousarray(g_nm), np.ascontiguousarray(g_nq), *out)
-        g_m, g_q, g_M, g_c, g_t, g_Q = out
+        _backward(
+            m, q, lab, M64, c64, Q64, np.ascontiguousarray(g_nm), np.ascontiguousarray(g_nq), *out
+        )
         return (
-            _back(g_m, like_m),
-            _back(g_q, like_q),
+            *(_back(g, like) for g, like in zip(out[:2], (means, quats))),
             None,
-            _back(g_M, like_M),
-            _back(g_c, like_c),
-            _back(g_t, like_t),
-            _back(g_Q, like_Q),
+            *(_back(g, like) for g, like in zip(out[2:], (M, c, t, Q))),
         )
 
 
