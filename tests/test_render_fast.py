@@ -187,3 +187,21 @@ def test_work_count_matches_a_per_pixel_count(scene):
     assert work["pairs"] == pairs > 1000
     assert work["footprint_pixels"] >= work["pairs"]
     assert work["gaussians"] == 400 and work["rows"] <= work["footprint_pixels"]
+
+
+def test_without_depth_the_same_images_and_gradients_bit_for_bit(scene):
+    # Oracle: the with-depth path under a loss that does not read the depth (whose gradient is
+    # then zero): skipping the depth's terms must change no bit of the images or the gradients.
+    means, quats, scales, opac, colors, cam, bg = scene
+    w = torch.rand(
+        cam.height, cam.width, colors.shape[1], generator=torch.Generator().manual_seed(1)
+    )
+    got = []
+    for with_depth in (True, False):
+        ps = [x.clone().double().requires_grad_(True) for x in (means, quats, scales, opac, colors)]
+        out = rasterization(*ps, cam, bg.double(), return_depth=with_depth, backend="fast")
+        assert (out.depth is None) == (not with_depth)
+        ((out.rgb * w).sum() + 0.3 * out.alpha.sum()).backward()
+        got.append([out.rgb.detach(), out.alpha.detach(), *(p.grad for p in ps)])
+    for a, b in zip(*got):
+        assert torch.equal(a, b)

@@ -51,10 +51,11 @@ def camera_arrays(camera: Camera):
     )
 
 
-def _forward(means, quats, scales, opacities, colors, background, camera):
+def _forward(means, quats, scales, opacities, colors, background, camera, with_depth=True):
     """Project, bin and composite: ((rgb [H, W, D], alpha [H, W], depth [H, W]) float64 numpy,
     state) where state holds what the backward needs (float64 inputs, projection, tile lists,
-    per-pixel totals); a forward-only caller drops it."""
+    per-pixel totals); a forward-only caller drops it. Without depth the depth image is zeros
+    and the backward takes no depth gradient."""
     m, q, s, o, col, bg = (_np(x) for x in (means, quats, scales, opacities, colors, background))
     n, D = col.shape
     W, H = camera.width, camera.height
@@ -87,7 +88,10 @@ def _forward(means, quats, scales, opacities, colors, background, camera):
         np.empty((row_start[-1], 2)),
         np.zeros(pair_gid.shape[0], np.int64),
     )
-    comp = (m2, con, o, col, dep, bg, boxes, tile_start, pair_gid, row_start, TILE, tiles_x, W, H)
+    comp = (
+        *(m2, con, o, col, dep, bg, boxes, tile_start, pair_gid, row_start),
+        *(TILE, tiles_x, W, H, bool(with_depth)),
+    )
     kernels.forward(*comp, rgb, alpha, depth, acc_c, acc_d, t_final, n_contrib, *rows)
     return (rgb, alpha, depth), (
         m,
@@ -107,8 +111,10 @@ def _forward(means, quats, scales, opacities, colors, background, camera):
 
 class _FastRasterize(torch.autograd.Function):
     @staticmethod
-    def forward(ctx, means, quats, scales, opacities, colors, background, camera):
-        images, ctx.saved = _forward(means, quats, scales, opacities, colors, background, camera)
+    def forward(ctx, means, quats, scales, opacities, colors, background, camera, with_depth):
+        images, ctx.saved = _forward(
+            means, quats, scales, opacities, colors, background, camera, with_depth
+        )
         ctx.like = torch.empty(0, dtype=means.dtype, device=means.device)
         return tuple(_to_torch(x, means) for x in images)
 
@@ -151,7 +157,7 @@ class _FastRasterize(torch.autograd.Function):
         )
         g_bg = np.einsum("hwd,hw->d", g_rgb, t_final)
         out = (v_means, v_quats, v_scales, G[:, 5], G[:, kernels.N_GRAD :], g_bg)
-        return tuple(_to_torch(x, ctx.like) for x in out) + (None,)
+        return tuple(_to_torch(x, ctx.like) for x in out) + (None, None)
 
 
 def work_count(means, quats, scales, opacities, colors, camera, background) -> dict[str, int]:
@@ -227,8 +233,9 @@ def rasterize_fast(
     """
     inputs = (means, quats, scales, opacities, colors, background)
     if torch.is_grad_enabled() and any(x.requires_grad for x in inputs):
-        rgb, alpha, depth = _FastRasterize.apply(*inputs, camera)
+        # without depth, its terms are skipped (the same numbers: its gradient would be zero)
+        rgb, alpha, depth = _FastRasterize.apply(*inputs, camera, return_depth)
     else:
-        images, _ = _forward(*inputs, camera)
+        images, _ = _forward(*inputs, camera, return_depth)
         rgb, alpha, depth = (_to_torch(x, means) for x in images)
     return rgb, alpha, (depth if return_depth else None)

@@ -211,6 +211,7 @@ def forward(
     tiles_x,
     width,
     height,
+    with_depth,
     out_rgb,
     out_alpha,
     out_depth,
@@ -243,6 +244,8 @@ def forward(
         tiles_x (int): tiles per image row.
         width (int): image width W, px.
         height (int): image height H, px.
+        with_depth (bool): accumulate the depth; False leaves out_depth and acc_d at 0 (a
+            caller that asked for no depth: the backward then takes no depth gradient).
         out_rgb (np.ndarray): [H, W, D], written.
         out_alpha (np.ndarray): [H, W], written.
         out_depth (np.ndarray): [H, W] expected depth sum z a T, written.
@@ -327,7 +330,8 @@ def forward(
                     else:
                         for c in range(D):
                             cacc[p, c] += w * col_g[c]
-                    dacc[p] += w * z
+                    if with_depth:
+                        dacc[p] += w * z
                     cnt[p] += 1
                     T[p] = nt
             n_rows[k] = ir - row_start[k]
@@ -362,6 +366,7 @@ def backward(
     tiles_x,
     width,
     height,
+    with_depth,
     acc_c,
     acc_d,
     t_final,
@@ -396,6 +401,8 @@ def backward(
         tiles_x (int): tiles per image row.
         width (int): image width W, px.
         height (int): image height H, px.
+        with_depth (bool): as in the forward; False skips the depth's terms (g_depth must then be
+            zero: the same numbers as with them).
         acc_c (np.ndarray): [H, W, D] the forward's totals.
         acc_d (np.ndarray): [H, W] the forward's totals.
         t_final (np.ndarray): [H, W] the forward's final transmittance.
@@ -435,9 +442,11 @@ def backward(
                     gc = g_rgb[ty0 + ly, tx0 + lx, c]
                     up_c[p, c] = gc
                     acc += gc * (acc_c[ty0 + ly, tx0 + lx, c] + tf * bg[c])
-                gz = g_depth[ty0 + ly, tx0 + lx]
-                up_d[p] = gz
-                S[p] = acc + gz * acc_d[ty0 + ly, tx0 + lx]
+                if with_depth:
+                    gz = g_depth[ty0 + ly, tx0 + lx]
+                    up_d[p] = gz
+                    acc += gz * acc_d[ty0 + ly, tx0 + lx]
+                S[p] = acc
         g_col = np.empty(D)
         col_g = np.empty(D)
         n_done = 0
@@ -493,7 +502,7 @@ def backward(
                         n_done += 1
                         continue
                     w = a * Tp
-                    u = up_d[p] * z
+                    u = up_d[p] * z if with_depth else 0.0
                     if D == 3:  # RGB unrolled, as in the forward
                         u0 = up_c[p, 0]
                         u1 = up_c[p, 1]
@@ -509,7 +518,8 @@ def backward(
                             gc = up_c[p, c]
                             u += gc * col_g[c]
                             g_col[c] += gc * w
-                    g_z += up_d[p] * w
+                    if with_depth:
+                        g_z += up_d[p] * w
                     Sp = S[p] - w * u
                     S[p] = Sp
                     T[p] = nt
