@@ -44,3 +44,21 @@ def test_unmatched_rows_and_bad_keys():
         compare_seeded(_old(), _old(), ["seed", "label"])
     with pytest.raises(ValueError, match="lacks key"):
         compare_seeded(_old(), _old().drop(columns="tree"), ["seed", "tree"])
+
+
+def test_keys_are_the_seed_and_the_non_numeric_columns():
+    from physgs.report.rerun import seeded_keys
+
+    t = _old().assign(profile="default")
+    assert seeded_keys(t) == ["seed", "tree", "label"]
+    with pytest.raises(ValueError, match="repeat"):
+        seeded_keys(t.drop(columns="tree"))
+    with pytest.raises(ValueError, match="no 'seed' column"):
+        seeded_keys(t.drop(columns="seed"))
+
+
+def test_flag_columns_are_not_compared():
+    old = _old().assign(reference=True)
+    new = old.assign(reference=False)
+    r = compare_seeded(old, new, ["seed", "tree"])
+    assert r.cells == 12 and r.identical == 12 and not r.beyond

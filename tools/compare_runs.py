@@ -1,36 +1,58 @@
 """Compare a seeded table's rerun with an earlier run: each changed cell against the seed spread.
 
     python tools/compare_runs.py OLD.csv NEW.csv [--keys seed,tree,config,method] [--show 15]
+    python tools/compare_runs.py OLD_TABLES_DIR NEW_TABLES_DIR      # every seeded CSV in both
+    python tools/compare_runs.py OLD/tab_transfer.csv NEW/tab_transfer.csv --keys seed,split,tree,condition
 
 Prints how many numeric cells are identical, changed within the old run's spread over seeds of
-their row, or beyond it (those listed, largest first). `physgs.report.rerun.compare_seeded`.
+their row, or beyond it (those listed, largest first). The keys default to the seed and the
+table's non-numeric columns (`physgs.report.rerun.seeded_keys`). `physgs.report.rerun.compare_seeded`.
 """
 
 from __future__ import annotations
 
 import argparse
+from pathlib import Path
 
 import pandas as pd
 
-from physgs.report.rerun import compare_seeded
+from physgs.report.rerun import compare_seeded, seeded_keys
+
+
+def report(old: Path, new: Path, keys: str, show: int) -> None:
+    a, b = pd.read_csv(old), pd.read_csv(new)
+    r = compare_seeded(a, b, seeded_keys(a) if keys == "auto" else keys.split(","))
+    print(
+        f"{new.name}: {r.rows} rows matched ({len(r.only_old)} only in old, {len(r.only_new)} "
+        f"only in new); {r.cells} numeric cells: {r.identical} identical, {r.within} changed "
+        f"within the seed spread of their row, {len(r.beyond)} beyond it"
+    )
+    for ch in r.beyond[:show]:
+        key = " ".join(f"{k}={v}" for k, v in ch.key.items())
+        print(f"  {key} {ch.column}: {ch.old:g} -> {ch.new:g} (seed spread {ch.spread:g})")
 
 
 def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    ap.add_argument("old")
-    ap.add_argument("new")
-    ap.add_argument("--keys", default="seed,tree,config,method")
+    ap.add_argument("old", type=Path, help="a table's CSV, or a folder of them")
+    ap.add_argument("new", type=Path, help="the rerun's CSV, or its folder")
+    ap.add_argument("--keys", default="auto", help="comma-separated key columns, or auto")
     ap.add_argument("--show", type=int, default=15, help="beyond-spread cells to list")
     args = ap.parse_args()
-    r = compare_seeded(pd.read_csv(args.old), pd.read_csv(args.new), args.keys.split(","))
-    print(
-        f"{r.rows} rows matched ({len(r.only_old)} only in old, {len(r.only_new)} only in new); "
-        f"{r.cells} numeric cells: {r.identical} identical, {r.within} changed within the seed "
-        f"spread of their row, {len(r.beyond)} beyond it"
-    )
-    for ch in r.beyond[: args.show]:
-        key = " ".join(f"{k}={v}" for k, v in ch.key.items())
-        print(f"  {key} {ch.column}: {ch.old:g} -> {ch.new:g} (seed spread {ch.spread:g})")
+    if not args.old.is_dir():
+        report(args.old, args.new, args.keys, args.show)
+        return
+    for old in sorted(args.old.glob("*.csv")):
+        new = args.new / old.name
+        if not new.exists():
+            print(f"{old.name}: not in {args.new}")
+        elif "seed" not in pd.read_csv(old, nrows=0).columns:
+            print(f"{old.name}: no seed column (compare it with cmp)")
+        else:
+            try:
+                report(old, new, args.keys, args.show)
+            except ValueError as e:  # keys that do not identify rows: name them for this table
+                print(f"{old.name}: {e}")
 
 
 if __name__ == "__main__":

@@ -56,6 +56,38 @@ class RerunComparison:
     beyond: list[CellChange]
 
 
+#: Columns that describe the run, not a row: never keys.
+PROVENANCE_COLUMNS = ("profile", "config_hash", "physgs_version")
+
+
+def seeded_keys(table: pd.DataFrame, seed: str = "seed") -> list[str]:
+    """The columns that identify a row of a seeded table: the seed and every non-numeric column
+    (tree, method, configuration, ...) but the run's provenance.
+
+    Args:
+        table: a seeded table.
+        seed: the seed column.
+
+    Returns:
+        The key columns, seed first.
+
+    Raises:
+        ValueError: no seed column, or keys that repeat (name them with ``keys`` instead).
+    """
+    if seed not in table.columns:
+        raise ValueError(f"seeded_keys: the table has no {seed!r} column")
+    keys = [seed] + [
+        c
+        for c in table.columns
+        if c != seed and c not in PROVENANCE_COLUMNS and not pd.api.types.is_numeric_dtype(table[c])
+    ]
+    if table.duplicated(keys).any():
+        raise ValueError(
+            f"seeded_keys: {keys} repeat in the table; name the key columns explicitly"
+        )
+    return keys
+
+
 def compare_seeded(
     old: pd.DataFrame, new: pd.DataFrame, keys: list[str], seed: str = "seed"
 ) -> RerunComparison:
@@ -86,7 +118,10 @@ def compare_seeded(
     numeric = [
         c
         for c in old.columns
-        if c not in keys and c in new.columns and pd.api.types.is_numeric_dtype(old[c])
+        if c not in keys
+        and c in new.columns
+        and pd.api.types.is_numeric_dtype(old[c])
+        and not pd.api.types.is_bool_dtype(old[c])  # a flag of the row, not a measurement
     ]
     group = [k for k in keys if k != seed]
     spread = old.groupby(group, dropna=False)[numeric].agg(lambda s: s.max() - s.min())
