@@ -83,3 +83,9 @@ def test_zero_grad_and_bad_settings():
     p.grad = torch.ones(3)
     with pytest.raises(ValueError, match="lr must be finite"):
         opt.step()
+
+
+def test_a_torch_without_the_fused_kernel_is_named(monkeypatch):
+    monkeypatch.delattr(torch, "_fused_adam_")
+    with pytest.raises(RuntimeError, match="no torch._fused_adam_"):
+        FusedAdam([{"params": [torch.zeros(1, requires_grad=True)], "lr": 0.1}])

@@ -29,10 +29,16 @@ class FusedAdam:
     Raises:
         ValueError: a group without params or lr, a negative or non-finite lr or eps, betas
             outside [0, 1), or a parameter that is not a floating-point leaf tensor.
+        RuntimeError: a torch without the fused kernel.
     """
 
     def __init__(self, groups, betas=(0.9, 0.999), eps: float = 1e-8):
         """Check the settings and keep the groups (arguments as the class's)."""
+        if not hasattr(torch, "_fused_adam_"):  # a private op: say so rather than fail mid-run
+            raise RuntimeError(
+                f"FusedAdam: this torch ({torch.__version__}) has no torch._fused_adam_; install "
+                "the pinned version (pyproject.toml)"
+            )
         b1, b2 = (float(b) for b in betas)
         if not (0.0 <= b1 < 1.0 and 0.0 <= b2 < 1.0):
             raise ValueError(f"FusedAdam: betas must lie in [0, 1); got {betas}")
