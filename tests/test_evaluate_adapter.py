@@ -93,7 +93,8 @@ def test_render_cache_never_leaks_across_frames_or_wind():
                 if p.ndim >= 1 and p.shape[0] in (n,):
                     continue
                 p.add_(0.05 * torch.randn_like(p))
-        fn = model_render_fn(model, obs)
+        seen: dict = {}
+        fn = model_render_fn(model, obs, means_seen=seen)
         for j, c in [(0, 0), (0, 1), (1, 1), (1, 0), (0, 0)]:
             got = fn(j, c, cam)[0]
             g = model.gaussians_at(j, torch.as_tensor(wind[c], dtype=torch.float32))
@@ -108,3 +109,8 @@ def test_render_cache_never_leaks_across_frames_or_wind():
             np.testing.assert_allclose(got, ref, atol=1e-6, err_msg=f"{name} frame {j} cond {c}")
         if name == "ours":  # the wind matters to ours, so the two conditions must differ
             assert np.abs(fn(1, 0, cam)[0] - fn(1, 1, cam)[0]).max() > 1e-4
+        # the training wind's deformations are kept for the tips, and handed back unchanged
+        assert sorted(seen) == [(0, 0), (1, 0)]
+        fresh, reuse = model_means_fn(model, obs), model_means_fn(model, obs, seen)
+        for j in (0, 1):
+            assert np.array_equal(reuse(j, 0), fresh(j, 0)) and reuse(j, 0) is seen[(j, 0)]

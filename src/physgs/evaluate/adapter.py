@@ -7,7 +7,7 @@ import numpy as np
 import torch
 
 
-def model_render_fn(model, observed, *, backend: str = "auto"):
+def model_render_fn(model, observed, *, backend: str = "auto", means_seen: dict | None = None):
     """render_fn(frame_idx, condition, camera) -> (rgb [H, W, 3] in [0, 1], alpha [H, W]) numpy.
 
     Runs without autograd; the last deformed frame is kept, so one deformation serves every camera
@@ -18,6 +18,10 @@ def model_render_fn(model, observed, *, backend: str = "auto"):
             ``defined(frame_idx, condition)``.
         observed (Observed): the dataset (its wind per condition and background colour).
         backend: the rasterizer backend (see [`rasterization`][physgs.render.rasterization]).
+        means_seen: if given, filled with ``(frame_idx, 0) -> means [N, 3]`` numpy (world
+            units) of every deformation made under the training wind (condition 0, what the tip
+            trajectories read; one condition keeps it to F x N x 3 floats), for
+            [`model_means_fn`][physgs.evaluate.adapter.model_means_fn] to reuse.
 
     Returns:
         (Callable): The callback, float64 arrays; it raises
@@ -42,6 +46,9 @@ def model_render_fn(model, observed, *, backend: str = "auto"):
         with torch.no_grad():
             if last.get("key") != key:
                 last["key"], last["g"] = key, model.gaussians_at(int(frame_idx), winds[condition])
+                if means_seen is not None and key[1] == 0:  # the training wind's, or any for
+                    # a model blind to the wind (the same deformation)
+                    means_seen[(int(frame_idx), 0)] = last["g"].means.cpu().numpy()
             g = last["g"]
             out = rasterization(
                 g.means,
@@ -62,12 +69,14 @@ def model_render_fn(model, observed, *, backend: str = "auto"):
     return render_fn
 
 
-def model_means_fn(model, observed):
+def model_means_fn(model, observed, seen: dict | None = None):
     """means_fn(frame_idx, condition) -> Gaussian means [N, 3] numpy (world units).
 
     Args:
         model (BaseModel): the trained model.
         observed (Observed): the dataset (its wind per condition).
+        seen: ``(frame_idx, condition) -> means`` already computed (a render_fn's
+            ``means_seen``), returned as they are instead of deforming again.
 
     Returns:
         (Callable): ``means_fn``; NaN means [N, 3] where the model makes no prediction.
@@ -75,6 +84,8 @@ def model_means_fn(model, observed):
     winds = [torch.as_tensor(w, dtype=torch.float32) for w in observed.wind]
 
     def means_fn(frame_idx: int, condition: int) -> np.ndarray:
+        if seen is not None and (int(frame_idx), int(condition)) in seen:
+            return seen[(int(frame_idx), int(condition))]
         if not model.defined(int(frame_idx), int(condition)):  # no prediction: NaN, not a path
             return np.full((model.canonical_state().means.shape[0], 3), np.nan, np.float32)
         with torch.no_grad():

@@ -154,9 +154,10 @@ def evaluate_checkpoint(
         FloatingPointError: when a split the model predicts scores non-finite (a corrupt
             checkpoint); nothing is written then.
     """
-    render_fn = model_render_fn(model, observed, backend=backend)
+    seen: dict = {}  # the evaluation's deformations under the training wind, for the tips
+    render_fn = model_render_fn(model, observed, backend=backend, means_seen=seen)
     res = evaluate(render_fn, observed, progress=progress)
-    traj = tip_trajectories(model_means_fn(model, observed), truth, observed, condition=0)
+    traj = tip_trajectories(model_means_fn(model, observed, seen), truth, observed, condition=0)
     panels = render_panels(render_fn, observed)
     summary = res.summary()
     undefined = undefined_splits(model, observed)  # NaN there is "not defined", not corruption
