@@ -19,8 +19,8 @@ from __future__ import annotations
 import numpy as np
 import torch
 
-from physgs.models.part_transform import transform_parts
 from physgs.models.gaussians import axis_angle_quat, quat_multiply, rodrigues_minus_identity
+from physgs.models.part_transform import transform_parts
 
 
 def depth_levels(parent) -> list[tuple[np.ndarray, np.ndarray]]:

@@ -16,6 +16,8 @@ from torch import nn
 # The one torch quaternion -> rotation matrix (zero-norm guarded), shared with the rasterizer.
 from physgs.render.project import quat_to_rotmat  # noqa: F401  (re-exported)
 
+from physgs.models.part_transform import transform_parts
+
 
 @dataclass(frozen=True)
 class GaussianState:
@@ -158,8 +160,6 @@ def rotate_parts(
     Returns:
         ``(means, quats)``: [N, 3] and [N, 4].
     """
-    from physgs.models.part_transform import transform_parts
-
     RmI = rodrigues_minus_identity(axis, angle)  # [K, 3, 3]
     q = axis_angle_quat(axis, angle)  # [K, 4]
     return transform_parts(means, quats, labels, RmI, pivot, torch.zeros_like(pivot), q)

@@ -22,6 +22,8 @@ import numba as nb
 import numpy as np
 import torch
 
+from physgs.numpy_bridge import float64_array, tensor_like
+
 
 @nb.njit(cache=True, inline="always")
 def _row4(a, i):  # pragma: no cover - compiled
@@ -92,16 +94,6 @@ def _backward(
             g_c[k, b] = -(M[k, 0, b] * g_t[k, 0] + M[k, 1, b] * g_t[k, 1] + M[k, 2, b] * g_t[k, 2])
 
 
-def _np64(x: torch.Tensor) -> np.ndarray:
-    return np.ascontiguousarray(x.detach().cpu().numpy(), dtype=np.float64)
-
-
-def _back(x: np.ndarray, like: torch.Tensor) -> torch.Tensor:
-    # cast in numpy (one thread, no torch op)
-    np_dtype = torch.empty((), dtype=like.dtype).numpy().dtype
-    return torch.from_numpy(np.ascontiguousarray(x, dtype=np_dtype)).to(like.device)
-
-
 class _PartTransform(torch.autograd.Function):
     @staticmethod
     def forward(ctx, means, quats, labels, M, c, t, Q):
@@ -110,7 +102,7 @@ class _PartTransform(torch.autograd.Function):
         lab = np.ascontiguousarray(labels.detach().cpu().numpy(), dtype=np.int64)
         out_m = np.empty(m.shape, m.dtype)
         out_q = np.empty(q.shape, q.dtype)
-        _forward(m, q, lab, *(_np64(x) for x in (M, c, t, Q)), out_m, out_q)
+        _forward(m, q, lab, *(float64_array(x) for x in (M, c, t, Q)), out_m, out_q)
         # saved as tensors: autograd then refuses a backward after an in-place edit of any
         ctx.save_for_backward(means, quats, labels, M, c, t, Q)
         return torch.from_numpy(out_m).to(means.device), torch.from_numpy(out_q).to(quats.device)
@@ -120,7 +112,7 @@ class _PartTransform(torch.autograd.Function):
         means, quats, labels, M, c, t, Q = ctx.saved_tensors
         m, q = means.detach().cpu().numpy(), quats.detach().cpu().numpy()
         lab = np.ascontiguousarray(labels.cpu().numpy(), dtype=np.int64)
-        M64, c64, Q64 = _np64(M), _np64(c), _np64(Q)
+        M64, c64, Q64 = float64_array(M), float64_array(c), float64_array(Q)
         g_nm = np.zeros(m.shape) if g_means is None else g_means.detach().cpu().numpy()  # [N, 3]
         g_nq = np.zeros(q.shape) if g_quats is None else g_quats.detach().cpu().numpy()
         K = M.shape[0]
@@ -135,11 +127,10 @@ class _PartTransform(torch.autograd.Function):
         _backward(
             m, q, lab, M64, c64, Q64, np.ascontiguousarray(g_nm), np.ascontiguousarray(g_nq), *out
         )
-        return (
-            *(_back(g, like) for g, like in zip(out[:2], (means, quats))),
-            None,
-            *(_back(g, like) for g, like in zip(out[2:], (M, c, t, Q))),
-        )
+        grads = [tensor_like(g, like) for g, like in zip(out, (means, quats, M, c, t, Q))]
+        grads.insert(2, None)  # labels
+        # None where no gradient is asked for (rotate_parts' zero translation, a fixed pivot)
+        return tuple(g if need else None for g, need in zip(grads, ctx.needs_input_grad))
 
 
 def _transform_parts_torch(means, quats, labels, M, c, t, Q):

@@ -12,20 +12,10 @@ import numpy as np
 import torch
 
 from physgs.camera import Camera
+from physgs.numpy_bridge import float64_array, tensor_like
 from physgs.render import kernels
 from physgs.render.constants import EPS2D, TILE
 from physgs.render.project import fov_clamp_limits
-
-
-def _np(x: torch.Tensor) -> np.ndarray:
-    # float64 whatever the input dtype: the kernels compute in float64 and compile only once.
-    return np.ascontiguousarray(x.detach().cpu().numpy(), dtype=np.float64)
-
-
-def _to_torch(x: np.ndarray, like: torch.Tensor) -> torch.Tensor:
-    # Cast in numpy (single-threaded) rather than torch: no OpenMP barrier for a tiny copy.
-    np_dtype = np.float32 if like.dtype == torch.float32 else np.float64
-    return torch.from_numpy(np.ascontiguousarray(x, dtype=np_dtype)).to(like.device)
 
 
 def camera_arrays(camera: Camera):
@@ -56,7 +46,9 @@ def _forward(means, quats, scales, opacities, colors, background, camera, with_d
     state) where state holds what the backward needs (float64 inputs, projection, tile lists,
     per-pixel totals); a forward-only caller drops it. Without depth the depth image is zeros
     and the backward takes no depth gradient."""
-    m, q, s, o, col, bg = (_np(x) for x in (means, quats, scales, opacities, colors, background))
+    m, q, s, o, col, bg = (
+        float64_array(x) for x in (means, quats, scales, opacities, colors, background)
+    )
     n, D = col.shape
     W, H = camera.width, camera.height
     cam = camera_arrays(camera)
@@ -116,7 +108,7 @@ class _FastRasterize(torch.autograd.Function):
             means, quats, scales, opacities, colors, background, camera, with_depth
         )
         ctx.like = torch.empty(0, dtype=means.dtype, device=means.device)
-        return tuple(_to_torch(x, means) for x in images)
+        return tuple(tensor_like(x, means) for x in images)
 
     @staticmethod
     def backward(ctx, g_rgb, g_alpha, g_depth):
@@ -157,7 +149,7 @@ class _FastRasterize(torch.autograd.Function):
         )
         g_bg = np.einsum("hwd,hw->d", g_rgb, t_final)
         out = (v_means, v_quats, v_scales, G[:, 5], G[:, kernels.N_GRAD :], g_bg)
-        return tuple(_to_torch(x, ctx.like) for x in out) + (None, None)
+        return tuple(tensor_like(x, ctx.like) for x in out) + (None, None)
 
 
 def work_count(means, quats, scales, opacities, colors, camera, background) -> dict[str, int]:
@@ -237,5 +229,5 @@ def rasterize_fast(
         rgb, alpha, depth = _FastRasterize.apply(*inputs, camera, return_depth)
     else:
         images, _ = _forward(*inputs, camera, return_depth)
-        rgb, alpha, depth = (_to_torch(x, means) for x in images)
+        rgb, alpha, depth = (tensor_like(x, means) for x in images)
     return rgb, alpha, (depth if return_depth else None)

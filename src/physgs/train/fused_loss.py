@@ -14,6 +14,8 @@ reference to ~1e-12 whatever the input dtype (the float32 torch form was off by 
 
 from __future__ import annotations
 
+import functools
+
 import numba as nb
 import numpy as np
 import torch
@@ -23,8 +25,10 @@ SSIM_C1 = 0.01**2
 SSIM_C2 = 0.03**2
 
 
+@functools.lru_cache(maxsize=8)
 def gauss_window(size: int, sigma: float) -> np.ndarray:
-    """Normalised 1D Gaussian window, the 2D SSIM window's separable factor.
+    """Normalised 1D Gaussian window, the 2D SSIM window's separable factor (cached: every
+    training iteration asks for it; read-only).
 
     Args:
         size: window length, px (odd).
@@ -35,7 +39,9 @@ def gauss_window(size: int, sigma: float) -> np.ndarray:
     """
     x = np.arange(size, dtype=np.float64) - (size - 1) / 2
     g = np.exp(-(x**2) / (2 * sigma**2))
-    return g / g.sum()
+    g /= g.sum()
+    g.flags.writeable = False
+    return g
 
 
 @nb.njit(cache=True)

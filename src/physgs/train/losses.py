@@ -23,7 +23,7 @@ BLUR_TILE = 32
 def _gauss_1d(size: int, sigma: float, dtype) -> torch.Tensor:
     """Normalised 1D Gaussian window [size] (sums to 1); the 2D window is its outer product (the
     fused pass's window, one definition)."""
-    return torch.as_tensor(gauss_window(size, sigma), dtype=dtype)
+    return torch.tensor(gauss_window(size, sigma), dtype=dtype)  # a copy: the window is read-only
 
 
 @functools.lru_cache(maxsize=16)
