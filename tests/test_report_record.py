@@ -296,3 +296,45 @@ def test_no_page_types_a_result_table():
             if any(RESULT_CELL.search(c) for c in cells):
                 found.append(f"docs/{page.name}:{n}: {line[:90]}")
     assert not found, "result tables typed by hand (the record shows results):\n" + "\n".join(found)
+
+
+def test_a_new_record_says_what_moved_against_the_one_it_replaces(tmp_path):
+    r, fit, claims = _run(tmp_path)
+    out = tmp_path / "record"
+    _record(r, out)
+    assert "No earlier record" in (out / "rerun.md").read_text()
+    # a rerun at another commit: one verdict and one table cell move, beyond the seed spread
+    claims.loc[2, ["measured", "ci_low", "ci_high", "verdict"]] = [3.1, 2.6, 3.6, "holds"]
+    claims.to_csv(r / "claims.csv", index=False)
+    fit.loc[0, "ceiling_frac"] = 0.5
+    fit.to_csv(r / "tables" / "tab_fit.csv", index=False)
+    stamp = record.Stamp(**{**json.loads((out / "stamp.json").read_text()), "commit": "def5678"})
+    record.write_record(
+        out,
+        stamp=stamp,
+        summary_md=r / "summary.md",
+        claims_csv=r / "claims.csv",
+        claims_md=r / "claims.md",
+        tables=sorted((r / "tables").glob("*.csv")),
+        figures=[],
+    )
+    text = (out / "rerun.md").read_text()
+    assert "commit `abc1234`" in text and "the same config hash" in text
+    assert "3 of 4 claims in both runs keep their verdict, 1 changed" in text
+    assert "| fails, +1.27 [+0.56, +1.97] x | **holds**, +3.1 [+2.6, +3.6] x |" in text
+    head, body = _parse_md_table(text.split("**The seeded tables**")[1].split("\n\n")[1])
+    row = dict(zip(head, body[0]))
+    assert row["table"] == "`tab_fit`" and (row["identical"], row["beyond it"]) == ("1", "1")
+    assert "`ceiling_frac` | 0.1346 | 0.5 |" in text
+    assert '--8<-- "docs/record/rerun.md"' in (out / "index.md").read_text()
+    # the same run recorded again (say, with Snakemake's report) keeps its comparison
+    record.write_record(
+        out,
+        stamp=stamp,
+        summary_md=r / "summary.md",
+        claims_csv=r / "claims.csv",
+        claims_md=r / "claims.md",
+        tables=sorted((r / "tables").glob("*.csv")),
+        figures=[],
+    )
+    assert (out / "rerun.md").read_text() == text

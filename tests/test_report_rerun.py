@@ -62,3 +62,67 @@ def test_flag_columns_are_not_compared():
     new = old.assign(reference=False)
     r = compare_seeded(old, new, ["seed", "tree"])
     assert r.cells == 12 and r.identical == 12 and not r.beyond
+
+
+def _ledger(verdicts, measured):
+    return pd.DataFrame(
+        {
+            "id": ["a/sparse", "b/sparse", "c/dense"][: len(verdicts)],
+            "claim": ["a holds", "b holds", "c holds"][: len(verdicts)],
+            "measured": measured,
+            "ci_low": [m - 1.0 for m in measured],
+            "ci_high": [m + 1.0 for m in measured],
+            "unit": ["dB"] * len(verdicts),
+            "threshold": ["> 0"] * len(verdicts),
+            "verdict": verdicts,
+        }
+    )
+
+
+def test_verdicts_compared_by_kind_with_both_intervals():
+    from physgs.report.rerun import compare_claims
+
+    old = _ledger(["holds", "undecided: one seed", "fails"], [2.0, 0.5, -3.0])
+    new = _ledger(
+        ["undecided: interval spans 0", "undecided: two seeds", "fails"], [0.5, 0.4, -2.0]
+    )
+    c = compare_claims(old, new)
+    assert c.same == 2 and [v.id for v in c.changed] == ["a/sparse"]  # reasons are not verdicts
+    v = c.changed[0]
+    assert (v.old, v.new) == ("holds", "undecided")
+    assert v.old_value == "+2 [+1, +3] dB" and v.new_value == "+0.5 [-0.5, +1.5] dB"
+    assert v.threshold == "> 0 dB"
+
+
+def test_claims_in_one_ledger_only_and_bad_ledgers():
+    from physgs.report.rerun import compare_claims
+
+    old = _ledger(["holds", "fails"], [1.0, -1.0])
+    new = _ledger(["holds", "fails", "holds"], [1.0, -1.0, 2.0]).iloc[[0, 2]]
+    c = compare_claims(old, new)
+    assert (c.same, c.changed, c.only_old, c.only_new) == (1, [], ["b/sparse"], ["c/dense"])
+    with pytest.raises(ValueError, match="repeats claim ids"):
+        compare_claims(pd.concat([old, old]), new)
+    with pytest.raises(ValueError, match="lacks column"):
+        compare_claims(old.drop(columns="verdict"), new)
+
+
+def test_timings_are_not_compared_and_named_tables_take_their_keys():
+    from physgs.report.rerun import TABLE_KEYS, table_keys
+
+    old = _old().assign(train_s=[1.0, 2.0, 3.0, 4.0, 5.0, 6.0])
+    new = old.assign(train_s=old["train_s"] * 10)  # a slower machine: not a result
+    r = compare_seeded(old, new, ["seed", "tree"])
+    assert r.cells == 12 and r.identical == 12
+    t = pd.DataFrame(
+        {
+            "seed": [0, 0],
+            "split": ["v", "v"],
+            "tree": ["s", "s"],
+            "condition": [1, 2],
+            "x": [1.0, 2.0],
+        }
+    )
+    assert table_keys("tab_transfer", t) == list(TABLE_KEYS["tab_transfer"])
+    with pytest.raises(ValueError, match="repeat"):
+        table_keys("tab_other", t)

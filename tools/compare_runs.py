@@ -2,11 +2,13 @@
 
     python tools/compare_runs.py OLD.csv NEW.csv [--keys seed,tree,config,method] [--show 15]
     python tools/compare_runs.py OLD_TABLES_DIR NEW_TABLES_DIR      # every seeded CSV in both
-    python tools/compare_runs.py OLD/tab_transfer.csv NEW/tab_transfer.csv --keys seed,split,tree,condition
+    python tools/compare_runs.py OLD_RECORD/claims.csv NEW_RECORD/claims.csv   # verdict by verdict
 
 Prints how many numeric cells are identical, changed within the old run's spread over seeds of
 their row, or beyond it (those listed, largest first). The keys default to the seed and the
-table's non-numeric columns (`physgs.report.rerun.seeded_keys`). `physgs.report.rerun.compare_seeded`.
+table's non-numeric columns (`physgs.report.rerun.table_keys`: a table named in `TABLE_KEYS`
+takes its keys from there). Two ledgers (`claims.csv`) are compared verdict by verdict
+(`physgs.report.rerun.compare_claims`). Job timings are never compared.
 """
 
 from __future__ import annotations
@@ -16,12 +18,12 @@ from pathlib import Path
 
 import pandas as pd
 
-from physgs.report.rerun import compare_seeded, seeded_keys
+from physgs.report.rerun import compare_claims, compare_seeded, table_keys
 
 
 def report(old: Path, new: Path, keys: str, show: int) -> None:
     a, b = pd.read_csv(old), pd.read_csv(new)
-    r = compare_seeded(a, b, seeded_keys(a) if keys == "auto" else keys.split(","))
+    r = compare_seeded(a, b, table_keys(old.stem, a) if keys == "auto" else keys.split(","))
     print(
         f"{new.name}: {r.rows} rows matched ({len(r.only_old)} only in old, {len(r.only_new)} "
         f"only in new); {r.cells} numeric cells: {r.identical} identical, {r.within} changed "
@@ -39,6 +41,19 @@ def main() -> None:
     ap.add_argument("--keys", default="auto", help="comma-separated key columns, or auto")
     ap.add_argument("--show", type=int, default=15, help="beyond-spread cells to list")
     args = ap.parse_args()
+    if not args.old.is_dir() and "seed" not in pd.read_csv(args.old, nrows=0).columns:
+        if "verdict" not in pd.read_csv(args.old, nrows=0).columns:
+            ap.error(f"{args.old}: neither a seeded table nor a claims ledger")
+        c = compare_claims(pd.read_csv(args.old), pd.read_csv(args.new))
+        print(
+            f"ledger: {c.same} verdicts the same, {len(c.changed)} changed; "
+            f"{len(c.only_new)} claims only in new, {len(c.only_old)} only in old"
+        )
+        for v in c.changed:
+            print(
+                f"  {v.id}: {v.old} {v.old_value} -> {v.new} {v.new_value} (threshold {v.threshold})"
+            )
+        return
     if not args.old.is_dir():
         report(args.old, args.new, args.keys, args.show)
         return

@@ -26,6 +26,8 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 
+from physgs.report import rerun
+
 #: The claim families that carry the paper's story, in the order the README tells it, each with
 #: the words a reader needs. A family is the claim id before its first ``/``.
 HEADLINE: tuple[tuple[str, str], ...] = (
@@ -55,6 +57,8 @@ COMMANDS: tuple[tuple[str, str], ...] = (
 )
 #: Widest figure in the record, px: the documentation's content column.
 FIGURE_WIDTH_PX = 1200
+#: Cells moved beyond their row's seed spread that the record lists, largest first.
+RERUN_CELLS_SHOWN = 10
 COSTS_COLUMNS = ("name", "command", "wall_s", "date", "commit", "cpu", "from_nothing", "segments")
 BEGIN, END = "<!-- record:begin -->", "<!-- record:end -->"
 
@@ -178,6 +182,122 @@ def _png_for_web(src: Path, dst: Path) -> None:
         im.save(dst, optimize=True)
 
 
+def _same_run(a: Mapping, b: Mapping) -> bool:
+    """Two stamps of one run (its record rewritten, say to add the Snakemake report)."""
+
+    def plain(v):  # a stamp read from JSON holds lists where the dataclass holds tuples
+        return list(v) if isinstance(v, (list, tuple)) else v
+
+    keys = ("commit", "config_hash", "profile", "seeds", "trees")
+    return all(plain(a.get(k)) == plain(b.get(k)) for k in keys)
+
+
+def rerun_lines(
+    previous: str | Path, stamp: Stamp, claims_csv: str | Path, tables: Sequence[str | Path]
+) -> list[str]:
+    """The record's "Against the previous record" section: this run's ledger verdict by verdict
+    and its seeded tables cell by cell against the record it replaces
+    ([`physgs.report.rerun`][physgs.report.rerun]).
+
+    A change that only reorders floating-point work moves every training's trajectory; this says
+    which verdicts and how many numbers moved, and whether beyond the seeds' own spread.
+
+    Args:
+        previous: the record folder being replaced (``stamp.json``, ``claims.csv``,
+            ``tables/*.csv``).
+        stamp: this run's stamp.
+        claims_csv: this run's ledger.
+        tables: this run's table CSVs.
+
+    Returns:
+        The section's Markdown lines (heading included); a line saying there is nothing to
+            compare with when ``previous`` holds no record.
+    """
+    prev = Path(previous)
+    head = ["## Against the previous record", ""]
+    if not ((prev / "stamp.json").is_file() and (prev / "claims.csv").is_file()):
+        return [*head, "No earlier record to compare with.", ""]
+    old = json.loads((prev / "stamp.json").read_text())
+    settings = (
+        "the same config hash"
+        if old.get("config_hash") == stamp.config_hash
+        else f"config hash `{old.get('config_hash')}`: the comparison spans a change of settings"
+    )
+    lines = [
+        *head,
+        f"This run (commit `{stamp.commit}`) against the record it replaced: commit "
+        f"`{old.get('commit')}`, written {old.get('date')}, {settings}. What changed between the "
+        "two commits is in `CHANGELOG.md`; `python tools/compare_runs.py OLD NEW` repeats the "
+        "tables' comparison for any two runs.",
+        "",
+    ]
+    text = {"config_hash": str}
+    c = rerun.compare_claims(
+        pd.read_csv(prev / "claims.csv", dtype=text), pd.read_csv(claims_csv, dtype=text)
+    )
+    total = c.same + len(c.changed)
+    lines.append(
+        f"**The ledger**: {c.same} of {total} claims in both runs keep their verdict"
+        + (f", {len(c.changed)} changed:" if c.changed else ".")
+    )
+    if c.only_new or c.only_old:
+        lines[-1] += (
+            f" ({len(c.only_new)} claims new in this run, {len(c.only_old)} no longer asked.)"
+        )
+    lines.append("")
+    if c.changed:
+        lines += ["| claim | before | after | threshold |", "|---|---|---|---|"]
+        lines += [
+            f"| `{v.id}`: {_cell(v.claim)} | {v.old}, {v.old_value} | **{v.new}**, {v.new_value}"
+            f" | {_cell(v.threshold)} |"
+            for v in c.changed
+        ]
+        lines.append("")
+    rows = [
+        "| table | rows in both | numeric cells | identical | within the seed spread | beyond it |",
+        "|---|---:|---:|---:|---:|---:|",
+    ]
+    moved: list[tuple[str, rerun.CellChange]] = []
+    for t in sorted(Path(p) for p in tables):
+        before = prev / "tables" / t.name
+        if not before.is_file():
+            continue
+        a, b = pd.read_csv(before, dtype=text), pd.read_csv(t, dtype=text)
+        if "seed" not in a.columns or "seed" not in b.columns:
+            same = "identical" if a.equals(b) else "changed"
+            rows.append(f"| `{t.stem}` (not seeded) | {len(b)} | | {same} | | |")
+            continue
+        r = rerun.compare_seeded(a, b, rerun.table_keys(t.stem, a))
+        rows.append(
+            f"| `{t.stem}` | {r.rows} | {r.cells} | {r.identical} | {r.within} | {len(r.beyond)} |"
+        )
+        moved += [(t.stem, ch) for ch in r.beyond]
+    lines += [
+        "**The seeded tables**, each numeric cell beside the previous run's spread (max - min) "
+        "over seeds of its row; job timings are left out:",
+        "",
+        *rows,
+        "",
+    ]
+    if moved:
+        moved.sort(key=lambda m: rerun.spreads_moved(m[1]), reverse=True)
+        lines += [
+            f"The largest moves beyond the spread ({min(len(moved), RERUN_CELLS_SHOWN)} of "
+            f"{len(moved)}):",
+            "",
+            "| table | row | column | before | after | seed spread |",
+            "|---|---|---|---:|---:|---:|",
+        ]
+        for name, ch in moved[:RERUN_CELLS_SHOWN]:
+            key = ", ".join(f"{k} {v}" for k, v in ch.key.items())
+            lines.append(
+                f"| `{name}` | {_cell(key)} | `{ch.column}` | {_cell(ch.old)} | {_cell(ch.new)} | "
+                f"{_cell(ch.spread)} |"
+            )
+        lines.append("")
+    return lines
+
+
 def write_record(
     out_dir: str | Path,
     *,
@@ -215,6 +335,16 @@ def write_record(
             raise FileNotFoundError(f"{p}: missing; finish the run first (snakemake --cores 2 all)")
     final = Path(out_dir)
     kept = (final / "costs.csv").read_bytes() if (final / "costs.csv").is_file() else None
+    # against the record this one replaces; the same run recorded again keeps its comparison
+    old_stamp = final / "stamp.json"
+    if (
+        old_stamp.is_file()
+        and (final / "rerun.md").is_file()
+        and _same_run(json.loads(old_stamp.read_text()), asdict(stamp))
+    ):
+        against = (final / "rerun.md").read_text()
+    else:
+        against = "\n".join(rerun_lines(final, stamp, claims_csv, tables))
     out = final.with_name(final.name + ".partial")  # the old record stands until this is whole
     if out.exists():
         shutil.rmtree(out)
@@ -231,6 +361,7 @@ def write_record(
         costs.write_bytes(kept)
         written.append(costs)
     put("stamp.json", json.dumps(asdict(stamp), indent=2) + "\n")
+    put("rerun.md", against)
     put("stamp.md", stamp.markdown())
     put("summary.md", demote(Path(summary_md).read_text()))
     put("claims.md", demote(Path(claims_md).read_text()))
@@ -279,6 +410,8 @@ def write_record(
                 "## Figures",
                 "",
                 '--8<-- "docs/record/figures.md"',
+                "",
+                '--8<-- "docs/record/rerun.md"',
                 "",
             ]
         ),

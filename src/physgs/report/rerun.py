@@ -1,4 +1,5 @@
-"""Two runs of one seeded table, cell by cell: did a change move a number beyond seed noise?
+"""Two runs compared: each seeded table cell by cell, and the claims ledger verdict by verdict.
+Did a change move a number beyond seed noise, or a verdict?
 
 A change that only reorders floating-point work (a fused kernel, another summation order) still
 moves a training's trajectory, and with it every number downstream; the question a reader asks
@@ -58,6 +59,12 @@ class RerunComparison:
 
 #: Columns that describe the run, not a row: never keys.
 PROVENANCE_COLUMNS = ("profile", "config_hash", "physgs_version")
+#: Columns that time a job (seconds, or a ratio of seconds): what the machine did, not what the
+#: method found; a rerun on a busier core moves them. Never compared.
+TIMING_COLUMNS = ("train_s", "select_s", "cost_x", "fit_s", "ours_train_s")
+#: Seeded tables whose non-numeric columns do not identify a row (a numeric column is part of
+#: the key): table name (the CSV's stem) -> its key columns, seed first.
+TABLE_KEYS: dict[str, tuple[str, ...]] = {"tab_transfer": ("seed", "split", "tree", "condition")}
 
 
 def seeded_keys(table: pd.DataFrame, seed: str = "seed") -> list[str]:
@@ -86,6 +93,20 @@ def seeded_keys(table: pd.DataFrame, seed: str = "seed") -> list[str]:
             f"seeded_keys: {keys} repeat in the table; name the key columns explicitly"
         )
     return keys
+
+
+def table_keys(name: str, table: pd.DataFrame) -> list[str]:
+    """The key columns of the seeded table ``name``: its entry in ``TABLE_KEYS``, else
+    [`seeded_keys`][physgs.report.rerun.seeded_keys].
+
+    Args:
+        name: the table's name (``tab_transfer``; the CSV's stem).
+        table: the table.
+
+    Returns:
+        The key columns, seed first.
+    """
+    return list(TABLE_KEYS[name]) if name in TABLE_KEYS else seeded_keys(table)
 
 
 def compare_seeded(
@@ -119,6 +140,7 @@ def compare_seeded(
         c
         for c in old.columns
         if c not in keys
+        and c not in TIMING_COLUMNS
         and c in new.columns
         and pd.api.types.is_numeric_dtype(old[c])
         and not pd.api.types.is_bool_dtype(old[c])  # a flag of the row, not a measurement
@@ -144,11 +166,128 @@ def compare_seeded(
                 within += 1
             else:
                 beyond.append(CellChange({k: row[k] for k in keys}, c, a, b, sp))
-    beyond.sort(key=_excess, reverse=True)
+    beyond.sort(key=spreads_moved, reverse=True)
     return RerunComparison(len(both), only_old, only_new, cells, identical, within, beyond)
 
 
-def _excess(ch: CellChange) -> float:
-    """How many seed spreads a cell moved (inf for a zero or undefined spread, or a NaN)."""
+def spreads_moved(ch: CellChange) -> float:
+    """How many of its row's seed spreads a cell moved.
+
+    Args:
+        ch: the cell's change.
+
+    Returns:
+        abs(new - old) / spread; inf for a zero or undefined spread, or a NaN in one run.
+    """
     r = abs(ch.new - ch.old) / ch.spread if ch.spread > 0 else float("inf")
     return r if r == r else float("inf")
+
+
+@dataclass(frozen=True)
+class VerdictChange:
+    """A claim of the ledger whose verdict differs between two runs.
+
+    Attributes:
+        id: the claim's id.
+        claim: the claim in words.
+        old: its verdict in the old run (holds, fails or undecided).
+        new: its verdict in the new run.
+        old_value: the old run's measurement with its interval, in words.
+        new_value: the new run's, in words.
+        threshold: the claim's threshold, in words.
+    """
+
+    id: str
+    claim: str
+    old: str
+    new: str
+    old_value: str
+    new_value: str
+    threshold: str
+
+
+@dataclass(frozen=True)
+class ClaimsComparison:
+    """Two runs' claims ledgers, verdict by verdict (see
+    [`compare_claims`][physgs.report.rerun.compare_claims]).
+
+    Attributes:
+        same: claims in both ledgers with the same verdict.
+        changed: the claims whose verdict changed, in the new ledger's order.
+        only_old: ids found only in the old ledger.
+        only_new: ids found only in the new ledger.
+    """
+
+    same: int
+    changed: list[VerdictChange]
+    only_old: list[str]
+    only_new: list[str]
+
+
+def verdict_kind(verdict: str) -> str:
+    """A verdict without its reason: ``undecided: one seed`` -> ``undecided``."""
+    return str(verdict).split(":")[0].strip()
+
+
+def _value(r: pd.Series) -> str:
+    """A claim's measurement and 95% interval in words (``--`` where not measured)."""
+    unit = r.get("unit")
+    unit = "" if pd.isna(unit) else f" {unit}"
+    if pd.isna(r["measured"]):
+        return "--"
+    if pd.isna(r.get("ci_low")) or pd.isna(r.get("ci_high")):
+        return f"{r['measured']:+.3g}{unit}"
+    return f"{r['measured']:+.3g} [{r['ci_low']:+.3g}, {r['ci_high']:+.3g}]{unit}"
+
+
+def compare_claims(old: pd.DataFrame, new: pd.DataFrame) -> ClaimsComparison:
+    """Compare two runs' claims ledgers (``claims.csv``) verdict by verdict.
+
+    A verdict is compared by its kind (holds, fails, undecided), not by the reason an undecided
+    one gives.
+
+    Args:
+        old: the earlier run's ledger (columns id, verdict, measured, ci_low, ci_high, unit,
+            threshold; claim optional).
+        new: the new run's ledger, same columns.
+
+    Returns:
+        The [`ClaimsComparison`][physgs.report.rerun.ClaimsComparison].
+
+    Raises:
+        ValueError: a ledger without an ``id`` or ``verdict`` column, or with an id repeated.
+    """
+    for name, df in (("old", old), ("new", new)):
+        missing = [c for c in ("id", "verdict", "measured") if c not in df.columns]
+        if missing:
+            raise ValueError(f"compare_claims: the {name} ledger lacks column(s) {missing}")
+        if df["id"].duplicated().any():
+            raise ValueError(f"compare_claims: the {name} ledger repeats claim ids")
+    before = {str(r["id"]): r for _, r in old.iterrows()}
+    same = 0
+    changed: list[VerdictChange] = []
+    for _, r in new.iterrows():
+        o = before.get(str(r["id"]))
+        if o is None:
+            continue
+        a, b = verdict_kind(o["verdict"]), verdict_kind(r["verdict"])
+        if a == b:
+            same += 1
+            continue
+        unit = "" if pd.isna(r.get("unit")) else f" {r.get('unit')}"
+        threshold = r.get("threshold")
+        changed.append(
+            VerdictChange(
+                id=str(r["id"]),
+                claim=str(r.get("claim", r["id"])),
+                old=a,
+                new=b,
+                old_value=_value(o),
+                new_value=_value(r),
+                threshold="--" if pd.isna(threshold) else f"{threshold}{unit}",
+            )
+        )
+    ids_new = set(new["id"].astype(str))
+    only_old = [i for i in old["id"].astype(str) if i not in ids_new]
+    only_new = [i for i in new["id"].astype(str) if i not in before]
+    return ClaimsComparison(same, changed, only_old, only_new)
