@@ -16,7 +16,9 @@ rule kselect:
         "results/benchmarks/kselect/{tree}/seed{seed}.tsv"
     conda:
         "../envs/physgs.yaml"
-    threads: 2
+    # one thread: a two-thread job on two cores starts only when both are free, which never
+    # happens while one-thread jobs are ready, so every selection waited for the run's end
+    threads: 1
     resources:
         mem_mb=4000,
         # minutes; about 1 s per iteration per candidate, generous for a cluster
