@@ -225,7 +225,14 @@ class ClaimsComparison:
 
 
 def verdict_kind(verdict: str) -> str:
-    """A verdict without its reason: ``undecided: one seed`` -> ``undecided``."""
+    """A verdict without its reason.
+
+    Args:
+        verdict: a ledger verdict (``undecided: one seed``).
+
+    Returns:
+        Its kind (``undecided``).
+    """
     return str(verdict).split(":")[0].strip()
 
 
