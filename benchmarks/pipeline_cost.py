@@ -11,6 +11,11 @@ targets from nothing would cost, from the same run's measured jobs (``snakemake 
 lists the plan; each planned job's benchmark file gives its seconds), scaled to wall time by the
 finished run's own ratio of wall time to job time (``--wall-s``): an estimate for a reader who
 wants one table (``--target results/tables/tab_null.tex``), not a measurement.
+
+The timeline (``--cores``, default 2; ``--bin-min``, default 10) says when the cores were busy:
+the jobs running at once in each stretch of the run (from the benchmark files' times), the
+stages that ran where fewer than ``--cores`` jobs did, and the core-minutes left unused while
+jobs ran (``physgs.experiments.cost.occupancy``).
 """
 
 from __future__ import annotations
@@ -20,6 +25,7 @@ import subprocess
 
 from physgs.experiments.cost import (
     extra_seed_wall_s,
+    occupancy,
     plan_cost,
     plan_jobs,
     read_costs,
@@ -37,6 +43,8 @@ def main() -> None:
     ap.add_argument("--benchmarks", default="results/benchmarks")
     ap.add_argument("--wall-s", type=float, default=None, help="the run's measured wall seconds")
     ap.add_argument("--target", nargs="+", default=None, help="Snakemake targets to cost")
+    ap.add_argument("--cores", type=int, default=2, help="the cores the run had")
+    ap.add_argument("--bin-min", type=float, default=10.0, help="timeline bin, minutes")
     args = ap.parse_args()
     jobs = read_costs(args.benchmarks)
     if args.target:
@@ -74,12 +82,29 @@ def main() -> None:
         "(CPU and peak RSS are Snakemake's samples, taken every 30 s after a job's first 15 s: "
         "lower bounds that miss up to a job's last 30 s; wall s is exact)"
     )
+    timeline(jobs, args.cores, args.bin_min * 60)
     if args.wall_s:
         extra = extra_seed_wall_s(summary, run_wall_s=args.wall_s)
         print(
             f"run wall time {_min(args.wall_s).strip()} min = {args.wall_s / summary['total_s']:.2f} x "
             f"job time; one more seed adds ~{_min(extra).strip()} min of wall time"
         )
+
+
+def timeline(jobs, cores: int, bin_s: float) -> None:
+    """Print the jobs running at once per bin, and what ran where the cores were not full."""
+    occ = occupancy(jobs, cores, bin_s)
+    print(f"\ntimeline: jobs running at once per {bin_s / 60:g} min (of {cores} cores)")
+    for k, (b, stages) in enumerate(zip(occ.busy, occ.running)):
+        ran = ""
+        if b < cores - 0.05:  # name what ran where a core sat idle
+            top = sorted(stages.items(), key=lambda kv: -kv[1])[:4]
+            ran = "  " + ", ".join(f"{st} {v / 60:.1f}" for st, v in top)
+        print(f"{k * bin_s / 60:7.0f} min {b:5.2f}{ran}")
+    print(
+        f"idle while jobs ran: {occ.idle_core_s / 60:.1f} core-min; no benchmarked job running: "
+        f"{occ.paused_s / 60:.1f} min (a pause between segments, or light jobs only)"
+    )
 
 
 def target_cost(targets, jobs, benchmarks, wall_s, run_job_s) -> None:

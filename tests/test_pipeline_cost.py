@@ -163,3 +163,31 @@ def test_a_plan_costs_the_measured_seconds_of_its_jobs(bench):
     assert cost["by_rule"] == {"testbed_dataset": (1, 50.0), "train": (1, 100.0)}
     assert cost["unmeasured"] == {"train": 1}  # the dense training did not run
     assert cost["light"] == {"recovery": 1, "table": 1}
+
+
+def _timed(root, rel, s, end):
+    """A benchmark file of a job of ``s`` seconds that ended at ``end`` (epoch seconds)."""
+    import os
+
+    _write(root, rel, s)
+    os.utime(root / rel, (end, end))
+
+
+def test_occupancy_places_each_job_in_time_and_counts_idle_cores(tmp_path):
+    from physgs.experiments.cost import occupancy
+
+    t = 1_000_000.0
+    # core A: train 0-100 s, then evaluate 100-150; core B: train 0-60, then nothing until a
+    # tracks job 200-260 (60-100 one core idle, 150-200 no job at all, 200-260 one idle)
+    _timed(tmp_path, "train/sparse/seed0/a.tsv", 100.0, t + 100)
+    _timed(tmp_path, "evaluate/sparse/seed0/a.tsv", 50.0, t + 150)
+    _timed(tmp_path, "train/sparse/seed0/b.tsv", 60.0, t + 60)
+    _timed(tmp_path, "tracks/sparse/seed0/c.tsv", 60.0, t + 260)
+    occ = occupancy(read_costs(tmp_path), cores=2, bin_s=100.0)
+    assert occ.busy == pytest.approx([1.6, 0.5, 1.0])  # (100 + 60) / 100, 50 / 100, 60 / 60
+    assert occ.running[0] == pytest.approx({"train": 160.0})
+    assert occ.running[1] == pytest.approx({"evaluate": 50.0})
+    assert occ.idle_core_s == pytest.approx(40.0 + 50.0 + 60.0)  # 60-100, 100-150, 200-260
+    assert occ.paused_s == pytest.approx(50.0)
+    with pytest.raises(ValueError, match="cores >= 1"):
+        occupancy(read_costs(tmp_path), cores=0)

@@ -202,6 +202,81 @@ def wall_spans(jobs: list[JobCost]) -> dict:
     return {"run_s": span(jobs), "by_stage": {k: span(v) for k, v in sorted(stages.items())}}
 
 
+@dataclass(frozen=True)
+class Occupancy:
+    """How many jobs ran at once over a run (see [`occupancy`][physgs.experiments.cost.occupancy]).
+
+    Attributes:
+        bin_s: width of a bin, s.
+        busy: [B] mean number of jobs running in each bin, from the first job's start.
+        running: [B] the stages of the jobs running in each bin, with the job-seconds each
+            spent in it (stage -> s).
+        idle_core_s: core-seconds of ``cores`` left unused while at least one job ran.
+        paused_s: seconds with no job running (the run stopped, or Snakemake between jobs).
+    """
+
+    bin_s: float
+    busy: list[float]
+    running: list[dict[str, float]]
+    idle_core_s: float
+    paused_s: float
+
+
+def occupancy(jobs: list[JobCost], cores: int, bin_s: float = 600.0) -> Occupancy:
+    """When the run's cores were busy: jobs running at once, per bin of time, and the core-time
+    left unused while jobs ran (a run packs its jobs well when ``busy`` stays at ``cores``; a
+    stretch below it says which stages ran alone, usually a tail of jobs that depend on each
+    other or a job that needs more cores than are free).
+
+    Each job ran from ``end - wall_s`` to ``end`` (its benchmark file's time) and counts as one
+    core: every rule of the workflow runs on one thread (a job of more threads, as the K
+    selection was before it ran on one, counts once). Light jobs without a benchmark file are
+    not seen: a stretch where only they ran reads as paused.
+
+    Args:
+        jobs: the jobs, as [`read_costs`][physgs.experiments.cost.read_costs] reads them.
+        cores: the cores the run had.
+        bin_s: width of a bin, s.
+
+    Returns:
+        The [`Occupancy`][physgs.experiments.cost.Occupancy].
+
+    Raises:
+        ValueError: without jobs, for a job without an end time, or for cores or bin_s < 1.
+    """
+    if not jobs:
+        raise ValueError("no jobs: nothing to place in time")
+    if any(j.end != j.end for j in jobs):
+        raise ValueError("a job has no end time (read the jobs with read_costs)")
+    if cores < 1 or not bin_s >= 1:
+        raise ValueError(f"occupancy needs cores >= 1 and bin_s >= 1 s (got {cores}, {bin_s})")
+    t0 = min(j.end - j.wall_s for j in jobs)
+    span = max(j.end for j in jobs) - t0
+    n_bins = max(1, int(-(-span // bin_s)))
+    busy = [0.0] * n_bins
+    running: list[dict[str, float]] = [{} for _ in range(n_bins)]
+    edges = []  # (time, +1 / -1): the number running changes only at a job's start or end
+    for j in jobs:
+        a, b = j.end - j.wall_s - t0, j.end - t0
+        edges += [(a, 1), (b, -1)]
+        for k in range(int(a // bin_s), min(n_bins - 1, int(b // bin_s)) + 1):
+            overlap = min(b, (k + 1) * bin_s) - max(a, k * bin_s)
+            if overlap > 0:
+                busy[k] += overlap
+                running[k][j.stage] = running[k].get(j.stage, 0.0) + overlap
+    widths = [min(bin_s, span - k * bin_s) for k in range(n_bins)]
+    busy = [b / w if w > 0 else 0.0 for b, w in zip(busy, widths)]
+    idle = paused = 0.0
+    n, last = 0, 0.0
+    for t, d in sorted(edges, key=lambda e: (e[0], e[1])):
+        if n == 0:
+            paused += t - last
+        else:
+            idle += max(0, cores - n) * (t - last)
+        n, last = n + d, t
+    return Occupancy(bin_s, busy, running, idle, paused)
+
+
 def resources_by_stage(jobs: list[JobCost]) -> dict[str, dict]:
     """What each stage's jobs used, to size a cluster's requests from measurement: per stage
     {jobs, wall_mean_s, wall_max_s, cpu_mean_s, cpu_max_s, rss_max_mb} (NaN-free maxima and
