@@ -194,3 +194,21 @@ class Thing:
         "args_only lacks Returns:",
         "bare lacks Args:/Returns:",
     ]
+
+
+def test_every_rule_runs_on_one_thread():
+    """On two cores a job of two threads starts only when both are free, which never happens
+    while one-thread jobs are ready: it waits for the end of the run (the K selections did).
+    Every ``threads:`` of the workflow is therefore 1 (a cluster gives a rule more with
+    ``--set-threads``)."""
+    found = []
+    for smk in sorted((ROOT / "workflow" / "rules").glob("*.smk")) + [ROOT / "Snakefile"]:
+        for i, line in enumerate(smk.read_text().splitlines(), 1):
+            key, _, value = line.strip().partition(":")
+            if key == "threads":
+                found.append((f"{smk.name}:{i}", value.split("#")[0].strip()))
+    assert found, "no threads: directive found; the rules declare threads (docs/development.md)"
+    wider = [f"{where} threads: {v}" for where, v in found if v != "1"]
+    assert not wider, "rules with more than one thread wait for the end of a 2-core run:\n" + (
+        "\n".join(wider)
+    )
