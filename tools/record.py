@@ -10,8 +10,10 @@ rewrites the README's block between `<!-- record:begin -->` and `<!-- record:end
 `summary.md`, `claims.{csv,md}`, `tables/*.csv`, `figures/*.png`, `benchmarks/`). The wall time
 is the benchmark files' span unless `--wall-s` gives the measured one (`tools/timed.py` measures
 it). `--snakemake-report` also makes Snakemake's report of the run (`snakemake --report
-<results>/report.html all`) and puts it in the record, linked from its page. `--readme-only`
-rewrites the README's block from the record already there.
+<results>/report.html all`) and puts it in the record, linked from its page; `--report-html
+FILE` takes one already made (by `snakemake --report` in the folder the run ran in, whose
+`.snakemake/` holds the jobs' metadata). `--readme-only` rewrites the README's block from the
+record already there.
 """
 
 from __future__ import annotations
@@ -37,6 +39,7 @@ def main() -> None:
     ap.add_argument("--commit", help="the commit the run was made at (default: git describe)")
     ap.add_argument("--readme-only", action="store_true")
     ap.add_argument("--snakemake-report", action="store_true", help="add `snakemake --report`")
+    ap.add_argument("--report-html", type=Path, help="a `snakemake --report` of the run, made")
     args = ap.parse_args()
     if not args.readme_only:
         r = args.results
@@ -54,7 +57,7 @@ def main() -> None:
             wall_s=args.wall_s if args.wall_s is not None else wall_spans(jobs)["run_s"],
             job_min_by_stage={k: sum(v.values()) / 60 for k, v in sorted(by_stage.items())},
         )
-        report = None
+        report = args.report_html
         if args.snakemake_report:
             report = r / "report.html"
             subprocess.run(["snakemake", "--report", str(report), "all"], check=True)
