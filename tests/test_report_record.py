@@ -75,11 +75,11 @@ def _stamp():
     )
 
 
-def _record(r, out, tables=None, figures=None, summary=None, **kw):
+def _record(r, out, tables=None, figures=None, summary=None, stamp=None, **kw):
     """write_record over the run ``r`` (every table and figure unless given)."""
     return record.write_record(
         out,
-        stamp=_stamp(),
+        stamp=stamp or _stamp(),
         summary_md=summary or r / "summary.md",
         claims_csv=r / "claims.csv",
         claims_md=r / "claims.md",
@@ -309,15 +309,7 @@ def test_a_new_record_says_what_moved_against_the_one_it_replaces(tmp_path):
     fit.loc[0, "ceiling_frac"] = 0.5
     fit.to_csv(r / "tables" / "tab_fit.csv", index=False)
     stamp = record.Stamp(**{**json.loads((out / "stamp.json").read_text()), "commit": "def5678"})
-    record.write_record(
-        out,
-        stamp=stamp,
-        summary_md=r / "summary.md",
-        claims_csv=r / "claims.csv",
-        claims_md=r / "claims.md",
-        tables=sorted((r / "tables").glob("*.csv")),
-        figures=[],
-    )
+    _record(r, out, figures=[], stamp=stamp)
     text = (out / "rerun.md").read_text()
     assert "commit `abc1234`" in text and "the same config hash" in text
     assert "3 of 4 claims in both runs keep their verdict, 1 changed" in text
@@ -328,13 +320,5 @@ def test_a_new_record_says_what_moved_against_the_one_it_replaces(tmp_path):
     assert "`ceiling_frac` | 0.1346 | 0.5 |" in text
     assert '--8<-- "docs/record/rerun.md"' in (out / "index.md").read_text()
     # the same run recorded again (say, with Snakemake's report) keeps its comparison
-    record.write_record(
-        out,
-        stamp=stamp,
-        summary_md=r / "summary.md",
-        claims_csv=r / "claims.csv",
-        claims_md=r / "claims.md",
-        tables=sorted((r / "tables").glob("*.csv")),
-        figures=[],
-    )
+    _record(r, out, figures=[], stamp=stamp)
     assert (out / "rerun.md").read_text() == text
