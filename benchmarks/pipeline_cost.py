@@ -100,7 +100,7 @@ def timeline(jobs, cores: int, bin_s: float) -> None:
         if b < cores - 0.05:  # name what ran where a core sat idle
             top = sorted(stages.items(), key=lambda kv: -kv[1])[:4]
             ran = "  " + ", ".join(f"{st} {v / 60:.1f}" for st, v in top)
-        print(f"{k * bin_s / 60:7.0f} min {b:5.2f}{ran}")
+        print(f"{k * bin_s / 60:7.{0 if bin_s >= 60 else 1}f} min {b:5.2f}{ran}")
     print(
         f"idle while jobs ran: {occ.idle_core_s / 60:.1f} core-min; no benchmarked job running: "
         f"{occ.paused_s / 60:.1f} min (a pause between segments, or light jobs only)"
