@@ -18,12 +18,14 @@ from pathlib import Path
 
 import pandas as pd
 
-from physgs.report.rerun import compare_claims, compare_seeded, table_keys
+from physgs.report.rerun import compare_claims, compare_seeded, compare_table_csv
 
 
 def report(old: Path, new: Path, keys: str, show: int) -> None:
-    a, b = pd.read_csv(old), pd.read_csv(new)
-    r = compare_seeded(a, b, table_keys(old.stem, a) if keys == "auto" else keys.split(","))
+    if keys == "auto":
+        r = compare_table_csv(old, new)
+    else:
+        r = compare_seeded(pd.read_csv(old), pd.read_csv(new), keys.split(","))
     print(
         f"{new.name}: {r.rows} rows matched ({len(r.only_old)} only in old, {len(r.only_new)} "
         f"only in new); {r.cells} numeric cells: {r.identical} identical, {r.within} changed "
@@ -41,8 +43,9 @@ def main() -> None:
     ap.add_argument("--keys", default="auto", help="comma-separated key columns, or auto")
     ap.add_argument("--show", type=int, default=15, help="beyond-spread cells to list")
     args = ap.parse_args()
-    if not args.old.is_dir() and "seed" not in pd.read_csv(args.old, nrows=0).columns:
-        if "verdict" not in pd.read_csv(args.old, nrows=0).columns:
+    columns = [] if args.old.is_dir() else list(pd.read_csv(args.old, nrows=0).columns)
+    if not args.old.is_dir() and "seed" not in columns:
+        if "verdict" not in columns:
             ap.error(f"{args.old}: neither a seeded table nor a claims ledger")
         c = compare_claims(pd.read_csv(args.old), pd.read_csv(args.new))
         print(

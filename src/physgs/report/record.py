@@ -267,7 +267,7 @@ def rerun_lines(
             same = "identical" if a.equals(b) else "changed"
             rows.append(f"| `{t.stem}` (not seeded) | {len(b)} | | {same} | | |")
             continue
-        r = rerun.compare_seeded(a, b, rerun.table_keys(t.stem, a))
+        r = rerun.compare_table_csv(before, t)
         rows.append(
             f"| `{t.stem}` | {r.rows} | {r.cells} | {r.identical} | {r.within} | {len(r.beyond)} |"
         )

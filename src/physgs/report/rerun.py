@@ -11,6 +11,7 @@ new run this module sets its change beside the old run's spread over seeds of th
 from __future__ import annotations
 
 from dataclasses import dataclass
+from pathlib import Path
 
 import pandas as pd
 
@@ -107,6 +108,22 @@ def table_keys(name: str, table: pd.DataFrame) -> list[str]:
         The key columns, seed first.
     """
     return list(TABLE_KEYS[name]) if name in TABLE_KEYS else seeded_keys(table)
+
+
+def compare_table_csv(old_csv, new_csv) -> RerunComparison:
+    """Compare two runs' CSVs of one seeded table, keyed by
+    [`table_keys`][physgs.report.rerun.table_keys] of its name.
+
+    Args:
+        old_csv (str | Path): the earlier run's table.
+        new_csv (str | Path): the rerun's table.
+
+    Returns:
+        The [`RerunComparison`][physgs.report.rerun.RerunComparison].
+    """
+    text = {"config_hash": str}  # a hash of digits stays text
+    a, b = pd.read_csv(old_csv, dtype=text), pd.read_csv(new_csv, dtype=text)
+    return compare_seeded(a, b, table_keys(Path(old_csv).stem, a))
 
 
 def compare_seeded(
