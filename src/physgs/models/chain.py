@@ -19,6 +19,7 @@ from __future__ import annotations
 import numpy as np
 import torch
 
+from physgs.models.chain_kernel import fused_chain_transforms, parent_of_levels
 from physgs.models.gaussians import axis_angle_quat, quat_multiply, rodrigues_minus_identity
 from physgs.models.part_transform import transform_parts
 
@@ -52,7 +53,9 @@ def chain_transforms(
 ) -> tuple[torch.Tensor, torch.Tensor, torch.Tensor]:
     """World transforms of chained parts at one instant.
 
-    Differentiable in axis, theta and pivot.
+    Differentiable in axis, theta and pivot: one numba pass each way on the CPU
+    ([`fused_chain_transforms`][physgs.models.chain_kernel.fused_chain_transforms], float64
+    inside), the same sums as torch ops, one depth at a time, on other devices.
 
     Args:
         axis: [K, 3] unit swing axes.
@@ -65,6 +68,14 @@ def chain_transforms(
         ``(E, u, q)``: E [K, 3, 3] = world rotation - I, u [K, 3] displacement of each part's
             pivot by its ancestors (world units), q [K, 4] world rotation quaternions (w, x, y, z).
     """
+    if axis.device.type == "cpu":
+        return fused_chain_transforms(axis, theta, pivot, parent_of_levels(levels, axis.shape[0]))
+    return _chain_transforms_torch(axis, theta, pivot, levels)
+
+
+def _chain_transforms_torch(axis, theta, pivot, levels):
+    """[`chain_transforms`][physgs.models.chain.chain_transforms] as torch ops with autograd
+    through each (other devices; the fused pass's reference in the tests)."""
     G = rodrigues_minus_identity(axis, theta)  # [K, 3, 3] own rotation - I
     qo = axis_angle_quat(axis, theta)  # [K, 4] own rotation
     E, u, q = G, torch.zeros_like(pivot), qo
