@@ -110,3 +110,13 @@ def test_bad_input_is_refused():
         fused_photometric_loss(a, b[:, :8])
     with pytest.raises(ValueError, match="must not require a gradient"):
         fused_photometric_loss(a, b.requires_grad_(True))
+
+
+def test_blur_refuses_scratch_without_its_padding():
+    # the blur's loops do not check bounds: a scratch plane without the window's padding must be
+    # refused, not written past its end
+    from physgs.train.fused_loss import _blur_plane
+
+    src = np.ones((8, 8))
+    with pytest.raises(ValueError, match="tmp must be"):
+        _blur_plane(src, gauss_window(11, 1.5), np.empty((8, 8)), np.empty((8, 8)))

@@ -55,6 +55,8 @@ def _blur_plane(src, g, tmp, dst):  # pragma: no cover - compiled
     H, W = src.shape
     n = g.shape[0]
     r = n // 2
+    if tmp.shape[0] < H or tmp.shape[1] != W + n - 1:  # the loops below do not check bounds
+        raise ValueError("_blur_plane: tmp must be [H, W + size - 1]")
     for i in range(H):
         t = tmp[i, r : r + W]
         t[:] = 0.0
