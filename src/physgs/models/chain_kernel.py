@@ -25,6 +25,7 @@ import numba as nb
 import numpy as np
 import torch
 
+from physgs.models.part_transform import hamilton, hamilton_vjp
 from physgs.numpy_bridge import float64_array, tensor_like
 
 
@@ -79,11 +80,8 @@ def _forward(axis, theta, pivot, parent, E, u, q):  # pragma: no cover - compile
                 + Eq[i, 1] * (pivot[p, 1] - pivot[a, 1])
                 + Eq[i, 2] * (pivot[p, 2] - pivot[a, 2])
             )
-        aw, ax, ay, az = q[a, 0], q[a, 1], q[a, 2], q[a, 3]
-        q[p, 0] = aw * ow - ax * ox - ay * oy - az * oz
-        q[p, 1] = aw * ox + ax * ow + ay * oz - az * oy
-        q[p, 2] = aw * oy - ax * oz + ay * ow + az * ox
-        q[p, 3] = aw * oz + ax * oy - ay * ox + az * ow
+        w, x, y, z = hamilton((q[a, 0], q[a, 1], q[a, 2], q[a, 3]), (ow, ox, oy, oz))
+        q[p, 0], q[p, 1], q[p, 2], q[p, 3] = w, x, y, z
 
 
 @nb.njit(cache=True)
@@ -125,16 +123,13 @@ def _backward(
                 gd = Eq[0, j] * gu[p, 0] + Eq[1, j] * gu[p, 1] + Eq[2, j] * gu[p, 2]
                 g_pivot[p, j] += gd
                 g_pivot[a, j] -= gd
-            # q_p = q_q * qo_p: bilinear; transpose its matrix in qo_p, then in q_q
-            aw, ax, ay, az = q[a, 0], q[a, 1], q[a, 2], q[a, 3]
-            gow = aw * hw + ax * hx + ay * hy + az * hz
-            gox = -ax * hw + aw * hx + az * hy - ay * hz
-            goy = -ay * hw - az * hx + aw * hy + ax * hz
-            goz = -az * hw + ay * hx - ax * hy + aw * hz
-            gq[a, 0] += ow * hw + ox * hx + oy * hy + oz * hz
-            gq[a, 1] += -ox * hw + ow * hx - oz * hy + oy * hz
-            gq[a, 2] += -oy * hw + oz * hx + ow * hy - ox * hz
-            gq[a, 3] += -oz * hw - oy * hx + ox * hy + ow * hz
+            # q_p = q_q * qo_p
+            gqa, go = hamilton_vjp(
+                (q[a, 0], q[a, 1], q[a, 2], q[a, 3]), (ow, ox, oy, oz), (hw, hx, hy, hz)
+            )
+            gow, gox, goy, goz = go
+            for i in range(4):
+                gq[a, i] += gqa[i]
         # G = s Kx + (1 - c) Kx Kx
         gt = 0.0
         for i in range(3):

@@ -31,6 +31,41 @@ def _row4(a, i):  # pragma: no cover - compiled
     return float(a[i, 0]), float(a[i, 1]), float(a[i, 2]), float(a[i, 3])
 
 
+@nb.njit(cache=True, inline="always")
+def hamilton(a, b):  # pragma: no cover - compiled
+    """The Hamilton product a * b of quaternions given as (w, x, y, z) tuples of floats."""
+    aw, ax, ay, az = a
+    bw, bx, by, bz = b
+    return (
+        aw * bw - ax * bx - ay * by - az * bz,
+        aw * bx + ax * bw + ay * bz - az * by,
+        aw * by - ax * bz + ay * bw + az * bx,
+        aw * bz + ax * by - ay * bx + az * bw,
+    )
+
+
+@nb.njit(cache=True, inline="always")
+def hamilton_vjp(a, b, h):  # pragma: no cover - compiled
+    """The gradients (w.r.t. a, w.r.t. b) of <h, a * b>: the product is bilinear, so each is
+    its matrix in the other factor, transposed, applied to h (all (w, x, y, z) tuples)."""
+    aw, ax, ay, az = a
+    bw, bx, by, bz = b
+    hw, hx, hy, hz = h
+    ga = (
+        bw * hw + bx * hx + by * hy + bz * hz,
+        -bx * hw + bw * hx - bz * hy + by * hz,
+        -by * hw + bz * hx + bw * hy - bx * hz,
+        -bz * hw - by * hx + bx * hy + bw * hz,
+    )
+    gb = (
+        aw * hw + ax * hx + ay * hy + az * hz,
+        -ax * hw + aw * hx + az * hy - ay * hz,
+        -ay * hw - az * hx + aw * hy + ax * hz,
+        -az * hw + ay * hx - ax * hy + aw * hz,
+    )
+    return ga, gb
+
+
 @nb.njit(cache=True)
 def _forward(means, quats, labels, M, c, t, Q, out_means, out_quats):  # pragma: no cover
     for i in range(means.shape[0]):
@@ -42,12 +77,8 @@ def _forward(means, quats, labels, M, c, t, Q, out_means, out_quats):  # pragma:
             out_means[i, a] = (
                 float(means[i, a]) + t[k, a] + (M[k, a, 0] * r0 + M[k, a, 1] * r1 + M[k, a, 2] * r2)
             )
-        aw, ax, ay, az = _row4(Q, k)
-        bw, bx, by, bz = _row4(quats, i)
-        out_quats[i, 0] = aw * bw - ax * bx - ay * by - az * bz
-        out_quats[i, 1] = aw * bx + ax * bw + ay * bz - az * by
-        out_quats[i, 2] = aw * by - ax * bz + ay * bw + az * bx
-        out_quats[i, 3] = aw * bz + ax * by - ay * bx + az * bw
+        w, x, y, z = hamilton(_row4(Q, k), _row4(quats, i))
+        out_quats[i, 0], out_quats[i, 1], out_quats[i, 2], out_quats[i, 3] = w, x, y, z
 
 
 @nb.njit(cache=True)
@@ -76,18 +107,10 @@ def _backward(
         g_t[k, 0] += g0
         g_t[k, 1] += g1
         g_t[k, 2] += g2
-        aw, ax, ay, az = _row4(Q, k)
-        bw, bx, by, bz = _row4(quats, i)
-        hw, hx, hy, hz = _row4(g_nq, i)
-        # the product is bilinear: transpose its matrix in b (for quats), then in a (for Q)
-        g_quats[i, 0] = aw * hw + ax * hx + ay * hy + az * hz
-        g_quats[i, 1] = -ax * hw + aw * hx + az * hy - ay * hz
-        g_quats[i, 2] = -ay * hw - az * hx + aw * hy + ax * hz
-        g_quats[i, 3] = -az * hw + ay * hx - ax * hy + aw * hz
-        g_Q[k, 0] += bw * hw + bx * hx + by * hy + bz * hz
-        g_Q[k, 1] += -bx * hw + bw * hx - bz * hy + by * hz
-        g_Q[k, 2] += -by * hw + bz * hx + bw * hy - bx * hz
-        g_Q[k, 3] += -bz * hw - by * hx + bx * hy + bw * hz
+        ga, gb = hamilton_vjp(_row4(Q, k), _row4(quats, i), _row4(g_nq, i))
+        for a in range(4):
+            g_quats[i, a] = gb[a]
+            g_Q[k, a] += ga[a]
     # c enters as means - c: its gradient is -M^T (the sum of g over the part)
     for k in range(M.shape[0]):
         for b in range(3):
