@@ -11,7 +11,8 @@ ancestors. Written as displacements, so that zero angles give exactly zero motio
     E_p = E_q + G_p + E_q G_p,   u_p = u_q + E_q (c_p - c_q),   q = parent(p), G_p = R_p - I,
 
 with E = G and u = 0 at the root. Parts must be numbered parents first (parent[p] < p), as
-[`physgs.models.topology`][] numbers them; one vectorised step per tree depth.
+[`physgs.models.topology`][] numbers them: on the CPU one pass over them in that order
+([`physgs.models.chain_kernel`][]), on other devices one vectorised step per tree depth.
 """
 
 from __future__ import annotations
