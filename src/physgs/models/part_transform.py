@@ -33,7 +33,15 @@ def _row4(a, i):  # pragma: no cover - compiled
 
 @nb.njit(cache=True, inline="always")
 def hamilton(a, b):  # pragma: no cover - compiled
-    """The Hamilton product a * b of quaternions given as (w, x, y, z) tuples of floats."""
+    """The Hamilton product a * b of two quaternions (rotation b first, then a).
+
+    Args:
+        a: (w, x, y, z) floats.
+        b: (w, x, y, z) floats.
+
+    Returns:
+        (tuple[float, float, float, float]): a * b as (w, x, y, z).
+    """
     aw, ax, ay, az = a
     bw, bx, by, bz = b
     return (
@@ -46,8 +54,17 @@ def hamilton(a, b):  # pragma: no cover - compiled
 
 @nb.njit(cache=True, inline="always")
 def hamilton_vjp(a, b, h):  # pragma: no cover - compiled
-    """The gradients (w.r.t. a, w.r.t. b) of <h, a * b>: the product is bilinear, so each is
-    its matrix in the other factor, transposed, applied to h (all (w, x, y, z) tuples)."""
+    """The gradients of <h, a * b> w.r.t. a and b: the product is bilinear, so each is its
+    matrix in the other factor, transposed, applied to h.
+
+    Args:
+        a: (w, x, y, z) floats, the left factor.
+        b: (w, x, y, z) floats, the right factor.
+        h: (w, x, y, z) floats, the gradient w.r.t. the product.
+
+    Returns:
+        (tuple[tuple, tuple]): (gradient w.r.t. a, gradient w.r.t. b), each (w, x, y, z).
+    """
     aw, ax, ay, az = a
     bw, bx, by, bz = b
     hw, hx, hy, hz = h
