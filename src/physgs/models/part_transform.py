@@ -36,8 +36,8 @@ def hamilton(a, b):  # pragma: no cover - compiled
     """The Hamilton product a * b of two quaternions (rotation b first, then a).
 
     Args:
-        a: (w, x, y, z) floats.
-        b: (w, x, y, z) floats.
+        a (tuple[float, float, float, float]): (w, x, y, z).
+        b (tuple[float, float, float, float]): (w, x, y, z).
 
     Returns:
         (tuple[float, float, float, float]): a * b as (w, x, y, z).
@@ -58,9 +58,9 @@ def hamilton_vjp(a, b, h):  # pragma: no cover - compiled
     matrix in the other factor, transposed, applied to h.
 
     Args:
-        a: (w, x, y, z) floats, the left factor.
-        b: (w, x, y, z) floats, the right factor.
-        h: (w, x, y, z) floats, the gradient w.r.t. the product.
+        a (tuple[float, float, float, float]): (w, x, y, z), the left factor.
+        b (tuple[float, float, float, float]): (w, x, y, z), the right factor.
+        h (tuple[float, float, float, float]): (w, x, y, z), the gradient w.r.t. the product.
 
     Returns:
         (tuple[tuple, tuple]): (gradient w.r.t. a, gradient w.r.t. b), each (w, x, y, z).
