@@ -18,14 +18,11 @@ from pathlib import Path
 
 import pandas as pd
 
-from physgs.report.rerun import compare_claims, compare_seeded, compare_table_csv
+from physgs.report.rerun import compare_claims, compare_table_csv
 
 
 def report(old: Path, new: Path, keys: str, show: int) -> None:
-    if keys == "auto":
-        r = compare_table_csv(old, new)
-    else:
-        r = compare_seeded(pd.read_csv(old), pd.read_csv(new), keys.split(","))
+    r = compare_table_csv(old, new, None if keys == "auto" else keys.split(","))
     print(
         f"{new.name}: {r.rows} rows matched ({len(r.only_old)} only in old, {len(r.only_new)} "
         f"only in new); {r.cells} numeric cells: {r.identical} identical, {r.within} changed "

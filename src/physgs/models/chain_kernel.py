@@ -96,7 +96,7 @@ def _backward(
     for p in range(axis.shape[0] - 1, -1, -1):  # children (p' > p) have passed theirs on
         G, Kx, KK, s, c = _own(axis, theta, p)
         h = 0.5 * theta[p]
-        ow, sh, ch = math.cos(h), math.sin(h), math.cos(h)
+        ow, sh = math.cos(h), math.sin(h)
         ox, oy, oz = sh * axis[p, 0], sh * axis[p, 1], sh * axis[p, 2]
         gEp = gE[p]
         hw, hx, hy, hz = gq[p, 0], gq[p, 1], gq[p, 2], gq[p, 3]
@@ -140,7 +140,7 @@ def _backward(
         g_axis[p, 1] += gK[0, 2] - gK[2, 0]
         g_axis[p, 2] += gK[1, 0] - gK[0, 1]
         # qo = (cos(theta / 2), sin(theta / 2) axis)
-        gt += 0.5 * (-sh * gow + ch * (axis[p, 0] * gox + axis[p, 1] * goy + axis[p, 2] * goz))
+        gt += 0.5 * (-sh * gow + ow * (axis[p, 0] * gox + axis[p, 1] * goy + axis[p, 2] * goz))
         g_axis[p, 0] += sh * gox
         g_axis[p, 1] += sh * goy
         g_axis[p, 2] += sh * goz

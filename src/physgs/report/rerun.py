@@ -110,20 +110,21 @@ def table_keys(name: str, table: pd.DataFrame) -> list[str]:
     return list(TABLE_KEYS[name]) if name in TABLE_KEYS else seeded_keys(table)
 
 
-def compare_table_csv(old_csv, new_csv) -> RerunComparison:
-    """Compare two runs' CSVs of one seeded table, keyed by
+def compare_table_csv(old_csv, new_csv, keys: list[str] | None = None) -> RerunComparison:
+    """Compare two runs' CSVs of one seeded table, keyed by ``keys`` or else by
     [`table_keys`][physgs.report.rerun.table_keys] of its name.
 
     Args:
         old_csv (str | Path): the earlier run's table.
         new_csv (str | Path): the rerun's table.
+        keys: the key columns; None for the table's own.
 
     Returns:
         The [`RerunComparison`][physgs.report.rerun.RerunComparison].
     """
     text = {"config_hash": str}  # a hash of digits stays text
     a, b = pd.read_csv(old_csv, dtype=text), pd.read_csv(new_csv, dtype=text)
-    return compare_seeded(a, b, table_keys(Path(old_csv).stem, a))
+    return compare_seeded(a, b, table_keys(Path(old_csv).stem, a) if keys is None else keys)
 
 
 def compare_seeded(
