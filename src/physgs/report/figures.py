@@ -37,6 +37,58 @@ COLORS = {
 }
 GOOD, BAD = "#1a9850", "#f46d43"  # green where ours is best, orange where a baseline beats it
 WINDOW, TAIL = "0.6", "tab:blue"
+#: The documentation's content column at a 1200-px browser window, px: a figure wider than it
+#: is shown at this width (MkDocs Material, measured in Chromium).
+PAGE_WIDTH_PX = 688
+#: The smallest text a reader can read on the page, px.
+MIN_TEXT_PX = 9.0
+#: A figure drawn this wide (inches) shows one point as one pixel on the page; fonts of
+#: ``FONT_PT`` points then read at ``FONT_PT`` px.
+PAGE_WIDTH_IN = PAGE_WIDTH_PX / 72
+FONT_PT = 9.0
+
+
+def text_px(fig) -> list[tuple[str, float]]:
+    """Every visible text of ``fig`` with its height on the page, px: its font size scaled by the
+    factor the page shows the figure at (its tight bounding box shrunk to ``PAGE_WIDTH_PX``).
+
+    Args:
+        fig (matplotlib.figure.Figure): a drawn figure (not yet closed).
+
+    Returns:
+        ``(text, px)`` per non-empty visible text (titles, labels, tick labels, legends).
+    """
+    fig.canvas.draw()
+    renderer = fig.canvas.get_renderer()
+    width_in = fig.get_tightbbox(renderer).width  # inches
+    scale = min(1.0, PAGE_WIDTH_PX / (width_in * 72))  # page px per point
+    out = []
+    for t in fig.findobj(matplotlib.text.Text):
+        if t.get_visible() and t.get_text().strip() and t.get_figure() is not None:
+            if t.get_window_extent(renderer).width > 0:
+                out.append((t.get_text(), t.get_fontsize() * scale))
+    return out
+
+
+def legends_over_data(fig) -> list[str]:
+    """The legends of ``fig`` that cover an axes' data area.
+
+    Args:
+        fig (matplotlib.figure.Figure): a drawn figure (not yet closed).
+
+    Returns:
+        One line per legend overlapping an axes (empty when every legend sits outside the data).
+    """
+    fig.canvas.draw()
+    renderer = fig.canvas.get_renderer()
+    legends = [a.get_legend() for a in fig.axes if a.get_legend() is not None] + list(fig.legends)
+    out = []
+    for lg in legends:
+        box = lg.get_window_extent(renderer)
+        for i, ax in enumerate(fig.axes):
+            if box.overlaps(ax.get_window_extent(renderer)):
+                out.append(f"legend {lg.get_texts()[0].get_text()!r}... covers axes {i}")
+    return out
 
 
 def save_figure(fig, outputs: Sequence[str | Path], dpi: int = 200) -> None:
@@ -125,8 +177,10 @@ def fig_temporal(
     Raises:
         KeyError: when a (tree, model) has no curve.
     """
+    from matplotlib.patches import Patch
+
     fig, axes = plt.subplots(
-        1, len(trees), figsize=(4.2 * len(trees), 3.2), squeeze=False, sharey=False
+        1, len(trees), figsize=(PAGE_WIDTH_IN, 3.4), squeeze=False, sharey=False
     )
     n_seeds = 1
     for ax, t in zip(axes[0], trees):
@@ -140,7 +194,7 @@ def fig_temporal(
                 x,
                 y,
                 color=COLORS.get(m),
-                lw=1.6 if spec_of(m).role == "prior" else 1.0,
+                lw=1.4 if spec_of(m).role == "prior" else 0.8,
                 ls="--" if m == "static" else "-",
                 label=label(m),
             )
@@ -151,17 +205,26 @@ def fig_temporal(
                 Y = np.atleast_2d(np.asarray(curves[(t, m)], dtype=np.float64))
                 ax.plot(x, Y.mean(0), color="k", lw=0.8, ls=":", label=label(m))
         ax.axvline(n_train + 0.5, color="k", lw=0.8, ls=":")
-        ax.axvspan(n_train + 0.5, len(y) + 0.5, color="0.92", zorder=0)
-        ax.set_title(t.capitalize())
-        ax.set_xlabel("frame")
+        ax.axvspan(n_train + 0.5, len(y) + 0.5, color="0.9", zorder=0)
+        ax.set_title(t.capitalize(), fontsize=FONT_PT + 1)
+        ax.set_xlabel("frame", fontsize=FONT_PT)
         ax.set_xlim(1, len(y))
-    axes[0, 0].set_ylabel("PSNR (dB)")
-    axes[0, -1].legend(fontsize=7, loc="lower left")
+        ax.tick_params(labelsize=FONT_PT)
+    axes[0, 0].set_ylabel("PSNR (dB)", fontsize=FONT_PT)
+    handles, labels_ = axes[0, 0].get_legend_handles_labels()
+    handles.append(Patch(color="0.9", label=f"beyond the training window (after frame {n_train})"))
     if n_seeds > 1:
-        fig.suptitle(
-            f"mean over {n_seeds} training seeds; bands: lowest to highest seed", fontsize=8
-        )
-    fig.tight_layout()
+        handles.append(Patch(color="0.5", alpha=0.3, label=f"lowest to highest of {n_seeds} seeds"))
+    fig.tight_layout(rect=(0, 0.2, 1, 1))
+    # below the panels, never over the data
+    fig.legend(
+        handles=handles,
+        loc="upper center",
+        bbox_to_anchor=(0.5, 0.16),
+        ncol=3,
+        fontsize=FONT_PT,
+        frameon=False,
+    )
     save_figure(fig, outputs)
 
 
@@ -270,8 +333,14 @@ def fig_results(
     Raises:
         KeyError: when a panel has no image.
     """
+    import textwrap
+
+    side = PAGE_WIDTH_IN / (len(columns) + 0.3)  # one panel, inches; the row labels beside
     fig, axes = plt.subplots(
-        len(rows), len(columns), figsize=(1.7 * len(columns), 1.8 * len(rows)), squeeze=False
+        len(rows),
+        len(columns),
+        figsize=(PAGE_WIDTH_IN, side * len(rows) + 0.5),
+        squeeze=False,
     )
     for i, r in enumerate(rows):
         scores = {c: images[(r, c)][1] for c in columns if images[(r, c)][1] is not None}
@@ -294,16 +363,18 @@ def fig_results(
                 ax.text(
                     0.03,
                     0.03,
-                    f"{score:.2f}",
+                    f"{score:.1f} dB",
                     transform=ax.transAxes,
-                    fontsize=7,
+                    fontsize=FONT_PT,
                     color=color,
-                    bbox=dict(facecolor="white", alpha=0.75, lw=0, pad=1),
+                    fontweight="bold" if color != "k" else "normal",
+                    bbox=dict(facecolor="white", alpha=0.8, lw=0, pad=1),
                 )
             if i == 0:
-                ax.set_title("Ground truth" if c == "gt" else label(c), fontsize=7)
+                name = "Ground truth" if c == "gt" else label(c)
+                ax.set_title(textwrap.fill(name, 12), fontsize=FONT_PT)
             if j == 0:
-                ax.set_ylabel(r, fontsize=7)
+                ax.set_ylabel(textwrap.fill(r, 14), fontsize=FONT_PT)
     fig.tight_layout(pad=0.3)
     save_figure(fig, outputs)
 
@@ -332,58 +403,93 @@ def fig_damping(
     Raises:
         KeyError: naming a ``(tree, config)`` (and model) without a result.
     """
-    fig, (a0, a1) = plt.subplots(1, 2, figsize=(10, 3.8))
+    from matplotlib.lines import Line2D
+    from matplotlib.patches import Patch
+
+    fig, (a0, a1) = plt.subplots(1, 2, figsize=(PAGE_WIDTH_IN, 3.6))
     tree_colors = dict(zip(trees, ["tab:green", "tab:blue", "tab:red", "tab:purple"]))
     markers = dict(zip(configs, ["o", "s", "^", "D"]))
-    pos, labels, allw = 0, [], []
-    for t in trees:
-        for c in configs:
-            for model, results in damping.items():
-                if (t, c) not in results:
+    models = list(damping)
+
+    def style(model, t):  # the first prior filled, the others hollow in the tree's colour
+        if model == models[0]:
+            return {"color": tree_colors[t]}
+        return {"facecolors": "none", "edgecolors": tree_colors[t]}
+
+    per_tree = len(configs) * len(models)
+    allw, centres = [], []
+    for i, t in enumerate(trees):
+        centres.append(i * (per_tree + 1) + (per_tree - 1) / 2)
+        for j, c in enumerate(configs):
+            for k, model in enumerate(models):
+                if (t, c) not in damping[model]:
                     who = "" if model == "ours" else f" of {model}"
                     raise KeyError(f"fig_damping: no damping result{who} for ({t}, {c})")
-                d = results[(t, c)]
-                jitter = np.random.default_rng(pos).uniform(-0.15, 0.15, len(d.zeta))  # display
-                a0.scatter(pos + jitter, d.zeta, s=6, color=tree_colors[t], alpha=0.5)
-                a0.plot([pos - 0.3, pos + 0.3], [d.median_zeta] * 2, color="k", lw=1.5)
-                tag = "" if model == "ours" else f" {spec_of(model).short.lower()}"
-                labels.append(f"{t} {c}{tag}")
-                pos += 1
-                a1.scatter(
-                    d.omega,
-                    d.gamma,
-                    s=8,
-                    marker=markers[c],
-                    alpha=0.6,
-                    # ours filled, the other priors hollow in the same colour
-                    **(
-                        {"color": tree_colors[t]}
-                        if model == "ours"
-                        else {"facecolors": "none", "edgecolors": tree_colors[t]}
-                    ),
-                    label=f"{t}, {c}{tag} (median $\\hat\\zeta$ {d.median_zeta:.3f})",
+                d = damping[model][(t, c)]
+                pos = i * (per_tree + 1) + j * len(models) + k  # a gap between trees
+                jitter = np.random.default_rng(pos).uniform(-0.2, 0.2, len(d.zeta))  # display
+                a0.scatter(
+                    pos + jitter, d.zeta, s=7, marker=markers[c], alpha=0.5, **style(model, t)
                 )
+                a0.plot([pos - 0.35, pos + 0.35], [d.median_zeta] * 2, color="k", lw=1.5)
+                a1.scatter(d.omega, d.gamma, s=9, marker=markers[c], alpha=0.6, **style(model, t))
                 allw.append(d.omega)
-    a0.axhline(zeta_true, color="k", ls="--", lw=0.8, label=f"truth $\\zeta$ = {zeta_true}")
-    a0.set_xticks(range(pos))
-    a0.set_xticklabels(labels, fontsize=7, rotation=40, ha="right")
-    a0.set_ylabel(r"$\hat\zeta_p$")
-    a0.set_title("damping ratio per part (bar: median)", fontsize=9)
-    a0.legend(fontsize=7)
+    a0.axhline(zeta_true, color="k", ls="--", lw=0.8)
+    a0.set_xticks(centres)
+    a0.set_xticklabels(trees, fontsize=FONT_PT)
+    a0.set_ylabel(r"$\hat\zeta_p$ (damping ratio, no unit)", fontsize=FONT_PT)
+    a0.set_title("damping ratio per part (bar: median)", fontsize=FONT_PT)
     w = np.concatenate(allw)
     grid = np.geomspace(w.min() * 0.9, w.max() * 1.1, 50)
-    a1.plot(grid, zeta_true * grid, "k--", lw=1, label=r"truth $\gamma = \zeta\omega$")
+    a1.plot(grid, zeta_true * grid, "k--", lw=1)
     a1.set_xscale("log")
     a1.set_yscale("log")
     for axis in (a1.xaxis, a1.yaxis):  # plain numbers: 10^x labels collide on a short log axis
         axis.set_major_locator(LogLocator(base=10, subs=(1.0, 2.0, 5.0)))
         axis.set_major_formatter(ScalarFormatter())
         axis.set_minor_formatter(NullFormatter())
-    a1.set_xlabel(r"$\hat\omega_p$ (rad/s)")
-    a1.set_ylabel(r"$\hat\gamma_p = \hat\zeta_p\hat\omega_p$ (1/s)")
-    a1.set_title("decay rate against natural frequency", fontsize=9)
-    a1.legend(fontsize=6, loc="upper left", bbox_to_anchor=(1.01, 1.0))
-    fig.tight_layout()
+    a1.set_xlabel(r"$\hat\omega_p$ (rad/s)", fontsize=FONT_PT)
+    a1.set_ylabel(r"$\hat\gamma_p = \hat\zeta_p\hat\omega_p$ (1/s)", fontsize=FONT_PT)
+    a1.set_title("decay rate against natural frequency", fontsize=FONT_PT)
+    for ax in (a0, a1):
+        ax.tick_params(labelsize=FONT_PT)
+    # one key for both panels, below them: colour = tree, marker = configuration, fill = prior
+    grey = "0.35"
+    handles = [Patch(color=tree_colors[t], label=t) for t in trees]
+    handles += [
+        Line2D([], [], ls="", marker=markers[c], color=grey, label=c, markersize=5) for c in configs
+    ]
+    handles += [
+        Line2D(
+            [],
+            [],
+            ls="",
+            marker="o",
+            markersize=5,
+            markerfacecolor=grey if m == models[0] else "none",
+            markeredgecolor=grey,
+            label=label(m) + (" (filled)" if m == models[0] else " (hollow)"),
+        )
+        for m in models
+    ]
+    handles.append(
+        Line2D(
+            [],
+            [],
+            color="k",
+            ls="--",
+            label=rf"truth $\zeta$ = {zeta_true} ($\gamma = \zeta\omega$)",
+        )
+    )
+    fig.tight_layout(rect=(0, 0.2, 1, 1))
+    fig.legend(
+        handles=handles,
+        loc="upper center",
+        bbox_to_anchor=(0.5, 0.15),
+        ncol=4,
+        fontsize=FONT_PT,
+        frameon=False,
+    )
     save_figure(fig, outputs)
 
 

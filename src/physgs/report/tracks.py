@@ -264,14 +264,13 @@ def fig_tracks(
         outputs: the paths to write (pdf, png).
         title: the figure's title.
     """
-    import matplotlib
-
-    matplotlib.use("Agg")
     import matplotlib.pyplot as plt
 
-    from physgs.atomic import atomic_path
+    from physgs.report.figures import FONT_PT, PAGE_WIDTH_IN, save_figure
 
-    fig, axes = plt.subplots(1, len(trees), figsize=(3.6 * len(trees), 3.9), squeeze=False)
+    fig, axes = plt.subplots(
+        1, len(trees), figsize=(PAGE_WIDTH_IN, PAGE_WIDTH_IN / len(trees) + 0.9), squeeze=False
+    )
     cmap = plt.get_cmap("tab20")
     for ax, t in zip(axes[0], trees):
         tr, lab = tracks[t], labels.get(t)
@@ -286,16 +285,14 @@ def fig_tracks(
         kept = float(tr.valid[s0, -1].mean()) if s0.any() else 0.0
         fitted = 0 if lab is None else int((np.asarray(lab) >= 0).sum())
         ax.set_title(
-            f"{t}: {tr.n_tracks} tracks, {100 * kept:.0f}% of frame 0's kept,\n"
-            f"{fitted} fitted in parts with an estimate",
-            fontsize=8,
+            f"{t}: {tr.n_tracks} tracks\n{100 * kept:.0f}% of frame 0's kept, {fitted} in parts",
+            fontsize=FONT_PT,
         )
-        ax.set_xticks([])
-        ax.set_yticks([])
+        # the image's own pixels are the scale: a path's length reads in px of the frame
+        ax.set_xlabel("x (px)", fontsize=FONT_PT)
+        ax.tick_params(labelsize=FONT_PT)
+    axes[0, 0].set_ylabel("y (px)", fontsize=FONT_PT)
     if title:
-        fig.suptitle(title, fontsize=9)
+        fig.suptitle(title, fontsize=FONT_PT)
     fig.tight_layout()
-    for out in outputs:
-        with atomic_path(out) as tmp:
-            fig.savefig(tmp, dpi=150)
-    plt.close(fig)
+    save_figure(fig, outputs, dpi=150)

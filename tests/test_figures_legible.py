@@ -1,0 +1,123 @@
+"""The record's figures read at the site's width: every text at least MIN_TEXT_PX on the page
+(the figure shrunk to the content column), every legend outside the data, units on the numbers.
+
+Each figure is drawn at the default run's shape (three trees, every model, three configurations)
+from small synthetic inputs; ``save_figure`` is replaced by a catcher so the figure is measured
+before it is closed. The page scale is computed independently here: the tight bounding box in
+inches, at 72 points per inch, shrunk to the column's px."""
+
+import numpy as np
+import pytest
+
+from physgs.models.registry import MODEL_NAMES
+from physgs.recovery import damping_summary
+from physgs.report import figures as FG
+from physgs.report.tracks import fig_tracks
+from physgs.tracks.track import Tracks
+
+TREES = ["sparse", "medium", "dense"]
+
+
+@pytest.fixture
+def caught(monkeypatch):
+    figs = []
+    monkeypatch.setattr(FG, "save_figure", lambda fig, outputs, dpi=200: figs.append(fig))
+    yield figs
+    import matplotlib.pyplot as plt
+
+    for f in figs:
+        plt.close(f)
+
+
+def _smallest_px(fig):
+    fig.canvas.draw()
+    r = fig.canvas.get_renderer()
+    scale = min(1.0, FG.PAGE_WIDTH_PX / (fig.get_tightbbox(r).width * 72))
+    sizes = [
+        (t.get_fontsize() * scale, t.get_text())
+        for t in fig.findobj(lambda a: hasattr(a, "get_fontsize") and hasattr(a, "get_text"))
+        if t.get_visible() and t.get_text().strip() and t.get_window_extent(r).width > 0
+    ]
+    return min(sizes)
+
+
+def _legible(fig):
+    px, text = _smallest_px(fig)
+    assert px >= FG.MIN_TEXT_PX, f"{text!r} is {px:.1f} px at the page's width"
+    assert not FG.legends_over_data(fig)
+    assert min(px for _, px in FG.text_px(fig)) == pytest.approx(px)
+
+
+def test_fig_temporal_reads_at_page_width_and_keys_the_beyond_window_band(caught):
+    rng = np.random.default_rng(0)
+    curves = {(t, m): 20 + rng.random((3, 60)) for t in TREES for m in MODEL_NAMES}
+    FG.fig_temporal(curves, TREES, 50, ["x.png"])
+    (fig,) = caught
+    _legible(fig)
+    keys = [t.get_text() for lg in fig.legends for t in lg.get_texts()]
+    assert "beyond the training window (after frame 50)" in keys
+    assert "lowest to highest of 3 seeds" in keys
+    assert fig.axes[0].get_ylabel() == "PSNR (dB)"
+
+
+def test_fig_damping_has_one_key_and_no_label_per_cell(caught):
+    rng = np.random.default_rng(1)
+    configs = ["joint32", "joint96", "single"]
+
+    def res():
+        w = rng.uniform(1, 10, 30)
+        return damping_summary(w, rng.uniform(0.05, 0.4, 30), 0.08)
+
+    damping = {m: {(t, c): res() for t in TREES for c in configs} for m in ("ours", "ours_chain")}
+    FG.fig_damping(damping, TREES, configs, 0.08, ["x.png"])
+    (fig,) = caught
+    _legible(fig)
+    assert [t.get_text() for t in fig.axes[0].get_xticklabels()] == TREES  # not 18 cells
+    (key,) = fig.legends
+    assert len(key.get_texts()) == len(TREES) + len(configs) + 2 + 1
+    assert "(rad/s)" in fig.axes[1].get_xlabel() and "(1/s)" in fig.axes[1].get_ylabel()
+
+
+def test_fig_results_prints_psnr_in_db_at_page_width(caught):
+    rows = [f"{t}: unseen {s}" for t in TREES for s in ("time", "view", "wind")]
+    cols = ["gt", *MODEL_NAMES]
+    img = np.ones((16, 16, 3))
+    images = {
+        (r, c): (img, None if c == "gt" else 20.0 + i) for r in rows for i, c in enumerate(cols)
+    }
+    FG.fig_results(rows, cols, images, ["x.png"])
+    (fig,) = caught
+    _legible(fig)
+    scores = [t.get_text() for ax in fig.axes for t in ax.texts]
+    assert scores and all(s.endswith(" dB") for s in scores)
+
+
+def test_fig_tracks_has_pixel_axes_and_titles_that_do_not_collide(caught):
+    rng = np.random.default_rng(2)
+    frames = {t: np.full((64, 64, 3), 255, np.uint8) for t in TREES}
+    xy = rng.uniform(5, 60, (20, 10, 2))
+    tracks = {t: Tracks(xy, np.ones((20, 10), bool), np.zeros(20, int)) for t in TREES}
+    labels = {t: rng.integers(-1, 4, 20) for t in TREES}
+    fig_tracks(frames, tracks, labels, TREES, ["x.png"], title="2D tracks (seed 0)")
+    (fig,) = caught
+    _legible(fig)
+    assert all(ax.get_xlabel() == "x (px)" for ax in fig.axes)
+    assert fig.axes[0].get_ylabel() == "y (px)"
+    r = fig.canvas.get_renderer()
+    sup = fig._suptitle.get_window_extent(r)
+    assert not any(sup.overlaps(ax.title.get_window_extent(r)) for ax in fig.axes)
+
+
+def test_small_text_is_measured_small(caught):
+    """The measure can fail: a wide figure with 7-pt text reads under 9 px at the page width."""
+    import matplotlib.pyplot as plt
+
+    fig, ax = plt.subplots(figsize=(13, 3))
+    ax.set_title("tiny", fontsize=7)
+    px = dict(FG.text_px(fig))["tiny"]
+    assert px == pytest.approx(7 * FG.PAGE_WIDTH_PX / (fig.get_tightbbox().width * 72))
+    assert px < FG.MIN_TEXT_PX
+    ax.plot([0, 1], [0, 1], label="over the data")
+    ax.legend(loc="center")
+    assert FG.legends_over_data(fig)
+    plt.close(fig)
