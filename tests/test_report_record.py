@@ -5,6 +5,7 @@ import json
 import re
 import subprocess
 import sys
+from dataclasses import asdict
 from pathlib import Path
 
 import numpy as np
@@ -56,8 +57,8 @@ def _run(tmp_path):
     claims.to_csv(r / "claims.csv", index=False)
     (r / "claims.md").write_text("# Claims ledger\n\ntext\n")
     (r / "summary.md").write_text("# Run summary\n\n## Claims ledger\n\n#not a heading\n")
-    Image.new("RGB", (2400, 600), (10, 20, 30)).save(r / "figures" / "fig_wide.png")
-    Image.new("RGB", (300, 200), (200, 20, 30)).save(r / "figures" / "fig_small.png")
+    Image.new("RGB", (2400, 600), (10, 20, 30)).save(r / "figures" / "fig_temporal.png")
+    Image.new("RGB", (300, 200), (200, 20, 30)).save(r / "figures" / "testbed_sparse.png")
     return r, fit, claims
 
 
@@ -89,19 +90,28 @@ def _record(r, out, tables=None, figures=None, summary=None, stamp=None, **kw):
     )
 
 
-def test_the_snakemake_report_is_copied_and_linked_only_when_given(tmp_path):
+def test_the_record_never_holds_the_snakemake_report_and_says_how_to_make_it(tmp_path):
     r, _, _ = _run(tmp_path)
     out = tmp_path / "record"
     _record(r, out)
-    assert (
-        not (out / "report.html").exists() and "report.html" not in (out / "index.md").read_text()
-    )
-    (r / "report.html").write_text("<html>the run</html>")
-    _record(r, out, report_html=r / "report.html")
-    assert (out / "report.html").read_text() == "<html>the run</html>"
-    assert "[report.html](record/report.html)" in (out / "index.md").read_text()
-    with pytest.raises(FileNotFoundError, match="nope.html"):
-        _record(r, out, report_html=r / "nope.html")
+    assert not (out / "report.html").exists()
+    assert "python tools/record.py --report-html" in (out / "index.md").read_text()
+    with pytest.raises(TypeError):
+        _record(r, out, report_html=r / "report.html")
+
+
+def test_no_tracked_file_exceeds_one_megabyte():
+    """A clone stays light: no file over 1 MB enters the repository (a Snakemake report is
+    ~10 MB; each record's would be in every clone's history)."""
+    files = subprocess.run(
+        ["git", "ls-files", "-z"], cwd=ROOT, capture_output=True, text=True, check=True
+    ).stdout.split("\0")
+    big = [
+        f"{f}: {(ROOT / f).stat().st_size / 1e6:.1f} MB"
+        for f in files
+        if f and (ROOT / f).is_file() and (ROOT / f).stat().st_size > 1_000_000
+    ]
+    assert not big, "tracked files over 1 MB:\n" + "\n".join(big)
 
 
 def _parse_md_table(text):
@@ -110,22 +120,24 @@ def _parse_md_table(text):
     return head, [[c.strip() for c in row] for row in body]
 
 
-def test_write_record_copies_every_table_as_csv_and_markdown_that_agree(tmp_path):
+def test_write_record_copies_every_table_as_csv_and_summarises_it_over_seeds(tmp_path):
     r, fit, _ = _run(tmp_path)
     out = tmp_path / "record"
     _record(r, out)
     assert (out / "tables" / "tab_fit.csv").read_bytes() == (r / "tables/tab_fit.csv").read_bytes()
     head, body = _parse_md_table((out / "tables" / "tab_fit.md").read_text())
-    assert head == list(fit.columns)
-    col = head.index("ceiling_frac")
-    assert float(body[0][col]) == pytest.approx(0.13456789, rel=5e-4)  # 4 significant digits
-    assert body[1][col] == "--"  # NaN is shown as missing, never as 0
-    assert body[0][head.index("config_hash")] == "0123abcd"  # a hash is not read as a number
-    # the index includes each table's Markdown and embeds each figure
+    assert head == ["tree", "model", "ceiling_frac"]  # no seed, no stamp columns
+    assert body == [["sparse", "ours", "0.1346"]]  # one seed has a value: shown alone
     tables = (out / "tables.md").read_text()
     assert '--8<-- "docs/record/tables/tab_fit.md"' in tables and "tab_psnr" in tables
-    assert "![fig_wide](record/figures/fig_wide.png)" in (out / "figures.md").read_text()
-    assert '--8<-- "docs/record/summary.md"' in (out / "index.md").read_text()
+    assert "[tab_fit.csv](record/tables/tab_fit.csv)" in tables  # per-seed rows: a download
+    assert "mean ± sd over training seeds 0, 1" in tables
+    index = (out / "index.md").read_text()
+    assert '--8<-- "docs/record/summary.md"' in index
+    # the figures first, then the ledger, then the tables, then the run
+    heads = [ln for ln in index.splitlines() if ln.startswith("## ")]
+    assert heads == ["## Figures", "## The paper against the measured", "## Tables", "## The run"]
+    assert "4 claims: 2 hold, 1 fail, 1 undecided" in index and "(ledger.md)" in index
     stamp = json.loads((out / "stamp.json").read_text())
     assert stamp["seeds"] == [0, 1] and stamp["wall_s"] == 11285.0
     assert "3 h 8 min" in (out / "stamp.md").read_text()
@@ -136,13 +148,104 @@ def test_write_record_copies_every_table_as_csv_and_markdown_that_agree(tmp_path
     assert "#not a heading" in summary
 
 
+def test_a_table_summary_is_mean_and_sd_over_seeds_in_readable_widths():
+    rng = np.random.default_rng(0)
+    rows = []
+    for seed in (0, 1, 2):
+        for tree in ("sparse", "dense"):
+            rows.append(
+                {"seed": seed, "tree": tree, "bones": 22 if tree == "sparse" else 562}
+                | {f"v{i}": rng.normal(10 * i, 1) for i in range(12)}
+                | {"profile": "default", "config_hash": "00ff"}
+            )
+    df = pd.DataFrame(rows)
+    summary, keys, seeds = record.table_summary(df)
+    assert keys == ["tree"] and seeds == [0, 1, 2]
+    assert list(summary["bones"]) == ["22", "562"]  # the same on every seed: no "± 0"
+    m, sd = summary.loc[1, "v3"].split(" ± ")
+    want = df[df["tree"] == "dense"]["v3"]
+    assert float(m) == pytest.approx(want.mean(), rel=1e-3)
+    assert float(sd) == pytest.approx(want.std(ddof=1), rel=0.05)  # two significant digits
+    parts = record.summary_markdown(df).strip().split("\n\n")
+    heads = [_parse_md_table(t)[0] for t in parts]
+    assert all(h[0] == "tree" for h in heads)  # the key repeated in each part
+    assert all(len(h) <= 1 + record.VALUE_COLUMNS_SHOWN for h in heads)
+    assert sum(len(h) - 1 for h in heads) == 13  # bones and v0..v11, each once
+
+
+def test_figures_are_shown_in_reading_order_each_with_a_caption_from_its_declaration(tmp_path):
+    from physgs.report import captions
+    from physgs.report.outputs import OUTPUTS
+
+    r, _, _ = _run(tmp_path)
+    for name in ("testbed_medium", "fig_damping"):
+        Image.new("RGB", (300, 200)).save(r / "figures" / f"{name}.png")
+    out = tmp_path / "record"
+    _record(r, out, stamp=record.Stamp(**{**asdict(_stamp()), "trees": ("sparse", "medium")}))
+    text = (out / "figures.md").read_text()
+    shown = re.findall(r"!\[(\w+)\]", text)
+    assert shown == ["fig_temporal", "fig_damping", "testbed_sparse", "testbed_medium"]
+    assert "*Seeds:* mean over training seeds 0, 1." in text  # fig_temporal reads all seeds
+    assert OUTPUTS["fig_damping"].seeds == "first"
+    assert "*Seeds:* training seed 0 (the first of the run's 2)." in text
+    assert "The synthetic medium tree" in text and "no training seed" in text
+    # every figure a run draws has a caption
+    for name in OUTPUTS:
+        if OUTPUTS[name].kind == "figure":
+            captions.find(name)
+    for name in ("fig_stabilisation_dense", "testbed_dense_damping"):
+        assert captions.find(name)[2] == "dense"
+    with pytest.raises(KeyError, match="fig_new"):
+        captions.caption("fig_new", [0])
+
+
+def test_the_committed_record_re_renders_from_its_own_files(tmp_path):
+    """The committed pages are what render_pages makes of the committed record's files."""
+    import shutil
+
+    copy = tmp_path / "record"
+    shutil.copytree(RECORD, copy)
+    record.render_pages(copy)
+    for page in (
+        "index.md",
+        "figures.md",
+        "tables.md",
+        "stamp.md",
+        *(f"tables/{t.stem}.md" for t in RECORD.glob("tables/*.csv")),
+    ):
+        assert (copy / page).read_text() == (RECORD / page).read_text(), (
+            f"docs/record/{page} is stale: run `python tools/record.py --pages-only`"
+        )
+
+
+def test_a_stamp_names_a_plain_commit_and_keeps_its_note_apart():
+    with pytest.raises(ValueError, match="plain commit hash"):
+        record.Stamp(**{**asdict(_stamp()), "commit": "50d07ab (as e78f42e)"})
+    with pytest.raises(ValueError, match="plain commit hash"):
+        record.Stamp(**{**asdict(_stamp()), "commit": "v0.1.0-240-gfbbbfaa"})
+    s = record.Stamp(**{**asdict(_stamp()), "note": "resumed twice", "jobs": 498})
+    md = s.markdown()
+    assert "commit `abc1234`;" in md and "- **Note**: resumed twice" in md
+    assert "498 benchmarked jobs" in md
+    committed = json.loads((RECORD / "stamp.json").read_text())
+    assert record.COMMIT.match(committed["commit"])
+    costs = record.read_costs(RECORD / "costs.csv")
+    assert all(record.COMMIT.match(str(c)) for c in costs["commit"]), list(costs["commit"])
+
+
+def test_git_commit_is_a_plain_hash():
+    from physgs.provenance import git_commit
+
+    assert record.COMMIT.match(git_commit(ROOT))
+
+
 def test_figures_are_web_sized_and_keep_their_aspect(tmp_path):
     r, _, _ = _run(tmp_path)
     out = tmp_path / "record"
     _record(r, out, tables=[])
-    with Image.open(out / "figures" / "fig_wide.png") as im:
+    with Image.open(out / "figures" / "fig_temporal.png") as im:
         assert (im.width, im.height) == (record.FIGURE_WIDTH_PX, 300)
-    with Image.open(out / "figures" / "fig_small.png") as im:
+    with Image.open(out / "figures" / "testbed_sparse.png") as im:
         assert (im.width, im.height) == (300, 200)  # never enlarged
 
 

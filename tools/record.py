@@ -1,19 +1,26 @@
 """The committed record of a finished default-profile run, and the README lines read from it.
 
-    python tools/record.py [results] [--out docs/record] [--wall-s S] [--commit REV]
-        [--snakemake-report]
+    python tools/record.py [results] [--out docs/record] [--wall-s S] [--commit HASH] [--note TEXT]
+    python tools/record.py --pages-only      # lay the record's pages out again from its own files
+    python tools/record.py --readme-only     # rewrite the README's block from the record
+    python tools/record.py --report-html [results/report.html]   # Snakemake's report, on demand
 
-Copies the run's summary, ledger, every table (CSV and Markdown) and every figure (PNG, web
-sized) into `docs/record/` with the run's stamp (`physgs.report.record.write_record`), then
-rewrites the README's block between `<!-- record:begin -->` and `<!-- record:end -->` from it
-(`physgs.report.record.readme_block`). The run's layout is the workflow's (`results/`:
-`summary.md`, `claims.{csv,md}`, `tables/*.csv`, `figures/*.png`, `benchmarks/`). The wall time
-is the benchmark files' span unless `--wall-s` gives the measured one (`tools/timed.py` measures
-it). `--snakemake-report` also makes Snakemake's report of the run (`snakemake --report
-<results>/report.html all`) and puts it in the record, linked from its page; `--report-html
-FILE` takes one already made (by `snakemake --report` in the folder the run ran in, whose
-`.snakemake/` holds the jobs' metadata). `--readme-only` rewrites the README's block from the
-record already there.
+Copies the run's summary, ledger, every table (CSV) and every figure (PNG, web sized) into
+`docs/record/` with the run's stamp (`physgs.report.record.write_record`), lays out the Results
+page's parts from them (`physgs.report.record.render_pages`: the figures with their captions,
+the ledger's counts, each table's summary over seeds), then rewrites the README's block between
+`<!-- record:begin -->` and `<!-- record:end -->` (`physgs.report.record.readme_block`). The
+run's layout is the workflow's (`results/`: `summary.md`, `claims.{csv,md}`, `tables/*.csv`,
+`figures/*.png`, `benchmarks/`).
+
+The wall time is the run's command's, measured by `tools/timed.py --name all` (summed over the
+segments of a resumed run): `--wall-s` gives it, else the `all` row of `costs.csv` when it was
+measured at the run's commit; there is no other definition. The commit is a plain hash
+(`--commit`, default HEAD's); anything else a reader should know goes in `--note`.
+
+`--report-html` makes Snakemake's report of the run (`snakemake --report PATH all`, run in the
+folder the run ran in, whose `.snakemake/` holds the jobs' metadata) into `results/`; it is ~10 MB
+and never enters the record.
 """
 
 from __future__ import annotations
@@ -25,9 +32,24 @@ from pathlib import Path
 
 import pandas as pd
 
-from physgs.experiments.cost import read_costs, summarise, wall_spans
+from physgs.experiments.cost import read_costs, summarise
 from physgs.provenance import git_commit, machine_cpu
 from physgs.report import record
+
+
+def _wall_s(args, commit: str) -> float:
+    """The run's wall time: ``--wall-s``, or the ``all`` row of the record's costs measured at
+    the run's commit."""
+    if args.wall_s is not None:
+        return args.wall_s
+    costs = record.read_costs(args.out / "costs.csv")
+    row = costs[costs["name"] == "all"]
+    if len(row) and str(row["commit"].iloc[0]) == commit:
+        return float(row["wall_s"].iloc[0])
+    raise SystemExit(
+        f"no wall time for commit {commit}: run the pipeline under `python tools/timed.py "
+        "--name all -- snakemake --cores 2 all`, or give --wall-s"
+    )
 
 
 def main() -> None:
@@ -35,32 +57,44 @@ def main() -> None:
     ap.add_argument("results", nargs="?", default="results", type=Path)
     ap.add_argument("--out", default="docs/record", type=Path)
     ap.add_argument("--readme", default="README.md", type=Path)
-    ap.add_argument("--wall-s", type=float, help="the run's measured wall time, s")
-    ap.add_argument("--commit", help="the commit the run was made at (default: git describe)")
+    ap.add_argument("--wall-s", type=float, help="the run's wall time (tools/timed.py), s")
+    ap.add_argument("--commit", help="the commit the run was made at (default: HEAD's hash)")
+    ap.add_argument("--note", default="", help="what a reader should know of how it was made")
     ap.add_argument("--readme-only", action="store_true")
-    ap.add_argument("--snakemake-report", action="store_true", help="add `snakemake --report`")
-    ap.add_argument("--report-html", type=Path, help="a `snakemake --report` of the run, made")
+    ap.add_argument("--pages-only", action="store_true", help="lay out the record's pages again")
+    ap.add_argument(
+        "--report-html",
+        nargs="?",
+        const=Path("results/report.html"),
+        type=Path,
+        help="make Snakemake's report of the run there (default results/report.html) and stop",
+    )
     args = ap.parse_args()
-    if not args.readme_only:
+    if args.report_html is not None:
+        subprocess.run(["snakemake", "--report", str(args.report_html), "all"], check=True)
+        print(f"{args.report_html}: Snakemake's report of the run (not part of the record)")
+        return
+    if args.pages_only:
+        print(f"{args.out}: {len(record.render_pages(args.out))} pages laid out again")
+    elif not args.readme_only:
         r = args.results
         fit = pd.read_csv(r / "tables" / "tab_fit.csv", dtype={"config_hash": str})
         jobs = read_costs(r / "benchmarks")
         by_stage = summarise(jobs)["by_stage"]
+        commit = args.commit or git_commit()
         stamp = record.Stamp(
             date=datetime.date.today().isoformat(),
-            commit=args.commit or git_commit(),
+            commit=commit,
             profile=str(fit["profile"].iloc[0]),
             config_hash=str(fit["config_hash"].iloc[0]),
             seeds=tuple(sorted(int(s) for s in fit["seed"].unique())),
             trees=tuple(dict.fromkeys(fit["tree"])),
             cpu=machine_cpu(),
-            wall_s=args.wall_s if args.wall_s is not None else wall_spans(jobs)["run_s"],
+            wall_s=_wall_s(args, commit),
             job_min_by_stage={k: sum(v.values()) / 60 for k, v in sorted(by_stage.items())},
+            note=args.note,
+            jobs=len(jobs),
         )
-        report = args.report_html
-        if args.snakemake_report:
-            report = r / "report.html"
-            subprocess.run(["snakemake", "--report", str(report), "all"], check=True)
         written = record.write_record(
             args.out,
             stamp=stamp,
@@ -69,7 +103,6 @@ def main() -> None:
             claims_md=r / "claims.md",
             tables=sorted((r / "tables").glob("*.csv")),
             figures=sorted((r / "figures").glob("*.png")),
-            report_html=report,
         )
         print(f"{args.out}: {len(written)} files")
     if not (args.out / "stamp.json").is_file():

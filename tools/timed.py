@@ -4,8 +4,8 @@
 
 Runs the command (its output goes through), then sets the row `--name` of
 `docs/record/costs.csv` (`physgs.report.record.record_costs`): the command, its wall time, the
-date, the commit and the machine's CPU. The README's "what each command costs" lines are printed
-from that file (`python tools/record.py --readme-only`). Names the README reads:
+date, the commit (a plain hash) and the machine's CPU. The README's "what each command costs"
+lines are printed from that file (`python tools/record.py --readme-only`). Names the README reads:
 `physgs.report.record.COMMANDS`. A command that fails records nothing and passes its exit code on.
 
 A run interrupted and resumed with the same command (a long pipeline spanning two sessions) is
@@ -25,7 +25,7 @@ import time
 from pathlib import Path
 
 from physgs.report import record
-from physgs.provenance import git_commit, machine_cpu
+from physgs.provenance import git_commit, git_dirty, machine_cpu
 
 
 def main() -> int:
@@ -46,6 +46,10 @@ def main() -> int:
     cmd = args.command[1:] if args.command[:1] == ["--"] else args.command
     if not cmd:
         ap.error("no command given (after --)")
+    if git_dirty():  # the row names HEAD's hash: what ran also had uncommitted changes
+        print(
+            f"warning: uncommitted changes; the cost is recorded at {git_commit()}", file=sys.stderr
+        )
     t0 = time.monotonic()
     rc = subprocess.call(cmd)
     wall = time.monotonic() - t0 + sum(args.earlier)

@@ -90,15 +90,36 @@ def machine_cpu(cpuinfo: str | Path = "/proc/cpuinfo") -> str:
 
 
 def git_commit(cwd: str | Path = ".") -> str:
-    """``git describe --always --dirty`` of ``cwd``, or ``unknown`` outside a checkout.
+    """The abbreviated hash of ``cwd``'s HEAD, or ``unknown`` outside a checkout.
+
+    A plain hash, never ``git describe``'s ``tag-N-gHASH`` (a clone without the tag cannot
+    resolve it) nor a ``-dirty`` suffix ([`git_dirty`][physgs.provenance.git_dirty] says that).
 
     Args:
         cwd: the directory git runs in.
 
     Returns:
-        The description (e.g. ``77c3389-dirty``), or ``'unknown'`` when git prints nothing.
+        The hash (e.g. ``77c3389``), or ``'unknown'`` when git prints nothing.
     """
     out = subprocess.run(
-        ["git", "describe", "--always", "--dirty"], capture_output=True, text=True, cwd=cwd
+        ["git", "rev-parse", "--short", "HEAD"], capture_output=True, text=True, cwd=cwd
     )
     return out.stdout.strip() or "unknown"
+
+
+def git_dirty(cwd: str | Path = ".") -> bool:
+    """Whether ``cwd``'s tracked files differ from its HEAD.
+
+    Args:
+        cwd: the directory git runs in.
+
+    Returns:
+        True when a tracked file is changed (False outside a checkout).
+    """
+    out = subprocess.run(
+        ["git", "status", "--porcelain", "--untracked-files=no"],
+        capture_output=True,
+        text=True,
+        cwd=cwd,
+    )
+    return bool(out.stdout.strip())

@@ -3,8 +3,11 @@
 A run's outputs (``results/``) are not committed; the record is: the run's stamp (date, commit,
 profile, config hash, seeds, the machine's CPU, wall time and job-minutes by stage), its
 ``summary.md``, the claims ledger, every table as CSV and as a Markdown table, and the figures as
-PNG sized for the web. The Results page includes the record's files (never a copy of their
-numbers), and the README's "what it found" and "what it costs" lines are printed from the record
+PNG sized for the web. The Results page includes the record's pages, which
+[`render_pages`][physgs.report.record.render_pages] writes from the record's own files (so the
+pages can be laid out again without a new run): the figures first, each with its caption
+([`physgs.report.captions`][physgs.report.captions]), then the ledger's counts, then each table
+as its summary over seeds beside its per-seed CSV, then the run's stamp and summary. The README's "what it found" and "what it costs" lines are printed from the record
 by [`readme_block`][physgs.report.record.readme_block], so neither can disagree with the run they
 describe.
 
@@ -18,6 +21,7 @@ from __future__ import annotations
 
 import json
 import math
+import re
 import shutil
 from collections.abc import Mapping, Sequence
 from dataclasses import asdict, dataclass, field
@@ -57,10 +61,17 @@ COMMANDS: tuple[tuple[str, str], ...] = (
 )
 #: Widest figure in the record, px: the documentation's content column.
 FIGURE_WIDTH_PX = 1200
+#: Value columns of one summary table on the page: a wider table is cut into several, its key
+#: columns repeated, so it reads in the content column.
+VALUE_COLUMNS_SHOWN = 5
+#: Columns every table carries that the record's stamp already states.
+STAMP_COLUMNS = ("profile", "config_hash", "physgs_version")
 #: Cells moved beyond their row's seed spread that the record lists, largest first.
 RERUN_CELLS_SHOWN = 10
 COSTS_COLUMNS = ("name", "command", "wall_s", "date", "commit", "cpu", "from_nothing", "segments")
 BEGIN, END = "<!-- record:begin -->", "<!-- record:end -->"
+#: A commit as the record names it: a plain (abbreviated) hash.
+COMMIT = re.compile(r"^[0-9a-f]{7,40}$")
 
 
 @dataclass(frozen=True)
@@ -69,14 +80,18 @@ class Stamp:
 
     Attributes:
         date: ISO date the record was made.
-        commit: the commit the run was made at (``git describe --always --dirty``).
+        commit: the commit the run was made at: a plain hash a clone can check out.
         profile: the config profile of the run.
         config_hash: the run's config hash (the tables' stamp).
         seeds: training seeds of the run.
         trees: trees of the run.
         cpu: the machine's CPU model and its bf16/AMX flags.
-        wall_s: wall time of the run, s (first job start to last job end, or as measured).
+        wall_s: wall time of the run, s: the time its command ran, summed over the segments
+            of a run resumed after an interruption, as ``tools/timed.py`` measures it (the one
+            definition the record, the costs and the README use).
         job_min_by_stage: job-minutes per stage, from the run's benchmark files.
+        note: what a reader should know about how the run was made (apart from the commit).
+        jobs: the run's benchmarked jobs (one benchmark file each; light jobs have none).
     """
 
     date: str
@@ -88,23 +103,36 @@ class Stamp:
     cpu: str
     wall_s: float
     job_min_by_stage: dict[str, float] = field(default_factory=dict)
+    note: str = ""
+    jobs: int = 0
+
+    def __post_init__(self):
+        """Refuse a commit that is not a plain hash (a sentence, or a tag a clone lacks)."""
+        if not COMMIT.match(self.commit):
+            raise ValueError(
+                f"stamp commit {self.commit!r}: a plain commit hash (7-40 hex digits); say the "
+                "rest in the stamp's note"
+            )
 
     def markdown(self) -> str:
         """The stamp as a short Markdown list.
 
         Returns:
-            Four bullet lines (run, commit and date, machine, wall time and job-minutes by stage)
-                and a blank line.
+            Bullet lines (run, commit and date, the note if any, machine, wall time with jobs
+                and job-minutes by stage) and a blank line.
         """
         stages = ", ".join(f"{k} {v:.1f}" for k, v in self.job_min_by_stage.items())
         total = sum(self.job_min_by_stage.values())
+        jobs = f"{self.jobs} benchmarked jobs, " if self.jobs else ""
         return "\n".join(
             [
                 f"- **Run**: profile `{self.profile}`, config hash `{self.config_hash}`, "
                 f"seeds {', '.join(map(str, self.seeds))}, trees {', '.join(self.trees)}",
                 f"- **Made at** commit `{self.commit}`; record written {self.date}",
+                *([f"- **Note**: {self.note}"] if self.note else []),
                 f"- **Machine**: {self.cpu}, 2 cores",
-                f"- **Wall time** {format_duration(self.wall_s)}; {total:.0f} job-minutes"
+                f"- **Wall time** {format_duration(self.wall_s)} (the time the run's command ran, "
+                f"summed over its segments; `tools/timed.py`); {jobs}{total:.0f} job-minutes"
                 + (f" ({stages})" if stages else ""),
                 "",
             ]
@@ -307,9 +335,11 @@ def write_record(
     claims_md: str | Path,
     tables: Sequence[str | Path],
     figures: Sequence[str | Path],
-    report_html: str | Path | None = None,
 ) -> list[Path]:
     """Write a run's record into ``out_dir`` (replacing the record there).
+
+    Snakemake's report of a run is not part of the record (it is ~10 MB: every clone would
+    carry each record's); ``tools/record.py --report-html`` makes it into ``results/``.
 
     Args:
         out_dir: the record's folder (the project keeps it at ``docs/record``).
@@ -317,10 +347,9 @@ def write_record(
         summary_md: the run's ``summary.md``.
         claims_csv: the claims ledger as CSV.
         claims_md: the claims ledger as Markdown.
-        tables: the run's table CSVs; each becomes ``tables/<name>.csv`` and ``.md``.
+        tables: the run's table CSVs; each becomes ``tables/<name>.csv`` and its summary
+            ``tables/<name>.md``.
         figures: the run's figure PNGs; each becomes ``figures/<name>.png``, web-sized.
-        report_html: Snakemake's report of the same run (``snakemake --report``), copied as
-            ``report.html`` and linked from the record's page; None: no report.
 
     Returns:
         The files written.
@@ -328,8 +357,7 @@ def write_record(
     Raises:
         FileNotFoundError: naming the first input that is missing.
     """
-    extra = [report_html] if report_html is not None else []
-    inputs = [Path(p) for p in (summary_md, claims_csv, claims_md, *tables, *figures, *extra)]
+    inputs = [Path(p) for p in (summary_md, claims_csv, claims_md, *tables, *figures)]
     for p in inputs:
         if not p.is_file():
             raise FileNotFoundError(f"{p}: missing; finish the run first (snakemake --cores 2 all)")
@@ -362,66 +390,202 @@ def write_record(
         written.append(costs)
     put("stamp.json", json.dumps(asdict(stamp), indent=2) + "\n")
     put("rerun.md", against)
-    put("stamp.md", stamp.markdown())
     put("summary.md", demote(Path(summary_md).read_text()))
     put("claims.md", demote(Path(claims_md).read_text()))
     shutil.copyfile(claims_csv, out / "claims.csv")
     written.append(out / "claims.csv")
-    index = []
     for t in sorted(Path(p) for p in tables):
-        df = pd.read_csv(t, dtype={"config_hash": str})
         shutil.copyfile(t, out / "tables" / t.name)
-        put(f"tables/{t.stem}.md", markdown_table(df))
         written.append(out / "tables" / t.name)
-        index += [f"### `{t.stem}`", "", f'--8<-- "docs/record/tables/{t.stem}.md"', ""]
-    put("tables.md", "\n".join(index))
-    gallery = []
     for f in sorted(Path(p) for p in figures):
         _png_for_web(f, out / "figures" / f.name)
         written.append(out / "figures" / f.name)
-        gallery += [f"### `{f.stem}`", "", f"![{f.stem}](record/figures/{f.name})", ""]
-    put("figures.md", "\n".join(gallery))
-    report_line = []
-    if report_html is not None:
-        shutil.copyfile(report_html, out / "report.html")
-        written.append(out / "report.html")
-        report_line = [
-            "The same run as Snakemake's report (every table, figure and job, browsable): "
-            "[report.html](record/report.html).",
+    written += render_pages(out)
+    old = final.with_name(final.name + ".old")
+    if final.exists():
+        final.rename(old)
+    out.rename(final)
+    shutil.rmtree(old, ignore_errors=True)
+    return sorted({final / p.relative_to(out) for p in written})
+
+
+def _mean_sd(values: pd.Series) -> str:
+    """``mean ± sd`` of a column's per-seed values (NaN dropped): the value alone where the seeds
+    agree (to rounding) or one seed has it, ``--`` where none has."""
+    v = pd.to_numeric(values, errors="coerce").dropna()
+    if v.empty:
+        return "--"
+    m, sd = float(v.mean()), float(v.std(ddof=1)) if len(v) > 1 else 0.0
+    if sd <= 1e-9 * max(1.0, abs(m)):  # a quantity the seeds do not change (the testbed's)
+        return _cell(m)
+    return f"{m:.4g} ± {sd:.2g}"
+
+
+def table_summary(df: pd.DataFrame) -> tuple[pd.DataFrame, list[str], list[int]]:
+    """A per-seed table as its summary over seeds: one row per key, each value column as
+    ``mean ± sd`` over the seeds (NaN seeds left out; the value alone where the seeds agree).
+
+    The keys are the text and true/false columns (tree, model, configuration...); the stamp's columns are
+    dropped, and so are columns with no value. A table without a ``seed`` column is returned as
+    it is, its keys its text columns.
+
+    Args:
+        df: the table, one row per seed (its CSV as read with the stamp's columns as text).
+
+    Returns:
+        ``(summary, key columns, seeds)``: the summary's cells as text, the key columns in
+            the table's order, the seeds summarised over (empty without a seed column).
+    """
+    df = df.drop(columns=[c for c in STAMP_COLUMNS if c in df]).dropna(axis=1, how="all")
+    keys = [c for c in df.columns if c != "seed" and not pd.api.types.is_numeric_dtype(df[c])]
+    if "seed" not in df:
+        return df.map(_cell).reset_index(drop=True), keys, []
+    seeds = sorted(int(x) for x in df["seed"].unique())
+    values = [c for c in df.columns if c not in keys and c != "seed"]
+    groups = df.groupby(keys, sort=False, dropna=False) if keys else [((), df)]
+    rows = []
+    for k, g in groups:
+        k = k if isinstance(k, tuple) else (k,)
+        rows.append([_cell(x) for x in k] + [_mean_sd(g[c]) for c in values])
+    return pd.DataFrame(rows, columns=[*keys, *values]), keys, seeds
+
+
+def summary_markdown(df: pd.DataFrame) -> str:
+    """[`table_summary`][physgs.report.record.table_summary] as Markdown tables of at most
+    ``VALUE_COLUMNS_SHOWN`` value columns each, the key columns repeated.
+
+    Args:
+        df: the table, one row per seed.
+
+    Returns:
+        The tables' lines, blank-line separated, ending in a newline.
+    """
+    summary, keys, _ = table_summary(df)
+    values = [c for c in summary.columns if c not in keys]
+    parts = [
+        values[i : i + VALUE_COLUMNS_SHOWN] for i in range(0, len(values), VALUE_COLUMNS_SHOWN)
+    ]
+    return "\n".join(markdown_table(summary[keys + cols]) for cols in parts or [[]])
+
+
+def render_pages(record_dir: str | Path) -> list[Path]:
+    """Lay out the record's pages from its own files: the Results page's parts.
+
+    From ``stamp.json``, ``claims.csv``, ``tables/*.csv`` and ``figures/*.png`` of the record,
+    writes ``stamp.md``, ``figures.md`` (each figure with its caption, in reading order),
+    ``tables/<name>.md`` (each table's summary over seeds), ``tables.md`` (the summaries, each
+    beside a link to its per-seed CSV) and ``index.md`` (figures, then the ledger's counts, then
+    the tables, then the run). No run is needed: ``tools/record.py --pages-only`` calls it on the
+    committed record.
+
+    Args:
+        record_dir: the record folder.
+
+    Returns:
+        The files written.
+
+    Raises:
+        KeyError: naming a figure without a caption (``physgs.report.captions``).
+    """
+    from physgs.report import captions
+
+    out = Path(record_dir)
+    stamp = Stamp(**json.loads((out / "stamp.json").read_text()))
+    written: list[Path] = []
+
+    def put(name: str, text: str) -> None:
+        (out / name).write_text(text)
+        written.append(out / name)
+
+    put("stamp.md", stamp.markdown())
+    index = []
+    for t in sorted((out / "tables").glob("*.csv")):
+        df = pd.read_csv(t, dtype={c: str for c in STAMP_COLUMNS})
+        _, _, seeds = table_summary(df)
+        put(f"tables/{t.stem}.md", summary_markdown(df))
+        over = (
+            f"mean ± sd over training seeds {', '.join(map(str, seeds))}"
+            if len(seeds) > 1
+            else ("training seed " + str(seeds[0]) if seeds else "not seeded: as the run wrote it")
+        )
+        index += [
+            f"### `{t.stem}`",
+            "",
+            f"{over}; every seed's row: [{t.name}](record/tables/{t.name}) ({len(df)} rows).",
+            "",
+            f'--8<-- "docs/record/tables/{t.stem}.md"',
             "",
         ]
+    put("tables.md", "\n".join(index))
+    gallery = []
+    names = captions.order([f.stem for f in (out / "figures").glob("*.png")], stamp.trees)
+    for name in names:
+        gallery += [
+            f"![{name}](record/figures/{name}.png)",
+            "",
+            captions.caption(name, stamp.seeds),
+            "",
+        ]
+    put("figures.md", "\n".join(gallery))
     put(
         "index.md",
         "\n".join(
             [
-                "## The run",
-                "",
-                '--8<-- "docs/record/stamp.md"',
-                "",
-                *report_line,
-                '--8<-- "docs/record/summary.md"',
-                "",
-                "## Every table",
-                "",
-                "One row per seed, as the run wrote it (`tables/<name>.csv` beside each).",
-                "",
-                '--8<-- "docs/record/tables.md"',
+                f"From the run at commit `{stamp.commit}` (profile `{stamp.profile}`, training "
+                f"seeds {', '.join(map(str, stamp.seeds))}; its stamp: [the run](#the-run)).",
                 "",
                 "## Figures",
                 "",
                 '--8<-- "docs/record/figures.md"',
+                "",
+                "## The paper against the measured",
+                "",
+                *ledger_lines(out / "claims.csv"),
+                "",
+                "## Tables",
+                "",
+                "Each table of the run as its summary over seeds (a wide table cut into several, "
+                "its key columns repeated); the per-seed rows are in the CSV beside it.",
+                "",
+                '--8<-- "docs/record/tables.md"',
+                "",
+                "## The run",
+                "",
+                '--8<-- "docs/record/stamp.md"',
+                "",
+                "Snakemake's report of a run (every table, figure and job, browsable) is made on "
+                "demand, not kept in the record: after the run, `python tools/record.py "
+                "--report-html` writes `results/report.html`.",
+                "",
+                '--8<-- "docs/record/summary.md"',
                 "",
                 '--8<-- "docs/record/rerun.md"',
                 "",
             ]
         ),
     )
-    old = final.with_name(final.name + ".old")
-    if final.exists():
-        final.rename(old)
-    out.rename(final)
-    shutil.rmtree(old, ignore_errors=True)
-    return [final / p.relative_to(out) for p in written]
+    return written
+
+
+def ledger_lines(claims_csv: str | Path) -> list[str]:
+    """The Results page's pointer to the ledger: its verdicts counted, and where the paper's value
+    stands beside the measured one.
+
+    Args:
+        claims_csv: the record's ``claims.csv``.
+
+    Returns:
+        The Markdown lines.
+    """
+    claims = pd.read_csv(claims_csv, dtype={"config_hash": str})
+    kind = claims["verdict"].astype(str).str.split(":").str[0].value_counts()
+    return [
+        f"The ledger holds {len(claims)} claims: {int(kind.get('holds', 0))} hold, "
+        f"{int(kind.get('fails', 0))} fail, {int(kind.get('undecided', 0))} undecided (95% "
+        "intervals over seeds). Each claim with the paper's value beside the measured one, its "
+        "threshold, verdict and the table cells it comes from: [the paper against the "
+        "measured](ledger.md).",
+    ]
 
 
 def write_unrecorded(out_dir: str | Path) -> Path:
