@@ -37,8 +37,9 @@ COLORS = {
 }
 GOOD, BAD = "#1a9850", "#f46d43"  # green where ours is best, orange where a baseline beats it
 WINDOW, TAIL = "0.6", "tab:blue"
-#: The documentation's content column at a 1200-px browser window, px: a figure wider than it
-#: is shown at this width (MkDocs Material, measured in Chromium).
+#: The documentation's content column, px: a figure wider than it is shown at this width
+#: (MkDocs Material in Chromium: 688 px at 1280-1440 px windows, where the contents sidebar shows;
+#: 911 px at 1200 px, where it folds away; the narrower is the one a figure must read at).
 PAGE_WIDTH_PX = 688
 #: The smallest text a reader can read on the page, px.
 MIN_TEXT_PX = 9.0
