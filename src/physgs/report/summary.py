@@ -150,8 +150,12 @@ def fit_section(tab_fit: pd.DataFrame) -> list[str]:
 
 
 def cost_section(benchmark_dir) -> list[str]:
-    """Wall time of the run and of each stage (first job start to last job end) and
-    job-minutes by stage, shared and per seed, from the benchmark files.
+    """The span of the run's benchmarked jobs and of each stage's (first job start to last job
+    end) and job-minutes by stage, shared and per seed, from the benchmark files.
+
+    A span is not the run's wall time: a run resumed after an interruption spans its pauses.
+    The wall time (the time the run's command ran, summed over its segments) is measured by
+    ``tools/timed.py`` and stated by the record's stamp.
 
     Args:
         benchmark_dir (str | Path): the run's benchmark folder.
@@ -170,14 +174,16 @@ def cost_section(benchmark_dir) -> list[str]:
     lines = [
         "## What the run cost",
         "",
-        f"Wall time **{spans['run_s'] / 60:.1f} min** from the first benchmarked job's start to "
-        f"the last one's end ({len(jobs)} jobs, {s['total_s'] / 60:.1f} job-minutes; a run "
-        "resumed after a pause counts the pause). Tables, figures and recovery are light jobs "
-        "without a benchmark file. Per stage: wall minutes of its span (stages overlap) and "
-        "job-minutes, shared by every seed or per training seed "
-        "(`python benchmarks/pipeline_cost.py` prints the same, and one more seed's cost).",
+        f"The benchmarked jobs span **{spans['run_s'] / 60:.1f} min** from the first one's start "
+        f"to the last one's end ({len(jobs)} benchmarked jobs, {s['total_s'] / 60:.1f} "
+        "job-minutes; a pause between the segments of a resumed run falls inside the span, so "
+        "the run's wall time is not this but the time its command ran, `tools/timed.py`'s, in "
+        "the record's stamp). Tables, figures and recovery are light jobs without a benchmark "
+        "file. Per stage: minutes of its span (stages overlap) and job-minutes, shared by every "
+        "seed or per training seed (`python benchmarks/pipeline_cost.py` prints the same, and "
+        "one more seed's cost).",
         "",
-        "| stage | wall min | " + " | ".join(f"job-min {h}" for h in head) + " |",
+        "| stage | span min | " + " | ".join(f"job-min {h}" for h in head) + " |",
         "|---|---|" + "---|" * len(cols),
     ]
     for stage, row in sorted(s["by_stage"].items()):
