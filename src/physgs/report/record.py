@@ -64,6 +64,9 @@ FIGURE_WIDTH_PX = 1200
 #: Value columns of one summary table on the page: a wider table is cut into several, its key
 #: columns repeated, so it reads in the content column.
 VALUE_COLUMNS_SHOWN = 5
+#: Lines of a summary (its rows times its parts) up to which it shows open on the Results page;
+#: a longer one is folded, its heading and CSV link still shown.
+OPEN_TABLE_ROWS = 30
 #: Columns every table carries that the record's stamp already states.
 STAMP_COLUMNS = ("profile", "config_hash", "physgs_version")
 #: Cells moved beyond their row's seed spread that the record lists, largest first.
@@ -501,19 +504,25 @@ def render_pages(record_dir: str | Path) -> list[Path]:
     index = []
     for t in sorted((out / "tables").glob("*.csv")):
         df = pd.read_csv(t, dtype={c: str for c in STAMP_COLUMNS})
-        _, _, seeds = table_summary(df)
-        put(f"tables/{t.stem}.md", summary_markdown(df))
+        summary, _, seeds = table_summary(df)
+        text = summary_markdown(df)
+        put(f"tables/{t.stem}.md", text)
         over = (
             f"mean ± sd over training seeds {', '.join(map(str, seeds))}"
             if len(seeds) > 1
             else ("training seed " + str(seeds[0]) if seeds else "not seeded: as the run wrote it")
         )
+        lines = len(summary) * (text.count("\n\n") + 1)  # rows of all its parts
+        # a long summary folds away (Material's collapsible block), a short one shows open
+        fold = "???+" if lines <= OPEN_TABLE_ROWS else "???"
         index += [
             f"### `{t.stem}`",
             "",
-            f"{over}; every seed's row: [{t.name}](record/tables/{t.name}) ({len(df)} rows).",
+            f"{over}; every seed's row: [{t.name}](record/tables/{t.stem}.csv) ({len(df)} rows).",
             "",
-            f'--8<-- "docs/record/tables/{t.stem}.md"',
+            f'{fold} note "{t.stem}: the summary, {len(summary)} rows"',
+            "",
+            f'    --8<-- "docs/record/tables/{t.stem}.md"',
             "",
         ]
     put("tables.md", "\n".join(index))
@@ -557,7 +566,10 @@ def render_pages(record_dir: str | Path) -> list[Path]:
                 "demand, not kept in the record: after the run, `python tools/record.py "
                 "--report-html` writes `results/report.html`.",
                 "",
-                '--8<-- "docs/record/summary.md"',
+                "??? note \"The run's own summary (`results/summary.md`): every verdict with its "
+                "interval, each model's fit, what the run cost\"",
+                "",
+                '    --8<-- "docs/record/summary.md"',
                 "",
                 '--8<-- "docs/record/rerun.md"',
                 "",
