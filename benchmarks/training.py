@@ -13,6 +13,9 @@ guard, the rest of the loop), then the total
 wall time the profile's training jobs imply (3 trees x 5 baselines `single` + ours
 single/joint32/joint96; the static warm-up iterations are charged at the static model's rate),
 and the RK4 forward+backward cost for K = 96 over the whole recording (lead-in + 350 frames).
+``--csv FILE`` also writes the rates (tree, model, configuration, CPU and wall s/iter, with the
+profile, date, commit and CPU): the input of ``physgs.experiments.cost.training_estimate``, which
+prices a profile's planned trainings (``tools/paper_estimate.py``).
 """
 
 from __future__ import annotations
@@ -32,6 +35,7 @@ from physgs.allocator import retain_freed_memory
 import physgs.render.fast
 import physgs.train.loop
 from physgs.models import build_model, training_jobs
+from physgs.models.registry import BASE_CONFIG, PRIOR_VARIANT_NAMES
 from physgs.models.oscillator import integrate
 from physgs.testbed import scene
 from physgs.testbed.dataset import simulate_tree, swept_points
@@ -209,6 +213,29 @@ def rk4_cost(T: int, K: int = 96, reps: int = 20) -> tuple[float, float]:
     return out[0], out[1]
 
 
+def _write_rates(path: str, profile: str, breakdown: dict) -> None:
+    """The measured s/iter per (tree, model, configuration) as a CSV, with where measured."""
+    import datetime
+
+    import pandas as pd
+
+    from physgs.provenance import git_commit, machine_cpu
+
+    rows = [
+        dict(tree=t, model=m, config=c, cpu_s_per_iter=v[0], wall_s_per_iter=v[1])
+        for t, jobs in breakdown.items()
+        for (m, c), v in jobs.items()
+    ]
+    stamp = dict(
+        profile=profile,
+        date=datetime.date.today().isoformat(),
+        commit=git_commit(),
+        cpu=machine_cpu(),
+    )
+    pd.DataFrame([r | stamp for r in rows]).to_csv(path, index=False)
+    print(f"{path}: {len(rows)} rates")
+
+
 def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--profile", default="default")
@@ -223,6 +250,13 @@ def main() -> None:
         help="YAML overlay merged into config/trees.yaml before the profile resolves (as "
         "Snakemake's --configfile; config/float32.yaml on a CPU without native bf16)",
     )
+    ap.add_argument("--csv", default=None, help="write the measured rates to this CSV")
+    ap.add_argument(
+        "--variants",
+        action="store_true",
+        help="also time the prior variants (topology parts, the forcing-free priors) in the base "
+        "configuration, as the parts study and the blind recovery train them",
+    )
     args = ap.parse_args()
     retain_freed_memory()  # as a workflow job (physgs.jobs)
     torch.set_num_threads(args.threads)
@@ -233,6 +267,8 @@ def main() -> None:
     trees = args.trees or cfg["trees"]
     it_total, warm = cfg["train"]["iterations"], cfg["train"]["warmup"]
     jobs = training_jobs(cfg["models"]["configs"])
+    if args.variants:
+        jobs += [(m, BASE_CONFIG) for m in PRIOR_VARIANT_NAMES]
     if args.models:
         jobs = [j for j in jobs if j[0] in args.models.split(",")]
     print(
@@ -266,6 +302,8 @@ def main() -> None:
         f"{cpu_total / 60:.1f} CPU-min -> about {cpu_total / 120:.1f} min wall on 2 idle cores "
         "(2 jobs at once, 1 thread each)"
     )
+    if args.csv:
+        _write_rates(args.csv, args.profile, breakdown)
     T = data.wind.shape[1]  # whole recording of the last tree: lead-in + 350 frames
     fast, ref = rk4_cost(T)
     print(

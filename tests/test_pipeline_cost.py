@@ -191,3 +191,33 @@ def test_occupancy_places_each_job_in_time_and_counts_idle_cores(tmp_path):
     assert occ.paused_s == pytest.approx(50.0)
     with pytest.raises(ValueError, match="cores >= 1"):
         occupancy(read_costs(tmp_path), cores=0)
+
+
+def test_a_training_estimate_counts_the_plan_and_never_guesses_a_rate():
+    from physgs.experiments.cost import training_estimate
+
+    dry = "\n".join(
+        [
+            "job count",
+            "---  ---",
+            "train 3",
+            "kselect 1",
+            "total 4",
+            "",
+            "rule train:",
+            "    benchmark: results/benchmarks/train/medium/seed0/ours_chain_joint32.tsv",
+            "rule train:",
+            "    benchmark: results/benchmarks/train/medium_damping/seed1/ours_chain_joint32.tsv",
+            "rule train:",
+            "    benchmark: results/benchmarks/train/dense/seed1/d3dgs_wind_single.tsv",
+            "rule kselect:",
+            "    benchmark: results/benchmarks/kselect/medium/seed0.tsv",
+        ]
+    )
+    planned = plan_jobs(dry)
+    rates = {("medium", "ours_chain", "joint32"): 0.3, ("medium", "static", "single"): 0.1}
+    est = training_estimate(planned, rates, ["single", "joint32"], iterations=1000, warmup=100)
+    # two rated trainings (the damping testbed costs as its tree): 100 x 0.1 + 900 x 0.3 each
+    assert est["jobs"] == 2 and est["cpu_s"] == pytest.approx(2 * (10 + 270))
+    assert est["per_seed"] == {0: 1, 1: 2}  # K selection is not a training
+    assert est["unrated"] == {("dense", "d3dgs_wind", "single"): 1}  # counted apart, no guess

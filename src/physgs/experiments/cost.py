@@ -401,3 +401,57 @@ def plan_cost(
         out["by_rule"][rule] = (n + 1, s + wall[rel])
         out["job_s"] += wall[rel]
     return out
+
+
+_TRAIN_JOB = re.compile(r"/train/(?P<tree>[^/]+)/seed(?P<seed>\d+)/(?P<job>[^/]+)\.tsv$")
+
+
+def training_estimate(
+    planned: list[tuple[str, str | None]],
+    rates: dict[tuple[str, str, str], float],
+    configs: list[str],
+    iterations: int,
+    warmup: int = 0,
+) -> dict:
+    """The CPU time a plan's trainings would take, from measured seconds per iteration.
+
+    A planned job whose benchmark is ``train/<tree>/seed<s>/<model>_<config>`` (any rule that
+    trains: methods, references, the K-selected trainings) costs ``warmup`` iterations at the
+    static pose's rate on its tree and ``iterations - warmup`` at its own (tree, model,
+    configuration)'s; a damping testbed costs as its tree (the same geometry). A job without a
+    measured rate is counted apart, never guessed; other jobs (K selection, evaluation,
+    recovery) are not trainings and are left out.
+
+    Args:
+        planned: the plan's jobs ([`plan_jobs`][physgs.experiments.cost.plan_jobs] of a dry run
+            of the profile's target, e.g. ``snakemake -n --forceall all --config profile=paper``).
+        rates: CPU seconds per iteration by ``(tree, model, configuration)``, measured at the
+            profile's resolution (``benchmarks/training.py --profile paper``).
+        configs: the configuration names a job name can end in (``models.configs`` and the
+            others the plan trains, e.g. ``auto``).
+        iterations: training iterations per job (``train.iterations``).
+        warmup: the static warm-up's iterations among them (``train.warmup``).
+
+    Returns:
+        {"cpu_s": CPU seconds of the rated trainings, "jobs": their number, "per_seed": {seed:
+        trainings planned}, "unrated": {(tree, model, configuration): jobs without a rate}}.
+    """
+    out: dict = {"cpu_s": 0.0, "jobs": 0, "per_seed": {}, "unrated": {}}
+    ends = sorted(configs, key=len, reverse=True)
+    for _, bench in planned:
+        m = _TRAIN_JOB.search(bench or "")
+        if m is None:
+            continue
+        tree = parse_id(m["tree"])[0]
+        seed, job = int(m["seed"]), m["job"]
+        config = next((c for c in ends if job.endswith("_" + c)), "")
+        model = job[: -len(config) - 1] if config else job
+        out["per_seed"][seed] = out["per_seed"].get(seed, 0) + 1
+        rate, static = rates.get((tree, model, config)), rates.get((tree, "static", "single"))
+        if rate is None or (warmup and static is None):
+            key = (tree, model, config)
+            out["unrated"][key] = out["unrated"].get(key, 0) + 1
+            continue
+        out["cpu_s"] += warmup * (static or 0.0) + (iterations - warmup) * rate
+        out["jobs"] += 1
+    return out

@@ -1,0 +1,84 @@
+"""What a profile's run would cost in CPU-hours, priced from today's plan and measured rates.
+
+    python tools/paper_estimate.py [--profile paper] [--rates docs/record/rates_paper.csv]
+        [--out docs/record/paper_estimate.md]
+
+Lists the profile's plan (`snakemake -n --forceall all --config profile=PROFILE`), prices each
+planned training at the measured CPU seconds per iteration of its tree, model and configuration
+(`benchmarks/training.py --profile PROFILE --variants --csv RATES`) through
+`physgs.experiments.cost.training_estimate`, and writes the paragraph the cluster page includes.
+A training without a measured rate is named and left out of the total, never guessed; jobs that
+do not train (K selection, evaluation, recovery) are not priced.
+"""
+
+from __future__ import annotations
+
+import argparse
+import subprocess
+from pathlib import Path
+
+import pandas as pd
+
+import physgs.config
+from physgs.experiments.cost import plan_jobs, training_estimate
+from physgs.report.record import format_duration
+
+
+def main() -> None:
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("--profile", default="paper")
+    ap.add_argument("--rates", default="docs/record/rates_paper.csv", type=Path)
+    ap.add_argument("--out", default="docs/record/paper_estimate.md", type=Path)
+    args = ap.parse_args()
+    dry = subprocess.run(
+        ["snakemake", "-n", "--forceall", "all", "--config", f"profile={args.profile}"],
+        capture_output=True,
+        text=True,
+        check=True,
+    ).stdout
+    planned = plan_jobs(dry)
+    cfg = physgs.config.load_workflow_config(
+        physgs.config.read_yaml("config/trees.yaml"), args.profile
+    )
+    rates_df = pd.read_csv(args.rates, dtype={"commit": str})
+    if set(rates_df["profile"]) != {args.profile}:
+        raise SystemExit(f"{args.rates}: rates of {set(rates_df['profile'])}, not {args.profile}")
+    rates = {(r.tree, r.model, r.config): r.cpu_s_per_iter for r in rates_df.itertuples()}
+    configs = sorted({c for _, _, c in rates} | set(cfg["models"]["configs"]))
+    it, warm = cfg["train"]["iterations"], cfg["train"]["warmup"]
+    est = training_estimate(planned, rates, configs, it, warm)
+    seeds = sorted(est["per_seed"])
+    per_seed = sorted(set(est["per_seed"].values()))
+    longest = max(rates_df["cpu_s_per_iter"]) * it
+    r0 = rates_df.iloc[0]
+    groups: dict[str, int] = {}  # by model and configuration, over trees
+    for (_, m, c), n in est["unrated"].items():
+        groups[f"`{m}`" + (f" {c}" if c else "")] = (
+            groups.get(f"`{m}`" + (f" {c}" if c else ""), 0) + n
+        )
+    unrated = ", ".join(f"{k} {n}" for k, n in sorted(groups.items()))
+    lines = [
+        f"The `{args.profile}` profile ({cfg['testbed']['resolution']} px, {it:,} iterations of "
+        f"which {warm:,} static warm-up, seeds {', '.join(map(str, seeds))}) plans "
+        f"**{sum(est['per_seed'].values())} trainings**, "
+        f"{' or '.join(map(str, per_seed))} per seed (`snakemake -n --forceall all --config "
+        f"profile={args.profile}`). The {est['jobs']} with a measured rate cost "
+        f"**{est['cpu_s'] / 3600:,.0f} CPU-hours** ({est['cpu_s'] / 3600 / len(seeds):,.0f} a "
+        f"seed): each its iterations at the CPU seconds per iteration of its tree, model and "
+        f"configuration, measured {r0['date']} at commit `{r0['commit']}` on {r0['cpu']}, one "
+        f"thread (`python benchmarks/training.py --profile {args.profile} --iters 2 --variants "
+        f"--csv {args.rates}`, on a machine shared with other work: CPU time, not wall time).",
+        "",
+        f"Not priced: {sum(est['unrated'].values())} trainings without a measured rate "
+        f"({unrated or 'none'}), and the jobs that do not train (K selection, evaluation, "
+        "recovery, the control). At one thread per job CPU-hours are job-hours; no run takes "
+        f"less than its longest training, {format_duration(longest)} at the slowest rate "
+        "measured.",
+        "",
+    ]
+    args.out.write_text("\n".join(lines))
+    print(args.out.read_text())
+
+
+if __name__ == "__main__":
+    main()
