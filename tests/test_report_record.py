@@ -116,7 +116,7 @@ def test_no_tracked_file_exceeds_one_megabyte():
 
 def _parse_md_table(text):
     rows = [ln.strip().strip("|").split("|") for ln in text.strip().splitlines()]
-    head, body = [c.strip() for c in rows[0]], rows[2:]
+    head, body = [c.strip().replace("<wbr>", "") for c in rows[0]], rows[2:]
     return head, [[c.strip() for c in row] for row in body]
 
 

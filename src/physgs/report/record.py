@@ -63,7 +63,7 @@ COMMANDS: tuple[tuple[str, str], ...] = (
 FIGURE_WIDTH_PX = 1200
 #: Value columns of one summary table on the page: a wider table is cut into several, its key
 #: columns repeated, so it reads in the content column.
-VALUE_COLUMNS_SHOWN = 5
+VALUE_COLUMNS_SHOWN = 4
 #: Lines of a summary (its rows times its parts) up to which it shows open on the Results page;
 #: a longer one is folded, its heading and CSV link still shown.
 OPEN_TABLE_ROWS = 30
@@ -468,7 +468,11 @@ def summary_markdown(df: pd.DataFrame) -> str:
     parts = [
         values[i : i + VALUE_COLUMNS_SHOWN] for i in range(0, len(values), VALUE_COLUMNS_SHOWN)
     ]
-    return "\n".join(markdown_table(summary[keys + cols]) for cols in parts or [[]])
+    # a long column name may break after an underscore (<wbr>: no character when copied)
+    heads = {c: str(c).replace("_", "_<wbr>") for c in summary.columns}
+    return "\n".join(
+        markdown_table(summary[keys + cols].rename(columns=heads)) for cols in parts or [[]]
+    )
 
 
 def render_pages(record_dir: str | Path) -> list[Path]:
