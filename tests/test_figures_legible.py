@@ -108,6 +108,21 @@ def test_fig_tracks_has_pixel_axes_and_titles_that_do_not_collide(caught):
     assert not any(sup.overlaps(ax.title.get_window_extent(r)) for ax in fig.axes)
 
 
+def test_fig_teaser_reads_at_page_width(caught):
+    from physgs.evaluate.trajectories import Trajectories
+
+    rng = np.random.default_rng(3)
+    F, n = 60, 50
+    gt = rng.random((2, F, 2)) * 10
+    models = ("ours", "d3dgs_wind")
+    tr = {m: Trajectories(gt, gt + 0.1, np.arange(2), 0, n) for m in models}
+    err = {m: rng.random((3, F)) for m in models}
+    FG.fig_teaser(tr, err, [1.0, 0.84, 0.71], ["x.png"], title="sparse tree, seed 0")
+    (fig,) = caught
+    _legible(fig)
+    assert fig.axes[-1].get_ylabel() == "error (px)"
+
+
 def test_small_text_is_measured_small(caught):
     """The measure can fail: a wide figure with 7-pt text reads under 9 px at the page width."""
     import matplotlib.pyplot as plt

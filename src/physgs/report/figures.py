@@ -261,8 +261,10 @@ def fig_teaser(
     panels = [("Ground truth", first.gt_px[tip])] + [
         (label(m), trajectories[m].pred_px[tip]) for m in models
     ]
-    fig = plt.figure(figsize=(3.0 * len(panels), 5.6))
-    gs = fig.add_gridspec(2, 2 * len(panels))
+    import textwrap
+
+    fig = plt.figure(figsize=(PAGE_WIDTH_IN, PAGE_WIDTH_IN / len(panels) + 4.2))
+    gs = fig.add_gridspec(2, 2 * len(panels), height_ratios=[1.0, 1.1])
     gt = first.gt_px[tip]
     pad = 0.15 * max(np.ptp(gt[:, 0]), np.ptp(gt[:, 1]), 1.0)
     lims = [gt[:, 0].min() - pad, gt[:, 0].max() + pad, gt[:, 1].max() + pad, gt[:, 1].min() - pad]
@@ -271,16 +273,19 @@ def fig_teaser(
         if i:
             ax.plot(gt[:, 0], gt[:, 1], color="k", lw=0.5, ls=":", label="ground truth")
         ax.plot(p[:n_train, 0], p[:n_train, 1], color=WINDOW, lw=0.9, label="training window")
-        ax.plot(p[n_train - 1 :, 0], p[n_train - 1 :, 1], color=TAIL, lw=1.4, label="tail")
+        ax.plot(
+            p[n_train - 1 :, 0], p[n_train - 1 :, 1], color=TAIL, lw=1.4, label="beyond the window"
+        )
         ax.set_xlim(lims[0], lims[1])
         ax.set_ylim(lims[2], lims[3])  # image y points down
         ax.set_aspect("equal", adjustable="box")
-        ax.set_title(name, fontsize=9)
-        ax.set_xlabel("x (px)")
+        ax.set_title(textwrap.fill(name, 16), fontsize=FONT_PT)
+        ax.set_xlabel("x (px)", fontsize=FONT_PT)
+        ax.tick_params(labelsize=FONT_PT)
         if i == 0:
-            ax.set_ylabel("y (px)")
-        if i == len(panels) - 1:
-            ax.legend(fontsize=6)
+            ax.set_ylabel("y (px)", fontsize=FONT_PT)
+        if i == len(panels) - 1:  # one key for the paths, right of the last panel
+            ax.legend(fontsize=FONT_PT, loc="upper left", bbox_to_anchor=(1.02, 1.0), frameon=False)
     unseen = unseen % len(conditions)
     half = len(panels)
     for j, (c, lab) in enumerate(
@@ -300,12 +305,14 @@ def fig_teaser(
                 label=f"{label(m)} (mean {e.mean():.1f} px)",
             )
         ax.axvline(n_train + 0.5, color="k", lw=0.8, ls=":")
-        ax.set_title(f"canopy-centroid error, {lab}", fontsize=9)
-        ax.set_xlabel("frame")
-        ax.set_ylabel("px")
-        ax.legend(fontsize=7)
+        ax.set_title(f"canopy-centroid error, {lab}", fontsize=FONT_PT)
+        ax.set_xlabel("frame", fontsize=FONT_PT)
+        ax.set_ylabel("error (px)", fontsize=FONT_PT)
+        ax.tick_params(labelsize=FONT_PT)
+        # below its panel, never over the curves
+        ax.legend(fontsize=FONT_PT, loc="upper center", bbox_to_anchor=(0.5, -0.22), frameon=False)
     if title:
-        fig.suptitle(title)
+        fig.suptitle(title, fontsize=FONT_PT + 1)
     fig.tight_layout()
     save_figure(fig, outputs)
 
