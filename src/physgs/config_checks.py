@@ -256,7 +256,7 @@ def tracks_is_runnable(cfg: dict) -> Iterator[Problem]:
 
 def oma_is_runnable(cfg: dict) -> Iterator[Problem]:
     """The training window carries the SSI model the output-only analysis asks for: 4 x
-    block_rows samples at least, and an order no higher than block_rows x components (the
+    block_rows samples at least, and an order no higher than (block_rows - 1) x components (the
     channels SSI reads). Fewer channels than components are only known once the video is seen:
     the job then stops, naming the key ([`physgs.oma.ssi.check_record`][]).
 

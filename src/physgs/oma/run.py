@@ -18,7 +18,14 @@ import numpy as np
 from physgs.atomic import atomic_path, write_json
 from physgs.oma.channels import Channels, FlowSettings, flow_channels, principal_channels
 from physgs.oma.parts import PartModes, assign_modes, cell_parts
-from physgs.oma.ssi import Modes, SSISettings, Stabilisation, identify_records
+from physgs.oma.ssi import (
+    Modes,
+    RecordError,
+    SSISettings,
+    Stabilisation,
+    check_record,
+    identify_records,
+)
 
 
 @dataclass(frozen=True)
@@ -89,6 +96,35 @@ def projected_records(videos: list[np.ndarray], background, s: OMASettings) -> R
     return Records(chans[0], [y @ load.T for y in ys], load)
 
 
+def check_channels(rec: Records, s: OMASettings) -> None:
+    """Stop when the records the video gave cannot carry the SSI model, naming why.
+
+    The config check at load ([`physgs.config_checks.oma_is_runnable`][]) assumes
+    ``oma/components`` channels; the video can give fewer (two per cell of ``oma/flow/cell_px``
+    px whose foreground share reaches ``oma/flow/min_fg``), which only the frames tell.
+
+    Args:
+        rec: the projected records.
+        s: the analysis' settings.
+
+    Raises:
+        RecordError: naming ``oma/ssi/...`` and the cells, channels and components behind it.
+    """
+    n_samples = min(y.shape[0] for y in rec.projected)
+    n_read = rec.projected[0].shape[1]
+    try:
+        check_record(n_samples, n_read, s.ssi)
+    except RecordError as e:
+        n_cells = rec.channels.n_cells
+        raise RecordError(
+            e.key,
+            f"{e.msg}. The video gives {n_cells} cell(s) of oma/flow/cell_px = {s.flow.cell_px} px"
+            f" with a foreground share of at least oma/flow/min_fg = {s.flow.min_fg}, so"
+            f" {2 * n_cells} channels and {n_read} components for SSI (oma/components ="
+            f" {s.components}): lower {e.key}, or lower oma/flow/cell_px for more cells",
+        ) from None
+
+
 def in_bounds(m: Modes, omega_hz: tuple[float, float]) -> np.ndarray:
     """Which modes lie inside ours' frequency bounds.
 
@@ -123,6 +159,7 @@ def identify_video(
 
     t0 = time.perf_counter()
     rec = projected_records(videos, background, s)
+    check_channels(rec, s)
     m = identify_records(rec.projected, fps, s.ssi)
     keep = in_bounds(m, s.omega_hz)
     shape = m.shape[keep] @ rec.load  # [M, C] over the cell channels

@@ -54,8 +54,10 @@ def check_record(n_samples: int, n_channels: int, s: SSISettings, key: str = "om
 
     SSI-cov needs ``2 * block_rows`` lags with samples to spare (each covariance averages
     ``n_samples - 2 block_rows`` products; at least as many again as lags), and a model order no
-    higher than the Hankel matrix's rank bound ``block_rows * n_channels``. Raises ValueError
-    naming the key (``<key>/block_rows`` or ``<key>/order_max``).
+    higher than ``(block_rows - 1) * n_channels``: the rows of the observability matrix less one
+    block, from which pyOMA-2's ``SSI_fast`` takes the square ``R[:n, :n]`` of each order n (a
+    higher order fails there with "Last 2 dimensions of the array must be square"). Raises
+    ValueError naming the key (``<key>/block_rows`` or ``<key>/order_max``).
 
     Args:
         n_samples: samples per channel in the record.
@@ -74,12 +76,12 @@ def check_record(n_samples: int, n_channels: int, s: SSISettings, key: str = "om
             f"= {s.block_rows} needs a record of at least 4 x {s.block_rows} ="
             f" {4 * s.block_rows} samples; this one has {n_samples}",
         )
-    if s.order_max > s.block_rows * n_channels:
+    if s.order_max > (s.block_rows - 1) * n_channels:
         raise RecordError(
             f"{key}/order_max",
-            f"= {s.order_max} exceeds block_rows x channels ="
-            f" {s.block_rows} x {n_channels} = {s.block_rows * n_channels}, the highest order"
-            " the Hankel matrix can carry",
+            f"= {s.order_max} exceeds (block_rows - 1) x channels ="
+            f" {s.block_rows - 1} x {n_channels} = {(s.block_rows - 1) * n_channels}, the highest"
+            " order the Hankel matrix can carry",
         )
     if s.min_stable > s.order_max // s.order_step:
         raise RecordError(
