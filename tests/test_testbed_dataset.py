@@ -105,6 +105,32 @@ def test_missing_and_corrupt_files_name_the_file_and_fix(tmp_path, tiny):
         load_truth(tmp_path / "truth.npz")
 
 
+
+@pytest.mark.parametrize(
+    "key, edit, says",
+    [
+        ("heldout_frames", lambda a: np.where(a == a.flat[0], np.nan, a), "NaN or infinite"),
+        ("heldout_camera_viewmat", lambda a: a + np.inf, "NaN or infinite"),
+        ("wind", lambda a: a * np.nan, "NaN or infinite"),
+        ("background", lambda a: a + np.nan, "NaN or infinite"),
+        ("frames", lambda a: a.astype(np.float32), "dtype float32, expected uint8"),
+        ("heldout_masks", lambda a: a.astype(np.float64), "dtype float64, expected bool"),
+        ("heldout_frame_idx", lambda a: a + 0.5, "dtype float64, expected integer"),
+    ],
+)
+def test_every_array_of_observed_is_checked_naming_the_file_and_the_array(
+    tmp_path, tiny, key, edit, says
+):
+    _, d = tiny
+    z = dict(np.load(d / "observed.npz"))
+    z[key] = edit(z[key].astype(np.float64) if "NaN" in says else z[key])
+    np.savez(tmp_path / "observed.npz", **z)
+    with pytest.raises(DatasetError) as e:
+        load_observed(tmp_path / "observed.npz")
+    msg = str(e.value)
+    assert str(tmp_path / "observed.npz") in msg and f"{key} " in msg and says in msg, msg
+    assert "rebuild" in msg
+
 def _box(w, d, h):
     g = np.array(np.meshgrid([-w / 2, w / 2], [-d / 2, d / 2], [0.0, h])).reshape(3, -1).T
     return g + [0.3, -0.2, 0.0]

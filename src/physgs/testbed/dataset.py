@@ -479,6 +479,41 @@ OBSERVED_KEYS = (
 )
 
 
+#: what each array of observed.npz holds (numpy's ``dtype.kind``): pixels uint8 (checked
+#: exactly), masks "b", counts, indices and sizes "i" or "u", everything else real numbers
+#: ("f", "i" or "u"; floats must all be finite)
+OBSERVED_KINDS = {
+    **dict.fromkeys(("frames", "heldout_frames"), "u1"),
+    **dict.fromkeys(("masks", "heldout_masks"), "b"),
+    **dict.fromkeys(
+        (
+            "fps",
+            "n_train",
+            "n_tail",
+            "lead_in_frames",
+            "heldout_frame_idx",
+            "train_camera_size",
+            "heldout_camera_size",
+        ),
+        "iu",
+    ),
+}
+
+
+def _check_arrays(path, d: dict) -> None:
+    """Every array of observed.npz is of its kind (``OBSERVED_KINDS``; real numbers otherwise)
+    and finite: a float array with NaN in place of pixels fails here, not in the renderer's checks."""
+    for k in OBSERVED_KEYS:
+        a = np.asarray(d[k])
+        want = OBSERVED_KINDS.get(k, "fiu")
+        if a.dtype.kind in "fc" and not np.isfinite(a).all():
+            n = int(np.size(a) - np.isfinite(a).sum())
+            _check(path, False, f"{k} holds {n} NaN or infinite value(s) (dtype {a.dtype})")
+        ok = a.dtype == np.uint8 if want == "u1" else a.dtype.kind in want
+        expected = {"u1": "uint8", "b": "bool", "iu": "integer", "fiu": "real numbers"}[want]
+        _check(path, ok, f"{k} has dtype {a.dtype}, expected {expected}")
+
+
 def load_observed(path: Path | str) -> Observed:
     """Load and validate ``observed.npz``.
 
@@ -489,9 +524,12 @@ def load_observed(path: Path | str) -> Observed:
         The [`Observed`][physgs.testbed.dataset.Observed] dataset.
 
     Raises:
-        DatasetError: the file is missing or invalid (the message names the file and the fix).
+        DatasetError: the file is missing or invalid: an array of the wrong dtype, NaN or
+            infinity in any array, shapes that disagree (the message names the file, the array
+            and the fix).
     """
     d = _open(path, OBSERVED_KEYS)
+    _check_arrays(path, d)
     C, F = len(d["conditions"]), int(d["n_train"]) + int(d["n_tail"])
     L = int(d["lead_in_frames"])
     _check(path, d["wind"].shape == (C, L + F), f"wind shape {d['wind'].shape} != ({C}, {L + F})")
@@ -514,13 +552,13 @@ def load_observed(path: Path | str) -> Observed:
     )
     _check(
         path,
-        d["canonical_xyz"].ndim == 2 and d["canonical_xyz"].shape[1] == 3,
-        "canonical_xyz not [N, 3]",
+        d["heldout_masks"].shape == d["heldout_frames"].shape[:4],
+        "held-out masks do not match held-out frames",
     )
     _check(
         path,
-        bool(np.isfinite(d["wind"]).all() and np.isfinite(d["canonical_xyz"]).all()),
-        "non-finite wind or canonical_xyz",
+        d["canonical_xyz"].ndim == 2 and d["canonical_xyz"].shape[1] == 3,
+        "canonical_xyz not [N, 3]",
     )
     cam = Camera.from_dict(
         {k: d[f"train_camera_{k}"] for k in ("viewmat", "intrinsics", "size", "near")}
