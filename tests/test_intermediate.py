@@ -1,13 +1,19 @@
 """A corrupt intermediate file (tracks, fits, evaluations, records) is named with the rule that
-rebuilds it and removed, so the next run of the same command rebuilds it instead of failing again
-on the same bytes (physgs.intermediate)."""
+rebuilds it and removed, so no later run fails again on the same bytes, and its message gives the
+flag that remakes it and what is made from it (physgs.intermediate)."""
 
 from __future__ import annotations
+
+import os
+import re
+import subprocess
+import sys
 
 import numpy as np
 import pytest
 
 from physgs.intermediate import IntermediateFileError, read_json, read_npz
+from workflow_helpers import ROOT
 
 
 def _tracks_file(path):
@@ -82,3 +88,63 @@ def test_a_good_file_is_kept_and_read(tmp_path):
     assert path.exists()
     (tmp_path / "b.json").write_text('{"x": 1}')
     assert read_json(tmp_path / "b.json", ("x",), rule="r") == {"x": 1}
+
+
+SNAKEFILE = """
+rule mid:
+    output:
+        "mid.json",
+    run:
+        import json
+
+        json.dump({"v": 1}, open(output[0], "w"))
+        open("mid.made", "a").write("x")
+
+
+rule fit:
+    input:
+        "mid.json",
+    output:
+        "fit.txt",
+    run:
+        from physgs.intermediate import read_json
+
+        open(output[0], "w").write(str(read_json(input[0], ["v"], rule="mid")["v"]))
+
+
+rule out:
+    input:
+        "fit.txt",
+    output:
+        "out.txt",
+    shell:
+        "cp {input} {output}"
+"""
+
+
+def test_the_command_in_the_message_remakes_the_file_and_what_is_made_from_it(tmp_path):
+    """Snakemake remakes a missing file only when a job that reads it has to run: after the
+    reading job (fit) stopped on it, the same command has nothing to do, the target made from it
+    (out.txt) being up to date. The command the message gives remakes it and what is made from
+    it."""
+    (tmp_path / "Snakefile").write_text(SNAKEFILE)
+    env = {**os.environ, "PYTHONPATH": str(ROOT / "src")}
+
+    def snakemake(*args):
+        cmd = [sys.executable, "-m", "snakemake", "--cores", "1", "out.txt", *args]
+        r = subprocess.run(cmd, cwd=tmp_path, env=env, capture_output=True, text=True, timeout=120)
+        return r.returncode, r.stdout + r.stderr
+
+    assert snakemake()[0] == 0 and (tmp_path / "mid.made").read_text() == "x"
+    (tmp_path / "mid.json").write_text("{not json")  # damaged (and newer) after fit.txt was made
+    rc, failed = snakemake()
+    assert rc != 0 and "mid.json is corrupt" in failed and "rule `mid`" in failed, failed
+    assert not (tmp_path / "mid.json").exists()
+    rc, log = snakemake()  # the same command: nothing to do, mid.json stays missing
+    assert rc == 0 and "Nothing to be done" in log and not (tmp_path / "mid.json").exists()
+    flags = re.findall(r"rerun this command with `([^`]+)` added", failed)
+    assert flags, f"the message gives no command that remakes the file:\n{failed}"
+    rc, log = snakemake(*flags[0].split())
+    assert rc == 0, log
+    assert (tmp_path / "mid.made").read_text() == "xx" and (tmp_path / "fit.txt").read_text() == "1"
+    assert "localrule out:" in log  # what is made from it was remade

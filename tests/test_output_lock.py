@@ -204,4 +204,3 @@ def test_a_second_run_on_the_same_output_leaves_the_holders_output_whole(tmp_pat
     assert "another job is making x.txt now" in out["c"] and "taken as made" in out["c"]
     log = (tmp_path / "slow.log").read_text()  # C's Snakemake deleted A's log as C's job began
     assert log.startswith(f"made by {a_pid}\n") and "taken as made" in log, log
-

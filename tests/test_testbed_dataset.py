@@ -105,7 +105,6 @@ def test_missing_and_corrupt_files_name_the_file_and_fix(tmp_path, tiny):
         load_truth(tmp_path / "truth.npz")
 
 
-
 @pytest.mark.parametrize(
     "key, edit, says",
     [
@@ -130,6 +129,7 @@ def test_every_array_of_observed_is_checked_naming_the_file_and_the_array(
     msg = str(e.value)
     assert str(tmp_path / "observed.npz") in msg and f"{key} " in msg and says in msg, msg
     assert "rebuild" in msg
+
 
 def _box(w, d, h):
     g = np.array(np.meshgrid([-w / 2, w / 2], [-d / 2, d / 2], [0.0, h])).reshape(3, -1).T

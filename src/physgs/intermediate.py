@@ -4,8 +4,11 @@ that names the file and the rule that rebuilds it, and removes a file it cannot 
 Every intermediate file is written atomically ([`physgs.atomic`][physgs.atomic]), so a corrupt one
 comes from outside the pipeline (a full disk, a copy cut short, a hand edit). Snakemake reruns a job
 only when its output is missing or older than its inputs, so a corrupt file left in place would be
-read again, and fail again, by every later run. The loader therefore deletes it before raising:
-rerunning the same command rebuilds it with the rule named in the message, then goes on.
+read again, and fail again, by every later run. The loader therefore deletes it before raising.
+Snakemake remakes a missing file only when a job that reads it has to run: when what was made from
+it is up to date (made before it was damaged), rerunning the same command has nothing to do. The
+message therefore gives the flag that remakes it and what is made from it in any case:
+``--forcerun <file>`` added to the command ([`remake_hint`][physgs.intermediate.remake_hint]).
 """
 
 from __future__ import annotations
@@ -22,6 +25,24 @@ class IntermediateFileError(ValueError):
     """A missing or unreadable intermediate file; the message names the file and its rule."""
 
 
+def remake_hint(path: str | Path) -> str:
+    """How to remake ``path`` and everything made from it with the settings of the command that
+    stopped: ``--forcerun <path>`` added to that command (Snakemake runs the job that makes it
+    even if the file is there, and every job of the command downstream of it).
+
+    Args:
+        path: the file, as the workflow names it.
+
+    Returns:
+        The sentence to end an error message with.
+    """
+    return (
+        f"to remake it and what is made from it, rerun this command with `--forcerun {path}` "
+        "added (as it was, the command remakes it only if a job that reads it still has to run: "
+        "Snakemake leaves a missing file alone when what was made from it is up to date)"
+    )
+
+
 def refuse(path: str | Path, what: str, rule: str) -> IntermediateFileError:
     """Remove the unreadable ``path`` and say so: the error to raise.
 
@@ -36,8 +57,7 @@ def refuse(path: str | Path, what: str, rule: str) -> IntermediateFileError:
     path = Path(path)
     path.unlink(missing_ok=True)
     return IntermediateFileError(
-        f"{path} {what}; it was removed, so rerunning the same snakemake command rebuilds it "
-        f"(rule `{rule}`) and goes on"
+        f"{path} {what}; it was removed (rule `{rule}` makes it); {remake_hint(path)}"
     )
 
 
@@ -96,7 +116,7 @@ def read_npz(path: str | Path, keys: Iterable[str], *, rule: str) -> dict[str, n
 
     Raises:
         IntermediateFileError: the file is missing, or is not a readable ``.npz`` of plain arrays
-            holding ``keys`` (then it is removed first, so the next run rebuilds it).
+            holding ``keys`` (then it is removed first, and the message says how to remake it).
     """
 
     def error(problem: str, detail: str) -> IntermediateFileError:
@@ -124,7 +144,7 @@ def read_json(path: str | Path, keys: Iterable[str] = (), *, rule: str) -> dict:
 
     Raises:
         IntermediateFileError: the file is missing, corrupt, not a mapping or lacks a key (a
-            file that is there is then removed, so rerunning the same command rebuilds it).
+            file that is there is then removed, and the message says how to remake it).
     """
     path = Path(path)
     if not path.is_file():

@@ -165,7 +165,8 @@ def evaluate_checkpoint(
     if bad:
         raise FloatingPointError(
             f"evaluation produced non-finite scores for {bad}; "
-            "the checkpoint is likely corrupt: delete it and retrain"
+            "the checkpoint is likely corrupt: to retrain it and remake what is made from it, "
+            "rerun this command with `--forcerun <the checkpoint's path>` added"
         )
     res.save(eval_path)
     traj.save(traj_path)

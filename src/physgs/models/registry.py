@@ -24,6 +24,7 @@ from typing import TYPE_CHECKING, Iterable
 import numpy as np
 
 from physgs.atomic import atomic_path
+from physgs.intermediate import remake_hint
 
 if TYPE_CHECKING:
     from physgs.models.base import BaseModel
@@ -563,10 +564,14 @@ def read_checkpoint(path) -> dict:
         blob = torch.load(path, map_location="cpu", weights_only=True)
     except Exception as e:  # noqa: BLE001 - any unpickling failure means a corrupt file
         raise ValueError(
-            f"checkpoint {path} is corrupt or not a physgs checkpoint ({e}); delete it and retrain"
+            f"checkpoint {path} is corrupt or not a physgs checkpoint ({e}); to retrain it "
+            f"{remake_hint(path).removeprefix('to remake it ')}"
         ) from None
     if not isinstance(blob, dict) or blob.get("format") != FORMAT:
-        raise ValueError(f"{path} is not a {FORMAT} checkpoint; delete it and retrain")
+        raise ValueError(
+            f"{path} is not a {FORMAT} checkpoint; to retrain it "
+            f"{remake_hint(path).removeprefix('to remake it ')}"
+        )
     return blob
 
 

@@ -140,7 +140,10 @@ class TrueMotion:
         """
         missing = [k for k in BUFFERS if prefix + k not in sd]
         if missing:
-            raise ValueError(f"truth_motion checkpoint lacks {missing}; delete it and retrain")
+            raise ValueError(
+                f"truth_motion checkpoint lacks {missing}: to retrain it, rerun this command with "
+                "`--forcerun <the checkpoint's path>` added"
+            )
         return TrueMotion(**{k: sd[prefix + k].cpu().numpy() for k in BUFFERS})
 
 
