@@ -469,11 +469,56 @@ def check(
         ConfigError: naming every problem's key path, its source and the fix.
     """
     profile = cfg.get("profile")
-    lines = [
-        _line(tuple(path), msg, _attribute(tuple(path), raw, profile, list(layers), source), source)
-        for path, msg in config_checks.problems(cfg)
-    ]
+    flags = [(s, v) for s, v in layers if _beats_profile(v)]
+    lines = []
+    for path, msg, read in _problems_and_reads(cfg):
+        line, src = _line(
+            tuple(path), msg, _attribute(tuple(path), raw, profile, list(layers), source), source
+        )
+        # a cross-key problem can come from another key than the one to change: name what the
+        # command line set among the keys its check read (--set train.iterations=20 against the
+        # profile's warm-up is the command line's doing, not config/trees.yaml's)
+        named = [(p, _source_of(p, flags, "")) for p in read if p != tuple(path)]
+        named = [(p, s) for p, s in named if s and s != src]
+        if named:
+            said = ", ".join(f"{_fmt(p)} = {_value_at(cfg, p)} from {s}" for p, s in named)
+            line = f"{line} (with {said})"
+            src = " or ".join(dict.fromkeys([*(s for _, s in named), src]))
+        lines.append((line, src))
     _raise(lines, source, profile)
+
+
+class _Reads(dict):
+    """A config mapping that records the key path of every leaf read through it: what a
+    cross-key check looked at."""
+
+    def __init__(self, d: dict, path: tuple, log: dict):
+        super().__init__(d)
+        self._path, self._log = path, log
+
+    def __getitem__(self, k):
+        v, p = super().__getitem__(k), self._path + (k,)
+        if isinstance(v, dict):
+            return _Reads(v, p, self._log)
+        self._log[p] = None  # ordered, once
+        return v
+
+    def get(self, k, default=None):
+        return self[k] if k in self else default
+
+
+def _problems_and_reads(cfg: dict) -> Iterator[tuple[tuple, str, list[tuple]]]:
+    """Each problem of ``config_checks.CHECKS`` with the key paths its check had read by then."""
+    for chk in config_checks.CHECKS:
+        log: dict = {}
+        for path, msg in chk(_Reads(cfg, (), log)):
+            yield tuple(path), msg, list(log)
+
+
+def _value_at(cfg: dict, path: tuple):
+    for k in path:
+        cfg = cfg[k]
+    return cfg
 
 
 # --------------------------------------------------------------------------------------------

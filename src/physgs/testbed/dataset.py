@@ -32,7 +32,7 @@ from tqdm import tqdm
 from physgs.camera import Camera
 from physgs.intermediate import load_npz
 from physgs.testbed import kinematics, physics, scene, variant, weberpenn, wind as windmod
-from physgs.testbed.mesh import TreeMesh, build_mesh
+from physgs.testbed.mesh import TreeMesh, build_mesh, mesh_vertex_count
 
 FORMAT_VERSION = 2  # 2: Gaussians in a seeded random order (gaussian_vertex), fill_height framing
 REBUILD = "rebuild it with `snakemake --cores 2 testbed` (delete the bad file first)"
@@ -133,6 +133,57 @@ class TreeSim:
     conditions: np.ndarray  # [C]
 
 
+def tree_geometry(tb: dict, preset: dict, *, seed: int, tree: str):
+    """The tree's skeleton and mesh, as the testbed builds them (no physics, wind or frames).
+
+    Args:
+        tb: the resolved ``testbed`` config section.
+        preset: ``presets.<tree>``.
+        seed: the run's seed.
+        tree: the tree's name (seeds its streams).
+
+    Returns:
+        (Skeleton, TreeMesh): the bones and stems, and the mesh.
+
+    Raises:
+        PresetError: for an inconsistent preset.
+        MeshBudgetError: when the vertex budget cannot hold the tubes.
+    """
+    skel = weberpenn.generate(preset, seed=seed, name=tree)
+    leaves = preset.get("leaves") or {}
+    mesh = build_mesh(
+        skel,
+        target_vertices=int(tb["vertices"][tree]),
+        leaf_fraction=float(leaves.get("fraction", 0.0)),
+        leaf_scale=float(leaves.get("scale", 0.1)),
+        seed_seq=_seed(seed, tree, "mesh"),
+    )
+    return skel, mesh
+
+
+def gaussian_count(tb: dict, preset: dict, skeleton, tree: str) -> int:
+    """The Gaussians the tree has: its mesh's vertex count, which can fall a little short of
+    ``testbed/vertices`` (385 of 400 on the quick sparse tree), computed without the mesh.
+
+    Args:
+        tb: the resolved ``testbed`` config section.
+        preset: ``presets.<tree>``.
+        skeleton (Skeleton): the tree's skeleton (``weberpenn.generate``).
+        tree: the tree's name.
+
+    Returns:
+        The count.
+
+    Raises:
+        MeshBudgetError: when the vertex budget cannot hold the tubes.
+    """
+    return mesh_vertex_count(
+        skeleton,
+        target_vertices=int(tb["vertices"][tree]),
+        leaf_fraction=float((preset.get("leaves") or {}).get("fraction", 0.0)),
+    )
+
+
 def simulate_tree(tb: dict, preset: dict, *, seed: int, tree: str) -> TreeSim:
     """Geometry, physics and wind for one tree (everything but the frames).
 
@@ -157,15 +208,7 @@ def simulate_tree(tb: dict, preset: dict, *, seed: int, tree: str) -> TreeSim:
         PresetError: for an inconsistent preset.
         MeshBudgetError: when the vertex budget cannot hold the tubes.
     """
-    skel = weberpenn.generate(preset, seed=seed, name=tree)
-    leaves = preset.get("leaves") or {}
-    mesh = build_mesh(
-        skel,
-        target_vertices=int(tb["vertices"][tree]),
-        leaf_fraction=float(leaves.get("fraction", 0.0)),
-        leaf_scale=float(leaves.get("scale", 0.1)),
-        seed_seq=_seed(seed, tree, "mesh"),
-    )
+    skel, mesh = tree_geometry(tb, preset, seed=seed, tree=tree)
     omega, c, clamped = physics.calibrate_omega(skel.radius, skel.length, tb["band_hz"])
     B = skel.n_bones
     # per-bone zeta (damping variant) from its own seeded stream: it changes nothing else

@@ -115,6 +115,29 @@ def _frames(points: np.ndarray, n_rings: int, rings_per_segment: int):
     return centres, dirs, normals, s
 
 
+def mesh_vertex_count(skeleton: Skeleton, *, target_vertices: int, leaf_fraction: float) -> int:
+    """The vertex count [`build_mesh`][physgs.testbed.mesh.build_mesh] gives, without building it:
+    the tubes at the chosen resolution, plus four vertices per leaf quad filling the rest of
+    the budget. It can fall short of ``target_vertices`` (the tubes' count is the largest the
+    resolutions reach within their budget; leaves come in fours).
+
+    Args:
+        skeleton: the tree's bones and stems.
+        target_vertices: the vertex budget (tubes and leaves together).
+        leaf_fraction: share of the budget given to leaves.
+
+    Returns:
+        The mesh's vertex count (= the Gaussians the models place).
+
+    Raises:
+        MeshBudgetError: when the budget cannot hold the tubes.
+    """
+    tube_budget = int(round(target_vertices * (1.0 - leaf_fraction)))
+    n_tube = tube_vertex_count(skeleton.stems, *choose_resolution(skeleton.stems, tube_budget))
+    n_leaves = max(0, (target_vertices - n_tube) // 4) if leaf_fraction > 0 else 0
+    return n_tube + 4 * n_leaves
+
+
 def build_mesh(
     skeleton: Skeleton,
     *,
