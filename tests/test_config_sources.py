@@ -28,7 +28,9 @@ def test_a_cross_key_refusal_names_the_config_flag_that_set_the_other_key():
     assert "models/omega_search/until" in msg and "train/iterations = 20 from --config" in msg
     assert msg.splitlines()[-1] == "Fix --config or config/trees.yaml.", msg
     msg = _refusal(command_line={"models": {"configs": {"single": {"K": 1}}}})
-    assert "parts_study/k_candidates/0" in msg and "models/configs/single/K = 1 from --config" in msg
+    assert (
+        "parts_study/k_candidates/0" in msg and "models/configs/single/K = 1 from --config" in msg
+    )
 
 
 def test_a_cross_key_refusal_names_the_set_flag_that_set_the_other_key():
