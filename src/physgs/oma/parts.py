@@ -19,13 +19,16 @@ import numpy as np
 @dataclass(frozen=True)
 class PartModes:
     """part_of_cell [N]; mode_part [M] the part each mode belongs to; omega [K] rad/s and zeta
-    [K] per part (NaN where ``estimated`` is False); mode_of_part [K] (-1: none)."""
+    [K] per part (NaN where ``estimated`` is False); mode_of_part [K] (-1: none); omega_std [K]
+    rad/s and zeta_std [K]: the part's mode's standard deviations (NaN where none)."""
 
     part_of_cell: np.ndarray
     mode_part: np.ndarray
     mode_of_part: np.ndarray
     omega: np.ndarray
     zeta: np.ndarray
+    omega_std: np.ndarray
+    zeta_std: np.ndarray
 
     @property
     def estimated(self) -> np.ndarray:
@@ -64,6 +67,8 @@ def assign_modes(
     channel_cell: np.ndarray,
     part_of_cell: np.ndarray,
     K: int,
+    freq_std: np.ndarray | None = None,
+    zeta_std: np.ndarray | None = None,
 ) -> PartModes:
     """Each mode to the part it moves most, each part to its strongest mode.
 
@@ -74,10 +79,12 @@ def assign_modes(
         channel_cell: [C] the cell of each channel.
         part_of_cell: [N] part of each cell, in [0, K).
         K: number of parts.
+        freq_std: [M] the modes' frequency standard deviations, Hz (None: NaN).
+        zeta_std: [M] the modes' damping standard deviations (None: NaN).
 
     Returns:
-        The [`PartModes`][physgs.oma.parts.PartModes]: omega (rad/s) and zeta per part, NaN where
-            a part has no mode.
+        The [`PartModes`][physgs.oma.parts.PartModes]: omega (rad/s), zeta and their standard
+            deviations per part, NaN where a part has no mode.
     """
     shape = np.asarray(shape)
     M = int(np.asarray(freq_hz).size)
@@ -101,6 +108,17 @@ def assign_modes(
         else np.full(K, np.nan)
     )
     mode_part = share.argmax(axis=1) if M else np.zeros(0, np.int64)
+
+    def per_part(x) -> np.ndarray:  # [M] -> [K], NaN where a part has no mode
+        x = np.full(M, np.nan) if x is None else np.asarray(x, float)
+        return np.where(est, x[np.maximum(mode_of_part, 0)], np.nan) if M else np.full(K, np.nan)
+
     return PartModes(
-        np.asarray(part_of_cell), np.asarray(mode_part, np.int64), mode_of_part, omega, zet
+        np.asarray(part_of_cell),
+        np.asarray(mode_part, np.int64),
+        mode_of_part,
+        omega,
+        zet,
+        2 * np.pi * per_part(freq_std),
+        per_part(zeta_std),
     )

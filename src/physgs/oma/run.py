@@ -11,12 +11,13 @@ like with like.
 from __future__ import annotations
 
 import json
-from dataclasses import asdict, dataclass
+from dataclasses import asdict, dataclass, replace
 
 import numpy as np
 
 from physgs.atomic import atomic_path, write_json
 from physgs.oma.channels import Channels, FlowSettings, flow_channels, principal_channels
+from physgs.oma.intervals import coverage, interval_hits, sigma_trusted
 from physgs.oma.parts import PartModes, assign_modes, cell_parts
 from physgs.oma.ssi import (
     Modes,
@@ -162,10 +163,8 @@ def identify_video(
     check_channels(rec, s)
     m = identify_records(rec.projected, fps, s.ssi)
     keep = in_bounds(m, s.omega_hz)
-    shape = m.shape[keep] @ rec.load  # [M, C] over the cell channels
-    modes = Modes(
-        m.freq_hz[keep], m.zeta[keep], shape, m.n_stable[keep], m.freq_spread[keep], m.stab
-    )
+    kept = m.select(keep)
+    modes = replace(kept, shape=kept.shape @ rec.load)  # [M, C] over the cell channels
     return Identification(rec.channels, modes, time.perf_counter() - t0)
 
 
@@ -189,7 +188,11 @@ def save_identification(path, ident: Identification, s: OMASettings) -> None:
                 shape=m.shape,
                 n_stable=m.n_stable,
                 freq_spread=m.freq_spread,
+                freq_std=m.freq_std,
+                zeta_std=m.zeta_std,
                 stab_freq_hz=m.stab.freq_hz,
+                stab_freq_std=m.stab.freq_std,
+                stab_zeta_std=m.stab.zeta_std,
                 stab_stable=m.stab.stable,
                 stab_orders=m.stab.orders,
                 cell_xy=ch.cell_xy,
@@ -215,7 +218,15 @@ def load_identification(path) -> Identification:
             d["shape"],
             d["n_stable"],
             d["freq_spread"],
-            Stabilisation(d["stab_freq_hz"], d["stab_stable"], d["stab_orders"]),
+            Stabilisation(
+                d["stab_freq_hz"],
+                d["stab_stable"],
+                d["stab_orders"],
+                d["stab_freq_std"],
+                d["stab_zeta_std"],
+            ),
+            d["freq_std"],
+            d["zeta_std"],
         )
         ch = Channels(np.zeros((0, d["channel_cell"].size)), d["cell_xy"], d["channel_cell"])
         return Identification(ch, modes, float(d["seconds"]))
@@ -238,7 +249,9 @@ def part_modes(ident: Identification, K: int, seed: int, n_init: int) -> PartMod
     """
     parts = cell_parts(ident.channels.cell_xy, K, seed, n_init)
     m = ident.modes
-    return assign_modes(m.freq_hz, m.zeta, m.shape, ident.channels.channel_cell, parts, K)
+    return assign_modes(
+        m.freq_hz, m.zeta, m.shape, ident.channels.channel_cell, parts, K, m.freq_std, m.zeta_std
+    )
 
 
 def recover_oma(
@@ -309,6 +322,7 @@ def recover_oma(
     if damping is not None:
         rec = with_damping_scores(rec, zeta, truth, damping)
     block = {
+        **interval_block(pm, rec.match, truth),
         "n_parts": int(K),
         "n_modes": int(pm.mode_part.size),
         "n_no_estimate": int((~est).sum()),
@@ -317,6 +331,51 @@ def recover_oma(
         "median_zeta": float(np.median(pm.zeta[est])) if est.any() else float("nan"),
     }
     return rec, block
+
+
+def interval_block(pm: PartModes, match, truth) -> dict:
+    """Each part's estimate with its standard deviations, the coverage of the trusted parts'
+    95% intervals (evaluation: the matched bones' true omega and zeta), and how many parts
+    each trust rule keeps (the matcher's trajectory correlation; the modes' own relative
+    damping sigma, [`sigma_trusted`][physgs.oma.intervals.sigma_trusted]).
+
+    Args:
+        pm: the parts' modes (zeta before ours' bounds clip it).
+        match (MatchResult): the matcher's result (``bone``, ``trusted``).
+        truth (Truth): the ground truth (``omega`` [B] rad/s, ``zeta`` [B]).
+
+    Returns:
+        ``omega``, ``zeta``, ``omega_std``, ``zeta_std`` (per part, NaN where none),
+            ``sigma_trusted`` (per part), ``n_sigma_trusted``, ``n_both_trusted`` and
+            ``coverage`` (``omega`` and ``zeta``: k, n, fraction and its 95% interval over the
+            matcher's trusted parts with an estimate).
+    """
+    bone = np.asarray(match.bone)
+    scored = np.asarray(match.trusted) & pm.estimated
+    w_true = np.asarray(truth.omega, np.float64)[bone]
+    z_true = np.asarray(truth.zeta, np.float64)[bone]
+    s_trust = sigma_trusted(pm.zeta, pm.zeta_std)
+
+    def nan_list(x):  # NaN where a part has no mode (written as NaN, as the record's others)
+        return [float(v) for v in np.asarray(x, float)]
+
+    return {
+        "omega": nan_list(pm.omega),
+        "zeta": nan_list(pm.zeta),
+        "omega_std": nan_list(pm.omega_std),
+        "zeta_std": nan_list(pm.zeta_std),
+        "sigma_trusted": s_trust.tolist(),
+        "n_sigma_trusted": int(s_trust.sum()),
+        "n_both_trusted": int((s_trust & np.asarray(match.trusted)).sum()),
+        "coverage": {
+            "omega": coverage(
+                interval_hits(pm.omega[scored], pm.omega_std[scored], w_true[scored])
+            ).to_dict(),
+            "zeta": coverage(
+                interval_hits(pm.zeta[scored], pm.zeta_std[scored], z_true[scored])
+            ).to_dict(),
+        },
+    }
 
 
 def save_oma_recovery(path, rec, block: dict) -> None:
