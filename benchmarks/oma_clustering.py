@@ -32,7 +32,7 @@ import numpy as np
 
 import physgs.config
 from physgs.oma.agreement import reproduced_modes
-from physgs.oma.clustering import PRESETS, cluster_modes
+from physgs.oma.clustering import PRESETS, ClusteringFailed, cluster_modes
 from physgs.oma.run import OMASettings, in_bounds, projected_records
 from physgs.oma.ssi import Modes, SSISettings, group_stable_poles, ssi_poles
 from physgs.testbed.dataset import load_observed
@@ -45,13 +45,22 @@ FREQ, ZETA, SECONDS = [0.5, 0.9, 1.4], [0.03, 0.05, 0.08], 200.0
 
 
 def modes_of(p, s: SSISettings, method: str) -> Modes:
-    """The modes ``method`` selects from the poles ``p``."""
+    """The modes ``method`` selects from the poles ``p`` (none where its clustering fails:
+    counted in ``FAILED``)."""
     if method == "grouping":
         fm, zm, sh, ns, sp, fsd, zsd = group_stable_poles(
             p.freq, p.xi, p.phi, p.stable, s, p.freq_std, p.xi_std
         )
         return Modes(fm, zm, sh, ns, sp, p.stabilisation(), fsd, zsd)
-    return cluster_modes(p, s, method)
+    try:
+        return cluster_modes(p, s, method)
+    except ClusteringFailed:
+        FAILED[method] = FAILED.get(method, 0) + 1
+        e = np.zeros(0)
+        return Modes(e, e, np.zeros((0, p.phi.shape[-1])), e, e, p.stabilisation(), e, e)
+
+
+FAILED: dict[str, int] = {}  # method -> identifications its clustering stopped on
 
 
 def oracle(n_seeds: int, nb: int) -> dict:
@@ -108,6 +117,7 @@ def main() -> None:
             print(f"{Path(tb).name:<10}{m:<12}{counts:>18}{f'{hit}/{found}':>12}")
     if args.testbeds:
         print("\nall trees: " + ", ".join(f"{m}: {h}/{f}" for m, (h, f) in totals.items()))
+    print(f"clustering stopped (counted as no mode): {FAILED or 'never'}")
 
 
 if __name__ == "__main__":

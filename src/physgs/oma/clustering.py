@@ -20,6 +20,10 @@ from physgs.oma.ssi import Modes, Poles, SSISettings, _normalise
 PRESETS = ("Reynders", "Neu", "Kvaale", "Dederichs")
 
 
+class ClusteringFailed(RuntimeError):
+    """pyOMA-2's clustering stopped on a set of poles (too few clusters for its own steps)."""
+
+
 def cluster_modes(p: Poles, s: SSISettings, preset: str, seed: int = 0) -> Modes:
     """The modes pyOMA-2's clustering preset ``preset`` selects from the poles.
 
@@ -35,6 +39,7 @@ def cluster_modes(p: Poles, s: SSISettings, preset: str, seed: int = 0) -> Modes
 
     Raises:
         ValueError: for a preset not in ``PRESETS``.
+        ClusteringFailed: when pyOMA-2's clustering stops on these poles.
     """
     from pyoma2.algorithms.data.result import SSIResult
     from pyoma2.algorithms.data.run_params import Clustering
@@ -64,6 +69,8 @@ def cluster_modes(p: Poles, s: SSISettings, preset: str, seed: int = 0) -> Modes
     np.random.seed(int(seed))
     try:
         alg.run_clustering(name=preset)
+    except (ValueError, IndexError) as e:  # e.g. its k-means of cluster sizes on one cluster
+        raise ClusteringFailed(f"pyOMA-2's {preset} clustering failed on these poles: {e}") from e
     finally:
         np.random.set_state(state)
     r = alg.result.clustering_results[preset]

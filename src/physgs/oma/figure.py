@@ -9,7 +9,8 @@ from physgs.atomic import atomic_path
 
 def stabilisation_figure(path, ident, omega_bones, title: str = "") -> None:
     """Poles (frequency Hz against model order; filled: stable) with the identified modes as
-    vertical lines, and the true bone frequencies as ticks in a strip below.
+    vertical lines, each with its 95% frequency interval (+-1.96 sigma) as an error bar above
+    the highest order, and the true bone frequencies as ticks in a strip below.
 
     The truth is drawn, never used to select anything.
 
@@ -33,8 +34,22 @@ def stabilisation_figure(path, ident, omega_bones, title: str = "") -> None:
     ok = np.isfinite(st.freq_hz)
     ax.scatter(st.freq_hz[ok & ~st.stable], orders[ok & ~st.stable], s=4, c="0.75", label="pole")
     ax.scatter(st.freq_hz[st.stable & ok], orders[st.stable & ok], s=6, c="C0", label="stable")
-    for f in ident.modes.freq_hz:
+    m = ident.modes
+    for f in m.freq_hz:
         ax.axvline(f, c="C3", lw=0.8)
+    if m.n_modes:
+        top = np.full(m.n_modes, float(st.orders.max()) + 2 * float(np.diff(st.orders[:2])[0]))
+        ax.errorbar(
+            m.freq_hz,
+            top,
+            xerr=1.96 * np.nan_to_num(m.freq_std),
+            fmt="v",
+            c="C3",
+            ms=4,
+            capsize=3,
+            lw=1.0,
+            label="mode, 95% interval",
+        )
     ax.set_ylabel("model order")
     ax.set_title(f"{title}: SSI-cov of the training window ({ident.modes.n_modes} modes, red)")
     ax.legend(loc="upper right", fontsize=7)

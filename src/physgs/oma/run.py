@@ -10,6 +10,7 @@ like with like.
 
 from __future__ import annotations
 
+import dataclasses
 import json
 from dataclasses import asdict, dataclass, replace
 
@@ -277,8 +278,8 @@ def recover_oma(
 
     Returns:
         (tuple[RecoveryRecord, dict]): ``(record, block)``: the
-            [`RecoveryRecord`][physgs.recovery.record.RecoveryRecord] and the record's ``oma``
-            block (part and mode counts, the parts without an estimate, each mode's part, the
+            [`RecoveryRecord`][physgs.recovery.record.RecoveryRecord] (its ``intervals``:
+            [`interval_block`][physgs.oma.run.interval_block]) and the record's ``oma`` block (part and mode counts, the parts without an estimate, each mode's part, the
             median zeta).
 
     Raises:
@@ -321,8 +322,8 @@ def recover_oma(
         rec = rec.with_visibility(bone_visible)
     if damping is not None:
         rec = with_damping_scores(rec, zeta, truth, damping)
+    rec = dataclasses.replace(rec, intervals=interval_block(pm, rec.match, truth))
     block = {
-        **interval_block(pm, rec.match, truth),
         "n_parts": int(K),
         "n_modes": int(pm.mode_part.size),
         "n_no_estimate": int((~est).sum()),

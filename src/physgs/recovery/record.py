@@ -34,6 +34,10 @@ class RecoveryRecord:
     #: when the recovery was not asked for them
     damping_scores: DampingScores | None = None
     damping_null: DampingNull | None = None
+    #: a method's own uncertainty of its estimates (the output-only analysis': each part's
+    #: standard deviations, its 95% intervals' coverage, the parts its sigma rule keeps:
+    #: ``physgs.oma.run.interval_block``); None for a method without one
+    intervals: dict | None = None
 
     def with_visibility(self, bone_visible: np.ndarray) -> "RecoveryRecord":
         """This record with the scores restricted to visible bones (``bone_visible`` [B] bool).
@@ -131,7 +135,8 @@ def recovery_dict(rec: RecoveryRecord) -> dict:
 
     Returns:
         ``match``, ``damping``, ``n_frozen``, ``n_trusted_visible``, ``median_rel_err_visible``,
-            ``damping_scores`` and ``damping_null`` (None where not scored).
+            ``damping_scores`` and ``damping_null`` (None where not scored), ``intervals`` (None
+            for a method without its own uncertainty).
     """
     return {
         "match": rec.match.to_dict(),
@@ -143,6 +148,7 @@ def recovery_dict(rec: RecoveryRecord) -> dict:
             rec.damping_scores.to_dict() if rec.damping_scores is not None else None
         ),
         "damping_null": (rec.damping_null.to_dict() if rec.damping_null is not None else None),
+        "intervals": rec.intervals,
     }
 
 
@@ -180,6 +186,7 @@ def load_recovery(path) -> RecoveryRecord:
         float(d.get("median_rel_err_visible", float("nan"))),
         DampingScores.from_dict(d["damping_scores"]) if d.get("damping_scores") else None,
         DampingNull.from_dict(d["damping_null"]) if d.get("damping_null") else None,
+        d.get("intervals"),
     )
 
 

@@ -66,6 +66,7 @@ RATE_EXPONENT = 0.5  # gamma ~ omega^p with p below this: the decay rate is near
 NULL_MATCH_PP = 0.5  # the trained model beats the null by less than this (points): "matches"
 GAP_RTOL = 0.25  # a nearest-bone gap within 25% of the paper's reproduces it
 FIT_BAR = 0.5  # an opponent reaches this fraction of the true-motion ceiling's in-window gain
+INTERVAL_COVER = 0.8  # the output-only analysis' 95% intervals hold the truth this often at least
 
 
 @dataclass(frozen=True)
@@ -617,7 +618,10 @@ def _blind_claims(
       other than ours, as ``claims_priors``');
     - ``oma_beats_null/sparse``: null / output-only median omega error above 1;
     - ``oma_recovers_zeta/<tree>``: output-only minus null median zeta error (points, the
-      damping benchmark's testbed) below 0.
+      damping benchmark's testbed) below 0;
+    - ``oma_frequency_interval_covers/<tree>``, ``oma_damping_interval_covers/<tree>`` (this
+      project's): the coverage of its 95% intervals at least ``INTERVAL_COVER``
+      (``_interval_claims``).
     """
     from physgs.models.registry import BLIND_CONFIG, BLIND_PRIORS, spec_of
     from physgs.report.tables import OMA
@@ -698,6 +702,44 @@ def _blind_claims(
                         cell(d[d["testbed"] == DAMPING], t, OMA, "trained_minus_null_pp")
                         for d in _per_seed(damping)
                     ],
+                )
+            )
+        if "omega_interval_cover" in damping.columns:
+            out += _interval_claims(damping, trees, cell)
+    return out
+
+
+def _interval_claims(damping: pd.DataFrame, trees: Sequence[str], cell) -> list:
+    """This project's claims on the output-only analysis' own uncertainty (not the paper's):
+    ``oma_frequency_interval_covers/<tree>`` and ``oma_damping_interval_covers/<tree>``, the
+    coverage of its 95% intervals for omega and zeta over the trusted parts of the damping
+    testbed (tab_damping, ``single``) at least ``INTERVAL_COVER``."""
+    from physgs.models.registry import BLIND_CONFIG
+    from physgs.report.tables import OMA
+    from physgs.testbed.variant import DAMPING
+
+    out = []
+    for q, col, name in (
+        ("frequency", "omega_interval_cover", "omega"),
+        ("damping", "zeta_interval_cover", "zeta"),
+    ):
+        for t in trees:
+            if not (damping["tree"] == t).any():
+                continue
+            out.append(
+                (
+                    Claim(
+                        f"oma_{q}_interval_covers/{t}",
+                        f"{t} (damping testbed): the output-only analysis' 95% intervals for "
+                        f"{name} hold the matched bone's true {name} on at least "
+                        f"{INTERVAL_COVER:.0%} of its trusted parts",
+                        "not in the paper (this project's)",
+                        f"tab_damping, {BLIND_CONFIG}: output-only {col}",
+                        INTERVAL_COVER,
+                        ">",
+                        "fraction",
+                    ),
+                    [cell(d[d["testbed"] == DAMPING], t, OMA, col) for d in _per_seed(damping)],
                 )
             )
     return out

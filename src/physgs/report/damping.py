@@ -27,6 +27,7 @@ from physgs.report.tables import (
     _seeds,
     _who,
     _wrap,
+    interval_cells,
     tree_label,
 )
 from physgs.testbed.variant import DAMPING, FAITHFUL
@@ -116,6 +117,7 @@ def tab_damping(
                     "gamma_exponent": sc.gamma_exponent,
                     "null_gamma_exponent": nl.median_gamma_exponent,
                     "gamma_exponent_true": sc.gamma_exponent_true,
+                    **interval_cells(rec),
                 }
             )
     df = pd.DataFrame(rows)

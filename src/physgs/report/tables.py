@@ -508,6 +508,7 @@ def tab_null(
                     "trained_median_rel_err_visible_pct": 100 * rec.median_rel_err_visible,
                     "null_parts_trusted_visible": nl.median_n_trusted_visible,
                     "null_median_rel_err_visible_pct": 100 * nl.median_median_rel_err_visible,
+                    **interval_cells(rec),
                 }
             )
     df = pd.DataFrame(rows)  # each seed's block: each tree's rows together, in ``keys`` order
@@ -652,8 +653,47 @@ def oma_rows(configs: Mapping[str, str], per_seed: Mapping[int, Mapping]) -> Met
         per_seed,
         rf" {OMA_LABEL}: modes identified from the training video alone (dense flow, SSI-cov; "
         r"no wind, no renderer), each assigned to a part by its shape, matched and trusted by "
-        r"the same rule, beside the null of its $K$.",
+        r"the same rule, beside the null of its $K$. Its seeds resample only the $k$-means of "
+        r"image cells into parts (the same video, so the same modes, at every seed): its seed "
+        r"intervals understate what another tree instance would do. The CSV gives the "
+        r"coverage of its modes' 95\% intervals ($\pm1.96\sigma$) over the trusted parts and "
+        r"the parts its own rule keeps (relative $\sigma_\zeta\le1/1.96$).",
     )
+
+
+#: tab_null / tab_damping's CSV columns of a method's own intervals (the output-only analysis';
+#: NaN for a method without them): the coverage of its trusted parts' 95% intervals for omega
+#: and zeta, the parts they cover, and the parts its sigma rule keeps (alone, and with ours')
+INTERVAL_COLUMNS = (
+    "omega_interval_cover",
+    "zeta_interval_cover",
+    "interval_parts",
+    "sigma_parts_trusted",
+    "sigma_and_corr_parts_trusted",
+)
+
+
+def interval_cells(rec) -> dict:
+    """A record's [`INTERVAL_COLUMNS`][physgs.report.tables.INTERVAL_COLUMNS] cells (NaN when
+    the record has no ``intervals``).
+
+    Args:
+        rec (RecoveryRecord): the record.
+
+    Returns:
+        Column -> value.
+    """
+    iv = rec.intervals
+    if not iv:
+        return dict.fromkeys(INTERVAL_COLUMNS, float("nan"))
+    cov = iv["coverage"]
+    return {
+        "omega_interval_cover": float(cov["omega"]["fraction"]),
+        "zeta_interval_cover": float(cov["zeta"]["fraction"]),
+        "interval_parts": float(cov["omega"]["n"]),
+        "sigma_parts_trusted": float(iv["n_sigma_trusted"]),
+        "sigma_and_corr_parts_trusted": float(iv["n_both_trusted"]),
+    }
 
 
 def _pct(x: float, bold: bool, digits: int = 2) -> str:
