@@ -119,3 +119,26 @@ def test_each_blind_prior_gets_its_anemometer_claim_against_its_counterpart():
     # a blind prior without its rows in the table has no claim
     alone = claims._blind_claims(null[null.method != "ours_chain_blind"], None, ["sparse"])
     assert [c.id for c, _ in alone] == ["anemometer_needed/sparse"]
+
+
+@pytest.mark.parametrize(
+    "cover, want", [([0.95, 0.97, 0.96], "holds"), ([0.5, 0.55, 0.52], "fails")]
+)
+def test_interval_claims_read_the_damping_testbeds_coverage(cover, want):
+    """This project's interval claims read tab_damping's coverage cells of the damping testbed
+    (the faithful testbed's, opposite, are ignored) and are marked as not the paper's."""
+    df = _damping([-9.0, -8.5, -9.5])
+    df["omega_interval_cover"] = [
+        1 - c if tb == "faithful" else c
+        for c, tb in zip([c for c in cover for _ in range(2)], df["testbed"])
+    ]
+    df["zeta_interval_cover"] = df["omega_interval_cover"]
+    got = {
+        c.id: (c, claims.verdict(c, v))
+        for c, v in claims._blind_claims(
+            _null([2.0] * 3, [3.0] * 3, [2.0] * 3, [4.0] * 3), df, ["sparse"]
+        )
+    }
+    for q in ("frequency", "damping"):
+        c, v = got[f"oma_{q}_interval_covers/sparse"]
+        assert v == want and "this project" in c.paper and c.threshold == 0.8
