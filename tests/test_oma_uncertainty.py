@@ -118,3 +118,22 @@ def test_coverage_counts_with_its_binomial_interval():
         False,
         False,
     ]
+
+
+def test_pyoma2_clustering_preset_runs_on_the_same_poles():
+    """pyOMA-2's Dederichs preset, the best of its presets on the oracle (docs/blind.md), finds
+    the three oracle modes from the poles the grouping reads, with their sigmas; an unknown
+    preset is refused by name."""
+    from physgs.oma.clustering import cluster_modes
+    from test_oma_ssi import tolerances
+
+    freq, zeta = [0.5, 0.9, 1.4], [0.03, 0.05, 0.08]
+    s = SSISettings(block_rows=20, order_max=40, nb=10)
+    p = ssi_poles([simulate(freq, zeta, 6, 200.0, 0)], FS, s)
+    m = cluster_modes(p, s, "Dederichs")
+    assert m.n_modes == 3, m.freq_hz
+    for f, z, fh in zip(freq, zeta, m.freq_hz):
+        assert abs(fh - f) / f < tolerances(f, z, 200.0)[0], (f, fh)
+    assert np.all(m.freq_std > 0) and np.all(m.zeta_std > 0)
+    with pytest.raises(ValueError, match="Magalhaes"):
+        cluster_modes(p, s, "Magalhaes")
