@@ -54,14 +54,15 @@ def main() -> None:
             for seed in seeds:
                 r = recovery_params(cfg, c, seed)
                 pm = part_modes(ident, r["K"], seed, r["kmeans_n_init"])
-                rec, block = recover_oma(
+                rec, _ = recover_oma(
                     pm, obs, truth, r["solver"], damping={"zeta_range": zr, "seed": seed}
                 )
                 b = rec.match.bone
                 sc = rec.match.trusted & pm.estimated
                 hw += interval_hits(pm.omega, pm.omega_std, truth.omega[b])[sc].tolist()
                 hz += interval_hits(pm.zeta, pm.zeta_std, truth.zeta[b])[sc].tolist()
-                n += [rec.match.n_trusted, block["n_sigma_trusted"], block["n_both_trusted"]]
+                iv = rec.intervals
+                n += [rec.match.n_trusted, iv["n_sigma_trusted"], iv["n_both_trusted"]]
             cw, cz = coverage(hw), coverage(hz)
             m = ident.modes
             rf, rz = np.median(m.freq_std / m.freq_hz), np.median(m.zeta_std / m.zeta)
