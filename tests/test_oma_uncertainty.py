@@ -137,3 +137,31 @@ def test_pyoma2_clustering_preset_runs_on_the_same_poles():
     assert np.all(m.freq_std > 0) and np.all(m.zeta_std > 0)
     with pytest.raises(ValueError, match="Magalhaes"):
         cluster_modes(p, s, "Magalhaes")
+
+
+def test_interval_block_scores_the_trusted_parts_against_their_bones():
+    """Three parts: two trusted with a mode (one interval holds its bone's omega, the other
+    misses it), one trusted without a mode (not scored); the sigma rule keeps the part whose
+    damping sigma is under 1/1.96 of its zeta."""
+    from types import SimpleNamespace
+
+    from physgs.oma.parts import PartModes
+    from physgs.oma.run import interval_block
+
+    nan = np.nan
+    pm = PartModes(
+        np.zeros(3, int),
+        np.array([0, 1]),
+        np.array([0, 1, -1]),
+        omega=np.array([6.0, 8.0, nan]),
+        zeta=np.array([0.05, 0.10, nan]),
+        omega_std=np.array([0.1, 0.1, nan]),
+        zeta_std=np.array([0.03, 0.04, nan]),
+    )
+    match = SimpleNamespace(bone=np.array([1, 0, 0]), trusted=np.array([True, True, True]))
+    truth = SimpleNamespace(omega=np.array([9.0, 6.1]), zeta=np.array([0.2, 0.06]))
+    b = interval_block(pm, match, truth)
+    assert b["coverage"]["omega"]["k"] == 1 and b["coverage"]["omega"]["n"] == 2
+    assert b["coverage"]["zeta"]["k"] == 1  # 0.05 +- 0.059 holds 0.06; 0.10 +- 0.078 not 0.2
+    assert b["sigma_trusted"] == [False, True, False] and b["n_both_trusted"] == 1
+    assert b["median_rel_std"]["zeta"] == pytest.approx(0.5)  # of 0.6 and 0.4

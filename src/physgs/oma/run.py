@@ -347,7 +347,8 @@ def interval_block(pm: PartModes, match, truth) -> dict:
 
     Returns:
         ``omega``, ``zeta``, ``omega_std``, ``zeta_std`` (per part, NaN where none),
-            ``sigma_trusted`` (per part), ``n_sigma_trusted``, ``n_both_trusted`` and
+            ``sigma_trusted`` (per part), ``n_sigma_trusted``, ``n_both_trusted``,
+            ``median_rel_std`` (``omega``, ``zeta``: sigma / value over the trusted parts) and
             ``coverage`` (``omega`` and ``zeta``: k, n, fraction and its 95% interval over the
             matcher's trusted parts with an estimate).
     """
@@ -368,6 +369,10 @@ def interval_block(pm: PartModes, match, truth) -> dict:
         "sigma_trusted": s_trust.tolist(),
         "n_sigma_trusted": int(s_trust.sum()),
         "n_both_trusted": int((s_trust & np.asarray(match.trusted)).sum()),
+        "median_rel_std": {  # over the trusted parts with an estimate (NaN: none)
+            "omega": _median_or_nan(pm.omega_std[scored] / pm.omega[scored]),
+            "zeta": _median_or_nan(pm.zeta_std[scored] / pm.zeta[scored]),
+        },
         "coverage": {
             "omega": coverage(
                 interval_hits(pm.omega[scored], pm.omega_std[scored], w_true[scored])
@@ -377,6 +382,12 @@ def interval_block(pm: PartModes, match, truth) -> dict:
             ).to_dict(),
         },
     }
+
+
+def _median_or_nan(x: np.ndarray) -> float:
+    """Median of the finite entries; NaN when there is none."""
+    x = x[np.isfinite(x)]
+    return float(np.median(x)) if x.size else float("nan")
 
 
 def save_oma_recovery(path, rec, block: dict) -> None:

@@ -663,8 +663,11 @@ def oma_rows(configs: Mapping[str, str], per_seed: Mapping[int, Mapping]) -> Met
 
 #: tab_null / tab_damping's CSV columns of a method's own intervals (the output-only analysis';
 #: NaN for a method without them): the coverage of its trusted parts' 95% intervals for omega
-#: and zeta, the parts they cover, and the parts its sigma rule keeps (alone, and with ours')
+#: and zeta, the parts they cover, the median relative standard deviations (sigma / value) over
+#: those parts, and the parts its sigma rule keeps (alone, and with ours')
 INTERVAL_COLUMNS = (
+    "omega_rel_sd",
+    "zeta_rel_sd",
     "omega_interval_cover",
     "zeta_interval_cover",
     "interval_parts",
@@ -688,6 +691,8 @@ def interval_cells(rec) -> dict:
         return dict.fromkeys(INTERVAL_COLUMNS, float("nan"))
     cov = iv["coverage"]
     return {
+        "omega_rel_sd": float(iv["median_rel_std"]["omega"]),
+        "zeta_rel_sd": float(iv["median_rel_std"]["zeta"]),
         "omega_interval_cover": float(cov["omega"]["fraction"]),
         "zeta_interval_cover": float(cov["zeta"]["fraction"]),
         "interval_parts": float(cov["omega"]["n"]),
