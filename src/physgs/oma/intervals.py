@@ -64,7 +64,11 @@ class Coverage:
     hi: float
 
     def to_dict(self) -> dict:
-        """The coverage as a plain dict."""
+        """The coverage as a plain dict.
+
+        Returns:
+            Field name -> value.
+        """
         return asdict(self)
 
 

@@ -136,7 +136,14 @@ class Modes:
     zeta_std: np.ndarray
 
     def select(self, keep: np.ndarray) -> "Modes":
-        """The modes where ``keep`` [M] (bool) holds, with the same stabilisation diagram."""
+        """The modes where ``keep`` holds, with the same stabilisation diagram.
+
+        Args:
+            keep: [M] bool.
+
+        Returns:
+            The kept modes.
+        """
         return Modes(
             self.freq_hz[keep],
             self.zeta[keep],
@@ -270,7 +277,11 @@ class Poles:
     orders: np.ndarray
 
     def stabilisation(self) -> Stabilisation:
-        """The stabilisation diagram of these poles."""
+        """The stabilisation diagram of these poles.
+
+        Returns:
+            The [`Stabilisation`][physgs.oma.ssi.Stabilisation] with the poles' sigmas.
+        """
         return Stabilisation(self.freq, self.stable, self.orders, self.freq_std, self.xi_std)
 
 
