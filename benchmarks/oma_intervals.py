@@ -7,7 +7,8 @@ The rules' own code, run in one process (``oma_identify``: identify_video; ``oma
 part_modes, recover_oma), so it prints what the pipeline's records hold: per testbed and
 configuration, over the matcher's trusted parts with an estimate (pooled over the training
 seeds), the fraction of +-1.96 sigma intervals that hold the matched bone's true omega and zeta
-with its Clopper-Pearson 95% interval, and the parts kept by ours' rule (trajectory
+with its Clopper-Pearson 95% interval (and over the distinct mode-bone pairs, since parts
+share modes), and the parts kept by ours' rule (trajectory
 correlation >= 0.7), by the modes' own sigma rule, and by both. The seeds resample only the
 k-means of cells into parts: the video, and so every mode and sigma, is the same at every seed.
 Evaluation: reads the truth (the scoring rule's).
@@ -50,7 +51,7 @@ def main() -> None:
             s = OMASettings.from_config(p, {"omega_hz": p["omega_hz"]})
             videos = [obs.frames[i, : obs.n_train] for i in p["conditions"]]
             ident = identify_video(videos, obs.background, obs.fps, s)
-            hw, hz, n = [], [], np.zeros(3, int)
+            hw, hz, n, pairs = [], [], np.zeros(3, int), {}
             for seed in seeds:
                 r = recovery_params(cfg, c, seed)
                 pm = part_modes(ident, r["K"], seed, r["kmeans_n_init"])
@@ -61,9 +62,15 @@ def main() -> None:
                 sc = rec.match.trusted & pm.estimated
                 hw += interval_hits(pm.omega, pm.omega_std, truth.omega[b])[sc].tolist()
                 hz += interval_hits(pm.zeta, pm.zeta_std, truth.zeta[b])[sc].tolist()
+                for k in np.flatnonzero(sc):  # distinct (mode, bone) pairs: independent-ish
+                    pairs[(pm.mode_of_part[k], b[k])] = (
+                        hw[-int(sc.sum()) + list(np.flatnonzero(sc)).index(k)],
+                        hz[-int(sc.sum()) + list(np.flatnonzero(sc)).index(k)],
+                    )
                 iv = rec.intervals
                 n += [rec.match.n_trusted, iv["n_sigma_trusted"], iv["n_both_trusted"]]
             cw, cz = coverage(hw), coverage(hz)
+            dw, dz = (sum(v[i] for v in pairs.values()) for i in (0, 1))
             m = ident.modes
             rf, rz = np.median(m.freq_std / m.freq_hz), np.median(m.zeta_std / m.zeta)
 
@@ -73,7 +80,8 @@ def main() -> None:
             print(
                 f"{Path(tb).name:<16}{c:<9}{ident.modes.n_modes:>6}{cell(cw):>26}{cell(cz):>26}"
                 f"{n[0] / len(seeds):>7.1f}{n[1] / len(seeds):>7.1f}{n[2] / len(seeds):>7.1f}"
-                f"{r['K']:>5}{rf:>10.3f}{rz:>10.2f}"
+                f"{r['K']:>5}{rf:>10.3f}{rz:>10.2f}   distinct mode-bone pairs: omega"
+                f" {dw}/{len(pairs)}, zeta {dz}/{len(pairs)}"
             )
 
 
