@@ -60,13 +60,12 @@ def main() -> None:
                 )
                 b = rec.match.bone
                 sc = rec.match.trusted & pm.estimated
-                hw += interval_hits(pm.omega, pm.omega_std, truth.omega[b])[sc].tolist()
-                hz += interval_hits(pm.zeta, pm.zeta_std, truth.zeta[b])[sc].tolist()
-                for k in np.flatnonzero(sc):  # distinct (mode, bone) pairs: independent-ish
-                    pairs[(pm.mode_of_part[k], b[k])] = (
-                        hw[-int(sc.sum()) + list(np.flatnonzero(sc)).index(k)],
-                        hz[-int(sc.sum()) + list(np.flatnonzero(sc)).index(k)],
-                    )
+                ow = interval_hits(pm.omega, pm.omega_std, truth.omega[b])
+                oz = interval_hits(pm.zeta, pm.zeta_std, truth.zeta[b])
+                hw += ow[sc].tolist()
+                hz += oz[sc].tolist()
+                for k in np.flatnonzero(sc):  # distinct (mode, bone) pairs: parts share modes
+                    pairs[(int(pm.mode_of_part[k]), int(b[k]))] = (bool(ow[k]), bool(oz[k]))
                 iv = rec.intervals
                 n += [rec.match.n_trusted, iv["n_sigma_trusted"], iv["n_both_trusted"]]
             cw, cz = coverage(hw), coverage(hz)

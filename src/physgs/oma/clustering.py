@@ -30,7 +30,7 @@ def cluster_modes(p: Poles, s: SSISettings, preset: str, seed: int = 0) -> Modes
     Args:
         p: the poles (all of them: the presets apply their own hard and soft criteria).
         s: the SSI settings (orders; ``err_fn``, ``err_xi``, ``err_phi`` are the presets' own).
-        preset: one of [`PRESETS`][physgs.oma.clustering.PRESETS].
+        preset: one of ``PRESETS`` (Reynders, Neu, Kvaale, Dederichs).
         seed: numpy's global seed while it runs (its k-means and GMM pre-clustering draw from it).
 
     Returns:

@@ -677,7 +677,7 @@ INTERVAL_COLUMNS = (
 
 
 def interval_cells(rec) -> dict:
-    """A record's [`INTERVAL_COLUMNS`][physgs.report.tables.INTERVAL_COLUMNS] cells (NaN when
+    """A record's ``INTERVAL_COLUMNS`` cells (NaN when
     the record has no ``intervals``).
 
     Args:
