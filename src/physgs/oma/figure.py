@@ -52,7 +52,7 @@ def stabilisation_figure(path, ident, omega_bones, title: str = "") -> None:
         )
     ax.set_ylabel("model order")
     ax.set_title(f"{title}: SSI-cov of the training window ({ident.modes.n_modes} modes, red)")
-    ax.legend(loc="upper right", fontsize=7)
+    ax.legend(loc="lower right", fontsize=7)  # the error bars run along the top
     fb = np.asarray(omega_bones, float) / (2 * np.pi)
     ax2.vlines(fb, 0, 1, colors="k", lw=0.8)
     ax2.set_yticks([])
