@@ -165,3 +165,13 @@ def test_interval_block_scores_the_trusted_parts_against_their_bones():
     assert b["coverage"]["zeta"]["k"] == 1  # 0.05 +- 0.059 holds 0.06; 0.10 +- 0.078 not 0.2
     assert b["sigma_trusted"] == [False, True, False] and b["n_both_trusted"] == 1
     assert b["median_rel_std"]["zeta"] == pytest.approx(0.5)  # of 0.6 and 0.4
+
+
+def test_more_data_blocks_than_the_record_holds_stops_naming_the_key():
+    """100 samples and 12 block rows leave 77 Hankel columns: 38 blocks of two at most."""
+    from physgs.oma.ssi import check_record
+
+    check_record(100, 4, SSISettings(block_rows=12, order_max=16, nb=38))
+    with pytest.raises(ValueError, match="oma/ssi/nb") as e:
+        check_record(100, 4, SSISettings(block_rows=12, order_max=16, nb=39))
+    assert "2 to 38" in e.value.msg

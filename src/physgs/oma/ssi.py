@@ -60,7 +60,8 @@ def check_record(n_samples: int, n_channels: int, s: SSISettings, key: str = "om
     higher than ``(block_rows - 1) * n_channels``: the rows of the observability matrix less one
     block, from which pyOMA-2's ``SSI_fast`` takes the square ``R[:n, :n]`` of each order n (a
     higher order fails there with "Last 2 dimensions of the array must be square"). Raises
-    ValueError naming the key (``<key>/block_rows`` or ``<key>/order_max``).
+    ValueError naming the key (``<key>/block_rows``, ``<key>/order_max``, ``<key>/nb`` (2 to half
+    the Hankel matrix's columns, so every data block holds two) or ``<key>/min_stable``).
 
     Args:
         n_samples: samples per channel in the record.
