@@ -19,8 +19,8 @@ import pandas as pd
 
 from physgs.experiments.cost import read_costs, summarise, wall_spans
 from physgs.models.registry import label
-from physgs.report.claims import FIT_BAR
-from physgs.report.claims_priors import AHEAD
+from physgs.report.thresholds import FIT_BAR
+from physgs.report.catalogue import AHEAD
 from physgs.report.seeds import interval
 
 VERDICTS = ("holds", "fails", "undecided")

@@ -1,0 +1,560 @@
+"""The catalogue of claims: every claim family of the ledger as one entry of data.
+
+An entry ([`ClaimSpec`][physgs.report.catalogue.ClaimSpec]) says what the family ranges over
+(its scope: trees, cells of a table, and, for ``of="priors"``, every prior of the registry other
+than ours that the run's tables hold), the table and the cells it reads, its threshold (a name
+of [`physgs.report.thresholds`][physgs.report.thresholds]) and side, its unit, its sentence, the
+paper's figure, whether it carries the story (a headline, with the words the README uses), and
+its origin: the paper's claim, or this project's own. [`physgs.report.claims.measure`][] loops
+over it; the tables the ledger reads, the README's headline families and the list of claims on
+the claims page ([`markdown`][physgs.report.catalogue.markdown]) are derived from it.
+
+Adding a claim family is one entry here (and, when no reader or scope fits, one function in
+[`physgs.report.claim_cells`][physgs.report.claim_cells]).
+
+Entries are Python, not YAML: a family's scope and reader are functions over the tables, and a
+frozen dataclass keeps them typed and importable where a YAML file would need a small language
+of its own for the cell arithmetic.
+"""
+
+from __future__ import annotations
+
+import string
+from dataclasses import dataclass
+from typing import Callable, Sequence
+
+import numpy as np
+
+from physgs.models.registry import MODELS, PRIOR_VARIANTS, label, models_of
+from physgs.report import claim_cells as cc
+from physgs.report import paper, thresholds
+from physgs.report.claim_cells import CONFIG, RECOVERY, Cell, Reader, Scope
+
+#: The origins of a claim: stated by the source paper, or this project's own.
+ORIGINS = ("paper", "project")
+#: The models the paper itself compared: a claim about any other model is this project's.
+PAPER_MODELS = (*models_of("control", "field"), "ours")
+
+#: The family the summary's line on the other priors counts (``physgs.report.summary``).
+AHEAD = "ahead_of_fields"
+#: Names a sentence may use: every threshold, and the ledger's recovery configuration.
+WORDS = {k: v for k, v in vars(thresholds).items() if k.isupper()} | {"CONFIG": CONFIG}
+
+
+@dataclass(frozen=True)
+class ClaimSpec:
+    """One claim family of the ledger.
+
+    Attributes:
+        family: the claim id's family (ids are ``[<prior>/]<family>[/<cell>]``).
+        of: ``"ours"`` (asked once) or ``"priors"`` (asked of every prior of the registry other
+            than ours that the run's tables hold, ids prefixed by the prior's).
+        over: the scope: the run -> the family's cells (``physgs.report.claim_cells``).
+        table: the table it reads (``claim_cells.RECOVERY``: the priors' damping summaries).
+        read: one seed's rows and a cell -> the value.
+        threshold: a name of ``physgs.report.thresholds``, ``-`` in front to negate it.
+        side: ``">"`` or ``"<"``: the side of the threshold the claim holds on.
+        unit: the value's unit (``"ratio"``: its interval is taken on the log scale).
+        text: the claim's sentence (``str.format`` fields: the cell's, ``name`` of the prior,
+            ``WORDS``).
+        source: where it is measured (same fields).
+        paper: the paper's figure, or a function of the cell giving it.
+        origin: ``"paper"`` or ``"project"`` (``ORIGINS``).
+        headline: the words the README tells the family with; "" when it is not a headline.
+        needs_variance: False for a claim about the fixed testbed (a verdict from one value).
+        optional: listed only when its table is given (a study or control the run may not
+            make); otherwise a missing table lists its claims "undecided: not measured".
+    """
+
+    family: str
+    of: str
+    over: Scope
+    table: str
+    read: Reader
+    threshold: str
+    side: str
+    unit: str
+    text: str
+    source: str
+    paper: str | Callable[[Cell], str] = "--"
+    origin: str = "paper"
+    headline: str = ""
+    needs_variance: bool = True
+    optional: bool = False
+
+    def __post_init__(self):
+        """Refuse an unknown side, origin, scope kind or threshold name, naming the family."""
+        if self.side not in (">", "<") or self.origin not in ORIGINS:
+            raise ValueError(f"claim {self.family!r}: side must be > or <, origin in {ORIGINS}")
+        if self.of not in ("ours", "priors"):
+            raise ValueError(f"claim {self.family!r}: of must be 'ours' or 'priors'")
+        if self.threshold.lstrip("-") not in WORDS:
+            raise ValueError(f"claim {self.family!r}: no threshold {self.threshold!r}")
+
+    @property
+    def value(self) -> float:
+        """The threshold's value."""
+        v = float(WORDS[self.threshold.lstrip("-")])
+        return -v if self.threshold.startswith("-") else v
+
+    def claim_id(self, cell: Cell) -> str:
+        """The id of the claim of ``cell`` (which holds ``model``, the prior asked)."""
+        prefix = cell.get("prefix", "" if cell["model"] == "ours" else f"{cell['model']}/")
+        return prefix + self.family + (f"/{cell['suffix']}" if cell.get("suffix") else "")
+
+    def words(self, template: str, cell: Cell) -> str:
+        """``template`` with the cell's fields, the prior's ``name`` and ``WORDS``."""
+        return template.format(**WORDS, **cell)
+
+    def figure(self, cell: Cell) -> str:
+        """The paper's figure for ``cell``."""
+        return self.paper(cell) if callable(self.paper) else self.words(self.paper, cell)
+
+
+# ---- the paper's figures ---------------------------------------------------------------------
+def _pp(c: Cell):
+    return paper.PSNR.get(c["tree"])
+
+
+def paper_best_field_minus_static(c: Cell) -> str:
+    """best learned field - static beyond the window, tab:psnr"""
+    pp = _pp(c)
+    if not pp:
+        return "--"
+    return f"best baseline - static = {max(pp[m][1] - pp['static'][1] for m in cc.fields()):+.2f} dB"
+
+
+def paper_ours_minus_static(c: Cell) -> str:
+    """ours - static beyond the window, tab:psnr"""
+    pp = _pp(c)
+    return f"{pp['ours'][1] - pp['static'][1]:+.2f} dB" if pp else "--"
+
+
+def paper_ours_behind(c: Cell) -> str:
+    """ours - best learned field on held-out views, tab:psnr"""
+    pp = _pp(c)
+    return f"{pp['ours'][0] - max(pp[m][0] for m in cc.fields()):+.2f} dB" if pp else "--"
+
+
+def paper_null_ratio(c: Cell) -> str:
+    """null / trained median omega error, tab:null"""
+    tr, nl = paper.NULL.get(c["tree"], (np.nan, np.nan))
+    return f"null / trained = {nl / tr:.2f}"
+
+
+def paper_null_difference(c: Cell) -> str:
+    """trained - null median omega error, tab:null"""
+    tr, nl = paper.NULL.get(c["tree"], (np.nan, np.nan))
+    return f"trained - null = {tr - nl:+.2f} points"
+
+
+def paper_gap(c: Cell) -> str:
+    """the median nearest-bone gap, section 4"""
+    return f"{paper.NEAREST_BONE_GAP_PCT[c['tree']]:.2f}%"
+
+
+def paper_zeta(c: Cell) -> str:
+    """the median fitted zeta, section 4"""
+    return f"median zeta_hat {paper.ZETA.get(c['tree'])} vs 0.08"
+
+
+def paper_margin(c: Cell) -> str:
+    """the margin's growth from the training wind to the farthest, tab:margin"""
+    p = paper.MARGIN.get(c["tree"])
+    return f"{p[-1] - p[0]:+.2f} dB" if p else "--"
+
+
+TRACKS_PROPOSAL = "not run (the paper's closing proposal)"
+
+# ---- the catalogue ---------------------------------------------------------------------------
+#: Every claim family, in the ledger's order.
+CATALOGUE: tuple[ClaimSpec, ...] = (
+    # the paper's: beyond the window and on held-out views (tab:psnr)
+    ClaimSpec(
+        "ours_above_static_beyond", "ours", cc.trees, "tab_psnr", cc.above_static,
+        "EVEN", ">", "dB",
+        "{tree}: ours is above the static pose beyond the window",
+        "tab_psnr, time column: ours - static",
+        paper_ours_minus_static,
+        headline="ours above the static pose beyond the training window",
+    ),
+    ClaimSpec(
+        "baselines_below_static_beyond", "ours", cc.trees, "tab_psnr",
+        cc.best_field_minus_static, "EVEN", "<", "dB",
+        "{tree}: every learned baseline is below the static pose beyond the window",
+        "tab_psnr, time column: max over learned fields of (model - static)",
+        paper_best_field_minus_static,
+        headline="every learned field below static beyond the window",
+    ),
+    ClaimSpec(
+        "ours_behind_on_views", "ours", cc.trees, "tab_psnr", cc.ahead_of_fields,
+        "EVEN", "<", "dB",
+        "{tree}: ours is behind the best learned field on held-out views",
+        "tab_psnr, view column: ours - max over learned fields",
+        paper_ours_behind,
+    ),
+    # the paper's: unseen wind (tab:transfer, tab:margin)
+    ClaimSpec(
+        "transfer_ours_ahead", "ours", cc.winds_beyond, "tab_transfer", cc.wind_ahead,
+        "EVEN", ">", "dB",
+        "{tree}, {cond} v0, beyond the window: ours ahead of the best baseline",
+        "tab_transfer (beyond): ours - max learned",
+        "ahead in every cell, by 0.38-4.68 dB",
+        headline="ours ahead of the best learned field under unseen wind",
+    ),
+    ClaimSpec(
+        "transfer_baselines_below_static", "ours", cc.winds_beyond, "tab_transfer",
+        cc.wind_fields_minus_static, "EVEN", "<", "dB",
+        "{tree}, {cond} v0, beyond the window: every learned baseline below static",
+        "tab_transfer (beyond): max learned - static",
+        "below static in all 24 cells, by 0.10-2.79 dB",
+    ),
+    ClaimSpec(
+        "margin_grows", "ours", cc.margin_trees, "tab_margin", cc.margin_growth,
+        "EVEN", ">", "dB",
+        "{tree}: the margin against MLP + wind grows as the wind departs from training",
+        "tab_margin: {last} - {first}",
+        paper_margin,
+    ),
+    # the paper's: recovery against the untrained null (tab:null, section 4)
+    ClaimSpec(
+        "null_factor", "ours", cc.null_trees_sparse, "tab_null", cc.null_over_trained,
+        "NULL_FACTOR", ">", "ratio",
+        "{tree}: ... by the paper's factor of {NULL_FACTOR:g}",
+        "tab_null, {config}: null / trained",
+        paper_null_ratio,
+        headline="ours beats the untrained null by the paper's factor on frequency",
+    ),
+    ClaimSpec(
+        "null_loses", "ours", cc.null_trees_sparse, "tab_null", cc.null_over_trained,
+        "RATIO_EVEN", ">", "ratio",
+        "{tree}: joint training beats the untrained null",
+        "tab_null, {config}: null / trained median rel. error",
+        paper_null_ratio,
+    ),
+    ClaimSpec(
+        "null_matches", "ours", cc.null_trees_dense, "tab_null", cc.trained_minus_null,
+        "-NULL_MATCH_PP", ">", "points",
+        "{tree}: the untrained null matches the trained model (it is not beaten by "
+        "{NULL_MATCH_PP} points or more)",
+        "tab_null, {config}: trained - null median rel. error (points)",
+        paper_null_difference,
+        headline="the untrained null matches ours on frequency",
+    ),
+    ClaimSpec(
+        "nearest_bone_gap", "ours", cc.gap_trees, "tab_testbed", cc.gap_off,
+        "GAP_RTOL", "<", "fraction",
+        "{tree}: the median nearest-bone gap is the paper's (within {GAP_RTOL:.0%} of it)",
+        "tab_testbed: |gap - paper| / paper",
+        paper_gap,
+        needs_variance=False,
+    ),
+    ClaimSpec(
+        "damping_not_recovered", "ours", cc.recovered_trees, RECOVERY, cc.damping_off,
+        "DAMPING_OFF", ">", "fraction",
+        "{tree}: damping is not recovered (median zeta_hat off the truth by more than "
+        "{DAMPING_OFF:.0%})",
+        "recovery ({config}): |median zeta_hat - zeta| / zeta",
+        paper_zeta,
+        headline="damping is not recovered",
+    ),
+    ClaimSpec(
+        "decay_rate_flat", "ours", cc.recovered_trees, RECOVERY, cc.decay_exponent,
+        "RATE_EXPONENT", "<", "exponent",
+        "{tree}: the fitted decay rate gamma = zeta*omega is nearly frequency-independent "
+        "(gamma ~ omega^p, p < {RATE_EXPONENT})",
+        "recovery ({config}): exponent p",
+        "nearly frequency-independent",
+    ),
+    # the premise of every comparison: the fields fit their window (a model the paper did not
+    # train makes its row this project's: ``origin_of``)
+    ClaimSpec(
+        "fits_window", "ours", cc.fit_models, "tab_fit", cc.fit_fraction,
+        "FIT_BAR", ">", "fraction",
+        "{tree}: {fit_label} fits its training window (reaches {FIT_BAR:.0%} of the "
+        "true-motion ceiling's in-window gain over static)",
+        "tab_fit: (fit - static) / (ceiling - static) on the trained frames",
+        "the fields 'fit the training window well'",
+    ),
+    # this project's: the paper's claims about ours asked again of every other prior
+    ClaimSpec(
+        "above_static_beyond", "priors", cc.trees, "tab_psnr", cc.above_static,
+        "EVEN", ">", "dB",
+        "{tree}: the {name} is above the static pose beyond the window",
+        "tab_psnr, time column: prior - static",
+        origin="project",
+        headline="the {name} above the static pose beyond the window",
+    ),
+    ClaimSpec(
+        AHEAD, "priors", cc.splits, "tab_psnr", cc.ahead_of_fields,
+        "EVEN", ">", "dB",
+        "{tree}: the {name} is ahead of the best learned field on {where}",
+        "tab_psnr, {split} column: prior - max over learned fields",
+        origin="project",
+    ),
+    ClaimSpec(
+        AHEAD, "priors", cc.winds, "tab_transfer", cc.wind_ahead,
+        "EVEN", ">", "dB",
+        "{tree}, {cond} v0, {where}: the {name} is ahead of the best learned field",
+        "tab_transfer ({split}): prior - max learned",
+        origin="project",
+    ),
+    ClaimSpec(
+        "margin_grows", "priors", cc.margin_trees, "tab_margin", cc.margin_growth,
+        "EVEN", ">", "dB",
+        "{tree}: the {name}'s margin against MLP + wind grows as the wind departs",
+        "tab_margin ({model}): {last} - {first}",
+        origin="project",
+    ),
+    ClaimSpec(
+        "beats_null", "priors", cc.recovery_trees, "tab_null", cc.trained_minus_null,
+        "-NULL_MATCH_PP", "<", "points",
+        "{tree}: the {name} beats the untrained null on frequency recovery (by "
+        "{NULL_MATCH_PP} points or more)",
+        "tab_null, {config}: trained - null median rel. error (points)",
+        origin="project",
+    ),
+    ClaimSpec(
+        "damping_recovered", "priors", cc.recovered_trees, RECOVERY, cc.damping_off,
+        "DAMPING_OFF", "<", "fraction",
+        "{tree}: the {name} recovers damping (median zeta_hat within {DAMPING_OFF:.0%} of the "
+        "truth)",
+        "recovery ({config}): |median zeta_hat - zeta| / zeta",
+        origin="project",
+    ),
+    ClaimSpec(
+        "decay_rate_flat", "priors", cc.recovered_trees, RECOVERY, cc.decay_exponent,
+        "RATE_EXPONENT", "<", "exponent",
+        "{tree}: the {name}'s fitted decay rate gamma = zeta*omega is nearly "
+        "frequency-independent (gamma ~ omega^p, p < {RATE_EXPONENT})",
+        "recovery ({config}): exponent p",
+        origin="project",
+    ),
+    # this project's: without the anemometer, and the output-only analysis (docs/blind.md)
+    ClaimSpec(
+        "anemometer_needed", "ours", cc.blind_trees, "tab_null", cc.blind_minus_wind,
+        "EVEN", ">", "pp",
+        "{tree}: without the measured wind (a learned forcing) {who} recovers omega worse",
+        "tab_null, {config}: {blind} - {wind} median rel. error (points)",
+        "the paper's closing limit: 'real footage needs an anemometer'",
+        origin="project",
+        headline="without the anemometer (a learned forcing), ours' frequency error grows "
+        "(points)",
+        optional=True,
+    ),
+    ClaimSpec(
+        "oma_beats_null", "ours", cc.oma_sparse, "tab_null", cc.null_over_trained,
+        "RATIO_EVEN", ">", "ratio",
+        "{tree}: output-only modal analysis of the video recovers omega better than the "
+        "untrained null",
+        "tab_null, {config}: null / output-only median rel. error",
+        "not run",
+        origin="project",
+        headline="output-only modal analysis of the video beats the untrained null",
+        optional=True,
+    ),
+    ClaimSpec(
+        "oma_recovers_zeta", "ours", cc.oma_damping_trees, "tab_damping", cc.oma_zeta_gain,
+        "EVEN", "<", "pp",
+        "{tree} (damping testbed): output-only modal analysis recovers zeta better than the "
+        "untrained null",
+        "tab_damping, {config}: output-only - null median zeta error (points)",
+        "no method here recovers zeta (the paper)",
+        origin="project",
+        optional=True,
+    ),
+    # this project's: the paper's two hypotheses about its prior (section 6), tested
+    ClaimSpec(
+        "topology_parts_reduce_damping_error", "ours", cc.parts_damping_trees, "tab_parts",
+        cc.topology_damping_gain, "EVEN", "<", "pp",
+        "{tree}: topology-aware parts reduce the damping error (damping testbed)",
+        "tab_parts ({config}): median rel. err. of zeta, topology - k-means parts",
+        "hypothesis (k-means parts 'plausibly feed the damping bias')",
+        origin="project",
+        optional=True,
+    ),
+    ClaimSpec(
+        "coupling_lifts_sparse_fit", "ours", cc.parts_coupling, "tab_parts", cc.coupling_gain,
+        "EVEN", ">", "fraction",
+        "{tree}: parent-child coupling lifts the in-window fit",
+        "tab_parts ({config}): fraction of the ceiling's gain, chained - independent topology "
+        "parts",
+        "hypothesis (independent parts 'represent no coupling')",
+        origin="project",
+        optional=True,
+    ),
+    # this project's: the 2D-track control (docs/tracks.md)
+    ClaimSpec(
+        "tracks_beats_null", "ours", cc.tracks_sparse, "tab_null", cc.null_over_trained,
+        "RATIO_EVEN", ">", "ratio",
+        "{tree}: oscillators fitted to 2D tracks recover omega better than the untrained null",
+        "tab_null, 2D tracks {config}: null / tracks median rel. error",
+        TRACKS_PROPOSAL,
+        origin="project",
+        optional=True,
+    ),
+    ClaimSpec(
+        "tracks_match_ours", "ours", cc.tracks_sparse, "tab_null", cc.tracks_minus_ours,
+        "NULL_MATCH_PP", "<", "points",
+        "{tree}: oscillators fitted to 2D tracks match ours' omega recovery (ours does not "
+        "beat them by {NULL_MATCH_PP} points or more)",
+        "tab_null, {config}: 2D tracks - ours median rel. error (points)",
+        TRACKS_PROPOSAL,
+        origin="project",
+        optional=True,
+    ),
+    ClaimSpec(
+        "tracks_extrapolate_as_ours", "ours", cc.tracks_trees, "tab_tracks", cc.tracks_tail,
+        "EVEN", "<", "px",
+        "{tree}: beyond the window, oscillators fitted to 2D tracks predict the tracked points "
+        "at least as well as ours' Gaussians",
+        "tab_tracks, {config}: tail displacement error, 2D tracks - ours (px)",
+        TRACKS_PROPOSAL,
+        origin="project",
+        optional=True,
+    ),
+)  # fmt: skip
+
+
+# ---- derived from the catalogue ----------------------------------------------------------------
+def tables(optional: bool = True) -> tuple[str, ...]:
+    """The tables the ledger reads, in catalogue order.
+
+    Args:
+        optional: include the tables only some runs make (``ClaimSpec.optional``).
+
+    Returns:
+        Table names (the recovery summaries are not a table: ``reads_recovery``).
+    """
+    required = {s.table for s in CATALOGUE if not s.optional}
+    every = dict.fromkeys(s.table for s in CATALOGUE if s.table != RECOVERY)
+    return tuple(t for t in every if optional or t in required)
+
+
+def required_tables() -> tuple[str, ...]:
+    """The tables every run's ledger reads (a missing one: its claims "not measured")."""
+    return tables(optional=False)
+
+
+def prior_tables() -> tuple[str, ...]:
+    """The tables whose rows or columns say that a run holds a prior other than ours (the
+    tables of the ``of="priors"`` families)."""
+    return tuple(dict.fromkeys(s.table for s in CATALOGUE if s.of == "priors" and s.table != RECOVERY))
+
+
+def reads_recovery() -> bool:
+    """Whether any family reads the priors' recovery records (``RECOVERY``)."""
+    return any(s.table == RECOVERY for s in CATALOGUE)
+
+
+def _name(model: str) -> str:
+    """A prior's label as words inside a sentence (its first letter lower case)."""
+    name = label(model)
+    return name[0].lower() + name[1:]
+
+
+def headline(priors: Sequence[str] | None = None) -> list[tuple[str, str, str]]:
+    """The families that carry the story, in catalogue order: ``(id prefix, words, origin)``;
+    a family asked of the priors gives one per prior other than ours.
+
+    Args:
+        priors: the priors other than ours (default: the registry's).
+
+    Returns:
+        One triple per headline family.
+    """
+    others = [m for m in models_of("prior") if m != "ours"] if priors is None else priors
+    out = []
+    for s in CATALOGUE:
+        if not s.headline:
+            continue
+        if s.of == "ours":
+            out.append((s.family, s.headline, s.origin))
+        else:
+            out += [(f"{m}/{s.family}", s.headline.format(name=_name(m)), s.origin) for m in others]
+    return out
+
+
+_MODEL_IDS = set(MODELS) | set(PRIOR_VARIANTS)
+
+
+def origin_of(claim_id: str) -> str:
+    """Whether a claim id is the paper's or this project's: its family's origin, and this
+    project's wherever the id names a model the paper did not train.
+
+    Args:
+        claim_id: a ledger id (``[<prior>/]<family>[/<cell>]``).
+
+    Returns:
+        ``"paper"`` or ``"project"``.
+
+    Raises:
+        ValueError: for an id of no family of the catalogue.
+    """
+    parts = claim_id.split("/")
+    if any(p in _MODEL_IDS and p not in PAPER_MODELS for p in parts):
+        return "project"
+    fam = parts[1] if parts[0] in _MODEL_IDS and len(parts) > 1 else parts[0]
+    for s in CATALOGUE:
+        if s.family == fam and (s.of == "priors") == (parts[0] in _MODEL_IDS):
+            return s.origin
+    raise ValueError(f"claim {claim_id!r}: no family {fam!r} in the catalogue")
+
+
+def _template(text: str) -> str:
+    """A sentence template as the claims page shows it: thresholds filled in, the cell's fields
+    as ``<field>``."""
+    out = []
+    for lit, field, spec, _ in string.Formatter().parse(text):
+        out.append(lit)
+        if field is None:
+            continue
+        if field in WORDS:
+            out.append(format(WORDS[field], spec or ""))
+        elif field == "name":
+            out.append("<prior>")
+        else:
+            out.append(f"<{field}>")
+    return "".join(out)
+
+
+def _doc(fn) -> str:
+    return (fn.__doc__ or fn.__name__).strip().splitlines()[0]
+
+
+BEGIN, END = "<!-- catalogue:begin -->", "<!-- catalogue:end -->"
+
+
+def markdown() -> str:
+    """The claims page's list of claims (``docs/claims.md``, between ``BEGIN`` and ``END``),
+    one row per family: generated, never typed (``tools/claims_reference.py``).
+
+    Returns:
+        The block, markers included.
+    """
+    head = [
+        BEGIN,
+        "",
+        "| family | asked of, over | claim | threshold | reads | the paper | origin |",
+        "|---|---|---|---|---|---|---|",
+    ]
+    rows = []
+    for s in CATALOGUE:
+        fam = f"`{s.family}`" if s.of == "ours" else f"`<prior>/{s.family}`"
+        if s.headline:
+            fam += " (headline)"
+        over = ("ours" if s.of == "ours" else "every other prior") + ", " + _doc(s.over)
+        thr = s.threshold.lstrip("-")
+        sign = "-" if s.threshold.startswith("-") else ""
+        figure = _doc(s.paper) if callable(s.paper) else _template(s.paper)
+        cells = [
+            fam,
+            over,
+            _template(s.text),
+            f"{s.side} {sign}`{thr}` = {s.value:g} {s.unit}",
+            f"{_template(s.source)}{' (optional)' if s.optional else ''}",
+            figure,
+            s.origin,
+        ]
+        rows.append("| " + " | ".join(c.replace("|", "\\|") for c in cells) + " |")
+    return "\n".join([*head, *rows, "", END])

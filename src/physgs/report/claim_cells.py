@@ -1,0 +1,414 @@
+"""Where each claim of the catalogue ([`physgs.report.catalogue`][physgs.report.catalogue]) is
+measured: what a claim family ranges over (its *scope*: the cells of the ledger it makes, from
+the run's trees, the priors of the registry and what the tables hold) and how one seed's value
+is read from one seed's rows of its table (its *reader*).
+
+A scope takes the [`Run`][physgs.report.claim_cells.Run] and returns its cells: one dict per
+claim, with ``suffix`` (the claim id after the family, "" for none), the fields its sentence
+and its reader use (``tree``, ``config``, ``method``, ...) and, where the id is not the asked
+prior's, ``prefix``. A reader takes one seed's rows and a cell and returns a float, NaN where
+the rows are not there (a model the run's table does not hold: "undecided: not measured").
+
+A table without a ``method`` (``model``) column is ours' alone (a table made before another
+prior joined it). Cells read by id or by display label alike where a table holds labels
+(``tab_psnr``).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from typing import Any, Callable, Mapping, Sequence
+
+import numpy as np
+import pandas as pd
+
+from physgs.models.registry import BLIND_CONFIG, BLIND_PRIORS, label, models_of, spec_of
+from physgs.report import paper
+from physgs.report.tables import OMA
+from physgs.testbed.variant import DAMPING
+
+#: The configuration the recovery claims read (the paper's joint K = 32; the base configuration
+#: where a config has none: ``physgs.report.build.claims_needs``).
+CONFIG = "joint32"
+#: The pseudo-table of the priors' damping summaries (one row per seed, model and tree:
+#: median_zeta, zeta_true, loglog_exponent), read from their recovery records.
+RECOVERY = "recovery"
+
+Cell = dict[str, Any]
+
+
+@dataclass(frozen=True)
+class Run:
+    """What a claim family is asked of.
+
+    Attributes:
+        tables: table name -> its CSV (one row per seed; ``RECOVERY`` the damping summaries).
+        trees: the run's trees.
+        model: the prior the claim is asked of (``ours``, or another prior of the registry).
+        others: the priors other than ours that the run's tables hold.
+    """
+
+    tables: Mapping[str, pd.DataFrame]
+    trees: Sequence[str]
+    model: str = "ours"
+    others: tuple[str, ...] = ()
+
+
+def fields() -> tuple[str, ...]:
+    """The learned deformation fields (registry role "field")."""
+    return models_of("field")
+
+
+# ---- helpers --------------------------------------------------------------------------------
+def value(df: pd.DataFrame, mask, col: str) -> float:
+    """The single cell of ``col`` where ``mask`` holds; NaN where no row does or ``col`` is
+    not a column."""
+    if col not in df.columns:
+        return float("nan")
+    v = df.loc[mask, col]
+    return float(v.iloc[0]) if len(v) else float("nan")
+
+
+def _rows_of(df: pd.DataFrame, who: str, col: str = "method") -> pd.Series:
+    """Rows of method (or model) ``who``; a table without the column holds ours' only."""
+    if col in df.columns:
+        return df[col].astype(str) == who
+    return pd.Series(who == "ours", index=df.index)
+
+
+def _psnr(d: pd.DataFrame, tree: str, model: str, split: str) -> float:
+    """tab_psnr's ``<tree>_<split>`` cell of ``model`` (its id or its label)."""
+    m = d["model"].astype(str)
+    return value(d, (m == model) | (m == label(model)), f"{tree}_{split}")
+
+
+def _recovery(d: pd.DataFrame, c: Cell, col: str) -> float:
+    return value(d, (d["model"] == c["model"]) & (d["tree"] == c["tree"]), col)
+
+
+# ---- scopes: what a family ranges over --------------------------------------------------------
+def trees(run: Run) -> list[Cell]:
+    """each tree"""
+    return [{"suffix": t, "tree": t} for t in run.trees]
+
+
+def sparse(run: Run) -> list[Cell]:
+    """the sparse tree"""
+    return [{"suffix": "sparse", "tree": "sparse"}] if "sparse" in run.trees else []
+
+
+def dense_trees(run: Run) -> list[Cell]:
+    """each tree but the sparse one"""
+    return [c for c in trees(run) if c["tree"] != "sparse"]
+
+
+def gap_trees(run: Run) -> list[Cell]:
+    """each tree whose nearest-bone gap the paper states"""
+    return [c for c in trees(run) if c["tree"] in paper.NEAREST_BONE_GAP_PCT]
+
+
+def recovered_trees(run: Run) -> list[Cell]:
+    """each tree with the asked prior's recovery records (joint K = 32)"""
+    rec = run.tables.get(RECOVERY)
+    if rec is None:
+        return []
+    have = set(rec.loc[rec["model"] == run.model, "tree"])
+    return [{**c, "config": CONFIG} for c in trees(run) if c["tree"] in have]
+
+
+def fit_models(run: Run) -> list[Cell]:
+    """each tree x each learned field, ours and every other prior the tables hold"""
+    return [
+        {"suffix": f"{t}/{m}", "tree": t, "fit_model": m, "fit_label": label(m)}
+        for t in run.trees
+        for m in (*fields(), "ours", *run.others)
+    ]
+
+
+def splits(run: Run) -> list[Cell]:
+    """each tree x held-out views and beyond the window"""
+    words = {"view": "held-out views", "time": "beyond the window"}
+    return [
+        {"suffix": f"{t}/{sp}", "tree": t, "split": sp, "where": w}
+        for t in run.trees
+        for sp, w in words.items()
+    ]
+
+
+def winds_beyond(run: Run) -> list[Cell]:
+    """each tree x unseen wind of tab_transfer, beyond the window"""
+    tr = run.tables.get("tab_transfer")
+    if tr is None:
+        return []
+    beyond = tr[tr["split"] == "beyond"] if "split" in tr.columns else tr
+    return [
+        {"suffix": f"{t}/{c:.2f}", "tree": t, "condition": c, "cond": f"{c:.2f}", "split": "beyond"}
+        for (t, c), _ in beyond.groupby(["tree", "condition"], sort=False)
+    ]
+
+
+def winds(run: Run) -> list[Cell]:
+    """each split (training timestamps, beyond the window) x tree x unseen wind of tab_transfer"""
+    tr = run.tables.get("tab_transfer")
+    if tr is None:
+        return []
+    where = {"beyond": "beyond the window"}
+    return [
+        {
+            "suffix": f"{t}/wind_{sp}/{c:.2f}",
+            "tree": t,
+            "condition": c,
+            "cond": f"{c:.2f}",
+            "split": sp,
+            "where": where.get(sp, "at training timestamps"),
+        }
+        for (sp, t, c), _ in tr.groupby(["split", "tree", "condition"], sort=False)
+    ]
+
+
+def margin_trees(run: Run) -> list[Cell]:
+    """each tree, tab_margin's first and last wind"""
+    mg = run.tables.get("tab_margin")
+    cols = [c for c in mg.columns if c.startswith("margin_")] if mg is not None else []
+    first, last = (cols[0], cols[-1]) if cols else ("first", "last")
+    return [{**c, "first": first, "last": last} for c in trees(run)]
+
+
+def recovery_trees(run: Run) -> list[Cell]:
+    """each tree, in the ledger's recovery configuration (joint K = 32)"""
+    return [{**c, "config": CONFIG, "method": run.model} for c in trees(run)]
+
+
+def null_trees_sparse(run: Run) -> list[Cell]:
+    """the sparse tree, in the ledger's recovery configuration (joint K = 32)"""
+    return [c for c in recovery_trees(run) if c["tree"] == "sparse"]
+
+
+def null_trees_dense(run: Run) -> list[Cell]:
+    """each tree but the sparse one, in the ledger's recovery configuration (joint K = 32)"""
+    return [c for c in recovery_trees(run) if c["tree"] != "sparse"]
+
+
+def _parts(run: Run) -> tuple[pd.DataFrame | None, set, str]:
+    df = run.tables.get("tab_parts")
+    if df is None or df.empty:
+        return None, set(), ""
+    return df, set(df["model"]), str(df["config"].iloc[0])
+
+
+def parts_damping_trees(run: Run) -> list[Cell]:
+    """each tree with a damping testbed in tab_parts (its first configuration), when it holds
+    the topology parts"""
+    df, models, c0 = _parts(run)
+    if df is None or "ours_topo" not in models:
+        return []
+    return [
+        {**c, "config": c0}
+        for c in trees(run)
+        if np.isfinite(df.loc[df["tree"] == c["tree"], "zeta_rel_err_pct"]).any()
+    ]
+
+
+def parts_coupling(run: Run) -> list[Cell]:
+    """the sparse tree in tab_parts (its first configuration), when it holds both topology
+    priors"""
+    df, models, c0 = _parts(run)
+    if df is None or not {"ours_topo", "ours_chain"} <= models or "sparse" not in run.trees:
+        return []
+    return [{"suffix": "", "tree": "sparse", "config": c0}]
+
+
+def tracks_sparse(run: Run) -> list[Cell]:
+    """the sparse tree, the 2D-track control's recovery in joint K = 32 (else its first
+    configuration)"""
+    null = run.tables.get("tab_null")
+    if null is None or "method" not in null.columns or "sparse" not in run.trees:
+        return []
+    cfgs = list(dict.fromkeys(null.loc[null["method"] == "tracks", "config"]))
+    if not cfgs:
+        return []
+    c = CONFIG if CONFIG in cfgs else cfgs[0]
+    return [{"suffix": "sparse", "tree": "sparse", "config": c, "method": "tracks"}]
+
+
+def tracks_trees(run: Run) -> list[Cell]:
+    """each tree in tab_tracks, its base configuration (else its first)"""
+    tr = run.tables.get("tab_tracks")
+    if tr is None:
+        return []
+    tc = list(dict.fromkeys(tr["config"]))
+    if not tc:
+        return []
+    c = "single" if "single" in tc else tc[0]
+    return [{**x, "config": c} for x in trees(run) if (tr["tree"] == x["tree"]).any()]
+
+
+def blind_trees(run: Run) -> list[Cell]:
+    """each forcing-free prior in tab_null x each tree, against the prior whose measured wind it
+    replaces (ids ``<prior>/...`` for a prior other than ours)"""
+    null = run.tables.get("tab_null")
+    if null is None or "method" not in null.columns:
+        return []
+    have, out = set(null["method"]), []
+    for blind in (m for m in BLIND_PRIORS if m in have):
+        wind = spec_of(blind).blind_of
+        who, prefix = ("ours", "") if wind == "ours" else (f"the {label(wind)}", f"{wind}/")
+        out += [
+            {**c, "prefix": prefix, "blind": blind, "wind": wind, "who": who, "config": BLIND_CONFIG}
+            for c in trees(run)
+            if (null["tree"] == c["tree"]).any()
+        ]
+    return out
+
+
+def oma_sparse(run: Run) -> list[Cell]:
+    """the sparse tree, when tab_null holds the output-only analysis"""
+    null = run.tables.get("tab_null")
+    if null is None or "method" not in null.columns or OMA not in set(null["method"]):
+        return []
+    return [{**c, "config": BLIND_CONFIG, "method": OMA} for c in sparse(run)]
+
+
+def oma_damping_trees(run: Run) -> list[Cell]:
+    """each tree of tab_damping, when it holds the output-only analysis"""
+    dmp = run.tables.get("tab_damping")
+    if dmp is None or "method" not in dmp.columns or OMA not in set(dmp["method"]):
+        return []
+    return [
+        {**c, "config": BLIND_CONFIG} for c in trees(run) if (dmp["tree"] == c["tree"]).any()
+    ]
+
+
+# ---- readers: one seed's value ---------------------------------------------------------------
+def best_field_minus_static(d: pd.DataFrame, c: Cell) -> float:
+    """tab_psnr, time column: max over learned fields of (model - static)"""
+    best = max(_psnr(d, c["tree"], m, "time") for m in fields())
+    return best - _psnr(d, c["tree"], "static", "time")
+
+
+def above_static(d: pd.DataFrame, c: Cell) -> float:
+    """tab_psnr, time column: the prior - static"""
+    return _psnr(d, c["tree"], c["model"], "time") - _psnr(d, c["tree"], "static", "time")
+
+
+def ahead_of_fields(d: pd.DataFrame, c: Cell) -> float:
+    """tab_psnr, the cell's split: the prior - max over learned fields"""
+    t, sp = c["tree"], c.get("split", "view")
+    return _psnr(d, t, c["model"], sp) - max(_psnr(d, t, m, sp) for m in fields())
+
+
+def _wind_row(d: pd.DataFrame, c: Cell):
+    return (d["split"] == c["split"]) & (d["tree"] == c["tree"]) & np.isclose(d["condition"], c["condition"])
+
+
+def wind_ahead(d: pd.DataFrame, c: Cell) -> float:
+    """tab_transfer: the prior - max over learned fields"""
+    row = _wind_row(d, c)
+    return value(d, row, c["model"]) - max(value(d, row, m) for m in fields())
+
+
+def wind_fields_minus_static(d: pd.DataFrame, c: Cell) -> float:
+    """tab_transfer: max over learned fields - static"""
+    row = _wind_row(d, c)
+    return max(value(d, row, m) for m in fields()) - value(d, row, "static")
+
+
+def margin_growth(d: pd.DataFrame, c: Cell) -> float:
+    """tab_margin: the prior's last wind's margin - its first's"""
+    mine = (d["tree"] == c["tree"]) & _rows_of(d, c["model"], "model")
+    return value(d, mine, c["last"]) - value(d, mine, c["first"])
+
+
+def _null_row(d: pd.DataFrame, c: Cell):
+    who = c.get("method", c["model"])
+    return _rows_of(d, who) & (d["tree"] == c["tree"]) & (d["config"] == c["config"])
+
+
+def null_over_trained(d: pd.DataFrame, c: Cell) -> float:
+    """tab_null: null / trained median omega error of the cell's method"""
+    row = _null_row(d, c)
+    return value(d, row, "null_median_rel_err_pct") / value(d, row, "trained_median_rel_err_pct")
+
+
+def trained_minus_null(d: pd.DataFrame, c: Cell) -> float:
+    """tab_null: trained - null median omega error of the cell's method (points)"""
+    row = _null_row(d, c)
+    return value(d, row, "trained_median_rel_err_pct") - value(d, row, "null_median_rel_err_pct")
+
+
+def gap_off(d: pd.DataFrame, c: Cell) -> float:
+    """tab_testbed: |nearest-bone gap - the paper's| / the paper's"""
+    g = paper.NEAREST_BONE_GAP_PCT[c["tree"]]
+    return abs(value(d, d["tree"] == c["tree"], "nearest_bone_gap_pct") - g) / g
+
+
+def damping_off(d: pd.DataFrame, c: Cell) -> float:
+    """the prior's recovery: |median zeta_hat - zeta| / zeta"""
+    z = _recovery(d, c, "zeta_true")
+    return abs(_recovery(d, c, "median_zeta") - z) / z
+
+
+def decay_exponent(d: pd.DataFrame, c: Cell) -> float:
+    """the prior's recovery: the exponent p of gamma ~ omega^p"""
+    return _recovery(d, c, "loglog_exponent")
+
+
+def fit_fraction(d: pd.DataFrame, c: Cell) -> float:
+    """tab_fit: (fit - static) / (ceiling - static) on the trained frames"""
+    return value(d, (d["tree"] == c["tree"]) & (d["model"] == c["fit_model"]), "ceiling_frac")
+
+
+def _parts_value(d: pd.DataFrame, c: Cell, model: str, col: str) -> float:
+    row = (d["tree"] == c["tree"]) & (d["model"] == model) & (d["config"] == c["config"])
+    return value(d, row, col)
+
+
+def topology_damping_gain(d: pd.DataFrame, c: Cell) -> float:
+    """tab_parts: median zeta error, topology - k-means parts (points)"""
+    col = "zeta_rel_err_pct"
+    return _parts_value(d, c, "ours_topo", col) - _parts_value(d, c, "ours", col)
+
+
+def coupling_gain(d: pd.DataFrame, c: Cell) -> float:
+    """tab_parts: ceiling fraction, chained - independent topology parts"""
+    col = "ceiling_frac"
+    return _parts_value(d, c, "ours_chain", col) - _parts_value(d, c, "ours_topo", col)
+
+
+def tracks_minus_ours(d: pd.DataFrame, c: Cell) -> float:
+    """tab_null: 2D tracks - ours median omega error (points); NaN at another K than ours'"""
+    tracks, ours = _null_row(d, c), _null_row(d, {**c, "method": "ours"})
+    if value(d, tracks, "K") != value(d, ours, "K"):
+        return float("nan")  # another K: not the same question
+    col = "trained_median_rel_err_pct"
+    return value(d, tracks, col) - value(d, ours, col)
+
+
+def tracks_tail(d: pd.DataFrame, c: Cell) -> float:
+    """tab_tracks: tail displacement error, 2D tracks - ours (px)"""
+    row = (d["tree"] == c["tree"]) & (d["config"] == c["config"])
+    return value(d, row, "tail_px") - value(d, row, "tail_ours_px")
+
+
+def blind_minus_wind(d: pd.DataFrame, c: Cell) -> float:
+    """tab_null: forcing-free prior - its wind-reading prior, median omega error (points)"""
+    col = "trained_median_rel_err_pct"
+    blind, wind = _null_row(d, {**c, "method": c["blind"]}), _null_row(d, {**c, "method": c["wind"]})
+    return value(d, blind, col) - value(d, wind, col)
+
+
+def oma_zeta_gain(d: pd.DataFrame, c: Cell) -> float:
+    """tab_damping (damping testbed): output-only - null median zeta error (points)"""
+    row = (
+        (d["testbed"] == DAMPING)
+        & (d["tree"] == c["tree"])
+        & (d["config"] == c["config"])
+        & (d["method"] == OMA)
+    )
+    return value(d, row, "trained_minus_null_pp")
+
+
+#: A reader: one seed's rows and a cell -> the claim's value.
+Reader = Callable[[pd.DataFrame, Cell], float]
+#: A scope: the run -> the family's cells.
+Scope = Callable[[Run], list[Cell]]
