@@ -8,6 +8,15 @@ import pytest
 from physgs.report import claims
 
 
+BLIND = ("anemometer_needed", "oma_beats_null", "oma_recovers_zeta")
+
+
+def _blind_claims(null, damping, trees):
+    """The forcing-free methods' claims of the ledger measured on tab_null (and tab_damping)."""
+    tabs = {"tab_null": null, **({"tab_damping": damping} if damping is not None else {})}
+    return [(c, v) for c, v in claims.measure(tabs, {}, trees) if set(BLIND) & set(c.id.split("/"))]
+
+
 def _null(ours, blind, oma, null_oma):
     rows = []
     for s, (o, b, m, n) in enumerate(zip(ours, blind, oma, null_oma)):
@@ -56,9 +65,7 @@ def test_blind_claims_follow_the_values(blind, oma, dz, anem, beats, zeta):
     ours = [2.0, 2.1, 2.05]
     got = {
         c.id: claims.verdict(c, v)
-        for c, v in claims._blind_claims(
-            _null(ours, blind, oma, [4.0] * 3), _damping(dz), ["sparse"]
-        )
+        for c, v in _blind_claims(_null(ours, blind, oma, [4.0] * 3), _damping(dz), ["sparse"])
     }
     assert got["anemometer_needed/sparse"] == anem
     assert got["oma_beats_null/sparse"] == beats
@@ -68,7 +75,7 @@ def test_blind_claims_follow_the_values(blind, oma, dz, anem, beats, zeta):
 def test_no_rows_no_claims():
     df = _null([2.0], [3.0], [2.0], [4.0])
     df = df[df["method"] == "ours"]
-    assert claims._blind_claims(df, None, ["sparse"]) == []
+    assert _blind_claims(df, None, ["sparse"]) == []
 
 
 def test_every_blind_prior_is_paired_with_a_prior_that_reads_the_wind():
@@ -107,7 +114,7 @@ def test_each_blind_prior_gets_its_anemometer_claim_against_its_counterpart():
             for m, v in err.items()
         ]
     )
-    got = {c.id: (c, v) for c, v in claims._blind_claims(null, None, ["sparse"])}
+    got = {c.id: (c, v) for c, v in _blind_claims(null, None, ["sparse"])}
     ours, v_ours = got["anemometer_needed/sparse"]
     chain, v_chain = got["ours_chain/anemometer_needed/sparse"]
     # by hand: 3.0 - 2.0, 3.3 - 2.2, 3.6 - 2.4; 0.5 - 1.0, 0.6 - 1.1, 0.7 - 1.2
@@ -117,7 +124,7 @@ def test_each_blind_prior_gets_its_anemometer_claim_against_its_counterpart():
     assert claims.verdict(chain, v_chain) == "fails"
     assert "ours_chain_blind - ours_chain" in chain.source and "ours_blind - ours" in ours.source
     # a blind prior without its rows in the table has no claim
-    alone = claims._blind_claims(null[null.method != "ours_chain_blind"], None, ["sparse"])
+    alone = _blind_claims(null[null.method != "ours_chain_blind"], None, ["sparse"])
     assert [c.id for c, _ in alone] == ["anemometer_needed/sparse"]
 
 

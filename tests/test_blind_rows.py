@@ -180,6 +180,7 @@ def test_tab_null_and_tab_damping_read_the_forcing_free_records_and_their_nulls(
     bare = dataclasses.replace(PLAN, oma={}, blind=[])
     assert not any(n[0] == "oma_recovery" for n in build.needs("tab_null", bare))
     assert ("eval", "sparse", "ours_blind", "single", 1) in build.needs("tab_fit", PLAN)
-    assert ("table", "tab_damping") in build.claims_needs(
-        ["sparse"], PLAN.configs, [0], damping=True
+    assert ("table", "tab_damping") in build.claims_needs(PLAN)
+    assert ("table", "tab_damping") not in build.claims_needs(
+        dataclasses.replace(PLAN, damping_trees=())
     )

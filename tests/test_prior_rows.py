@@ -10,7 +10,6 @@ from physgs.models.registry import MODELS, label, models_of, training_jobs
 from physgs.report import build
 from physgs.report import claims as C
 from physgs.report import tables as T
-from physgs.report.claims_priors import prior_claims
 from physgs.report.summary import prior_lines
 from test_report_tables import BONES, null, paired, record
 
@@ -61,7 +60,7 @@ def test_recovery_outputs_read_the_chained_prior_in_every_configuration_and_test
         for c in ("single", "joint32"):
             assert ("prior_recovery", tb, "ours_chain", c, 0) in damp
     assert not any(n[0] == "prior_recovery" and n[3] == "joint96" for n in damp)
-    ledger = build.claims_needs(["sparse"], CONFIGS, [0, 1])
+    ledger = build.claims_needs(build.Plan(["sparse"], CONFIGS, [0, 1]))
     assert ("prior_recovery", "sparse", "ours_chain", "joint32", 1) in ledger
 
 
@@ -194,6 +193,12 @@ def _tables(ahead: float, seeds=(0, 1, 2)):
         "tab_margin": pd.DataFrame(margin),
         "tab_null": pd.DataFrame(null_rows),
     }
+
+
+def prior_claims(model, tables, damping, trees):
+    """The ledger's claims asked of ``model`` (ids ``<model>/...``) measured on ``tables``."""
+    measured = C.measure(tables, {}, trees, {model: damping})
+    return [(c, v) for c, v in measured if c.id.startswith(f"{model}/")]
 
 
 @pytest.mark.parametrize("ahead, want", [(1.0, "holds"), (-1.0, "fails")])

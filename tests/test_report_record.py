@@ -280,14 +280,38 @@ def test_headline_counts_the_verdicts_and_gives_each_story_claim_its_interval():
             "ci_high": [2.77, 1.97, np.nan, np.nan],
             "unit": ["dB", "x", "", ""],
             "verdict": ["holds", "fails", "undecided: one seed", "holds"],
+            "origin": ["paper", "paper", "project", "project"],
         }
     )
     lines = record.headline_lines(claims)
-    assert "4 claims" in lines[0] and "2 hold, 1 fail, 1 undecided" in lines[0]
-    assert len(lines) == 3  # counts, then the two story families present, in HEADLINE's order
-    assert lines[1].startswith("- Ours above the static pose")
-    assert "sparse **holds** (+1.99 [+1.2, +2.77] dB)" in lines[1]
-    assert "sparse **fails** (+1.27 [+0.56, +1.97] x)" in lines[2]
+    # the paper's claims counted apart from this project's, the paper's first
+    assert "The paper's 2 claims: 1 hold, 1 fail, 0 undecided" in lines[0]
+    assert "this project's own 2: 1 hold, 0 fail, 1 undecided" in lines[0]
+    # whether the paper's story stands, from its headline families' verdicts
+    assert "stands in part**: 1 of its 2 headline claims hold" in lines[1]
+    assert "fails on ours beats the untrained null by the paper's factor" in lines[1]
+    assert len(lines) == 4  # counts, story, then the two story families present, in order
+    assert lines[2].startswith("- Ours above the static pose")
+    assert "sparse **holds** (+1.99 [+1.2, +2.77] dB)" in lines[2]
+    assert "sparse **fails** (+1.27 [+0.56, +1.97] x)" in lines[3]
+
+
+def test_a_ledger_without_origins_takes_them_from_the_catalogue():
+    claims = pd.DataFrame(
+        {
+            "id": [
+                "fits_window/sparse/mlp",
+                "fits_window/sparse/ours_chain",
+                "oma_beats_null/sparse",
+            ],
+            "verdict": ["holds", "fails", "undecided"],
+        }
+    )
+    # the paper's family, but a model the paper did not train; the output-only analysis
+    assert record.origins(claims).tolist() == ["paper", "project", "project"]
+    assert record.story_line(claims) == ""  # none of the paper's headline claims
+    with pytest.raises(ValueError, match="no family"):
+        record.origins(pd.DataFrame({"id": ["nothing/x"], "verdict": ["holds"]}))
 
 
 def test_a_headline_family_of_another_prior_is_found_by_its_id_prefix():

@@ -19,7 +19,7 @@ from physgs.recovery.damping_scores import damping_null, damping_scores
 from physgs.recovery.matcher import MatchResult
 from physgs.recovery.null import NullResult
 from physgs.recovery.record import RecoveryRecord, load_recovery
-from physgs.report import build, claims
+from physgs.report import build, claims, thresholds
 from physgs.report import tables as T
 from physgs.report.damping import TRACKS_NOTE, tab_damping
 from physgs.report.tracks import tab_tracks
@@ -454,6 +454,12 @@ def _tracks_csv(diffs):
     )
 
 
+def _tracks_claims(null, tracks, trees):
+    """The 2D-track control's claims of the ledger measured on these two tables."""
+    measured = claims.measure({"tab_null": null, "tab_tracks": tracks}, {}, trees)
+    return [(c, v) for c, v in measured if c.id.startswith("tracks_")]
+
+
 @pytest.mark.parametrize(
     "tracks_err, tail, beats, match, extrap",
     [
@@ -464,13 +470,13 @@ def _tracks_csv(diffs):
 def test_tracks_claims_follow_the_paired_values(tracks_err, tail, beats, match, extrap):
     got = {
         c.id: (c, v)
-        for c, v in claims._tracks_claims(_null_csv(tracks_err), _tracks_csv(tail), ["sparse"])
+        for c, v in _tracks_claims(_null_csv(tracks_err), _tracks_csv(tail), ["sparse"])
     }
     c, v = got["tracks_beats_null/sparse"]
     assert v == pytest.approx([5.0 / e for e in tracks_err]) and claims.verdict(c, v) == beats
     c, v = got["tracks_match_ours/sparse"]
     assert v == pytest.approx([e - (2.0 + 0.01 * s) for s, e in enumerate(tracks_err)])
-    assert c.threshold == claims.NULL_MATCH_PP and claims.verdict(c, v) == match
+    assert c.threshold == thresholds.NULL_MATCH_PP and claims.verdict(c, v) == match
     c, v = got["tracks_extrapolate_as_ours/sparse"]
     assert v == pytest.approx(tail) and claims.verdict(c, v) == extrap
 
@@ -478,7 +484,7 @@ def test_tracks_claims_follow_the_paired_values(tracks_err, tail, beats, match, 
 def test_a_tracks_fit_at_another_k_is_not_compared_with_ours():
     got = {
         c.id: (c, v)
-        for c, v in claims._tracks_claims(
+        for c, v in _tracks_claims(
             _null_csv([2.0, 2.0], tracks_k=2), _tracks_csv([0, 0]), ["sparse"]
         )
     }
@@ -489,8 +495,9 @@ def test_a_tracks_fit_at_another_k_is_not_compared_with_ours():
 def test_ours_claims_read_ours_rows_of_a_table_with_tracks_rows():
     """null_loses/sparse reads ours' row even where the tracks row comes first."""
     df = _null_csv([1.0, 1.0]).iloc[::-1]
-    sel = claims._ours(df)
-    assert set(sel.method) == {"ours"} and len(sel) == 2
+    got = {c.id: v for c, v in claims.measure({"tab_null": df}, {}, ["sparse"])}
+    # ours' errors 2.0, 2.01 against the null's 5.0 (the tracks' 1.0 would give 5.0)
+    assert got["null_loses/sparse"] == pytest.approx([5.0 / 2.0, 5.0 / 2.01])
 
 
 # --- what each output reads --------------------------------------------------------------------
@@ -540,9 +547,8 @@ def test_needs_of_the_tracks_outputs():
     )
     assert ("tracks_recovery", "sparse_damping", "joint32", 0) in damp
     assert not any(n[0] == "tracks_recovery" and n[2] == "single" for n in damp)
-    assert ("table", "tab_tracks") in build.claims_needs(
-        ["sparse"], {"single": {}}, [0], tracks=True
-    )
+    assert ("table", "tab_tracks") in build.claims_needs(plan({"single": 2}, [0]))
+    assert ("table", "tab_tracks") not in build.claims_needs(plan({}, [0]))
     # a run without the control builds neither of its outputs (fig_tracks: without parts)
     assert not build.in_report("tab_tracks", plan({}, [0]))
     assert build.needs("fig_tracks", plan({}, [0])) == [

@@ -14,6 +14,7 @@ ledger (`physgs.report.build.claims_frame`, the claims rule's own code) with its
 from __future__ import annotations
 
 import argparse
+import dataclasses
 from pathlib import Path
 
 import physgs.config
@@ -32,7 +33,8 @@ def main() -> None:
     cfg = physgs.config.load(args.config, args.profile)
     seeds = args.seeds if args.seeds is not None else cfg["seeds"]
     trees = args.trees or cfg["trees"]
-    needs = build.claims_needs(trees, cfg["models"]["configs"], seeds, True, True, True)
+    plan = dataclasses.replace(build.Plan.from_config(cfg), trees=trees, seeds=seeds)
+    needs = build.claims_needs(plan, every=True)
     paths = {  # the workflow's layout (common.smk: TABLE, RECOVERY)
         "table": "tables/{name}.csv",
         "prior_recovery": "recovery/{tree}/seed{seed}/{model}_{config}.json",

@@ -61,22 +61,12 @@ rule report:
         parts_jobs(),
 
 
-# The claims ledger: every quantitative claim of the paper with its measured value, seed
-# interval and a verdict computed by code (physgs.report.claims).
+# The claims ledger: every claim of the catalogue (physgs.report.catalogue) with its measured
+# value, seed interval and a verdict computed by code (physgs.report.claims); the tables it reads
+# are the catalogue's.
 rule claims:
     input:
-        unpack(
-            lambda wc: need_paths(
-                _build.claims_needs(
-                    TREES,
-                    CONFIGS,
-                    SEEDS,
-                    parts=bool(PARTS_MODELS),
-                    tracks=bool(TRACKS_CONFIGS),
-                    damping=bool(DAMPING["trees"]),
-                )
-            )
-        ),
+        unpack(lambda wc: need_paths(_build.claims_needs(REPORT_PLAN))),
     output:
         md=report("results/claims.md", category="5. Claims"),
         csv="results/claims.csv",

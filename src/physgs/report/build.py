@@ -18,6 +18,8 @@ import pandas as pd
 
 from physgs.models.registry import BASE_CONFIG, models_of
 from physgs.recovery.record import load_recovery
+from physgs.report import catalogue
+from physgs.report.claim_cells import CONFIG as CLAIMS_CONFIG
 from physgs.report.outputs import NEED_FIELDS, OUTPUTS, Plan, key, reader
 from physgs.report.outputs.views import fit_row
 
@@ -28,9 +30,6 @@ __all__ = ["NEED_FIELDS", "Plan", "fit_row", "key"]
 
 TABLES = tuple(n for n, o in OUTPUTS.items() if o.kind == "table")
 FIGURES = tuple(n for n, o in OUTPUTS.items() if o.kind == "figure")
-#: Tables the claims ledger reads (their CSVs), and the configuration whose damping it reads.
-CLAIMS_TABLES = ("tab_psnr", "tab_transfer", "tab_margin", "tab_null", "tab_testbed", "tab_fit")
-CLAIMS_CONFIG = "joint32"
 
 
 def _output(name: str):
@@ -56,44 +55,31 @@ def in_report(name: str, plan: Plan) -> bool:
     return _output(name).in_report(plan)
 
 
-def claims_needs(
-    trees: Sequence[str],
-    configs: Mapping[str, dict],
-    seeds: Sequence[int],
-    parts: bool = False,
-    tracks: bool = False,
-    damping: bool = False,
-) -> list[tuple]:
-    """What the claims ledger reads.
-
-    The tables' CSVs and every prior's recovery (damping; ours first) of every seed in the joint
-    K=32 configuration (the paper's), or the base configuration when the config has none.
+def claims_needs(plan: Plan, every: bool = False) -> list[tuple]:
+    """What the claims ledger reads: the tables of the catalogue
+    ([`physgs.report.catalogue.tables`][]) that the run builds, and every prior's recovery
+    (damping) of every seed in the joint K=32 configuration (the paper's), or the base
+    configuration when the config has none.
 
     Args:
-        trees: the trees.
-        configs: ``models.configs``.
-        seeds: the training seeds.
-        parts: add tab_parts (the parts study's hypotheses).
-        tracks: add tab_tracks (the 2D-track control's; its recovery rows are in tab_null).
-        damping: add tab_damping (the damping benchmark's: the output-only analysis' zeta claims).
+        plan: the run's plan (trees, configurations, seeds; whether it builds the optional
+            tables: ``in_report``).
+        every: every table of the catalogue, built or not (``tools/ledger.py`` reads what
+            exists).
 
     Returns:
         Need tuples (module docstring).
     """
-    c = CLAIMS_CONFIG if CLAIMS_CONFIG in configs else BASE_CONFIG
-    extra = [("table", "tab_parts")] if parts else []
-    extra += [("table", "tab_tracks")] if tracks else []
-    extra += [("table", "tab_damping")] if damping else []
-    return (
-        [("table", n) for n in CLAIMS_TABLES]
-        + extra
-        + [
-            ("prior_recovery", t, m, c, int(s))
-            for m in models_of("prior")
-            for t in trees
-            for s in seeds
-        ]
-    )
+    c = CLAIMS_CONFIG if CLAIMS_CONFIG in plan.configs else BASE_CONFIG
+    required = catalogue.required_tables()
+    tabs = [n for n in catalogue.tables() if every or n in required or _output(n).in_report(plan)]
+    recovery = [
+        ("prior_recovery", t, m, c, int(s))
+        for m in models_of("prior")
+        for t in plan.trees
+        for s in plan.seeds
+    ]
+    return [("table", n) for n in tabs] + (recovery if catalogue.reads_recovery() else [])
 
 
 def claims_frame(inputs: Mapping[str, str], trees: Sequence[str]) -> pd.DataFrame:
@@ -112,7 +98,7 @@ def claims_frame(inputs: Mapping[str, str], trees: Sequence[str]) -> pd.DataFram
     """
     from physgs.report import claims
 
-    names = (*CLAIMS_TABLES, "tab_parts", "tab_tracks", "tab_damping")
+    names = catalogue.tables()
     tabs = {n: pd.read_csv(inputs[key(("table", n))]) for n in names if key(("table", n)) in inputs}
     damping: dict[str, dict[str, list]] = {}  # model -> tree -> one summary per seed
     for k, p in sorted(inputs.items()):  # prior_recovery/<tree>/<model>/<config>/<seed>

@@ -121,7 +121,9 @@ def paper_best_field_minus_static(c: Cell) -> str:
     pp = _pp(c)
     if not pp:
         return "--"
-    return f"best baseline - static = {max(pp[m][1] - pp['static'][1] for m in cc.fields()):+.2f} dB"
+    return (
+        f"best baseline - static = {max(pp[m][1] - pp['static'][1] for m in cc.fields()):+.2f} dB"
+    )
 
 
 def paper_ours_minus_static(c: Cell) -> str:
@@ -439,7 +441,9 @@ def required_tables() -> tuple[str, ...]:
 def prior_tables() -> tuple[str, ...]:
     """The tables whose rows or columns say that a run holds a prior other than ours (the
     tables of the ``of="priors"`` families)."""
-    return tuple(dict.fromkeys(s.table for s in CATALOGUE if s.of == "priors" and s.table != RECOVERY))
+    return tuple(
+        dict.fromkeys(s.table for s in CATALOGUE if s.of == "priors" and s.table != RECOVERY)
+    )
 
 
 def reads_recovery() -> bool:

@@ -254,7 +254,14 @@ def blind_trees(run: Run) -> list[Cell]:
         wind = spec_of(blind).blind_of
         who, prefix = ("ours", "") if wind == "ours" else (f"the {label(wind)}", f"{wind}/")
         out += [
-            {**c, "prefix": prefix, "blind": blind, "wind": wind, "who": who, "config": BLIND_CONFIG}
+            {
+                **c,
+                "prefix": prefix,
+                "blind": blind,
+                "wind": wind,
+                "who": who,
+                "config": BLIND_CONFIG,
+            }
             for c in trees(run)
             if (null["tree"] == c["tree"]).any()
         ]
@@ -274,9 +281,7 @@ def oma_damping_trees(run: Run) -> list[Cell]:
     dmp = run.tables.get("tab_damping")
     if dmp is None or "method" not in dmp.columns or OMA not in set(dmp["method"]):
         return []
-    return [
-        {**c, "config": BLIND_CONFIG} for c in trees(run) if (dmp["tree"] == c["tree"]).any()
-    ]
+    return [{**c, "config": BLIND_CONFIG} for c in trees(run) if (dmp["tree"] == c["tree"]).any()]
 
 
 # ---- readers: one seed's value ---------------------------------------------------------------
@@ -298,7 +303,11 @@ def ahead_of_fields(d: pd.DataFrame, c: Cell) -> float:
 
 
 def _wind_row(d: pd.DataFrame, c: Cell):
-    return (d["split"] == c["split"]) & (d["tree"] == c["tree"]) & np.isclose(d["condition"], c["condition"])
+    return (
+        (d["split"] == c["split"])
+        & (d["tree"] == c["tree"])
+        & np.isclose(d["condition"], c["condition"])
+    )
 
 
 def wind_ahead(d: pd.DataFrame, c: Cell) -> float:
@@ -393,7 +402,10 @@ def tracks_tail(d: pd.DataFrame, c: Cell) -> float:
 def blind_minus_wind(d: pd.DataFrame, c: Cell) -> float:
     """tab_null: forcing-free prior - its wind-reading prior, median omega error (points)"""
     col = "trained_median_rel_err_pct"
-    blind, wind = _null_row(d, {**c, "method": c["blind"]}), _null_row(d, {**c, "method": c["wind"]})
+    blind, wind = (
+        _null_row(d, {**c, "method": c["blind"]}),
+        _null_row(d, {**c, "method": c["wind"]}),
+    )
     return value(d, blind, col) - value(d, wind, col)
 
 

@@ -30,27 +30,8 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 
-from physgs.report import rerun
+from physgs.report import catalogue, rerun
 
-#: The claim families that carry the paper's story, in the order the README tells it, each with
-#: the words a reader needs. A family is the claim id before its first ``/``.
-HEADLINE: tuple[tuple[str, str], ...] = (
-    ("ours_above_static_beyond", "ours above the static pose beyond the training window"),
-    ("baselines_below_static_beyond", "every learned field below static beyond the window"),
-    ("transfer_ours_ahead", "ours ahead of the best learned field under unseen wind"),
-    ("null_factor", "ours beats the untrained null by the paper's factor on frequency"),
-    ("null_matches", "the untrained null matches ours on frequency"),
-    ("damping_not_recovered", "damping is not recovered"),
-    (
-        "ours_chain/above_static_beyond",
-        "the chained prior (this project's) above the static pose beyond the window",
-    ),
-    (
-        "anemometer_needed",
-        "without the anemometer (a learned forcing), ours' frequency error grows (points)",
-    ),
-    ("oma_beats_null", "output-only modal analysis of the video beats the untrained null"),
-)
 #: The commands whose cost the README states, keyed as ``tools/timed.py --name`` records them.
 COMMANDS: tuple[tuple[str, str], ...] = (
     ("quick_all", "snakemake --cores 2 all --config profile=quick"),
@@ -622,9 +603,93 @@ def write_unrecorded(out_dir: str | Path) -> Path:
     return out / "index.md"
 
 
+def origins(claims: pd.DataFrame) -> pd.Series:
+    """Each claim's origin, ``paper`` or ``project``: the ledger's ``origin`` column, or the
+    catalogue's word for its id in a ledger written before the column
+    ([`physgs.report.catalogue.origin_of`][]).
+
+    Args:
+        claims: the ledger (``claims.csv``).
+
+    Returns:
+        One origin per row.
+    """
+    if "origin" in claims.columns:
+        return claims["origin"].astype(str)
+    return claims["id"].astype(str).map(catalogue.origin_of)
+
+
+def _counted(kind: pd.Series) -> str:
+    c = kind.value_counts()
+    return (
+        f"{int(c.get('holds', 0))} hold, {int(c.get('fails', 0))} fail, "
+        f"{int(c.get('undecided', 0))} undecided"
+    )
+
+
+def count_line(claims: pd.DataFrame) -> str:
+    """The ledger's counts, the paper's claims first and this project's apart.
+
+    Args:
+        claims: the ledger (``id``, ``verdict``; ``origin`` where written).
+
+    Returns:
+        One Markdown bullet.
+    """
+    kind = claims["verdict"].astype(str).str.split(":").str[0]
+    origin = origins(claims)
+    paper, own = kind[origin == "paper"], kind[origin == "project"]
+    return (
+        f"- **The paper's {len(paper)} claims: {_counted(paper)}**; this project's own "
+        f"{len(own)}: {_counted(own)} (95% intervals over seeds)."
+    )
+
+
+def _family_rows(claims: pd.DataFrame, fam: str) -> pd.DataFrame:
+    """The claims of a headline family: their id is it, or starts with it + "/"."""
+    ids = claims["id"].astype(str)
+    return claims[(ids == fam) | ids.str.startswith(fam + "/")]
+
+
+def story_line(claims: pd.DataFrame) -> str:
+    """Whether the paper's story stands, and where it does not: its headline families'
+    verdicts (``catalogue.headline`` of origin "paper"), cell by cell.
+
+    Args:
+        claims: the ledger.
+
+    Returns:
+        One Markdown bullet; "" when the ledger holds none of the paper's headline claims.
+    """
+    fails, open_, n, held = [], [], 0, 0
+    for fam, words, origin in catalogue.headline():
+        rows = _family_rows(claims, fam)
+        if origin != "paper" or rows.empty:
+            continue
+        kind = rows["verdict"].astype(str).str.split(":").str[0]
+        where = {
+            v: ", ".join(str(i)[len(fam) + 1 :] or "all" for i in rows["id"][kind == v])
+            for v in ("fails", "undecided")
+        }
+        n, held = n + len(rows), held + int((kind == "holds").sum())
+        fails += [f"{words} ({where['fails']})"] if where["fails"] else []
+        open_ += [f"{words} ({where['undecided']})"] if where["undecided"] else []
+    if not n:
+        return ""
+    if held == n:
+        return f"- **The paper's story stands**: all {n} of its headline claims hold."
+    text = f"- **The paper's story stands in part**: {held} of its {n} headline claims hold"
+    if fails:
+        text += "; it fails on " + "; ".join(fails)
+    if open_:
+        text += "; undecided: " + "; ".join(open_)
+    return text + "."
+
+
 def headline_lines(claims: pd.DataFrame) -> list[str]:
-    """What the run found, in a few lines: the ledger's counts, then each ``HEADLINE``
-    family's verdict per cell with its measured value and 95% interval.
+    """What the run found, in a few lines: the ledger's counts (the paper's claims apart from
+    this project's), whether the paper's story stands, then each headline family's
+    (``catalogue.headline``) verdict per cell with its measured value and 95% interval.
 
     Args:
         claims: the ledger (``claims.csv``: id, measured, ci_low, ci_high, unit, verdict).
@@ -633,20 +698,14 @@ def headline_lines(claims: pd.DataFrame) -> list[str]:
         The Markdown lines.
     """
     kind = claims["verdict"].astype(str).str.split(":").str[0]
-    counts = kind.value_counts()
-    lines = [
-        f"- **{len(claims)} claims of the paper measured: {int(counts.get('holds', 0))} hold, "
-        f"{int(counts.get('fails', 0))} fail, {int(counts.get('undecided', 0))} undecided** "
-        "(95% intervals over seeds)."
-    ]
-    ids = claims["id"].astype(str)
-    for fam, words in HEADLINE:  # a family: the claims whose id is it, or starts with it + "/"
-        mine = (ids == fam) | ids.str.startswith(fam + "/")
-        rows = claims[mine]
+    story = story_line(claims)
+    lines = [count_line(claims), *([story] if story else [])]
+    for fam, words, _ in catalogue.headline():
+        rows = _family_rows(claims, fam)
         if rows.empty:
             continue
         cells = []
-        for (_, r), k in zip(rows.iterrows(), kind[mine]):
+        for (_, r), k in zip(rows.iterrows(), kind[rows.index]):
             where = str(r["id"])[len(fam) + 1 :] or "all"
             value = (
                 f"{r['measured']:+.3g} [{r['ci_low']:+.3g}, {r['ci_high']:+.3g}] {r['unit']}"
