@@ -523,7 +523,8 @@ def _template(text: str) -> str:
 
 
 def _doc(fn) -> str:
-    return (fn.__doc__ or fn.__name__).strip().splitlines()[0]
+    """A function's docstring's first paragraph, on one line."""
+    return " ".join((fn.__doc__ or fn.__name__).strip().split("\n\n")[0].split())
 
 
 BEGIN, END = "<!-- catalogue:begin -->", "<!-- catalogue:end -->"
@@ -551,6 +552,7 @@ def markdown() -> str:
         thr = s.threshold.lstrip("-")
         sign = "-" if s.threshold.startswith("-") else ""
         figure = _doc(s.paper) if callable(s.paper) else _template(s.paper)
+        figure = "this project" if figure == "--" else figure
         cells = [
             fam,
             over,

@@ -21,6 +21,7 @@ from physgs.experiments.cost import read_costs, summarise, wall_spans
 from physgs.models.registry import label
 from physgs.report.thresholds import FIT_BAR
 from physgs.report.catalogue import AHEAD
+from physgs.report.record import origins, story_line
 from physgs.report.seeds import interval
 
 VERDICTS = ("holds", "fails", "undecided")
@@ -45,7 +46,8 @@ def _stale(stamp: Mapping[str, str], df: pd.DataFrame, name: str) -> list[str]:
 
 
 def claims_section(claims: pd.DataFrame) -> list[str]:
-    """Verdict counts and one line per claim (verdict, measured value with its interval).
+    """Verdict counts, the paper's claims apart from this project's, whether the paper's story
+    stands, and one line per claim (verdict, measured value with its interval).
 
     Args:
         claims: the ledger (``claims.csv``).
@@ -60,15 +62,20 @@ def claims_section(claims: pd.DataFrame) -> list[str]:
     bad = sorted(set(kind) - set(VERDICTS))
     if bad:
         raise ValueError(f"claims: unknown verdicts {bad} (expected one of {VERDICTS})")
-    counts = kind.value_counts()
+    origin = origins(claims)
+
+    def counted(who: str) -> str:
+        mine = kind[origin == who]
+        c = mine.value_counts()
+        return f"{len(mine)} claims: " + ", ".join(f"**{v}** {int(c.get(v, 0))}" for v in VERDICTS)
+
     lines = [
         "## Claims ledger",
         "",
-        f"{len(claims)} claims: "
-        + ", ".join(f"**{v}** {int(counts.get(v, 0))}" for v in VERDICTS)
-        + ". The claims, the paper's figures and the cells each verdict comes from: "
-        "[claims.md](claims.md).",
+        f"The paper's {counted('paper')}. This project's own {counted('project')}. The claims, "
+        "the paper's figures and the cells each verdict comes from: [claims.md](claims.md).",
         "",
+        *([story_line(claims), ""] if story_line(claims) else []),
         *prior_lines(claims),
         "| claim | measured [95% interval] | threshold | verdict |",
         "|---|---|---|---|",
