@@ -314,3 +314,86 @@ def test_every_claim_points_the_right_way(claims_true):
     want = "holds" if claims_true else "fails"
     wrong = df[df["verdict"] != want]
     assert wrong.empty, wrong[["measured", "threshold", "verdict"]].to_string()
+
+
+# --- ratios on the log scale, and the seeds that would decide ------------------------------------
+
+RATIO = C.Claim("r", "null / trained above 1", "--", "--", 1.0, ">", "ratio")
+
+
+def test_a_ratios_interval_is_the_log_ratios_t_interval_exponentiated():
+    from scipy import stats
+
+    v = np.array([1.7497, 0.7568, 1.1377])  # a ratio whose arithmetic interval goes below 0
+    logs = np.log(v)
+    lo, hi = stats.t.interval(0.95, len(v) - 1, loc=logs.mean(), scale=stats.sem(logs))
+    m, sd, got_lo, got_hi = C.estimate(RATIO, v)
+    assert m == pytest.approx(stats.gmean(v), rel=1e-12)
+    assert sd == pytest.approx(np.std(logs, ddof=1), rel=1e-12)
+    assert (got_lo, got_hi) == (pytest.approx(np.exp(lo), rel=1e-12), pytest.approx(np.exp(hi)))
+    assert got_lo > 0 and C.interval(v)[2] < 0  # positive on the log scale, not on the linear
+    with pytest.raises(ValueError, match="positive"):
+        C.estimate(RATIO, [1.0, -0.5, 2.0])
+
+
+@pytest.mark.parametrize(
+    "values, want",
+    [
+        ([3.0, 3.3, 3.6], "holds"),
+        ([0.3, 0.33, 0.36], "fails"),
+        ([1.52, 1.19, 1.43], "holds"),  # log interval [1.003, 1.88]: above 1
+        ([0.5, 2.0, 1.0], "undecided"),
+    ],
+)
+def test_a_ratios_verdict_reads_its_log_interval(values, want):
+    assert C.verdict(RATIO, values) == want
+
+
+def _power_oracle(d, level=0.95, power=0.8):
+    """The smallest n whose one-sample two-sided t-test at effect size d has the power: scipy's
+    noncentral t, n by n."""
+    from scipy import stats
+
+    for n in range(2, 10_000):
+        crit = stats.t.ppf(0.5 + level / 2, n - 1)
+        nc = d * np.sqrt(n)
+        p = stats.nct.sf(crit, n - 1, nc) + stats.nct.cdf(-crit, n - 1, nc)
+        if p >= power:
+            return n
+    return None
+
+
+@pytest.mark.parametrize("effect, sd", [(1.0, 1.0), (0.5, 0.3), (-2.0, 1.5), (0.2, 1.0)])
+def test_seeds_to_decide_against_a_scipy_oracle(effect, sd):
+    from scipy import stats
+
+    plug, power = C.seeds_to_decide(effect, sd)
+    # by hand: the first n whose t half-width is below |effect|
+    n = 2
+    while stats.t.ppf(0.975, n - 1) * sd / np.sqrt(n) >= abs(effect):
+        n += 1
+    assert plug == n
+    # the half-width one seed earlier is not below it (the search stopped at the first)
+    assert stats.t.ppf(0.975, n - 2) * sd / np.sqrt(n - 1) >= abs(effect) or n == 2
+    assert power == _power_oracle(abs(effect) / sd)
+    assert power >= plug  # 80% power asks more than deciding half the time
+
+
+def test_only_an_undecided_claim_gets_an_estimate():
+    rows = C.ledger(
+        [
+            (CLAIM, [1.0, 1.2, 0.9]),  # holds
+            (CLAIM, [1.0, -0.8, 0.5]),  # undecided
+            (CLAIM, [0.4]),  # one seed
+            (RATIO, [0.6, 2.0, 1.1]),  # undecided on the log scale
+        ]
+    )
+    est = rows[["seeds_to_decide_t_est", "seeds_to_decide_power80_est"]].to_numpy()
+    assert np.isnan(est[[0, 2]]).all() and np.isfinite(est[[1, 3]]).all()
+    v = np.array([1.0, -0.8, 0.5])
+    assert tuple(est[1]) == C.seeds_to_decide(v.mean(), v.std(ddof=1))
+    logs = np.log([0.6, 2.0, 1.1])  # the ratio's effect and sd are its logs', from log 1 = 0
+    assert tuple(est[3]) == C.seeds_to_decide(logs.mean(), logs.std(ddof=1))
+    assert list(rows["scale"]) == ["linear", "linear", "linear", "log"]
+    md = C.ledger_markdown(rows.assign(origin="paper"))
+    assert f"t {int(est[1][0])} / power {int(est[1][1])}" in md

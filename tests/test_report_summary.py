@@ -109,7 +109,7 @@ def test_verdict_counts_and_each_verdict_come_from_the_ledger(run):
         assert f"**{v}** {int((kinds == v).sum())}" in text
     for _, r in claims.iterrows():
         row = next(line for line in text.splitlines() if line.startswith(f"| `{r['id']}` |"))
-        assert row.endswith(f"| {r['verdict']} |")
+        assert row.split(" | ")[3] == r["verdict"]  # the verdict column, before the estimate
 
 
 def test_fit_fractions_per_tree_and_model(run):
@@ -180,3 +180,31 @@ def test_bad_input_stops_with_the_file_named(tmp_path):
         write_claims(tmp_path / "claims.csv")
         run_summary(STAMP, tmp_path / "claims.csv", tmp_path / "tab_fit.csv", tmp_path / "none")
     assert np.isfinite(df["measured"]).all()
+
+
+def test_the_paper_apart_and_the_seeds_that_would_decide():
+    from physgs.report.summary import claims_section
+
+    def claim(i, origin):
+        return C.Claim(f"c{i}", f"claim {i}", "--", "fixture", 0.0, ">", "dB", origin=origin)
+
+    measured = [
+        (claim(0, "paper"), [2.0, 2.1, 1.9]),  # holds
+        (claim(1, "paper"), [1.0, -0.8, 0.5]),  # undecided, effect 0.23, sd 0.95
+        (claim(2, "paper"), [1.0, 0.2, 0.6]),  # undecided, effect 0.6, sd 0.4
+        (claim(3, "project"), [-2.0, -2.1, -1.9]),  # fails
+        (claim(4, "project"), [0.4]),  # one seed: no estimate
+    ]
+    df = C.ledger(measured)
+    text = "\n".join(claims_section(df))
+    assert "The paper's 3 claims: **holds** 1, **fails** 0, **undecided** 2" in text
+    assert "This project's own 2 claims: **holds** 0, **fails** 1, **undecided** 1" in text
+    # by hand (t half-width 2.776 sd / sqrt(3) > effect now): claim 2 decides at
+    # t_{0.975, n-1} 0.4 / sqrt(n) < 0.6, first at n = 5 (2.776 * 0.4 / 2.236 = 0.497)
+    assert df.loc[2, "seeds_to_decide_t_est"] == 5
+    n1 = df.loc[1, "seeds_to_decide_t_est"]
+    assert n1 > 6
+    row = next(ln for ln in text.splitlines() if ln.startswith("| the paper's (2) | plug-in t |"))
+    assert row == "| the paper's (2) | plug-in t | 0 | 1 | 1 | 1 |"
+    assert "| this project's (0) | plug-in t | 0 | 0 | 0 | 0 |" in text
+    assert "| `c2` | " in text and "| t 5 / power" in text

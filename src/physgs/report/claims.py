@@ -26,7 +26,10 @@ import pandas as pd
 from physgs.models.registry import label, models_of
 from physgs.report.catalogue import CATALOGUE, origin_of, prior_tables
 from physgs.report.claim_cells import RECOVERY, Run
-from physgs.report.seeds import interval
+from physgs.report.seeds import MAX_SEEDS, finite, interval, log_interval, seeds_to_decide  # noqa: F401
+
+#: The unit of a ratio: its interval is taken on the log scale (``estimate``).
+RATIO = "ratio"
 
 
 @dataclass(frozen=True)
@@ -46,6 +49,27 @@ class Claim:
     origin: str = "paper"
 
 
+def log_scale(claim: Claim) -> bool:
+    """Whether the claim's interval is taken on the log scale (a ratio)."""
+    return claim.unit == RATIO
+
+
+def estimate(claim: Claim, values: Sequence[float]) -> tuple[float, float, float, float]:
+    """(estimate, sd, low, high) of a claim over seeds: Student's t on the mean
+    ([`interval`][physgs.report.seeds.interval]); for a ratio, on the mean of the per-seed
+    log-ratios, exponentiated ([`log_interval`][physgs.report.seeds.log_interval]: the
+    geometric mean, the sd of the logs, and an interval that stays positive).
+
+    Args:
+        claim: the claim (its unit).
+        values: its per-seed values.
+
+    Returns:
+        ``(estimate, sd, low, high)``.
+    """
+    return log_interval(values) if log_scale(claim) else interval(values)
+
+
 def verdict(claim: Claim, values: Sequence[float]) -> str:
     """'holds', 'fails', 'undecided' or 'undecided: one seed' (see the module docstring).
 
@@ -57,7 +81,7 @@ def verdict(claim: Claim, values: Sequence[float]) -> str:
         The verdict; ``'undecided: not measured'`` without a finite value, and the one-seed
             verdict says on which side the point estimate lies.
     """
-    m, _, lo, hi = interval(values)
+    m, _, lo, hi = estimate(claim, values)
     if not np.isfinite(m):
         return "undecided: not measured"
     on = (lambda x: x > claim.threshold) if claim.side == ">" else (lambda x: x < claim.threshold)
@@ -170,9 +194,30 @@ def measure(
     return out
 
 
+def to_decide(claim: Claim, values: Sequence[float]) -> tuple[float, float]:
+    """The seeds that would decide an undecided claim at its observed effect and sd, an
+    estimate two ways ([`seeds_to_decide`][physgs.report.seeds.seeds_to_decide]: the plug-in
+    t half-width, and ``tt_solve_power`` at 80% power); on the log scale for a ratio.
+
+    Args:
+        claim: the claim.
+        values: its per-seed values.
+
+    Returns:
+        ``(plug-in n, power n)``; NaN for a claim that is decided, or has fewer than two seeds.
+    """
+    if verdict(claim, values) != "undecided":
+        return np.nan, np.nan
+    v = finite(values)
+    v, thr = (np.log(v), np.log(claim.threshold)) if log_scale(claim) else (v, claim.threshold)
+    return seeds_to_decide(float(v.mean()) - thr, float(v.std(ddof=1)))
+
+
 def ledger(measured: Sequence[tuple[Claim, list[float]]]) -> pd.DataFrame:
-    """One row per claim: the claim, the paper's figure, the measured mean, sd, 95% interval and
-    number of seeds, the threshold and side, the verdict and where it comes from.
+    """One row per claim: the claim, the paper's figure, the measured mean (a ratio's geometric
+    mean), sd (a ratio's: of its logs, ``scale`` "log"), 95% interval and number of seeds, the
+    threshold and side, the verdict, where it comes from, its origin, and for an undecided claim
+    the seeds that would decide it (an estimate: ``to_decide``).
 
     Args:
         measured: [`measure`][physgs.report.claims.measure]'s pairs.
@@ -182,7 +227,8 @@ def ledger(measured: Sequence[tuple[Claim, list[float]]]) -> pd.DataFrame:
     """
     rows = []
     for c, values in measured:
-        m, sd, lo, hi = interval(values)
+        m, sd, lo, hi = estimate(c, values)
+        n_t, n_power = to_decide(c, values)
         rows.append(
             {
                 "id": c.id,
@@ -198,6 +244,9 @@ def ledger(measured: Sequence[tuple[Claim, list[float]]]) -> pd.DataFrame:
                 "verdict": verdict(c, values),
                 "source": c.source,
                 "origin": c.origin,
+                "scale": "log" if log_scale(c) else "linear",
+                "seeds_to_decide_t_est": n_t,
+                "seeds_to_decide_power80_est": n_power,
             }
         )
     return pd.DataFrame(rows)
@@ -213,22 +262,35 @@ def ledger_markdown(df: pd.DataFrame, stamp: Mapping[str, str] | None = None) ->
     Returns:
         The page's Markdown, ending in a newline.
     """
-    counts = df["verdict"].str.split(":").str[0].value_counts().to_dict()
+    kind = df["verdict"].astype(str).str.split(":").str[0]
+
+    def counted(who: str) -> str:
+        c = kind[df["origin"] == who].value_counts().to_dict()
+        return ", ".join(f"{k} {v}" for k, v in sorted(c.items())) or "none"
+
     lines = [
         "# Claims ledger",
         "",
-        "Each claim of the paper, measured by this pipeline; verdicts are computed by "
-        "`physgs.report.claims` (holds / fails when the seed interval lies on one side of "
-        "the threshold, undecided when it straddles it or when one seed gives no interval).",
+        "Each claim, measured by this pipeline: the paper's claims and this project's own, "
+        "counted apart; verdicts are computed by `physgs.report.claims` (holds / fails when "
+        "the seed interval lies on one side of the threshold, undecided when it straddles it "
+        "or when one seed gives no interval). A ratio's estimate is the geometric mean over "
+        "seeds and its interval the per-seed log-ratios' t-interval, exponentiated (it stays "
+        "positive). For an undecided claim, the seeds that would decide it if its effect and "
+        "sd stayed as observed, an estimate: the plug-in t half-width / a t-test at 80% power "
+        "(`tt_solve_power`).",
         "",
     ]
     if stamp:
         lines += ["Made by: " + ", ".join(f"{k}={v}" for k, v in stamp.items()), ""]
+    paper, own = (df["origin"] == "paper").sum(), (df["origin"] == "project").sum()
     lines += [
-        "Verdicts: " + ", ".join(f"{k} {v}" for k, v in sorted(counts.items())),
+        f"The paper's {paper} claims: {counted('paper')}. This project's own {own}: "
+        f"{counted('project')}.",
         "",
-        "| claim | paper | measured | threshold | verdict | from |",
-        "|---|---|---|---|---|---|",
+        "| claim | origin | paper | measured | threshold | verdict | seeds to decide (est.) "
+        "| from |",
+        "|---|---|---|---|---|---|---|---|",
     ]
     for _, r in df.iterrows():
         meas = "--" if not np.isfinite(r.measured) else f"{r.measured:+.3g} {r.unit}"
@@ -237,6 +299,27 @@ def ledger_markdown(df: pd.DataFrame, stamp: Mapping[str, str] | None = None) ->
         elif np.isfinite(r.measured):
             meas += f", {r.seeds} seed"
         lines.append(
-            f"| {r.claim} | {r.paper} | {meas} | {r.threshold} | **{r.verdict}** | {r.source} |"
+            f"| {r.claim} | {r.origin} | {r.paper} | {meas} | {r.threshold} | **{r.verdict}** | "
+            f"{decide_cell(r)} | {r.source} |"
         )
     return "\n".join(lines) + "\n"
+
+
+def decide_cell(row) -> str:
+    """An undecided claim's seeds to decide, ``t 5 / power 8`` (``> MAX_SEEDS`` beyond the
+    search); "" for a claim with no estimate (decided, or fewer than two seeds).
+
+    Args:
+        row (pd.Series): a ledger row (``verdict``, ``seeds_to_decide_t_est``,
+            ``seeds_to_decide_power80_est``).
+
+    Returns:
+        The cell's text.
+    """
+    if str(row["verdict"]) != "undecided" or "seeds_to_decide_t_est" not in row.index:
+        return ""
+
+    def n(x) -> str:
+        return f"{int(x)}" if np.isfinite(x) else f"> {MAX_SEEDS}"
+
+    return f"t {n(row['seeds_to_decide_t_est'])} / power {n(row['seeds_to_decide_power80_est'])}"

@@ -15,6 +15,8 @@ import numpy as np
 
 LEVEL = 0.95  # two-sided confidence level of every interval
 UNDECIDED = r"$^{\dagger}$"  # .tex mark of a difference whose interval contains 0 (or one seed)
+POWER = 0.8  # the power at which ``seeds_to_decide`` sizes a two-sided t-test
+MAX_SEEDS = 1000  # ``seeds_to_decide`` looks no further (NaN: more than this)
 
 
 def finite(values: Sequence[float]) -> np.ndarray:
@@ -51,6 +53,73 @@ def interval(values: Sequence[float], level: float = LEVEL) -> tuple[float, floa
     sd = float(v.std(ddof=1))
     h = float(stats.t.ppf(0.5 + level / 2, v.size - 1)) * sd / np.sqrt(v.size)
     return m, sd, m - h, m + h
+
+
+def log_interval(
+    values: Sequence[float], level: float = LEVEL
+) -> tuple[float, float, float, float]:
+    """A ratio's (geometric mean, sd of the logs, low, high) over seeds: Student's t on the mean
+    of the per-seed log-ratios, exponentiated, so that the interval of a ratio stays positive.
+
+    Args:
+        values: per-seed ratios (> 0; NaN dropped).
+        level: the interval's coverage.
+
+    Returns:
+        ``(exp(mean log), sd of log, exp(low), exp(high))``; NaN as ``interval``'s.
+
+    Raises:
+        ValueError: for a ratio that is not positive (it has no log).
+    """
+    v = finite(values)
+    if (v <= 0).any():
+        raise ValueError(f"log_interval: ratios must be positive, got {v.tolist()}")
+    m, sd, lo, hi = interval(np.log(v), level)
+    return float(np.exp(m)), sd, float(np.exp(lo)), float(np.exp(hi))
+
+
+def seeds_to_decide(
+    effect: float, sd: float, level: float = LEVEL, power: float = POWER
+) -> tuple[float, float]:
+    """How many seeds would decide a claim whose mean lies ``effect`` from its threshold with
+    seed-to-seed spread ``sd``, if both stayed as observed: an estimate, two ways.
+
+    - plug-in: the smallest n whose t half-width, ``t_{(1+level)/2, n-1} sd / sqrt(n)``, is below
+      ``|effect|`` (the interval would then clear the threshold);
+    - power: statsmodels' ``tt_solve_power`` for a one-sample two-sided t-test of effect size
+      ``|effect| / sd`` at ``alpha = 1 - level`` and ``power``, rounded up (the plug-in decides
+      about half the time at its n; this one ``power`` of the time).
+
+    Args:
+        effect: the mean's distance from the threshold, in the claim's unit (log units for a
+            ratio).
+        sd: the per-seed sd, same unit.
+        level: the interval's coverage.
+        power: the test's power.
+
+    Returns:
+        ``(plug-in n, power n)``; NaN where it is not finite (no spread, no effect) or above
+            ``MAX_SEEDS``.
+    """
+    from scipy import stats  # here: the workflow plans with modules that import this one
+    from statsmodels.stats.power import tt_solve_power
+
+    e = abs(float(effect))
+    if not (np.isfinite(e) and np.isfinite(sd) and sd > 0 and e > 0):
+        return np.nan, np.nan
+    n = np.arange(2, MAX_SEEDS + 1)
+    ok = stats.t.ppf(0.5 + level / 2, n - 1) * sd / np.sqrt(n) < e
+    plug = float(n[np.argmax(ok)]) if ok.any() else np.nan
+    try:
+        need = float(
+            tt_solve_power(
+                effect_size=e / sd, alpha=1 - level, power=power, alternative="two-sided"
+            )
+        )
+    except (ValueError, RuntimeError):  # no root in statsmodels' bracket: far too many seeds
+        need = np.nan
+    pw = float(np.ceil(need)) if np.isfinite(need) and need <= MAX_SEEDS else np.nan
+    return plug, pw
 
 
 def decided(values: Sequence[float], level: float = LEVEL) -> bool:

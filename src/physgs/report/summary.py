@@ -21,6 +21,7 @@ from physgs.experiments.cost import read_costs, summarise, wall_spans
 from physgs.models.registry import label
 from physgs.report.thresholds import FIT_BAR
 from physgs.report.catalogue import AHEAD
+from physgs.report.claims import decide_cell
 from physgs.report.record import origins, story_line
 from physgs.report.seeds import interval
 
@@ -77,15 +78,62 @@ def claims_section(claims: pd.DataFrame) -> list[str]:
         "",
         *([story_line(claims), ""] if story_line(claims) else []),
         *prior_lines(claims),
-        "| claim | measured [95% interval] | threshold | verdict |",
-        "|---|---|---|---|",
+        *decide_lines(claims),
+        "| claim | measured [95% interval] | threshold | verdict | seeds to decide (est.) |",
+        "|---|---|---|---|---|",
     ]
     for _, r in claims.iterrows():
         meas = "--" if not np.isfinite(r["measured"]) else f"{r['measured']:+.3g} {r['unit']}"
         if np.isfinite(r["ci_low"]):
             meas += f" [{r['ci_low']:+.3g}, {r['ci_high']:+.3g}]"
-        lines.append(f"| `{r['id']}` | {meas} | {r['threshold']} | {r['verdict']} |")
+        lines.append(
+            f"| `{r['id']}` | {meas} | {r['threshold']} | {r['verdict']} | {decide_cell(r)} |"
+        )
     return lines + [""]
+
+
+#: The seed counts ``decide_lines`` tabulates (the default profile runs three).
+DECIDE_AT = (4, 5, 6)
+
+
+def decide_lines(claims: pd.DataFrame) -> list[str]:
+    """How many undecided claims would decide at 4, 5 and 6 seeds if their effect and sd
+    stayed as observed (an estimate: the ledger's ``seeds_to_decide_t_est``, the plug-in t
+    half-width, and ``seeds_to_decide_power80_est``, a t-test at 80% power), the paper's claims
+    apart from this project's.
+
+    Args:
+        claims: the ledger.
+
+    Returns:
+        The lines of a short Markdown table and a blank one; none for a ledger without the
+            estimates.
+    """
+    cols = {"plug-in t": "seeds_to_decide_t_est", "80% power": "seeds_to_decide_power80_est"}
+    if not set(cols.values()) <= set(claims.columns):
+        return []
+    undecided = claims["verdict"].astype(str) == "undecided"
+    origin = origins(claims)
+    lines = [
+        "Seeds that would decide each undecided claim, **an estimate** at its observed effect "
+        "and sd (the plug-in t half-width; a t-test at 80% power, `tt_solve_power`): how many "
+        "would decide at each seed count.",
+        "",
+        "| undecided claims | estimate | "
+        + " | ".join(f"by {n} seeds" for n in DECIDE_AT)
+        + " | more |",
+        "|---|---|" + "---:|" * (len(DECIDE_AT) + 1),
+    ]
+    for who, words in (("paper", "the paper's"), ("project", "this project's")):
+        mine = claims[undecided & (origin == who)]
+        for est, col in cols.items():
+            n = mine[col].to_numpy(dtype=float)
+            at = [int((n <= k).sum()) for k in DECIDE_AT]
+            more = len(n) - at[-1]
+            lines.append(
+                f"| {words} ({len(mine)}) | {est} | " + " | ".join(map(str, at)) + f" | {more} |"
+            )
+    return [*lines, ""]
 
 
 def prior_lines(claims: pd.DataFrame) -> list[str]:
