@@ -71,3 +71,41 @@ def test_the_ledgers_tables_come_from_the_catalogue():
     fams = [f for f, _, _ in catalogue.headline(["ours_chain"])]
     assert fams[:2] == ["ours_above_static_beyond", "baselines_below_static_beyond"]
     assert "ours_chain/above_static_beyond" in fams
+
+
+def test_a_new_family_is_one_entry(monkeypatch):
+    """One more ClaimSpec (an existing scope and reader) reaches the ledger, its origin, the
+    README's headline families, the tables the ledger reads and the claims page."""
+    import pandas as pd
+
+    from physgs.report import claim_cells as cc
+    from physgs.report import claims, record
+
+    new = ClaimSpec(
+        "fits_window_strictly", "ours", cc.fit_models, "tab_fit", cc.fit_fraction,
+        "FIT_BAR", ">", "fraction",
+        "{tree}: {fit_label} fits its window", "tab_fit: ceiling fraction",
+        "this project", origin="project", headline="every model fits its window",
+    )  # fmt: skip
+    monkeypatch.setattr(catalogue, "CATALOGUE", (*CATALOGUE, new))
+    monkeypatch.setattr(claims, "CATALOGUE", catalogue.CATALOGUE)
+    fit = pd.DataFrame(
+        [
+            {"seed": s, "tree": "sparse", "model": m, "ceiling_frac": 0.8 + 0.01 * s}
+            for s in range(3)
+            for m in ("mlp", "mlp_wind", "d3dgs", "d3dgs_wind", "ours")
+        ]
+    )
+    led = claims.ledger(claims.measure({"tab_fit": fit}, {}, ["sparse"])).set_index("id")
+    row = led.loc["fits_window_strictly/sparse/mlp"]
+    assert row["verdict"] == "holds" and row["origin"] == "project"
+    assert origin_of("fits_window_strictly/sparse/mlp") == "project"
+    assert ("fits_window_strictly", "every model fits its window", "project") in (
+        catalogue.headline()
+    )
+    assert any(
+        ln.startswith("- Every model fits its window")
+        for ln in record.headline_lines(led.reset_index())
+    )
+    assert "`fits_window_strictly` (headline)" in catalogue.markdown()
+    assert "tab_fit" in catalogue.required_tables()
