@@ -93,7 +93,7 @@ def test_every_blind_prior_is_paired_with_a_prior_that_reads_the_wind():
 def test_each_blind_prior_gets_its_anemometer_claim_against_its_counterpart():
     """tab_null rows of two winds' priors and their forcing-free variants: each variant's
     claim is its error minus its own counterpart's, ours' under the old id, the chain's under
-    its prefix (claims_priors' convention)."""
+    its prefix (the catalogue's prefix convention)."""
     err = {  # median omega error (%) per seed
         "ours": [2.0, 2.2, 2.4],
         "ours_chain": [1.0, 1.1, 1.2],

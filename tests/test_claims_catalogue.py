@@ -36,7 +36,14 @@ def test_the_page_lists_every_family_with_its_origin_and_threshold():
 def test_a_spec_refuses_what_it_cannot_decide():
     base = CATALOGUE[0]
     kw = {f: getattr(base, f) for f in base.__dataclass_fields__}
-    for bad in ({"side": ">="}, {"origin": "both"}, {"of": "fields"}, {"threshold": "NOPE"}):
+    for bad in (
+        {"side": ">="},
+        {"origin": "both"},
+        {"of": "fields"},
+        {"threshold": "NOPE"},
+        {"over": "every_leaf"},
+        {"read": "a_cell"},
+    ):
         with pytest.raises(ValueError, match=base.family):
             ClaimSpec(**{**kw, **bad})
 
@@ -78,11 +85,10 @@ def test_a_new_family_is_one_entry(monkeypatch):
     README's headline families, the tables the ledger reads and the claims page."""
     import pandas as pd
 
-    from physgs.report import claim_cells as cc
     from physgs.report import claims, record
 
     new = ClaimSpec(
-        "fits_window_strictly", "ours", cc.fit_models, "tab_fit", cc.fit_fraction,
+        "fits_window_strictly", "ours", "fit_models", "tab_fit", "fit_fraction",
         "FIT_BAR", ">", "fraction",
         "{tree}: {fit_label} fits its window", "tab_fit: ceiling fraction",
         "this project", origin="project", headline="every model fits its window",

@@ -24,11 +24,12 @@ from dataclasses import dataclass
 from typing import Callable, Sequence
 
 import numpy as np
+import pandas as pd
 
 from physgs.models.registry import MODELS, PRIOR_VARIANTS, label, models_of
 from physgs.report import claim_cells as cc
 from physgs.report import paper, thresholds
-from physgs.report.claim_cells import CONFIG, RECOVERY, Cell, Reader, Scope
+from physgs.report.claim_cells import CONFIG, READERS, RECOVERY, SCOPES, Cell
 
 #: The origins of a claim: stated by the source paper, or this project's own.
 ORIGINS = ("paper", "project")
@@ -49,9 +50,10 @@ class ClaimSpec:
         family: the claim id's family (ids are ``[<prior>/]<family>[/<cell>]``).
         of: ``"ours"`` (asked once) or ``"priors"`` (asked of every prior of the registry other
             than ours that the run's tables hold, ids prefixed by the prior's).
-        over: the scope: the run -> the family's cells (``physgs.report.claim_cells``).
+        over: its scope, a name of ``claim_cells.SCOPES`` (the run -> the family's cells).
         table: the table it reads (``claim_cells.RECOVERY``: the priors' damping summaries).
-        read: one seed's rows and a cell -> the value.
+        read: its reader, a name of ``claim_cells.READERS`` (one seed's rows and a cell -> the
+            value).
         threshold: a name of ``physgs.report.thresholds``, ``-`` in front to negate it.
         side: ``">"`` or ``"<"``: the side of the threshold the claim holds on.
         unit: the value's unit (``"ratio"``: its interval is taken on the log scale).
@@ -68,9 +70,9 @@ class ClaimSpec:
 
     family: str
     of: str
-    over: Scope
+    over: str
     table: str
-    read: Reader
+    read: str
     threshold: str
     side: str
     unit: str
@@ -83,13 +85,17 @@ class ClaimSpec:
     optional: bool = False
 
     def __post_init__(self):
-        """Refuse an unknown side, origin, scope kind or threshold name, naming the family."""
+        """Refuse an unknown side, origin, scope, reader or threshold name, naming the family."""
         if self.side not in (">", "<") or self.origin not in ORIGINS:
             raise ValueError(f"claim {self.family!r}: side must be > or <, origin in {ORIGINS}")
         if self.of not in ("ours", "priors"):
             raise ValueError(f"claim {self.family!r}: of must be 'ours' or 'priors'")
         if self.threshold.lstrip("-") not in WORDS:
             raise ValueError(f"claim {self.family!r}: no threshold {self.threshold!r}")
+        if self.over not in SCOPES or self.read not in READERS:
+            raise ValueError(
+                f"claim {self.family!r}: no scope {self.over!r} or reader {self.read!r}"
+            )
 
     @property
     def value(self) -> float:
@@ -97,17 +103,62 @@ class ClaimSpec:
         v = float(WORDS[self.threshold.lstrip("-")])
         return -v if self.threshold.startswith("-") else v
 
+    def cells(self, run: cc.Run) -> list[Cell]:
+        """The family's cells in ``run`` (its scope).
+
+        Args:
+            run: what the family is asked of.
+
+        Returns:
+            One cell per claim.
+        """
+        return SCOPES[self.over](run)
+
+    def measure(self, rows: pd.DataFrame, cell: Cell) -> float:
+        """One seed's value of the claim of ``cell`` (its reader).
+
+        Args:
+            rows: one seed's rows of the family's table.
+            cell: the claim's cell.
+
+        Returns:
+            The value, in ``unit``; NaN where the rows are not there.
+        """
+        return float(READERS[self.read](rows, cell))
+
     def claim_id(self, cell: Cell) -> str:
-        """The id of the claim of ``cell`` (which holds ``model``, the prior asked)."""
+        """The id of the claim of ``cell``.
+
+        Args:
+            cell: the claim's cell (``model``: the prior asked; ``prefix``, ``suffix``).
+
+        Returns:
+            ``[<prior>/]<family>[/<suffix>]``.
+        """
         prefix = cell.get("prefix", "" if cell["model"] == "ours" else f"{cell['model']}/")
         return prefix + self.family + (f"/{cell['suffix']}" if cell.get("suffix") else "")
 
     def words(self, template: str, cell: Cell) -> str:
-        """``template`` with the cell's fields, the prior's ``name`` and ``WORDS``."""
+        """A sentence of the claim of ``cell``.
+
+        Args:
+            template: ``text`` or ``source``.
+            cell: the claim's cell (its fields and ``name``, the prior's label).
+
+        Returns:
+            ``template`` with the cell's fields and ``WORDS`` filled in.
+        """
         return template.format(**WORDS, **cell)
 
     def figure(self, cell: Cell) -> str:
-        """The paper's figure for ``cell``."""
+        """The paper's figure for the claim of ``cell``.
+
+        Args:
+            cell: the claim's cell.
+
+        Returns:
+            ``paper``, filled in or computed.
+        """
         return self.paper(cell) if callable(self.paper) else self.words(self.paper, cell)
 
 
@@ -116,7 +167,7 @@ def _pp(c: Cell):
     return paper.PSNR.get(c["tree"])
 
 
-def paper_best_field_minus_static(c: Cell) -> str:
+def _paper_best_field_minus_static(c: Cell) -> str:
     """best learned field - static beyond the window, tab:psnr"""
     pp = _pp(c)
     if not pp:
@@ -126,41 +177,41 @@ def paper_best_field_minus_static(c: Cell) -> str:
     )
 
 
-def paper_ours_minus_static(c: Cell) -> str:
+def _paper_ours_minus_static(c: Cell) -> str:
     """ours - static beyond the window, tab:psnr"""
     pp = _pp(c)
     return f"{pp['ours'][1] - pp['static'][1]:+.2f} dB" if pp else "--"
 
 
-def paper_ours_behind(c: Cell) -> str:
+def _paper_ours_behind(c: Cell) -> str:
     """ours - best learned field on held-out views, tab:psnr"""
     pp = _pp(c)
     return f"{pp['ours'][0] - max(pp[m][0] for m in cc.fields()):+.2f} dB" if pp else "--"
 
 
-def paper_null_ratio(c: Cell) -> str:
+def _paper_null_ratio(c: Cell) -> str:
     """null / trained median omega error, tab:null"""
     tr, nl = paper.NULL.get(c["tree"], (np.nan, np.nan))
     return f"null / trained = {nl / tr:.2f}"
 
 
-def paper_null_difference(c: Cell) -> str:
+def _paper_null_difference(c: Cell) -> str:
     """trained - null median omega error, tab:null"""
     tr, nl = paper.NULL.get(c["tree"], (np.nan, np.nan))
     return f"trained - null = {tr - nl:+.2f} points"
 
 
-def paper_gap(c: Cell) -> str:
+def _paper_gap(c: Cell) -> str:
     """the median nearest-bone gap, section 4"""
     return f"{paper.NEAREST_BONE_GAP_PCT[c['tree']]:.2f}%"
 
 
-def paper_zeta(c: Cell) -> str:
+def _paper_zeta(c: Cell) -> str:
     """the median fitted zeta, section 4"""
     return f"median zeta_hat {paper.ZETA.get(c['tree'])} vs 0.08"
 
 
-def paper_margin(c: Cell) -> str:
+def _paper_margin(c: Cell) -> str:
     """the margin's growth from the training wind to the farthest, tab:margin"""
     p = paper.MARGIN.get(c["tree"])
     return f"{p[-1] - p[0]:+.2f} dB" if p else "--"
@@ -173,31 +224,31 @@ TRACKS_PROPOSAL = "not run (the paper's closing proposal)"
 CATALOGUE: tuple[ClaimSpec, ...] = (
     # the paper's: beyond the window and on held-out views (tab:psnr)
     ClaimSpec(
-        "ours_above_static_beyond", "ours", cc.trees, "tab_psnr", cc.above_static,
+        "ours_above_static_beyond", "ours", "trees", "tab_psnr", "above_static",
         "EVEN", ">", "dB",
         "{tree}: ours is above the static pose beyond the window",
         "tab_psnr, time column: ours - static",
-        paper_ours_minus_static,
+        _paper_ours_minus_static,
         headline="ours above the static pose beyond the training window",
     ),
     ClaimSpec(
-        "baselines_below_static_beyond", "ours", cc.trees, "tab_psnr",
-        cc.best_field_minus_static, "EVEN", "<", "dB",
+        "baselines_below_static_beyond", "ours", "trees", "tab_psnr",
+        "best_field_minus_static", "EVEN", "<", "dB",
         "{tree}: every learned baseline is below the static pose beyond the window",
         "tab_psnr, time column: max over learned fields of (model - static)",
-        paper_best_field_minus_static,
+        _paper_best_field_minus_static,
         headline="every learned field below static beyond the window",
     ),
     ClaimSpec(
-        "ours_behind_on_views", "ours", cc.trees, "tab_psnr", cc.ahead_of_fields,
+        "ours_behind_on_views", "ours", "trees", "tab_psnr", "ahead_of_fields",
         "EVEN", "<", "dB",
         "{tree}: ours is behind the best learned field on held-out views",
         "tab_psnr, view column: ours - max over learned fields",
-        paper_ours_behind,
+        _paper_ours_behind,
     ),
     # the paper's: unseen wind (tab:transfer, tab:margin)
     ClaimSpec(
-        "transfer_ours_ahead", "ours", cc.winds_beyond, "tab_transfer", cc.wind_ahead,
+        "transfer_ours_ahead", "ours", "winds_beyond", "tab_transfer", "wind_ahead",
         "EVEN", ">", "dB",
         "{tree}, {cond} v0, beyond the window: ours ahead of the best baseline",
         "tab_transfer (beyond): ours - max learned",
@@ -205,63 +256,63 @@ CATALOGUE: tuple[ClaimSpec, ...] = (
         headline="ours ahead of the best learned field under unseen wind",
     ),
     ClaimSpec(
-        "transfer_baselines_below_static", "ours", cc.winds_beyond, "tab_transfer",
-        cc.wind_fields_minus_static, "EVEN", "<", "dB",
+        "transfer_baselines_below_static", "ours", "winds_beyond", "tab_transfer",
+        "wind_fields_minus_static", "EVEN", "<", "dB",
         "{tree}, {cond} v0, beyond the window: every learned baseline below static",
         "tab_transfer (beyond): max learned - static",
         "below static in all 24 cells, by 0.10-2.79 dB",
     ),
     ClaimSpec(
-        "margin_grows", "ours", cc.margin_trees, "tab_margin", cc.margin_growth,
+        "margin_grows", "ours", "margin_trees", "tab_margin", "margin_growth",
         "EVEN", ">", "dB",
         "{tree}: the margin against MLP + wind grows as the wind departs from training",
         "tab_margin: {last} - {first}",
-        paper_margin,
+        _paper_margin,
     ),
     # the paper's: recovery against the untrained null (tab:null, section 4)
     ClaimSpec(
-        "null_factor", "ours", cc.null_trees_sparse, "tab_null", cc.null_over_trained,
+        "null_factor", "ours", "null_trees_sparse", "tab_null", "null_over_trained",
         "NULL_FACTOR", ">", "ratio",
         "{tree}: ... by the paper's factor of {NULL_FACTOR:g}",
         "tab_null, {config}: null / trained",
-        paper_null_ratio,
+        _paper_null_ratio,
         headline="ours beats the untrained null by the paper's factor on frequency",
     ),
     ClaimSpec(
-        "null_loses", "ours", cc.null_trees_sparse, "tab_null", cc.null_over_trained,
+        "null_loses", "ours", "null_trees_sparse", "tab_null", "null_over_trained",
         "RATIO_EVEN", ">", "ratio",
         "{tree}: joint training beats the untrained null",
         "tab_null, {config}: null / trained median rel. error",
-        paper_null_ratio,
+        _paper_null_ratio,
     ),
     ClaimSpec(
-        "null_matches", "ours", cc.null_trees_dense, "tab_null", cc.trained_minus_null,
+        "null_matches", "ours", "null_trees_dense", "tab_null", "trained_minus_null",
         "-NULL_MATCH_PP", ">", "points",
         "{tree}: the untrained null matches the trained model (it is not beaten by "
         "{NULL_MATCH_PP} points or more)",
         "tab_null, {config}: trained - null median rel. error (points)",
-        paper_null_difference,
+        _paper_null_difference,
         headline="the untrained null matches ours on frequency",
     ),
     ClaimSpec(
-        "nearest_bone_gap", "ours", cc.gap_trees, "tab_testbed", cc.gap_off,
+        "nearest_bone_gap", "ours", "gap_trees", "tab_testbed", "gap_off",
         "GAP_RTOL", "<", "fraction",
         "{tree}: the median nearest-bone gap is the paper's (within {GAP_RTOL:.0%} of it)",
         "tab_testbed: |gap - paper| / paper",
-        paper_gap,
+        _paper_gap,
         needs_variance=False,
     ),
     ClaimSpec(
-        "damping_not_recovered", "ours", cc.recovered_trees, RECOVERY, cc.damping_off,
+        "damping_not_recovered", "ours", "recovered_trees", RECOVERY, "damping_off",
         "DAMPING_OFF", ">", "fraction",
         "{tree}: damping is not recovered (median zeta_hat off the truth by more than "
         "{DAMPING_OFF:.0%})",
         "recovery ({config}): |median zeta_hat - zeta| / zeta",
-        paper_zeta,
+        _paper_zeta,
         headline="damping is not recovered",
     ),
     ClaimSpec(
-        "decay_rate_flat", "ours", cc.recovered_trees, RECOVERY, cc.decay_exponent,
+        "decay_rate_flat", "ours", "recovered_trees", RECOVERY, "decay_exponent",
         "RATE_EXPONENT", "<", "exponent",
         "{tree}: the fitted decay rate gamma = zeta*omega is nearly frequency-independent "
         "(gamma ~ omega^p, p < {RATE_EXPONENT})",
@@ -271,7 +322,7 @@ CATALOGUE: tuple[ClaimSpec, ...] = (
     # the premise of every comparison: the fields fit their window (a model the paper did not
     # train makes its row this project's: ``origin_of``)
     ClaimSpec(
-        "fits_window", "ours", cc.fit_models, "tab_fit", cc.fit_fraction,
+        "fits_window", "ours", "fit_models", "tab_fit", "fit_fraction",
         "FIT_BAR", ">", "fraction",
         "{tree}: {fit_label} fits its training window (reaches {FIT_BAR:.0%} of the "
         "true-motion ceiling's in-window gain over static)",
@@ -280,7 +331,7 @@ CATALOGUE: tuple[ClaimSpec, ...] = (
     ),
     # this project's: the paper's claims about ours asked again of every other prior
     ClaimSpec(
-        "above_static_beyond", "priors", cc.trees, "tab_psnr", cc.above_static,
+        "above_static_beyond", "priors", "trees", "tab_psnr", "above_static",
         "EVEN", ">", "dB",
         "{tree}: the {name} is above the static pose beyond the window",
         "tab_psnr, time column: prior - static",
@@ -288,28 +339,28 @@ CATALOGUE: tuple[ClaimSpec, ...] = (
         headline="the {name} above the static pose beyond the window",
     ),
     ClaimSpec(
-        AHEAD, "priors", cc.splits, "tab_psnr", cc.ahead_of_fields,
+        AHEAD, "priors", "splits", "tab_psnr", "ahead_of_fields",
         "EVEN", ">", "dB",
         "{tree}: the {name} is ahead of the best learned field on {where}",
         "tab_psnr, {split} column: prior - max over learned fields",
         origin="project",
     ),
     ClaimSpec(
-        AHEAD, "priors", cc.winds, "tab_transfer", cc.wind_ahead,
+        AHEAD, "priors", "winds", "tab_transfer", "wind_ahead",
         "EVEN", ">", "dB",
         "{tree}, {cond} v0, {where}: the {name} is ahead of the best learned field",
         "tab_transfer ({split}): prior - max learned",
         origin="project",
     ),
     ClaimSpec(
-        "margin_grows", "priors", cc.margin_trees, "tab_margin", cc.margin_growth,
+        "margin_grows", "priors", "margin_trees", "tab_margin", "margin_growth",
         "EVEN", ">", "dB",
         "{tree}: the {name}'s margin against MLP + wind grows as the wind departs",
         "tab_margin ({model}): {last} - {first}",
         origin="project",
     ),
     ClaimSpec(
-        "beats_null", "priors", cc.recovery_trees, "tab_null", cc.trained_minus_null,
+        "beats_null", "priors", "recovery_trees", "tab_null", "trained_minus_null",
         "-NULL_MATCH_PP", "<", "points",
         "{tree}: the {name} beats the untrained null on frequency recovery (by "
         "{NULL_MATCH_PP} points or more)",
@@ -317,7 +368,7 @@ CATALOGUE: tuple[ClaimSpec, ...] = (
         origin="project",
     ),
     ClaimSpec(
-        "damping_recovered", "priors", cc.recovered_trees, RECOVERY, cc.damping_off,
+        "damping_recovered", "priors", "recovered_trees", RECOVERY, "damping_off",
         "DAMPING_OFF", "<", "fraction",
         "{tree}: the {name} recovers damping (median zeta_hat within {DAMPING_OFF:.0%} of the "
         "truth)",
@@ -325,7 +376,7 @@ CATALOGUE: tuple[ClaimSpec, ...] = (
         origin="project",
     ),
     ClaimSpec(
-        "decay_rate_flat", "priors", cc.recovered_trees, RECOVERY, cc.decay_exponent,
+        "decay_rate_flat", "priors", "recovered_trees", RECOVERY, "decay_exponent",
         "RATE_EXPONENT", "<", "exponent",
         "{tree}: the {name}'s fitted decay rate gamma = zeta*omega is nearly "
         "frequency-independent (gamma ~ omega^p, p < {RATE_EXPONENT})",
@@ -334,7 +385,7 @@ CATALOGUE: tuple[ClaimSpec, ...] = (
     ),
     # this project's: without the anemometer, and the output-only analysis (docs/blind.md)
     ClaimSpec(
-        "anemometer_needed", "ours", cc.blind_trees, "tab_null", cc.blind_minus_wind,
+        "anemometer_needed", "ours", "blind_trees", "tab_null", "blind_minus_wind",
         "EVEN", ">", "pp",
         "{tree}: without the measured wind (a learned forcing) {who} recovers omega worse",
         "tab_null, {config}: {blind} - {wind} median rel. error (points)",
@@ -345,7 +396,7 @@ CATALOGUE: tuple[ClaimSpec, ...] = (
         optional=True,
     ),
     ClaimSpec(
-        "oma_beats_null", "ours", cc.oma_sparse, "tab_null", cc.null_over_trained,
+        "oma_beats_null", "ours", "oma_sparse", "tab_null", "null_over_trained",
         "RATIO_EVEN", ">", "ratio",
         "{tree}: output-only modal analysis of the video recovers omega better than the "
         "untrained null",
@@ -356,7 +407,7 @@ CATALOGUE: tuple[ClaimSpec, ...] = (
         optional=True,
     ),
     ClaimSpec(
-        "oma_recovers_zeta", "ours", cc.oma_damping_trees, "tab_damping", cc.oma_zeta_gain,
+        "oma_recovers_zeta", "ours", "oma_damping_trees", "tab_damping", "oma_zeta_gain",
         "EVEN", "<", "pp",
         "{tree} (damping testbed): output-only modal analysis recovers zeta better than the "
         "untrained null",
@@ -367,8 +418,8 @@ CATALOGUE: tuple[ClaimSpec, ...] = (
     ),
     # this project's: the paper's two hypotheses about its prior (section 6), tested
     ClaimSpec(
-        "topology_parts_reduce_damping_error", "ours", cc.parts_damping_trees, "tab_parts",
-        cc.topology_damping_gain, "EVEN", "<", "pp",
+        "topology_parts_reduce_damping_error", "ours", "parts_damping_trees", "tab_parts",
+        "topology_damping_gain", "EVEN", "<", "pp",
         "{tree}: topology-aware parts reduce the damping error (damping testbed)",
         "tab_parts ({config}): median rel. err. of zeta, topology - k-means parts",
         "hypothesis (k-means parts 'plausibly feed the damping bias')",
@@ -376,7 +427,7 @@ CATALOGUE: tuple[ClaimSpec, ...] = (
         optional=True,
     ),
     ClaimSpec(
-        "coupling_lifts_sparse_fit", "ours", cc.parts_coupling, "tab_parts", cc.coupling_gain,
+        "coupling_lifts_sparse_fit", "ours", "parts_coupling", "tab_parts", "coupling_gain",
         "EVEN", ">", "fraction",
         "{tree}: parent-child coupling lifts the in-window fit",
         "tab_parts ({config}): fraction of the ceiling's gain, chained - independent topology "
@@ -387,7 +438,7 @@ CATALOGUE: tuple[ClaimSpec, ...] = (
     ),
     # this project's: the 2D-track control (docs/tracks.md)
     ClaimSpec(
-        "tracks_beats_null", "ours", cc.tracks_sparse, "tab_null", cc.null_over_trained,
+        "tracks_beats_null", "ours", "tracks_sparse", "tab_null", "null_over_trained",
         "RATIO_EVEN", ">", "ratio",
         "{tree}: oscillators fitted to 2D tracks recover omega better than the untrained null",
         "tab_null, 2D tracks {config}: null / tracks median rel. error",
@@ -396,7 +447,7 @@ CATALOGUE: tuple[ClaimSpec, ...] = (
         optional=True,
     ),
     ClaimSpec(
-        "tracks_match_ours", "ours", cc.tracks_sparse, "tab_null", cc.tracks_minus_ours,
+        "tracks_match_ours", "ours", "tracks_sparse", "tab_null", "tracks_minus_ours",
         "NULL_MATCH_PP", "<", "points",
         "{tree}: oscillators fitted to 2D tracks match ours' omega recovery (ours does not "
         "beat them by {NULL_MATCH_PP} points or more)",
@@ -406,7 +457,7 @@ CATALOGUE: tuple[ClaimSpec, ...] = (
         optional=True,
     ),
     ClaimSpec(
-        "tracks_extrapolate_as_ours", "ours", cc.tracks_trees, "tab_tracks", cc.tracks_tail,
+        "tracks_extrapolate_as_ours", "ours", "tracks_trees", "tab_tracks", "tracks_tail",
         "EVEN", "<", "px",
         "{tree}: beyond the window, oscillators fitted to 2D tracks predict the tracked points "
         "at least as well as ours' Gaussians",
@@ -434,20 +485,31 @@ def tables(optional: bool = True) -> tuple[str, ...]:
 
 
 def required_tables() -> tuple[str, ...]:
-    """The tables every run's ledger reads (a missing one: its claims "not measured")."""
+    """The tables every run's ledger reads.
+
+    Returns:
+        Table names (a missing one leaves its claims "undecided: not measured").
+    """
     return tables(optional=False)
 
 
 def prior_tables() -> tuple[str, ...]:
-    """The tables whose rows or columns say that a run holds a prior other than ours (the
-    tables of the ``of="priors"`` families)."""
+    """The tables whose rows or columns say that a run holds a prior other than ours.
+
+    Returns:
+        The tables of the ``of="priors"`` families.
+    """
     return tuple(
         dict.fromkeys(s.table for s in CATALOGUE if s.of == "priors" and s.table != RECOVERY)
     )
 
 
 def reads_recovery() -> bool:
-    """Whether any family reads the priors' recovery records (``RECOVERY``)."""
+    """Whether any family reads the priors' recovery records.
+
+    Returns:
+        True when a family's table is ``RECOVERY``.
+    """
     return any(s.table == RECOVERY for s in CATALOGUE)
 
 
@@ -548,7 +610,7 @@ def markdown() -> str:
         fam = f"`{s.family}`" if s.of == "ours" else f"`<prior>/{s.family}`"
         if s.headline:
             fam += " (headline)"
-        over = ("ours" if s.of == "ours" else "every other prior") + ", " + _doc(s.over)
+        over = ("ours" if s.of == "ours" else "every other prior") + ", " + _doc(SCOPES[s.over])
         thr = s.threshold.lstrip("-")
         sign = "-" if s.threshold.startswith("-") else ""
         figure = _doc(s.paper) if callable(s.paper) else _template(s.paper)

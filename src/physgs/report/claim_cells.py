@@ -55,14 +55,26 @@ class Run:
 
 
 def fields() -> tuple[str, ...]:
-    """The learned deformation fields (registry role "field")."""
+    """The learned deformation fields.
+
+    Returns:
+        The model ids of registry role "field".
+    """
     return models_of("field")
 
 
 # ---- helpers --------------------------------------------------------------------------------
-def value(df: pd.DataFrame, mask, col: str) -> float:
-    """The single cell of ``col`` where ``mask`` holds; NaN where no row does or ``col`` is
-    not a column."""
+def value(df: pd.DataFrame, mask: pd.Series, col: str) -> float:
+    """The single cell of ``col`` where ``mask`` holds.
+
+    Args:
+        df: one seed's rows of a table.
+        mask: the row to read, ``[len(df)]`` booleans.
+        col: the column.
+
+    Returns:
+        The cell; NaN where no row holds or ``col`` is not a column.
+    """
     if col not in df.columns:
         return float("nan")
     v = df.loc[mask, col]
@@ -87,36 +99,36 @@ def _recovery(d: pd.DataFrame, c: Cell, col: str) -> float:
 
 
 # ---- scopes: what a family ranges over --------------------------------------------------------
-def trees(run: Run) -> list[Cell]:
+def _trees(run: Run) -> list[Cell]:
     """each tree"""
     return [{"suffix": t, "tree": t} for t in run.trees]
 
 
-def sparse(run: Run) -> list[Cell]:
+def _sparse(run: Run) -> list[Cell]:
     """the sparse tree"""
     return [{"suffix": "sparse", "tree": "sparse"}] if "sparse" in run.trees else []
 
 
-def dense_trees(run: Run) -> list[Cell]:
+def _dense_trees(run: Run) -> list[Cell]:
     """each tree but the sparse one"""
-    return [c for c in trees(run) if c["tree"] != "sparse"]
+    return [c for c in _trees(run) if c["tree"] != "sparse"]
 
 
-def gap_trees(run: Run) -> list[Cell]:
+def _gap_trees(run: Run) -> list[Cell]:
     """each tree whose nearest-bone gap the paper states"""
-    return [c for c in trees(run) if c["tree"] in paper.NEAREST_BONE_GAP_PCT]
+    return [c for c in _trees(run) if c["tree"] in paper.NEAREST_BONE_GAP_PCT]
 
 
-def recovered_trees(run: Run) -> list[Cell]:
+def _recovered_trees(run: Run) -> list[Cell]:
     """each tree with the asked prior's recovery records (joint K = 32)"""
     rec = run.tables.get(RECOVERY)
     if rec is None:
         return []
     have = set(rec.loc[rec["model"] == run.model, "tree"])
-    return [{**c, "config": CONFIG} for c in trees(run) if c["tree"] in have]
+    return [{**c, "config": CONFIG} for c in _trees(run) if c["tree"] in have]
 
 
-def fit_models(run: Run) -> list[Cell]:
+def _fit_models(run: Run) -> list[Cell]:
     """each tree x each learned field, ours and every other prior the tables hold"""
     return [
         {"suffix": f"{t}/{m}", "tree": t, "fit_model": m, "fit_label": label(m)}
@@ -125,7 +137,7 @@ def fit_models(run: Run) -> list[Cell]:
     ]
 
 
-def splits(run: Run) -> list[Cell]:
+def _splits(run: Run) -> list[Cell]:
     """each tree x held-out views and beyond the window"""
     words = {"view": "held-out views", "time": "beyond the window"}
     return [
@@ -135,7 +147,7 @@ def splits(run: Run) -> list[Cell]:
     ]
 
 
-def winds_beyond(run: Run) -> list[Cell]:
+def _winds_beyond(run: Run) -> list[Cell]:
     """each tree x unseen wind of tab_transfer, beyond the window"""
     tr = run.tables.get("tab_transfer")
     if tr is None:
@@ -147,7 +159,7 @@ def winds_beyond(run: Run) -> list[Cell]:
     ]
 
 
-def winds(run: Run) -> list[Cell]:
+def _winds(run: Run) -> list[Cell]:
     """each split (training timestamps, beyond the window) x tree x unseen wind of tab_transfer"""
     tr = run.tables.get("tab_transfer")
     if tr is None:
@@ -166,27 +178,27 @@ def winds(run: Run) -> list[Cell]:
     ]
 
 
-def margin_trees(run: Run) -> list[Cell]:
+def _margin_trees(run: Run) -> list[Cell]:
     """each tree, tab_margin's first and last wind"""
     mg = run.tables.get("tab_margin")
     cols = [c for c in mg.columns if c.startswith("margin_")] if mg is not None else []
     first, last = (cols[0], cols[-1]) if cols else ("first", "last")
-    return [{**c, "first": first, "last": last} for c in trees(run)]
+    return [{**c, "first": first, "last": last} for c in _trees(run)]
 
 
-def recovery_trees(run: Run) -> list[Cell]:
+def _recovery_trees(run: Run) -> list[Cell]:
     """each tree, in the ledger's recovery configuration (joint K = 32)"""
-    return [{**c, "config": CONFIG, "method": run.model} for c in trees(run)]
+    return [{**c, "config": CONFIG, "method": run.model} for c in _trees(run)]
 
 
-def null_trees_sparse(run: Run) -> list[Cell]:
+def _null_trees_sparse(run: Run) -> list[Cell]:
     """the sparse tree, in the ledger's recovery configuration (joint K = 32)"""
-    return [c for c in recovery_trees(run) if c["tree"] == "sparse"]
+    return [c for c in _recovery_trees(run) if c["tree"] == "sparse"]
 
 
-def null_trees_dense(run: Run) -> list[Cell]:
+def _null_trees_dense(run: Run) -> list[Cell]:
     """each tree but the sparse one, in the ledger's recovery configuration (joint K = 32)"""
-    return [c for c in recovery_trees(run) if c["tree"] != "sparse"]
+    return [c for c in _recovery_trees(run) if c["tree"] != "sparse"]
 
 
 def _parts(run: Run) -> tuple[pd.DataFrame | None, set, str]:
@@ -196,7 +208,7 @@ def _parts(run: Run) -> tuple[pd.DataFrame | None, set, str]:
     return df, set(df["model"]), str(df["config"].iloc[0])
 
 
-def parts_damping_trees(run: Run) -> list[Cell]:
+def _parts_damping_trees(run: Run) -> list[Cell]:
     """each tree with a damping testbed in tab_parts (its first configuration), when it holds
     the topology parts"""
     df, models, c0 = _parts(run)
@@ -204,12 +216,12 @@ def parts_damping_trees(run: Run) -> list[Cell]:
         return []
     return [
         {**c, "config": c0}
-        for c in trees(run)
+        for c in _trees(run)
         if np.isfinite(df.loc[df["tree"] == c["tree"], "zeta_rel_err_pct"]).any()
     ]
 
 
-def parts_coupling(run: Run) -> list[Cell]:
+def _parts_coupling(run: Run) -> list[Cell]:
     """the sparse tree in tab_parts (its first configuration), when it holds both topology
     priors"""
     df, models, c0 = _parts(run)
@@ -218,7 +230,7 @@ def parts_coupling(run: Run) -> list[Cell]:
     return [{"suffix": "", "tree": "sparse", "config": c0}]
 
 
-def tracks_sparse(run: Run) -> list[Cell]:
+def _tracks_sparse(run: Run) -> list[Cell]:
     """the sparse tree, the 2D-track control's recovery in joint K = 32 (else its first
     configuration)"""
     null = run.tables.get("tab_null")
@@ -231,7 +243,7 @@ def tracks_sparse(run: Run) -> list[Cell]:
     return [{"suffix": "sparse", "tree": "sparse", "config": c, "method": "tracks"}]
 
 
-def tracks_trees(run: Run) -> list[Cell]:
+def _tracks_trees(run: Run) -> list[Cell]:
     """each tree in tab_tracks, its base configuration (else its first)"""
     tr = run.tables.get("tab_tracks")
     if tr is None:
@@ -240,10 +252,10 @@ def tracks_trees(run: Run) -> list[Cell]:
     if not tc:
         return []
     c = "single" if "single" in tc else tc[0]
-    return [{**x, "config": c} for x in trees(run) if (tr["tree"] == x["tree"]).any()]
+    return [{**x, "config": c} for x in _trees(run) if (tr["tree"] == x["tree"]).any()]
 
 
-def blind_trees(run: Run) -> list[Cell]:
+def _blind_trees(run: Run) -> list[Cell]:
     """each forcing-free prior in tab_null x each tree, against the prior whose measured wind it
     replaces (ids ``<prior>/...`` for a prior other than ours)"""
     null = run.tables.get("tab_null")
@@ -262,41 +274,41 @@ def blind_trees(run: Run) -> list[Cell]:
                 "who": who,
                 "config": BLIND_CONFIG,
             }
-            for c in trees(run)
+            for c in _trees(run)
             if (null["tree"] == c["tree"]).any()
         ]
     return out
 
 
-def oma_sparse(run: Run) -> list[Cell]:
+def _oma_sparse(run: Run) -> list[Cell]:
     """the sparse tree, when tab_null holds the output-only analysis"""
     null = run.tables.get("tab_null")
     if null is None or "method" not in null.columns or OMA not in set(null["method"]):
         return []
-    return [{**c, "config": BLIND_CONFIG, "method": OMA} for c in sparse(run)]
+    return [{**c, "config": BLIND_CONFIG, "method": OMA} for c in _sparse(run)]
 
 
-def oma_damping_trees(run: Run) -> list[Cell]:
+def _oma_damping_trees(run: Run) -> list[Cell]:
     """each tree of tab_damping, when it holds the output-only analysis"""
     dmp = run.tables.get("tab_damping")
     if dmp is None or "method" not in dmp.columns or OMA not in set(dmp["method"]):
         return []
-    return [{**c, "config": BLIND_CONFIG} for c in trees(run) if (dmp["tree"] == c["tree"]).any()]
+    return [{**c, "config": BLIND_CONFIG} for c in _trees(run) if (dmp["tree"] == c["tree"]).any()]
 
 
 # ---- readers: one seed's value ---------------------------------------------------------------
-def best_field_minus_static(d: pd.DataFrame, c: Cell) -> float:
+def _best_field_minus_static(d: pd.DataFrame, c: Cell) -> float:
     """tab_psnr, time column: max over learned fields of (model - static)"""
     best = max(_psnr(d, c["tree"], m, "time") for m in fields())
     return best - _psnr(d, c["tree"], "static", "time")
 
 
-def above_static(d: pd.DataFrame, c: Cell) -> float:
+def _above_static(d: pd.DataFrame, c: Cell) -> float:
     """tab_psnr, time column: the prior - static"""
     return _psnr(d, c["tree"], c["model"], "time") - _psnr(d, c["tree"], "static", "time")
 
 
-def ahead_of_fields(d: pd.DataFrame, c: Cell) -> float:
+def _ahead_of_fields(d: pd.DataFrame, c: Cell) -> float:
     """tab_psnr, the cell's split: the prior - max over learned fields"""
     t, sp = c["tree"], c.get("split", "view")
     return _psnr(d, t, c["model"], sp) - max(_psnr(d, t, m, sp) for m in fields())
@@ -310,19 +322,19 @@ def _wind_row(d: pd.DataFrame, c: Cell):
     )
 
 
-def wind_ahead(d: pd.DataFrame, c: Cell) -> float:
+def _wind_ahead(d: pd.DataFrame, c: Cell) -> float:
     """tab_transfer: the prior - max over learned fields"""
     row = _wind_row(d, c)
     return value(d, row, c["model"]) - max(value(d, row, m) for m in fields())
 
 
-def wind_fields_minus_static(d: pd.DataFrame, c: Cell) -> float:
+def _wind_fields_minus_static(d: pd.DataFrame, c: Cell) -> float:
     """tab_transfer: max over learned fields - static"""
     row = _wind_row(d, c)
     return max(value(d, row, m) for m in fields()) - value(d, row, "static")
 
 
-def margin_growth(d: pd.DataFrame, c: Cell) -> float:
+def _margin_growth(d: pd.DataFrame, c: Cell) -> float:
     """tab_margin: the prior's last wind's margin - its first's"""
     mine = (d["tree"] == c["tree"]) & _rows_of(d, c["model"], "model")
     return value(d, mine, c["last"]) - value(d, mine, c["first"])
@@ -333,36 +345,36 @@ def _null_row(d: pd.DataFrame, c: Cell):
     return _rows_of(d, who) & (d["tree"] == c["tree"]) & (d["config"] == c["config"])
 
 
-def null_over_trained(d: pd.DataFrame, c: Cell) -> float:
+def _null_over_trained(d: pd.DataFrame, c: Cell) -> float:
     """tab_null: null / trained median omega error of the cell's method"""
     row = _null_row(d, c)
     return value(d, row, "null_median_rel_err_pct") / value(d, row, "trained_median_rel_err_pct")
 
 
-def trained_minus_null(d: pd.DataFrame, c: Cell) -> float:
+def _trained_minus_null(d: pd.DataFrame, c: Cell) -> float:
     """tab_null: trained - null median omega error of the cell's method (points)"""
     row = _null_row(d, c)
     return value(d, row, "trained_median_rel_err_pct") - value(d, row, "null_median_rel_err_pct")
 
 
-def gap_off(d: pd.DataFrame, c: Cell) -> float:
+def _gap_off(d: pd.DataFrame, c: Cell) -> float:
     """tab_testbed: |nearest-bone gap - the paper's| / the paper's"""
     g = paper.NEAREST_BONE_GAP_PCT[c["tree"]]
     return abs(value(d, d["tree"] == c["tree"], "nearest_bone_gap_pct") - g) / g
 
 
-def damping_off(d: pd.DataFrame, c: Cell) -> float:
+def _damping_off(d: pd.DataFrame, c: Cell) -> float:
     """the prior's recovery: |median zeta_hat - zeta| / zeta"""
     z = _recovery(d, c, "zeta_true")
     return abs(_recovery(d, c, "median_zeta") - z) / z
 
 
-def decay_exponent(d: pd.DataFrame, c: Cell) -> float:
+def _decay_exponent(d: pd.DataFrame, c: Cell) -> float:
     """the prior's recovery: the exponent p of gamma ~ omega^p"""
     return _recovery(d, c, "loglog_exponent")
 
 
-def fit_fraction(d: pd.DataFrame, c: Cell) -> float:
+def _fit_fraction(d: pd.DataFrame, c: Cell) -> float:
     """tab_fit: (fit - static) / (ceiling - static) on the trained frames"""
     return value(d, (d["tree"] == c["tree"]) & (d["model"] == c["fit_model"]), "ceiling_frac")
 
@@ -372,19 +384,19 @@ def _parts_value(d: pd.DataFrame, c: Cell, model: str, col: str) -> float:
     return value(d, row, col)
 
 
-def topology_damping_gain(d: pd.DataFrame, c: Cell) -> float:
+def _topology_damping_gain(d: pd.DataFrame, c: Cell) -> float:
     """tab_parts: median zeta error, topology - k-means parts (points)"""
     col = "zeta_rel_err_pct"
     return _parts_value(d, c, "ours_topo", col) - _parts_value(d, c, "ours", col)
 
 
-def coupling_gain(d: pd.DataFrame, c: Cell) -> float:
+def _coupling_gain(d: pd.DataFrame, c: Cell) -> float:
     """tab_parts: ceiling fraction, chained - independent topology parts"""
     col = "ceiling_frac"
     return _parts_value(d, c, "ours_chain", col) - _parts_value(d, c, "ours_topo", col)
 
 
-def tracks_minus_ours(d: pd.DataFrame, c: Cell) -> float:
+def _tracks_minus_ours(d: pd.DataFrame, c: Cell) -> float:
     """tab_null: 2D tracks - ours median omega error (points); NaN at another K than ours'"""
     tracks, ours = _null_row(d, c), _null_row(d, {**c, "method": "ours"})
     if value(d, tracks, "K") != value(d, ours, "K"):
@@ -393,13 +405,13 @@ def tracks_minus_ours(d: pd.DataFrame, c: Cell) -> float:
     return value(d, tracks, col) - value(d, ours, col)
 
 
-def tracks_tail(d: pd.DataFrame, c: Cell) -> float:
+def _tracks_tail(d: pd.DataFrame, c: Cell) -> float:
     """tab_tracks: tail displacement error, 2D tracks - ours (px)"""
     row = (d["tree"] == c["tree"]) & (d["config"] == c["config"])
     return value(d, row, "tail_px") - value(d, row, "tail_ours_px")
 
 
-def blind_minus_wind(d: pd.DataFrame, c: Cell) -> float:
+def _blind_minus_wind(d: pd.DataFrame, c: Cell) -> float:
     """tab_null: forcing-free prior - its wind-reading prior, median omega error (points)"""
     col = "trained_median_rel_err_pct"
     blind, wind = (
@@ -409,7 +421,7 @@ def blind_minus_wind(d: pd.DataFrame, c: Cell) -> float:
     return value(d, blind, col) - value(d, wind, col)
 
 
-def oma_zeta_gain(d: pd.DataFrame, c: Cell) -> float:
+def _oma_zeta_gain(d: pd.DataFrame, c: Cell) -> float:
     """tab_damping (damping testbed): output-only - null median zeta error (points)"""
     row = (
         (d["testbed"] == DAMPING)
@@ -424,3 +436,50 @@ def oma_zeta_gain(d: pd.DataFrame, c: Cell) -> float:
 Reader = Callable[[pd.DataFrame, Cell], float]
 #: A scope: the run -> the family's cells.
 Scope = Callable[[Run], list[Cell]]
+
+#: The scopes a catalogue entry names (``ClaimSpec.over``); each one's docstring says what it
+#: ranges over (the claims page prints it).
+SCOPES: dict[str, Scope] = {
+    "trees": _trees,
+    "sparse": _sparse,
+    "dense_trees": _dense_trees,
+    "gap_trees": _gap_trees,
+    "recovered_trees": _recovered_trees,
+    "fit_models": _fit_models,
+    "splits": _splits,
+    "winds_beyond": _winds_beyond,
+    "winds": _winds,
+    "margin_trees": _margin_trees,
+    "recovery_trees": _recovery_trees,
+    "null_trees_sparse": _null_trees_sparse,
+    "null_trees_dense": _null_trees_dense,
+    "parts_damping_trees": _parts_damping_trees,
+    "parts_coupling": _parts_coupling,
+    "tracks_sparse": _tracks_sparse,
+    "tracks_trees": _tracks_trees,
+    "blind_trees": _blind_trees,
+    "oma_sparse": _oma_sparse,
+    "oma_damping_trees": _oma_damping_trees,
+}
+#: The readers a catalogue entry names (``ClaimSpec.read``); each one's docstring says what it
+#: reads.
+READERS: dict[str, Reader] = {
+    "best_field_minus_static": _best_field_minus_static,
+    "above_static": _above_static,
+    "ahead_of_fields": _ahead_of_fields,
+    "wind_ahead": _wind_ahead,
+    "wind_fields_minus_static": _wind_fields_minus_static,
+    "margin_growth": _margin_growth,
+    "null_over_trained": _null_over_trained,
+    "trained_minus_null": _trained_minus_null,
+    "gap_off": _gap_off,
+    "damping_off": _damping_off,
+    "decay_exponent": _decay_exponent,
+    "fit_fraction": _fit_fraction,
+    "topology_damping_gain": _topology_damping_gain,
+    "coupling_gain": _coupling_gain,
+    "tracks_minus_ours": _tracks_minus_ours,
+    "tracks_tail": _tracks_tail,
+    "blind_minus_wind": _blind_minus_wind,
+    "oma_zeta_gain": _oma_zeta_gain,
+}

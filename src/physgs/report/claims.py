@@ -50,7 +50,14 @@ class Claim:
 
 
 def log_scale(claim: Claim) -> bool:
-    """Whether the claim's interval is taken on the log scale (a ratio)."""
+    """Whether a claim's interval is taken on the log scale.
+
+    Args:
+        claim: the claim.
+
+    Returns:
+        True for a ratio (unit ``RATIO``).
+    """
     return claim.unit == RATIO
 
 
@@ -176,7 +183,7 @@ def measure(
             continue
         seeds = _per_seed(tabs[spec.table]) if spec.table in tabs else []
         for model in ("ours",) if spec.of == "ours" else others:
-            for cell in spec.over(Run(tabs, trees, model, others)):
+            for cell in spec.cells(Run(tabs, trees, model, others)):
                 cell = {"model": model, "name": label(model), **cell}
                 cid = spec.claim_id(cell)
                 claim = Claim(
@@ -190,7 +197,7 @@ def measure(
                     spec.needs_variance,
                     origin_of(cid),
                 )
-                out.append((claim, [float(spec.read(d, cell)) for d in seeds]))
+                out.append((claim, [spec.measure(d, cell) for d in seeds]))
     return out
 
 
