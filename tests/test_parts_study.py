@@ -107,6 +107,13 @@ def test_tab_parts_without_a_damping_testbed_shows_no_damping_cell():
         row(f, 23.0, 27.0, _rec(0.02), null, _rec(0.02))
 
 
+def _parts_claims(parts, trees):
+    """The parts study's claims of the ledger, measured on tab_parts."""
+    fams = ("coupling_lifts_sparse_fit", "topology_parts_reduce_damping_error")
+    measured = claims.measure({"tab_parts": parts}, {}, trees)
+    return [(c, v) for c, v in measured if c.id.split("/")[0] in fams]
+
+
 @pytest.mark.parametrize(
     "chain_gain, topo_zeta, coupling, damping",
     [(0.2, 0.3, "holds", "holds"), (-0.2, 0.7, "fails", "fails")],
@@ -119,7 +126,7 @@ def test_parts_claims_follow_the_paired_seed_differences(chain_gain, topo_zeta, 
         ["ours", "ours_topo", "ours_chain"],
         {"single": "s"},
     ).df
-    measured = {c.id: (c, v) for c, v in claims._parts_claims(df, ["sparse", "medium"])}
+    measured = {c.id: (c, v) for c, v in _parts_claims(df, ["sparse", "medium"])}
     c, v = measured["coupling_lifts_sparse_fit"]
     assert v == pytest.approx([chain_gain + 0.01 * s / 13.3 for s in range(3)], rel=1e-6)
     assert claims.verdict(c, v) == coupling
@@ -163,7 +170,7 @@ def test_ledger_frame_is_a_dataframe_with_the_parts_claims():
     df = tab_parts(
         _rows(), ["sparse"], {"sparse": 22}, ["ours", "ours_topo", "ours_chain"], {"single": "s"}
     ).df
-    led = claims.ledger(claims._parts_claims(df, ["sparse"]))
+    led = claims.ledger(_parts_claims(df, ["sparse"]))
     assert isinstance(led, pd.DataFrame) and len(led) == 2
 
 

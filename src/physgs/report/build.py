@@ -16,9 +16,11 @@ from typing import TYPE_CHECKING, Mapping, Sequence
 
 import pandas as pd
 
+from physgs.atomic import atomic_path, write_text
+from physgs.config import study_seeds
 from physgs.models.registry import BASE_CONFIG, models_of
 from physgs.recovery.record import load_recovery
-from physgs.report import catalogue
+from physgs.report import catalogue, claims, tables
 from physgs.report.claim_cells import CONFIG as CLAIMS_CONFIG
 from physgs.report.outputs import NEED_FIELDS, OUTPUTS, Plan, key, reader
 from physgs.report.outputs.views import fit_row
@@ -96,8 +98,6 @@ def claims_frame(inputs: Mapping[str, str], trees: Sequence[str]) -> pd.DataFram
     Returns:
         The ledger, one row per claim.
     """
-    from physgs.report import claims
-
     names = catalogue.tables()
     tabs = {n: pd.read_csv(inputs[key(("table", n))]) for n in names if key(("table", n)) in inputs}
     damping: dict[str, dict[str, list]] = {}  # model -> tree -> one summary per seed
@@ -131,9 +131,6 @@ def make_claims(inputs: Mapping[str, str], trees: Sequence[str], md_path, csv_pa
     Returns:
         (pd.DataFrame): The ledger (without the stamp's columns).
     """
-    from physgs.atomic import atomic_path, write_text
-    from physgs.report import claims
-
     df = claims_frame(inputs, trees)
     sd = stamp.to_dict() if stamp is not None else None
     write_text(md_path, claims.ledger_markdown(df, sd))
@@ -190,8 +187,6 @@ def settings_for(name: str, cfg: dict) -> dict:
     Raises:
         ValueError: for an unknown output.
     """
-    from physgs.config import study_seeds
-
     o = _output(name)
     trees = list(
         cfg["damping_benchmark"]["trees"] if o.trees == "damping_benchmark" else cfg["trees"]
@@ -225,8 +220,6 @@ def make_table(
     Raises:
         ValueError: for a name that is not a table.
     """
-    from physgs.report import tables
-
     o = _output(name)
     if o.kind != "table":
         raise ValueError(f"unknown table '{name}'; choose one of {TABLES}")

@@ -17,6 +17,9 @@ from typing import Mapping, Sequence
 import numpy as np
 import pandas as pd
 
+from physgs.atomic import atomic_path
+from physgs.evaluate.metrics import ceiling_fraction
+from physgs.experiments.kmatch import matched_k
 from physgs.models.registry import label
 from physgs.report import seeds as seedstats
 from physgs.report.tables import Table, _by_seed, _check, _seeds, _wrap, tree_label
@@ -67,8 +70,6 @@ def row(
     Raises:
         ValueError: when ``damping_recovery`` has no damping scores.
     """
-    from physgs.evaluate.metrics import ceiling_fraction
-
     out = {
         "purity": float(purity),
         "fit_psnr_db": fit["fit"],
@@ -243,8 +244,6 @@ def fig_parts(
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
 
-    from physgs.atomic import atomic_path
-
     cols = max(len(records[t]["models"]) for t in trees)
     fig, axes = plt.subplots(
         len(trees), cols, figsize=(3.2 * cols, 3.4 * len(trees)), squeeze=False
@@ -305,8 +304,6 @@ def tab_parts_k(
     Returns:
         The [`Table`][physgs.report.tables.Table].
     """
-    from physgs.experiments.kmatch import matched_k
-
     seeds = _seeds(per_seed, "tab_parts_k")
     recs = []
     for s in seeds:

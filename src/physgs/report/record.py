@@ -29,6 +29,7 @@ from pathlib import Path
 
 import numpy as np
 import pandas as pd
+from PIL import Image
 
 from physgs.report import catalogue, rerun
 
@@ -185,8 +186,6 @@ def demote(markdown: str) -> str:
 
 def _png_for_web(src: Path, dst: Path) -> None:
     """Copy a PNG, downscaled to ``FIGURE_WIDTH_PX`` wide if wider."""
-    from PIL import Image
-
     with Image.open(src) as im:
         if im.width > FIGURE_WIDTH_PX:
             h = round(im.height * FIGURE_WIDTH_PX / im.width)

@@ -20,8 +20,8 @@ from physgs.evaluate.metrics import ceiling_fraction
 from physgs.models.registry import MODEL_NAMES as MODELS
 from physgs.models.registry import MODELS as SPECS
 from physgs.models.registry import label, spec_of
+from physgs.report import paper
 from physgs.report import seeds as seedstats
-
 
 #: LaTeX name of the 2D-track control's rows (physgs.report.tracks, docs/tracks.md)
 TRACKS_LABEL = r"\emph{2D tracks}"
@@ -934,8 +934,6 @@ def tab_testbed(stats: Mapping[str, Mapping], trees: Sequence[str], digits: int 
     Returns:
         The [`Table`][physgs.report.tables.Table].
     """
-    from physgs.report import paper
-
     _check(list(trees), stats, "tab_testbed")
     rows = []
     for t in trees:

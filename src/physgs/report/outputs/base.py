@@ -13,6 +13,13 @@ from __future__ import annotations
 from dataclasses import dataclass, field
 from typing import Any, Callable, Mapping, Sequence
 
+from physgs.config import study_seeds
+from physgs.experiments.kselect import selected_models
+from physgs.models.registry import blind_priors
+from physgs.oma.settings import parts as oma_k
+from physgs.tracks.settings import fields_scored
+from physgs.tracks.settings import parts as tracks_k
+
 #: The fields of each need tuple after its kind (what a workflow path template is formatted with).
 NEED_FIELDS = {
     "eval": ("tree", "model", "config", "seed"),
@@ -112,13 +119,6 @@ class Plan:
         Returns:
             Plan: its trees, configurations, seeds and study settings.
         """
-        from physgs.config import study_seeds
-        from physgs.experiments.kselect import selected_models
-        from physgs.models.registry import blind_priors
-        from physgs.oma.settings import parts as oma_k
-        from physgs.tracks.settings import fields_scored
-        from physgs.tracks.settings import parts as tracks_k
-
         trees, configs = list(cfg["trees"]), dict(cfg["models"]["configs"])
         parts_models = list(cfg["parts_study"]["models"])
         tracks = list(cfg["tracks"]["configs"])

@@ -4,11 +4,18 @@ against the untrained null), tab_damping (the damping benchmark), fig_damping an
 
 from __future__ import annotations
 
-from physgs.experiments.kselect import BASE_MODEL, selected_models
+import pandas as pd
+
+from physgs.evaluate.splits import load_eval
+from physgs.experiments.kselect import BASE_MODEL, load_selection, selected_models
 from physgs.models.registry import BLIND_CONFIG, blind_priors, config_label, models_of
+from physgs.oma.settings import parts as oma_k
 from physgs.recovery.record import load_null, load_recovery
-from physgs.report import kselect
+from physgs.report import kselect, tables
+from physgs.report.damping import TRACKS_NOTE, tab_damping
 from physgs.report.outputs.base import Output
+from physgs.testbed.variant import DAMPING, FAITHFUL, damping_id
+from physgs.tracks.settings import parts as tracks_k
 
 #: tab_kselect's rows: ours at the fixed K of the base configuration, and at the chosen K
 KSELECT_ROWS = tuple(c for c, _ in kselect.ROWS)
@@ -34,8 +41,6 @@ def _method_settings(cfg: dict, configs) -> dict:
     table's configurations): priors {model: {config: label}}, every prior of the registry (ours
     first) in each of them; oma {config: {K, label}}; blind {model: {config: label}}, the
     forcing-free priors (``registry.blind_priors``) in ``BLIND_CONFIG``."""
-    from physgs.oma.settings import parts as oma_k
-
     mc = cfg["models"]["configs"]
     return {
         "priors": {m: {c: config_label(c, mc[c]) for c in configs} for m in models_of("prior")},
@@ -72,7 +77,6 @@ def _methods(settings: dict, records, tracks_note: str, prior_note: str = "") ->
     """tab_null / tab_damping's ``MethodRows`` in row order: every prior (ours first), the
     2D-track control, the output-only analysis, the forcing-free priors. records(kind, *fields,
     configs): the table's per-seed records of need ``kind`` in ``configs`` ({config: K})."""
-    from physgs.report import tables
 
     def prior(m, labels):
         K = {c: settings["configs"][c]["K"] for c in labels}
@@ -129,8 +133,6 @@ def _null_needs(plan, seeds):
 def _tracks_settings(cfg: dict, configs) -> dict:
     """tracks {config: {K, label}}: the 2D-track control's configurations among ``configs``, in
     that order, each with its own K."""
-    from physgs.tracks.settings import parts as tracks_k
-
     return {
         "tracks": {
             c: {"K": (k := tracks_k(cfg, c)[0]), "label": label_with_k(cfg, c, k)}
@@ -149,8 +151,6 @@ def _null_settings(cfg: dict) -> dict:
 
 
 def _tab_null(path, settings, inputs, out):
-    from physgs.report import tables
-
     trees, seeds = settings["trees"], settings["seeds"]
 
     def paired(kind, *fields, configs):
@@ -178,8 +178,6 @@ TAB_NULL = Output("tab_null", "table", _null_needs, _tab_null, settings=_null_se
 # ---- tab_damping ---------------------------------------------------------------------------
 def _testbeds(tree: str) -> dict:
     """{variant: testbed id} of a damping-benchmark tree: its faithful and damping testbeds."""
-    from physgs.testbed.variant import DAMPING, FAITHFUL, damping_id
-
     return {FAITHFUL: tree, DAMPING: damping_id(tree)}
 
 
@@ -204,8 +202,6 @@ def _damping_settings(cfg: dict) -> dict:
 
 
 def _tab_damping(path, settings, inputs, out):
-    from physgs.report.damping import TRACKS_NOTE, tab_damping
-
     trees, seeds = settings["trees"], settings["seeds"]
 
     def records(kind, *fields, configs):
@@ -293,11 +289,6 @@ def _kselect_needs(plan, seeds):
 
 
 def _tab_kselect(path, settings, inputs, out):
-    import pandas as pd
-
-    from physgs.evaluate.splits import load_eval
-    from physgs.experiments.kselect import load_selection
-
     rows = {}
     for s in settings["seeds"]:
         rows[s] = {}

@@ -4,11 +4,15 @@ with parts cut by k-means or along the tree), fig_parts (their segmentations) an
 
 from __future__ import annotations
 
+from physgs.evaluate.parts import load_segmentations
 from physgs.intermediate import read_json
 from physgs.models.registry import BASE_CONFIG, REFERENCE_NAMES, config_label
 from physgs.recovery.record import load_null, load_recovery
+from physgs.report import parts
 from physgs.report.outputs.base import Output
 from physgs.report.outputs.views import fit_row, fit_settings
+from physgs.report.parts import fig_parts
+from physgs.testbed.variant import damping_id
 
 #: The prior every variant of the parts study is set beside, and the rows its fit fraction needs.
 BASELINE_PRIOR = "ours"
@@ -23,8 +27,6 @@ def _studied(plan) -> bool:
 def _parts_needs(plan, seeds):
     """Every prior's evaluation, loss log and recovery on each tree (and damping testbed), the
     null of each K, the static pose's and the ceiling's fit, and the segmentation record."""
-    from physgs.testbed.variant import damping_id
-
     priors = [BASELINE_PRIOR, *plan.parts_models]
     configs = plan.parts_configs
     damping_trees = [t for t in plan.damping_trees if t in plan.trees]
@@ -54,10 +56,6 @@ def _parts_settings(cfg: dict) -> dict:
 
 
 def _tab_parts(path, settings, inputs, out):
-    from physgs.evaluate.parts import load_segmentations
-    from physgs.report import parts
-    from physgs.testbed.variant import damping_id
-
     trees, models, configs = settings["trees"], settings["models"], settings["configs"]
     n, every = int(settings["n_train"]), int(settings["holdout_every"])
     rows: dict[int, dict] = {}
@@ -105,9 +103,6 @@ TAB_PARTS = Output(
 
 # ---- fig_parts -----------------------------------------------------------------------------
 def _fig_parts(path, settings, inputs, out):
-    from physgs.evaluate.parts import load_segmentations
-    from physgs.report.parts import fig_parts
-
     trees, s0 = settings["trees"], settings["seeds"][0]
     recs = {t: load_segmentations(path("parts", t, s0)) for t in trees}
     fig_parts(recs, trees, out, title=f"parts of each prior (single), training seed {s0}")
@@ -147,8 +142,6 @@ def _kmatch_settings(cfg: dict) -> dict:
 
 
 def _tab_parts_k(path, settings, inputs, out):
-    from physgs.report import parts
-
     n, every, K = int(settings["n_train"]), int(settings["holdout_every"]), int(settings["K"])
 
     def held(m, t, s):

@@ -2,13 +2,12 @@
 
 from __future__ import annotations
 
+from physgs.report import tables
 from physgs.report.outputs.base import Output
+from physgs.testbed.stats import load_stats
 
 
 def _tab_testbed(path, settings, inputs, out):
-    from physgs.report import tables
-    from physgs.testbed.stats import load_stats
-
     trees = settings["trees"]
     return tables.tab_testbed(
         {t: load_stats(path("stats", t)) for t in trees}, trees, digits=settings["digits"]

@@ -9,6 +9,9 @@ import pandas as pd
 from physgs.intermediate import read_json
 from physgs.report.outputs.base import Output, key
 from physgs.report.outputs.recovery import label_with_k
+from physgs.report.tracks import fig_tracks, tab_tracks
+from physgs.tracks.settings import parts as tracks_k
+from physgs.tracks.store import load_fit, load_tracks
 
 
 def _controlled(plan) -> bool:
@@ -29,8 +32,6 @@ def _tab_tracks_needs(plan, seeds):
 
 
 def _tab_tracks_settings(cfg: dict) -> dict:
-    from physgs.tracks.settings import parts as tracks_k
-
     return {
         "configs": {
             c: {
@@ -44,8 +45,6 @@ def _tab_tracks_settings(cfg: dict) -> dict:
 
 
 def _tab_tracks(path, settings, inputs, out):
-    from physgs.report.tracks import tab_tracks
-
     scores = {}
     for s in settings["seeds"]:
         scores[s] = {}
@@ -91,9 +90,6 @@ def _fig_tracks_needs(plan, seeds):
 
 
 def _fig_tracks(path, settings, inputs, out):
-    from physgs.report.tracks import fig_tracks
-    from physgs.tracks.store import load_fit, load_tracks
-
     trees, s0, configs = settings["trees"], settings["seeds"][0], list(settings["configs"])
     frames, tracks, labels = {}, {}, {}
     for t in trees:

@@ -10,8 +10,10 @@ import numpy as np
 import pandas as pd
 
 from physgs.evaluate.splits import load_eval
+from physgs.evaluate.trajectories import load_trajectories
 from physgs.experiments.recipe import heldout_split
 from physgs.models.registry import BASE_CONFIG, BLIND_CONFIG, blind_priors, models_of
+from physgs.report import tables
 from physgs.report.outputs.base import Output
 
 #: the roles of the methods compared on images, and of the references shown beside them
@@ -111,8 +113,6 @@ def fit_settings(cfg: dict) -> dict:
 
 # ---- tables --------------------------------------------------------------------------------
 def _tab_psnr(path, settings, inputs, out):
-    from physgs.report import tables
-
     seeds = settings["seeds"]
     return tables.tab_psnr(
         summaries(path, settings["trees"], models_of(*METHODS, *REFERENCES), seeds),
@@ -142,8 +142,6 @@ def _fit_table_settings(cfg: dict) -> dict:
 
 
 def _tab_fit(path, settings, inputs, out):
-    from physgs.report import tables
-
     n, every = int(settings["n_train"]), int(settings["holdout_every"])
     config = {m: BASE_CONFIG for m in models_of(*METHODS, *REFERENCES)}
     config.update({m: BLIND_CONFIG for m in settings.get("blind", [])})
@@ -167,8 +165,6 @@ def _tab_fit(path, settings, inputs, out):
 
 
 def _tab_transfer(path, settings, inputs, out):
-    from physgs.report import tables
-
     return tables.tab_transfer(
         summaries(path, settings["trees"], models_of(*METHODS), settings["seeds"]),
         settings["trees"],
@@ -184,8 +180,6 @@ def _margin_models() -> tuple[str, ...]:
 
 
 def _tab_margin(path, settings, inputs, out):
-    from physgs.report import tables
-
     return tables.tab_margin(
         summaries(path, settings["trees"], _margin_models(), settings["seeds"]),
         settings["trees"],
@@ -255,7 +249,6 @@ def _fig_temporal(path, settings, inputs, out):
 
 
 def _fig_teaser(path, settings, inputs, out):
-    from physgs.evaluate.trajectories import load_trajectories
     from physgs.report import figures
 
     t, s0 = teaser_tree(settings["trees"]), settings["seeds"][0]
