@@ -25,8 +25,8 @@ import numba as nb
 import numpy as np
 import torch
 
-from physgs.models.part_transform import hamilton, hamilton_vjp
 from physgs.numpy_bridge import float64_array, tensor_like
+from physgs.rotations import hamilton, hamilton_vjp
 
 
 @nb.njit(cache=True, inline="always")

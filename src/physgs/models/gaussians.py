@@ -13,10 +13,16 @@ import scipy.spatial
 import torch
 from torch import nn
 
-# The one torch quaternion -> rotation matrix (zero-norm guarded), shared with the rasterizer.
-from physgs.render.project import quat_to_rotmat  # noqa: F401  (re-exported)
-
 from physgs.models.part_transform import transform_parts
+
+# the rotation maths lives in its leaf module; these names stay importable from here
+from physgs.rotations import (  # noqa: F401  (re-exported)
+    axis_angle_quat,
+    quat_multiply,
+    quat_to_rotmat,
+    rodrigues,
+    rodrigues_minus_identity,
+)
 
 
 @dataclass(frozen=True)
@@ -32,78 +38,6 @@ class GaussianState:
     scales: torch.Tensor
     opacities: torch.Tensor
     colors: torch.Tensor
-
-
-def quat_multiply(a: torch.Tensor, b: torch.Tensor) -> torch.Tensor:
-    """Hamilton product a * b of quaternions [..., 4] (w, x, y, z); rotation b first, then a.
-
-    Args:
-        a: [..., 4] quaternions (w, x, y, z).
-        b: [..., 4] quaternions, broadcast against ``a``.
-
-    Returns:
-        [..., 4] the products (unit when both are unit).
-    """
-    aw, ax, ay, az = a.unbind(-1)
-    bw, bx, by, bz = b.unbind(-1)
-    return torch.stack(
-        [
-            aw * bw - ax * bx - ay * by - az * bz,
-            aw * bx + ax * bw + ay * bz - az * by,
-            aw * by - ax * bz + ay * bw + az * bx,
-            aw * bz + ax * by - ay * bx + az * bw,
-        ],
-        dim=-1,
-    )
-
-
-def axis_angle_quat(axis: torch.Tensor, angle: torch.Tensor) -> torch.Tensor:
-    """Unit quaternions [..., 4] for rotations by ``angle`` [...] rad about unit ``axis`` [..., 3].
-
-    Args:
-        axis: [..., 3] unit axes.
-        angle: [...] angles, rad.
-
-    Returns:
-        [..., 4] quaternions (w, x, y, z).
-    """
-    half = 0.5 * angle
-    return torch.cat([torch.cos(half)[..., None], torch.sin(half)[..., None] * axis], dim=-1)
-
-
-def rodrigues_minus_identity(axis: torch.Tensor, angle: torch.Tensor) -> torch.Tensor:
-    """R - I [..., 3, 3] for rotations by ``angle`` [...] rad about unit ``axis`` [..., 3].
-
-    Kept apart from I so that a zero angle gives exactly zero (and small angles lose no digits).
-
-    Args:
-        axis: [..., 3] unit axes.
-        angle: [...] angles, rad.
-
-    Returns:
-        [..., 3, 3] R - I.
-    """
-    x, y, z = axis.unbind(-1)
-    zero = torch.zeros_like(x)
-    Kx = torch.stack([zero, -z, y, z, zero, -x, -y, x, zero], -1).reshape(axis.shape[:-1] + (3, 3))
-    s = torch.sin(angle)[..., None, None]
-    c = torch.cos(angle)[..., None, None]
-    return s * Kx + (1 - c) * (Kx @ Kx)
-
-
-def rodrigues(axis: torch.Tensor, angle: torch.Tensor) -> torch.Tensor:
-    """Rotation matrices [..., 3, 3] by ``angle`` [...] rad about unit ``axis`` [..., 3].
-
-    Args:
-        axis: [..., 3] unit axes.
-        angle: [...] angles, rad.
-
-    Returns:
-        [..., 3, 3] rotation matrices.
-    """
-    return torch.eye(3, dtype=axis.dtype, device=axis.device) + rodrigues_minus_identity(
-        axis, angle
-    )
 
 
 def rotate_about_pivot(

@@ -23,64 +23,13 @@ import numpy as np
 import torch
 
 from physgs.numpy_bridge import float64_array, tensor_like
+from physgs.rotations import hamilton, hamilton_vjp, quat_multiply
 
 
 @nb.njit(cache=True, inline="always")
 def _row4(a, i):  # pragma: no cover - compiled
     """Row i of a [*, 4] array as four float64 scalars."""
     return float(a[i, 0]), float(a[i, 1]), float(a[i, 2]), float(a[i, 3])
-
-
-@nb.njit(cache=True, inline="always")
-def hamilton(a, b):  # pragma: no cover - compiled
-    """The Hamilton product a * b of two quaternions (rotation b first, then a).
-
-    Args:
-        a (tuple[float, float, float, float]): (w, x, y, z).
-        b (tuple[float, float, float, float]): (w, x, y, z).
-
-    Returns:
-        (tuple[float, float, float, float]): a * b as (w, x, y, z).
-    """
-    aw, ax, ay, az = a
-    bw, bx, by, bz = b
-    return (
-        aw * bw - ax * bx - ay * by - az * bz,
-        aw * bx + ax * bw + ay * bz - az * by,
-        aw * by - ax * bz + ay * bw + az * bx,
-        aw * bz + ax * by - ay * bx + az * bw,
-    )
-
-
-@nb.njit(cache=True, inline="always")
-def hamilton_vjp(a, b, h):  # pragma: no cover - compiled
-    """The gradients of <h, a * b> w.r.t. a and b: the product is bilinear, so each is its
-    matrix in the other factor, transposed, applied to h.
-
-    Args:
-        a (tuple[float, float, float, float]): (w, x, y, z), the left factor.
-        b (tuple[float, float, float, float]): (w, x, y, z), the right factor.
-        h (tuple[float, float, float, float]): (w, x, y, z), the gradient w.r.t. the product.
-
-    Returns:
-        (tuple[tuple, tuple]): (gradient w.r.t. a, gradient w.r.t. b), each (w, x, y, z).
-    """
-    aw, ax, ay, az = a
-    bw, bx, by, bz = b
-    hw, hx, hy, hz = h
-    ga = (
-        bw * hw + bx * hx + by * hy + bz * hz,
-        -bx * hw + bw * hx - bz * hy + by * hz,
-        -by * hw + bz * hx + bw * hy - bx * hz,
-        -bz * hw - by * hx + bx * hy + bw * hz,
-    )
-    gb = (
-        aw * hw + ax * hx + ay * hy + az * hz,
-        -ax * hw + aw * hx + az * hy - ay * hz,
-        -ay * hw - az * hx + aw * hy + ax * hz,
-        -az * hw + ay * hx - ax * hy + aw * hz,
-    )
-    return ga, gb
 
 
 @nb.njit(cache=True)
@@ -176,8 +125,6 @@ class _PartTransform(torch.autograd.Function):
 def _transform_parts_torch(means, quats, labels, M, c, t, Q):
     """[`transform_parts`][physgs.models.part_transform.transform_parts] as torch ops, on any
     device with autograd through every op (the fused pass's reference in the tests)."""
-    from physgs.models.gaussians import quat_multiply
-
     rel = (means - c[labels])[..., None]  # [N, 3, 1]
     new_means = means + t[labels] + (M[labels] @ rel)[..., 0]
     return new_means, quat_multiply(Q[labels], quats)

@@ -23,9 +23,8 @@ EPS2D = 0.3
 # gsplat ``persp_proj``: (W - cx) / fx + 0.3 * tan_fov), i.e. 1.3 x the half field of view for
 # a centred principal point, so a Gaussian far to the side gets no huge, ill-conditioned blob.
 FOV_CLAMP_MARGIN = 0.3
-# Floor on a quaternion's norm before normalising: a zero quaternion gives the identity rotation
-# instead of NaN.
-QUAT_NORM_EPS = 1e-12
+# The floor on a quaternion's norm before normalising lives with the rotations
+# (``physgs.rotations.QUAT_NORM_EPS``).
 
 # --- compositing (3DGS, Kerbl et al. 2023; gsplat's ALPHA_THRESHOLD, MAX_ALPHA,
 # TRANSMITTANCE_THRESHOLD) ----------------------------------------------------------------------

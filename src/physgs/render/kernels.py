@@ -22,14 +22,14 @@ import numpy as np
 # Module globals: numba freezes them into the compiled (and cached) kernels.
 from physgs.render.constants import (
     ALPHA_MAX,
-    BOX_SLACK_PX,
     ALPHA_MIN,
+    BOX_SLACK_PX,
     FOOTPRINT_SLACK,
     INV_ALPHA_MIN,
-    QUAT_NORM_EPS,
     ROW_SPAN_TOL,
     T_MIN,
 )
+from physgs.rotations import QUAT_NORM_EPS, quat_rotmat
 
 N_GRAD = 7  # per-pair gradient columns before colours: mx, my, conic a, b, c, opacity, depth
 # Floating-point operations (compares and min included) per composited pixel-Gaussian pair, for
@@ -569,20 +569,6 @@ def reduce_pairs(pair_gid, pair_grad, n):  # pragma: no cover - compiled
 
 
 @nb.njit(cache=True, inline="always")
-def _quat_rotmat(qw, qx, qy, qz, Rq):  # pragma: no cover - compiled
-    """Unit quaternion (w, x, y, z) -> rotation matrix, written into Rq [3, 3]."""
-    Rq[0, 0] = 1 - 2 * (qy * qy + qz * qz)
-    Rq[0, 1] = 2 * (qx * qy - qw * qz)
-    Rq[0, 2] = 2 * (qx * qz + qw * qy)
-    Rq[1, 0] = 2 * (qx * qy + qw * qz)
-    Rq[1, 1] = 1 - 2 * (qx * qx + qz * qz)
-    Rq[1, 2] = 2 * (qy * qz - qw * qx)
-    Rq[2, 0] = 2 * (qx * qz - qw * qy)
-    Rq[2, 1] = 2 * (qy * qz + qw * qx)
-    Rq[2, 2] = 1 - 2 * (qx * qx + qy * qy)
-
-
-@nb.njit(cache=True, inline="always")
 def _mm(A, B, out, ta, tb):  # pragma: no cover - compiled
     """out = op(A) @ op(B), op = transpose when ta / tb. Plain loops: numba's @ calls BLAS,
     far too slow for 3x3 blocks, and allocates."""
@@ -641,7 +627,7 @@ def project_forward(
                 quats[i, 0] ** 2 + quats[i, 1] ** 2 + quats[i, 2] ** 2 + quats[i, 3] ** 2
             )
             qn = max(qn, QUAT_NORM_EPS)
-            _quat_rotmat(quats[i, 0] / qn, quats[i, 1] / qn, quats[i, 2] / qn, quats[i, 3] / qn, Rq)
+            quat_rotmat(quats[i, 0] / qn, quats[i, 1] / qn, quats[i, 2] / qn, quats[i, 3] / qn, Rq)
             _mm(Rc, Rq, M, False, False)
             for col in range(3):
                 for row in range(3):
@@ -760,7 +746,7 @@ def project_backward(
             QUAT_NORM_EPS,
         )
         qw, qx, qy, qz = quats[i, 0] / qn, quats[i, 1] / qn, quats[i, 2] / qn, quats[i, 3] / qn
-        _quat_rotmat(qw, qx, qy, qz, Rq)
+        quat_rotmat(qw, qx, qy, qz, Rq)
         _mm(Rc, Rq, RR, False, False)
         for col in range(3):
             for row in range(3):

@@ -22,8 +22,8 @@ from physgs.render.constants import (
     EPS2D,
     FOV_CLAMP_MARGIN,
     INV_ALPHA_MIN,
-    QUAT_NORM_EPS,
 )
+from physgs.rotations import quat_to_rotmat
 
 
 @dataclass(frozen=True)
@@ -42,36 +42,6 @@ class Projected:
     depths: torch.Tensor
     cov2d: torch.Tensor
     valid: torch.Tensor
-
-
-def quat_to_rotmat(quats: torch.Tensor) -> torch.Tensor:
-    """Rotation matrices of quaternions, normalised here.
-
-    The package's one torch implementation ([`physgs.models.gaussians`][] re-exports it; the numba
-    kernels have a scalar twin, ``kernels._quat_rotmat``). A zero quaternion gives the identity.
-
-    Args:
-        quats: [..., 4] quaternions (w, x, y, z), any norm.
-
-    Returns:
-        [..., 3, 3] rotation matrices, same dtype and device.
-    """
-    q = quats / quats.norm(dim=-1, keepdim=True).clamp_min(QUAT_NORM_EPS)
-    w, x, y, z = q.unbind(-1)
-    return torch.stack(
-        [
-            1 - 2 * (y * y + z * z),
-            2 * (x * y - w * z),
-            2 * (x * z + w * y),
-            2 * (x * y + w * z),
-            1 - 2 * (x * x + z * z),
-            2 * (y * z - w * x),
-            2 * (x * z - w * y),
-            2 * (y * z + w * x),
-            1 - 2 * (x * x + y * y),
-        ],
-        dim=-1,
-    ).reshape(q.shape[:-1] + (3, 3))
 
 
 def fov_clamp_limits(camera: Camera) -> tuple[float, float, float, float]:
