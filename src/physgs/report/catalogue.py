@@ -602,6 +602,7 @@ def markdown() -> str:
     head = [
         BEGIN,
         "",
+        "<!-- no verdict -->",  # thresholds and the paper's figures: the record states verdicts
         "| family | asked of, over | claim | threshold | reads | the paper | origin |",
         "|---|---|---|---|---|---|---|",
     ]

@@ -574,13 +574,16 @@ def ledger_lines(claims_csv: str | Path) -> list[str]:
         The Markdown lines.
     """
     claims = pd.read_csv(claims_csv, dtype={"config_hash": str})
-    kind = claims["verdict"].astype(str).str.split(":").str[0].value_counts()
+    kind = claims["verdict"].astype(str).str.split(":").str[0]
+    origin = origins(claims)
+    paper, own = kind[origin == "paper"], kind[origin == "project"]
+    story = story_line(claims)
     return [
-        f"The ledger holds {len(claims)} claims: {int(kind.get('holds', 0))} hold, "
-        f"{int(kind.get('fails', 0))} fail, {int(kind.get('undecided', 0))} undecided (95% "
-        "intervals over seeds). Each claim with the paper's value beside the measured one, its "
-        "threshold, verdict and the table cells it comes from: [the paper against the "
-        "measured](ledger.md).",
+        f"The ledger holds the paper's {len(paper)} claims: {_counted(paper)}; and this "
+        f"project's own {len(own)}: {_counted(own)} (95% intervals over seeds). Each claim with "
+        "the paper's value beside the measured one, its threshold, verdict and the table cells "
+        "it comes from: [the paper against the measured](ledger.md).",
+        *(["", story[2:]] if story else []),
     ]
 
 
