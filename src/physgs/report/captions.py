@@ -15,6 +15,8 @@ import re
 from collections.abc import Sequence
 from dataclasses import dataclass
 
+from physgs.report.outputs import OUTPUTS
+
 
 @dataclass(frozen=True)
 class Caption:
@@ -189,8 +191,6 @@ def scope(caption: Caption) -> str:
     Returns:
         The output's declared scope, or ``SCOPES``' for a figure drawn outside the outputs.
     """
-    from physgs.report.outputs import OUTPUTS
-
     if caption.pattern in OUTPUTS:
         return OUTPUTS[caption.pattern].seeds
     return SCOPES.get(caption.pattern, SCOPES_DEFAULT)

@@ -8,12 +8,14 @@ so nothing needs a display.
 
 from __future__ import annotations
 
+import textwrap
 from pathlib import Path
 from typing import Mapping, Sequence
 
 import matplotlib
 
 matplotlib.use("Agg")
+
 import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
 import pandas as pd  # noqa: E402
@@ -21,8 +23,7 @@ from matplotlib.ticker import LogLocator, NullFormatter, ScalarFormatter  # noqa
 
 from physgs.atomic import atomic_path  # noqa: E402
 from physgs.models.registry import MODEL_NAMES as MODELS  # noqa: E402
-from physgs.models.registry import REFERENCE_NAMES  # noqa: E402
-from physgs.models.registry import label, spec_of  # noqa: E402
+from physgs.models.registry import REFERENCE_NAMES, label, spec_of  # noqa: E402
 from physgs.report.tables import condition_label  # noqa: E402
 
 COLORS = {
@@ -261,7 +262,6 @@ def fig_teaser(
     panels = [("Ground truth", first.gt_px[tip])] + [
         (label(m), trajectories[m].pred_px[tip]) for m in models
     ]
-    import textwrap
 
     fig = plt.figure(figsize=(PAGE_WIDTH_IN, PAGE_WIDTH_IN / len(panels) + 4.2))
     gs = fig.add_gridspec(2, 2 * len(panels), height_ratios=[1.0, 1.1])
@@ -341,8 +341,6 @@ def fig_results(
     Raises:
         KeyError: when a panel has no image.
     """
-    import textwrap
-
     side = PAGE_WIDTH_IN / (len(columns) + 0.3)  # one panel, inches; the row labels beside
     fig, axes = plt.subplots(
         len(rows),

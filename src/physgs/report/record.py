@@ -31,7 +31,7 @@ import numpy as np
 import pandas as pd
 from PIL import Image
 
-from physgs.report import catalogue, rerun
+from physgs.report import captions, catalogue, rerun
 
 #: The commands whose cost the README states, keyed as ``tools/timed.py --name`` records them.
 COMMANDS: tuple[tuple[str, str], ...] = (
@@ -474,8 +474,6 @@ def render_pages(record_dir: str | Path) -> list[Path]:
     Raises:
         KeyError: naming a figure without a caption (``physgs.report.captions``).
     """
-    from physgs.report import captions
-
     out = Path(record_dir)
     stamp = Stamp(**json.loads((out / "stamp.json").read_text()))
     written: list[Path] = []
