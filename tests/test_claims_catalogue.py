@@ -115,3 +115,46 @@ def test_a_new_family_is_one_entry(monkeypatch):
     )
     assert "`fits_window_strictly` (headline)" in catalogue.markdown()
     assert "tab_fit" in catalogue.required_tables()
+
+
+def test_moving_a_family_to_another_table_is_its_table_field(monkeypatch):
+    """The scopes read only the family's own table: the 2D-track control's rows read from a
+    table of another name give the same claims when the entries name that table."""
+    import dataclasses
+
+    import pandas as pd
+
+    from physgs.report import claims
+
+    rows = pd.DataFrame(
+        [
+            dict(
+                seed=s,
+                tree="sparse",
+                config="joint32",
+                method=m,
+                K=32,
+                trained_median_rel_err_pct=e + 0.1 * s,
+                null_median_rel_err_pct=5.0,
+            )
+            for s in range(3)
+            for m, e in (("ours", 2.0), ("tracks", 1.5))
+        ]
+    )
+
+    def tracks(tables):
+        got = claims.ledger(claims.measure(tables, {}, ["sparse"])).set_index("id")
+        return got.loc[["tracks_beats_null/sparse", "tracks_match_ours/sparse"]]
+
+    before = tracks({"tab_null": rows})
+    moved = tuple(
+        dataclasses.replace(s, table="tab_other") if s.family.startswith("tracks_") else s
+        for s in CATALOGUE
+    )
+    monkeypatch.setattr(catalogue, "CATALOGUE", moved)
+    monkeypatch.setattr(claims, "CATALOGUE", moved)
+    after = tracks({"tab_null": rows[rows.method == "ours"], "tab_other": rows})
+    cols = ["measured", "ci_low", "ci_high", "verdict"]
+    pd.testing.assert_frame_equal(before[cols], after[cols])
+    assert after["source"].str.startswith("tab_other").all()
+    assert "tab_other" in catalogue.tables()

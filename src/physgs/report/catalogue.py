@@ -59,7 +59,7 @@ class ClaimSpec:
         unit: the value's unit (``"ratio"``: its interval is taken on the log scale).
         text: the claim's sentence (``str.format`` fields: the cell's, ``name`` of the prior,
             ``WORDS``).
-        source: where it is measured (same fields).
+        source: where it is measured (same fields, and ``table``).
         paper: the paper's figure, or a function of the cell giving it.
         origin: ``"paper"`` or ``"project"`` (``ORIGINS``).
         headline: the words the README tells the family with; "" when it is not a headline.
@@ -274,7 +274,7 @@ CATALOGUE: tuple[ClaimSpec, ...] = (
         "null_factor", "ours", "null_trees_sparse", "tab_null", "null_over_trained",
         "NULL_FACTOR", ">", "ratio",
         "{tree}: ... by the paper's factor of {NULL_FACTOR:g}",
-        "tab_null, {config}: null / trained",
+        "{table}, {config}: null / trained",
         _paper_null_ratio,
         headline="ours beats the untrained null by the paper's factor on frequency",
     ),
@@ -282,7 +282,7 @@ CATALOGUE: tuple[ClaimSpec, ...] = (
         "null_loses", "ours", "null_trees_sparse", "tab_null", "null_over_trained",
         "RATIO_EVEN", ">", "ratio",
         "{tree}: joint training beats the untrained null",
-        "tab_null, {config}: null / trained median rel. error",
+        "{table}, {config}: null / trained median rel. error",
         _paper_null_ratio,
     ),
     ClaimSpec(
@@ -290,7 +290,7 @@ CATALOGUE: tuple[ClaimSpec, ...] = (
         "-NULL_MATCH_PP", ">", "points",
         "{tree}: the untrained null matches the trained model (it is not beaten by "
         "{NULL_MATCH_PP} points or more)",
-        "tab_null, {config}: trained - null median rel. error (points)",
+        "{table}, {config}: trained - null median rel. error (points)",
         _paper_null_difference,
         headline="the untrained null matches ours on frequency",
     ),
@@ -364,7 +364,7 @@ CATALOGUE: tuple[ClaimSpec, ...] = (
         "-NULL_MATCH_PP", "<", "points",
         "{tree}: the {name} beats the untrained null on frequency recovery (by "
         "{NULL_MATCH_PP} points or more)",
-        "tab_null, {config}: trained - null median rel. error (points)",
+        "{table}, {config}: trained - null median rel. error (points)",
         origin="project",
     ),
     ClaimSpec(
@@ -388,7 +388,7 @@ CATALOGUE: tuple[ClaimSpec, ...] = (
         "anemometer_needed", "ours", "blind_trees", "tab_null", "blind_minus_wind",
         "EVEN", ">", "pp",
         "{tree}: without the measured wind (a learned forcing) {who} recovers omega worse",
-        "tab_null, {config}: {blind} - {wind} median rel. error (points)",
+        "{table}, {config}: {blind} - {wind} median rel. error (points)",
         "the paper's closing limit: 'real footage needs an anemometer'",
         origin="project",
         headline="without the anemometer (a learned forcing), ours' frequency error grows "
@@ -400,7 +400,7 @@ CATALOGUE: tuple[ClaimSpec, ...] = (
         "RATIO_EVEN", ">", "ratio",
         "{tree}: output-only modal analysis of the video recovers omega better than the "
         "untrained null",
-        "tab_null, {config}: null / output-only median rel. error",
+        "{table}, {config}: null / output-only median rel. error",
         "not run",
         origin="project",
         headline="output-only modal analysis of the video beats the untrained null",
@@ -441,7 +441,7 @@ CATALOGUE: tuple[ClaimSpec, ...] = (
         "tracks_beats_null", "ours", "tracks_sparse", "tab_null", "null_over_trained",
         "RATIO_EVEN", ">", "ratio",
         "{tree}: oscillators fitted to 2D tracks recover omega better than the untrained null",
-        "tab_null, 2D tracks {config}: null / tracks median rel. error",
+        "{table}, 2D tracks {config}: null / tracks median rel. error",
         TRACKS_PROPOSAL,
         origin="project",
         optional=True,
@@ -451,7 +451,7 @@ CATALOGUE: tuple[ClaimSpec, ...] = (
         "NULL_MATCH_PP", "<", "points",
         "{tree}: oscillators fitted to 2D tracks match ours' omega recovery (ours does not "
         "beat them by {NULL_MATCH_PP} points or more)",
-        "tab_null, {config}: 2D tracks - ours median rel. error (points)",
+        "{table}, {config}: 2D tracks - ours median rel. error (points)",
         TRACKS_PROPOSAL,
         origin="project",
         optional=True,
@@ -567,7 +567,7 @@ def origin_of(claim_id: str) -> str:
     raise ValueError(f"claim {claim_id!r}: no family {fam!r} in the catalogue")
 
 
-def _template(text: str) -> str:
+def _template(text: str, table: str = "") -> str:
     """A sentence template as the claims page shows it: thresholds filled in, the cell's fields
     as ``<field>``."""
     out = []
@@ -579,6 +579,8 @@ def _template(text: str) -> str:
             out.append(format(WORDS[field], spec or ""))
         elif field == "name":
             out.append("<prior>")
+        elif field == "table":
+            out.append(table)
         else:
             out.append(f"<{field}>")
     return "".join(out)
@@ -621,7 +623,7 @@ def markdown() -> str:
             over,
             _template(s.text),
             f"{s.side} {sign}`{thr}` = {s.value:g} {s.unit}",
-            f"{_template(s.source)}{' (optional)' if s.optional else ''}",
+            f"{_template(s.source, s.table)}{' (optional)' if s.optional else ''}",
             figure,
             s.origin,
         ]

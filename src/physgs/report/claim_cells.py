@@ -3,7 +3,8 @@ measured: what a claim family ranges over (its *scope*: the cells of the ledger 
 the run's trees, the priors of the registry and what the tables hold) and how one seed's value
 is read from one seed's rows of its table (its *reader*).
 
-A scope takes the [`Run`][physgs.report.claim_cells.Run] and returns its cells: one dict per
+A scope takes the [`Run`][physgs.report.claim_cells.Run] (and reads only the family's own table,
+``Run.own``: moving a family to another table is its entry's ``table``) and returns its cells: one dict per
 claim, with ``suffix`` (the claim id after the family, "" for none), the fields its sentence
 and its reader use (``tree``, ``config``, ``method``, ...) and, where the id is not the asked
 prior's, ``prefix``. A reader takes one seed's rows and a cell and returns a float, NaN where
@@ -46,12 +47,19 @@ class Run:
         trees: the run's trees.
         model: the prior the claim is asked of (``ours``, or another prior of the registry).
         others: the priors other than ours that the run's tables hold.
+        table: the family's table (``ClaimSpec.table``): the one its scope reads.
     """
 
     tables: Mapping[str, pd.DataFrame]
     trees: Sequence[str]
     model: str = "ours"
     others: tuple[str, ...] = ()
+    table: str = ""
+
+    @property
+    def own(self) -> pd.DataFrame | None:
+        """The family's table, None where the run did not make it."""
+        return self.tables.get(self.table)
 
 
 def fields() -> tuple[str, ...]:
@@ -121,7 +129,7 @@ def _gap_trees(run: Run) -> list[Cell]:
 
 def _recovered_trees(run: Run) -> list[Cell]:
     """each tree with the asked prior's recovery records (joint K = 32)"""
-    rec = run.tables.get(RECOVERY)
+    rec = run.own
     if rec is None:
         return []
     have = set(rec.loc[rec["model"] == run.model, "tree"])
@@ -149,7 +157,7 @@ def _splits(run: Run) -> list[Cell]:
 
 def _winds_beyond(run: Run) -> list[Cell]:
     """each tree x unseen wind of tab_transfer, beyond the window"""
-    tr = run.tables.get("tab_transfer")
+    tr = run.own
     if tr is None:
         return []
     beyond = tr[tr["split"] == "beyond"] if "split" in tr.columns else tr
@@ -161,7 +169,7 @@ def _winds_beyond(run: Run) -> list[Cell]:
 
 def _winds(run: Run) -> list[Cell]:
     """each split (training timestamps, beyond the window) x tree x unseen wind of tab_transfer"""
-    tr = run.tables.get("tab_transfer")
+    tr = run.own
     if tr is None:
         return []
     where = {"beyond": "beyond the window"}
@@ -180,7 +188,7 @@ def _winds(run: Run) -> list[Cell]:
 
 def _margin_trees(run: Run) -> list[Cell]:
     """each tree, tab_margin's first and last wind"""
-    mg = run.tables.get("tab_margin")
+    mg = run.own
     cols = [c for c in mg.columns if c.startswith("margin_")] if mg is not None else []
     first, last = (cols[0], cols[-1]) if cols else ("first", "last")
     return [{**c, "first": first, "last": last} for c in _trees(run)]
@@ -202,7 +210,7 @@ def _null_trees_dense(run: Run) -> list[Cell]:
 
 
 def _parts(run: Run) -> tuple[pd.DataFrame | None, set, str]:
-    df = run.tables.get("tab_parts")
+    df = run.own
     if df is None or df.empty:
         return None, set(), ""
     return df, set(df["model"]), str(df["config"].iloc[0])
@@ -233,7 +241,7 @@ def _parts_coupling(run: Run) -> list[Cell]:
 def _tracks_sparse(run: Run) -> list[Cell]:
     """the sparse tree, the 2D-track control's recovery in joint K = 32 (else its first
     configuration)"""
-    null = run.tables.get("tab_null")
+    null = run.own
     if null is None or "method" not in null.columns or "sparse" not in run.trees:
         return []
     cfgs = list(dict.fromkeys(null.loc[null["method"] == "tracks", "config"]))
@@ -245,7 +253,7 @@ def _tracks_sparse(run: Run) -> list[Cell]:
 
 def _tracks_trees(run: Run) -> list[Cell]:
     """each tree in tab_tracks, its base configuration (else its first)"""
-    tr = run.tables.get("tab_tracks")
+    tr = run.own
     if tr is None:
         return []
     tc = list(dict.fromkeys(tr["config"]))
@@ -258,7 +266,7 @@ def _tracks_trees(run: Run) -> list[Cell]:
 def _blind_trees(run: Run) -> list[Cell]:
     """each forcing-free prior in tab_null x each tree, against the prior whose measured wind it
     replaces (ids ``<prior>/...`` for a prior other than ours)"""
-    null = run.tables.get("tab_null")
+    null = run.own
     if null is None or "method" not in null.columns:
         return []
     have, out = set(null["method"]), []
@@ -282,7 +290,7 @@ def _blind_trees(run: Run) -> list[Cell]:
 
 def _oma_sparse(run: Run) -> list[Cell]:
     """the sparse tree, when tab_null holds the output-only analysis"""
-    null = run.tables.get("tab_null")
+    null = run.own
     if null is None or "method" not in null.columns or OMA not in set(null["method"]):
         return []
     return [{**c, "config": BLIND_CONFIG, "method": OMA} for c in _sparse(run)]
@@ -290,7 +298,7 @@ def _oma_sparse(run: Run) -> list[Cell]:
 
 def _oma_damping_trees(run: Run) -> list[Cell]:
     """each tree of tab_damping, when it holds the output-only analysis"""
-    dmp = run.tables.get("tab_damping")
+    dmp = run.own
     if dmp is None or "method" not in dmp.columns or OMA not in set(dmp["method"]):
         return []
     return [{**c, "config": BLIND_CONFIG} for c in _trees(run) if (dmp["tree"] == c["tree"]).any()]

@@ -183,8 +183,8 @@ def measure(
             continue
         seeds = _per_seed(tabs[spec.table]) if spec.table in tabs else []
         for model in ("ours",) if spec.of == "ours" else others:
-            for cell in spec.cells(Run(tabs, trees, model, others)):
-                cell = {"model": model, "name": label(model), **cell}
+            for cell in spec.cells(Run(tabs, trees, model, others, spec.table)):
+                cell = {"model": model, "name": label(model), "table": spec.table, **cell}
                 cid = spec.claim_id(cell)
                 claim = Claim(
                     cid,
