@@ -416,6 +416,26 @@ CATALOGUE: tuple[ClaimSpec, ...] = (
         origin="project",
         optional=True,
     ),
+    ClaimSpec(
+        "oma_frequency_interval_covers", "ours", "oma_interval_trees", "tab_damping",
+        "oma_omega_cover", "INTERVAL_COVER", ">", "fraction",
+        "{tree} (damping testbed): the output-only analysis' 95% intervals for omega hold the "
+        "matched bone's true omega on at least {INTERVAL_COVER:.0%} of its trusted parts",
+        "{table}, {config}: output-only omega_interval_cover",
+        "not in the paper (this project's)",
+        origin="project",
+        optional=True,
+    ),
+    ClaimSpec(
+        "oma_damping_interval_covers", "ours", "oma_interval_trees", "tab_damping",
+        "oma_zeta_cover", "INTERVAL_COVER", ">", "fraction",
+        "{tree} (damping testbed): the output-only analysis' 95% intervals for zeta hold the "
+        "matched bone's true zeta on at least {INTERVAL_COVER:.0%} of its trusted parts",
+        "{table}, {config}: output-only zeta_interval_cover",
+        "not in the paper (this project's)",
+        origin="project",
+        optional=True,
+    ),
     # this project's: the paper's two hypotheses about its prior (section 6), tested
     ClaimSpec(
         "topology_parts_reduce_damping_error", "ours", "parts_damping_trees", "tab_parts",

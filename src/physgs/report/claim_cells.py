@@ -304,6 +304,14 @@ def _oma_damping_trees(run: Run) -> list[Cell]:
     return [{**c, "config": BLIND_CONFIG} for c in _trees(run) if (dmp["tree"] == c["tree"]).any()]
 
 
+def _oma_interval_trees(run: Run) -> list[Cell]:
+    """each tree of tab_damping, when it holds the output-only analysis' interval coverage"""
+    dmp = run.own
+    if dmp is None or "omega_interval_cover" not in dmp.columns:
+        return []
+    return _oma_damping_trees(run)
+
+
 # ---- readers: one seed's value ---------------------------------------------------------------
 def _best_field_minus_static(d: pd.DataFrame, c: Cell) -> float:
     """tab_psnr, time column: max over learned fields of (model - static)"""
@@ -431,13 +439,26 @@ def _blind_minus_wind(d: pd.DataFrame, c: Cell) -> float:
 
 def _oma_zeta_gain(d: pd.DataFrame, c: Cell) -> float:
     """tab_damping (damping testbed): output-only - null median zeta error (points)"""
-    row = (
+    return value(d, _oma_damping_row(d, c), "trained_minus_null_pp")
+
+
+def _oma_damping_row(d: pd.DataFrame, c: Cell) -> pd.Series:
+    return (
         (d["testbed"] == DAMPING)
         & (d["tree"] == c["tree"])
         & (d["config"] == c["config"])
         & (d["method"] == OMA)
     )
-    return value(d, row, "trained_minus_null_pp")
+
+
+def _oma_omega_cover(d: pd.DataFrame, c: Cell) -> float:
+    """tab_damping (damping testbed): the output-only analysis' omega interval coverage"""
+    return value(d, _oma_damping_row(d, c), "omega_interval_cover")
+
+
+def _oma_zeta_cover(d: pd.DataFrame, c: Cell) -> float:
+    """tab_damping (damping testbed): the output-only analysis' zeta interval coverage"""
+    return value(d, _oma_damping_row(d, c), "zeta_interval_cover")
 
 
 #: A reader: one seed's rows and a cell -> the claim's value.
@@ -468,6 +489,7 @@ SCOPES: dict[str, Scope] = {
     "blind_trees": _blind_trees,
     "oma_sparse": _oma_sparse,
     "oma_damping_trees": _oma_damping_trees,
+    "oma_interval_trees": _oma_interval_trees,
 }
 #: The readers a catalogue entry names (``ClaimSpec.read``); each one's docstring says what it
 #: reads.
@@ -490,4 +512,6 @@ READERS: dict[str, Reader] = {
     "tracks_tail": _tracks_tail,
     "blind_minus_wind": _blind_minus_wind,
     "oma_zeta_gain": _oma_zeta_gain,
+    "oma_omega_cover": _oma_omega_cover,
+    "oma_zeta_cover": _oma_zeta_cover,
 }

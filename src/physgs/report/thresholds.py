@@ -12,6 +12,8 @@ NULL_MATCH_PP = 0.5
 GAP_RTOL = 0.25
 #: an opponent reaches this fraction of the true-motion ceiling's in-window gain over static.
 FIT_BAR = 0.5
+#: the output-only analysis' 95% intervals hold the truth on at least this share of its parts.
+INTERVAL_COVER = 0.8
 #: the paper's factor: the untrained null's median omega error over the trained model's.
 NULL_FACTOR = 2.5
 #: a ratio above this: the one above it is better (null / trained errors).
