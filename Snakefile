@@ -54,7 +54,7 @@ RUN = [
     rules.report.input,
     expand(TABLE, name="tab_kselect", ext=("tex", "csv")),
     rules.claims.output,
-    rules.oma.input,  # the stabilisation diagrams (the records are in tab_null / tab_damping)
+    rules.oma.input,  # the stabilisation diagrams (the records are in tab_recovery / tab_damping)
 ]
 
 
@@ -71,6 +71,7 @@ rule studies:
     input:
         rules.speed_accuracy.output,
         rules.fit_curve.output,
+        expand(FIGURE, name=("fig_speed_accuracy", "fig_fit_curve"), ext=("pdf", "png")),
         expand(TABLE, name="tab_parts_k", ext=("tex", "csv"))
         if "ours_chain" in PARTS_MODELS
         else [],

@@ -18,8 +18,9 @@ BLIND = (
 
 
 def _blind_claims(null, damping, trees):
-    """The forcing-free methods' claims of the ledger measured on tab_null (and tab_damping)."""
-    tabs = {"tab_null": null, **({"tab_damping": damping} if damping is not None else {})}
+    """The forcing-free methods' claims of the ledger measured on tab_recovery (and
+    tab_damping)."""
+    tabs = {"tab_recovery": null, **({"tab_damping": damping} if damping is not None else {})}
     return [(c, v) for c, v in claims.measure(tabs, {}, trees) if set(BLIND) & set(c.id.split("/"))]
 
 
@@ -97,7 +98,7 @@ def test_every_blind_prior_is_paired_with_a_prior_that_reads_the_wind():
 
 
 def test_each_blind_prior_gets_its_anemometer_claim_against_its_counterpart():
-    """tab_null rows of two winds' priors and their forcing-free variants: each variant's
+    """tab_recovery rows of two winds' priors and their forcing-free variants: each variant's
     claim is its error minus its own counterpart's, ours' under the old id, the chain's under
     its prefix (the catalogue's prefix convention)."""
     err = {  # median omega error (%) per seed

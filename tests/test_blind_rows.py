@@ -1,5 +1,5 @@
 """The forcing-free methods' rows: the output-only analysis and the forcing-free
-priors in tab_null and tab_damping, each in its own configurations beside the null of its own
+priors in tab_recovery and tab_damping, each in its own configurations beside the null of its own
 K, ours' and the other rows left as they were; the forcing-free priors in tab_fit with their
 undefined splits written as not defined; what the outputs read."""
 
@@ -9,7 +9,7 @@ import numpy as np
 import pandas as pd
 import pytest
 
-from physgs.models.registry import BLIND_PRIORS, label
+from physgs.models.registry import BLIND_PRIORS, label, recovery_label
 from physgs.report import build
 from physgs.report import tables as T
 from physgs.report.damping import tab_damping
@@ -37,23 +37,23 @@ def _methods(oma_null=0.10):
     }
     blind = {s: {("sparse", "single"): (record(1, 0.06), null(0.0456))} for s in SEEDS}
     return {
-        T.OMA: T.oma_rows({"single": "single (K=2)", "joint32": "joint (K=2)"}, oma),
-        "ours_blind": T.prior_rows("ours_blind", {"single": "single"}, blind),
+        T.OMA: T.method_rows(T.OMA, {"single": "single (K=2)", "joint32": "joint (K=2)"}, oma),
+        "ours_blind": T.method_rows("ours_blind", {"single": "single"}, blind),
     }
 
 
-def _tab_null(methods=None):
+def _tab_recovery(methods=None):
     rec, nl, tracks, chain = _null_inputs()
     priors = {
-        m: T.prior_rows(m, CONFIGS, paired(d, nl), T.NULL_PRIOR_NOTE)
+        m: T.method_rows(m, CONFIGS, paired(d, nl))
         for m, d in (("ours", rec), ("ours_chain", chain))
     }
-    rows = {**priors, T.TRACKS: T.tracks_rows({"single": "single"}, tracks, T.NULL_TRACKS_NOTE)}
-    return T.tab_null({**rows, **(methods or {})}, ["sparse"], BONES)
+    rows = {**priors, T.TRACKS: T.method_rows(T.TRACKS, {"single": "single"}, tracks)}
+    return T.tab_recovery({**rows, **(methods or {})}, ["sparse"], BONES)
 
 
-def test_tab_null_adds_the_forcing_free_rows_with_their_own_null():
-    tab = _tab_null(_methods())
+def test_tab_recovery_adds_the_forcing_free_rows_with_their_own_null():
+    tab = _tab_recovery(_methods())
     df = tab.df[tab.df.seed == 1]
     assert list(zip(df.method, df.config)) == [
         ("ours", "single"),
@@ -72,25 +72,25 @@ def test_tab_null_adds_the_forcing_free_rows_with_their_own_null():
     np.testing.assert_allclose(oma.trained_minus_null_pp, np.repeat([-8.0, -7.5, -7.0], 2))
     blind = tab.df[tab.df.method == "ours_blind"]
     np.testing.assert_allclose(blind.trained_minus_null_pp, 6.0 - 4.56)
-    assert rf"{T.OMA_LABEL}, joint (K=2)" in tab.tex
+    assert rf"{recovery_label(T.OMA)}, joint (K=2)" in tab.tex
     assert f"{label('ours_blind')}, single" in tab.tex
 
 
-def test_tab_null_leaves_the_other_rows_as_they_were():
-    before, after = _tab_null().df, _tab_null(_methods()).df
+def test_tab_recovery_leaves_the_other_rows_as_they_were():
+    before, after = _tab_recovery().df, _tab_recovery(_methods()).df
     kept = after[~after.method.isin([T.OMA, "ours_blind"])].reset_index(drop=True)
     pd.testing.assert_frame_equal(kept, before)
 
 
-def test_tab_null_refuses_a_method_row_without_its_record_or_with_another_k():
+def test_tab_recovery_refuses_a_method_row_without_its_record_or_with_another_k():
     methods = _methods()
     short = dataclasses.replace(methods[T.OMA], per_seed={s: {} for s in SEEDS})
     with pytest.raises(KeyError, match="oma"):
-        _tab_null({T.OMA: short})
+        _tab_recovery({T.OMA: short})
     rec2 = {s: {k: (r, dataclasses.replace(n, n_parts=2)) for k, (r, n) in v.items()}
             for s, v in methods[T.OMA].per_seed.items()}  # fmt: skip
     with pytest.raises(ValueError, match="K=2"):
-        _tab_null({T.OMA: dataclasses.replace(methods[T.OMA], per_seed=rec2)})
+        _tab_recovery({T.OMA: dataclasses.replace(methods[T.OMA], per_seed=rec2)})
 
 
 def test_tab_damping_adds_the_forcing_free_rows_with_their_own_scores():
@@ -109,10 +109,10 @@ def test_tab_damping_adds_the_forcing_free_rows_with_their_own_scores():
     blind = {s: {("sparse", v, "single"): damping_record(zb * 0.9, zb, s) for v in ("faithful", "damping")}
              for s in SEEDS}  # fmt: skip
     methods = {
-        T.OMA: T.oma_rows({"single": "single"}, oma),
-        "ours_blind": T.prior_rows("ours_blind", {"single": "single"}, blind),
+        T.OMA: T.method_rows(T.OMA, {"single": "single"}, oma, damping=True),
+        "ours_blind": T.method_rows("ours_blind", {"single": "single"}, blind, damping=True),
     }
-    mine = {"ours": T.prior_rows("ours", CONFIGS, ours)}
+    mine = {"ours": T.method_rows("ours", CONFIGS, ours, damping=True)}
     before = tab_damping(mine, ["sparse"], {"sparse": 22})
     tab = tab_damping({**mine, **methods}, ["sparse"], {"sparse": 22})
     d = tab.df[(tab.df.seed == 0) & (tab.df.testbed == "damping")]
@@ -121,7 +121,7 @@ def test_tab_damping_adds_the_forcing_free_rows_with_their_own_scores():
     np.testing.assert_allclose(tab.df[tab.df.method == "ours_blind"].rel_err_pct, 10.0, atol=1e-9)
     kept = tab.df[tab.df.method == "ours"].reset_index(drop=True)
     pd.testing.assert_frame_equal(kept, before.df)
-    assert rf"{T.OMA_LABEL}, single" in tab.tex and label("ours_blind") in tab.tex
+    assert rf"{recovery_label(T.OMA)}, single" in tab.tex and label("ours_blind") in tab.tex
 
 
 def test_tab_fit_writes_the_blind_priors_undefined_splits_as_not_defined(tmp_path):
@@ -159,26 +159,34 @@ PLAN = build.Plan(
     [0, 1],
     damping_trees=["sparse"],
     damping_configs=["single"],
-    oma={"single": 2, "joint32": 32},
-    blind=list(BLIND_PRIORS),
+    recovery={
+        "ours": {"single": 32, "joint32": 32},
+        "ours_chain": {"single": 32, "joint32": 32},
+        "oma": {"single": 2, "joint32": 32},
+        **{m: {"single": 32} for m in BLIND_PRIORS},
+    },
 )
 
 
-def test_tab_null_and_tab_damping_read_the_forcing_free_records_and_their_nulls():
-    needs = build.needs("tab_null", PLAN)
+def test_tab_recovery_and_tab_damping_read_the_forcing_free_records_and_their_nulls():
+    needs = build.needs("tab_recovery", PLAN)
     for c in ("single", "joint32"):
-        assert ("oma_recovery", "sparse", c, 1) in needs
+        assert ("recovery", "sparse", "oma", c, 1) in needs
     for m in BLIND_PRIORS:
-        assert ("prior_recovery", "sparse", m, "single", 0) in needs
-        assert not any(n[0] == "prior_recovery" and n[2] == m and n[3] != "single" for n in needs)
+        assert ("recovery", "sparse", m, "single", 0) in needs
+        assert not any(n[0] == "recovery" and n[2] == m and n[3] != "single" for n in needs)
     assert ("null", "sparse", 2, 1) in needs  # the analysis' own K
     damp = build.needs("tab_damping", PLAN)
     for tb in ("sparse", "sparse_damping"):
-        assert ("oma_recovery", tb, "single", 0) in damp
-        assert ("prior_recovery", tb, "ours_blind", "single", 0) in damp
-    assert not any(n[0] == "oma_recovery" and n[2] == "joint32" for n in damp)
-    bare = dataclasses.replace(PLAN, oma={}, blind=[])
-    assert not any(n[0] == "oma_recovery" for n in build.needs("tab_null", bare))
+        assert ("recovery", tb, "oma", "single", 0) in damp
+        assert ("recovery", tb, "ours_blind", "single", 0) in damp
+    assert not any(n[2] == "oma" and n[3] == "joint32" for n in damp)
+    # tab_null: the paper's rows alone (ours and the null of its K)
+    assert {n[2] for n in build.needs("tab_null", PLAN) if n[0] == "recovery"} == {"ours"}
+    assert ("null", "sparse", 2, 1) not in build.needs("tab_null", PLAN)
+    bare = dataclasses.replace(PLAN, recovery={m: PLAN.recovery[m] for m in ("ours", "ours_chain")})
+    assert not any(n[2] == "oma" for n in build.needs("tab_recovery", bare))
+    assert bare.blind == () and PLAN.blind == BLIND_PRIORS
     assert ("eval", "sparse", "ours_blind", "single", 1) in build.needs("tab_fit", PLAN)
     assert ("table", "tab_damping") in build.claims_needs(PLAN)
     assert ("table", "tab_damping") not in build.claims_needs(

@@ -66,6 +66,7 @@ def test_the_ledgers_tables_come_from_the_catalogue():
         "tab_transfer",
         "tab_margin",
         "tab_null",
+        "tab_recovery",
         "tab_testbed",
         "tab_fit",
     }
@@ -146,14 +147,14 @@ def test_moving_a_family_to_another_table_is_its_table_field(monkeypatch):
         got = claims.ledger(claims.measure(tables, {}, ["sparse"])).set_index("id")
         return got.loc[["tracks_beats_null/sparse", "tracks_match_ours/sparse"]]
 
-    before = tracks({"tab_null": rows})
+    before = tracks({"tab_recovery": rows})
     moved = tuple(
         dataclasses.replace(s, table="tab_other") if s.family.startswith("tracks_") else s
         for s in CATALOGUE
     )
     monkeypatch.setattr(catalogue, "CATALOGUE", moved)
     monkeypatch.setattr(claims, "CATALOGUE", moved)
-    after = tracks({"tab_null": rows[rows.method == "ours"], "tab_other": rows})
+    after = tracks({"tab_recovery": rows[rows.method == "ours"], "tab_other": rows})
     cols = ["measured", "ci_low", "ci_high", "verdict"]
     pd.testing.assert_frame_equal(before[cols], after[cols])
     assert after["source"].str.startswith("tab_other").all()

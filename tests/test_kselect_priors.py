@@ -223,7 +223,7 @@ def test_tab_kselect_reads_the_chains_selection_and_models():
     assert ("kselect", "sparse", 3) in got and ("prior_kselect", "sparse", "ours_chain", 3) in got
     for c in ("single", "auto"):
         assert ("eval", "sparse", "ours_chain", c, 3) in got
-        assert ("prior_recovery", "sparse", "ours_chain", c, 3) in got
+        assert ("recovery", "sparse", "ours_chain", c, 3) in got
         assert ("loss", "sparse", "ours_chain", c, 3) in got
-        assert ("prior_recovery", "sparse", "ours", c, 3) in got  # ours through every prior's kind
+        assert ("recovery", "sparse", "ours", c, 3) in got  # ours through every prior's kind
     assert not any(n[0] == "prior_kselect" for n in needs("tab_kselect", Plan(["sparse"], {}, [3])))

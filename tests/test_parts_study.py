@@ -146,10 +146,10 @@ def test_parts_needs_read_every_prior_and_no_damping_where_none_is_built():
         parts_configs=single,
     )
     got = needs("tab_parts", plan)
-    assert ("prior_recovery", "sparse", "ours_chain", "single", 1) in got
-    assert ("prior_recovery", "medium_damping", "ours", "single", 0) in got
+    assert ("recovery", "sparse", "ours_chain", "single", 1) in got
+    assert ("recovery", "medium_damping", "ours", "single", 0) in got
     assert not any(
-        n[:2] in {("prior_recovery", t) for t in ("sparse_damping", "dense_damping")} for n in got
+        n[:2] in {("recovery", t) for t in ("sparse_damping", "dense_damping")} for n in got
     )
     assert ("eval", "sparse", "truth_motion", "single", 0) in got
     assert ("parts", "medium", 1) in got and ("null", "medium", 32, 0) in got

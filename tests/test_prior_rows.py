@@ -6,6 +6,7 @@ import numpy as np
 import pandas as pd
 import pytest
 
+from physgs.experiments.recipe import canonical
 from physgs.models.registry import MODELS, label, models_of, training_jobs
 from physgs.report import build
 from physgs.report import claims as C
@@ -38,37 +39,40 @@ def test_every_output_that_reads_ours_reads_every_prior():
     """ours is one prior among the registry's: no output reads it by a need kind of its own."""
     from physgs.report.outputs import NEED_FIELDS
 
-    assert "recovery" not in NEED_FIELDS  # ours' records are read as every prior's
+    # one need kind serves every recovery method: ours' records are read as every prior's
+    assert [k for k in NEED_FIELDS if "recovery" in k] == ["recovery"]
     for name in ("tab_psnr", "tab_transfer", "tab_margin", "fig_temporal", "fig_results"):
         got = {n[2] for n in build.needs(name, PLAN) if n[0] == "eval"}
         assert {"ours", "ours_chain"} <= got, name
-    for name in ("tab_null", "tab_damping", "fig_damping"):
-        got = {n[2] for n in build.needs(name, PLAN) if n[0] == "prior_recovery"}
+    for name in ("tab_recovery", "tab_damping", "fig_damping"):
+        got = {n[2] for n in build.needs(name, PLAN) if n[0] == "recovery"}
         assert got == {"ours", "ours_chain"}, name
+    # tab_null is the paper's table: ours alone
+    assert {n[2] for n in build.needs("tab_null", PLAN) if n[0] == "recovery"} == {"ours"}
     assert ("loss", "sparse", "ours_chain", "single", 1) in build.needs("tab_fit", PLAN)
     assert ("traj", "sparse", "ours_chain", "single", 0) in build.needs("fig_teaser", PLAN)
 
 
 def test_recovery_outputs_read_the_chained_prior_in_every_configuration_and_testbed():
-    null_needs = build.needs("tab_null", PLAN)
+    null_needs = build.needs("tab_recovery", PLAN)
     for c in CONFIGS:
-        assert ("prior_recovery", "sparse", "ours_chain", c, 1) in null_needs
+        assert ("recovery", "sparse", "ours_chain", c, 1) in null_needs
     assert ("null", "sparse", 96, 0) in null_needs  # its K's null, shared with ours'
     assert not any(n[0] == "null" and n[2] not in (32, 96) for n in null_needs)
     damp = build.needs("tab_damping", PLAN)
     for tb in ("sparse", "sparse_damping"):
         for c in ("single", "joint32"):
-            assert ("prior_recovery", tb, "ours_chain", c, 0) in damp
-    assert not any(n[0] == "prior_recovery" and n[3] == "joint96" for n in damp)
+            assert ("recovery", tb, "ours_chain", c, 0) in damp
+    assert not any(n[0] == "recovery" and n[3] == "joint96" for n in damp)
     ledger = build.claims_needs(build.Plan(["sparse"], CONFIGS, [0, 1]))
-    assert ("prior_recovery", "sparse", "ours_chain", "joint32", 1) in ledger
+    assert ("recovery", "sparse", "ours_chain", "joint32", 1) in ledger
 
 
 # --- its rows ----------------------------------------------------------------------------------
 def _priors(ours, chain, nl, configs):
-    """tab_null's methods: ours and the chained prior, each beside the null of its K."""
+    """tab_recovery's methods: ours and the chained prior, each beside the null of its K."""
     return {
-        m: T.prior_rows(m, configs, paired(per_seed, nl), T.NULL_PRIOR_NOTE)
+        m: T.method_rows(m, configs, paired(per_seed, nl))
         for m, per_seed in (("ours", ours), ("ours_chain", chain))
     }
 
@@ -78,7 +82,7 @@ def test_tab_null_sets_each_prior_beside_the_null_of_its_k():
     rec = {s: {("sparse", c): record(3, 0.03) for c in configs} for s in (0, 1, 2)}
     chain = {s: {("sparse", c): record(4, 0.010 + 0.001 * s) for c in configs} for s in (0, 1, 2)}
     nl = {s: {("sparse", c): null(0.0456) for c in configs} for s in (0, 1, 2)}
-    tab = T.tab_null(_priors(rec, chain, nl, configs), ["sparse"], BONES)
+    tab = T.tab_recovery(_priors(rec, chain, nl, configs), ["sparse"], BONES)
     df = tab.df[tab.df.seed == 1]
     assert list(df.method) == ["ours", "ours", "ours_chain", "ours_chain"]
     mine = df[df.method == "ours_chain"]
@@ -87,50 +91,56 @@ def test_tab_null_sets_each_prior_beside_the_null_of_its_k():
     np.testing.assert_allclose(df[df.method == "ours"].trained_median_rel_err_pct, [3.0, 3.0])
     assert f"{label('ours_chain')}, joint96" in tab.tex
     with pytest.raises(KeyError, match="ours_chain"):
-        T.tab_null(_priors(rec, {0: {}}, nl, configs), ["sparse"], BONES)
+        T.tab_recovery(_priors(rec, {0: {}}, nl, configs), ["sparse"], BONES)
 
 
-def test_a_prior_added_to_the_registry_gets_tab_null_rows_through_its_entry_alone(
+def test_a_prior_added_to_the_registry_gets_recovery_rows_through_its_entries_alone(
     tmp_path, monkeypatch
 ):
-    """A new model of role "prior" (its registry entry, nothing else) is read and scored by
-    tab_null beside ours, against the null of its K."""
+    """A new model of role "prior" (its registry entry and its entry in the list of recovery
+    methods, nothing else) is read and scored by tab_recovery beside ours, against the null of
+    its K; tab_null stays the paper's."""
     from physgs.models import registry
     from physgs.recovery.record import save_null, save_recovery
     from physgs.report.outputs import key
 
     spec = registry.ModelSpec("A new prior", "New", "ours", True, "prior")
-    monkeypatch.setitem(registry.MODELS, "ours_new", spec)
+    monkeypatch.setitem(registry.MODELS, "new_prior", spec)
+    new = registry.RecoveryMethod(None, "recovery", note="a note.")
+    monkeypatch.setitem(registry.RECOVERY_METHODS, "new_prior", new)
     cfg = {
         "trees": ["sparse"],
         "presets": {"sparse": {"bones": 22}},
         "seeds": [0, 1],
-        "report": {"tab_null": {"digits": 2}},
+        "report": {"tab_recovery": {"digits": 2}},
         "models": {"configs": {"joint32": {"K": 4, "conditions": "all"}}},
         "tracks": {"configs": []},
         "oma": {"configs": []},
     }
     plan = build.Plan(["sparse"], cfg["models"]["configs"], [0, 1])
-    err = {"ours": 0.03, "ours_chain": 0.02, "ours_new": 0.012}  # each prior's median error
+    err = {"ours": 0.03, "ours_chain": 0.02, "new_prior": 0.012}  # each prior's median error
     inputs = {}
-    for need in build.needs("tab_null", plan):
+    assert {n[2] for n in build.needs("tab_null", plan) if n[0] == "recovery"} == {"ours"}
+    for need in build.needs("tab_recovery", plan):
         path = tmp_path / (key(need).replace("/", "_") + ".json")
         if need[0] == "null":
             save_null(path, null(0.0456))
         else:
-            assert need[0] == "prior_recovery", need
+            assert need[0] == "recovery", need
             save_recovery(path, record(3, err[need[2]]))
         inputs[key(need)] = str(path)
-    assert {k.split("/")[2] for k in inputs if k.startswith("prior_recovery")} == set(err)
-    settings = build.settings_for("tab_null", cfg)
-    tab = build.make_table("tab_null", inputs, settings, tmp_path / "n.tex", tmp_path / "n.csv")
+    assert {k.split("/")[2] for k in inputs if k.startswith("recovery")} == set(err)
+    # the rule's params arrive with their keys sorted (recipe.canonical): rows keep the list's order
+    settings = canonical(build.settings_for("tab_recovery", cfg))
+    assert list(settings["methods"]) == ["new_prior", "ours", "ours_chain"]  # sorted
+    tab = build.make_table("tab_recovery", inputs, settings, tmp_path / "n.tex", tmp_path / "n.csv")
     df = tab.df[tab.df.seed == 1]
-    assert list(df.method) == ["ours", "ours_chain", "ours_new"]
-    new = df[df.method == "ours_new"]
+    assert list(df.method) == ["ours", "ours_chain", "new_prior"]
+    new = df[df.method == "new_prior"]
     # trained 1.2 %, the null of its K 4.56 %: by hand
     np.testing.assert_allclose(new.trained_median_rel_err_pct, 1.2)
     np.testing.assert_allclose(new.trained_minus_null_pp, 1.2 - 4.56)
-    assert "A new prior, joint ($K{=}4$)" in tab.tex
+    assert "A new prior, joint ($K{=}4$)" in tab.tex and " A new prior: a note." in tab.tex
 
 
 # --- its claims --------------------------------------------------------------------------------
@@ -149,7 +159,7 @@ def _tables(ahead: float, seeds=(0, 1, 2)):
             psnr.append(
                 {
                     "seed": s,
-                    "model": label(m),
+                    "model": m,
                     "sparse_view": base + jitter,
                     "sparse_time": base + jitter,
                 }
@@ -191,7 +201,8 @@ def _tables(ahead: float, seeds=(0, 1, 2)):
         "tab_psnr": pd.DataFrame(psnr),
         "tab_transfer": pd.DataFrame(transfer),
         "tab_margin": pd.DataFrame(margin),
-        "tab_null": pd.DataFrame(null_rows),
+        "tab_null": pd.DataFrame([r for r in null_rows if r["method"] == "ours"]),
+        "tab_recovery": pd.DataFrame(null_rows),
     }
 
 
@@ -239,7 +250,7 @@ def test_ours_claims_read_ours_rows_only_and_the_chain_joins_the_ledger():
         k: d[d.get("method", d.get("model", pd.Series("x", d.index))) != "ours_chain"]
         for k, d in tabs.items()
     }
-    old["tab_psnr"] = tabs["tab_psnr"][tabs["tab_psnr"].model != label("ours_chain")]
+    old["tab_psnr"] = tabs["tab_psnr"][tabs["tab_psnr"].model != "ours_chain"]
     old["tab_transfer"] = tabs["tab_transfer"].drop(columns="ours_chain")
     assert not any(i.startswith("ours_chain/") for i in C.ledger(C.measure(old, {}, ["sparse"])).id)
 
@@ -264,7 +275,10 @@ def test_tab_damping_sets_each_prior_beside_ours_on_both_testbeds():
     configs = {"a": "A", "b": "B"}
 
     def methods(chain):
-        return {m: T.prior_rows(m, configs, d) for m, d in (("ours", ours), ("ours_chain", chain))}
+        return {
+            m: T.method_rows(m, configs, d, damping=True)
+            for m, d in (("ours", ours), ("ours_chain", chain))
+        }
 
     tab = tab_damping(methods(chain), ["sparse"], {"sparse": 22})
     df = tab.df

@@ -11,14 +11,14 @@ from physgs.recovery.damping_scores import DampingNull, DampingScores, damping_n
 from physgs.recovery.matcher import MatchResult
 from physgs.recovery.record import RecoveryRecord, load_recovery, save_recovery
 from physgs.report.damping import tab_damping
-from physgs.report.tables import prior_rows, write_table
+from physgs.report.tables import method_rows, write_table
 
 CONFIGS = {"single": "single", "joint32": "joint"}
 
 
 def ours(per_seed, configs=CONFIGS):
     """tab_damping's methods holding ours' rows alone."""
-    return {"ours": prior_rows("ours", configs, per_seed)}
+    return {"ours": method_rows("ours", configs, per_seed, damping=True)}
 
 
 def _record(zeta_hat, zeta_bones, seed):

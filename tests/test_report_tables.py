@@ -76,7 +76,7 @@ def test_one_seed_tab_psnr_agrees_and_bolds_nothing(tmp_path):
     cols = ["sparse_view", "sparse_time", "medium_view", "medium_time"]
     assert list(tab.df.columns) == ["seed", "model", *cols, "difference"]
     n = len(T.MODELS)  # the paper's five and its prior, and this project's chained prior
-    assert list(tab.df.model[:n]) == [T.label(m) for m in T.MODELS] and n == 7
+    assert list(tab.df.model[:n]) == list(T.MODELS) and n == 7  # ids; labels in the .tex
     T.write_table(tab, tmp_path / "t.tex", tmp_path / "t.csv")
     csv = pd.read_csv(tmp_path / "t.csv")
     rows = tex_rows((tmp_path / "t.tex").read_text())
@@ -87,7 +87,7 @@ def test_one_seed_tab_psnr_agrees_and_bolds_nothing(tmp_path):
     S = per_seed(1)[0]
     best_view = max(S[("sparse", m)]["view"] for m in ("mlp", "mlp_wind", "d3dgs", "d3dgs_wind"))
     for i, p in ((n, "ours"), (n + 2, "ours_chain")):  # each prior: - static, - best field
-        assert csv.loc[i, "model"] == f"{T.label(p)} - {T.label('static')}"
+        assert csv.loc[i, "model"] == f"{p}-static" and csv.loc[i + 1, "model"] == f"{p}-best_field"
         p_static = S[("medium", p)]["time"] - S[("medium", "static")]["time"]
         assert csv.loc[i, "medium_time"] == pytest.approx(p_static)
         assert csv.loc[i + 1, "sparse_view"] == pytest.approx(S[("sparse", p)]["view"] - best_view)
@@ -98,7 +98,7 @@ def test_seeds_give_mean_sd_and_a_decided_best(tmp_path):
     data = per_seed(4, noise=0.05)
     tab = T.tab_psnr(data, TREES, BONES)
     assert sorted(tab.df.seed.unique()) == [0, 1, 2, 3] and len(tab.df) == 4 * 11
-    ours = tab.df[tab.df.model == T.label("ours")]["medium_time"].to_numpy()
+    ours = tab.df[tab.df.model == "ours"]["medium_time"].to_numpy()
     m, sd = ours.mean(), ours.std(ddof=1)  # independent of the module: numpy
     assert f"{m:.2f} $\\pm$ {sd:.2f}" in tab.tex
     # ours is 31 + shift + noise on every seed: ~5 dB above every other model, paired -> bold
@@ -235,7 +235,7 @@ def paired(rec, nl):
 
 def ours(rec, nl, configs):
     """tab_null's methods holding ours' rows alone."""
-    return {"ours": T.prior_rows("ours", configs, paired(rec, nl))}
+    return {"ours": T.method_rows("ours", configs, paired(rec, nl))}
 
 
 def test_tab_null_per_seed_difference_and_nan_cells(tmp_path):

@@ -1,5 +1,5 @@
 """The 2D-track control as a method of the pipeline: its config, its files, its rows in
-tab_null / tab_damping, tab_tracks, its ledger claims, what its outputs read, and its rules' plan
+tab_recovery / tab_damping, tab_tracks, its ledger claims, what its outputs read, and its rules' plan
 (the tracker and the fit never read truth.npz)."""
 
 from __future__ import annotations
@@ -21,7 +21,7 @@ from physgs.recovery.null import NullResult
 from physgs.recovery.record import RecoveryRecord, load_recovery
 from physgs.report import build, claims, thresholds
 from physgs.report import tables as T
-from physgs.report.damping import TRACKS_NOTE, tab_damping
+from physgs.report.damping import tab_damping
 from physgs.report.tracks import tab_tracks
 from physgs.tracks import settings as tsettings
 from oracles import quick_config
@@ -233,7 +233,7 @@ def _null(err, K=4):
     )
 
 
-def test_tab_null_adds_the_tracks_rows_after_ours_and_leaves_ours_rows_as_they_were():
+def test_tab_recovery_adds_the_tracks_rows_after_ours_and_leaves_ours_rows_as_they_were():
     cfg = {"single": "single", "joint32": "joint"}
     rec = {s: {(t, c): _record(0.02 + 0.001 * s) for t in BONES for c in cfg} for s in (0, 1)}
     nl = {s: {(t, c): _null(0.05) for t in BONES for c in cfg} for s in (0, 1)}
@@ -242,8 +242,8 @@ def test_tab_null_adds_the_tracks_rows_after_ours_and_leaves_ours_rows_as_they_w
         for s in (0, 1)
     }
     plain = T.tab_null(ours_rows(rec, nl, cfg), list(BONES), BONES).df
-    both = T.tab_null(
-        {**ours_rows(rec, nl, cfg), "tracks": T.tracks_rows({"joint32": "j2"}, tracks, "")},
+    both = T.tab_recovery(
+        {**ours_rows(rec, nl, cfg), "tracks": T.method_rows("tracks", {"joint32": "j2"}, tracks)},
         list(BONES),
         BONES,
     )
@@ -267,10 +267,10 @@ def test_tab_null_adds_the_tracks_rows_after_ours_and_leaves_ours_rows_as_they_w
     assert r"\emph{2D tracks}, j2" in both.tex
     bad = {0: {(t, "joint32"): (_record(0.03, K=2), _null(0.06, K=4)) for t in BONES}}
     with pytest.raises(ValueError, match="K=4 but the model has K=2"):
-        T.tab_null(
+        T.tab_recovery(
             {
                 **ours_rows({0: rec[0]}, {0: nl[0]}, cfg),
-                "tracks": T.tracks_rows({"joint32": "j"}, bad, ""),
+                "tracks": T.method_rows("tracks", {"joint32": "j"}, bad),
             },
             list(BONES),
             BONES,
@@ -300,8 +300,8 @@ def test_tab_damping_adds_the_tracks_rows_with_their_own_scores():
         for s in (0, 1)
     }
     methods = {
-        "ours": T.prior_rows("ours", {"a": "A", "b": "B"}, ours),
-        "tracks": T.tracks_rows({"a": "A"}, mine, TRACKS_NOTE),
+        "ours": T.method_rows("ours", {"a": "A", "b": "B"}, ours, damping=True),
+        "tracks": T.method_rows("tracks", {"a": "A"}, mine, damping=True),
     }
     tab = tab_damping(methods, ["sparse"], {"sparse": 22})
     df = tab.df
@@ -316,7 +316,7 @@ def test_tab_damping_adds_the_tracks_rows_with_their_own_scores():
     }
     with pytest.raises(ValueError, match="tracks control"):
         tab_damping(
-            {**methods, "tracks": T.tracks_rows({"a": "A"}, none, TRACKS_NOTE)},
+            {**methods, "tracks": T.method_rows("tracks", {"a": "A"}, none, damping=True)},
             ["sparse"],
             {"sparse": 22},
         )
@@ -506,7 +506,11 @@ def test_ours_claims_read_ours_rows_of_a_table_with_tracks_rows():
 def test_needs_of_the_tracks_outputs():
     def plan(configs, seeds, fields=()):
         return build.Plan(
-            ["sparse"], {"single": {"K": 32}}, seeds, tracks=configs, tracks_fields=fields
+            ["sparse"],
+            {"single": {"K": 32}},
+            seeds,
+            recovery={"ours": {"single": 32}, **({"tracks": configs} if configs else {})},
+            tracks_fields=fields,
         )
 
     assert build.needs("tab_tracks", plan({"single": 2, "joint32": 2}, [0, 1])) == [
@@ -530,23 +534,25 @@ def test_needs_of_the_tracks_outputs():
         ("tracks", "sparse", 0, 5),
         ("tracks_fit", "sparse", "joint32", 5),
     ]
-    null = build.needs("tab_null", plan({"single": 2}, [0]))
-    assert ("tracks_recovery", "sparse", "single", 0) in null
+    null = build.needs("tab_recovery", plan({"single": 2}, [0]))
+    assert ("recovery", "sparse", "tracks", "single", 0) in null
     assert ("null", "sparse", 2, 0) in null and ("null", "sparse", 32, 0) in null
-    assert not any(n[0].startswith("tracks") for n in build.needs("tab_null", plan({}, [0])))
+    # tab_null is the paper's: ours and the null of its K, never the control's
+    paper = build.needs("tab_null", plan({"single": 2}, [0]))
+    assert not any("tracks" in n for n in paper) and ("null", "sparse", 2, 0) not in paper
     damp = build.needs(
         "tab_damping",
         build.Plan(
             ["sparse"],
             {"single": {"K": 32}, "joint32": {"K": 32}},
             [0],
-            tracks={"joint32": 2},
+            recovery={"ours": {"single": 32, "joint32": 32}, "tracks": {"joint32": 2}},
             damping_trees=["sparse"],
             damping_configs=["single", "joint32"],
         ),
     )
-    assert ("tracks_recovery", "sparse_damping", "joint32", 0) in damp
-    assert not any(n[0] == "tracks_recovery" and n[2] == "single" for n in damp)
+    assert ("recovery", "sparse_damping", "tracks", "joint32", 0) in damp
+    assert not any(n[2] == "tracks" and n[3] == "single" for n in damp)
     assert ("table", "tab_tracks") in build.claims_needs(plan({"single": 2}, [0]))
     assert ("table", "tab_tracks") not in build.claims_needs(plan({}, [0]))
     # a run without the control builds neither of its outputs (fig_tracks: without parts)
@@ -562,7 +568,8 @@ def test_settings_of_the_tracks_outputs_are_narrow():
     s = build.settings_for("tab_tracks", cfg)
     assert set(s["configs"]) == set(cfg["tracks"]["configs"])
     assert s["configs"]["single"]["label"] == "single ($K{=}2$)"  # the control's own K
-    assert build.settings_for("tab_null", cfg)["tracks"]["joint32"]["K"] == 2
+    assert build.settings_for("tab_recovery", cfg)["methods"]["tracks"]["joint32"]["K"] == 2
+    assert set(build.settings_for("tab_null", cfg)["methods"]) == {"ours"}
     assert build.settings_for("fig_tracks", cfg)["seeds"] == [cfg["seeds"][0]]
     assert "tracks" not in build.settings_for("tab_psnr", cfg)
 
@@ -572,7 +579,7 @@ def test_settings_of_the_tracks_outputs_are_narrow():
 
 @pytest.fixture(scope="module")
 def plan():
-    """One quick dry run of tab_tracks, fig_tracks and tab_null from an empty results folder (a
+    """One quick dry run of tab_tracks, fig_tracks and tab_recovery from an empty results folder (a
     scratch copy of the workflow)."""
     import tempfile
     from pathlib import Path
@@ -594,7 +601,7 @@ def plan():
                 "--",
                 "results/tables/tab_tracks.tex",
                 "results/figures/fig_tracks.png",
-                "results/tables/tab_null.tex",
+                "results/tables/tab_recovery.tex",
             ],
             cwd=wd,
             capture_output=True,
@@ -663,8 +670,8 @@ def test_the_learned_fields_are_scored_beside_ours_where_they_are_trained(plan):
     assert "fields_single.json" in table and "fields_joint32.json" not in table
 
 
-def test_tab_null_pairs_the_tracks_rows_with_the_null_of_their_k(plan):
-    table = [b for b in _blocks(plan, "table") if "tab_null" in b][0]
+def test_tab_recovery_pairs_the_tracks_rows_with_the_null_of_their_k(plan):
+    table = [b for b in _blocks(plan, "table") if "tab_recovery" in b][0]
     assert "results/recovery/sparse/seed0/tracks_joint32.json" in table
     assert "results/recovery/sparse/seed0/null_K2.json" in table  # quick: tracks/K = 2
     assert "rule fit_tracks" in plan and "rule tracks_evaluate" in plan

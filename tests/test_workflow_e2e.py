@@ -24,15 +24,7 @@ QUICK = pconfig.resolve(yaml.safe_load((ROOT / "config" / "trees.yaml").read_tex
 TREES = ["sparse"]
 # the quick profile builds no damping testbed (its 2.5 s window cannot hold a calm): no tab_damping
 BUILT = [n for n in TABLES if n != "tab_damping" or QUICK["damping_benchmark"]["trees"]]
-MODELS = [
-    "Static pose",
-    "Deformation MLP",
-    "Deformation MLP + wind",
-    "Deformable-3DGS",
-    "Deformable-3DGS + wind",
-    "Ours",
-    "Chained prior (this project)",
-]
+MODELS = ["static", "mlp", "mlp_wind", "d3dgs", "d3dgs_wind", "ours", "ours_chain"]
 
 
 @pytest.fixture
@@ -66,14 +58,15 @@ def test_every_output_exists(run):
 
 def test_tab_psnr_rows_columns_and_finite(run):
     df = _csv(run, "tab_psnr")
-    # the models, the reference, then each prior's two paired differences; one seed
+    # the models, the reference, then each prior's two paired differences; one seed; ids (the
+    # labels are the .tex's)
     assert list(df["model"]) == [
         *MODELS,
-        "True motion (ceiling)",
-        "Ours - Static pose",
-        "Ours - best learned field",
-        "Chained prior (this project) - Static pose",
-        "Chained prior (this project) - best learned field",
+        "truth_motion",
+        "ours-static",
+        "ours-best_field",
+        "ours_chain-static",
+        "ours_chain-best_field",
     ]
     assert list(df["reference"]) == [False] * len(MODELS) + [True] + [False] * 4
     assert list(df["difference"]) == [False] * (len(MODELS) + 1) + [True] * 4
@@ -83,9 +76,10 @@ def test_tab_psnr_rows_columns_and_finite(run):
     vals = df.loc[~df["difference"], cols].to_numpy(float)
     assert np.isfinite(vals).all() and (vals > 5).all() and (vals < 60).all()
     diff = df.loc[df["difference"], cols].to_numpy(float)
-    ours, static = (df.loc[df["model"] == m, cols].to_numpy(float) for m in ("Ours", "Static pose"))
+    ours, static = (df.loc[df["model"] == m, cols].to_numpy(float) for m in ("ours", "static"))
     np.testing.assert_allclose(diff[0], (ours - static)[0], atol=1e-4)
     tex = (run / "results" / "tables" / "tab_psnr.tex").read_text()
+    assert "Chained prior (this project) $-$ best learned field" in tex
     # one seed: no interval, so no best is decided and nothing is bold
     assert r"\toprule" in tex and r"\bottomrule" in tex and r"\textbf{" not in tex
 
@@ -119,8 +113,21 @@ def test_tab_margin_is_ours_minus_mlp_wind(run):
         assert row["margin_v0"] == pytest.approx(ours["train_c0"] - base["train_c0"], abs=1e-4)
 
 
-def test_tab_null_rows_columns_and_finite_where_defined(run):
+def test_tab_null_holds_the_papers_rows_alone(run):
+    """tab_null: ours in every configuration beside the null of the same K (the paper's)."""
     df = _csv(run, "tab_null")
+    configs = list(QUICK["models"]["configs"])
+    assert list(df["method"]) == ["ours"] * len(TREES) * len(configs)
+    assert sorted(df["config"]) == sorted(configs * len(TREES))
+    want_k = df["config"].map(lambda c: QUICK["models"]["configs"][c]["K"])
+    assert (df["K"] == want_k).all()  # each beside the null of the same K
+    rec = _csv(run, "tab_recovery")
+    mine = rec[rec["method"] == "ours"].reset_index(drop=True)
+    pd.testing.assert_frame_equal(df, mine)  # the same rows in both tables
+
+
+def test_tab_recovery_rows_columns_and_finite_where_defined(run):
+    df = _csv(run, "tab_recovery")
     configs = list(QUICK["models"]["configs"])
     from physgs.models.registry import BLIND_PRIORS
 
@@ -215,10 +222,8 @@ def test_speed_accuracy_csv(run):
 
 
 def test_tab_null_plan_trains_ours_only():
-    """`snakemake results/tables/tab_null.tex` must train no baseline: the priors only (and the
-    forcing-free priors, whose rows it holds)."""
-    from physgs.models.registry import BLIND_PRIORS
-
+    """`snakemake results/tables/tab_null.tex` trains ours alone (the paper's table) and runs no
+    other recovery method (tab_recovery's)."""
     import tempfile
     from pathlib import Path
 
@@ -229,8 +234,10 @@ def test_tab_null_plan_trains_ours_only():
         ).stdout
     trained = re.findall(r"results/models/\w+/seed\d+/(\w+?)_(single|joint32|joint96)\.pt", out)
     assert trained, "the plan trains nothing"
-    assert {m for m, _ in trained} == {"ours", "ours_chain", *BLIND_PRIORS}
+    assert {m for m, _ in trained} == {"ours"}
     assert "rule evaluate:" not in out
+    for rule in ("track", "fit_tracks", "tracks_evaluate", "oma_identify", "oma_recovery"):
+        assert f"rule {rule}:" not in out, rule
 
 
 def test_snakemake_report_collects_tables_and_figures(run, tmp_path):

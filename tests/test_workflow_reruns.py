@@ -93,7 +93,8 @@ def test_an_unchanged_config_plans_nothing(plans):
 def test_sweep_knobs_plan_no_training(plans):
     plan = _counts(plans["sweep_K"])
     # a study: `all` and its summary do not wait for it
-    assert plan == {"speed_accuracy_point": 1, "speed_accuracy": 1, "studies": 1}, plan
+    # the sweep's CSV, and fig_speed_accuracy drawn from it by the generic figure rule
+    assert plan == {"speed_accuracy_point": 1, "speed_accuracy": 1, "figure": 1, "studies": 1}, plan
 
 
 def test_mlp_width_and_search_retrain_their_own_models_only(plans):
@@ -124,17 +125,17 @@ def test_table_format_rebuilds_that_table_only(plans):
 
 @pytest.fixture(scope="module")
 def fresh_recovery_plan(tmp_path_factory) -> str:
-    """The dry-run plan of tab_null and tab_damping from an empty results folder (default
+    """The dry-run plan of tab_recovery and tab_damping from an empty results folder (default
     profile, one seed): one dry run that the recovery rows' plan tests share."""
     from workflow_helpers import workflow_copy
 
     wd = workflow_copy(tmp_path_factory.mktemp("fresh"))
-    targets = ["results/tables/tab_null.tex", "results/tables/tab_damping.tex"]
+    targets = ["results/tables/tab_recovery.tex", "results/tables/tab_damping.tex"]
     return snakemake(wd, "-n", "--cores", "2", *targets, "--config", "seeds=[0]").stdout
 
 
 def test_the_chained_priors_rows_plan_its_own_jobs_only(fresh_recovery_plan):
-    """tab_null reads the chained prior's recovery in every configuration, tab_damping on both
+    """tab_recovery reads the chained prior's recovery in every configuration, tab_damping on both
     testbeds of the damping benchmark's configurations: a fresh plan trains and scores it there,
     and evaluates it in the base configuration only (no table reads a joint evaluation)."""
     out = fresh_recovery_plan
@@ -152,7 +153,7 @@ def test_the_chained_priors_rows_plan_its_own_jobs_only(fresh_recovery_plan):
 
 
 def test_the_forcing_free_rows_plan_their_jobs(fresh_recovery_plan):
-    """tab_null and tab_damping read the output-only analysis in each of ``oma.configs`` and the
+    """tab_recovery and tab_damping read the output-only analysis in each of ``oma.configs`` and the
     forcing-free priors in ``single`` only, on every tree and on the damping testbeds of the
     damping benchmark's configurations: a fresh plan identifies, trains and scores them there,
     with the null of the analysis' own K."""
@@ -233,7 +234,7 @@ def test_tracks_fit_settings_refit_the_tracks_control_only(plans):
         "fit_tracks": 1,  # one job fits (and one scores) both configurations
         "tracks_evaluate": 1,
         "tracks_fields": 1,  # the learned fields at the tracks of single
-        "table": 2,  # tab_null (its tracks rows) and tab_tracks
+        "table": 2,  # tab_recovery (its tracks rows) and tab_tracks
         "figure": 1,  # fig_tracks colours the tracks by the fit's parts
         "claims": 1,
         "summary": 1,

@@ -37,7 +37,7 @@ def main() -> None:
     needs = build.claims_needs(plan, every=True)
     paths = {  # the workflow's layout (common.smk: TABLE, RECOVERY)
         "table": "tables/{name}.csv",
-        "prior_recovery": "recovery/{tree}/seed{seed}/{model}_{config}.json",
+        "recovery": "recovery/{tree}/seed{seed}/{method}_{config}.json",
     }
     inputs = {}
     for need in needs:

@@ -66,7 +66,10 @@ LOSS = "results/models/{tree}/seed{seed}/{model}_{config}.loss.csv"
 EVAL = "results/eval/{tree}/seed{seed}/{model}_{config}.npz"
 TRAJ = "results/eval/{tree}/seed{seed}/{model}_{config}.traj.npz"
 PANELS = "results/eval/{tree}/seed{seed}/{model}_{config}.panels.npz"
-RECOVERY = "results/recovery/{tree}/seed{seed}/{model}_{config}.json"  # any oscillator prior
+# any recovery method's record (physgs.models.registry.RECOVERY_METHODS: the priors, the
+# forcing-free priors, the 2D-track control, the output-only analysis), ours' format; the rule
+# of each method's entry writes it (recovery_record)
+RECOVERY = "results/recovery/{tree}/seed{seed}/{method}_{config}.json"
 PARTS_RECORD = "results/parts/{tree}/seed{seed}.npz"  # the priors' segmentations and purity
 KMATCH = "results/parts/{tree}/seed{seed}_chain_K{K}.json"  # the chained prior at a smaller K
 NULL = "results/recovery/{tree}/seed{seed}/null_K{K}.json"
@@ -84,12 +87,10 @@ TRACKS = "results/tracks/{tree}/c{condition}.npz"
 SEEDED_TRACKS = "results/tracks/{tree}/seed{seed}/c{condition}.npz"
 TRACKS_FIT = "results/tracks/{tree}/seed{seed}/fit_{config}.npz"
 TRACKS_EVAL = "results/tracks/{tree}/seed{seed}/eval_{config}.json"
-TRACKS_RECOVERY = RECOVERY.replace("{model}", "tracks")  # ours' record format, beside ours'
 TRACKS_FIELDS = "results/tracks/{tree}/seed{seed}/fields_{config}.json"  # the fields at the tracks
-# output-only modal analysis: the modes of the training video (observed only), its recovery record
-# (ours' format, beside ours') and each tree's stabilisation diagram
+# output-only modal analysis: the modes of the training video (observed only) and each tree's
+# stabilisation diagram (its recovery record: RECOVERY)
 OMA_MODES = "results/oma/{tree}/seed{seed}/modes_{config}.npz"
-OMA_RECOVERY = RECOVERY.replace("{model}", "oma")
 OMA_FIGURE = "results/figures/fig_stabilisation_{tree}.png"
 #: need kind (physgs.report.build.needs) -> path template
 NEED_PATHS = {
@@ -97,7 +98,7 @@ NEED_PATHS = {
     "traj": TRAJ,
     "panels": PANELS,
     "loss": LOSS,
-    "prior_recovery": RECOVERY,
+    "recovery": RECOVERY,
     "parts": PARTS_RECORD,
     "kmatch": KMATCH,
     "null": NULL,
@@ -105,8 +106,6 @@ NEED_PATHS = {
     "prior_kselect": PRIOR_KSELECT,
     "stats": STATS,
     "table": TABLE.replace("{ext}", "csv"),
-    "tracks_recovery": TRACKS_RECOVERY,
-    "oma_recovery": OMA_RECOVERY,
     "tracks_eval": TRACKS_EVAL,
     "tracks_fields": TRACKS_FIELDS,
     "tracks_fit": TRACKS_FIT,
@@ -124,6 +123,8 @@ FC_PROFILE_MODELS = ["static", *FC["models"], *_models.REFERENCE_NAMES]
 wildcard_constraints:
     tree="|".join(TESTBEDS),
     model="|".join([*_models.MODEL_NAMES, *_models.PRIOR_VARIANT_NAMES, *_models.REFERENCE_NAMES]),
+    # a recovery method's id (registry.RECOVERY_METHODS) or a parts-study variant's (tab_parts)
+    method="|".join(dict.fromkeys([*_models.RECOVERY_METHOD_NAMES, *_models.PRIOR_VARIANT_NAMES])),
     config="|".join([*CONFIGS, _models.AUTO_CONFIG]),
     K=r"\d+",
     point="|".join(SWEEP_POINTS),
@@ -134,6 +135,19 @@ wildcard_constraints:
 
 
 # ---- input functions ----------------------------------------------------------------------
+def recovery_record(method):
+    """The record template of one recovery method ({tree}, {seed}, {config} left to the job),
+    checked against the rule its entry names (physgs.models.registry.RECOVERY_METHODS)."""
+    return RECOVERY.replace("{method}", method)
+
+
+def recovery_ckpt(wildcards):
+    """The checkpoint whose recovery rule ``recovery`` scores (a trained prior)."""
+    return CKPT.format(
+        tree=wildcards.tree, seed=wildcards.seed, model=wildcards.method, config=wildcards.config
+    )
+
+
 def testbed_files(tree, seed):
     """{observed, truth, stats} paths of the instance training seed ``seed`` reads: the tree's
     one instance, or with testbed_seeds the instance built with testbed seed ``seed``."""
@@ -227,16 +241,6 @@ def sweep_inputs(wildcards):
     """The sweep tree's dataset for this seed's points."""
     f = testbed_files(SA_TREE, wildcards.seed)
     return {"observed": f["observed"], "truth": f["truth"]}
-
-
-def sweep_collect_inputs(wildcards):
-    """Every sweep point of every seed, and the untrained null of the sweep tree at the
-    profile's K per seed (the chance level the recovery panel draws)."""
-    k = int(CONFIGS[_models.BASE_CONFIG]["K"])
-    return {
-        "points": expand(SWEEP_POINT, seed=STUDY_SEEDS, point=SWEEP_POINTS),
-        "nulls": expand(NULL, tree=SA_TREE, seed=STUDY_SEEDS, K=k),
-    }
 
 
 def fit_point_params(wildcards):

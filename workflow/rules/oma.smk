@@ -31,7 +31,7 @@ rule oma_recovery:
     input:
         unpack(oma_recovery_inputs),
     output:
-        record=OMA_RECOVERY,
+        record=recovery_record("oma"),
     log:
         "logs/oma/{tree}/seed{seed}/recovery_{config}.log",
     benchmark:
@@ -70,8 +70,9 @@ rule fig_stabilisation:
         "../scripts/oma_figure.py"
 
 
-# every record and figure of the analysis (part of `all`; tab_null and tab_damping read the records)
+# every record and figure of the analysis (part of `all`; tab_recovery and tab_damping read the
+# records)
 rule oma:
     input:
-        expand(OMA_RECOVERY, tree=TESTBEDS, seed=SEEDS, config=OMA_CONFIGS),
+        expand(recovery_record("oma"), tree=TESTBEDS, seed=SEEDS, config=OMA_CONFIGS),
         expand(OMA_FIGURE, tree=TREES) if OMA_CONFIGS else [],

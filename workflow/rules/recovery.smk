@@ -6,16 +6,18 @@
 
 rule recovery:
     input:
-        ckpt=CKPT,
+        ckpt=recovery_ckpt,
         observed=observed_input,
         truth=truth_input,
         stats=stats_input,
     output:
         record=RECOVERY,
     log:
-        "logs/recovery/{tree}/seed{seed}/{model}_{config}.log",
+        "logs/recovery/{tree}/seed{seed}/{method}_{config}.log",
     wildcard_constraints:
-        model="|".join(
+        # a trained prior's record: the recovery methods whose entry names this rule
+        # (registry.RECOVERY_METHODS) and the parts study's variants (tab_parts)
+        method="|".join(
             m for m in (*_models.MODEL_NAMES, *_models.PRIOR_VARIANT_NAMES) if _models.is_prior(m)
         ),
     conda:

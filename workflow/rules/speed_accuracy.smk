@@ -23,13 +23,14 @@ rule speed_accuracy_point:
         "../scripts/speed_accuracy_point.py"
 
 
+# the sweep's points in one CSV; fig_speed_accuracy (physgs.report.outputs.trade) draws it
 rule speed_accuracy:
     input:
-        unpack(sweep_collect_inputs),
+        points=expand(SWEEP_POINT, seed=STUDY_SEEDS, point=SWEEP_POINTS),
     output:
-        csv=report("results/tables/speed_accuracy.csv", category="4. Speed-accuracy trade"),
-        pdf="results/figures/fig_speed_accuracy.pdf",
-        png=report("results/figures/fig_speed_accuracy.png", category="4. Speed-accuracy trade"),
+        csv=report(
+            TABLE.format(name="speed_accuracy", ext="csv"), category="4. Speed-accuracy trade"
+        ),
     log:
         "logs/speed_accuracy/collect.log",
     conda:
@@ -80,13 +81,12 @@ use rule fit_curve_point as fit_curve_window_point with:
         series=lambda wc: wc.model + _fit_curve.WINDOW_SERIES,
 
 
+# the fit curve's points in one CSV; fig_fit_curve (physgs.report.outputs.trade) draws it
 rule fit_curve:
     input:
         unpack(fit_curve_inputs),
     output:
-        csv=report("results/tables/fit_curve.csv", category="4. Speed-accuracy trade"),
-        pdf="results/figures/fig_fit_curve.pdf",
-        png=report("results/figures/fig_fit_curve.png", category="4. Speed-accuracy trade"),
+        csv=report(TABLE.format(name="fit_curve", ext="csv"), category="4. Speed-accuracy trade"),
     log:
         "logs/fit_curve/collect.log",
     conda:

@@ -83,7 +83,7 @@ rule tracks_evaluate:
         unpack(tracks_evaluate_inputs),
     output:
         scores=tracks_outputs(TRACKS_EVAL, TRACKS_CONFIGS),
-        records=tracks_outputs(TRACKS_RECOVERY, TRACKS_CONFIGS),
+        records=tracks_outputs(recovery_record("tracks"), TRACKS_CONFIGS),
     log:
         "logs/tracks/{tree}/seed{seed}/eval.log",
     benchmark:
@@ -107,7 +107,7 @@ rule tracks_evaluate:
 use rule tracks_evaluate as tracks_evaluate_damping with:
     output:
         scores=tracks_outputs(TRACKS_EVAL, TRACKS_DAMPING_CONFIGS),
-        records=tracks_outputs(TRACKS_RECOVERY, TRACKS_DAMPING_CONFIGS),
+        records=tracks_outputs(recovery_record("tracks"), TRACKS_DAMPING_CONFIGS),
     wildcard_constraints:
         tree="|".join(DAMPING_TREES) or "(?!x)x",
         config="|".join(TRACKS_DAMPING_CONFIGS) or "(?!x)x",

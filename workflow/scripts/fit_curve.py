@@ -1,11 +1,10 @@
-"""Snakemake script of rule `fit_curve`: the fit curve's CSV and fig_fit_curve."""
+"""Snakemake script of rule `fit_curve`: the fit curve's CSV (fig_fit_curve: rule figure)."""
 
 from physgs.atomic import atomic_path
 from physgs.experiments.fit_curve import ceiling_fraction, collect
 from physgs.intermediate import read_json
 from physgs.jobs import job
 from physgs.report.build import fit_row
-from physgs.report.figures import fig_fit_curve
 
 sm = snakemake  # noqa: F821 (injected by Snakemake)
 p = sm.params
@@ -24,5 +23,4 @@ with job(sm) as log:
     df["of_ceiling"] = ceiling_fraction(df)
     with atomic_path(sm.output.csv) as tmp:
         df.to_csv(tmp, index=False, float_format="%.6g")
-    fig_fit_curve(df, [sm.output.pdf, sm.output.png])
     print(df.to_string(), file=log)

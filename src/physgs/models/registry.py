@@ -167,6 +167,147 @@ def blind_priors(configs: Iterable[str]) -> tuple[str, ...]:
     return BLIND_PRIORS if BLIND_CONFIG in configs else ()
 
 
+@dataclass(frozen=True)
+class RecoveryMethod:
+    """One method that recovers omega and zeta, scored on recovery against the untrained null of
+    its K (tab_null, tab_recovery, tab_damping). Its record is ``results/recovery/<testbed>/
+    seed<seed>/<id>_<config>.json`` (ours' format, ``physgs.recovery.record``), written by the
+    workflow rule ``rule``: adding a method is one entry here plus the rules that write it.
+
+    label: its rows' LaTeX name; None: the model's registry label (``label``); "": none, its
+    rows are labelled by their configuration alone (ours: the paper's). rule: the workflow rule
+    that writes its record. section: the config section that lists its configurations and K
+    (``<section>.configs`` and ``<section>.K``: ``same`` for each configuration's own K, or an
+    integer); None: a trained prior, in the configurations it is trained in (``configs_for``),
+    each with its K. note: its sentence in the recovery tables' captions, after '<label>: '
+    ("" none). damping_note: tab_damping's sentence, where it differs (None: ``note``). paper:
+    the paper's method (tab_null's rows)."""
+
+    label: str | None
+    rule: str
+    section: str | None = None
+    note: str = ""
+    damping_note: str | None = None
+    paper: bool = False
+
+
+#: the caption sentence of a prior beside ours (scored like ours)
+_PRIOR_NOTE = (
+    r"the same scoring of its own parts, beside the null of its $K$ (a null depends on $K$ only)."
+)
+#: the caption sentence of a forcing-free prior (``BLIND_PRIORS``)
+_BLIND_NOTE = (
+    "the measured wind replaced by a forcing learned from the training video (trained "
+    r"in its configuration only), beside the null of its $K$."
+)
+#: The one list of recovery methods; order = row order of every recovery table.
+RECOVERY_METHODS: dict[str, RecoveryMethod] = {
+    "ours": RecoveryMethod("", "recovery", paper=True),
+    "ours_chain": RecoveryMethod(None, "recovery", note=_PRIOR_NOTE, damping_note=""),
+    # the 2D-track control (physgs.tracks): ours' oscillators fitted to point tracks
+    "tracks": RecoveryMethod(
+        r"\emph{2D tracks}",
+        "tracks_evaluate",
+        section="tracks",
+        note=(
+            r"the same oscillators fitted to point tracks of the training "
+            r"video (no renderer), matched and trusted by the same rule, beside the null of its "
+            r"$K$; a part with too few tracks has no estimate and is never trusted."
+        ),
+        damping_note=(
+            r"the same oscillators fitted to point tracks of the training "
+            r"video (no renderer), scored on its own matching against its own null draw."
+        ),
+    ),
+    # the output-only modal analysis of the training video (physgs.oma)
+    "oma": RecoveryMethod(
+        r"\emph{Output-only (SSI)}",
+        "oma_recovery",
+        section="oma",
+        note=(
+            r"modes identified from the training video alone (dense flow, SSI-cov; "
+            r"no wind, no renderer), each assigned to a part by its shape, matched and trusted by "
+            r"the same rule, beside the null of its $K$. Its seeds resample only the $k$-means of "
+            r"image cells into parts (the same video, so the same modes, at every seed): its seed "
+            r"intervals understate what another tree instance would do. The CSV gives the "
+            r"coverage of its modes' 95\% intervals ($\pm1.96\sigma$) over the trusted parts and "
+            r"the parts its own rule keeps (relative $\sigma_\zeta\le1/1.96$)."
+        ),
+    ),
+    **{m: RecoveryMethod(None, "recovery", note=_BLIND_NOTE) for m in BLIND_PRIORS},
+}
+RECOVERY_METHOD_NAMES = tuple(RECOVERY_METHODS)
+#: ``<section>.K`` value meaning "the configuration's own K" (``models.configs.<c>.K``)
+SAME_K = "same"
+
+
+def section_k(cfg: dict, section: str, config: str) -> int:
+    """K of a method with a config section of its own (``tracks``, ``oma``) in ``config``.
+
+    Args:
+        cfg: the resolved config.
+        section: the method's config section (``RecoveryMethod.section``).
+        config: a configuration name of ``models.configs``.
+
+    Returns:
+        ``<section>.K``, or the configuration's own K where that is ``same`` (or absent).
+    """
+    k = cfg[section].get("K", SAME_K)
+    return int(cfg["models"]["configs"][config]["K"]) if k == SAME_K else int(k)
+
+
+def recovery_configs(method: str, cfg: dict) -> dict[str, int]:
+    """The configurations a recovery method runs in, each with its K.
+
+    Args:
+        method: a recovery method's id (``RECOVERY_METHODS``).
+        cfg: the resolved config (``models.configs`` and the method's section).
+
+    Returns:
+        configuration -> K, in the order its section (or ``models.configs``) lists them; {} when
+            it runs in none.
+
+    Raises:
+        ValueError: for an id not in ``RECOVERY_METHODS``.
+    """
+    if method not in RECOVERY_METHODS:
+        raise ValueError(
+            f"unknown recovery method {method!r}; choose one of {RECOVERY_METHOD_NAMES}"
+        )
+    mc = cfg["models"]["configs"]
+    section = RECOVERY_METHODS[method].section
+    if section is None:
+        return {c: int(mc[c]["K"]) for c in configs_for(method, mc) if c in mc}
+    return {c: section_k(cfg, section, c) for c in cfg[section]["configs"]}
+
+
+def recovery_plan(cfg: dict) -> dict[str, dict[str, int]]:
+    """Every recovery method the run scores, with its configurations and their K.
+
+    Args:
+        cfg: the resolved config.
+
+    Returns:
+        method id -> ``recovery_configs``, in ``RECOVERY_METHODS`` order; a method that runs in
+            no configuration is left out.
+    """
+    out = {m: recovery_configs(m, cfg) for m in RECOVERY_METHODS}
+    return {m: v for m, v in out.items() if v}
+
+
+def recovery_label(method: str) -> str:
+    """The LaTeX name of a recovery method's rows (``RecoveryMethod.label``).
+
+    Args:
+        method: a recovery method's id.
+
+    Returns:
+        Its label ("" for the paper's method, labelled by configuration alone).
+    """
+    own = RECOVERY_METHODS[method].label
+    return label(method) if own is None else own
+
+
 def is_reference(model: str) -> bool:
     """Whether ``model`` is a reference id (``REFERENCES``), not a method.
 

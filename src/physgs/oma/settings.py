@@ -5,6 +5,8 @@ The workflow imports this module to plan jobs, so it imports neither pyOMA-2 nor
 
 from __future__ import annotations
 
+from physgs.models.registry import section_k
+
 
 def identify_params(cfg: dict, config: str) -> dict:
     """Rule ``oma_identify``: the conditions of ``config`` (``models.configs``: train -> [0],
@@ -42,8 +44,7 @@ def parts(cfg: dict, config: str) -> int:
     Returns:
         K.
     """
-    k = cfg["oma"].get("K", "same")
-    return int(cfg["models"]["configs"][config]["K"]) if k == "same" else int(k)
+    return section_k(cfg, "oma", config)
 
 
 def recovery_params(cfg: dict, config: str, seed: int) -> dict:

@@ -2,7 +2,7 @@
 
 The library never knows where the workflow keeps its files. Each output (``physgs.report.outputs``)
 declares what it needs as *need tuples* (``needs``): ``("eval" | "traj" | "panels" | "loss", tree,
-model, config, seed)``, ``("prior_recovery", tree, model, config, seed)``, ``("null", tree, K, seed)``,
+model, config, seed)``, ``("recovery", tree, method, config, seed)``, ``("null", tree, K, seed)``,
 ``("kselect", tree, seed)``, ``("stats", tree)``, ``("table", name)`` and the rest of
 ``NEED_FIELDS``; seed is a training seed. The workflow maps each tuple to a path
 (``workflow/rules/common.smk``) and hands the builders a mapping ``key(need) -> path``; the
@@ -76,12 +76,34 @@ def claims_needs(plan: Plan, every: bool = False) -> list[tuple]:
     required = catalogue.required_tables()
     tabs = [n for n in catalogue.tables() if every or n in required or _output(n).in_report(plan)]
     recovery = [
-        ("prior_recovery", t, m, c, int(s))
+        ("recovery", t, m, c, int(s))
         for m in models_of("prior")
         for t in plan.trees
         for s in plan.seeds
     ]
     return [("table", n) for n in tabs] + (recovery if catalogue.reads_recovery() else [])
+
+
+def read_table(name: str, path) -> pd.DataFrame:
+    """A report table's CSV, read through its declared columns (``Output.columns``): refused
+    when it breaks the declaration (a CSV of another version, a column renamed).
+
+    Args:
+        name: the table's name.
+        path (str | Path): its CSV.
+
+    Returns:
+        The table.
+
+    Raises:
+        ValueError: for a name that is not a table, or a CSV that breaks its columns.
+    """
+    o = _output(name)
+    if o.kind != "table":
+        raise ValueError(f"unknown table '{name}'; choose one of {TABLES}")
+    df = pd.read_csv(path, dtype={"config_hash": str})  # a hash of digits stays text
+    o.columns.check(name, list(df.columns))
+    return df
 
 
 def claims_frame(inputs: Mapping[str, str], trees: Sequence[str]) -> pd.DataFrame:
@@ -99,11 +121,13 @@ def claims_frame(inputs: Mapping[str, str], trees: Sequence[str]) -> pd.DataFram
         The ledger, one row per claim.
     """
     names = catalogue.tables()
-    tabs = {n: pd.read_csv(inputs[key(("table", n))]) for n in names if key(("table", n)) in inputs}
+    tabs = {
+        n: read_table(n, inputs[key(("table", n))]) for n in names if key(("table", n)) in inputs
+    }
     damping: dict[str, dict[str, list]] = {}  # model -> tree -> one summary per seed
-    for k, p in sorted(inputs.items()):  # prior_recovery/<tree>/<model>/<config>/<seed>
+    for k, p in sorted(inputs.items()):  # recovery/<tree>/<model>/<config>/<seed>
         kind, tree, *rest = k.split("/")
-        if kind != "prior_recovery":
+        if kind != "recovery":
             continue
         d = load_recovery(p).damping
         damping.setdefault(rest[0], {}).setdefault(tree, []).append(
@@ -226,6 +250,7 @@ def make_table(
     settings = {**settings, "seeds": [int(x) for x in settings.get("seeds", ())]}
     settings["digits"] = settings.get("digits", 2)
     table = o.build(reader(inputs), settings, inputs, None)
+    o.columns.check(name, list(table.df.columns))  # the CSV keeps its declared contract
     tables.write_table(table, tex_path, csv_path, stamp=stamp)
     return table
 
@@ -247,5 +272,5 @@ def make_figure(
     o = _output(name)
     if o.kind != "figure":
         raise ValueError(f"unknown figure '{name}'; choose one of {FIGURES}")
-    settings = {**settings, "seeds": [int(x) for x in settings["seeds"]]}
+    settings = {**settings, "seeds": [int(x) for x in settings.get("seeds", ())]}
     o.build(reader(inputs), settings, inputs, outputs)

@@ -142,6 +142,31 @@ FIGURES: tuple[Caption, ...] = (
         "cannot be recovered from the video.",
     ),
     Caption(
+        "fig_speed_accuracy",
+        "The speed-accuracy trade",
+        "Ours on the sweep's tree, one knob at a time away from the profile's setting (image "
+        "side, iterations, RK4 substeps, K, Gaussians). Left: PSNR on the time split (dB) against "
+        "the wall time per point (s, log); right: the median relative omega error over trusted "
+        "parts (%) against the same time. One line per knob through its values, points the mean "
+        "over the seeds with the sd as error bars on both axes; the profile's setting starred. "
+        "On the right, the untrained null of the profile's K: its median (line) and the central "
+        "95% of its draws (band).",
+        "A knob whose line climbs to the left buys accuracy cheaply; a recovery point inside the "
+        "null's band is chance.",
+    ),
+    Caption(
+        "fig_fit_curve",
+        "Fit against training budget",
+        "Each model trained on one tree at each budget: the in-window fit PSNR (dB, trained "
+        "frames) and the time-split PSNR (dB, the tail) against training iterations (log), and "
+        "the fit against training wall time (s, log); points the mean over the seeds, error bars "
+        "the sd. The static pose (dashed) and the true-motion ceiling (dotted) at the profile's "
+        "budget are horizontal lines; the profile's budget is starred; a field trained with "
+        "Deformable-3DGS's window-normalised time is drawn as open diamonds in its colour.",
+        "A curve still climbing at the profile's budget means that model is under-trained there; "
+        "one flat across budgets has converged.",
+    ),
+    Caption(
         "testbed_{tree}_damping",
         "The {tree} damping testbed",
         "The damping benchmark's variant of the {tree} tree, drawn as its testbed (bones by "

@@ -99,7 +99,7 @@ def _rows_of(df: pd.DataFrame, who: str, col: str = "method") -> pd.Series:
 def _psnr(d: pd.DataFrame, tree: str, model: str, split: str) -> float:
     """tab_psnr's ``<tree>_<split>`` cell of ``model`` (its id or its label)."""
     m = d["model"].astype(str)
-    return value(d, (m == model) | (m == label(model)), f"{tree}_{split}")
+    return value(d, m == model, f"{tree}_{split}")  # ids (the labels are the .tex's)
 
 
 def _recovery(d: pd.DataFrame, c: Cell, col: str) -> float:
@@ -264,7 +264,7 @@ def _tracks_trees(run: Run) -> list[Cell]:
 
 
 def _blind_trees(run: Run) -> list[Cell]:
-    """each forcing-free prior in tab_null x each tree, against the prior whose measured wind it
+    """each forcing-free prior in tab_recovery x each tree, against the prior whose measured wind it
     replaces (ids ``<prior>/...`` for a prior other than ours)"""
     null = run.own
     if null is None or "method" not in null.columns:
@@ -289,7 +289,7 @@ def _blind_trees(run: Run) -> list[Cell]:
 
 
 def _oma_sparse(run: Run) -> list[Cell]:
-    """the sparse tree, when tab_null holds the output-only analysis"""
+    """the sparse tree, when tab_recovery holds the output-only analysis"""
     null = run.own
     if null is None or "method" not in null.columns or OMA not in set(null["method"]):
         return []
@@ -362,13 +362,13 @@ def _null_row(d: pd.DataFrame, c: Cell):
 
 
 def _null_over_trained(d: pd.DataFrame, c: Cell) -> float:
-    """tab_null: null / trained median omega error of the cell's method"""
+    """tab_null / tab_recovery: null / trained median omega error of the cell's method"""
     row = _null_row(d, c)
     return value(d, row, "null_median_rel_err_pct") / value(d, row, "trained_median_rel_err_pct")
 
 
 def _trained_minus_null(d: pd.DataFrame, c: Cell) -> float:
-    """tab_null: trained - null median omega error of the cell's method (points)"""
+    """tab_null / tab_recovery: trained - null median omega error of the cell's method (points)"""
     row = _null_row(d, c)
     return value(d, row, "trained_median_rel_err_pct") - value(d, row, "null_median_rel_err_pct")
 
@@ -413,7 +413,7 @@ def _coupling_gain(d: pd.DataFrame, c: Cell) -> float:
 
 
 def _tracks_minus_ours(d: pd.DataFrame, c: Cell) -> float:
-    """tab_null: 2D tracks - ours median omega error (points); NaN at another K than ours'"""
+    """tab_recovery: 2D tracks - ours median omega error (points); NaN at another K than ours'"""
     tracks, ours = _null_row(d, c), _null_row(d, {**c, "method": "ours"})
     if value(d, tracks, "K") != value(d, ours, "K"):
         return float("nan")  # another K: not the same question
@@ -428,7 +428,7 @@ def _tracks_tail(d: pd.DataFrame, c: Cell) -> float:
 
 
 def _blind_minus_wind(d: pd.DataFrame, c: Cell) -> float:
-    """tab_null: forcing-free prior - its wind-reading prior, median omega error (points)"""
+    """tab_recovery: forcing-free prior - its wind-reading prior, median omega error (points)"""
     col = "trained_median_rel_err_pct"
     blind, wind = (
         _null_row(d, {**c, "method": c["blind"]}),

@@ -136,11 +136,11 @@ def _recovery_table(
 
 def _holds(tables: Mapping[str, pd.DataFrame], model: str) -> bool:
     """Whether a table read of the other priors (``catalogue.prior_tables``) has a row or column
-    of ``model`` (its id, or its label in tab_psnr)."""
+    of ``model`` (its id)."""
     for df in (tables[k] for k in prior_tables() if k in tables):
         if model in df.columns:
             return True
-        for col, v in (("model", model), ("model", label(model)), ("method", model)):
+        for col, v in (("model", model), ("method", model)):
             if col in df.columns and (df[col].astype(str) == v).any():
                 return True
     return False

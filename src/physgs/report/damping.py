@@ -33,11 +33,6 @@ from physgs.report.tables import (
 from physgs.testbed.variant import DAMPING, FAITHFUL
 
 VARIANTS = (FAITHFUL, DAMPING)
-#: tab_damping's caption sentence for the 2D-track control (``tables.tracks_rows``)
-TRACKS_NOTE = (
-    r" \emph{2D tracks}: the same oscillators fitted to point tracks of the training "
-    r"video (no renderer), scored on its own matching against its own null draw."
-)
 COLUMNS = (
     "trusted",
     "rel_err_pct",

@@ -15,6 +15,9 @@ from pathlib import Path
 
 import pandas as pd
 
+from physgs.report.outputs import OUTPUTS
+from physgs.report.outputs.base import PROVENANCE_COLUMNS
+
 
 @dataclass(frozen=True)
 class CellChange:
@@ -58,14 +61,12 @@ class RerunComparison:
     beyond: list[CellChange]
 
 
-#: Columns that describe the run, not a row: never keys.
-PROVENANCE_COLUMNS = ("profile", "config_hash", "physgs_version")
 #: Columns that time a job (seconds, or a ratio of seconds): what the machine did, not what the
-#: method found; a rerun on a busier core moves them. Never compared.
-TIMING_COLUMNS = ("train_s", "select_s", "cost_x", "fit_s", "ours_train_s")
-#: Seeded tables whose non-numeric columns do not identify a row (a numeric column is part of
-#: the key): table name (the CSV's stem) -> its key columns, seed first.
-TABLE_KEYS: dict[str, tuple[str, ...]] = {"tab_transfer": ("seed", "split", "tree", "condition")}
+#: method found; a rerun on a busier core moves them. Never compared. Every table's declared
+#: timing columns (``physgs.report.outputs``: ``Columns.timing``).
+TIMING_COLUMNS = tuple(
+    dict.fromkeys(c for o in OUTPUTS.values() if o.columns for c in o.columns.timing)
+)
 
 
 def seeded_keys(table: pd.DataFrame, seed: str = "seed") -> list[str]:
@@ -97,8 +98,8 @@ def seeded_keys(table: pd.DataFrame, seed: str = "seed") -> list[str]:
 
 
 def table_keys(name: str, table: pd.DataFrame) -> list[str]:
-    """The key columns of the seeded table ``name``: its entry in ``TABLE_KEYS``, else
-    [`seeded_keys`][physgs.report.rerun.seeded_keys].
+    """The key columns of the seeded table ``name``: its declared keys (a report table's
+    ``Columns.keys``), else [`seeded_keys`][physgs.report.rerun.seeded_keys].
 
     Args:
         name: the table's name (``tab_transfer``; the CSV's stem).
@@ -107,7 +108,22 @@ def table_keys(name: str, table: pd.DataFrame) -> list[str]:
     Returns:
         The key columns, seed first.
     """
-    return list(TABLE_KEYS[name]) if name in TABLE_KEYS else seeded_keys(table)
+    o = OUTPUTS.get(name)
+    return list(o.columns.keys) if o is not None and o.columns else seeded_keys(table)
+
+
+def timing_columns(name: str) -> tuple[str, ...]:
+    """The columns of table ``name`` that time its jobs: its declared ones (a report table's
+    ``Columns.timing``), else every table's (``TIMING_COLUMNS``).
+
+    Args:
+        name: the table's name (the CSV's stem).
+
+    Returns:
+        The timing column names.
+    """
+    o = OUTPUTS.get(name)
+    return tuple(o.columns.timing) if o is not None and o.columns else TIMING_COLUMNS
 
 
 def compare_table_csv(old_csv, new_csv, keys: list[str] | None = None) -> RerunComparison:
@@ -124,11 +140,17 @@ def compare_table_csv(old_csv, new_csv, keys: list[str] | None = None) -> RerunC
     """
     text = {"config_hash": str}  # a hash of digits stays text
     a, b = pd.read_csv(old_csv, dtype=text), pd.read_csv(new_csv, dtype=text)
-    return compare_seeded(a, b, table_keys(Path(old_csv).stem, a) if keys is None else keys)
+    name = Path(old_csv).stem
+    keys = table_keys(name, a) if keys is None else keys
+    return compare_seeded(a, b, keys, timing=timing_columns(name))
 
 
 def compare_seeded(
-    old: pd.DataFrame, new: pd.DataFrame, keys: list[str], seed: str = "seed"
+    old: pd.DataFrame,
+    new: pd.DataFrame,
+    keys: list[str],
+    seed: str = "seed",
+    timing: tuple[str, ...] = TIMING_COLUMNS,
 ) -> RerunComparison:
     """Compare a table's rerun with its earlier run, cell by cell against the seed spread.
 
@@ -137,6 +159,7 @@ def compare_seeded(
         new: the rerun's table, same columns.
         keys: the columns that identify a row, ``seed`` among them.
         seed: the seed column.
+        timing: the columns that time jobs, never compared (the table's declared ones).
 
     Returns:
         The [`RerunComparison`][physgs.report.rerun.RerunComparison]. A cell whose value is NaN
@@ -158,7 +181,8 @@ def compare_seeded(
         c
         for c in old.columns
         if c not in keys
-        and c not in TIMING_COLUMNS
+        and c not in timing
+        and c not in PROVENANCE_COLUMNS
         and c in new.columns
         and pd.api.types.is_numeric_dtype(old[c])
         and not pd.api.types.is_bool_dtype(old[c])  # a flag of the row, not a measurement

@@ -19,15 +19,12 @@ from physgs.atomic import atomic_path, write_text
 from physgs.evaluate.metrics import ceiling_fraction
 from physgs.models.registry import MODEL_NAMES as MODELS
 from physgs.models.registry import MODELS as SPECS
-from physgs.models.registry import label, spec_of
+from physgs.models.registry import RECOVERY_METHODS, label, recovery_label, spec_of
 from physgs.report import paper
 from physgs.report import seeds as seedstats
 
-#: LaTeX name of the 2D-track control's rows (physgs.report.tracks, docs/tracks.md)
-TRACKS_LABEL = r"\emph{2D tracks}"
-#: method id and LaTeX name of the output-only modal analysis' rows (physgs.oma, docs/blind.md)
-OMA = "oma"
-OMA_LABEL = r"\emph{Output-only (SSI)}"
+#: the method ids of the 2D-track control and the output-only analysis (``RECOVERY_METHODS``)
+TRACKS, OMA = "tracks", "oma"
 #: a .tex cell that a method does not define (a forcing-free prior beyond the window): never 0
 NOT_DEFINED = "n/d"
 
@@ -43,13 +40,12 @@ class Table:
 
 @dataclass(frozen=True)
 class MethodRows:
-    """One method's rows in tab_null or tab_damping: every prior (ours first), the 2D-track
-    control, the output-only analysis each give one (``prior_rows``, ``tracks_rows``,
-    ``oma_rows``).
+    """One recovery method's rows in tab_null, tab_recovery or tab_damping (``method_rows``;
+    ``registry.RECOVERY_METHODS``).
 
     label: its LaTeX name ("" for ours, the paper's prior: its rows are labelled by their
     configuration alone); configs: its configurations (name -> LaTeX label, with its own K), in
-    row order; per_seed: ``per_seed[seed][key]``, the table's record of each key (tab_null:
+    row order; per_seed: ``per_seed[seed][key]``, the table's record of each key (tab_null, tab_recovery:
     ``(tree, config)`` -> (``RecoveryRecord``, the ``NullResult`` of its K); tab_damping:
     ``(tree, variant, config)`` -> ``RecoveryRecord``); note: its sentence of the caption."""
 
@@ -196,6 +192,24 @@ def _seed_note(n_seeds: int) -> str:
     )
 
 
+#: tab_psnr's difference rows: ``<prior>-static`` and ``<prior>-best_field`` (column ``model``)
+PSNR_MINUS = "-"
+#: the id of "the best learned field, per seed" in tab_psnr's difference rows
+BEST_FIELD = "best_field"
+
+
+def psnr_row_label(row_id: str) -> str:
+    """The label of one side of a tab_psnr difference row: a model's, or the best field's.
+
+    Args:
+        row_id: a model id or ``BEST_FIELD``.
+
+    Returns:
+        Its label.
+    """
+    return "best learned field" if row_id == BEST_FIELD else label(row_id)
+
+
 def tab_psnr(
     per_seed: Mapping[int, Mapping[tuple[str, str], Mapping[str, float]]],
     trees: Sequence[str],
@@ -205,6 +219,9 @@ def tab_psnr(
     references: Sequence[str] = (),
 ) -> Table:
     """PSNR (dB) on the view and time splits, one row per model, two columns per tree.
+
+    The CSV's ``model`` column holds ids (a difference row: ``<prior>-static``,
+    ``<prior>-best_field``); the labels are the .tex's.
 
     Below the models: references (the true-motion ceiling; never bold) and two paired
     differences, ours - static and ours - the best learned field (per seed, the learned field with
@@ -246,7 +263,7 @@ def tab_psnr(
             rows.append(
                 {
                     "seed": s,
-                    "model": label(m),
+                    "model": m,
                     **val[m],
                     "reference": m in references,
                     "difference": False,
@@ -257,7 +274,7 @@ def tab_psnr(
                 rows.append(
                     {
                         "seed": s,
-                        "model": f"{label(p)} - {label('static')}",
+                        "model": f"{p}{PSNR_MINUS}static",
                         **{c: val[p][c] - val["static"][c] for c in cols},
                         "reference": False,
                         "difference": True,
@@ -267,7 +284,7 @@ def tab_psnr(
                 rows.append(
                     {
                         "seed": s,
-                        "model": f"{label(p)} - best learned field",
+                        "model": f"{p}{PSNR_MINUS}{BEST_FIELD}",
                         **{c: val[p][c] - max(val[m][c] for m in learned) for c in cols},
                         "reference": False,
                         "difference": True,
@@ -294,10 +311,10 @@ def tab_psnr(
             lines.append("    \\midrule")
         if diff[i]:
             cells = [seedstats.difference(V[c][:, i], fmt) for c in cols]
-            name = r["model"].replace(" - ", " $-$ ")
+            name = " $-$ ".join(psnr_row_label(x) for x in r["model"].split(PSNR_MINUS))
         else:
             cells = [seedstats.pm(V[c][:, i], fmt, bold[c][i]) for c in cols]
-            name = rf"\emph{{{r['model']}}}" if ref[i] else r["model"]
+            name = rf"\emph{{{label(r['model'])}}}" if ref[i] else label(r["model"])
         lines.append(f"    {name} & " + " & ".join(cells) + r" \\")
     lines += ["    \\bottomrule", "  \\end{tabular}", ""]
     if not references:
@@ -448,6 +465,58 @@ def tab_null(
     bones: Mapping[str, int],
     digits: int = 2,
 ) -> Table:
+    """The paper's tab:null: ours' frequency recovery beside the untrained null of the same K,
+    per tree and configuration (``recovery_table``'s columns).
+
+    Args:
+        methods: method id -> its [`MethodRows`][physgs.report.tables.MethodRows]: the paper's
+            (``RecoveryMethod.paper``: ours), as in ``recovery_table``.
+        trees: the trees.
+        bones: tree -> its bone count.
+        digits: decimals shown in the .tex.
+
+    Returns:
+        The [`Table`][physgs.report.tables.Table].
+    """
+    lead = "Frequency recovery against an untrained null."
+    return recovery_table("tab_null", lead, methods, trees, bones, digits)
+
+
+def tab_recovery(
+    methods: Mapping[str, MethodRows],
+    trees: Sequence[str],
+    bones: Mapping[str, int],
+    digits: int = 2,
+) -> Table:
+    """Every recovery method's frequency recovery (``registry.RECOVERY_METHODS``), each beside
+    the untrained null of its own K; ours' rows (tab_null's) first, as the reference the others'
+    claims compare with.
+
+    Args:
+        methods: method id -> its [`MethodRows`][physgs.report.tables.MethodRows], as in
+            ``recovery_table``.
+        trees: the trees.
+        bones: tree -> its bone count.
+        digits: decimals shown in the .tex.
+
+    Returns:
+        The [`Table`][physgs.report.tables.Table].
+    """
+    lead = (
+        r"Frequency recovery of every method against the untrained null of its $K$; rows "
+        r"labelled by their configuration alone are ours (Table~\ref{tab:null})."
+    )
+    return recovery_table("tab_recovery", lead, methods, trees, bones, digits)
+
+
+def recovery_table(
+    name: str,
+    lead: str,
+    methods: Mapping[str, MethodRows],
+    trees: Sequence[str],
+    bones: Mapping[str, int],
+    digits: int = 2,
+) -> Table:
     """Frequency recovery of each method against the untrained null, per tree and config.
 
     Each tree's rows: every method's in turn, each in its configurations; column ``method`` the
@@ -456,9 +525,10 @@ def tab_null(
     negative means the trained model beats chance), and the median nearest-bone gap (%).
 
     Args:
+        name: the table's name (its LaTeX label: ``tab:<name without tab_>``).
+        lead: the caption's first sentence.
         methods: method id -> its [`MethodRows`][physgs.report.tables.MethodRows], in row order
-            (ours first, then the other priors, the 2D-track control, the output-only analysis,
-            the forcing-free priors; a method with no configurations has no rows):
+            (``RECOVERY_METHODS``'; a method with no configurations has no rows):
             ``per_seed[seed][(tree, config)]`` = (its ``RecoveryRecord``, the ``NullResult``
             drawn with that seed and the method's K).
         trees: the trees.
@@ -469,7 +539,7 @@ def tab_null(
         The [`Table`][physgs.report.tables.Table].
     """
     methods = {m: mr for m, mr in methods.items() if mr.configs}
-    seeds = _seeds(next(iter(methods.values())).per_seed if methods else {}, "tab_null")
+    seeds = _seeds(next(iter(methods.values())).per_seed if methods else {}, name)
     keys = [(t, c, m) for t in trees for m, mr in methods.items() for c in mr.configs]
     rows = []
     for s in seeds:
@@ -477,14 +547,14 @@ def tab_null(
             _check(
                 [k[:2] for k in keys if k[2] == m],
                 mr.per_seed.get(s, {}),
-                f"tab_null ({_who(m)}, seed {s})",
+                f"{name} ({_who(m)}, seed {s})",
             )
         for t, c, method in keys:
             rec, nl = methods[method].per_seed[s][(t, c)]
             m = rec.match
             if nl.n_parts != m.n_parts:
                 raise ValueError(
-                    f"tab_null: null for {t}/{c} (seed {s}) has K={nl.n_parts} but the "
+                    f"{name}: null for {t}/{c} (seed {s}) has K={nl.n_parts} but the "
                     f"model has K={m.n_parts}; re-run the null with the model's K"
                 )
             tr, nu = 100 * m.median_rel_err, 100 * nl.median_median_rel_err
@@ -558,7 +628,7 @@ def tab_null(
     lines += _tree_blocks(first, trees, cells)
     lines += ["    \\bottomrule", "  \\end{tabular}", ""]
     cap = (
-        r"Frequency recovery against an untrained null. Parts: parts trusted ($|\mathrm{corr}|\geq0.7$) "
+        lead + r" Parts: parts trusted ($|\mathrm{corr}|\geq0.7$) "
         r"of $K$ (mean over seeds). Median relative error over trusted parts; $R^2$ of "
         r"$\log\hat\omega_p$ against $\log\omega_p$. Null entries are medians over 8 draws "
         r"of each seed, with the trained model's $K$; Trained $-$ null: percentage points, "
@@ -567,98 +637,34 @@ def tab_null(
         r"motion moves at least a pixel in the training camera (the CSV also gives the part "
         r"counts)." + "".join(mr.note for mr in methods.values()) + _seed_note(len(seeds))
     )
-    return Table("tab_null", df, _wrap("\n".join(lines), cap, "tab:null"))
+    return Table(name, df, _wrap("\n".join(lines), cap, "tab:" + name.removeprefix("tab_")))
 
 
 def _who(method: str) -> str:
-    """A method's name in tab_null / tab_damping's errors."""
+    """A method's name in the recovery tables' errors."""
     return "tracks control" if method == TRACKS else method
 
 
-def prior_rows(
-    model: str, configs: Mapping[str, str], per_seed: Mapping[int, Mapping], note: str = ""
+def method_rows(
+    method: str, configs: Mapping[str, str], per_seed: Mapping[int, Mapping], damping: bool = False
 ) -> MethodRows:
-    """An oscillator prior's rows for tab_null / tab_damping, labelled from the registry.
-
-    Ours' (the paper's) are labelled by their configuration alone and carry no caption sentence;
-    a forcing-free prior's carry the sentence saying its forcing is learned; any other's the
-    sentence '<label>: <note>' (none without ``note``).
+    """A recovery method's rows (``registry.RECOVERY_METHODS``) for tab_null, tab_recovery or
+    tab_damping: its label and caption sentence from its entry.
 
     Args:
-        model: a registry model of role "prior", or a forcing-free prior
-            (``registry.BLIND_PRIORS``).
-        configs: name -> LaTeX label, as in [`MethodRows`][physgs.report.tables.MethodRows].
+        method: a recovery method's id.
+        configs: name -> LaTeX label (with its own K), as in
+            [`MethodRows`][physgs.report.tables.MethodRows].
         per_seed: its records, as in ``MethodRows``.
-        note: the table's word on the priors beside ours.
+        damping: tab_damping's caption sentence (``RecoveryMethod.damping_note``) in place of
+            the frequency tables'.
 
     Returns:
-        The rows.
+        The rows; the caption sentence '<label>: <note>' (none without a note).
     """
-    if model == "ours":
-        return MethodRows("", configs, per_seed)
-    name = label(model)
-    if spec_of(model).forcing == "learned":
-        note = (
-            "the measured wind replaced by a forcing learned from the training video (trained "
-            r"in its configuration only), beside the null of its $K$."
-        )
+    rm, name = RECOVERY_METHODS[method], recovery_label(method)
+    note = rm.damping_note if damping and rm.damping_note is not None else rm.note
     return MethodRows(name, configs, per_seed, f" {name}: {note}" if note else "")
-
-
-#: tab_null's word on a prior beside ours (``prior_rows``)
-NULL_PRIOR_NOTE = (
-    r"the same scoring of its own parts, beside the null of its $K$ (a null depends on $K$ only)."
-)
-#: the method id of the 2D-track control's rows
-TRACKS = "tracks"
-
-
-def tracks_rows(
-    configs: Mapping[str, str], per_seed: Mapping[int, Mapping], note: str
-) -> MethodRows:
-    """The 2D-track control's rows ([`physgs.tracks`][physgs.tracks]) for tab_null / tab_damping.
-
-    Args:
-        configs: name -> LaTeX label with its own K.
-        per_seed: its records, as in [`MethodRows`][physgs.report.tables.MethodRows].
-        note: the table's sentence for it (``NULL_TRACKS_NOTE``,
-            ``physgs.report.damping.TRACKS_NOTE``).
-
-    Returns:
-        The rows.
-    """
-    return MethodRows(TRACKS_LABEL, configs, per_seed, note)
-
-
-NULL_TRACKS_NOTE = (
-    r" \emph{2D tracks}: the same oscillators fitted to point tracks of the training "
-    r"video (no renderer), matched and trusted by the same rule, beside the null of its "
-    r"$K$; a part with too few tracks has no estimate and is never trusted."
-)
-
-
-def oma_rows(configs: Mapping[str, str], per_seed: Mapping[int, Mapping]) -> MethodRows:
-    """The output-only modal analysis' rows ([`physgs.oma`][physgs.oma]) for tab_null / tab_damping.
-
-    Args:
-        configs: name -> LaTeX label with its own K.
-        per_seed: as in [`MethodRows`][physgs.report.tables.MethodRows].
-
-    Returns:
-        The rows, with their caption sentence.
-    """
-    return MethodRows(
-        OMA_LABEL,
-        configs,
-        per_seed,
-        rf" {OMA_LABEL}: modes identified from the training video alone (dense flow, SSI-cov; "
-        r"no wind, no renderer), each assigned to a part by its shape, matched and trusted by "
-        r"the same rule, beside the null of its $K$. Its seeds resample only the $k$-means of "
-        r"image cells into parts (the same video, so the same modes, at every seed): its seed "
-        r"intervals understate what another tree instance would do. The CSV gives the "
-        r"coverage of its modes' 95\% intervals ($\pm1.96\sigma$) over the trusted parts and "
-        r"the parts its own rule keeps (relative $\sigma_\zeta\le1/1.96$).",
-    )
 
 
 #: tab_null / tab_damping's CSV columns of a method's own intervals (the output-only analysis';

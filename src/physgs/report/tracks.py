@@ -21,9 +21,10 @@ from typing import Mapping, Sequence
 import numpy as np
 import pandas as pd
 
+from physgs.models.registry import recovery_label
 from physgs.report import seeds as seedstats
 from physgs.report.tables import (
-    TRACKS_LABEL,
+    TRACKS,
     Table,
     _by_seed,
     _check,
@@ -33,10 +34,10 @@ from physgs.report.tables import (
     tree_label,
 )
 
-#: the method label of the tracks control's rows in tab_null and tab_damping (column ``method``)
-METHOD = "tracks"
-#: LaTeX name of the control in other tables' rows
-LABEL = TRACKS_LABEL
+#: the method id of the tracks control's rows in tab_recovery and tab_damping (column ``method``)
+METHOD = TRACKS
+#: LaTeX name of the control in other tables' rows (``registry.RECOVERY_METHODS``)
+LABEL = recovery_label(TRACKS)
 TRACKER_COLUMNS = (
     "n_tracks",
     "n_seed0",

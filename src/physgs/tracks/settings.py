@@ -14,8 +14,8 @@ initialisation, RK4 substeps and guard) and ``train.lr.physics`` (Adam's rate on
 
 from __future__ import annotations
 
-#: ``tracks.K`` value meaning "the configuration's own K" (``models.configs.<c>.K``)
-SAME_K = "same"
+from physgs.models.registry import SAME_K, section_k
+
 #: ours' settings the oscillator fit reads (``physgs.tracks.fit.Oscillators.from_config``)
 OURS_KEYS = ("omega_hz", "zeta", "omega_init_hz", "zeta_init", "substeps", "rk4_guard")
 
@@ -62,10 +62,8 @@ def parts(cfg: dict, config: str) -> tuple[int, str]:
     Returns:
         (K, the config key): ``models/configs/<config>/K``, or ``tracks/K`` when that overrides it.
     """
-    k = cfg["tracks"]["K"]
-    if k == SAME_K:
-        return int(cfg["models"]["configs"][config]["K"]), f"models/configs/{config}/K"
-    return int(k), "tracks/K"
+    key = f"models/configs/{config}/K" if cfg["tracks"]["K"] == SAME_K else "tracks/K"
+    return section_k(cfg, "tracks", config), key
 
 
 def fields_scored(cfg: dict, config: str, testbed: str) -> list[str]:

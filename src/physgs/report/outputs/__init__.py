@@ -4,9 +4,16 @@ the models of its role (``physgs.models.registry.models_of``) through its regist
 (``physgs.models.registry.MODELS``), and a new output is one ``Output`` added here."""
 
 from physgs.report.outputs.base import NEED_FIELDS, Output, Plan, key, reader
-from physgs.report.outputs.recovery import FIG_DAMPING, TAB_DAMPING, TAB_KSELECT, TAB_NULL
+from physgs.report.outputs.recovery import (
+    FIG_DAMPING,
+    TAB_DAMPING,
+    TAB_KSELECT,
+    TAB_NULL,
+    TAB_RECOVERY,
+)
 from physgs.report.outputs.studies import FIG_PARTS, TAB_PARTS, TAB_PARTS_K
 from physgs.report.outputs.testbed import TAB_TESTBED
+from physgs.report.outputs.trade import FIG_FIT_CURVE, FIG_SPEED_ACCURACY
 from physgs.report.outputs.tracks import FIG_TRACKS, TAB_TRACKS
 from physgs.report.outputs.views import (
     FIG_RESULTS,
@@ -25,6 +32,7 @@ OUTPUTS: dict[str, Output] = {
         TAB_TESTBED,
         TAB_PSNR,
         TAB_NULL,
+        TAB_RECOVERY,
         TAB_TRANSFER,
         TAB_MARGIN,
         TAB_KSELECT,
@@ -39,6 +47,8 @@ OUTPUTS: dict[str, Output] = {
         FIG_DAMPING,
         FIG_PARTS,
         FIG_TRACKS,
+        FIG_SPEED_ACCURACY,
+        FIG_FIT_CURVE,
     )
 }
 

@@ -1,6 +1,8 @@
-"""The outputs that score recovered physics against the ground truth: tab_null (frequencies
-against the untrained null), tab_damping (the damping benchmark), fig_damping and tab_kselect
-(ours with K chosen from the data)."""
+"""The outputs that score recovered physics against the ground truth: tab_null (the paper's:
+ours' frequencies against the untrained null), tab_recovery (every recovery method's, each
+against the null of its K), tab_damping (the damping benchmark), fig_damping and tab_kselect
+(ours with K chosen from the data). The recovery tables' rows come from the one list of
+recovery methods (``registry.RECOVERY_METHODS``): one need kind (``recovery``) serves them all."""
 
 from __future__ import annotations
 
@@ -8,22 +10,21 @@ import pandas as pd
 
 from physgs.evaluate.splits import load_eval
 from physgs.experiments.kselect import BASE_MODEL, load_selection, selected_models
-from physgs.models.registry import BLIND_CONFIG, blind_priors, config_label, models_of
-from physgs.oma.settings import parts as oma_k
+from physgs.models.registry import RECOVERY_METHODS, config_label, models_of, recovery_plan
 from physgs.recovery.record import load_null, load_recovery
 from physgs.report import kselect, tables
-from physgs.report.damping import TRACKS_NOTE, tab_damping
-from physgs.report.outputs.base import Output
+from physgs.report.damping import COLUMNS as DAMPING_VALUES
+from physgs.report.damping import tab_damping
+from physgs.report.outputs.base import Columns, Output
 from physgs.testbed.variant import DAMPING, FAITHFUL, damping_id
-from physgs.tracks.settings import parts as tracks_k
 
 #: tab_kselect's rows: ours at the fixed K of the base configuration, and at the chosen K
 KSELECT_ROWS = tuple(c for c, _ in kselect.ROWS)
 
 
 def label_with_k(cfg: dict, config: str, K: int) -> str:
-    """The LaTeX label of configuration ``config`` for a method that sets its own K (the 2D-track
-    control, the output-only analysis).
+    """The LaTeX label of configuration ``config`` for a method with K parts there (a method
+    with a K of its own: the 2D-track control, the output-only analysis).
 
     Args:
         cfg: the resolved config.
@@ -36,143 +37,128 @@ def label_with_k(cfg: dict, config: str, K: int) -> str:
     return config_label(config, {**cfg["models"]["configs"][config], "K": K})
 
 
-def _method_settings(cfg: dict, configs) -> dict:
-    """The methods of tab_null / tab_damping besides the 2D-track control, in ``configs`` (the
-    table's configurations): priors {model: {config: label}}, every prior of the registry (ours
-    first) in each of them; oma {config: {K, label}}; blind {model: {config: label}}, the
-    forcing-free priors (``registry.blind_priors``) in ``BLIND_CONFIG``."""
-    mc = cfg["models"]["configs"]
+def _methods_settings(cfg: dict, methods, configs) -> dict:
+    """methods {id: {config: {K, label}}}: each recovery method of ``methods`` the run scores
+    (``registry.recovery_plan``), in the table's configurations ``configs``, each with its K."""
+    plan = recovery_plan(cfg)
     return {
-        "priors": {m: {c: config_label(c, mc[c]) for c in configs} for m in models_of("prior")},
-        "oma": {
-            c: {"K": (k := oma_k(cfg, c)), "label": label_with_k(cfg, c, k)}
-            for c in cfg["oma"]["configs"]
-            if c in configs
-        },
-        "blind": {
-            m: {BLIND_CONFIG: config_label(BLIND_CONFIG, mc[BLIND_CONFIG])}
-            for m in blind_priors(configs)
-        },
+        "methods": {
+            m: {
+                c: {"K": k, "label": label_with_k(cfg, c, k)}
+                for c, k in plan[m].items()
+                if c in configs
+            }
+            for m in methods
+            if m in plan
+        }
     }
 
 
-def _method_needs(plan, configs, testbeds, s) -> list[tuple]:
-    """The recoveries of tab_null / tab_damping's methods besides the 2D-track control on
-    ``testbeds`` in ``configs`` (seed ``s``): every prior's, the output-only analysis' and the
-    run's forcing-free priors' (``plan.blind``, in ``BLIND_CONFIG``)."""
-    blind = [m for m in plan.blind if BLIND_CONFIG in configs]
-    return (
-        [
-            ("prior_recovery", tb, m, c, s)
-            for tb in testbeds
-            for m in models_of("prior")
-            for c in configs
-        ]
-        + [("oma_recovery", tb, c, s) for tb in testbeds for c in plan.oma if c in configs]
-        + [("prior_recovery", tb, m, BLIND_CONFIG, s) for tb in testbeds for m in blind]
+def _methods_needs(plan, methods, configs, testbeds, s) -> list[tuple]:
+    """The records of the recovery ``methods`` on ``testbeds`` in the table's ``configs``
+    (seed ``s``)."""
+    return [
+        ("recovery", tb, m, c, s)
+        for tb in testbeds
+        for m in methods
+        for c in plan.recovery.get(m, {})
+        if c in configs
+    ]
+
+
+def _method_rows(settings: dict, records, damping: bool = False) -> dict:
+    """The table's ``MethodRows`` in row order (``RECOVERY_METHODS``', ours first: the settings
+    arrive with their keys sorted). records(method, configs): the table's per-seed records of a
+    method in ``configs`` ({config: K})."""
+    methods = settings["methods"]
+    return {
+        m: tables.method_rows(
+            m,
+            {c: v["label"] for c, v in methods[m].items()},
+            records(m, {c: v["K"] for c, v in methods[m].items()}),
+            damping=damping,
+        )
+        for m in RECOVERY_METHODS
+        if m in methods
+    }
+
+
+def _paper(plan_or_methods) -> list[str]:
+    """The paper's recovery methods (``RecoveryMethod.paper``: tab_null's rows) among these."""
+    return [m for m in plan_or_methods if RECOVERY_METHODS[m].paper]
+
+
+# ---- tab_null and tab_recovery: frequencies against the null of each method's K -------------
+#: tab_null's and tab_recovery's CSV: one row per seed, tree, configuration and method id
+NULL_COLUMNS = Columns(
+    keys=("seed", "tree", "config", "method"),
+    values=(
+        "trained_parts_trusted",
+        "trained_median_rel_err_pct",
+        "trained_loglog_r2",
+        "null_parts_trusted",
+        "null_median_rel_err_pct",
+        "null_loglog_r2",
+        "trained_minus_null_pp",
+        "nearest_bone_gap_pct",
+        "trained_parts_trusted_visible",
+        "trained_median_rel_err_visible_pct",
+        "null_parts_trusted_visible",
+        "null_median_rel_err_visible_pct",
+        *tables.INTERVAL_COLUMNS,  # a method's own intervals (the output-only analysis')
+    ),
+    about=("bones", "K"),
+)
+
+
+def _frequency_output(name: str, methods, build, in_report=lambda plan: True) -> Output:
+    """A frequency-recovery table of the recovery methods ``methods(ids)`` (tab_null: the
+    paper's; tab_recovery: every one), each row beside the untrained null of its K."""
+
+    def needs(plan, seeds):
+        mine = methods(plan.recovery)
+        out = []
+        for s in seeds:
+            out += _methods_needs(plan, mine, plan.configs, plan.trees, s)
+            nulls = {int(k) for m in mine for k in plan.recovery[m].values()}
+            out += [("null", t, k, s) for t in plan.trees for k in sorted(nulls)]
+        return out
+
+    def settings(cfg):
+        return _methods_settings(cfg, methods(recovery_plan(cfg)), cfg["models"]["configs"])
+
+    def table(path, settings, inputs, out):
+        trees, seeds = settings["trees"], settings["seeds"]
+
+        def paired(m, configs):
+            """{seed: {(tree, config): (its record, the null of its K)}}; configs: {config: K}."""
+            return {
+                s: {
+                    (t, c): (
+                        load_recovery(path("recovery", t, m, c, s)),
+                        load_null(path("null", t, int(k), s)),
+                    )
+                    for t in trees
+                    for c, k in configs.items()
+                }
+                for s in seeds
+            }
+
+        rows = _method_rows(settings, paired)
+        return build(rows, trees, settings["bones"], digits=settings["digits"])
+
+    return Output(
+        name, "table", needs, table, settings=settings, in_report=in_report, columns=NULL_COLUMNS
     )
 
 
-def _methods(settings: dict, records, tracks_note: str, prior_note: str = "") -> dict:
-    """tab_null / tab_damping's ``MethodRows`` in row order: every prior (ours first), the
-    2D-track control, the output-only analysis, the forcing-free priors. records(kind, *fields,
-    configs): the table's per-seed records of need ``kind`` in ``configs`` ({config: K})."""
-
-    def prior(m, labels):
-        K = {c: settings["configs"][c]["K"] for c in labels}
-        return tables.prior_rows(m, labels, records("prior_recovery", m, configs=K), prior_note)
-
-    tracks, oma = settings.get("tracks", {}), settings.get("oma", {})
-    return {
-        **{m: prior(m, labels) for m, labels in settings["priors"].items()},
-        tables.TRACKS: tables.tracks_rows(
-            {c: v["label"] for c, v in tracks.items()},
-            records("tracks_recovery", configs={c: v["K"] for c, v in tracks.items()}),
-            tracks_note,
-        ),
-        tables.OMA: tables.oma_rows(
-            {c: v["label"] for c, v in oma.items()},
-            records("oma_recovery", configs={c: v["K"] for c, v in oma.items()}),
-        ),
-        **{m: prior(m, labels) for m, labels in settings["blind"].items()},
-    }
-
-
-def _configs(cfg: dict, names=None) -> dict:
-    """configs {name: {K, conditions}} of the table's configurations ``names`` (all: None)."""
-    mc = cfg["models"]["configs"]
-    return {
-        "configs": {
-            c: {"K": int(v["K"]), "conditions": v["conditions"]}
-            for c, v in mc.items()
-            if names is None or c in names
-        }
-    }
-
-
-# ---- tab_null ------------------------------------------------------------------------------
-def _null_needs(plan, seeds):
-    out = []
-    for s in seeds:
-        out += _method_needs(plan, plan.configs, plan.trees, s)
-        out += [("tracks_recovery", t, c, s) for t in plan.trees for c in plan.tracks]
-        out += list(
-            dict.fromkeys(
-                [
-                    ("null", t, int(plan.configs[c]["K"]), s)
-                    for t in plan.trees
-                    for c in plan.configs
-                ]
-                + [("null", t, int(k), s) for t in plan.trees for k in plan.tracks.values()]
-                + [("null", t, int(k), s) for t in plan.trees for k in plan.oma.values()]
-            )
-        )
-    return out
-
-
-def _tracks_settings(cfg: dict, configs) -> dict:
-    """tracks {config: {K, label}}: the 2D-track control's configurations among ``configs``, in
-    that order, each with its own K."""
-    return {
-        "tracks": {
-            c: {"K": (k := tracks_k(cfg, c)[0]), "label": label_with_k(cfg, c, k)}
-            for c in configs
-            if c in cfg["tracks"]["configs"]
-        }
-    }
-
-
-def _null_settings(cfg: dict) -> dict:
-    return {
-        **_configs(cfg),
-        **_tracks_settings(cfg, cfg["tracks"]["configs"]),
-        **_method_settings(cfg, cfg["models"]["configs"]),
-    }
-
-
-def _tab_null(path, settings, inputs, out):
-    trees, seeds = settings["trees"], settings["seeds"]
-
-    def paired(kind, *fields, configs):
-        """{seed: {(tree, config): (record of need ``kind``, the null of its K)}}; configs:
-        {config: K}."""
-        return {
-            s: {
-                (t, c): (
-                    load_recovery(path(kind, t, *fields, c, s)),
-                    load_null(path("null", t, int(k), s)),
-                )
-                for t in trees
-                for c, k in configs.items()
-            }
-            for s in seeds
-        }
-
-    methods = _methods(settings, paired, tables.NULL_TRACKS_NOTE, tables.NULL_PRIOR_NOTE)
-    return tables.tab_null(methods, trees, settings["bones"], digits=settings["digits"])
-
-
-TAB_NULL = Output("tab_null", "table", _null_needs, _tab_null, settings=_null_settings)
+TAB_NULL = _frequency_output("tab_null", _paper, tables.tab_null)
+TAB_RECOVERY = _frequency_output(
+    "tab_recovery",
+    list,
+    tables.tab_recovery,
+    in_report=lambda plan: len(plan.recovery) > len(_paper(plan.recovery)),
+)
 
 
 # ---- tab_damping ---------------------------------------------------------------------------
@@ -183,32 +169,26 @@ def _testbeds(tree: str) -> dict:
 
 def _damping_needs(plan, seeds):
     testbeds = [tb for t in plan.damping_trees for tb in _testbeds(t).values()]
-    tracks = [c for c in plan.damping_configs if c in plan.tracks]
     return [
         x
         for s in seeds
-        for x in _method_needs(plan, plan.damping_configs, testbeds, int(s))
-        + [("tracks_recovery", tb, c, int(s)) for tb in testbeds for c in tracks]
+        for x in _methods_needs(plan, plan.recovery, plan.damping_configs, testbeds, int(s))
     ]
 
 
 def _damping_settings(cfg: dict) -> dict:
     configs = cfg["damping_benchmark"]["configs"]
-    return {
-        **_configs(cfg, configs),
-        **_tracks_settings(cfg, configs),
-        **_method_settings(cfg, configs),
-    }
+    return _methods_settings(cfg, RECOVERY_METHODS, configs)
 
 
 def _tab_damping(path, settings, inputs, out):
     trees, seeds = settings["trees"], settings["seeds"]
 
-    def records(kind, *fields, configs):
-        """{seed: {(tree, variant, config): record}} of need ``kind`` on each tree's testbeds."""
+    def records(m, configs):
+        """{seed: {(tree, variant, config): record}} of a method on each tree's testbeds."""
         return {
             s: {
-                (t, v, c): load_recovery(path(kind, tb, *fields, c, s))
+                (t, v, c): load_recovery(path("recovery", tb, m, c, s))
                 for t in trees
                 for v, tb in _testbeds(t).items()
                 for c in configs
@@ -216,9 +196,15 @@ def _tab_damping(path, settings, inputs, out):
             for s in seeds
         }
 
-    methods = _methods(settings, records, TRACKS_NOTE)
+    methods = _method_rows(settings, records, damping=True)
     return tab_damping(methods, trees, settings["bones"], digits=settings["digits"])
 
+
+DAMPING_COLUMNS = Columns(
+    keys=("seed", "tree", "testbed", "config", "method"),
+    values=(*DAMPING_VALUES, *tables.INTERVAL_COLUMNS),
+    about=("bones",),
+)
 
 TAB_DAMPING = Output(
     "tab_damping",
@@ -228,7 +214,16 @@ TAB_DAMPING = Output(
     settings=_damping_settings,
     trees="damping_benchmark",
     in_report=lambda plan: bool(plan.damping_trees),
+    columns=DAMPING_COLUMNS,
 )
+
+
+def _configs(cfg: dict) -> dict:
+    """configs {name: {K, conditions}}: the run's configurations (``models.configs``)."""
+    mc = cfg["models"]["configs"]
+    return {
+        "configs": {c: {"K": int(v["K"]), "conditions": v["conditions"]} for c, v in mc.items()}
+    }
 
 
 # ---- fig_damping ---------------------------------------------------------------------------
@@ -238,7 +233,7 @@ def _fig_damping(path, settings, inputs, out):
     trees, configs, s0 = settings["trees"], list(settings["configs"]), settings["seeds"][0]
     damping = {
         m: {
-            (t, c): load_recovery(path("prior_recovery", t, m, c, s0)).damping
+            (t, c): load_recovery(path("recovery", t, m, c, s0)).damping
             for t in trees
             for c in configs
         }
@@ -251,7 +246,7 @@ FIG_DAMPING = Output(
     "fig_damping",
     "figure",
     lambda plan, seeds: [
-        ("prior_recovery", t, m, c, s)
+        ("recovery", t, m, c, s)
         for s in seeds
         for t in plan.trees
         for m in models_of("prior")
@@ -283,7 +278,7 @@ def _kselect_needs(plan, seeds):
             for m in _kselect_models(plan):
                 out.append(_selection_need(t, m, s))
                 for c in KSELECT_ROWS:
-                    rec = ("prior_recovery", t, m, c, s)
+                    rec = ("recovery", t, m, c, s)
                     out += [("eval", t, m, c, s), rec, ("loss", t, m, c, s)]
     return out
 
@@ -297,7 +292,7 @@ def _tab_kselect(path, settings, inputs, out):
                 sel = load_selection(path(*_selection_need(t, m, s)))
                 for c in KSELECT_ROWS:
                     ev = load_eval(path("eval", t, m, c, s)).summary()
-                    rec = load_recovery(path("prior_recovery", t, m, c, s))
+                    rec = load_recovery(path("recovery", t, m, c, s))
                     loss = pd.read_csv(path("loss", t, m, c, s))
                     rows[s][(t, m, c)] = {
                         "K": rec.match.n_parts,
@@ -321,6 +316,21 @@ def _tab_kselect(path, settings, inputs, out):
     )
 
 
+KSELECT_COLUMNS = Columns(
+    keys=("seed", "tree", "model", "config"),
+    values=(
+        "view_psnr_db",
+        "time_psnr_db",
+        "median_rel_err_pct",
+        "parts_trusted",
+        "parts_frozen",
+        "k_heldout",
+        "k_bic",
+    ),
+    timing=("train_s", "select_s", "cost_x"),
+    about=("bones", "K"),
+)
+
 TAB_KSELECT = Output(
     "tab_kselect",
     "table",
@@ -331,4 +341,5 @@ TAB_KSELECT = Output(
         "models": list(selected_models(cfg["models"]["kselect"])),
     },
     in_report=lambda plan: False,  # `all` builds it (Snakefile): K selection costs trainings
+    columns=KSELECT_COLUMNS,
 )

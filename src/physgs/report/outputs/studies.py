@@ -9,7 +9,7 @@ from physgs.intermediate import read_json
 from physgs.models.registry import BASE_CONFIG, REFERENCE_NAMES, config_label
 from physgs.recovery.record import load_null, load_recovery
 from physgs.report import parts
-from physgs.report.outputs.base import Output
+from physgs.report.outputs.base import Columns, Output
 from physgs.report.outputs.views import fit_row, fit_settings
 from physgs.report.parts import fig_parts
 from physgs.testbed.variant import damping_id
@@ -36,9 +36,9 @@ def _parts_needs(plan, seeds):
             out += [(k, t, m, BASE_CONFIG, s) for m in FIT_FRAME for k in ("eval", "loss")]
             for c in configs:
                 for m in priors:
-                    out += [(k, t, m, c, s) for k in ("eval", "loss", "prior_recovery")]
+                    out += [(k, t, m, c, s) for k in ("eval", "loss", "recovery")]
                     if t in damping_trees:
-                        out.append(("prior_recovery", damping_id(t), m, c, s))
+                        out.append(("recovery", damping_id(t), m, c, s))
             out += list(dict.fromkeys(("null", t, int(configs[c]["K"]), s) for c in configs))
             out.append(("parts", t, s))
     return out
@@ -73,7 +73,7 @@ def _tab_parts(path, settings, inputs, out):
                 null = load_null(path("null", t, int(settings["K"][c]), s))
                 for m in models:
                     damp = (
-                        load_recovery(path("prior_recovery", damping_id(t), m, c, s))
+                        load_recovery(path("recovery", damping_id(t), m, c, s))
                         if t in settings["damping_trees"]
                         else None
                     )
@@ -81,7 +81,7 @@ def _tab_parts(path, settings, inputs, out):
                         fit_row(path("eval", t, m, c, s), path("loss", t, m, c, s), n, every),
                         frame["static"]["fit"],
                         frame[FIT_FRAME[1]]["fit"],
-                        load_recovery(path("prior_recovery", t, m, c, s)),
+                        load_recovery(path("recovery", t, m, c, s)),
                         null,
                         damp,
                         purity=float(seg[f"{m}/overall"]) if c == BASE_CONFIG else float("nan"),
@@ -91,6 +91,24 @@ def _tab_parts(path, settings, inputs, out):
     )
 
 
+PARTS_COLUMNS = Columns(
+    keys=("seed", "tree", "model", "config"),
+    values=(
+        "purity",
+        "fit_psnr_db",
+        "ceiling_frac",
+        "view_psnr_db",
+        "time_psnr_db",
+        "trusted",
+        "omega_rel_err_pct",
+        "omega_null_rel_err_pct",
+        "zeta_rel_err_pct",
+        "zeta_null_rel_err_pct",
+    ),
+    timing=("train_s",),
+    about=("bones",),
+)
+
 TAB_PARTS = Output(
     "tab_parts",
     "table",
@@ -98,6 +116,7 @@ TAB_PARTS = Output(
     _tab_parts,
     settings=_parts_settings,
     in_report=_studied,
+    columns=PARTS_COLUMNS,
 )
 
 
@@ -168,6 +187,11 @@ def _tab_parts_k(path, settings, inputs, out):
     )
 
 
+#: tab_parts_k's CSV: the chained prior at several K (a numeric key)
+PARTS_K_COLUMNS = Columns(
+    keys=("seed", "tree", "model", "K"), values=("heldout_psnr_db", "matched_k"), about=("bones",)
+)
+
 TAB_PARTS_K = Output(
     "tab_parts_k",
     "table",
@@ -176,4 +200,5 @@ TAB_PARTS_K = Output(
     settings=_kmatch_settings,
     seeds="studies",
     in_report=lambda plan: False,  # a study: the `studies` target (Snakefile)
+    columns=PARTS_K_COLUMNS,
 )

@@ -7,9 +7,9 @@ import numpy as np
 import pandas as pd
 
 from physgs.intermediate import read_json
-from physgs.report.outputs.base import Output, key
+from physgs.report.outputs.base import Columns, Output, key
 from physgs.report.outputs.recovery import label_with_k
-from physgs.report.tracks import fig_tracks, tab_tracks
+from physgs.report.tracks import TRACKER_COLUMNS, fig_tracks, tab_tracks
 from physgs.tracks.settings import parts as tracks_k
 from physgs.tracks.store import load_fit, load_tracks
 
@@ -67,6 +67,25 @@ def _tab_tracks(path, settings, inputs, out):
     )
 
 
+#: tab_tracks' CSV: the tracker, the fit and the displacement errors per case (``tail``, each
+#: unseen wind) of the control, ours, the best field, the static pose and each field scored
+TRACKS_COLUMNS = Columns(
+    keys=("seed", "tree", "config"),
+    values=(
+        *TRACKER_COLUMNS,
+        "parts_estimated",
+        "n_fitted",
+        "fit_rms_px",
+        *(
+            f"{case}{who}_px"
+            for case in ("tail", "wind_{wind}")
+            for who in ("", "_ours", "_best_field", "_static", "_field_{model}")
+        ),
+    ),
+    timing=("fit_s", "ours_train_s"),
+    about=("bones", "conditions", "K"),
+)
+
 TAB_TRACKS = Output(
     "tab_tracks",
     "table",
@@ -74,6 +93,7 @@ TAB_TRACKS = Output(
     _tab_tracks,
     settings=_tab_tracks_settings,
     in_report=_controlled,
+    columns=TRACKS_COLUMNS,
 )
 
 

@@ -14,7 +14,7 @@ from physgs.evaluate.trajectories import load_trajectories
 from physgs.experiments.recipe import heldout_split
 from physgs.models.registry import BASE_CONFIG, BLIND_CONFIG, blind_priors, models_of
 from physgs.report import tables
-from physgs.report.outputs.base import Output
+from physgs.report.outputs.base import Columns, Output
 
 #: the roles of the methods compared on images, and of the references shown beside them
 METHODS = ("control", "field", "prior")
@@ -191,26 +191,51 @@ def _tab_margin(path, settings, inputs, out):
     )
 
 
+#: tab_psnr's CSV: one row per model id (a difference row: ``<prior>-static``,
+#: ``<prior>-best_field``), two columns per tree
+PSNR_COLUMNS = Columns(
+    keys=("seed", "model"), values=("{tree}_view", "{tree}_time"), about=("reference", "difference")
+)
+
 TAB_PSNR = Output(
     "tab_psnr",
     "table",
     _evals(("eval",), METHODS + REFERENCES),
     _tab_psnr,
+    columns=PSNR_COLUMNS,
 )
+FIT_COLUMNS = Columns(
+    keys=("seed", "tree", "model"),
+    values=("fit_psnr_db", "heldout_psnr_db", "ceiling_frac", "view_psnr_db", "time_psnr_db"),
+    timing=("train_s",),
+    about=("bones", "reference"),
+)
+
 TAB_FIT = Output(
     "tab_fit",
     "table",
     _fit_needs,
     _tab_fit,
     settings=_fit_table_settings,
+    columns=FIT_COLUMNS,
 )
+#: tab_transfer's CSV: one column per model id; the wind (``condition``) is a numeric key
+TRANSFER_COLUMNS = Columns(
+    keys=("seed", "split", "tree", "condition"), values=("{model}",), about=("bones",)
+)
+
 TAB_TRANSFER = Output(
     "tab_transfer",
     "table",
     _evals(("eval",), METHODS),
     _tab_transfer,
     settings=_conditions,
+    columns=TRANSFER_COLUMNS,
 )
+MARGIN_COLUMNS = Columns(
+    keys=("seed", "model", "tree"), values=("margin_{wind}",), about=("bones",)
+)
+
 TAB_MARGIN = Output(
     "tab_margin",
     "table",
@@ -219,6 +244,7 @@ TAB_MARGIN = Output(
     ],
     _tab_margin,
     settings=_conditions,
+    columns=MARGIN_COLUMNS,
 )
 
 
