@@ -455,8 +455,9 @@ def _tracks_csv(diffs):
 
 
 def _tracks_claims(null, tracks, trees):
-    """The 2D-track control's claims of the ledger measured on these two tables."""
-    measured = claims.measure({"tab_null": null, "tab_tracks": tracks}, {}, trees)
+    """The 2D-track control's claims of the ledger measured on these two tables (its recovery
+    rows beside ours' in tab_recovery)."""
+    measured = claims.measure({"tab_recovery": null, "tab_tracks": tracks}, {}, trees)
     return [(c, v) for c, v in measured if c.id.startswith("tracks_")]
 
 
