@@ -33,6 +33,7 @@ import argparse
 import os
 import resource
 import subprocess
+import sys
 import tempfile
 import threading
 import time
@@ -173,10 +174,13 @@ def main() -> None:
     ap.add_argument("--cores", type=int, default=2)
     ap.add_argument("--cases", default=CASES, help=f"loop:setting, loops among {', '.join(LOOPS)}")
     ap.add_argument("--window", type=float, default=30.0, help="s of the peak-share window")
-    ap.add_argument("--watch", nargs=argparse.REMAINDER, help="-- COMMAND: measure it instead")
-    args = ap.parse_args()
+    ap.add_argument("--watch", action="store_true", help="measure the command after `--` instead")
+    argv = sys.argv[1:]
+    cut = argv.index("--") if "--" in argv else len(argv)
+    args, cmd = ap.parse_args(argv[:cut]), argv[cut + 1 :]
+    if args.watch != bool(cmd):
+        ap.error("--watch takes a command after `--`, and a command needs --watch")
     if args.watch:
-        cmd = args.watch[1:] if args.watch[0] == "--" else args.watch
         u = watch(cmd, window=args.window)
         print(f"{'command':<40}{HEAD}\n{' '.join(cmd)[:39]:<40}{row(u)}")
         return
