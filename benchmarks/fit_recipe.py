@@ -9,9 +9,8 @@ splits: this is what recipe settings are chosen on.
     python benchmarks/fit_recipe.py results/testbed/medium --models static,mlp,truth_motion \
         --set train.iterations=3000 --set train.lr.deform=2e-3
 
-``--set KEY.PATH=VALUE`` overrides any config key; ``--candidate NAME=VALUE`` applies a recipe
-candidate that is code rather than config (loss_pyramid, output_scale, band_anneal:
-benchmarks/recipe_candidates.py). The recipe log in docs/models.md lists what each bought.
+``--set KEY.PATH=VALUE`` overrides any config key. The recipe log in docs/models.md lists what
+each candidate bought.
 """
 
 from __future__ import annotations
@@ -39,15 +38,7 @@ def main(argv: list[str] | None = None) -> None:
     ap.add_argument("--profile", default="default")
     ap.add_argument("--set", action="append", default=[], help="KEY.PATH=VALUE override")
     ap.add_argument("--every", type=int, default=3, help="score every k-th trained frame")
-    ap.add_argument(
-        "--candidate", action="append", default=[], help="NAME=VALUE: recipe_candidates.py"
-    )
     args = ap.parse_args(argv)
-    if args.candidate:
-        import recipe_candidates  # its sibling: run as python benchmarks/fit_recipe.py
-
-        for a in args.candidate:
-            recipe_candidates.apply(a)
     cfg = physgs.config.load("config/trees.yaml", args.profile)
     # the same schema and cross-key checks as the config: a bad --set stops here, key named
     cfg = physgs.config.apply_overrides(cfg, args.set)
@@ -56,7 +47,7 @@ def main(argv: list[str] | None = None) -> None:
     n = int(obs.n_train)
     every = int(cfg["train"].get("holdout_every", 0)) or 10
     trained, held = heldout_split(n, every)
-    print(f"# {args.dataset} overrides={args.set} candidates={args.candidate}")
+    print(f"# {args.dataset} overrides={args.set}")
     print(f"{'model':14s} {'fit dB':>8s} {'held dB':>8s} {'train s':>8s}")
     res = {}
     for m in args.models.split(","):

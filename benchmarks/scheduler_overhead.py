@@ -93,8 +93,13 @@ def _busiest(samples: list[tuple[float, float]], window: float) -> float:
     return best
 
 
-def watch(cmd: list[str], cwd: str | None = None, every: float = 0.2, window: float = 30.0,
-          quiet: bool = False) -> Usage:
+def watch(
+    cmd: list[str],
+    cwd: str | None = None,
+    every: float = 0.2,
+    window: float = 30.0,
+    quiet: bool = False,
+) -> Usage:
     """Run `cmd` and sample its process (Snakemake's main process) until it exits.
 
     Args:

@@ -235,8 +235,8 @@ def cost_section(benchmark_dir) -> list[str]:
         "the run's wall time is not this but the time its command ran, `tools/timed.py`'s, in "
         "the record's stamp). Tables, figures and recovery are light jobs without a benchmark "
         "file. Per stage: minutes of its span (stages overlap) and job-minutes, shared by every "
-        "seed or per training seed (`python benchmarks/pipeline_cost.py` prints the same, and "
-        "one more seed's cost).",
+        "seed or per training seed (`python tools/pipeline_cost.py` prints the same, and one "
+        "more seed's cost).",
         "",
         "| stage | span min | " + " | ".join(f"job-min {h}" for h in head) + " |",
         "|---|---|" + "---|" * len(cols),

@@ -1,6 +1,6 @@
 """What a finished pipeline run cost: job-seconds per stage and seed, and what one more seed adds.
 
-    python benchmarks/pipeline_cost.py [--benchmarks results/benchmarks] [--wall-s SECONDS]
+    python tools/pipeline_cost.py [--benchmarks results/benchmarks] [--wall-s SECONDS]
         [--target TARGET ...]
 
 Reads every Snakemake benchmark file of the run (physgs.experiments.cost) and prints job wall
