@@ -7,10 +7,17 @@ import subprocess
 import sys
 import threading
 import time
+from pathlib import Path
 
 import pytest
+import yaml
+from snakemake.settings.types import MaxJobsPerTimespan
 
 from physgs.scheduling import single_reevaluation_timer
+
+ROOT = Path(__file__).resolve().parents[1]
+#: the profiles that run the jobs on this machine (the cluster's runs them elsewhere)
+LOCAL_PROFILES = ("default", "quick")
 
 
 def fake_scheduler_cls():
@@ -116,13 +123,13 @@ onsuccess:
 """
 
 
-def run_threads(tmp_path, install: bool) -> int:
-    d = tmp_path / ("patched" if install else "upstream")
-    d.mkdir()
+def run_threads(tmp_path, install: bool, *args: str) -> int:
+    d = tmp_path / ("patched" if install else "upstream") / str(len(args))
+    d.mkdir(parents=True)
     code = "import physgs.scheduling\nphysgs.scheduling.install()" if install else ""
     (d / "Snakefile").write_text(SNAKEFILE.format(install=code))
     out = subprocess.run(
-        [sys.executable, "-m", "snakemake", "--cores", "2", "--workflow-profile", "none"],
+        [sys.executable, "-m", "snakemake", "--cores", "2", "--workflow-profile", "none", *args],
         cwd=d,
         capture_output=True,
         text=True,
@@ -139,3 +146,25 @@ def test_snakemake_run_ends_with_one_timer_not_one_per_job(tmp_path):
     patched = run_threads(tmp_path, install=True)
     assert upstream >= 20, upstream
     assert patched <= 4, patched
+
+
+def profile_limit(profile: str) -> str:
+    spec = yaml.safe_load((ROOT / "workflow/profiles" / profile / "config.yaml").read_text())
+    return spec["max-jobs-per-timespan"]
+
+
+@pytest.mark.parametrize("profile", LOCAL_PROFILES)
+def test_local_profiles_keep_the_job_rate_timer_from_firing(profile):
+    """Snakemake's job-rate limiter is always on; each local profile sets a cap no run reaches
+    over a timespan longer than a run, so it never holds a job back and the loop's re-evaluation
+    timer never fires (read by Snakemake's own parser)."""
+    limit = MaxJobsPerTimespan.parse_choice(profile_limit(profile))
+    assert limit.max_jobs >= 10_000  # `all` at the default profile: 715 jobs
+    assert limit.timespan >= 86_400  # s; `all` at the default profile: 4 h 11 min on 2 cores
+
+
+def test_profiles_setting_with_the_patch_ends_at_once_with_one_timer(tmp_path):
+    """The profiles' day-long timespan with the workflow's loop: the run ends (its one pending
+    timer is a daemon thread; upstream's would hold the exit for a day) with at most one timer."""
+    threads = run_threads(tmp_path, True, "--max-jobs-per-timespan", profile_limit("quick"))
+    assert threads <= 4, threads
