@@ -10,7 +10,8 @@ full default-profile run the Snakemake process held 391 timer threads and used 7
 near the end (``benchmarks/scheduler_overhead.py``), on a machine whose two cores the jobs need.
 
 The loop needs only one pending wake-up: the rate limiter's (after a timespan, to admit jobs the
-limit held back), while finished jobs wake it themselves.
+limit held back), while finished jobs wake it themselves. The local profiles set a limit no run
+reaches over a day (``max-jobs-per-timespan: 100000/1d``), so that wake-up never fires either.
 [`single_reevaluation_timer`][physgs.scheduling.single_reevaluation_timer] replaces the method on
 the class so that a request is dropped when a timer that fires no later
 is already pending; an earlier request replaces the pending one. The timer is a daemon thread,
