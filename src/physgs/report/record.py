@@ -55,6 +55,22 @@ STAMP_COLUMNS = ("profile", "config_hash", "physgs_version")
 RERUN_CELLS_SHOWN = 10
 COSTS_COLUMNS = ("name", "command", "wall_s", "date", "commit", "cpu", "from_nothing", "segments")
 BEGIN, END = "<!-- record:begin -->", "<!-- record:end -->"
+
+#: The words and units of the findings, defined once under them (the glossary says more).
+WORDS = (
+    "<sub>Each finding: the measured mean over seeds and its 95% interval; **holds** / **fails** "
+    "when the interval lies on one side of the paper's threshold, **undecided** when it straddles "
+    "it. dB: a difference of PSNR (peak signal-to-noise ratio, decibels) on held-out frames; "
+    "points (pp): percentage points of relative error; fraction: a share of the true value; "
+    "ratio: a quotient of errors (its interval on the log scale, so it stays positive); "
+    "`sparse/0.84`: a tree under an unseen wind of 0.84 times the training speed. "
+    "*Static pose*: the Gaussians frozen at rest; *learned field*: a neural deformation field "
+    "(the baselines); *untrained null*: oscillators with ω drawn over the true range, not "
+    "fitted; *chained prior*: ours with each part riding on its parent; *learned forcing*: "
+    "ours with the wind learned instead of measured; *from nothing*: after `rm -rf results`; "
+    "*segment*: one stretch of a run resumed with the same command (the glossary defines the rest).</sub>",
+)
+
 #: A commit as the record names it: a plain (abbreviated) hash.
 COMMIT = re.compile(r"^[0-9a-f]{7,40}$")
 
@@ -800,6 +816,8 @@ def found_lines(record_dir: str | Path) -> list[str]:
             f"commit `{stamp['commit']}`:",
             "",
             *headline_lines(claims),
+            "",
+            *WORDS,
         ]
     else:
         lines.append(
