@@ -126,7 +126,14 @@ def test_tab_damping_adds_the_forcing_free_rows_with_their_own_scores():
 
 def test_tab_fit_writes_the_blind_priors_undefined_splits_as_not_defined(tmp_path):
     def row(fit, time):
-        return {"fit": fit, "heldout": fit - 1, "view": fit - 2, "time": time, "train_s": 60.0}
+        return {
+            "fit": fit,
+            "heldout": fit - 1,
+            "view": fit - 2,
+            "time": time,
+            "train_s": 60.0,
+            "iterations": 3000,
+        }
 
     rows = {
         s: {

@@ -100,6 +100,8 @@ def test_an_empty_profile_changes_nothing():
         (("testbed", "zeta"), -0.1),
         (("train", "warmup"), -5),  # a recipe setting out of range
         (("train", "lr_final_ratio"), 0.0),
+        (("train", "stopping", "patience"), 0),
+        (("train", "stopping", "tol"), 1.0),
         (("speed_accuracy", "fit_curve", "iterations"), [500, 1]),
         (("speed_accuracy", "fit_curve", "models"), ["mlp", "truth_motion"]),
     ],
@@ -358,6 +360,14 @@ def _set(path, value, profile=None):
             _set(("models", "mlp", "time_top_hz", "d3dgs"), 1.0),
             "default",
             "models/mlp/time_top_hz/d3dgs",
+        ),
+        # the stopping rule reads held-out window frames
+        (_set(("train", "holdout_every"), 0), "default", "train/stopping/enabled"),
+        (_set(("train", "stopping", "every"), 0), "default", "train/stopping/every"),
+        (
+            lambda c: c["train"].update(holdout_every=0, stopping={**c["train"]["stopping"], "enabled": False}),
+            "default",
+            None,
         ),
         # the studies' seeds come from seeds
         (_set(("speed_accuracy", "seeds"), [0, 7]), "default", "speed_accuracy/seeds"),

@@ -54,6 +54,7 @@ def write_tab_fit(path, seeds=(0, 1)):
                     "view": fit,
                     "time": fit,
                     "train_s": 1.0,
+                    "iterations": 3000,
                 }
         per_seed[s] = rows
     tab = T.tab_fit(

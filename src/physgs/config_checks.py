@@ -504,6 +504,33 @@ def holdout_leaves_training_frames(cfg: dict) -> Iterator[Problem]:
         )
 
 
+def stopping_has_held_out_frames(cfg: dict) -> Iterator[Problem]:
+    """The stopping rule (train.stopping) reads held-out window frames: enabled, it needs
+    train.holdout_every > 0 and a scoring period.
+
+    Args:
+        cfg: The resolved config (profile merged, schema-valid).
+
+    Yields:
+        ``(key path, message)`` per problem (the module docstring); none when the config passes.
+    """
+    st = cfg["train"]["stopping"]
+    if not st["enabled"]:
+        return
+    if int(cfg["train"]["holdout_every"]) == 0:
+        yield (
+            ("train", "stopping", "enabled"),
+            "true needs held-out window frames to read: set train/holdout_every > 0, or "
+            "enabled: false to train train/iterations",
+        )
+    if int(st["every"]) == 0:
+        yield (
+            ("train", "stopping", "every"),
+            "0 never scores the held-out frames, so the enabled rule could never stop; set it "
+            "> 0 or enabled: false",
+        )
+
+
 def _freeze_iteration(ours: dict, iterations: int) -> int:
     """The iteration at which freezing runs, round(freeze_at x iterations), as
     [`physgs.models.visibility.freeze_schedule`][] computes it (that module loads torch)."""
@@ -831,6 +858,7 @@ CHECKS: list[Check] = [
     damping_transient_fits,
     warmup_below_iterations,
     holdout_leaves_training_frames,
+    stopping_has_held_out_frames,
     freeze_inside_deformation_phase,
     ours_bounds_ordered,
     omega_search_is_runnable,

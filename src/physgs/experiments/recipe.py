@@ -218,8 +218,10 @@ def fit(
     )
     conds = condition_indices(job.conditions, len(observed.conditions))
     every = int(job.train.get("holdout_every", 0))
-    if frame_pool is None and every:
-        frame_pool = heldout_split(int(observed.n_train), every)[0]
+    held = None
+    if every:
+        trained, held = heldout_split(int(observed.n_train), every)
+        frame_pool = trained if frame_pool is None else frame_pool
     result = train_model(
         model,
         observed,
@@ -230,10 +232,58 @@ def fit(
         progress=progress,
         frame_pool=frame_pool,
         on_iteration=training_hooks(observed, job, conds),
+        holdout=holdout_eval(observed, job, held, conds),
+        earliest_stop=earliest_stop(job),
     )
     if is_prior(job.model):
         result.stats["frozen_parts"] = int(result.model.frozen.sum())
     return result
+
+
+def holdout_eval(observed, job: Job, held, conditions: list[int]):
+    """The evaluator of the held-out window frames the stopping rule reads, or None when the
+    rule neither evaluates (``train.stopping.every`` 0) nor has frames to read.
+
+    Args:
+        observed (Observed): the dataset.
+        job: the training job.
+        held (np.ndarray | None): the held-out frame indices (``heldout_split``), or None.
+        conditions: the trained conditions' indices (their winds' held-out frames only).
+
+    Returns:
+        (HoldoutEval | None): the evaluator.
+    """
+    from physgs.train.holdout import HoldoutEval
+    from physgs.train.stopping import StopRule
+
+    if held is None or held.size == 0 or StopRule.from_config(job.train).every <= 0:
+        return None
+    return HoldoutEval.build(observed, held, conditions, job.train)
+
+
+def earliest_stop(job: Job) -> int:
+    """The first iteration the stopping rule may count: after the recipe's last change to the
+    model (freezing of invisible parts, the end of the search over omega), so a stopped
+    training has had every step of its recipe.
+
+    Args:
+        job: the training job.
+
+    Returns:
+        The iteration (0 when the recipe changes nothing after the warm-up).
+    """
+    from physgs.models.omega_search import OmegaSearch, search_iteration
+    from physgs.models.registry import searches_omega
+    from physgs.models.visibility import freeze_schedule
+
+    out = 0
+    if is_prior(job.model):
+        freeze = freeze_schedule(job.settings, job.train)
+        out = freeze or 0
+        if searches_omega(job.settings, job.model):
+            search = OmegaSearch.from_config(job.settings["omega_search"])
+            out = max(out, search_iteration(search, job.train, freeze))
+    return out
 
 
 def training_hooks(observed, job: Job, conditions: list[int]) -> list:

@@ -358,7 +358,7 @@ def tab_fit(
         per_seed: ``per_seed[seed][(tree, model)]``: fit (dB: mean PSNR over the trained
             training-window frames at the training camera and wind), heldout (dB: the same over
             the held-out training-window frames), view, time (dB: the evaluation splits), train_s
-            (seconds of training).
+            (seconds of training), iterations (training iterations used: the stopping rule's).
         trees: the trees.
         bones: tree -> its bone count.
         models: the models, in row order.
@@ -392,6 +392,7 @@ def tab_fit(
                         "view_psnr_db": r["view"],
                         "time_psnr_db": r["time"],
                         "train_s": r["train_s"],
+                        "iterations": r["iterations"],
                     }
                 )
     df = pd.DataFrame(recs)
@@ -405,13 +406,14 @@ def tab_fit(
             "view_psnr_db",
             "time_psnr_db",
             "train_s",
+            "iterations",
         )
     }
     fmt = f".{int(digits)}f"
     lines = [
-        "  \\begin{tabular}{llcccccr}",
+        "  \\begin{tabular}{llcccccrr}",
         "    \\toprule",
-        r"    Tree & Model & Fit & Held-out frames & Of ceiling & View & Time & Train (s) \\",
+        r"    Tree & Model & Fit & Held-out frames & Of ceiling & View & Time & Train (s) & Iter. \\",
         "    \\midrule",
     ]
     first["_i"] = np.arange(len(first))
@@ -429,6 +431,7 @@ def tab_fit(
                 for c in ("view_psnr_db", "time_psnr_db")
             ),
             seedstats.pm(V["train_s"][:, i], ".0f"),
+            seedstats.pm(V["iterations"][:, i], ".0f"),
         ]
 
     lines += _tree_blocks(first, trees, cells)
@@ -440,6 +443,7 @@ def tab_fit(
         + r" training-window frame, never trained on; \emph{Of ceiling}: "
         r"(model $-$ static) / "
         r"(true motion $-$ static) on the fit. \emph{View}, \emph{Time}: the evaluation splits. "
+        r"\emph{Iter.}: training iterations used (the stopping rule's, capped at train.iterations). "
         r"In italics the reference: the canonical Gaussians moved by the ground-truth motion."
         + (
             f" {NOT_DEFINED}: not defined (a learned forcing has no wind to read beyond the "

@@ -16,10 +16,25 @@ from physgs.models.base import BaseModel
 from physgs.render import rasterization
 from physgs.train.adam import FusedAdam
 from physgs.train.divergence import SUSPECT_GROWN, Divergence, DivergenceGuard, pinned
+from physgs.train.holdout import HoldoutEval
 from physgs.train.losses import photometric_loss
 from physgs.train.schedule import lr_factor
+from physgs.train.stopping import STOP_CAP, STOP_PLATEAU, Plateau, StopRule
 
-LOG_FIELDS = ("iteration", "phase", "condition", "frame", "loss", "l1", "dssim", "seconds")
+#: The loss log's columns. phase: warmup | deform | anneal (the final decay after the stopping
+#: rule triggered: a log whose last phase is anneal stopped on a plateau); holdout: the held-out
+#: window frames' mean loss, evaluated before that iteration (empty between evaluations).
+LOG_FIELDS = (
+    "iteration",
+    "phase",
+    "condition",
+    "frame",
+    "loss",
+    "l1",
+    "dssim",
+    "holdout",
+    "seconds",
+)
 
 
 class TrainingError(RuntimeError):
@@ -77,6 +92,8 @@ def train_model(
     progress: bool = True,
     frame_pool=None,
     on_iteration=None,
+    holdout: HoldoutEval | None = None,
+    earliest_stop: int = 0,
 ) -> TrainResult:
     """Fit ``model`` to the training-camera frames of ``observed``.
 
@@ -84,6 +101,11 @@ def train_model(
     j < n_train, renders the model at the training camera and steps Adam on
     (1 - w) L1 + w D-SSIM. The first ``warmup`` iterations render the canonical Gaussians only
     (the shared static warm-up).
+
+    With ``holdout`` and ``train.stopping.every`` > 0, the held-out window frames are scored
+    every ``every`` iterations (logged in the loss log's ``holdout`` column); with
+    ``train.stopping.enabled``, a plateau of that loss ([`physgs.train.stopping`][]) starts the
+    schedule's final anneal and the training ends after it, before ``train.iterations``.
 
     Args:
         model: the model to train (in place).
@@ -98,13 +120,18 @@ def train_model(
         on_iteration (Callable | list | None): a hook ``on_iteration(it, model, optimizer) -> dict |
             None``, or a list of them called in order, before each iteration; the dicts they return
             are merged into the statistics (freezing, the search over omega).
+        holdout: the held-out window frames' evaluator (None: no evaluation, no early stop).
+        earliest_stop: the stopping rule counts no evaluation before this iteration (the
+            recipe's last change to the model: freezing, the end of the search over omega).
 
     Returns:
         The [`TrainResult`][physgs.train.loop.TrainResult]: the model in eval mode, its statistics
             and the per-iteration loss log.
 
     Raises:
-        ValueError: warmup outside [0, iterations), conditions or frame_pool out of range.
+        ValueError: warmup outside [0, iterations), conditions or frame_pool out of range, a
+            stopping rule that cannot run (``train.stopping``), or one enabled without held-out
+            frames.
         TrainingError: the loss turns NaN or inf, the fit diverges (non-finite or exploding
             parameters, Gaussians far outside the scene, a loss far above its warm-up level:
             [`physgs.train.divergence`][]), or the model's forward pass raises (chained); it names
@@ -124,6 +151,15 @@ def train_model(
                 f"frame_pool must hold training-frame indices in [0, "
                 f"{observed.n_train}); got {frame_pool.size} frames"
             )
+    rule = StopRule.from_config(train_cfg)
+    rule.check()
+    if rule.enabled and holdout is None:
+        raise ValueError(
+            "train.stopping.enabled needs held-out window frames (train.holdout_every > 0)"
+        )
+    evaluate = holdout is not None and rule.every > 0
+    plateau = Plateau(rule.patience, rule.tol, earliest=max(earliest_stop, warmup))
+    anneal_from, end, eval_s = None, iterations, 0.0
     extra: dict = {}
     if on_iteration is None:
         hooks = []
@@ -172,8 +208,19 @@ def train_model(
     t0 = time.perf_counter()
     bar = tqdm(range(iterations), desc=f"train {name}", disable=not progress, mininterval=2.0)
     for it in bar:
+        if it >= end:
+            break
         for hook in hooks:
             extra.update(hook(it, model, opt) or {})
+        held = None
+        if evaluate and anneal_from is None and it > 0 and it % rule.every == 0:
+            te = time.perf_counter()
+            held, _ = holdout.evaluate(model, warm=it < warmup)
+            eval_s += time.perf_counter() - te
+            # a trigger whose anneal would pass the cap changes nothing: the budget's own tail
+            # is that anneal
+            if plateau.update(it, held) and rule.enabled and it + rule.anneal < iterations:
+                anneal_from, end = it, it + rule.anneal
         c = int(conditions[rng.integers(len(conditions))])
         j = int(
             rng.integers(observed.n_train)
@@ -242,7 +289,9 @@ def train_model(
         if d is not None:
             raise diverged(it, d)
         for g in opt.param_groups:
-            g["lr"] = g["base_lr"] * lr_factor(g["name"], it, iterations, warmup, final)
+            g["lr"] = g["base_lr"] * lr_factor(
+                g["name"], it, iterations, warmup, final, anneal_from, end
+            )
             moved[g["name"]] += g["lr"]
         opt.zero_grad(set_to_none=True)
         loss.backward()
@@ -253,32 +302,39 @@ def train_model(
         log.append(
             {
                 "iteration": it,
-                "phase": "warmup" if warm else "deform",
+                "phase": "warmup" if warm else "deform" if anneal_from is None else "anneal",
                 "condition": c,
                 "frame": j,
                 "loss": loss.item(),
                 "l1": l1.item(),
                 "dssim": dssim.item(),
+                "holdout": "" if held is None else held,
                 "seconds": time.perf_counter() - t0,
             }
         )
         if it % 10 == 0:
             bar.set_postfix(loss=f"{loss.item():.4f}")
     wall = time.perf_counter() - t0
+    used = len(log)
     d = pinned(model.bounded_positions())
     if d is not None:  # a saturated fit is a failed fit, not a checkpoint to score
         raise TrainingError(
-            f"model '{name}': after {iterations} iterations {d.what}; "
+            f"model '{name}': after {used} iterations {d.what}; "
             f"{likely(d.groups)}; "
             "no checkpoint written"
         )
     model.eval()
-    tail = [r["loss"] for r in log[-max(1, iterations // 10) :]]
+    tail = [r["loss"] for r in log[-max(1, used // 10) :]]
     stats = {
-        "iterations": iterations,
+        "iterations": used,
+        "budget": iterations,
+        "stopped": STOP_PLATEAU if anneal_from is not None else STOP_CAP,
+        "stop_trigger": -1 if anneal_from is None else int(anneal_from),
+        "holdout_evals": len(plateau.history),
+        "holdout_s": eval_s,
         "warmup": warmup,
         "wall_s": wall,
-        "s_per_iter": wall / iterations,
+        "s_per_iter": wall / used,
         "final_loss": float(np.mean(tail)),
         "conditions": list(conditions),
         "seed": int(seed),

@@ -67,8 +67,8 @@ def summaries(path, trees, models, seeds) -> dict:
 
 def fit_row(eval_path, loss_path, n_train: int, holdout_every: int) -> dict:
     """One tab_fit row from a model's evaluation and loss log: fit and held-out-frame PSNR (dB,
-    training camera and wind, frames < n_train), view and time PSNR (dB), training seconds
-    (NaN without a loss log).
+    training camera and wind, frames < n_train), view and time PSNR (dB), training seconds and
+    iterations used (NaN without a loss log).
 
     Args:
         eval_path (str | Path): the model's evaluation ``.npz``.
@@ -77,7 +77,7 @@ def fit_row(eval_path, loss_path, n_train: int, holdout_every: int) -> dict:
         holdout_every: the held-out stride (0: no held-out frames, ``heldout`` NaN).
 
     Returns:
-        ``fit``, ``heldout``, ``view``, ``time`` (dB) and ``train_s`` (s).
+        ``fit``, ``heldout``, ``view``, ``time`` (dB), ``train_s`` (s) and ``iterations``.
     """
     ev = load_eval(eval_path)
     cam = np.asarray(ev.camera_psnr[0, :n_train], dtype=np.float64)  # [n_train] dB
@@ -86,13 +86,18 @@ def fit_row(eval_path, loss_path, n_train: int, holdout_every: int) -> dict:
     else:
         trained, held = np.arange(n_train), np.arange(0)
     s = ev.summary()
-    secs = pd.read_csv(loss_path)["seconds"] if loss_path is not None else pd.Series([np.nan])
+    log = (
+        pd.read_csv(loss_path, usecols=["iteration", "seconds"])
+        if loss_path is not None
+        else pd.DataFrame({"iteration": [np.nan], "seconds": [np.nan]})
+    )
     return {
         "fit": float(cam[trained].mean()),
         "heldout": float(cam[held].mean()) if held.size else float("nan"),
         "view": s["view"],
         "time": s["time"],
-        "train_s": float(secs.iloc[-1]),
+        "train_s": float(log["seconds"].iloc[-1]),
+        "iterations": float(log["iteration"].iloc[-1]) + 1,
     }
 
 

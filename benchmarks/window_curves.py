@@ -1,0 +1,103 @@
+"""Held-out-window fit curves: each model's loss on the frames its training window holds out
+(every ``train.holdout_every``-th, of the trained wind) every ``--every`` iterations of one
+full-budget training (the profile's). What the stopping rule's N, tolerance and patience are
+chosen on (docs/models.md); never the views, the tail or another wind.
+
+    PYTHONPATH=src nice -n 10 env OMP_NUM_THREADS=1 python benchmarks/window_curves.py \
+        --tree sparse --out curves/sparse.csv [--models static,mlp,...] [--every 50]
+
+Writes one CSV row per (model, iteration): the held-out loss (the training loss, L1 + D-SSIM),
+its PSNR (dB), the training loss (mean of the last ``--every`` iterations), the wall time.
+"""
+
+from __future__ import annotations
+
+import argparse
+import csv
+import os
+import time
+
+import numpy as np
+import torch
+
+from physgs.config import load
+from physgs.experiments.recipe import Job, heldout_split, job_spec, training_hooks
+from physgs.models.registry import BLIND_PRIORS, build_model, is_reference, training_jobs
+from physgs.testbed.dataset import load_observed, load_truth
+from physgs.train.holdout import HoldoutEval
+from physgs.train.loop import condition_indices, train_model
+from physgs.train.seeding import seed_everything
+
+RULE_OFF = {"enabled": False, "every": 0, "patience": 1, "tol": 0.0, "anneal": 1}
+FIELDS = ("model", "tree", "seed", "iteration", "holdout_loss", "holdout_psnr", "train_loss", "seconds")
+
+
+def models_that_train(cfg: dict) -> list[str]:
+    """Every model kind trained in `single`: the methods, the forcing-free priors, the parts
+    study's variants and the ceiling."""
+    ms = [m for m, c in training_jobs(cfg["models"]["configs"]) if c == "single"]
+    ms += [m for m in BLIND_PRIORS] + [m for m in cfg["parts_study"]["models"] if m not in ms]
+    return [*ms, "truth_motion"]
+
+
+def main() -> None:
+    ap = argparse.ArgumentParser(description=__doc__)
+    ap.add_argument("--tree", required=True)
+    ap.add_argument("--out", required=True)
+    ap.add_argument("--models", default="")
+    ap.add_argument("--every", type=int, default=50)
+    ap.add_argument("--seed", type=int, default=0)
+    ap.add_argument("--profile", default="default")
+    a = ap.parse_args()
+    cfg = load("config/trees.yaml", a.profile)
+    obs = load_observed(f"results/testbed/{a.tree}/observed.npz")
+    truth = load_truth(f"results/testbed/{a.tree}/truth.npz")
+    models = a.models.split(",") if a.models else models_that_train(cfg)
+    new = not os.path.exists(a.out)
+    with open(a.out, "a", newline="") as fh:
+        w = csv.DictWriter(fh, fieldnames=FIELDS)
+        if new:
+            w.writeheader()
+        for m in models:
+            job = Job.from_dict(job_spec(cfg, m, "single", seed=a.seed))
+            # the full budget, scored by the hook below: the curve the rule is chosen on
+            job = job.replace(train={**job.train, "stopping": {**RULE_OFF}})
+            seed_everything(job.seed)
+            model = build_model(
+                m, obs, job.settings, config=job.config, K=job.K, seed=job.seed,
+                truth=truth if is_reference(m) else None,
+            )
+            conds = condition_indices(job.conditions, len(obs.conditions))
+            trained, held = heldout_split(int(obs.n_train), int(job.train["holdout_every"]))
+            ev = HoldoutEval.build(obs, held, conds, job.train)
+            t0 = time.perf_counter()
+            rows = []
+
+            def record(it, mdl, opt, _ev=ev, _rows=rows, _m=m, _t0=t0):
+                if it % a.every == 0 and it > 0:
+                    loss, p = _ev.evaluate(mdl, warm=it < int(job.train["warmup"]))
+                    _rows.append(dict(model=_m, tree=a.tree, seed=a.seed, iteration=it,
+                                      holdout_loss=loss, holdout_psnr=p,
+                                      seconds=time.perf_counter() - _t0))
+
+            res = train_model(
+                model, obs, job.train, conditions=conds, seed=job.seed, name=m, progress=False,
+                frame_pool=trained, on_iteration=[*training_hooks(obs, job, conds), record],
+            )
+            loss, p = ev.evaluate(res.model, warm=False)
+            rows.append(dict(model=m, tree=a.tree, seed=a.seed, iteration=len(res.log),
+                             holdout_loss=loss, holdout_psnr=p,
+                             seconds=time.perf_counter() - t0))
+            tl = np.array([r["loss"] for r in res.log])
+            for r in rows:
+                i = r["iteration"]
+                r["train_loss"] = float(tl[max(0, i - a.every) : i].mean())
+                w.writerow(r)
+            fh.flush()
+            print(f"{a.tree} {m}: {len(res.log)} it, {res.stats['wall_s']:.0f} s, "
+                  f"holdout loss {loss:.4f}, {p:.2f} dB", flush=True)
+
+
+if __name__ == "__main__":
+    torch.set_num_threads(1)
+    main()

@@ -1,0 +1,142 @@
+"""The stopping rule: the plateau detector on curves worked by hand, the schedule's final anneal,
+and a tiny real training that stops on its held-out window frames and records it."""
+
+import numpy as np
+import pandas as pd
+import pytest
+
+from physgs.experiments import job_spec, train_and_save
+from physgs.experiments.recipe import Job, fit
+from physgs.models import build_model, load_checkpoint
+from physgs.train import train_model
+from physgs.train.schedule import DECAYING, lr_factor
+from physgs.train.stopping import STOP_CAP, STOP_PLATEAU, plateau_iteration
+from oracles import quick_train_cfg
+
+EVERY = 100
+ITS = np.arange(EVERY, 3001, EVERY)
+
+
+def test_rule_stops_on_a_plateau_at_the_iteration_worked_by_hand():
+    # 1 / (1 + it / 200) falls >= 8% per evaluation up to 1000, then stays flat: the score at
+    # 1000 is the last improvement; 1100, 1200, 1300 are three without one
+    loss = np.where(ITS <= 1000, 1 / (1 + ITS / 200), 1 / 6)
+    assert plateau_iteration(ITS, loss, patience=3, tol=0.01) == 1300
+    # noise below the tolerance does not reset the count
+    noisy = loss * np.where(ITS > 1000, 1 - 0.004 * (ITS % 200 == 0), 1.0)
+    assert plateau_iteration(ITS, noisy, patience=3, tol=0.01) == 1300
+    # the recipe's last change at 1500: nothing counts before it (best = 1500's, then 3 more)
+    assert plateau_iteration(ITS, loss, patience=3, tol=0.01, earliest=1500) == 1800
+
+
+def test_rule_does_not_stop_a_curve_still_improving():
+    fast = np.exp(-ITS / 500)  # 18% per evaluation
+    assert plateau_iteration(ITS, fast, patience=3, tol=0.01) is None
+    # 0.6% per evaluation: each single step is under tol = 1%, but two are over it, inside the
+    # patience of 3, so the best moves every second evaluation and the rule never triggers
+    slow = 0.994 ** (ITS / EVERY)
+    assert plateau_iteration(ITS, slow, patience=3, tol=0.01) is None
+    # ... while 0.3% per evaluation (0.9% over three) is a plateau: best at 100, stop at 400
+    slower = 0.997 ** (ITS / EVERY)
+    assert plateau_iteration(ITS, slower, patience=3, tol=0.01) == 400
+
+
+@pytest.mark.parametrize("group", DECAYING)
+def test_schedule_stopped_early_ends_at_its_final_factor(group):
+    its, warm, final, s, A = 3000, 50, 0.1, 1200, 300
+    f = [lr_factor(group, i, its, warm, final, s, s + A) for i in range(s + A + 1)]
+    assert f[s + A] == pytest.approx(final, rel=1e-12)  # the end of the stopped run
+    # the last trained iteration: one anneal step short of it, as the full schedule's last is
+    assert f[s + A - 1] == pytest.approx(final ** (1 - (1 - _progress(group, s, its, warm)) / A))
+    # continuous at the trigger, and never increasing
+    assert f[s] == pytest.approx(lr_factor(group, s, its, warm, final))
+    assert np.all(np.diff(f) <= 1e-15)
+
+
+def _progress(group, it, its, warm):
+    start = 0 if group == "means" else warm
+    return (it - start) / (its - start)
+
+
+@pytest.mark.parametrize("group", [*DECAYING, "colors"])
+def test_anneal_at_the_budgets_tail_is_the_schedule_without_a_stop(group):
+    its, warm, final, A = 3000, 50, 0.1, 300
+    for i in (0, 49, 50, 1000, its - A, its - A + 1, 2999, 3000):
+        base = lr_factor(group, i, its, warm, final)
+        assert lr_factor(group, i, its, warm, final, its - A, its) == pytest.approx(base, rel=1e-12)
+        if group in DECAYING:  # the closed form: final ** ((it - start) / span)
+            start = 0 if group == "means" else warm
+            assert base == pytest.approx(final ** min(max((i - start) / (its - start), 0), 1))
+
+
+def _stop_cfg(**stopping):
+    cfg = quick_train_cfg(200, 5)
+    cfg["train"]["stopping"] = {
+        "enabled": True,
+        "every": 5,
+        "patience": 2,
+        "tol": 0.9,  # an improvement would be a 10x lower loss: none comes, the count is exact
+        "anneal": 10,
+        **stopping,
+    }
+    return cfg
+
+
+def test_tiny_training_stops_on_its_held_out_frames_and_records_it(tmp_path, swaying):
+    cfg = _stop_cfg()
+    ck, lg = tmp_path / "static_single.pt", tmp_path / "static_single.loss.csv"
+    train_and_save(
+        swaying, job_spec(cfg, "static", "single"), checkpoint_path=ck, loss_path=lg, progress=False
+    )
+    st = load_checkpoint(ck).checkpoint_info["stats"]
+    # scored at 5 (the first deformation iteration: the best), 10, 15: two without an
+    # improvement trigger at 15; the anneal's 10 iterations end the run at 25 of the 200
+    assert (st["stopped"], st["stop_trigger"], st["iterations"], st["budget"]) == (
+        STOP_PLATEAU,
+        15,
+        25,
+        200,
+    )
+    assert st["holdout_evals"] == 3 and st["holdout_s"] > 0
+    log = pd.read_csv(lg)
+    assert len(log) == 25 and log["iteration"].iloc[-1] == 24
+    assert list(log.loc[log["holdout"].notna(), "iteration"]) == [5, 10, 15]
+    assert (log["phase"].iloc[15:] == "anneal").all() and (log["phase"].iloc[5:15] == "deform").all()
+
+
+def test_a_rule_that_never_triggers_trains_the_whole_budget(swaying):
+    cfg = _stop_cfg(tol=0.0, patience=50)  # any decrease counts
+    cfg["train"]["iterations"] = 40
+    res = fit(swaying, Job.from_dict(job_spec(cfg, "static", "single")), progress=False)
+    assert (res.stats["stopped"], res.stats["iterations"], res.stats["holdout_evals"]) == (
+        STOP_CAP,
+        40,
+        7,
+    )
+
+
+def test_scoring_the_held_out_frames_leaves_the_training_unchanged(swaying):
+    """The rule off but scoring: bitwise the training without scores (no side effect)."""
+    losses = []
+    for every in (0, 5):
+        cfg = _stop_cfg(enabled=False, every=every)
+        cfg["train"]["iterations"] = 30
+        res = fit(swaying, Job.from_dict(job_spec(cfg, "mlp", "single")), progress=False)
+        losses.append([r["loss"] for r in res.log])
+        assert res.stats["stopped"] == STOP_CAP and res.stats["holdout_evals"] == (
+            0 if every == 0 else 5
+        )
+    assert losses[0] == losses[1]
+
+
+def test_enabled_rule_without_held_out_frames_is_refused(swaying):
+    cfg = _stop_cfg()
+    model = build_model("static", swaying, cfg["models"], seed=0)
+    with pytest.raises(ValueError, match="holdout_every"):
+        train_model(model, swaying, cfg["train"], conditions=[0], seed=0, progress=False)
+
+
+def test_plateau_counts_relative_improvements():
+    # by hand: best 1.0; 0.995 is 0.5% (< 1%: no); 0.989 is 1.1% (yes: best 0.989)
+    assert plateau_iteration([1, 2, 3, 4], [1.0, 0.995, 0.989, 0.988], 2, 0.01) is None
+    assert plateau_iteration([1, 2, 3, 4, 5], [1.0, 0.995, 0.989, 0.988, 0.985], 2, 0.01) == 5
