@@ -8,6 +8,11 @@ chosen on (docs/models.md); never the views, the tail or another wind.
 
 Writes one CSV row per (model, iteration): the held-out loss (the training loss, L1 + D-SSIM),
 its PSNR (dB), the training loss (mean of the last ``--every`` iterations), the wall time.
+
+``--rule`` instead trains each model as the pipeline does (``recipe.fit``, the config's
+``train.stopping``, overridable with ``--stop-every/--tol/--patience/--anneal``) and writes one
+row per model: the iterations used, why it stopped, the held-out loss and PSNR at its end, its
+wall time and the time its held-out scores took.
 """
 
 from __future__ import annotations
@@ -21,7 +26,7 @@ import numpy as np
 import torch
 
 from physgs.config import load
-from physgs.experiments.recipe import Job, heldout_split, job_spec, training_hooks
+from physgs.experiments.recipe import Job, fit, heldout_split, job_spec, training_hooks
 from physgs.models.registry import BLIND_PRIORS, build_model, is_reference, training_jobs
 from physgs.testbed.dataset import load_observed, load_truth
 from physgs.train.holdout import HoldoutEval
@@ -29,7 +34,16 @@ from physgs.train.loop import condition_indices, train_model
 from physgs.train.seeding import seed_everything
 
 RULE_OFF = {"enabled": False, "every": 0, "patience": 1, "tol": 0.0, "anneal": 1}
-FIELDS = ("model", "tree", "seed", "iteration", "holdout_loss", "holdout_psnr", "train_loss", "seconds")
+FIELDS = (
+    "model",
+    "tree",
+    "seed",
+    "iteration",
+    "holdout_loss",
+    "holdout_psnr",
+    "train_loss",
+    "seconds",
+)
 
 
 def models_that_train(cfg: dict) -> list[str]:
@@ -40,6 +54,76 @@ def models_that_train(cfg: dict) -> list[str]:
     return [*ms, "truth_motion"]
 
 
+RULE_FIELDS = (
+    "model",
+    "tree",
+    "seed",
+    "every",
+    "patience",
+    "tol",
+    "anneal",
+    "iterations",
+    "stopped",
+    "stop_trigger",
+    "holdout_loss",
+    "holdout_psnr",
+    "wall_s",
+    "holdout_s",
+    "holdout_evals",
+)
+
+
+def run_rule(a, cfg: dict, obs, truth, models: list[str]) -> None:
+    """Train each model with the stopping rule on and append its row to ``a.out``."""
+    st = dict(cfg["train"]["stopping"], enabled=True)
+    for k, v in (
+        ("every", a.stop_every),
+        ("tol", a.tol),
+        ("patience", a.patience),
+        ("anneal", a.anneal),
+    ):
+        if v is not None:
+            st[k] = v
+    cfg["train"]["stopping"] = st
+    new = not os.path.exists(a.out)
+    with open(a.out, "a", newline="") as fh:
+        w = csv.DictWriter(fh, fieldnames=RULE_FIELDS)
+        if new:
+            w.writeheader()
+        for m in models:
+            job = Job.from_dict(job_spec(cfg, m, "single", seed=a.seed))
+            res = fit(obs, job, truth=truth if is_reference(m) else None, progress=False)
+            held = heldout_split(int(obs.n_train), int(job.train["holdout_every"]))[1]
+            conds = condition_indices(job.conditions, len(obs.conditions))
+            loss, p = HoldoutEval.build(obs, held, conds, job.train).evaluate(res.model)
+            s = res.stats
+            w.writerow(
+                dict(
+                    model=m,
+                    tree=a.tree,
+                    seed=a.seed,
+                    every=st["every"],
+                    patience=st["patience"],
+                    tol=st["tol"],
+                    anneal=st["anneal"],
+                    iterations=s["iterations"],
+                    stopped=s["stopped"],
+                    stop_trigger=s["stop_trigger"],
+                    holdout_loss=loss,
+                    holdout_psnr=p,
+                    wall_s=s["wall_s"],
+                    holdout_s=s["holdout_s"],
+                    holdout_evals=s["holdout_evals"],
+                )
+            )
+            fh.flush()
+            print(
+                f"{a.tree} {m}: {s['iterations']} it ({s['stopped']}), {s['wall_s']:.0f} s "
+                f"(scores {s['holdout_s']:.1f} s), holdout loss {loss:.4f}, {p:.2f} dB",
+                flush=True,
+            )
+
+
 def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__)
     ap.add_argument("--tree", required=True)
@@ -48,11 +132,19 @@ def main() -> None:
     ap.add_argument("--every", type=int, default=50)
     ap.add_argument("--seed", type=int, default=0)
     ap.add_argument("--profile", default="default")
+    ap.add_argument("--rule", action="store_true", help="train with the stopping rule on")
+    ap.add_argument("--stop-every", type=int, default=None)
+    ap.add_argument("--tol", type=float, default=None)
+    ap.add_argument("--patience", type=int, default=None)
+    ap.add_argument("--anneal", type=int, default=None)
     a = ap.parse_args()
     cfg = load("config/trees.yaml", a.profile)
     obs = load_observed(f"results/testbed/{a.tree}/observed.npz")
     truth = load_truth(f"results/testbed/{a.tree}/truth.npz")
     models = a.models.split(",") if a.models else models_that_train(cfg)
+    if a.rule:
+        run_rule(a, cfg, obs, truth, models)
+        return
     new = not os.path.exists(a.out)
     with open(a.out, "a", newline="") as fh:
         w = csv.DictWriter(fh, fieldnames=FIELDS)
@@ -64,7 +156,12 @@ def main() -> None:
             job = job.replace(train={**job.train, "stopping": {**RULE_OFF}})
             seed_everything(job.seed)
             model = build_model(
-                m, obs, job.settings, config=job.config, K=job.K, seed=job.seed,
+                m,
+                obs,
+                job.settings,
+                config=job.config,
+                K=job.K,
+                seed=job.seed,
                 truth=truth if is_reference(m) else None,
             )
             conds = condition_indices(job.conditions, len(obs.conditions))
@@ -73,29 +170,57 @@ def main() -> None:
             t0 = time.perf_counter()
             rows = []
 
-            def record(it, mdl, opt, _ev=ev, _rows=rows, _m=m, _t0=t0):
+            warmup = int(job.train["warmup"])
+
+            def record(it, mdl, opt, _ev=ev, _rows=rows, _m=m, _t0=t0, _w=warmup):
                 if it % a.every == 0 and it > 0:
-                    loss, p = _ev.evaluate(mdl, warm=it < int(job.train["warmup"]))
-                    _rows.append(dict(model=_m, tree=a.tree, seed=a.seed, iteration=it,
-                                      holdout_loss=loss, holdout_psnr=p,
-                                      seconds=time.perf_counter() - _t0))
+                    loss, p = _ev.evaluate(mdl, warm=it < _w)
+                    _rows.append(
+                        dict(
+                            model=_m,
+                            tree=a.tree,
+                            seed=a.seed,
+                            iteration=it,
+                            holdout_loss=loss,
+                            holdout_psnr=p,
+                            seconds=time.perf_counter() - _t0,
+                        )
+                    )
 
             res = train_model(
-                model, obs, job.train, conditions=conds, seed=job.seed, name=m, progress=False,
-                frame_pool=trained, on_iteration=[*training_hooks(obs, job, conds), record],
+                model,
+                obs,
+                job.train,
+                conditions=conds,
+                seed=job.seed,
+                name=m,
+                progress=False,
+                frame_pool=trained,
+                on_iteration=[*training_hooks(obs, job, conds), record],
             )
             loss, p = ev.evaluate(res.model, warm=False)
-            rows.append(dict(model=m, tree=a.tree, seed=a.seed, iteration=len(res.log),
-                             holdout_loss=loss, holdout_psnr=p,
-                             seconds=time.perf_counter() - t0))
+            rows.append(
+                dict(
+                    model=m,
+                    tree=a.tree,
+                    seed=a.seed,
+                    iteration=len(res.log),
+                    holdout_loss=loss,
+                    holdout_psnr=p,
+                    seconds=time.perf_counter() - t0,
+                )
+            )
             tl = np.array([r["loss"] for r in res.log])
             for r in rows:
                 i = r["iteration"]
                 r["train_loss"] = float(tl[max(0, i - a.every) : i].mean())
                 w.writerow(r)
             fh.flush()
-            print(f"{a.tree} {m}: {len(res.log)} it, {res.stats['wall_s']:.0f} s, "
-                  f"holdout loss {loss:.4f}, {p:.2f} dB", flush=True)
+            print(
+                f"{a.tree} {m}: {len(res.log)} it, {res.stats['wall_s']:.0f} s, "
+                f"holdout loss {loss:.4f}, {p:.2f} dB",
+                flush=True,
+            )
 
 
 if __name__ == "__main__":

@@ -365,7 +365,9 @@ def _set(path, value, profile=None):
         (_set(("train", "holdout_every"), 0), "default", "train/stopping/enabled"),
         (_set(("train", "stopping", "every"), 0), "default", "train/stopping/every"),
         (
-            lambda c: c["train"].update(holdout_every=0, stopping={**c["train"]["stopping"], "enabled": False}),
+            lambda c: c["train"].update(
+                holdout_every=0, stopping={**c["train"]["stopping"], "enabled": False}
+            ),
             "default",
             None,
         ),

@@ -101,7 +101,9 @@ def test_tiny_training_stops_on_its_held_out_frames_and_records_it(tmp_path, swa
     log = pd.read_csv(lg)
     assert len(log) == 25 and log["iteration"].iloc[-1] == 24
     assert list(log.loc[log["holdout"].notna(), "iteration"]) == [5, 10, 15]
-    assert (log["phase"].iloc[15:] == "anneal").all() and (log["phase"].iloc[5:15] == "deform").all()
+    assert (log["phase"].iloc[15:] == "anneal").all() and (
+        log["phase"].iloc[5:15] == "deform"
+    ).all()
 
 
 def test_a_rule_that_never_triggers_trains_the_whole_budget(swaying):
