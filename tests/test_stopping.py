@@ -133,9 +133,16 @@ def test_scoring_the_held_out_frames_leaves_the_training_unchanged(swaying):
 
 def test_enabled_rule_without_held_out_frames_is_refused(swaying):
     cfg = _stop_cfg()
+    cfg["train"]["holdout_every"] = 0
+    with pytest.raises(ValueError, match="holdout_every > 0"):
+        fit(swaying, Job.from_dict(job_spec(cfg, "static", "single")), progress=False)
+
+
+def test_the_loop_without_held_out_frames_trains_its_budget(swaying):
+    cfg = _stop_cfg()
     model = build_model("static", swaying, cfg["models"], seed=0)
-    with pytest.raises(ValueError, match="holdout_every"):
-        train_model(model, swaying, cfg["train"], conditions=[0], seed=0, progress=False)
+    res = train_model(model, swaying, cfg["train"], conditions=[0], seed=0, progress=False)
+    assert (res.stats["iterations"], res.stats["stopped"]) == (200, STOP_CAP)
 
 
 def test_plateau_counts_relative_improvements():

@@ -252,13 +252,22 @@ def holdout_eval(observed, job: Job, held, conditions: list[int]):
 
     Returns:
         (HoldoutEval | None): the evaluator.
+
+    Raises:
+        ValueError: the rule is enabled and no frame is held out.
     """
     from physgs.train.holdout import HoldoutEval
     from physgs.train.stopping import StopRule
 
-    if held is None or held.size == 0 or StopRule.from_config(job.train).every <= 0:
+    rule = StopRule.from_config(job.train)
+    if held is None or held.size == 0:
+        if rule.enabled:
+            raise ValueError(
+                "train.stopping.enabled needs held-out window frames to read: set "
+                "train.holdout_every > 0, or train.stopping.enabled: false"
+            )
         return None
-    return HoldoutEval.build(observed, held, conditions, job.train)
+    return HoldoutEval.build(observed, held, conditions, job.train) if rule.every > 0 else None
 
 
 def earliest_stop(job: Job) -> int:

@@ -105,7 +105,9 @@ def train_model(
     With ``holdout`` and ``train.stopping.every`` > 0, the held-out window frames are scored
     every ``every`` iterations (logged in the loss log's ``holdout`` column); with
     ``train.stopping.enabled``, a plateau of that loss ([`physgs.train.stopping`][]) starts the
-    schedule's final anneal and the training ends after it, before ``train.iterations``.
+    schedule's final anneal and the training ends after it, before ``train.iterations``. Without
+    ``holdout`` the loop trains ``train.iterations`` (the recipe,
+    [`fit`][physgs.experiments.recipe.fit], passes it whenever the rule is on).
 
     Args:
         model: the model to train (in place).
@@ -120,7 +122,7 @@ def train_model(
         on_iteration (Callable | list | None): a hook ``on_iteration(it, model, optimizer) -> dict |
             None``, or a list of them called in order, before each iteration; the dicts they return
             are merged into the statistics (freezing, the search over omega).
-        holdout: the held-out window frames' evaluator (None: no evaluation, no early stop).
+        holdout: the held-out window frames' evaluator (None: no scores, no early stop).
         earliest_stop: the stopping rule counts no evaluation before this iteration (the
             recipe's last change to the model: freezing, the end of the search over omega).
 
@@ -129,9 +131,8 @@ def train_model(
             and the per-iteration loss log.
 
     Raises:
-        ValueError: warmup outside [0, iterations), conditions or frame_pool out of range, a
-            stopping rule that cannot run (``train.stopping``), or one enabled without held-out
-            frames.
+        ValueError: warmup outside [0, iterations), conditions or frame_pool out of range, or
+            a stopping rule that cannot run (``train.stopping``).
         TrainingError: the loss turns NaN or inf, the fit diverges (non-finite or exploding
             parameters, Gaussians far outside the scene, a loss far above its warm-up level:
             [`physgs.train.divergence`][]), or the model's forward pass raises (chained); it names
@@ -153,12 +154,8 @@ def train_model(
             )
     rule = StopRule.from_config(train_cfg)
     rule.check()
-    if rule.enabled and holdout is None:
-        raise ValueError(
-            "train.stopping.enabled needs held-out window frames (train.holdout_every > 0)"
-        )
     evaluate = holdout is not None and rule.every > 0
-    plateau = Plateau(rule.patience, rule.tol, earliest=max(earliest_stop, warmup))
+    plateau = Plateau(rule.patience, rule.tol, earliest=max(earliest_stop, warmup, 1))
     anneal_from, end, eval_s = None, iterations, 0.0
     extra: dict = {}
     if on_iteration is None:
@@ -213,9 +210,10 @@ def train_model(
         for hook in hooks:
             extra.update(hook(it, model, opt) or {})
         held = None
-        if evaluate and anneal_from is None and it > 0 and it % rule.every == 0:
+        # no score before the recipe's last change: the rule would not count it
+        if evaluate and anneal_from is None and it >= plateau.earliest and it % rule.every == 0:
             te = time.perf_counter()
-            held, _ = holdout.evaluate(model, warm=it < warmup)
+            held, _ = holdout.evaluate(model)
             eval_s += time.perf_counter() - te
             # a trigger whose anneal would pass the cap changes nothing: the budget's own tail
             # is that anneal
