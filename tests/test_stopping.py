@@ -77,6 +77,7 @@ def _stop_cfg(**stopping):
         "patience": 2,
         "tol": 0.9,  # an improvement would be a 10x lower loss: none comes, the count is exact
         "anneal": 10,
+        "start": 0.0,
         **stopping,
     }
     return cfg
@@ -113,7 +114,7 @@ def test_a_rule_that_never_triggers_trains_the_whole_budget(swaying):
     assert (res.stats["stopped"], res.stats["iterations"], res.stats["holdout_evals"]) == (
         STOP_CAP,
         40,
-        7,
+        5,  # 5 .. 25: from 30 on, an anneal of 10 could not end before the cap
     )
 
 
@@ -149,3 +150,21 @@ def test_plateau_counts_relative_improvements():
     # by hand: best 1.0; 0.995 is 0.5% (< 1%: no); 0.989 is 1.1% (yes: best 0.989)
     assert plateau_iteration([1, 2, 3, 4], [1.0, 0.995, 0.989, 0.988], 2, 0.01) is None
     assert plateau_iteration([1, 2, 3, 4, 5], [1.0, 0.995, 0.989, 0.988, 0.985], 2, 0.01) == 5
+
+
+def test_scores_only_where_a_trigger_could_still_stop_the_run():
+    from physgs.train.stopping import StopRule
+
+    r = StopRule(enabled=True, every=300, patience=2, tol=0.01, anneal=300, start=0.5)
+    # from max(earliest, 0.5 x 3000) = 1500, every 300, while it + 300 < 3000
+    assert [i for i in range(3001) if r.scores_at(i, 3000, 50)] == [1500, 1800, 2100, 2400]
+    assert [i for i in range(3001) if r.scores_at(i, 3000, 1600)] == [1800, 2100, 2400]
+    off = StopRule(enabled=False, every=300, patience=2, tol=0.01, anneal=300, start=0.5)
+    assert [i for i in range(3001) if off.scores_at(i, 3000, 50)] == [
+        1500,
+        1800,
+        2100,
+        2400,
+        2700,
+        3000,
+    ]

@@ -210,14 +210,13 @@ def train_model(
         for hook in hooks:
             extra.update(hook(it, model, opt) or {})
         held = None
-        # no score before the recipe's last change: the rule would not count it
-        if evaluate and anneal_from is None and it >= plateau.earliest and it % rule.every == 0:
+        # no score before the recipe's last change (the rule would not count it) or where a
+        # trigger could no longer stop the run early
+        if evaluate and anneal_from is None and rule.scores_at(it, iterations, plateau.earliest):
             te = time.perf_counter()
             held, _ = holdout.evaluate(model)
             eval_s += time.perf_counter() - te
-            # a trigger whose anneal would pass the cap changes nothing: the budget's own tail
-            # is that anneal
-            if plateau.update(it, held) and rule.enabled and it + rule.anneal < iterations:
+            if plateau.update(it, held) and rule.enabled:
                 anneal_from, end = it, it + rule.anneal
         c = int(conditions[rng.integers(len(conditions))])
         j = int(

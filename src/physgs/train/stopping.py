@@ -26,7 +26,8 @@ class StopRule:
     enabled: off = train ``train.iterations`` (the held-out frames are still scored and logged
     when ``every`` > 0); every: evaluation period N, iterations; patience: P, evaluations without
     an improvement; tol: the relative improvement that counts (a fraction of the best loss);
-    anneal: iterations of the final decay after the trigger.
+    anneal: iterations of the final decay after the trigger; start: the fraction of the budget
+    before which nothing is scored (no trigger came earlier on any curve it was chosen on).
     """
 
     enabled: bool
@@ -34,6 +35,7 @@ class StopRule:
     patience: int
     tol: float
     anneal: int
+    start: float = 0.0
 
     @staticmethod
     def from_config(train_cfg: dict) -> "StopRule":
@@ -52,7 +54,25 @@ class StopRule:
             patience=int(s.get("patience", 1)),
             tol=float(s.get("tol", 0.0)),
             anneal=int(s.get("anneal", 0)),
+            start=float(s.get("start", 0.0)),
         )
+
+    def scores_at(self, it: int, iterations: int, earliest: int) -> bool:
+        """Whether iteration ``it`` of a ``iterations`` budget scores the held-out frames: every
+        ``every``-th from ``max(earliest, start x iterations)``, and, with the rule enabled,
+        only while a trigger could still stop the run early (``it + anneal < iterations``).
+
+        Args:
+            it: the iteration.
+            iterations: the budget (the cap).
+            earliest: the recipe's last change to the model (the first iteration that counts).
+
+        Returns:
+            True when the loop scores before iteration ``it``.
+        """
+        if self.every <= 0 or it % self.every or it < max(earliest, self.start * iterations):
+            return False
+        return not self.enabled or it + self.anneal < iterations
 
     def check(self) -> None:
         """Raise ValueError when the rule cannot run (a rule whose anneal does not fit in the
@@ -65,6 +85,8 @@ class StopRule:
             raise ValueError("train.stopping.every must be > 0 when train.stopping.enabled")
         if self.enabled and self.anneal < 1:
             raise ValueError(f"train.stopping.anneal must be >= 1, got {self.anneal}")
+        if not 0.0 <= self.start < 1.0:
+            raise ValueError(f"train.stopping.start must lie in [0, 1), got {self.start}")
 
 
 @dataclass
