@@ -25,14 +25,16 @@ CAP, ANNEAL, FREEZE = 3000, 300, 1500  # the default profile: train.iterations, 
 # models.ours.freeze_at x iterations (the priors' recipe changes the model there)
 
 
-def stops(df: pd.DataFrame, every: int, tol: float, patience: int, anneal: int = ANNEAL):
+def stops(
+    df: pd.DataFrame, every: int, tol: float, patience: int, anneal: int = ANNEAL, start=0.0
+):
     """One row per (tree, model): trigger, iterations used, loss at the trigger / at the cap."""
     out = []
     for (t, m), g in df.groupby(["tree", "model"]):
         g = g.sort_values("iteration")
         g = g[g["iteration"] % every == 0]
         its, loss = g["iteration"].to_numpy(), g["holdout_loss"].to_numpy()
-        earliest = FREEZE if is_prior(m) else 0
+        earliest = max(FREEZE if is_prior(m) else 0, int(start * CAP))
         trig = plateau_iteration(its[its < CAP], loss[its < CAP], patience, tol, earliest)
         if trig is not None and trig + anneal >= CAP:
             trig = None
@@ -63,10 +65,13 @@ def main() -> None:
     ap.add_argument("--every", type=int)
     ap.add_argument("--tol", type=float)
     ap.add_argument("--patience", type=int)
+    ap.add_argument("--start", type=float, default=0.0)
     a = ap.parse_args()
-    df = pd.concat([pd.read_csv(p) for p in a.curves], ignore_index=True)
+    df = pd.concat([pd.read_csv(p).assign(src=i) for i, p in enumerate(a.curves)])
+    # a model recorded by two processes on one tree: the first file's record
+    df = df[df["src"] == df.groupby(["tree", "model"])["src"].transform("min")]
     if a.every:
-        r = stops(df, a.every, a.tol, a.patience)
+        r = stops(df, a.every, a.tol, a.patience, start=a.start)
         print(r.to_string(index=False, float_format=lambda x: f"{x:.4g}"))
         kept = (r["used"] / CAP * r["wall_cap_s"]).sum() / r["wall_cap_s"].sum()
         print(f"iterations kept {r['used'].sum() / (CAP * len(r)):.3f}, time kept {kept:.3f}")
@@ -75,7 +80,7 @@ def main() -> None:
     for every, tol, p in itertools.product(
         (100, 200, 300), (0.0, 0.0025, 0.005, 0.01, 0.02), (1, 2, 3, 4, 5)
     ):
-        r = stops(df, every, tol, p)
+        r = stops(df, every, tol, p, start=a.start)
         rows.append(
             {
                 "every": every,

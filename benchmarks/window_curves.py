@@ -133,6 +133,7 @@ def main() -> None:
     ap.add_argument("--seed", type=int, default=0)
     ap.add_argument("--profile", default="default")
     ap.add_argument("--rule", action="store_true", help="train with the stopping rule on")
+    ap.add_argument("--budget", type=int, default=None, help="train this many iterations")
     ap.add_argument("--stop-every", type=int, default=None)
     ap.add_argument("--tol", type=float, default=None)
     ap.add_argument("--patience", type=int, default=None)
@@ -153,7 +154,11 @@ def main() -> None:
         for m in models:
             job = Job.from_dict(job_spec(cfg, m, "single", seed=a.seed))
             # the full budget, scored by the hook below: the curve the rule is chosen on
-            job = job.replace(train={**job.train, "stopping": {**RULE_OFF}})
+            train = {**job.train, "stopping": {**RULE_OFF}}
+            if a.budget:  # a per-model budget: the schedule and the recipe's fractions over it
+                frac = train["warmup"] / train["iterations"]
+                train.update(iterations=a.budget, warmup=int(round(frac * a.budget)))
+            job = job.replace(train=train)
             seed_everything(job.seed)
             model = build_model(
                 m,
