@@ -33,11 +33,12 @@ def main() -> None:
     ap.add_argument("--models", default="static,ours,mlp,mlp_wind,d3dgs,d3dgs_wind")
     ap.add_argument("--iterations", type=int, default=60)
     ap.add_argument("--repeats", type=int, default=3)
+    ap.add_argument("--every", type=int, default=300, help="N: iterations between scores")
     a = ap.parse_args()
     cfg = load("config/trees.yaml", "default")
     obs = load_observed(a.testbed / "observed.npz")
     truth = load_truth(a.testbed / "truth.npz")
-    every = int(cfg["train"]["stopping"]["every"])
+    every = a.every
     print(
         f"{'model':>12} {'ms/iter':>8} {'ms/score':>9} {'frames':>6} {'share':>6} (every {every})"
     )
@@ -59,7 +60,11 @@ def main() -> None:
             ev.evaluate(res.model)
             t.append(time.perf_counter() - t0)
         sc_ms = 1e3 * float(np.median(t))
-        n_scores = (3000 - max(earliest_stop(job), 1)) // every
+        # the scores of an enabled rule: every N from the recipe's last change, while a trigger
+        # (+ the anneal) could still end the run before the cap
+        anneal, cap = int(job.train["stopping"]["anneal"]), 3000
+        first = max(earliest_stop(job), 1)
+        n_scores = len([i for i in range(first, cap - anneal) if i % every == 0])
         share = n_scores * sc_ms / (3000 * it_ms)
         print(f"{m:>12} {it_ms:8.1f} {sc_ms:9.0f} {len(ev.pairs):6d} {100 * share:5.1f}%")
 

@@ -25,9 +25,7 @@ CAP, ANNEAL, FREEZE = 3000, 300, 1500  # the default profile: train.iterations, 
 # models.ours.freeze_at x iterations (the priors' recipe changes the model there)
 
 
-def stops(
-    df: pd.DataFrame, every: int, tol: float, patience: int, anneal: int = ANNEAL, start=0.0
-):
+def stops(df: pd.DataFrame, every: int, tol: float, patience: int, anneal: int = ANNEAL, start=0.0):
     """One row per (tree, model): trigger, iterations used, loss at the trigger / at the cap."""
     out = []
     for (t, m), g in df.groupby(["tree", "model"]):

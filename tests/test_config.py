@@ -361,9 +361,21 @@ def _set(path, value, profile=None):
             "default",
             "models/mlp/time_top_hz/d3dgs",
         ),
-        # the stopping rule reads held-out window frames
-        (_set(("train", "holdout_every"), 0), "default", "train/stopping/enabled"),
-        (_set(("train", "stopping", "every"), 0), "default", "train/stopping/every"),
+        # the stopping rule, enabled, reads held-out window frames and scores them
+        (
+            lambda c: c["train"].update(
+                holdout_every=0, stopping={**c["train"]["stopping"], "enabled": True, "every": 300}
+            ),
+            "default",
+            "train/stopping/enabled",
+        ),
+        (
+            lambda c: c["train"].update(
+                stopping={**c["train"]["stopping"], "enabled": True, "every": 0}
+            ),
+            "default",
+            "train/stopping/every",
+        ),
         (
             lambda c: c["train"].update(
                 holdout_every=0, stopping={**c["train"]["stopping"], "enabled": False}
