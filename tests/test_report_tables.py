@@ -313,12 +313,17 @@ def test_tab_fit_fraction_of_the_ceiling():
                 "view": 21.0,
                 "time": 21.5,
                 "train_s": 12.0,
+                "iterations": 1800.0 if m == "static" else 3000.0,
             }
     tab = T.tab_fit({0: rows}, TREES, BONES, models, "truth_motion")
     frac = dict(zip(tab.df.model[tab.df.tree == "sparse"], tab.df.ceiling_frac))
     # (model - static) / (ceiling - static): 0, 2/10, 6/10, 1
     assert frac == pytest.approx({"static": 0.0, "mlp": 0.2, "ours": 0.6, "truth_motion": 1.0})
     assert "60\\%" in tab.tex and "20\\%" in tab.tex
+    # the iterations each model used, in the CSV and as the last .tex column
+    assert dict(zip(tab.df.model[tab.df.tree == "sparse"], tab.df.iterations))["static"] == 1800
+    static = next(ln for ln in tab.tex.splitlines() if "& Static pose &" in ln)
+    assert static.rstrip(" \\").endswith("& 12 & 1800")
 
 
 def test_fit_row_splits_trained_and_held_out_frames(tmp_path):
@@ -340,7 +345,9 @@ def test_fit_row_splits_trained_and_held_out_frames(tmp_path):
         n_tail=n_tail,
     )
     ev.save(tmp_path / "e.npz")
-    pd.DataFrame({"seconds": [1.0, 2.0, 42.5]}).to_csv(tmp_path / "l.csv", index=False)
+    log = pd.DataFrame({"iteration": [0, 1, 2], "seconds": [1.0, 2.0, 42.5]})
+    log.to_csv(tmp_path / "l.csv", index=False)
     r = fit_row(tmp_path / "e.npz", tmp_path / "l.csv", n_train, 10)
     assert r["fit"] == pytest.approx(10.0) and r["heldout"] == pytest.approx(20.0)
     assert r["train_s"] == 42.5 and r["view"] == pytest.approx(7.0)
+    assert r["iterations"] == 3  # the loss log's rows: iterations 0, 1, 2
