@@ -10,7 +10,6 @@ import pandas as pd
 from physgs.experiments.sweep import null_level
 from physgs.models.registry import BASE_CONFIG
 from physgs.recovery.record import load_null
-from physgs.report import figures
 from physgs.report.outputs.base import Output
 
 #: the studies' CSVs (need ``("table", <study>)``), written by the rules of the same name
@@ -33,7 +32,15 @@ def _fig_speed_accuracy(path, settings, inputs, out):
     df = pd.read_csv(path("table", SPEED_ACCURACY))
     K = settings["K"]
     null = null_level([load_null(path("null", settings["tree"], K, s)) for s in settings["seeds"]])
+    from physgs.report import figures  # matplotlib: not for the workflow's planning imports
+
     figures.fig_speed_accuracy(df, out, null=null)
+
+
+def _fig_fit_curve(path, settings, inputs, out):
+    from physgs.report import figures  # matplotlib: not for the workflow's planning imports
+
+    figures.fig_fit_curve(pd.read_csv(path("table", FIT_CURVE)), out)
 
 
 FIG_SPEED_ACCURACY = Output(
@@ -55,9 +62,7 @@ FIG_FIT_CURVE = Output(
     "fig_fit_curve",
     "figure",
     lambda plan, seeds: [("table", FIT_CURVE)],
-    lambda path, settings, inputs, out: figures.fig_fit_curve(
-        pd.read_csv(path("table", FIT_CURVE)), out
-    ),
+    _fig_fit_curve,
     seeds="studies",  # its CSV holds the studies' seeds' points
     in_report=_studies_only,
 )

@@ -211,7 +211,14 @@ TAB_PSNR = Output(
 )
 FIT_COLUMNS = Columns(
     keys=("seed", "tree", "model"),
-    values=("fit_psnr_db", "heldout_psnr_db", "ceiling_frac", "view_psnr_db", "time_psnr_db"),
+    values=(
+        "fit_psnr_db",
+        "heldout_psnr_db",
+        "ceiling_frac",
+        "view_psnr_db",
+        "time_psnr_db",
+        "iterations",
+    ),
     timing=("train_s",),
     about=("bones", "reference"),
 )
