@@ -59,9 +59,18 @@ def test_a_second_job_waits_naming_output_and_holder_then_makes_what_a_killed_ho
     holder, capsys
 ):
     out, locks, proc = holder
-    threading.Timer(1.0, proc.kill).start()  # SIGKILL: the kernel drops the flock
+    killed = threading.Event()
+
+    def kill():  # SIGKILL: the kernel drops the flock
+        killed.set()
+        proc.kill()
+
+    threading.Timer(1.0, kill).start()
     with output_locks([out], locks, key="k") as made_by:
-        assert proc.poll() is not None, "the body ran while another process held the output"
+        assert killed.is_set(), "the body ran while another process held the output"
+        # the kernel drops the flock while the killed holder exits, a moment before its status
+        # can be read (poll() may still say None): its status follows
+        assert proc.wait(timeout=10) == -signal.SIGKILL
         assert made_by is None  # the holder made nothing: this job makes it
     err = capsys.readouterr().err
     assert f"another job is making {os.path.relpath(out)} now (pid {proc.pid}" in err, err

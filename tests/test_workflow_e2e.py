@@ -288,7 +288,7 @@ def test_claims_ledger_has_a_computed_verdict_per_claim(run):
     # over no trusted part) rather than guessing
     needs = df[~df["id"].str.startswith("nearest_bone_gap")]
     assert needs["verdict"].str.match(r"undecided: (one seed|not measured)").all()
-    assert "| claim | paper | measured |" in (run / "results" / "claims.md").read_text()
+    assert "| claim | origin | paper | measured |" in (run / "results" / "claims.md").read_text()
 
 
 def test_fit_curve_passes_through_the_tables_numbers(run):
@@ -355,8 +355,16 @@ def test_summary_is_printed_from_the_run(run):
     stamp = ledger[["profile", "config_hash", "physgs_version"]].iloc[0]
     assert f"profile=quick, config_hash={stamp.config_hash}," in text
     kinds = ledger["verdict"].str.split(":").str[0]
-    for v in ("holds", "fails", "undecided"):
-        assert f"**{v}** {int((kinds == v).sum())}" in text
+    # the paper's claims counted apart from this project's, the paper's first
+    paper = kinds[ledger["origin"] == "paper"]
+    own = kinds[ledger["origin"] == "project"]
+    assert len(paper) + len(own) == len(ledger)
+    counts = lambda k: ", ".join(
+        f"**{v}** {int((k == v).sum())}" for v in ("holds", "fails", "undecided")
+    )  # noqa: E731
+    assert f"The paper's {len(paper)} claims: {counts(paper)}." in text
+    assert f"This project's own {len(own)} claims: {counts(own)}." in text
+    assert text.index("The paper's") < text.index("This project's own")
     assert "| model | sparse |" in text and "Warning" not in text
     for stage in ("testbed", "train", "evaluate"):
         assert f"| {stage} | " in text

@@ -93,18 +93,7 @@ def _tab_parts(path, settings, inputs, out):
 
 PARTS_COLUMNS = Columns(
     keys=("seed", "tree", "model", "config"),
-    values=(
-        "purity",
-        "fit_psnr_db",
-        "ceiling_frac",
-        "view_psnr_db",
-        "time_psnr_db",
-        "trusted",
-        "omega_rel_err_pct",
-        "omega_null_rel_err_pct",
-        "zeta_rel_err_pct",
-        "zeta_null_rel_err_pct",
-    ),
+    values=tuple(c for c in parts.COLUMNS if c != "train_s"),  # the table's own column list
     timing=("train_s",),
     about=("bones",),
 )
