@@ -11,6 +11,7 @@ from dataclasses import dataclass
 import numpy as np
 import torch
 
+from physgs.evaluate.metrics import psnr
 from physgs.render import rasterization
 from physgs.train.losses import photometric_loss
 
@@ -92,7 +93,7 @@ class HoldoutEval:
                     return_depth=False,
                 )
                 loss, _, _ = photometric_loss(out.rgb, target, self.ssim_weight)
-                mse = float(torch.mean((out.rgb.clamp(0, 1) - target) ** 2))
                 losses.append(float(loss))
-                psnrs.append(10.0 * np.log10(1.0 / max(mse, 1e-12)))
+                rgb = out.rgb.clamp(0, 1).float().cpu().numpy()
+                psnrs.append(float(psnr(rgb, target.float().cpu().numpy())))
         return float(np.mean(losses)), float(np.mean(psnrs))
