@@ -155,6 +155,28 @@ def representative_frame(psnr_ours: np.ndarray, psnr_base: np.ndarray) -> int:
 
 
 # --------------------------------------------------------------------------------------------
+
+
+def _legend_below(fig, handles: list, *, ncol: int, top: float) -> None:
+    """The figure's key below its panels, never over the data: the panels keep the top 80%.
+
+    Args:
+        fig: the figure, its panels drawn.
+        handles: the key's entries.
+        ncol: entries per row.
+        top: where the key's top sits, in figure fractions (below 0.2).
+    """
+    fig.tight_layout(rect=(0, 0.2, 1, 1))
+    fig.legend(
+        handles=handles,
+        loc="upper center",
+        bbox_to_anchor=(0.5, top),
+        ncol=ncol,
+        fontsize=FONT_PT,
+        frameon=False,
+    )
+
+
 def fig_temporal(
     curves: Mapping[tuple[str, str], np.ndarray],
     trees: Sequence[str],
@@ -217,16 +239,7 @@ def fig_temporal(
     handles.append(Patch(color="0.9", label=f"beyond the training window (after frame {n_train})"))
     if n_seeds > 1:
         handles.append(Patch(color="0.5", alpha=0.3, label=f"lowest to highest of {n_seeds} seeds"))
-    fig.tight_layout(rect=(0, 0.2, 1, 1))
-    # below the panels, never over the data
-    fig.legend(
-        handles=handles,
-        loc="upper center",
-        bbox_to_anchor=(0.5, 0.16),
-        ncol=3,
-        fontsize=FONT_PT,
-        frameon=False,
-    )
+    _legend_below(fig, handles, ncol=3, top=0.16)
     save_figure(fig, outputs)
 
 
@@ -487,15 +500,7 @@ def fig_damping(
             label=rf"truth $\zeta$ = {zeta_true} ($\gamma = \zeta\omega$)",
         )
     )
-    fig.tight_layout(rect=(0, 0.2, 1, 1))
-    fig.legend(
-        handles=handles,
-        loc="upper center",
-        bbox_to_anchor=(0.5, 0.15),
-        ncol=4,
-        fontsize=FONT_PT,
-        frameon=False,
-    )
+    _legend_below(fig, handles, ncol=4, top=0.15)
     save_figure(fig, outputs)
 
 
