@@ -136,3 +136,35 @@ def test_small_text_is_measured_small(caught):
     ax.legend(loc="center")
     assert FG.legends_over_data(fig)
     plt.close(fig)
+
+
+def test_fig_stabilisation_one_column_a_tree_with_intervals_and_the_true_frequencies(caught):
+    from physgs.oma.run import Identification
+    from physgs.oma.ssi import Modes, Stabilisation
+    from physgs.report.stabilisation import fig_stabilisation
+
+    rng = np.random.default_rng(3)
+    orders = np.arange(2, 42, 2)
+    idents, omega = {}, {}
+    for i, t in enumerate(TREES):
+        freq = np.array([0.6, 1.2 + 0.1 * i])
+        poles = freq[:, None] + 0.01 * rng.standard_normal((2, orders.size))
+        stab = Stabilisation(poles, rng.random(poles.shape) > 0.3, orders)
+        m = Modes(
+            freq, np.array([0.04, 0.08]), np.ones((2, 3), complex), np.array([12, 9]),
+            np.array([0.01, 0.02]), stab, np.array([0.02, 0.05]), np.array([0.01, 0.02]),
+        )  # fmt: skip
+        idents[t] = Identification(None, m, 1.0)
+        omega[t] = 2 * np.pi * np.array([0.61, 1.19, 2.4])
+    fig_stabilisation(idents, omega, TREES, ["x.png"], title="t")
+    (fig,) = caught
+    _legible(fig)
+    assert [a.get_title() for a in fig.axes[:3]] == [f"{t}: 2 modes" for t in TREES]
+    for ax in fig.axes[:3]:  # the error bars' half-widths are the 95% intervals, Hz
+        (bars,) = [c for c in ax.collections if c.__class__.__name__ == "LineCollection"]
+        half = [abs(seg[1, 0] - seg[0, 0]) / 2 for seg in bars.get_segments()]
+        np.testing.assert_allclose(half, 1.96 * np.array([0.02, 0.05]))
+    for ax in fig.axes[3:]:  # the strip: the true frequencies in Hz
+        (ticks,) = ax.collections
+        xs = sorted(seg[0, 0] for seg in ticks.get_segments())
+        np.testing.assert_allclose(xs, [0.61, 1.19, 2.4])

@@ -193,7 +193,8 @@ def test_figures_are_shown_in_reading_order_each_with_a_caption_from_its_declara
     for name in OUTPUTS:
         if OUTPUTS[name].kind == "figure":
             captions.find(name)
-    for name in ("fig_stabilisation_dense", "testbed_dense_damping"):
+    assert captions.find("fig_stabilisation")[2] == ""  # one figure, every tree a column
+    for name in ("fig_stabilisation_dense", "testbed_dense_damping"):  # an older record's, ours
         assert captions.find(name)[2] == "dense"
     with pytest.raises(KeyError, match="fig_new"):
         captions.caption("fig_new", [0])

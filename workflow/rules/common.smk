@@ -88,10 +88,9 @@ SEEDED_TRACKS = "results/tracks/{tree}/seed{seed}/c{condition}.npz"
 TRACKS_FIT = "results/tracks/{tree}/seed{seed}/fit_{config}.npz"
 TRACKS_EVAL = "results/tracks/{tree}/seed{seed}/eval_{config}.json"
 TRACKS_FIELDS = "results/tracks/{tree}/seed{seed}/fields_{config}.json"  # the fields at the tracks
-# output-only modal analysis: the modes of the training video (observed only) and each tree's
-# stabilisation diagram (its recovery record: RECOVERY)
+# output-only modal analysis: the modes of the training video (observed only; its recovery
+# record: RECOVERY)
 OMA_MODES = "results/oma/{tree}/seed{seed}/modes_{config}.npz"
-OMA_FIGURE = "results/figures/fig_stabilisation_{tree}.png"
 #: need kind (physgs.report.build.needs) -> path template
 NEED_PATHS = {
     "eval": EVAL,
@@ -112,6 +111,8 @@ NEED_PATHS = {
     # a figure reads the instance of its seed (the one instance without testbed_seeds)
     "tracks": SEEDED_TRACKS if TESTBED_SEEDS else TRACKS,
     "observed": SEEDED_OBSERVED if TESTBED_SEEDS else OBSERVED,
+    "truth": SEEDED_TRUTH if TESTBED_SEEDS else TRUTH,
+    "oma_modes": OMA_MODES,
 }
 SA_TREE = CFG["speed_accuracy"]["tree"]
 SWEEP_POINTS = _sweep.sweep_points(CFG)

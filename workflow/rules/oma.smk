@@ -1,6 +1,7 @@
 # Output-only modal analysis (docs/blind.md): SSI-cov of the training video's dense flow.
-# `oma_identify` reads observed.npz's frames only (never the wind); `oma_recovery` and
-# `fig_stabilisation` read the truth (the matcher's bones; the true frequencies drawn).
+# `oma_identify` reads observed.npz's frames only (never the wind); `oma_recovery` reads the
+# truth (the matcher's bones), and so does the report's `fig_stabilisation` (the true
+# frequencies drawn, never used).
 
 
 rule oma_identify:
@@ -51,28 +52,10 @@ rule oma_recovery:
         "../scripts/oma_recovery.py"
 
 
-# the first seed's stabilisation diagram of each tree, the true bone frequencies beside it
-rule fig_stabilisation:
-    input:
-        modes=lambda w: OMA_MODES.format(tree=w.tree, seed=SEEDS[0], config=OMA_CONFIGS[0]),
-        truth=lambda w: testbed_files(w.tree, SEEDS[0])["truth"],
-    output:
-        figure=OMA_FIGURE,
-    log:
-        "logs/oma/{tree}/fig_stabilisation.log",
-    conda:
-        "../envs/physgs.yaml"
-    threads: 1
-    resources:
-        mem_mb=2000,
-        runtime=10,
-    script:
-        "../scripts/oma_figure.py"
-
-
 # every record and figure of the analysis (part of `all`; tab_recovery and tab_damping read the
 # records)
 rule oma:
     input:
         expand(recovery_record("oma"), tree=TESTBEDS, seed=SEEDS, config=OMA_CONFIGS),
-        expand(OMA_FIGURE, tree=TREES) if OMA_CONFIGS else [],
+        # each tree's stabilisation diagram (an output: physgs.report.outputs.oma)
+        expand(FIGURE, name="fig_stabilisation", ext=("pdf", "png")) if OMA_CONFIGS else [],

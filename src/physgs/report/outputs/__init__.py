@@ -4,6 +4,7 @@ the models of its role (``physgs.models.registry.models_of``) through its regist
 (``physgs.models.registry.MODELS``), and a new output is one ``Output`` added here."""
 
 from physgs.report.outputs.base import NEED_FIELDS, Output, Plan, key, reader
+from physgs.report.outputs.oma import FIG_STABILISATION
 from physgs.report.outputs.recovery import (
     FIG_DAMPING,
     TAB_DAMPING,
@@ -47,6 +48,7 @@ OUTPUTS: dict[str, Output] = {
         FIG_DAMPING,
         FIG_PARTS,
         FIG_TRACKS,
+        FIG_STABILISATION,
         FIG_SPEED_ACCURACY,
         FIG_FIT_CURVE,
     )

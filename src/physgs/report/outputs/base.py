@@ -49,6 +49,9 @@ NEED_FIELDS = {
     "tracks_fit": ("tree", "config", "seed"),
     "tracks": ("tree", "condition", "seed"),
     "observed": ("tree", "seed"),
+    # the output-only analysis: one identification, and the truth its figure draws beside it
+    "oma_modes": ("tree", "config", "seed"),
+    "truth": ("tree", "seed"),
 }
 
 

@@ -1,0 +1,84 @@
+"""fig_stabilisation: the output-only analysis' stabilisation diagrams ([`physgs.oma`][],
+docs/blind.md), one panel per tree, the bones' true frequencies in a strip below each.
+
+The truth is drawn, never used to select anything: the modes are the identification's own.
+"""
+
+from __future__ import annotations
+
+from typing import Mapping, Sequence
+
+import numpy as np
+
+#: the panels' frequency axis ends at max(this, 1.2 x the highest bone's), Hz
+MIN_FREQ_AXIS_HZ = 3.0
+
+
+def fig_stabilisation(
+    idents: Mapping[str, object],
+    omega_bones: Mapping[str, np.ndarray],
+    trees: Sequence[str],
+    outputs: Sequence[str],
+    title: str = "",
+) -> None:
+    """One column per tree: the poles (frequency in Hz against model order; filled where stable)
+    with the identified modes as vertical lines, each with its 95% frequency interval
+    (+-1.96 sigma) as an error bar above the highest order; below, the bones' true frequencies.
+
+    Args:
+        idents: ``idents[tree]``: its [`Identification`][physgs.oma.run.Identification], the
+            stabilisation diagram included.
+        omega_bones: ``omega_bones[tree]``: [B] the bones' true natural frequencies, rad/s.
+        trees: the trees, one column each.
+        outputs: the paths to write (pdf, png).
+        title: the figure's title.
+    """
+    import matplotlib.pyplot as plt
+    from matplotlib.lines import Line2D
+
+    from physgs.report.figures import FONT_PT, PAGE_WIDTH_IN, _legend_below, save_figure
+
+    fig, axes = plt.subplots(
+        2,
+        len(trees),
+        figsize=(PAGE_WIDTH_IN, 4.6),
+        sharex="col",
+        squeeze=False,
+        gridspec_kw={"height_ratios": [4, 1]},
+    )
+    for j, t in enumerate(trees):
+        ax, strip = axes[0, j], axes[1, j]
+        st, m = idents[t].modes.stab, idents[t].modes
+        orders = np.broadcast_to(st.orders[None, :], st.freq_hz.shape)
+        ok = np.isfinite(st.freq_hz)
+        ax.scatter(st.freq_hz[ok & ~st.stable], orders[ok & ~st.stable], s=3, c="0.75")
+        ax.scatter(st.freq_hz[ok & st.stable], orders[ok & st.stable], s=5, c="C0")
+        for f in m.freq_hz:
+            ax.axvline(f, c="C3", lw=0.8)
+        if m.n_modes:
+            step = float(np.diff(st.orders[:2])[0]) if st.orders.size > 1 else 1.0
+            top = np.full(m.n_modes, float(st.orders.max()) + 2 * step)
+            ax.errorbar(
+                m.freq_hz, top, xerr=1.96 * np.nan_to_num(m.freq_std), fmt="v", c="C3", ms=4,
+                capsize=3, lw=1.0,
+            )  # fmt: skip
+        ax.set_title(f"{t}: {m.n_modes} modes", fontsize=FONT_PT)
+        ax.tick_params(labelsize=FONT_PT)
+        fb = np.asarray(omega_bones[t], float) / (2 * np.pi)
+        strip.vlines(fb, 0, 1, colors="k", lw=0.8)
+        strip.set_yticks([])
+        strip.set_xlim(0, max(MIN_FREQ_AXIS_HZ, 1.2 * float(fb.max(initial=0.0))))
+        strip.set_xlabel("frequency (Hz)", fontsize=FONT_PT)
+        strip.tick_params(labelsize=FONT_PT)
+    axes[0, 0].set_ylabel("model order", fontsize=FONT_PT)
+    axes[1, 0].set_ylabel("bones", fontsize=FONT_PT)
+    if title:
+        fig.suptitle(title, fontsize=FONT_PT)
+    handles = [
+        Line2D([], [], ls="", marker="o", ms=3, c="0.75", label="pole"),
+        Line2D([], [], ls="", marker="o", ms=3, c="C0", label="stable pole"),
+        Line2D([], [], c="C3", lw=0.8, marker="v", ms=4, label="mode, 95% interval"),
+        Line2D([], [], c="k", lw=0.8, label="a bone's true frequency"),
+    ]
+    _legend_below(fig, handles, ncol=4, top=0.1)
+    save_figure(fig, outputs, dpi=150)
