@@ -15,6 +15,22 @@ import json
 import math
 from typing import Callable, Iterator
 
+from physgs.experiments.kselect import selected_models, settings_for
+from physgs.models.omega_search import search_problem
+from physgs.models.registry import (
+    MODEL_NAMES,
+    MODELS,
+    PRIOR_VARIANT_NAMES,
+    is_prior,
+    searches_omega,
+    spec_of,
+)
+from physgs.models.timescale import WINDOW_TIME
+from physgs.oma.ssi import RecordError, SSISettings, check_record
+from physgs.testbed import physics, wind  # the formulas the testbed itself uses
+from physgs.testbed.dataset import gaussian_count
+from physgs.testbed.weberpenn import PresetError, generate
+
 Problem = tuple[tuple, str]
 Check = Callable[[dict], Iterator[Problem]]
 
@@ -104,8 +120,6 @@ def lead_in_fits_wind_period(cfg: dict) -> Iterator[Problem]:
     Yields:
         ``(key path, message)`` per problem (the module docstring); none when the config passes.
     """
-    from physgs.testbed import physics, wind  # the formulas the testbed itself uses
-
     tb = cfg["testbed"]
     lo, hi = tb["band_hz"]
     if not 0 < lo < hi:
@@ -278,7 +292,6 @@ def oma_is_runnable(cfg: dict) -> Iterator[Problem]:
                 f"'{c}' is not one of models/configs {sorted(cfg['models']['configs'])}: the "
                 "analysis runs in ours' configurations (their winds' videos and K)",
             )
-    from physgs.oma.ssi import RecordError, SSISettings, check_record
 
     try:
         check_record(int(cfg["testbed"]["n_train"]), int(o["components"]), SSISettings(**o["ssi"]))
@@ -388,9 +401,6 @@ def field_time_scales_valid(cfg: dict) -> Iterator[Problem]:
     Yields:
         ``(key path, message)`` per problem (the module docstring); none when the config passes.
     """
-    from physgs.models.registry import MODELS
-    from physgs.models.timescale import WINDOW_TIME
-
     nyquist = 0.5 * float(cfg["testbed"]["fps"])
     for family in ("mlp", "d3dgs"):
         tops = cfg["models"][family]["time_top_hz"]
@@ -451,8 +461,6 @@ def _kselect_runs(cfg: dict, *own_keys: str) -> Iterator[tuple[str, tuple, dict]
     own keys) and each prior's under models/kselect/priors (its keys over the section's); with
     ``own_keys``, a prior's only where its entry sets one of them (else a problem with them is
     ours', reported once under ours' key)."""
-    from physgs.experiments.kselect import selected_models, settings_for
-
     ks = cfg["models"]["kselect"]
     for m in selected_models(ks):
         where = ("models", "kselect") if m == "ours" else ("models", "kselect", "priors", m)
@@ -577,9 +585,6 @@ def omega_search_is_runnable(cfg: dict) -> Iterator[Problem]:
     Yields:
         ``(key path, message)`` per problem (the module docstring); none when the config passes.
     """
-    from physgs.models.omega_search import search_problem
-    from physgs.models.registry import MODEL_NAMES, PRIOR_VARIANT_NAMES, is_prior
-
     osr = cfg["models"].get("omega_search")
     if not osr:
         return
@@ -614,9 +619,6 @@ def kselect_priors_are_runnable(cfg: dict) -> Iterator[Problem]:
     Yields:
         ``(key path, message)`` per problem; none when the config passes.
     """
-    from physgs.models.omega_search import search_problem
-    from physgs.models.registry import MODELS, is_prior, searches_omega, spec_of
-
     valid = [m for m in MODELS if m != "ours" and is_prior(m) and spec_of(m).forcing == "wind"]
     own = cfg["models"]["kselect"].get("priors") or {}
     for m in own:
@@ -699,8 +701,6 @@ def configs_have_single(cfg: dict) -> Iterator[Problem]:
 @functools.lru_cache(maxsize=16)
 def _skeleton(preset_json: str, seed: int, tree: str):
     """A tree's skeleton (built once per load for presets_reach_bone_counts and the K bound)."""
-    from physgs.testbed.weberpenn import generate
-
     return generate(json.loads(preset_json), seed=seed, name=tree)
 
 
@@ -711,8 +711,6 @@ def _preset_key(preset: dict) -> str:
 def _gaussians(cfg: dict, tree: str) -> int | None:
     """The vertex count of ``tree``'s mesh (its Gaussians); None when it cannot be built (a
     missing preset or a preset or budget error, which other checks report)."""
-    from physgs.testbed.dataset import gaussian_count
-
     preset = cfg["presets"].get(tree)
     if preset is None:
         return None
@@ -794,8 +792,6 @@ def presets_reach_bone_counts(cfg: dict) -> Iterator[Problem]:
     Yields:
         ``(key path, message)`` per problem (the module docstring); none when the config passes.
     """
-    from physgs.testbed.weberpenn import PresetError
-
     for tree in cfg["trees"]:
         preset = cfg["presets"].get(tree)
         if preset is None:
