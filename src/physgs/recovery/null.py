@@ -177,7 +177,7 @@ def null_control(
     """
     import torch  # here, not at the top: reading a null record needs no torch
 
-    from physgs.models.oscillator import integrate  # the trained model's own solver
+    from physgs.models.oscillator import integrate  # the trained model's own solver (torch too)
 
     omega_bones = np.asarray(omega_bones, dtype=np.float64)
     draws = draw_null_omegas(omega_bones, n_parts, n_draws, seed)  # [D, K]

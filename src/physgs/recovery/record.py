@@ -10,9 +10,9 @@ import numpy as np
 from physgs.atomic import write_json
 from physgs.intermediate import read_json
 from physgs.recovery.damping import DampingResult, damping_summary
-from physgs.recovery.damping_scores import DampingNull, DampingScores
+from physgs.recovery.damping_scores import DampingNull, DampingScores, damping_null, score_match
 from physgs.recovery.matcher import MatchResult, match_parts, restricted, training_window
-from physgs.recovery.null import NullResult
+from physgs.recovery.null import N_DRAWS, NullResult, null_control
 
 
 @dataclass(frozen=True)
@@ -113,8 +113,6 @@ def with_damping_scores(rec: RecoveryRecord, zeta_hat, truth, damping: dict) -> 
     Returns:
         A copy with ``damping_scores`` and ``damping_null`` set.
     """
-    from physgs.recovery.damping_scores import damping_null, score_match
-
     zb, ob = np.asarray(truth.zeta, np.float64), np.asarray(truth.omega, np.float64)
     m = rec.match
     return dataclasses.replace(
@@ -245,8 +243,6 @@ def run_null(
     Returns:
         The [`NullResult`][physgs.recovery.null.NullResult].
     """
-    from physgs.recovery.null import N_DRAWS, null_control
-
     wind = np.asarray(observed.wind[0], dtype=np.float64)  # [L+F]
     L, n_train = int(observed.lead_in_frames), int(observed.n_train)
     return null_control(

@@ -6,13 +6,11 @@ functions that run it, so a dry run does not pay torch's start-up."""
 from __future__ import annotations
 
 import dataclasses
-from typing import TYPE_CHECKING
 
 import numpy as np
 
-if TYPE_CHECKING:
-    from physgs.recovery.null import NullResult
-    from physgs.recovery.record import RecoveryRecord
+from physgs.recovery.null import NullResult
+from physgs.recovery.record import RecoveryRecord, run_null, score_recovery, with_damping_scores
 
 
 def recover_model(
@@ -40,9 +38,7 @@ def recover_model(
         TypeError: for a model without ``part_theta``.
         RuntimeError: if a frozen part were matched as trusted.
     """
-    import torch
-
-    from physgs.recovery.record import score_recovery, with_damping_scores
+    import torch  # here: the workflow imports this module to plan jobs (module docstring)
 
     if not hasattr(model, "part_theta"):
         raise TypeError(f"recovery needs the oscillator prior ('ours'); got {type(model).__name__}")
@@ -109,9 +105,9 @@ def null_control(observed, truth, settings: dict, bone_visible=None) -> NullResu
     Returns:
         The [`NullResult`][physgs.recovery.null.NullResult].
     """
+    # here: these load torch, and the workflow imports this module to plan jobs
     from physgs.models.oscillator import STABILITY_GUARD
     from physgs.models.ours import prior_substeps
-    from physgs.recovery.record import run_null
 
     dt = 1.0 / observed.fps
     substeps = prior_substeps(

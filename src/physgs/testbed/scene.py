@@ -34,6 +34,7 @@ def convex_hull_points(chunks) -> np.ndarray:
     Returns:
         [K, 3] hull vertices (all points where the set is flat or too small for a hull).
     """
+    # here: scipy; the config checks import this module (via testbed.dataset) to plan jobs
     from scipy.spatial import ConvexHull, QhullError
 
     keep = np.empty((0, 3))

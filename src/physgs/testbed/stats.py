@@ -33,6 +33,9 @@ from __future__ import annotations
 
 import numpy as np
 
+from physgs.atomic import write_json
+from physgs.intermediate import read_json
+from physgs.recovery.null import nearest_bone_gap  # the null control's own definition
 from physgs.testbed import kinematics
 
 
@@ -108,8 +111,6 @@ def median_nearest_bone_gap(omega, n_grid: int = 200_001) -> float:
     Returns:
         The median relative gap (fraction).
     """
-    from physgs.recovery.null import nearest_bone_gap  # the null control's own definition
-
     om = np.asarray(omega, dtype=np.float64)
     grid = np.exp(np.linspace(np.log(om.min()), np.log(om.max()), int(n_grid)))
     ob = np.unique(om)
@@ -385,8 +386,6 @@ def save_stats(path, stats: dict) -> None:
         path (str | Path): the JSON file to write.
         stats: the dict of [`testbed_stats`][physgs.testbed.stats.testbed_stats].
     """
-    from physgs.atomic import write_json
-
     write_json(
         path, {k: (v.tolist() if isinstance(v, np.ndarray) else v) for k, v in stats.items()}
     )
@@ -404,7 +403,5 @@ def load_stats(path) -> dict:
     Raises:
         IntermediateFileError: when the file is missing or corrupt (names the rule that makes it).
     """
-    from physgs.intermediate import read_json
-
     d = read_json(path, rule="testbed_stats")
     return {k: (np.asarray(v) if isinstance(v, list) else v) for k, v in d.items()}

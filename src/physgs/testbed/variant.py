@@ -18,6 +18,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from physgs.testbed import physics
+
 FAITHFUL, DAMPING = "faithful", "damping"
 VARIANTS = (FAITHFUL, DAMPING)
 
@@ -280,7 +282,5 @@ def lead_in_frames(omega: np.ndarray, zeta: np.ndarray, lead_in_tau: float, fps:
     Returns:
         The lead-in, frames.
     """
-    from physgs.testbed import physics  # torch: the workflow imports this module to plan jobs
-
     i = int(np.argmin(np.asarray(zeta) * np.asarray(omega)))
     return physics.lead_in_frames(float(omega[i]), float(zeta[i]), lead_in_tau, fps)
