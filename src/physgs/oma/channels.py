@@ -15,6 +15,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from physgs.tracks.track import foreground, to_gray
+
 
 @dataclass(frozen=True)
 class FlowSettings:
@@ -68,9 +70,7 @@ def flow_channels(
     Returns:
         ``Channels`` over the cells whose foreground share in frame 0 reaches ``s.min_fg``.
     """
-    import cv2
-
-    from physgs.tracks.track import foreground, to_gray
+    import cv2  # here: the OMA recovery jobs import this module and never read a video
 
     gray = to_gray(frames)  # [T, H, W]
     T, H, W = gray.shape

@@ -13,6 +13,9 @@ representative pole or average. ``benchmarks/oma_clustering.py`` measures them b
 from __future__ import annotations
 
 import numpy as np
+from pyoma2.algorithms.data.result import SSIResult
+from pyoma2.algorithms.data.run_params import Clustering
+from pyoma2.algorithms.ssi import SSI
 
 from physgs.oma.ssi import Modes, Poles, SSISettings, _normalise
 
@@ -41,10 +44,6 @@ def cluster_modes(p: Poles, s: SSISettings, preset: str, seed: int = 0) -> Modes
         ValueError: for a preset not in ``PRESETS``.
         ClusteringFailed: when pyOMA-2's clustering stops on these poles.
     """
-    from pyoma2.algorithms.data.result import SSIResult
-    from pyoma2.algorithms.data.run_params import Clustering
-    from pyoma2.algorithms.ssi import SSI
-
     if preset not in PRESETS:
         raise ValueError(f"unknown clustering preset {preset!r}; one of {PRESETS}")
     alg = SSI(

@@ -52,6 +52,8 @@ def cell_parts(cell_xy: np.ndarray, K: int, seed: int, n_init: int) -> np.ndarra
     Raises:
         ValueError: when K exceeds the cells.
     """
+    # here: tracks.fit loads torch and numba, which the OMA scripts load only after
+    # physgs.jobs.job has set the rule's threads
     from physgs.tracks.fit import track_parts
 
     n = int(np.asarray(cell_xy).shape[0])

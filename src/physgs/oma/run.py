@@ -12,6 +12,7 @@ from __future__ import annotations
 
 import dataclasses
 import json
+import time
 from dataclasses import asdict, dataclass, replace
 
 import numpy as np
@@ -28,6 +29,7 @@ from physgs.oma.ssi import (
     check_record,
     identify_records,
 )
+from physgs.recovery.record import recovery_dict, score_recovery, with_damping_scores
 
 
 @dataclass(frozen=True)
@@ -157,8 +159,6 @@ def identify_video(
         The [`Identification`][physgs.oma.run.Identification]: the first video's channels, the
             modes in ``s.omega_hz`` (Hz), and the wall time, s.
     """
-    import time
-
     t0 = time.perf_counter()
     rec = projected_records(videos, background, s)
     check_channels(rec, s)
@@ -285,11 +285,11 @@ def recover_oma(
     Raises:
         RuntimeError: if a part without a mode were matched as trusted.
     """
+    # here: torch and the solver, which identification (the same module) never needs
     import torch
 
     from physgs.models.oscillator import integrate
     from physgs.models.ours import prior_substeps
-    from physgs.recovery.record import score_recovery, with_damping_scores
 
     dt = 1.0 / float(observed.fps)
     sub = prior_substeps(
@@ -398,6 +398,4 @@ def save_oma_recovery(path, rec, block: dict) -> None:
         rec (RecoveryRecord): the record.
         block: the ``oma`` block.
     """
-    from physgs.recovery.record import recovery_dict
-
     write_json(path, {**recovery_dict(rec), "oma": block})

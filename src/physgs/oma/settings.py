@@ -6,6 +6,8 @@ The workflow imports this module to plan jobs, so it imports neither pyOMA-2 nor
 from __future__ import annotations
 
 from physgs.models.registry import section_k
+from physgs.recovery.run import null_settings
+from physgs.tracks.settings import condition_indices
 
 
 def identify_params(cfg: dict, config: str) -> dict:
@@ -20,8 +22,6 @@ def identify_params(cfg: dict, config: str) -> dict:
     Returns:
         ``conditions``, ``flow``, ``components``, ``ssi`` and ``omega_hz`` (Hz).
     """
-    from physgs.tracks.settings import condition_indices
-
     o = cfg["oma"]
     n = len(cfg["testbed"]["conditions"])
     return {
@@ -60,8 +60,6 @@ def recovery_params(cfg: dict, config: str, seed: int) -> dict:
     Returns:
         ``K``, ``seed``, ``kmeans_n_init`` and ``solver``.
     """
-    from physgs.recovery.run import null_settings
-
     K = parts(cfg, config)
     return {
         "K": K,

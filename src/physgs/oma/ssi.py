@@ -308,6 +308,7 @@ def ssi_poles(ys: list[np.ndarray], fs: float, s: SSISettings) -> Poles:
         ValueError: on records of different channel counts, non-finite or non-2-D records, or a
             record that cannot carry the settings (``RecordError``, naming the key).
     """
+    # here: pyOMA-2 and scipy (~1 s); the config checks import this module to plan jobs
     from pyoma2.functions import gen, ssi
 
     from physgs.oma.uncertainty import combine_blocks, pole_std
