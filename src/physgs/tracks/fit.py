@@ -158,7 +158,7 @@ def track_parts(seed_xy: np.ndarray, K: int, seed: int, n_init: int = 4) -> np.n
             f"models.configs K = {K} parts exceeds the {len(seed_xy)} tracks long enough to fit "
             f"(>= {MIN_TRACK_FRAMES} frames); lower K for the tracks control"
         )
-    from sklearn.cluster import KMeans
+    from sklearn.cluster import KMeans  # here: ~1 s that the jobs loading a fit never need
 
     km = KMeans(n_clusters=K, random_state=seed, n_init=n_init).fit(seed_xy)
     c = km.cluster_centers_

@@ -9,6 +9,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from physgs.atomic import write_json
+from physgs.intermediate import read_json
 from physgs.recovery.record import (
     RecoveryRecord,
     recovery_dict,
@@ -129,6 +130,4 @@ def load_tracks_block(path) -> dict:
     Raises:
         IntermediateFileError: when the file is missing, corrupt or lacks the block.
     """
-    from physgs.intermediate import read_json
-
     return read_json(path, ("tracks",), rule="tracks_evaluate")["tracks"]

@@ -13,8 +13,10 @@ from __future__ import annotations
 
 import numpy as np
 
+from physgs.evaluate.adapter import model_means_fn
 from physgs.tracks.fit import FitSettings, Oscillators, TrackFit, fit_tracks, predict_tracks
 from physgs.tracks.recover import TracksRecovery, recover_tracks
+from physgs.tracks.score import associate, model_point_tracks, motion_errors, score_tracker
 from physgs.tracks.track import Tracks
 
 
@@ -110,9 +112,6 @@ def models_at_tracks(models: dict, fit: TrackFit, tracks0: Tracks, observed, tru
             [`motion_cases`][physgs.tracks.run.motion_cases], errors from
             [`motion_errors`][physgs.tracks.score.motion_errors].
     """
-    from physgs.evaluate.adapter import model_means_fn
-    from physgs.tracks.score import associate, model_point_tracks, motion_errors
-
     cam = observed.train_camera
     fitted = _fitted(fit)
     verts = associate(truth, cam, tracks0, 0)
@@ -167,8 +166,6 @@ def evaluate_job(
     Raises:
         ValueError: when the fit's first condition is not the training one.
     """
-    from physgs.tracks.score import motion_errors, score_tracker
-
     if fit.conditions[0] != 0:
         raise ValueError(f"the fit's first condition is {fit.conditions[0]}, not the training one")
     cam = observed.train_camera

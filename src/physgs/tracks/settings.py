@@ -14,7 +14,8 @@ initialisation, RK4 substeps and guard) and ``train.lr.physics`` (Adam's rate on
 
 from __future__ import annotations
 
-from physgs.models.registry import SAME_K, section_k
+from physgs.models.registry import SAME_K, configs_for, section_k
+from physgs.testbed.variant import FAITHFUL, parse_id
 
 #: ours' settings the oscillator fit reads (``physgs.tracks.fit.Oscillators.from_config``)
 OURS_KEYS = ("omega_hz", "zeta", "omega_init_hz", "zeta_init", "substeps", "rk4_guard")
@@ -81,9 +82,6 @@ def fields_scored(cfg: dict, config: str, testbed: str) -> list[str]:
     Returns:
         Model ids from ``tracks.fields``, in its order.
     """
-    from physgs.models.registry import configs_for
-    from physgs.testbed.variant import FAITHFUL, parse_id
-
     if parse_id(testbed)[1] != FAITHFUL:
         return []
     configs = cfg["models"]["configs"]

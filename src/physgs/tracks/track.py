@@ -137,7 +137,7 @@ def to_gray(frames: np.ndarray) -> np.ndarray:
     Raises:
         ValueError: for another shape or dtype.
     """
-    import cv2
+    import cv2  # here: the workflow imports this module (Tracks) to plan jobs
 
     frames = np.asarray(frames)
     if frames.ndim != 4 or frames.shape[-1] != 3 or frames.dtype != np.uint8:
@@ -158,7 +158,7 @@ def foreground(frames: np.ndarray, background, tol: int, dilate_px: int) -> np.n
     Returns:
         [T, H, W] bool mask.
     """
-    import cv2
+    import cv2  # here: the workflow imports this module (Tracks) to plan jobs
 
     bg = np.round(np.asarray(background, dtype=np.float64) * 255.0).astype(np.int16)
     fg = (np.abs(frames.astype(np.int16) - bg).max(axis=-1) > tol).astype(np.uint8)
@@ -170,7 +170,7 @@ def foreground(frames: np.ndarray, background, tol: int, dilate_px: int) -> np.n
 
 def _seeds(gray, fg, live_xy, s: TrackSettings, n_max: int) -> np.ndarray:
     """[n, 2] float32 OpenCV-pixel corners in ``fg`` [H, W] away from live_xy [m, 2]."""
-    import cv2
+    import cv2  # here: the workflow imports this module (Tracks) to plan jobs
 
     if n_max <= 0:
         return np.zeros((0, 2), np.float32)
@@ -202,7 +202,7 @@ def track_video(frames: np.ndarray, background, settings: TrackSettings | None =
         The [`Tracks`][physgs.tracks.track.Tracks], P the number of tracks ever started (0 when
             nothing is tracked).
     """
-    import cv2
+    import cv2  # here: the workflow imports this module (Tracks) to plan jobs
 
     s = settings or TrackSettings()
     gray = to_gray(frames)  # [T, H, W]
