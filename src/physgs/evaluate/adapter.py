@@ -6,6 +6,8 @@ from __future__ import annotations
 import numpy as np
 import torch
 
+from physgs.evaluate.splits import NotDefined
+
 
 def model_render_fn(model, observed, *, backend: str = "auto", means_seen: dict | None = None):
     """render_fn(frame_idx, condition, camera) -> (rgb [H, W, 3] in [0, 1], alpha [H, W]) numpy.
@@ -27,6 +29,8 @@ def model_render_fn(model, observed, *, backend: str = "auto", means_seen: dict 
         (Callable): The callback, float64 arrays; it raises
             [`NotDefined`][physgs.evaluate.splits.NotDefined] where the model makes no prediction.
     """
+    # here: the rasterizer loads numba, which the evaluate job should load only once
+    # physgs.jobs.job has set the rule's threads (its pool then starts at that size)
     from physgs.render import rasterization
 
     winds = [torch.as_tensor(w, dtype=torch.float32) for w in observed.wind]  # C x [L+F] m/s
@@ -37,8 +41,6 @@ def model_render_fn(model, observed, *, backend: str = "auto", means_seen: dict 
 
     def render_fn(frame_idx: int, condition: int, camera):
         if not model.defined(int(frame_idx), int(condition)):
-            from physgs.evaluate.splits import NotDefined
-
             raise NotDefined(
                 f"{model.name}: no prediction at frame {frame_idx}, condition {condition}"
             )

@@ -11,6 +11,9 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from physgs.atomic import atomic_path
+from physgs.intermediate import read_npz
+
 
 @dataclass(frozen=True)
 class Purity:
@@ -112,8 +115,6 @@ def save_segmentations(path, record: dict[str, np.ndarray]) -> None:
         record: the arrays of
             [`segmentation_record`][physgs.evaluate.parts.segmentation_record].
     """
-    from physgs.atomic import atomic_path
-
     with atomic_path(path) as tmp, open(tmp, "wb") as f:
         np.savez_compressed(f, **record)
 
@@ -130,6 +131,4 @@ def load_segmentations(path) -> dict[str, np.ndarray]:
     Raises:
         IntermediateFileError: when the file is missing or corrupt (rule ``parts_segmentation``).
     """
-    from physgs.intermediate import read_npz
-
     return read_npz(path, (), rule="parts_segmentation")

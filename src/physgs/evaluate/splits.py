@@ -15,6 +15,7 @@ import numpy as np
 
 from physgs.atomic import save_npz
 from physgs.evaluate.metrics import centroid_error, psnr, to_float_image
+from physgs.intermediate import read_npz
 
 
 class NotDefined(Exception):
@@ -101,8 +102,6 @@ def load_eval(path) -> EvalResult:
     Raises:
         IntermediateFileError: the file is missing or not an evaluation (rule ``evaluate``).
     """
-    from physgs.intermediate import read_npz
-
     d = read_npz(path, [f.name for f in fields(EvalResult)], rule="evaluate")
     d["n_train"], d["n_tail"] = int(d["n_train"]), int(d["n_tail"])
     return EvalResult(**d)

@@ -8,6 +8,8 @@ from typing import Callable
 import numpy as np
 
 from physgs.atomic import save_npz
+from physgs.intermediate import read_npz
+from physgs.testbed.kinematics import pose_vertices
 
 MeansFn = Callable[[int, int], np.ndarray]  # (frame_idx, condition) -> Gaussian means [N, 3]
 
@@ -57,8 +59,6 @@ def load_trajectories(path) -> Trajectories:
     Raises:
         IntermediateFileError: the file is missing or not a trajectories file (rule ``evaluate``).
     """
-    from physgs.intermediate import read_npz
-
     d = read_npz(path, [f.name for f in fields(Trajectories)], rule="evaluate")
     d["condition"], d["n_train"] = int(d["condition"]), int(d["n_train"])
     return Trajectories(**d)
@@ -93,8 +93,7 @@ def gt_tip_positions(
         ValueError: when the truth holds fewer than L + F samples.
     """
     if pose_fn is None:
-        # imported here so the metric code loads without the testbed package
-        from physgs.testbed.kinematics import pose_vertices as pose_fn
+        pose_fn = pose_vertices
     theta = np.asarray(truth.theta)[condition]  # [L+F, B]
     if lead_in_frames + n_frames > theta.shape[0]:
         raise ValueError(

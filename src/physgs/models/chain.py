@@ -23,6 +23,7 @@ import torch
 from physgs.models.chain_kernel import fused_chain_transforms, parent_of_levels
 from physgs.models.gaussians import axis_angle_quat, quat_multiply, rodrigues_minus_identity
 from physgs.models.part_transform import transform_parts
+from physgs.models.topology import part_depth
 
 
 def depth_levels(parent) -> list[tuple[np.ndarray, np.ndarray]]:
@@ -38,8 +39,6 @@ def depth_levels(parent) -> list[tuple[np.ndarray, np.ndarray]]:
     Raises:
         ValueError: for parents not numbered first.
     """
-    from physgs.models.topology import part_depth
-
     parent = np.asarray(parent, dtype=np.int64)
     depth = part_depth(parent)
     out = []

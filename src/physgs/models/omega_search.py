@@ -105,6 +105,7 @@ def unit_responses(omega, zeta, wind, vbar: float, dt: float, substeps: int) -> 
     Returns:
         [G, T] responses, rad per unit of m^2/s^2 forcing.
     """
+    # here: torch loads only to integrate; the config checks import this module to plan jobs
     import torch
 
     from physgs.models.oscillator import integrate
@@ -223,7 +224,7 @@ def omega_search_callback(observed, models_cfg: dict, train_cfg: dict, condition
     Raises:
         ValueError: when the phase cannot end between the warm-up and freezing.
     """
-    from physgs.models.visibility import freeze_schedule
+    from physgs.models.visibility import freeze_schedule  # here: loads torch (module docstring)
 
     search = OmegaSearch.from_config(models_cfg["omega_search"])
     at = search_iteration(search, train_cfg, freeze_schedule(models_cfg, train_cfg))

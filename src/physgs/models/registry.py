@@ -25,8 +25,9 @@ import numpy as np
 
 from physgs.atomic import atomic_path
 from physgs.intermediate import remake_hint
+from physgs.models.omega_search import OmegaSearch
 
-if TYPE_CHECKING:
+if TYPE_CHECKING:  # the model classes load torch (module docstring)
     from physgs.models.base import BaseModel
 
 
@@ -527,6 +528,7 @@ def build_model(
             not have when K is not given, or a learned-forcing prior listed for the search over
             omega.
     """
+    # here: the model classes load torch, and the workflow plans with this module (docstring)
     from physgs.models.base import ModelContext, context_from_observed
     from physgs.models.fields import FieldModel
     from physgs.models.ours import OscillatorPrior
@@ -598,8 +600,6 @@ def build_model(
     spec = spec_of(name)
     options = {}
     if searches_omega(cfg, name):
-        from physgs.models.omega_search import OmegaSearch
-
         options["search"] = OmegaSearch.from_config(cfg["omega_search"])
     if spec.parts == "topology":
         t = cfg["topology"]
@@ -610,7 +610,7 @@ def build_model(
             canonical_pose=canonical_pose_of(t),
         )
     if spec.forcing == "learned":
-        from physgs.models.blind import BlindOscillatorPrior
+        from physgs.models.blind import BlindOscillatorPrior  # here: torch, as above
 
         if options.get("search") is not None:
             raise ValueError(f"{name} has no search over omega: remove it from models/omega_search")
@@ -661,7 +661,7 @@ def save_checkpoint(
         train_cfg: the ``train`` config section it was trained with.
         stats: the training statistics.
     """
-    import torch
+    import torch  # here: the workflow plans with this module (module docstring)
 
     path = Path(path)
     path.parent.mkdir(parents=True, exist_ok=True)
@@ -694,7 +694,7 @@ def read_checkpoint(path) -> dict:
         FileNotFoundError: when there is no file.
         ValueError: when it does not unpickle or is not a checkpoint of this format.
     """
-    import torch
+    import torch  # here: the workflow plans with this module (module docstring)
 
     path = Path(path)
     if not path.is_file():
@@ -731,6 +731,7 @@ def load_checkpoint(path) -> BaseModel:
         FileNotFoundError: when there is no file.
         ValueError: for a corrupt checkpoint.
     """
+    # here: torch, as in build_model
     from physgs.models.base import ModelContext
     from physgs.models.truth_motion import TrueMotion
 

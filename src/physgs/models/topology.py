@@ -53,6 +53,9 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 import numpy as np
+import scipy.sparse
+import scipy.sparse.csgraph as csgraph
+import scipy.spatial
 
 #: Default neighbours per Gaussian of the graph (see module docstring for why).
 KNN = 10
@@ -101,9 +104,6 @@ def neighbour_graph(xyz: np.ndarray, knn: int = KNN):
     Raises:
         ValueError: for ``knn`` outside [1, N - 1] or positions that are not [N, 3] and finite.
     """
-    import scipy.sparse
-    import scipy.spatial
-
     xyz = _check_xyz(xyz)
     n = xyz.shape[0]
     if not 1 <= knn < n:
@@ -128,10 +128,6 @@ def join_components(xyz: np.ndarray, graph, root: int):
             [N, N] and the ``(i, j, length)`` edges added, i in the main part (the input graph
             and no joins when it is connected already).
     """
-    import scipy.sparse
-    import scipy.sparse.csgraph as csgraph
-    import scipy.spatial
-
     xyz = _check_xyz(xyz)
     n_comp, comp = csgraph.connected_components(graph, directed=False)
     joins = []
@@ -173,8 +169,6 @@ def geodesic_from_root(graph, root: int) -> tuple[np.ndarray, np.ndarray]:
     Raises:
         ValueError: when a point is unreachable (the graph is not connected).
     """
-    import scipy.sparse.csgraph as csgraph
-
     dist, pred = csgraph.dijkstra(graph, directed=False, indices=root, return_predecessors=True)
     if not np.isfinite(dist).all():
         raise ValueError("neighbour graph is not connected after joining; this is a bug")
@@ -194,8 +188,6 @@ def slab_segments(graph, dist: np.ndarray, n_bins: int) -> np.ndarray:
     Returns:
         [N] int64 segment ids.
     """
-    import scipy.sparse.csgraph as csgraph
-
     top = float(dist.max())
     slab = np.zeros(len(dist), dtype=np.int64)
     if top > 0:

@@ -14,6 +14,7 @@ import torch
 
 from physgs.camera import Camera
 from physgs.render.fast import rasterize_fast
+from physgs.render.gsplat_backend import rasterize_gsplat
 from physgs.render.project import project_gaussians
 from physgs.render.reference import composite_reference
 
@@ -95,7 +96,7 @@ def _check_inputs(means, quats, scales, opacities, colors, camera, background):
 def _gsplat_available(device: torch.device) -> bool:
     if device.type != "cuda":
         return False
-    try:
+    try:  # here: gsplat is optional (CUDA only), probed and never required
         import gsplat  # noqa: F401
     except ImportError:
         return False
@@ -155,8 +156,6 @@ def rasterization(
                 "rasterization: backend 'gsplat' needs CUDA tensors and the gsplat "
                 "package; use backend='fast' on the CPU or `pip install gsplat`"
             )
-        from physgs.render.gsplat_backend import rasterize_gsplat
-
         rgb, alpha, depth = rasterize_gsplat(
             means, quats, scales, opacities, colors, camera, background, return_depth
         )

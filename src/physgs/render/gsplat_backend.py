@@ -42,7 +42,7 @@ def rasterize_gsplat(
             depth [H, W] or None)`` on the CUDA device, in the dtype of ``means`` (gsplat computes
             in float32).
     """
-    import gsplat
+    import gsplat  # here: an optional package (CUDA only); the module loads without it
 
     dev, dt = means.device, means.dtype
     viewmat = torch.as_tensor(camera.viewmat, dtype=torch.float32, device=dev)[None]

@@ -9,6 +9,8 @@ import numpy as np
 import torch
 
 from physgs.camera import Camera, look_at
+from physgs.models.gaussians import CanonicalGaussians
+from physgs.testbed.dataset import load_observed
 
 
 def random_scene(
@@ -67,9 +69,6 @@ def tree_scene(dataset_dir, canonical_cfg: dict | None = None, dtype=torch.float
             [N, 3], quats [N, 4], scales [N, 3], opacities [N], colors [N, 3], camera, background
             [3])``, the image the camera's size (pixels).
     """
-    from physgs.models.gaussians import CanonicalGaussians
-    from physgs.testbed.dataset import load_observed
-
     obs = load_observed(Path(dataset_dir) / "observed.npz")
     with torch.no_grad():
         st = CanonicalGaussians(obs.canonical_xyz, **(canonical_cfg or {})).state()
