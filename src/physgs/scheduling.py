@@ -29,6 +29,8 @@ import inspect
 import threading
 import time
 
+from snakemake.scheduling.job_scheduler import JobScheduler
+
 #: marks a class whose method is already replaced (a Snakefile can be loaded more than once)
 _MARK = "_physgs_single_timer"
 
@@ -93,6 +95,4 @@ def single_reevaluation_timer(scheduler_cls: type) -> None:
 def install() -> None:
     """Install [`single_reevaluation_timer`][physgs.scheduling.single_reevaluation_timer] on
     Snakemake's ``JobScheduler``."""
-    from snakemake.scheduling.job_scheduler import JobScheduler
-
     single_reevaluation_timer(JobScheduler)

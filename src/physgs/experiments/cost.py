@@ -13,6 +13,7 @@ measured wall time of the run says how much they and the scheduling add.
 from __future__ import annotations
 
 import csv
+import math
 import re
 from dataclasses import dataclass
 from pathlib import Path
@@ -288,7 +289,6 @@ def resources_by_stage(jobs: list[JobCost]) -> dict[str, dict]:
     Returns:
         Stage -> its statistics, stages sorted by name; seconds and MB.
     """
-    import math
 
     def stats(xs):
         xs = [x for x in xs if not math.isnan(x)]

@@ -17,7 +17,7 @@ from typing import Mapping
 
 import numpy as np
 
-from physgs.experiments.recipe import Job, heldout_split
+from physgs.experiments.recipe import Job, fit, heldout_split
 
 
 def point_job(job: Mapping, K: int) -> dict:
@@ -47,7 +47,6 @@ def kmatch_point(observed, job: Mapping, *, progress: bool = False) -> dict:
             mean over the trained frames), ``frozen`` (parts), ``train_s`` (seconds).
     """
     from physgs.evaluate.run import training_camera_scores  # torch: only when training
-    from physgs.experiments.recipe import fit
 
     j = Job.from_dict(dict(job))
     every = int(j.train["holdout_every"])

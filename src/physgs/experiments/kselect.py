@@ -30,6 +30,7 @@ import numpy as np
 
 from physgs.atomic import write_json
 from physgs.experiments.recipe import Job, fit, heldout_split  # noqa: F401 (re-exported)
+from physgs.intermediate import read_json, refuse
 from physgs.models.registry import AUTO_CONFIG
 
 METHODS = ("heldout", "bic")
@@ -214,8 +215,6 @@ def load_selection(path) -> KSelection:
         IntermediateFileError: the file is missing or not a K selection (it is removed, so rule
             ``kselect`` rebuilds it).
     """
-    from physgs.intermediate import read_json, refuse
-
     d = read_json(path, rule="kselect")
     try:
         return KSelection.from_dict(d)

@@ -11,6 +11,7 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
+from physgs.models.omega_search import OmegaSearch, omega_search_callback, search_iteration
 from physgs.models.registry import (
     build_model,
     configs_for,
@@ -18,10 +19,11 @@ from physgs.models.registry import (
     is_reference,
     model_settings,
     save_checkpoint,
+    searches_omega,
     spec_of,
 )
 
-if TYPE_CHECKING:
+if TYPE_CHECKING:  # the training machinery loads torch (module docstring)
     from physgs.train.loop import TrainResult
 
 
@@ -194,6 +196,7 @@ def fit(
         ValueError: an unknown model, or a truth given to a method.
         TrainingError: the fit diverged or the model failed (no result).
     """
+    # here: the training machinery loads torch (module docstring)
     from physgs.train.loop import condition_indices, train_model
     from physgs.train.seeding import seed_everything
 
@@ -256,7 +259,7 @@ def holdout_eval(observed, job: Job, held, conditions: list[int]):
     Raises:
         ValueError: the rule is enabled and no frame is held out.
     """
-    from physgs.train.holdout import HoldoutEval
+    from physgs.train.holdout import HoldoutEval  # here: torch (module docstring)
     from physgs.train.stopping import StopRule
 
     rule = StopRule.from_config(job.train)
@@ -281,9 +284,7 @@ def earliest_stop(job: Job) -> int:
     Returns:
         The iteration (0 when the recipe changes nothing after the warm-up).
     """
-    from physgs.models.omega_search import OmegaSearch, search_iteration
-    from physgs.models.registry import searches_omega
-    from physgs.models.visibility import freeze_schedule
+    from physgs.models.visibility import freeze_schedule  # here: torch (module docstring)
 
     out = 0
     if is_prior(job.model):
@@ -310,9 +311,7 @@ def training_hooks(observed, job: Job, conditions: list[int]) -> list:
     Raises:
         ValueError: for a freezing iteration or a search end outside the deformation phase.
     """
-    from physgs.models.omega_search import omega_search_callback
-    from physgs.models.registry import searches_omega
-    from physgs.models.visibility import freeze_callback
+    from physgs.models.visibility import freeze_callback  # here: torch (module docstring)
 
     hooks = []
     if is_prior(job.model):
@@ -346,7 +345,7 @@ def check_precision_supported(settings: dict, families: tuple[str, ...] = ("mlp"
     ]
     if not asked:
         return
-    from physgs.models.fields import native_bf16
+    from physgs.models.fields import native_bf16  # here: torch, only when bf16 is asked for
 
     if not native_bf16():
         import torch
@@ -380,7 +379,7 @@ def train_and_save(
     Returns:
         The [`TrainResult`][physgs.train.loop.TrainResult].
     """
-    from physgs.train.loop import write_loss_log
+    from physgs.train.loop import write_loss_log  # here: torch (module docstring)
 
     job = Job.from_dict(job) if isinstance(job, dict) else job
     result = fit(observed, job, truth=truth, progress=progress)

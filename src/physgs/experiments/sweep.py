@@ -21,6 +21,8 @@ import pandas as pd
 
 from physgs.experiments.recipe import canonical, fit, job_spec
 from physgs.models.registry import BASE_CONFIG
+from physgs.recovery.run import recover_model
+from physgs.testbed.dataset import build_dataset, load_observed, load_truth, save_dataset
 from physgs.testbed.variant import effective_settings
 
 KNOBS = ("resolution", "iterations", "substeps", "K", "vertices")
@@ -184,9 +186,6 @@ def run_point(point: dict, observed_path, truth_path, *, progress: bool = False)
             ``frozen`` counts.
     """
     from physgs.evaluate.run import training_camera_scores  # torch: only when training
-
-    from physgs.recovery.run import recover_model
-    from physgs.testbed.dataset import build_dataset, load_observed, load_truth, save_dataset
 
     name, tree = point["point"], point["tree"]
     rec = {
