@@ -20,7 +20,8 @@ resonance only ~zeta wide. The search replaces omega by something the loss is sm
 
 Pure functions over arrays here; the prior ([`physgs.models.ours`][]) holds the bank and calls
 ``project_to_oscillators``; ``SearchHook`` is the training loop's hook. torch loads only
-when a response is integrated: the config's checks import ``search_iteration`` to plan.
+when a response is integrated: the workflow imports this module to plan (the config checks'
+``search_problem``, the recipe's ``search_iteration``).
 """
 
 from __future__ import annotations

@@ -116,8 +116,7 @@ def load_fit(path) -> tuple[TrackFit, Oscillators, dict]:
     Raises:
         IntermediateFileError: when the file is missing, corrupt or lacks an entry (it is removed).
     """
-    # here: these load torch, and the tracker's job (and the workflow's planning) import this
-    # module
+    # here: these load torch; the tracker's job and the workflow's planning import this module
     from physgs.models.oscillator_params import OscillatorBounds
     from physgs.tracks.fit import Oscillators, TrackFit
 
