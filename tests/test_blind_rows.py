@@ -199,3 +199,13 @@ def test_tab_recovery_and_tab_damping_read_the_forcing_free_records_and_their_nu
     assert ("table", "tab_damping") not in build.claims_needs(
         dataclasses.replace(PLAN, damping_trees=())
     )
+
+
+def test_fig_stabilisation_reads_the_first_seeds_first_configuration_and_its_truth():
+    assert build.needs("fig_stabilisation", PLAN) == [
+        ("oma_modes", "sparse", "single", 0),
+        ("truth", "sparse", 0),
+    ]
+    assert build.in_report("fig_stabilisation", PLAN)
+    no_oma = dataclasses.replace(PLAN, recovery={"ours": {"single": 32}})
+    assert not build.in_report("fig_stabilisation", no_oma)  # nothing to draw: not built
