@@ -5,7 +5,8 @@ import pytest
 import torch
 
 from physgs.camera import Camera, look_at
-from physgs.render import rasterization
+from physgs.models.gaussians import GaussianState
+from physgs.render import rasterization, render_state
 from physgs.render.scenes import random_scene
 from oracles import pixel_centres, rotation_wxyz
 
@@ -248,3 +249,21 @@ def test_bad_inputs_name_the_cause():
     if not torch.cuda.is_available():
         with pytest.raises(RuntimeError, match="gsplat"):
             rasterization(*g, cam, [0, 0, 0], backend="gsplat")
+
+
+def test_render_state_passes_each_field_to_its_argument():
+    # An anisotropic, rotated, half-transparent Gaussian: swapping any two of the five fields
+    # changes the image, so this pins the field order against the closed-form alpha profile.
+    cam = axis_camera(w=40, h=36, f=50.0)
+    d, sx, sy, o = 4.0, 0.3, 0.1, 0.6
+    half = np.sqrt(0.5)
+    g = gaussians([[0.0, 0.0, d]], [[sx, sy, 0.05]], [o], [[0.2, 0.5, 0.9]], [[half, 0, 0, half]])
+    out = render_state(GaussianState(*g), cam, [0.0, 0.0, 0.0], backend="reference")
+    # (w, z) = (cos 45, sin 45): 90 degrees about the optical axis turns x onto the image y
+    vx, vy = (cam.fx * sy / d) ** 2 + 0.3, (cam.fy * sx / d) ** 2 + 0.3
+    xx, yy = pixel_centres(cam)
+    a = np.minimum(0.99, o * np.exp(-0.5 * ((xx - cam.cx) ** 2 / vx + (yy - cam.cy) ** 2 / vy)))
+    a = np.where(a < 1 / 255, 0.0, a)
+    np.testing.assert_allclose(out.alpha.numpy(), a, atol=2e-3)
+    np.testing.assert_allclose(out.rgb.numpy(), a[..., None] * np.array([0.2, 0.5, 0.9]), atol=2e-3)
+    assert out.depth is None

@@ -8,7 +8,7 @@ import torch
 
 from physgs.experiments import job_spec, train_and_save
 from physgs.models import MODEL_NAMES, build_model, load_checkpoint
-from physgs.render import rasterization
+from physgs.render import render_state
 from physgs.train import TrainingError, photometric_loss, ssim, train_model
 from physgs.train.seeding import seed_everything
 from oracles import quick_train_cfg
@@ -28,16 +28,7 @@ def _eval_loss(model, data):
         tot = 0.0
         for j in range(0, data.n_train, 4):
             s = model.gaussians_at(j, torch.tensor(data.wind[0]))
-            out = rasterization(
-                s.means,
-                s.quats,
-                s.scales,
-                s.opacities,
-                s.colors,
-                data.train_camera,
-                data.background,
-                return_depth=False,
-            )
+            out = render_state(s, data.train_camera, data.background)
             tgt = torch.from_numpy(data.frames[0, j]).float() / 255
             tot += float(photometric_loss(out.rgb, tgt)[0])
     return tot

@@ -30,7 +30,7 @@ from physgs.models import (
     training_jobs,
 )
 from physgs.models.registry import label
-from physgs.render import rasterization
+from physgs.render import rasterization, render_state
 from physgs.testbed import kinematics
 from physgs.train import photometric_loss
 from oracles import rotation_wxyz
@@ -268,17 +268,7 @@ def test_training_lowers_the_loss_and_changes_only_appearance(pair, trained):
             tot = 0.0
             for j in range(N_TRAIN):
                 s = m.gaussians_at(j, torch.tensor(observed.wind[0]))
-                out = rasterization(
-                    s.means,
-                    s.quats,
-                    s.scales,
-                    s.opacities,
-                    s.colors,
-                    observed.train_camera,
-                    observed.background,
-                    backend="fast",
-                    return_depth=False,
-                )
+                out = render_state(s, observed.train_camera, observed.background, backend="fast")
                 tgt = torch.from_numpy(observed.frames[0, j]).float() / 255
                 tot += float(photometric_loss(out.rgb, tgt)[0])
         return tot

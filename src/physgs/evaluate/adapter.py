@@ -31,7 +31,7 @@ def model_render_fn(model, observed, *, backend: str = "auto", means_seen: dict 
     """
     # here: the rasterizer loads numba, which the evaluate job should load only once
     # physgs.jobs.job has set the rule's threads (its pool then starts at that size)
-    from physgs.render import rasterization
+    from physgs.render import render_state
 
     winds = [torch.as_tensor(w, dtype=torch.float32) for w in observed.wind]  # C x [L+F] m/s
     bg = torch.as_tensor(np.asarray(observed.background), dtype=torch.float32)
@@ -52,17 +52,7 @@ def model_render_fn(model, observed, *, backend: str = "auto", means_seen: dict 
                     # a model blind to the wind (the same deformation)
                     means_seen[(int(frame_idx), 0)] = last["g"].means.cpu().numpy()
             g = last["g"]
-            out = rasterization(
-                g.means,
-                g.quats,
-                g.scales,
-                g.opacities,
-                g.colors,
-                camera,
-                bg,
-                backend=backend,
-                return_depth=False,
-            )
+            out = render_state(g, camera, bg, backend=backend)
         return (
             out.rgb.clamp(0, 1).cpu().numpy().astype(np.float64),
             out.alpha.cpu().numpy().astype(np.float64),

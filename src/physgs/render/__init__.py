@@ -182,4 +182,37 @@ def rasterization(
     return RenderOutput(rgb, alpha, depth)
 
 
-__all__ = ["rasterization", "RenderOutput", "BACKENDS"]
+def render_state(
+    state, camera: Camera, background, *, backend: str = "auto", return_depth: bool = False
+) -> RenderOutput:
+    """Render a model's Gaussians at one instant: ``rasterization`` on the state's five arrays.
+
+    Training, the held-out window frames, the evaluation and the tests all render a
+    [`GaussianState`][physgs.models.gaussians.GaussianState] this way; one call keeps the order
+    of its fields in one place.
+
+    Args:
+        state: any object with ``means`` [N, 3], ``quats`` [N, 4], ``scales`` [N, 3],
+            ``opacities`` [N] and ``colors`` [N, 3] (a ``GaussianState``).
+        camera: the camera; the image is camera.height x camera.width px.
+        background (torch.Tensor | np.ndarray | list): [3] background colour.
+        backend: as for [`rasterization`][physgs.render.rasterization].
+        return_depth: whether to compute the expected depth (off: the losses read colour only).
+
+    Returns:
+        The [`RenderOutput`][physgs.render.RenderOutput].
+    """
+    return rasterization(
+        state.means,
+        state.quats,
+        state.scales,
+        state.opacities,
+        state.colors,
+        camera,
+        background,
+        backend=backend,
+        return_depth=return_depth,
+    )
+
+
+__all__ = ["rasterization", "render_state", "RenderOutput", "BACKENDS"]

@@ -12,7 +12,7 @@ import numpy as np
 import torch
 
 from physgs.evaluate.metrics import psnr
-from physgs.render import rasterization
+from physgs.render import render_state
 from physgs.train.losses import photometric_loss
 
 
@@ -81,17 +81,7 @@ class HoldoutEval:
             canon = model.canonical_state() if warm else None
             for (c, j), target in zip(self.pairs, self.targets):
                 s = canon if warm else model.gaussians_at(j, self.winds[c])
-                out = rasterization(
-                    s.means,
-                    s.quats,
-                    s.scales,
-                    s.opacities,
-                    s.colors,
-                    self.camera,
-                    self.background,
-                    backend=self.backend,
-                    return_depth=False,
-                )
+                out = render_state(s, self.camera, self.background, backend=self.backend)
                 loss, _, _ = photometric_loss(out.rgb, target, self.ssim_weight)
                 losses.append(float(loss))
                 rgb = out.rgb.clamp(0, 1).float().cpu().numpy()

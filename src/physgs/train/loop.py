@@ -13,7 +13,7 @@ from tqdm import tqdm
 
 from physgs.atomic import atomic_path
 from physgs.models.base import BaseModel
-from physgs.render import rasterization
+from physgs.render import render_state
 from physgs.train.adam import FusedAdam
 from physgs.train.divergence import SUSPECT_GROWN, Divergence, DivergenceGuard, pinned
 from physgs.train.holdout import HoldoutEval
@@ -261,17 +261,7 @@ def train_model(
         d = guard.check_means(s.means.detach().cpu().numpy())
         if d is not None:
             raise diverged(it, d)
-        out = rasterization(
-            s.means,
-            s.quats,
-            s.scales,
-            s.opacities,
-            s.colors,
-            cam,
-            bg,
-            backend=backend,
-            return_depth=False,
-        )
+        out = render_state(s, cam, bg, backend=backend)
         loss, l1, dssim = photometric_loss(out.rgb, target, w_ssim)
         if not math.isfinite(loss.item()):
             raise diverged(
