@@ -18,6 +18,7 @@ wall time and the time its held-out scores took.
 from __future__ import annotations
 
 import argparse
+import contextlib
 import csv
 import os
 import time
@@ -26,12 +27,11 @@ import numpy as np
 import torch
 
 from physgs.config import load
-from physgs.experiments.recipe import Job, fit, heldout_split, job_spec, training_hooks
-from physgs.models.registry import BLIND_PRIORS, build_model, is_reference, training_jobs
+from physgs.experiments.recipe import Job, fit, heldout_split, job_spec
+from physgs.models.registry import BLIND_PRIORS, is_reference, training_jobs
 from physgs.testbed.dataset import load_observed, load_truth
 from physgs.train.holdout import HoldoutEval
-from physgs.train.loop import condition_indices, train_model
-from physgs.train.seeding import seed_everything
+from physgs.train.loop import condition_indices
 
 RULE_OFF = {"enabled": False, "every": 0, "patience": 1, "tol": 0.0, "anneal": 1}
 FIELDS = (
@@ -52,6 +52,25 @@ def models_that_train(cfg: dict) -> list[str]:
     ms = [m for m, c in training_jobs(cfg["models"]["configs"]) if c == "single"]
     ms += [m for m in BLIND_PRIORS] + [m for m in cfg["parts_study"]["models"] if m not in ms]
     return [*ms, "truth_motion"]
+
+
+@contextlib.contextmanager
+def appending(path: str, fields: tuple[str, ...]):
+    """A CSV writer appending to ``path`` (the header only when the file is new): one output
+    file gathers the runs of several trees and models."""
+    new = not os.path.exists(path)
+    with open(path, "a", newline="") as fh:
+        w = csv.DictWriter(fh, fieldnames=fields)
+        if new:
+            w.writeheader()
+        yield w, fh
+
+
+def window_holdout(obs, job: Job) -> HoldoutEval:
+    """The evaluator of the frames ``job``'s training window holds out, of its trained winds."""
+    held = heldout_split(int(obs.n_train), int(job.train["holdout_every"]))[1]
+    conds = condition_indices(job.conditions, len(obs.conditions))
+    return HoldoutEval.build(obs, held, conds, job.train)
 
 
 RULE_FIELDS = (
@@ -85,17 +104,11 @@ def run_rule(a, cfg: dict, obs, truth, models: list[str]) -> None:
         if v is not None:
             st[k] = v
     cfg["train"]["stopping"] = st
-    new = not os.path.exists(a.out)
-    with open(a.out, "a", newline="") as fh:
-        w = csv.DictWriter(fh, fieldnames=RULE_FIELDS)
-        if new:
-            w.writeheader()
+    with appending(a.out, RULE_FIELDS) as (w, fh):
         for m in models:
             job = Job.from_dict(job_spec(cfg, m, "single", seed=a.seed))
             res = fit(obs, job, truth=truth if is_reference(m) else None, progress=False)
-            held = heldout_split(int(obs.n_train), int(job.train["holdout_every"]))[1]
-            conds = condition_indices(job.conditions, len(obs.conditions))
-            loss, p = HoldoutEval.build(obs, held, conds, job.train).evaluate(res.model)
+            loss, p = window_holdout(obs, job).evaluate(res.model)
             s = res.stats
             w.writerow(
                 dict(
@@ -146,11 +159,7 @@ def main() -> None:
     if a.rule:
         run_rule(a, cfg, obs, truth, models)
         return
-    new = not os.path.exists(a.out)
-    with open(a.out, "a", newline="") as fh:
-        w = csv.DictWriter(fh, fieldnames=FIELDS)
-        if new:
-            w.writeheader()
+    with appending(a.out, FIELDS) as (w, fh):
         for m in models:
             job = Job.from_dict(job_spec(cfg, m, "single", seed=a.seed))
             # the full budget, scored by the hook below: the curve the rule is chosen on
@@ -159,19 +168,7 @@ def main() -> None:
                 frac = train["warmup"] / train["iterations"]
                 train.update(iterations=a.budget, warmup=int(round(frac * a.budget)))
             job = job.replace(train=train)
-            seed_everything(job.seed)
-            model = build_model(
-                m,
-                obs,
-                job.settings,
-                config=job.config,
-                K=job.K,
-                seed=job.seed,
-                truth=truth if is_reference(m) else None,
-            )
-            conds = condition_indices(job.conditions, len(obs.conditions))
-            trained, held = heldout_split(int(obs.n_train), int(job.train["holdout_every"]))
-            ev = HoldoutEval.build(obs, held, conds, job.train)
+            ev = window_holdout(obs, job)
             t0 = time.perf_counter()
             rows = []
 
@@ -192,17 +189,8 @@ def main() -> None:
                         )
                     )
 
-            res = train_model(
-                model,
-                obs,
-                job.train,
-                conditions=conds,
-                seed=job.seed,
-                name=m,
-                progress=False,
-                frame_pool=trained,
-                on_iteration=[*training_hooks(obs, job, conds), record],
-            )
+            truth_m = truth if is_reference(m) else None
+            res = fit(obs, job, truth=truth_m, progress=False, name=m, hooks=(record,))
             loss, p = ev.evaluate(res.model, warm=False)
             rows.append(
                 dict(

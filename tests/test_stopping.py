@@ -6,7 +6,8 @@ import pandas as pd
 import pytest
 
 from physgs.experiments import job_spec, train_and_save
-from physgs.experiments.recipe import Job, fit
+from physgs.experiments.recipe import Job, fit, heldout_split
+from physgs.train.holdout import HoldoutEval
 from physgs.models import build_model, load_checkpoint
 from physgs.train import train_model
 from physgs.train.schedule import DECAYING, lr_factor
@@ -130,6 +131,28 @@ def test_scoring_the_held_out_frames_leaves_the_training_unchanged(swaying):
             0 if every == 0 else 5
         )
     assert losses[0] == losses[1]
+
+
+def test_a_fit_curve_hook_sees_every_iteration_and_changes_nothing(swaying):
+    """``fit(hooks=...)``, as benchmarks/window_curves.py records its curves: the hook runs at
+    every iteration after the recipe's, and scoring the held-out frames in it leaves the
+    training bitwise as it is without."""
+    cfg = _stop_cfg(enabled=False, every=0)
+    cfg["train"]["iterations"] = 30
+    job = Job.from_dict(job_spec(cfg, "mlp", "single"))
+    held = heldout_split(int(swaying.n_train), int(job.train["holdout_every"]))[1]
+    ev = HoldoutEval.build(swaying, held, [0], job.train)
+    seen, scores = [], []
+
+    def record(it, model, opt):
+        seen.append(it)
+        if it % 10 == 0:
+            scores.append(ev.evaluate(model, warm=it < int(job.train["warmup"]))[0])
+
+    hooked = fit(swaying, job, progress=False, hooks=(record,))
+    plain = fit(swaying, job, progress=False)
+    assert seen == list(range(30)) and len(scores) == 3 and all(np.isfinite(scores))
+    assert [r["loss"] for r in hooked.log] == [r["loss"] for r in plain.log]
 
 
 def test_enabled_rule_without_held_out_frames_is_refused(swaying):

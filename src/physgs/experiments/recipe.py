@@ -170,6 +170,7 @@ def fit(
     frame_pool=None,
     progress: bool = True,
     name: str | None = None,
+    hooks: tuple = (),
 ) -> TrainResult:
     """Seed, build and train one model.
 
@@ -188,6 +189,8 @@ def fit(
             every training frame not held out.
         progress: show a progress bar.
         name: the name the progress and errors use; None: the job's.
+        hooks: ``on_iteration`` callbacks ``(iteration, model, optimiser)`` run after the
+            recipe's own (a benchmark's recorder of the fit curve); they must not change the model.
 
     Returns:
         The [`TrainResult`][physgs.train.loop.TrainResult] (model in eval mode).
@@ -234,7 +237,7 @@ def fit(
         name=name or job.name,
         progress=progress,
         frame_pool=frame_pool,
-        on_iteration=training_hooks(observed, job, conds),
+        on_iteration=[*training_hooks(observed, job, conds), *hooks],
         holdout=holdout_eval(observed, job, held, conds),
         earliest_stop=earliest_stop(job),
     )
