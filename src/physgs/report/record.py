@@ -734,8 +734,8 @@ def headline_lines(claims: pd.DataFrame) -> list[str]:
 
 
 def cost_lines(costs: pd.DataFrame) -> list[str]:
-    """What each of ``COMMANDS`` costs on 2 cores, from ``costs.csv``; ``not measured``
-    where the record has no row for it.
+    """What each of ``COMMANDS`` costs on 2 cores, from ``costs.csv``, each shown as the command
+    it was measured with; ``not measured`` where the record has no row for it.
 
     Args:
         costs: ``costs.csv`` as [`read_costs`][physgs.report.record.read_costs] reads it.
@@ -756,8 +756,9 @@ def cost_lines(costs: pd.DataFrame) -> list[str]:
         n = int(r["segments"])
         if n > 1:  # a run resumed after an interruption: its wall time is the segments' sum
             start += f", in {n} segments"
+        # the command as it was measured (e.g. tab_null at three seeds), not the canonical one
         lines.append(
-            f"| `{command}` | {format_duration(float(r['wall_s']))}{start} | "
+            f"| `{r['command']}` | {format_duration(float(r['wall_s']))}{start} | "
             f"{r['date']}, commit `{r['commit']}`, {r['cpu']} |"
         )
     return lines
