@@ -194,8 +194,7 @@ def test_figures_are_shown_in_reading_order_each_with_a_caption_from_its_declara
         if OUTPUTS[name].kind == "figure":
             captions.find(name)
     assert captions.find("fig_stabilisation")[2] == ""  # one figure, every tree a column
-    for name in ("fig_stabilisation_dense", "testbed_dense_damping"):  # an older record's, ours
-        assert captions.find(name)[2] == "dense"
+    assert captions.find("testbed_dense_damping")[2] == "dense"
     with pytest.raises(KeyError, match="fig_new"):
         captions.caption("fig_new", [0])
 
@@ -250,7 +249,7 @@ def test_figures_are_web_sized_and_keep_their_aspect(tmp_path):
         assert (im.width, im.height) == (300, 200)  # never enlarged
 
 
-def test_a_missing_input_is_named_and_costs_outlive_a_new_record(tmp_path):
+def test_a_missing_input_is_named_and_what_no_run_makes_outlives_a_new_record(tmp_path):
     r, _, _ = _run(tmp_path)
     out = tmp_path / "record"
     record.record_costs(
@@ -268,8 +267,15 @@ def test_a_missing_input_is_named_and_costs_outlive_a_new_record(tmp_path):
     )
     with pytest.raises(FileNotFoundError, match="summary.md"):
         _record(r, out, tables=[], figures=[], summary=r / "nope" / "summary.md")
+    (out / "rates_paper.csv").write_text("model,ms\nours,1\n")
+    (out / "paper_estimate.md").write_text("an estimate\n")
+    (out / "from_the_old_run.md").write_text("gone\n")
     _record(r, out, tables=[], figures=[])
     assert record.read_costs(out / "costs.csv")["wall_s"].tolist() == [100.0]
+    # what no run makes outlives the record; what the old run made goes with it
+    assert (out / "rates_paper.csv").read_text() == "model,ms\nours,1\n"
+    assert (out / "paper_estimate.md").read_text() == "an estimate\n"
+    assert not (out / "from_the_old_run.md").exists()
 
 
 def test_headline_counts_the_verdicts_and_gives_each_story_claim_its_interval():

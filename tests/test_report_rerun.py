@@ -91,7 +91,19 @@ def test_verdicts_compared_by_kind_with_both_intervals():
     v = c.changed[0]
     assert (v.old, v.new) == ("holds", "undecided")
     assert v.old_value == "+2 [+1, +3] dB" and v.new_value == "+0.5 [-0.5, +1.5] dB"
-    assert v.threshold == "> 0 dB"
+    assert v.threshold == "> 0 dB" and v.overlap == "yes"  # [1, 3] and [-0.5, 1.5]
+
+
+def test_a_moved_verdict_says_whether_its_two_intervals_overlap():
+    from physgs.report.rerun import compare_claims
+
+    old = _ledger(["holds", "holds"], [4.0, 2.0])  # [3, 5] and [1, 3]
+    new = _ledger(["fails", "fails"], [-4.0, 1.0])  # [-5, -3] and [0, 2]
+    new.loc[1, ["ci_low", "ci_high"]] = float("nan")  # one seed: no interval
+    c = compare_claims(old, new)
+    assert [(v.id, v.overlap) for v in c.changed] == [("a/sparse", "no"), ("b/sparse", "--")]
+    new.loc[1, ["ci_low", "ci_high"]] = [3.0, 3.5]  # touching at 3 counts as overlapping
+    assert compare_claims(old, new).changed[1].overlap == "yes"
 
 
 def test_claims_in_one_ledger_only_and_bad_ledgers():

@@ -192,7 +192,7 @@ def render_state(
     of its fields in one place.
 
     Args:
-        state: any object with ``means`` [N, 3], ``quats`` [N, 4], ``scales`` [N, 3],
+        state (GaussianState): any object with ``means`` [N, 3], ``quats`` [N, 4], ``scales`` [N, 3],
             ``opacities`` [N] and ``colors`` [N, 3] (a ``GaussianState``).
         camera: the camera; the image is camera.height x camera.width px.
         background (torch.Tensor | np.ndarray | list): [3] background colour.

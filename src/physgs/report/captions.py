@@ -130,18 +130,6 @@ FIGURES: tuple[Caption, ...] = (
         "Columns of stable poles are modes the video shows; where they sit over the strip's "
         "ticks, the analysis finds the bones' frequencies without a model of the tree.",
     ),
-    # records made before fig_stabilisation was one of the outputs (e.g. a run at cbd7537) hold
-    # one diagram a tree: their pages still lay out with this caption
-    Caption(
-        "fig_stabilisation_{tree}",
-        "Output-only modal analysis, {tree} tree",
-        "The stabilisation diagram of the {tree} tree's training window: every pole found "
-        "(frequency in Hz, horizontal) at every model order tried (vertical), filled where stable "
-        "across orders; the identified modes as vertical lines. The strip below marks the bones' "
-        "true frequencies (Hz); they are drawn, never used to select a mode.",
-        "Columns of stable poles are modes the video shows; where they sit over the strip's "
-        "ticks, the analysis finds the bones' frequencies without a model of the tree.",
-    ),
     Caption(
         "testbed_{tree}",
         "The {tree} testbed",

@@ -56,6 +56,12 @@ RERUN_CELLS_SHOWN = 10
 COSTS_COLUMNS = ("name", "command", "wall_s", "date", "commit", "cpu", "from_nothing", "segments")
 BEGIN, END = "<!-- record:begin -->", "<!-- record:end -->"
 
+#: Files of the record's folder that no run makes, kept when a new record replaces the old:
+#: each command's measured cost (``tools/timed.py``), the paper profile's measured iteration
+#: rates (``benchmarks/training.py``) and the estimate ``tools/paper_estimate.py`` computes
+#: from them and today's plan.
+OUTLIVE = ("costs.csv", "rates_paper.csv", "paper_estimate.md")
+
 #: The words and units of the findings, defined once under them (the glossary says more).
 WORDS = (
     "<sub>Each finding: the measured mean over seeds and its 95% interval; **holds** / **fails** "
@@ -273,11 +279,21 @@ def rerun_lines(
         )
     lines.append("")
     if c.changed:
-        lines += ["| claim | before | after | threshold |", "|---|---|---|---|"]
+        lines += [
+            "| claim | before | after | threshold | intervals overlap |",
+            "|---|---|---|---|---|",
+        ]
         lines += [
             f"| `{v.id}`: {_cell(v.claim)} | {v.old}, {v.old_value} | **{v.new}**, {v.new_value}"
-            f" | {_cell(v.threshold)} |"
+            f" | {_cell(v.threshold)} | {v.overlap} |"
             for v in c.changed
+        ]
+        n_apart = sum(v.overlap == "no" for v in c.changed)
+        lines += [
+            "",
+            f"Of the {len(c.changed)} moved verdicts, {n_apart} moved with intervals that do not "
+            "overlap (the runs disagree beyond their seeds' noise); the others moved within it, "
+            "an interval that now clears or now touches its threshold.",
         ]
         lines.append("")
     rows = [
@@ -361,7 +377,7 @@ def write_record(
         if not p.is_file():
             raise FileNotFoundError(f"{p}: missing; finish the run first (snakemake --cores 2 all)")
     final = Path(out_dir)
-    kept = (final / "costs.csv").read_bytes() if (final / "costs.csv").is_file() else None
+    kept = {n: (final / n).read_bytes() for n in OUTLIVE if (final / n).is_file()}
     # against the record this one replaces; the same run recorded again keeps its comparison
     old_stamp = final / "stamp.json"
     if (
@@ -375,7 +391,6 @@ def write_record(
     out = final.with_name(final.name + ".partial")  # the old record stands until this is whole
     if out.exists():
         shutil.rmtree(out)
-    costs = out / "costs.csv"
     (out / "tables").mkdir(parents=True)
     (out / "figures").mkdir()
     written: list[Path] = []
@@ -384,9 +399,9 @@ def write_record(
         (out / name).write_text(text)
         written.append(out / name)
 
-    if kept is not None:  # measured by tools/timed.py, not by the run: it outlives the record
-        costs.write_bytes(kept)
-        written.append(costs)
+    for name, data in kept.items():
+        (out / name).write_bytes(data)
+        written.append(out / name)
     put("stamp.json", json.dumps(asdict(stamp), indent=2) + "\n")
     put("rerun.md", against)
     put("summary.md", demote(Path(summary_md).read_text()))

@@ -237,6 +237,9 @@ class VerdictChange:
         old_value: the old run's measurement with its interval, in words.
         new_value: the new run's, in words.
         threshold: the claim's threshold, in words.
+        overlap: whether the two runs' 95% intervals overlap (``yes`` / ``no``; ``--`` where
+            either run has no interval): a verdict that moved with overlapping intervals moved
+            within the seeds' noise.
     """
 
     id: str
@@ -246,6 +249,7 @@ class VerdictChange:
     old_value: str
     new_value: str
     threshold: str
+    overlap: str = "--"
 
 
 @dataclass(frozen=True)
@@ -287,6 +291,14 @@ def _value(r: pd.Series) -> str:
     if pd.isna(r.get("ci_low")) or pd.isna(r.get("ci_high")):
         return f"{r['measured']:+.3g}{unit}"
     return f"{r['measured']:+.3g} [{r['ci_low']:+.3g}, {r['ci_high']:+.3g}]{unit}"
+
+
+def _overlap(a: pd.Series, b: pd.Series) -> str:
+    """Whether two claims' 95% intervals [ci_low, ci_high] overlap: yes, no, or -- without both."""
+    ends = [pd.to_numeric(r.get(k), errors="coerce") for r in (a, b) for k in ("ci_low", "ci_high")]
+    if any(pd.isna(e) for e in ends):
+        return "--"
+    return "yes" if max(ends[0], ends[2]) <= min(ends[1], ends[3]) else "no"
 
 
 def compare_claims(old: pd.DataFrame, new: pd.DataFrame) -> ClaimsComparison:
@@ -334,6 +346,7 @@ def compare_claims(old: pd.DataFrame, new: pd.DataFrame) -> ClaimsComparison:
                 old_value=_value(o),
                 new_value=_value(r),
                 threshold="--" if pd.isna(threshold) else f"{threshold}{unit}",
+                overlap=_overlap(o, r),
             )
         )
     ids_new = set(new["id"].astype(str))
