@@ -468,7 +468,9 @@ def test_a_new_record_says_what_moved_against_the_one_it_replaces(tmp_path):
     text = (out / "rerun.md").read_text()
     assert "commit `abc1234`" in text and "the same config hash" in text
     assert "3 of 4 claims in both runs keep their verdict, 1 changed" in text
-    assert "| fails, +1.27 [+0.56, +1.97] x | **holds**, +3.1 [+2.6, +3.6] x |" in text
+    assert "| fails, +1.27 [+0.56, +1.97] x | **holds**, +3.1 [+2.6, +3.6] x | 2.5 x | no |" in text
+    assert "Of the 1 moved verdicts, 0 moved with overlapping intervals" in text
+    assert "1 with intervals apart" in text
     head, body = _parse_md_table(text.split("**The seeded tables**")[1].split("\n\n")[1])
     row = dict(zip(head, body[0]))
     assert row["table"] == "`tab_fit`" and (row["identical"], row["beyond it"]) == ("1", "1")

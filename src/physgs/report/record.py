@@ -288,12 +288,14 @@ def rerun_lines(
             f" | {_cell(v.threshold)} | {v.overlap} |"
             for v in c.changed
         ]
-        n_apart = sum(v.overlap == "no" for v in c.changed)
+        n = {k: sum(v.overlap == k for v in c.changed) for k in ("yes", "no", "--")}
         lines += [
             "",
-            f"Of the {len(c.changed)} moved verdicts, {n_apart} moved with intervals that do not "
-            "overlap (the runs disagree beyond their seeds' noise); the others moved within it, "
-            "an interval that now clears or now touches its threshold.",
+            f"Of the {len(c.changed)} moved verdicts, {n['yes']} moved with overlapping intervals "
+            f"(within the seeds' noise: an interval that now clears or now touches its "
+            f"threshold), {n['no']} with intervals apart (the runs disagree beyond that noise)"
+            + (f", {n['--']} without an interval in one of the runs" if n["--"] else "")
+            + ".",
         ]
         lines.append("")
     rows = [

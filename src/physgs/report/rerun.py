@@ -249,7 +249,7 @@ class VerdictChange:
     old_value: str
     new_value: str
     threshold: str
-    overlap: str = "--"
+    overlap: str
 
 
 @dataclass(frozen=True)
