@@ -116,9 +116,9 @@ class Parts:
             saved.append((obj, name, obj.__dict__.get(name, _MISSING)))
             setattr(obj, name, value)
 
-        raster = loop.rasterization
+        raster = loop.render_state
 
-        def rasterization(*a, **k):
+        def render_state(*a, **k):
             with self.timed("raster_fwd"):
                 out = raster(*a, **k)
             if out.rgb.requires_grad:  # the loss's backward reaches the image here
@@ -138,7 +138,7 @@ class Parts:
             self.sec["field"] += (c1 - mark) - (self.sec["raster_bwd"] - r0)
             return None
 
-        patch(loop, "rasterization", rasterization)
+        patch(loop, "render_state", render_state)
         patch(loop, "photometric_loss", self.wrap("loss", loop.photometric_loss))
         patch(loop, "_abs_maxes", self.wrap("guard", loop._abs_maxes))
         patch(loop, "_finite", self.wrap("guard", loop._finite))
