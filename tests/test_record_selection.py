@@ -2,13 +2,16 @@
 exactly the tables, figures and benchmarked jobs of `all`'s plan, whatever else the folder holds
 (a `snakemake studies` run made in it, an earlier run's files)."""
 
+import importlib.util
 import subprocess
 import sys
 from pathlib import Path
 
 import pytest
 
+import physgs.config
 from physgs.experiments.cost import plan_jobs, plan_outputs, summarise
+from physgs.provenance import config_hash
 from physgs.report import record
 
 ROOT = Path(__file__).resolve().parents[1]
@@ -174,10 +177,23 @@ def _dry_run(target: str) -> str:
     ).stdout
 
 
-def test_alls_real_plan_leaves_the_studies_tables_figures_and_jobs_out(tmp_path):
-    """The workflow's own plans (quick profile): a folder holding everything `all` and `studies`
-    make gives the record all's files and jobs, and lists exactly what studies alone makes."""
-    a_out, a_bench = _plan(_dry_run("all"))
+def _record_tool():
+    spec = importlib.util.spec_from_file_location("record_tool", ROOT / "tools" / "record.py")
+    mod = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(mod)
+    return mod
+
+
+def test_alls_real_plan_leaves_the_studies_tables_figures_and_jobs_out(tmp_path, monkeypatch):
+    """The workflow's own plans (quick profile), all's as tools/record.py reads it: a folder
+    holding everything `all` and `studies` make gives the record all's files and jobs, and
+    lists exactly what studies alone makes; a run of another config is refused."""
+    tool = _record_tool()
+    monkeypatch.chdir(ROOT)
+    with pytest.raises(SystemExit, match="another run's"):
+        tool._plan("quick", "000000000000")
+    quick = config_hash(physgs.config.load(ROOT / "config" / "trees.yaml", "quick"))
+    a_out, a_bench = tool._plan("quick", quick)
     s_out, s_bench = _plan(_dry_run("studies"))
     r = tmp_path / "results"
     for rel in {*a_out, *s_out}:
