@@ -5,13 +5,25 @@
     python tools/record.py --readme-only     # rewrite the README's block from the record
     python tools/record.py --report-html [results/report.html]   # Snakemake's report, on demand
 
-Copies the run's summary, ledger, every table (CSV) and every figure (PNG, web sized) into
-`docs/record/` with the run's stamp (`physgs.report.record.write_record`), lays out the Results
-page's parts from them (`physgs.report.record.render_pages`: the figures with their captions,
-the ledger's counts, each table's summary over seeds), then rewrites the README's block between
-`<!-- record:begin -->` and `<!-- record:end -->` (`physgs.report.record.readme_block`). The
-run's layout is the workflow's (`results/`: `summary.md`, `claims.{csv,md}`, `tables/*.csv`,
-`figures/*.png`, `benchmarks/`).
+Copies the run's summary, ledger, the tables (CSV) and figures (PNG, web sized) that `all`
+makes into `docs/record/` with the run's stamp (`physgs.report.record.write_record`), lays out
+the Results page's parts from them (`physgs.report.record.render_pages`: the figures with their
+captions, the ledger's counts, each table's summary over seeds), then rewrites the README's
+block between `<!-- record:begin -->` and `<!-- record:end -->`
+(`physgs.report.record.readme_block`). The run's layout is the workflow's (`results/`:
+`summary.md`, `claims.{csv,md}`, `tables/*.csv`, `figures/*.png`, `benchmarks/`).
+
+It takes exactly what `all`'s plan makes, not what the folder holds: Snakemake's dry run of
+`all` in this checkout (`snakemake -n --forceall all --config profile=P`, P the profile of the
+run's `tab_fit.csv`) names every output and benchmark file of `all`'s jobs
+(`physgs.experiments.cost.plan_outputs`, `plan_jobs`), and `physgs.report.record.run_files`
+keeps those: the tables and figures among the outputs, and the jobs of those benchmark files
+for the stamp's job count and job-minutes by stage (the jobs of the run whose wall time it
+states). A table, figure or benchmark file of the plan that the folder lacks stops it, named;
+what the folder holds beyond the plan (a `snakemake studies` run's tables, figures and
+speed_accuracy/fit_curve/kmatch jobs, or an earlier run's) is left out and listed. Run it in the
+checkout and config the run was made with: a config whose hash is not the run's (its tables'
+`config_hash`) is refused, since its plan is another run's.
 
 The wall time is the run's command's, measured by `tools/timed.py --name all` (summed over the
 segments of a resumed run): `--wall-s` gives it, else the `all` row of `costs.csv` when it was
@@ -32,9 +44,35 @@ from pathlib import Path
 
 import pandas as pd
 
-from physgs.experiments.cost import read_costs, summarise
-from physgs.provenance import git_commit, machine_cpu
+import physgs.config
+from physgs.experiments.cost import plan_jobs, plan_outputs, summarise
+from physgs.provenance import config_hash, git_commit, machine_cpu
 from physgs.report import record
+
+
+#: the run's folder as the workflow's paths name it: every output and benchmark file is below it
+RUN_ROOT = Path("results")
+TARGET = "all"  # the record is of the run of `all`
+
+
+def _plan(profile: str, run_hash: str) -> tuple[list[str], list[str]]:
+    """`all`'s outputs and benchmark files at ``profile``, relative to the run's folder, from
+    Snakemake's dry run in this checkout; refused unless this checkout's config is the run's."""
+    here = config_hash(physgs.config.load("config/trees.yaml", profile))
+    if here != run_hash:
+        raise SystemExit(
+            f"this checkout's {profile} config hashes to {here}, the run's tables to {run_hash}: "
+            "its plan is another run's; record from the checkout and config the run was made with"
+        )
+    cmd = ["snakemake", "-n", "--forceall", TARGET, "--config", f"profile={profile}"]
+    dry = subprocess.run(cmd, capture_output=True, text=True)
+    if dry.returncode:
+        raise SystemExit(f"`{' '.join(cmd)}` failed:\n{dry.stderr[-2000:]}")
+
+    def below(paths):
+        return [str(Path(p).relative_to(RUN_ROOT)) for p in paths if RUN_ROOT in Path(p).parents]
+
+    return below(plan_outputs(dry.stdout)), below(b for _, b in plan_jobs(dry.stdout) if b)
 
 
 def _wall_s(args, commit: str) -> float:
@@ -79,8 +117,11 @@ def main() -> None:
     elif not args.readme_only:
         r = args.results
         fit = pd.read_csv(r / "tables" / "tab_fit.csv", dtype={"config_hash": str})
-        jobs = read_costs(r / "benchmarks")
-        by_stage = summarise(jobs)["by_stage"]
+        outputs, benchmarks = _plan(str(fit["profile"].iloc[0]), fit["config_hash"].iloc[0])
+        run = record.run_files(r, outputs, benchmarks, target=TARGET)
+        print(f"{r}: {len(run.jobs)} benchmarked jobs of {TARGET}'s plan")
+        print(run.left_out_line())
+        by_stage = summarise(list(run.jobs))["by_stage"]
         commit = args.commit or git_commit()
         stamp = record.Stamp(
             date=datetime.date.today().isoformat(),
@@ -93,7 +134,7 @@ def main() -> None:
             wall_s=_wall_s(args, commit),
             job_min_by_stage={k: sum(v.values()) / 60 for k, v in sorted(by_stage.items())},
             note=args.note,
-            jobs=len(jobs),
+            jobs=len(run.jobs),
         )
         written = record.write_record(
             args.out,
@@ -101,8 +142,8 @@ def main() -> None:
             summary_md=r / "summary.md",
             claims_csv=r / "claims.csv",
             claims_md=r / "claims.md",
-            tables=sorted((r / "tables").glob("*.csv")),
-            figures=sorted((r / "figures").glob("*.png")),
+            tables=run.tables,
+            figures=run.figures,
         )
         print(f"{args.out}: {len(written)} files")
     if not (args.out / "stamp.json").is_file():

@@ -15,6 +15,7 @@ from __future__ import annotations
 import csv
 import math
 import re
+from collections.abc import Collection
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -68,24 +69,39 @@ def _number(x) -> float:
         return float("nan")
 
 
-def read_costs(benchmark_dir) -> list[JobCost]:
-    """Every ``*.tsv`` under ``benchmark_dir`` as a JobCost.
+def read_costs(benchmark_dir, only: Collection[str] | None = None) -> list[JobCost]:
+    """Every ``*.tsv`` under ``benchmark_dir`` as a JobCost, or only the files ``only`` names.
 
     Args:
         benchmark_dir (str | Path): the run's benchmark folder (searched recursively).
+        only: the benchmark files to read, relative to ``benchmark_dir``
+            (``train/sparse/seed0/ours_single.tsv``): one target's jobs of a folder that
+            other targets' runs wrote into too (``physgs.report.record.run_files``).
 
     Returns:
-        One [`JobCost`][physgs.experiments.cost.JobCost] per file.
+        One [`JobCost`][physgs.experiments.cost.JobCost] per file, sorted by path.
 
     Raises:
-        FileNotFoundError: if the folder is missing or holds no ``*.tsv``.
+        FileNotFoundError: if the folder is missing or holds no ``*.tsv``, or naming the files
+            of ``only`` that are missing.
         ValueError: naming the file if one has no ``s`` column or no data row.
     """
     root = Path(benchmark_dir)
     if not root.is_dir():
         raise FileNotFoundError(f"{root}: no benchmark folder (run the pipeline first)")
+    if only is None:
+        files = sorted(root.rglob("*.tsv"))
+    else:
+        files = sorted({root / p for p in only})
+        missing = [str(f.relative_to(root)) for f in files if not f.is_file()]
+        if missing:
+            raise FileNotFoundError(
+                f"{root}: {len(missing)} benchmark files of the plan missing "
+                f"({', '.join(missing[:5])}{', ...' if len(missing) > 5 else ''}): "
+                "finish the run first"
+            )
     jobs = []
-    for f in sorted(root.rglob("*.tsv")):
+    for f in files:
         with f.open() as fh:
             rows = list(csv.DictReader(fh, delimiter="\t"))
         if not rows or "s" not in rows[-1]:
@@ -313,6 +329,7 @@ def resources_by_stage(jobs: list[JobCost]) -> dict[str, dict]:
 
 
 _BENCHMARK_LINE = re.compile(r"^\s*benchmark:\s*(\S+)\s*$")
+_OUTPUT_LINE = re.compile(r"^\s*output:\s*(\S.*?)\s*$")
 _RULE_LINE = re.compile(r"^\s*(?:local)?rule (\w+):\s*$")
 _STATS_ROW = re.compile(r"^(\w+)\s+(\d+)\s*$")
 
@@ -369,6 +386,30 @@ def plan_jobs(dry_run: str) -> list[tuple[str, str | None]]:
             f"{stats or 'nothing'}, the job blocks read {counted}"
         )
     return [(r, b) for r, b in jobs]
+
+
+def plan_outputs(dry_run: str) -> list[str]:
+    """The output files of a Snakemake dry run's jobs (``snakemake -n --forceall TARGET``):
+    what the target's plan makes, each once, in the printout's order.
+
+    Args:
+        dry_run: the printout; each job is a ``rule <name>:`` block whose ``output:`` line lists
+            its outputs, comma-separated.
+
+    Returns:
+        The output paths as printed (relative to the workflow's folder).
+
+    Raises:
+        ValueError: the printout's jobs cannot be read
+            ([`plan_jobs`][physgs.experiments.cost.plan_jobs]).
+    """
+    plan_jobs(dry_run)  # refuses a printout whose jobs do not add up to its job-stats table
+    out: dict[str, None] = {}  # ordered, each path once (a job's outputs are another's inputs)
+    for line in dry_run.splitlines():
+        m = _OUTPUT_LINE.match(line)
+        if m:
+            out.update(dict.fromkeys(p.strip() for p in m.group(1).split(",")))
+    return list(out)
 
 
 def plan_cost(

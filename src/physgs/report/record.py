@@ -23,14 +23,15 @@ import json
 import math
 import re
 import shutil
-from collections.abc import Mapping, Sequence
+from collections.abc import Iterable, Mapping, Sequence
 from dataclasses import asdict, dataclass, field
-from pathlib import Path
+from pathlib import Path, PurePosixPath
 
 import numpy as np
 import pandas as pd
 from PIL import Image
 
+from physgs.experiments import cost
 from physgs.report import captions, catalogue, rerun
 
 #: The commands whose cost the README states, keyed as ``tools/timed.py --name`` records them.
@@ -341,6 +342,122 @@ def rerun_lines(
             )
         lines.append("")
     return lines
+
+
+#: What the record takes of a run's folder (``results/``), as the workflow lays it out: each
+#: table's CSV and each figure's PNG (folder, suffix), and the jobs' benchmark files (below
+#: ``benchmarks/``, ``physgs.experiments.cost``).
+RUN_FILES = {"tables": ("tables", ".csv"), "figures": ("figures", ".png")}
+BENCHMARKS = "benchmarks"
+
+
+@dataclass(frozen=True)
+class RunFiles:
+    """The files of a finished run that its record takes: exactly what its target's plan makes
+    ([`run_files`][physgs.report.record.run_files]).
+
+    Attributes:
+        target: the target whose plan it is (``all``).
+        tables: the plan's table CSVs, sorted.
+        figures: the plan's figure PNGs, sorted.
+        jobs: the plan's benchmarked jobs, one per benchmark file
+            ([`JobCost`][physgs.experiments.cost.JobCost]).
+        left_out: the tables, figures and benchmark files the folder holds that the plan does
+            not make (another target's, such as ``studies``, or an earlier run's), relative to
+            the folder, sorted.
+    """
+
+    target: str
+    tables: tuple[Path, ...]
+    figures: tuple[Path, ...]
+    jobs: tuple[cost.JobCost, ...]
+    left_out: tuple[str, ...] = ()
+
+    def left_out_line(self) -> str:
+        """What was left out, in a line: the tables and figures by name, the benchmark files
+        counted by stage.
+
+        Returns:
+            ``left out (not made by all): tables/x.csv, ...; N benchmark files (stage n, ...)``,
+                or ``left out (not made by all): nothing``.
+        """
+        files = [p for p in self.left_out if PurePosixPath(p).parts[0] != BENCHMARKS]
+        stages: dict[str, int] = {}
+        for p in self.left_out:
+            parts = PurePosixPath(p).parts
+            if parts[0] == BENCHMARKS:
+                stages[parts[1]] = stages.get(parts[1], 0) + 1
+        bench = (
+            f"{sum(stages.values())} benchmark files ("
+            + ", ".join(f"{k} {n}" for k, n in sorted(stages.items()))
+            + ")"
+            if stages
+            else ""
+        )
+        what = "; ".join(x for x in (", ".join(files), bench) if x) or "nothing"
+        return f"left out (not made by {self.target}): {what}"
+
+
+def run_files(
+    results: str | Path,
+    outputs: Iterable[str],
+    benchmarks: Iterable[str],
+    target: str = "all",
+) -> RunFiles:
+    """The tables, figures and benchmarked jobs of a run's folder that its target's plan makes.
+
+    A folder may hold more than one target's files (``snakemake studies`` run in it after
+    ``all``, or an earlier run's): the record of ``all`` takes ``all``'s alone, so its stamp's
+    jobs and job-minutes are those of the run whose wall time it states. The plan is
+    Snakemake's own (``snakemake -n --forceall all``: the jobs' outputs and benchmark files,
+    [`plan_outputs`][physgs.experiments.cost.plan_outputs] and
+    [`plan_jobs`][physgs.experiments.cost.plan_jobs]), so no second list of what ``all`` makes
+    is kept here.
+
+    Args:
+        results: the run's folder (``results/``).
+        outputs: every output file of the plan, relative to ``results``
+            (``tables/tab_fit.csv``); those outside ``RUN_FILES`` are not the record's.
+        benchmarks: every benchmark file of the plan, relative to ``results``
+            (``benchmarks/train/sparse/seed0/ours_single.tsv``).
+        target: the plan's target, named in messages.
+
+    Returns:
+        The [`RunFiles`][physgs.report.record.RunFiles].
+
+    Raises:
+        FileNotFoundError: naming every table or figure of the plan that the folder lacks, or
+            the benchmark files of the plan it lacks (an unfinished run, or another config's).
+    """
+    root = Path(results)
+    made = {PurePosixPath(p) for p in outputs}
+    picked: dict[str, list[Path]] = {}
+    missing: list[str] = []
+    left_out: list[str] = []
+    for kind, (folder, suffix) in RUN_FILES.items():
+        planned = {p for p in made if p.parent == PurePosixPath(folder) and p.suffix == suffix}
+        missing += sorted(str(p) for p in planned if not (root / p).is_file())
+        picked[kind] = sorted(root / p for p in planned)
+        present = {PurePosixPath(folder, f.name) for f in (root / folder).glob(f"*{suffix}")}
+        left_out += [str(p) for p in present - planned]
+    if missing:
+        raise FileNotFoundError(
+            f"{root}: {', '.join(missing)} missing: {target} makes them (finish the run: "
+            f"snakemake --cores 2 {target})"
+        )
+    bench = {PurePosixPath(p).relative_to(BENCHMARKS).as_posix() for p in benchmarks}
+    jobs = cost.read_costs(root / BENCHMARKS, only=bench)
+    present = {
+        f.relative_to(root / BENCHMARKS).as_posix() for f in (root / BENCHMARKS).rglob("*.tsv")
+    }
+    left_out += [f"{BENCHMARKS}/{p}" for p in present - bench]
+    return RunFiles(
+        target,
+        tuple(picked["tables"]),
+        tuple(picked["figures"]),
+        tuple(jobs),
+        tuple(sorted(left_out)),
+    )
 
 
 def write_record(
