@@ -13,6 +13,8 @@ forward and backward; the imports that render needs are timed apart) and the los
 part transform's kernels. A job's start-up is its script's imports plus the first uses it
 reaches: a training steps an optimiser, ours' training also runs k-means, and every job that
 renders loads the kernels.
+Last, what a job's end costs: Python's finalisation of a process that imported torch, numba and
+scipy (the difference to ending it with `os._exit`, as `physgs.jobs.end_process` does).
 `python -X importtime -c "<imports>"` says which module costs what.
 """
 
@@ -119,6 +121,9 @@ def main() -> None:
             base[setup] = least(setup, args.reps)
         total = least(f"{setup}\n{code}", args.reps)
         print(f"{label:<36} {total - base[setup]:>6.2f}")
+    heavy = "import torch\nimport numba\nimport scipy.spatial"
+    ended = least(f"{heavy}\nimport os\nos._exit(0)", args.reps)
+    print(f"{'exit: finalisation (torch, numba, scipy)':<36} {least(heavy, args.reps) - ended:>6.2f}")
 
 
 if __name__ == "__main__":

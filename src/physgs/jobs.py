@@ -20,6 +20,7 @@ from __future__ import annotations
 import contextlib
 import fcntl
 import hashlib
+import logging
 import os
 import sys
 import time
@@ -188,6 +189,37 @@ def set_threads(threads: int) -> None:
         os.environ["NUMBA_NUM_THREADS"] = str(threads)
 
 
+def run_by_snakemake(sm) -> bool:
+    """Whether ``sm`` is the ``snakemake`` object Snakemake gives a script it runs (not a stand-in
+    a test or a notebook builds).
+
+    Args:
+        sm: the script's ``snakemake`` object.
+
+    Returns:
+        True for Snakemake's own class.
+    """
+    return type(sm).__module__.split(".")[0] == "snakemake"
+
+
+def end_process() -> None:
+    """End this process now, status 0, without Python's finalisation.
+
+    A job's outputs and log are written and closed by then. What finalisation would still do is
+    tear down the modules the job imported: 0.3-0.35 CPU-s for torch, numba and scipy
+    (`python benchmarks/job_startup.py`, "exit"), paid by each of a run's jobs for memory the
+    kernel frees anyway. The atexit handlers those modules register (torch's, numba's,
+    llvmlite's, matplotlib's, multiprocessing's, weakref finalisers) only free memory or end
+    threads; this does what the rest would for the job's output: logging's handlers flushed and
+    closed, stdout and stderr flushed.
+    """
+    logging.shutdown()
+    for stream in (sys.stdout, sys.stderr, sys.__stdout__, sys.__stderr__):
+        if stream is not None:
+            stream.flush()
+    os._exit(0)
+
+
 @contextlib.contextmanager
 def job(sm):
     """Run a Snakemake script's body: ``with job(snakemake) as log: ...``.
@@ -199,7 +231,11 @@ def job(sm):
     ``threads`` ([`set_threads`][physgs.jobs.set_threads]), sends stdout and stderr (progress
     bars included) to ``sm.log[0]``, and writes the traceback of a failure there too (not only
     to the console) before re-raising it. The log is put back if another job of the rule
-    started meanwhile (Snakemake deletes a job's log before it starts).
+    started meanwhile (Snakemake deletes a job's log before it starts). A job that Snakemake runs
+    ([`run_by_snakemake`][physgs.jobs.run_by_snakemake]) and whose body ended without an error
+    ends its process when the block ends ([`end_process`][physgs.jobs.end_process]): nothing
+    after the ``with`` block runs, so a workflow script does all its work inside it
+    (`tests/test_job_exit.py` checks every script).
 
     Args:
         sm (snakemake.script.Snakemake): the script's ``snakemake`` object (reads ``threads``,
@@ -236,3 +272,5 @@ def job(sm):
                     _keep_log(log, sm.log[0])
     if made_by is not None:
         raise SystemExit(0)  # after the locks are released: nothing left to do
+    if run_by_snakemake(sm):
+        end_process()
