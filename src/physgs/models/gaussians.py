@@ -9,7 +9,6 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 import numpy as np
-import scipy.spatial
 import torch
 from torch import nn
 
@@ -121,7 +120,10 @@ def nearest_neighbour_scale(xyz: np.ndarray, k: int = 3) -> np.ndarray:
     if not np.isfinite(xyz).all():
         raise ValueError("canonical positions contain NaN or inf; regenerate the testbed dataset")
     k = min(k, xyz.shape[0] - 1)
-    d, _ = scipy.spatial.cKDTree(xyz).query(xyz, k=k + 1)
+    # here: ~0.25 CPU-s of start-up that the jobs loading a trained model never need
+    from scipy.spatial import cKDTree
+
+    d, _ = cKDTree(xyz).query(xyz, k=k + 1)
     s = d[:, 1:].mean(axis=1)
     if not (s > 0).any():
         raise ValueError("all canonical positions coincide; the mesh is degenerate")
@@ -146,7 +148,7 @@ class CanonicalGaussians(nn.Module):
         *,
         opacity: float = 0.1,
         color: float = 0.5,
-        knn: int = 3,
+        knn: int | None = 3,
         scale_factor: float = 1.0,
     ):
         """One Gaussian per vertex of ``xyz``.
@@ -155,7 +157,10 @@ class CanonicalGaussians(nn.Module):
             xyz: [N, 3] mesh vertices, world units.
             opacity: starting opacity, in (0, 1).
             color: starting grey level, in (0, 1).
-            knn: neighbours whose mean distance sets the starting scale.
+            knn: neighbours whose mean distance sets the starting scale; None: no starting
+                scale (every scale 1), for a set whose state a checkpoint then replaces
+                ([`load_checkpoint`][physgs.models.registry.load_checkpoint]), which so needs no
+                neighbour search.
             scale_factor: factor on that distance.
 
         Raises:
@@ -168,7 +173,9 @@ class CanonicalGaussians(nn.Module):
                 f"{color} (config models.canonical)"
             )
         xyz = np.asarray(xyz, dtype=np.float64)
-        s = nearest_neighbour_scale(xyz, knn) * scale_factor  # [N]
+        s = (  # [N]
+            np.ones(xyz.shape[0]) if knn is None else nearest_neighbour_scale(xyz, knn) * scale_factor
+        )
         n = xyz.shape[0]
         self.means = nn.Parameter(torch.tensor(xyz, dtype=torch.float32))
         q = torch.zeros(n, 4)

@@ -741,10 +741,12 @@ def load_checkpoint(path) -> BaseModel:
     parent = sd["part_parent"].numpy() if "part_parent" in sd else None
     # a reference's motion is in its own buffers: no truth.npz needed to reload it
     motion = TrueMotion.from_state_dict(sd) if is_reference(blob["model"]) else None
+    # the checkpoint's state replaces the starting scales: no neighbour search (nor scipy)
+    cfg = {**blob["models_cfg"], "canonical": {**blob["models_cfg"]["canonical"], "knn": None}}
     model = build_model(
         blob["model"],
         ModelContext.from_dict(blob["context"]),
-        blob["models_cfg"],
+        cfg,
         config=blob["config"],
         K=blob["K"],
         seed=blob["seed"],

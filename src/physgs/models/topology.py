@@ -53,9 +53,9 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 import numpy as np
-import scipy.sparse
-import scipy.sparse.csgraph as csgraph
-import scipy.spatial
+
+# scipy (~0.25 CPU-s of start-up) is imported by the functions that build a topology: every job
+# that loads a trained prior imports this module (ours, the chained prior) but builds nothing
 
 #: Default neighbours per Gaussian of the graph (see module docstring for why).
 KNN = 10
@@ -108,6 +108,9 @@ def neighbour_graph(xyz: np.ndarray, knn: int = KNN):
     n = xyz.shape[0]
     if not 1 <= knn < n:
         raise ValueError(f"models.topology.knn must lie in [1, N - 1 = {n - 1}], got {knn}")
+    import scipy.sparse
+    import scipy.spatial
+
     d, j = scipy.spatial.cKDTree(xyz).query(xyz, k=knn + 1)
     rows = np.repeat(np.arange(n), knn)
     w = np.maximum(d[:, 1:].ravel(), 1e-12)
@@ -129,6 +132,10 @@ def join_components(xyz: np.ndarray, graph, root: int):
             and no joins when it is connected already).
     """
     xyz = _check_xyz(xyz)
+    import scipy.sparse
+    import scipy.spatial
+    from scipy.sparse import csgraph
+
     n_comp, comp = csgraph.connected_components(graph, directed=False)
     joins = []
     in_main = comp == comp[root]
@@ -169,6 +176,8 @@ def geodesic_from_root(graph, root: int) -> tuple[np.ndarray, np.ndarray]:
     Raises:
         ValueError: when a point is unreachable (the graph is not connected).
     """
+    from scipy.sparse import csgraph
+
     dist, pred = csgraph.dijkstra(graph, directed=False, indices=root, return_predecessors=True)
     if not np.isfinite(dist).all():
         raise ValueError("neighbour graph is not connected after joining; this is a bug")
@@ -195,6 +204,8 @@ def slab_segments(graph, dist: np.ndarray, n_bins: int) -> np.ndarray:
     coo = graph.tocoo()
     keep = slab[coo.row] == slab[coo.col]
     inside = graph.__class__((coo.data[keep], (coo.row[keep], coo.col[keep])), shape=graph.shape)
+    from scipy.sparse import csgraph
+
     _, seg = csgraph.connected_components(inside, directed=False)
     return seg.astype(np.int64)
 
