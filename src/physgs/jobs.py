@@ -206,7 +206,7 @@ def end_process() -> None:
     """End this process now, status 0, without Python's finalisation.
 
     A job's outputs and log are written and closed by then. What finalisation would still do is
-    tear down the modules the job imported: 0.3-0.35 CPU-s for torch, numba and scipy
+    tear down the modules the job imported: 0.3-0.45 CPU-s for torch, numba and scipy
     (`python benchmarks/job_startup.py`, "exit"), paid by each of a run's jobs for memory the
     kernel frees anyway. The atexit handlers those modules register (torch's, numba's,
     llvmlite's, matplotlib's, multiprocessing's, weakref finalisers) only free memory or end
