@@ -123,7 +123,9 @@ def main() -> None:
         print(f"{label:<36} {total - base[setup]:>6.2f}")
     heavy = "import torch\nimport numba\nimport scipy.spatial"
     ended = least(f"{heavy}\nimport os\nos._exit(0)", args.reps)
-    print(f"{'exit: finalisation (torch, numba, scipy)':<36} {least(heavy, args.reps) - ended:>6.2f}")
+    print(
+        f"{'exit: finalisation (torch, numba, scipy)':<36} {least(heavy, args.reps) - ended:>6.2f}"
+    )
 
 
 if __name__ == "__main__":

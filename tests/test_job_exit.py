@@ -67,7 +67,11 @@ def test_a_snakemake_job_ends_without_finalisation_and_loses_nothing(tmp_path):
 def test_a_stand_in_snakemake_object_keeps_the_process(tmp_path):
     # a test or a notebook passes its own object: job() must return to it
     sm = SimpleNamespace(
-        threads=1, rule="r", input=[], output=[str(tmp_path / "o")], params=[],
+        threads=1,
+        rule="r",
+        input=[],
+        output=[str(tmp_path / "o")],
+        params=[],
         log=[str(tmp_path / "o.log")],
     )
     assert not run_by_snakemake(sm)

@@ -194,7 +194,7 @@ def run_by_snakemake(sm) -> bool:
     a test or a notebook builds).
 
     Args:
-        sm: the script's ``snakemake`` object.
+        sm (object): the script's ``snakemake`` object.
 
     Returns:
         True for Snakemake's own class.

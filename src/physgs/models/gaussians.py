@@ -174,7 +174,9 @@ class CanonicalGaussians(nn.Module):
             )
         xyz = np.asarray(xyz, dtype=np.float64)
         s = (  # [N]
-            np.ones(xyz.shape[0]) if knn is None else nearest_neighbour_scale(xyz, knn) * scale_factor
+            np.ones(xyz.shape[0])
+            if knn is None
+            else nearest_neighbour_scale(xyz, knn) * scale_factor
         )
         n = xyz.shape[0]
         self.means = nn.Parameter(torch.tensor(xyz, dtype=torch.float32))
