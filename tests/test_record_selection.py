@@ -10,7 +10,7 @@ from pathlib import Path
 import pytest
 
 import physgs.config
-from physgs.experiments.cost import plan_jobs, plan_outputs, summarise
+from physgs.experiments.cost import plan_jobs, plan_outputs, read_costs, summarise
 from physgs.provenance import config_hash
 from physgs.report import record
 
@@ -187,20 +187,29 @@ def _record_tool():
 def test_alls_real_plan_leaves_the_studies_tables_figures_and_jobs_out(tmp_path, monkeypatch):
     """The workflow's own plans (quick profile), all's as tools/record.py reads it: a folder
     holding everything `all` and `studies` make gives the record all's files and jobs, and
-    lists exactly what studies alone makes; a run of another config is refused."""
+    lists exactly the tables and figures studies alone makes; the studies' own jobs keep their
+    benchmark files apart (results/studies/benchmarks/), so neither the record nor the summary
+    of `all` counts them; a run of another config is refused."""
     tool = _record_tool()
     monkeypatch.chdir(ROOT)
     with pytest.raises(SystemExit, match="another run's"):
         tool._plan("quick", "000000000000")
     quick = config_hash(physgs.config.load(ROOT / "config" / "trees.yaml", "quick"))
     a_out, a_bench = tool._plan("quick", quick)
-    s_out, s_bench = _plan(_dry_run("studies"))
+    s_dry = _dry_run("studies")
+    s_out = _below_results(plan_outputs(s_dry))
+    s_bench = _below_results(b for _, b in plan_jobs(s_dry) if b)
+    studies_jobs = set(s_bench) - set(a_bench)
+    assert studies_jobs and all(p.startswith("studies/benchmarks/") for p in studies_jobs)
+    assert all(p.startswith("benchmarks/") for p in a_bench)
+    stages = {Path(p).parts[2] for p in studies_jobs}
+    assert {"speed_accuracy", "fit_curve"} <= stages
     r = tmp_path / "results"
     for rel in {*a_out, *s_out}:
         if rel.startswith(("tables/", "figures/")):
             _touch(r / rel)
-    for rel in {*a_bench, *s_bench}:
-        _bench(r, str(Path(rel).relative_to("benchmarks")), 1.0)
+    for rel in {*a_bench, *s_bench}:  # each where its rule writes it
+        _touch(r / rel, HEADER + "1.0\t0:00:00\t1\t1\t1\t1\t0\t0\t50\t1.0\n")
     sel = record.run_files(r, a_out, a_bench)
     assert len(sel.jobs) == len(set(a_bench)) > 0
     assert "tables/tab_fit.csv" in {p.relative_to(r).as_posix() for p in sel.tables}
@@ -209,9 +218,9 @@ def test_alls_real_plan_leaves_the_studies_tables_figures_and_jobs_out(tmp_path,
         for p in set(s_out) - set(a_out)
         if (p.startswith("tables/") and p.endswith(".csv"))
         or (p.startswith("figures/") and p.endswith(".png"))
-    } | set(s_bench) - set(a_bench)
+    }
     assert set(sel.left_out) == studies_only
     assert {"tables/fit_curve.csv", "tables/speed_accuracy.csv"} <= studies_only
-    stages = {Path(p).parts[1] for p in studies_only if p.startswith("benchmarks/")}
-    assert {"speed_accuracy", "fit_curve"} <= stages
     assert not stages & {j.stage for j in sel.jobs}  # the studies' stages add no job-minutes
+    # and what the summary of `all` reads: every benchmark file under results/benchmarks/
+    assert {j.stage for j in read_costs(r / "benchmarks")} == {j.stage for j in sel.jobs}

@@ -33,7 +33,7 @@ rule kmatch_point:
     log:
         "logs/parts/{tree}/seed{seed}_chain_K{K}.log",
     benchmark:
-        "results/benchmarks/kmatch/{tree}/seed{seed}_chain_K{K}.tsv"
+        "results/studies/benchmarks/kmatch/{tree}/seed{seed}_chain_K{K}.tsv"
     conda:
         "../envs/physgs.yaml"
     threads: 1

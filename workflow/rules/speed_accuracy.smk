@@ -10,7 +10,7 @@ rule speed_accuracy_point:
     log:
         "logs/speed_accuracy/seed{seed}/{point}.log",
     benchmark:
-        "results/benchmarks/speed_accuracy/seed{seed}/{point}.tsv"
+        "results/studies/benchmarks/speed_accuracy/seed{seed}/{point}.tsv"
     conda:
         "../envs/physgs.yaml"
     threads: 1  # two points run side by side on 2 cores (better throughput than 2 threads each)
@@ -53,7 +53,7 @@ rule fit_curve_point:
     log:
         "logs/fit_curve/{tree}/seed{seed}/{model}_it{iterations}.log",
     benchmark:
-        "results/benchmarks/fit_curve/{tree}/seed{seed}/{model}_it{iterations}.tsv"
+        "results/studies/benchmarks/fit_curve/{tree}/seed{seed}/{model}_it{iterations}.tsv"
     conda:
         "../envs/physgs.yaml"
     threads: 1
@@ -75,7 +75,7 @@ use rule fit_curve_point as fit_curve_window_point with:
     log:
         "logs/fit_curve/{tree}/seed{seed}/{model}_it{iterations}_windowtime.log",
     benchmark:
-        "results/benchmarks/fit_curve/{tree}/seed{seed}/{model}_it{iterations}_windowtime.tsv"
+        "results/studies/benchmarks/fit_curve/{tree}/seed{seed}/{model}_it{iterations}_windowtime.tsv"
     params:
         job=fit_window_params,
         series=lambda wc: wc.model + _fit_curve.WINDOW_SERIES,

@@ -1,7 +1,9 @@
 # results/summary.md: what the finished run says (stamp, the ledger's verdicts, tab_fit's
 # fractions, wall time and job-minutes by stage), printed from the run's own files by
-# physgs.report.summary. It reads every benchmark file, so it waits for everything `all` makes
-# (RUN, in the Snakefile); always rerun with the run, since the benchmark files are not outputs.
+# physgs.report.summary. It reads every benchmark file under results/benchmarks/, so it waits for
+# everything `all` makes (RUN, in the Snakefile); always rerun with the run, since the benchmark
+# files are not outputs. The studies' own jobs keep theirs apart (results/studies/benchmarks/):
+# a `studies` run in the same folder adds nothing to the summary of `all`.
 
 
 rule summary:

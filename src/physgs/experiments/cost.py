@@ -1,9 +1,11 @@
 """What a pipeline run cost, from Snakemake's per-job benchmark files.
 
 Every heavy rule writes ``results/benchmarks/<stage>/.../<job>.tsv`` (Snakemake ``benchmark:``),
-one row with the job's wall seconds ``s``. The path says what the job
-was: its stage (first folder), its training seed (a ``seed<N>`` folder, or a ``_seed<N>`` suffix
-for a seeded testbed) and whether it belongs to the damping benchmark (a ``<tree>_damping`` tree).
+one row with the job's wall seconds ``s``; the jobs only the ``studies`` target plans write theirs
+under ``results/studies/benchmarks/``, so that a studies run adds nothing to the cost of ``all``.
+The path says what the job was: its stage (first folder), its training seed (a ``seed<N>``
+folder, or a ``_seed<N>`` suffix for a seeded testbed) and whether it belongs to the damping
+benchmark (a ``<tree>_damping`` tree).
 From those rows this module answers the questions a user asks before adding seeds: how many
 job-seconds one seed costs, what is shared by all seeds (the testbeds), and what the damping
 benchmark adds. Light jobs without a benchmark (tables, figures, recovery) are not counted: the
