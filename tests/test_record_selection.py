@@ -3,14 +3,12 @@ exactly the tables, figures and benchmarked jobs of `all`'s plan, whatever else 
 (a `snakemake studies` run made in it, an earlier run's files)."""
 
 import importlib.util
-import subprocess
-import sys
 from pathlib import Path
 
 import pytest
 
 import physgs.config
-from physgs.experiments.cost import plan_jobs, plan_outputs, read_costs, summarise
+from physgs.experiments.cost import dry_run, plan_jobs, plan_outputs, read_costs, summarise
 from physgs.provenance import config_hash
 from physgs.report import record
 
@@ -166,17 +164,6 @@ def test_what_all_makes_but_the_folder_lacks_is_named(run):
         record.run_files(run, outputs, benchmarks)
 
 
-def _dry_run(target: str) -> str:
-    return subprocess.run(
-        [sys.executable, "-m", "snakemake", "-n", "--forceall", "--nolock", target]
-        + ["--config", "profile=quick"],
-        cwd=ROOT,
-        capture_output=True,
-        text=True,
-        check=True,
-    ).stdout
-
-
 def _record_tool():
     spec = importlib.util.spec_from_file_location("record_tool", ROOT / "tools" / "record.py")
     mod = importlib.util.module_from_spec(spec)
@@ -196,7 +183,7 @@ def test_alls_real_plan_leaves_the_studies_tables_figures_and_jobs_out(tmp_path,
         tool._plan("quick", "000000000000")
     quick = config_hash(physgs.config.load(ROOT / "config" / "trees.yaml", "quick"))
     a_out, a_bench = tool._plan("quick", quick)
-    s_dry = _dry_run("studies")
+    s_dry = dry_run(["studies"], ["profile=quick"], cwd=ROOT)
     s_out = _below_results(plan_outputs(s_dry))
     s_bench = _below_results(b for _, b in plan_jobs(s_dry) if b)
     studies_jobs = set(s_bench) - set(a_bench)
@@ -224,3 +211,8 @@ def test_alls_real_plan_leaves_the_studies_tables_figures_and_jobs_out(tmp_path,
     assert not stages & {j.stage for j in sel.jobs}  # the studies' stages add no job-minutes
     # and what the summary of `all` reads: every benchmark file under results/benchmarks/
     assert {j.stage for j in read_costs(r / "benchmarks")} == {j.stage for j in sel.jobs}
+
+
+def test_a_plan_snakemake_refuses_is_an_error_naming_the_command():
+    with pytest.raises(RuntimeError, match="-n --forceall --nolock --config profile=quick -- nope"):
+        dry_run(["nope"], ["profile=quick"], cwd=ROOT)

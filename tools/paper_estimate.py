@@ -14,13 +14,12 @@ do not train (K selection, evaluation, recovery) are not priced.
 from __future__ import annotations
 
 import argparse
-import subprocess
 from pathlib import Path
 
 import pandas as pd
 
 import physgs.config
-from physgs.experiments.cost import plan_jobs, training_estimate
+from physgs.experiments.cost import dry_run, plan_jobs, training_estimate
 from physgs.report.record import format_duration
 
 
@@ -30,13 +29,7 @@ def main() -> None:
     ap.add_argument("--rates", default="docs/record/rates_paper.csv", type=Path)
     ap.add_argument("--out", default="docs/record/paper_estimate.md", type=Path)
     args = ap.parse_args()
-    dry = subprocess.run(
-        ["snakemake", "-n", "--forceall", "all", "--config", f"profile={args.profile}"],
-        capture_output=True,
-        text=True,
-        check=True,
-    ).stdout
-    planned = plan_jobs(dry)
+    planned = plan_jobs(dry_run(["all"], [f"profile={args.profile}"]))
     cfg = physgs.config.load_workflow_config(
         physgs.config.read_yaml("config/trees.yaml"), args.profile
     )

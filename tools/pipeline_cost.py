@@ -21,9 +21,9 @@ jobs ran (``physgs.experiments.cost.occupancy``).
 from __future__ import annotations
 
 import argparse
-import subprocess
 
 from physgs.experiments.cost import (
+    dry_run,
     extra_seed_wall_s,
     occupancy,
     plan_cost,
@@ -109,10 +109,7 @@ def timeline(jobs, cores: int, bin_s: float) -> None:
 
 def target_cost(targets, jobs, benchmarks, wall_s, run_job_s) -> None:
     """Print the cost of a run of ``targets`` from nothing, from the finished run's jobs."""
-    dry = subprocess.run(
-        ["snakemake", "-n", "--forceall", *targets], capture_output=True, text=True, check=True
-    ).stdout
-    cost = plan_cost(plan_jobs(dry), jobs, benchmarks)
+    cost = plan_cost(plan_jobs(dry_run(targets)), jobs, benchmarks)
     print(f"{' '.join(targets)}: job minutes by rule (measured in the finished run)")
     for rule, (n, s) in sorted(cost["by_rule"].items(), key=lambda kv: -kv[1][1]):
         print(f"{rule:<24}{n:>5} jobs{_min(s)} job-min")

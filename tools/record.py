@@ -20,8 +20,9 @@ run's `tab_fit.csv`) names every output and benchmark file of `all`'s jobs
 keeps those: the tables and figures among the outputs, and the jobs of those benchmark files
 for the stamp's job count and job-minutes by stage (the jobs of the run whose wall time it
 states). A table, figure or benchmark file of the plan that the folder lacks stops it, named;
-what the folder holds beyond the plan (a `snakemake studies` run's tables, figures and
-speed_accuracy/fit_curve/kmatch jobs, or an earlier run's) is left out and listed. Run it in the
+what the folder holds beyond the plan (a `snakemake studies` run's tables and figures, whose
+jobs keep their benchmark files under `results/studies/benchmarks/`, or an earlier run's files)
+is left out and listed. Run it in the
 checkout and config the run was made with: a config whose hash is not the run's (its tables'
 `config_hash`) is refused, since its plan is another run's.
 
@@ -45,7 +46,7 @@ from pathlib import Path
 import pandas as pd
 
 import physgs.config
-from physgs.experiments.cost import plan_jobs, plan_outputs, summarise
+from physgs.experiments.cost import dry_run, plan_jobs, plan_outputs, summarise
 from physgs.provenance import config_hash, git_commit, machine_cpu
 from physgs.report import record
 
@@ -64,15 +65,12 @@ def _plan(profile: str, run_hash: str) -> tuple[list[str], list[str]]:
             f"this checkout's {profile} config hashes to {here}, the run's tables to {run_hash}: "
             "its plan is another run's; record from the checkout and config the run was made with"
         )
-    cmd = ["snakemake", "-n", "--forceall", TARGET, "--config", f"profile={profile}"]
-    dry = subprocess.run(cmd, capture_output=True, text=True)
-    if dry.returncode:
-        raise SystemExit(f"`{' '.join(cmd)}` failed:\n{dry.stderr[-2000:]}")
+    dry = dry_run([TARGET], [f"profile={profile}"])
 
     def below(paths):
         return [str(Path(p).relative_to(RUN_ROOT)) for p in paths if RUN_ROOT in Path(p).parents]
 
-    return below(plan_outputs(dry.stdout)), below(b for _, b in plan_jobs(dry.stdout) if b)
+    return below(plan_outputs(dry)), below(b for _, b in plan_jobs(dry) if b)
 
 
 def _wall_s(args, commit: str) -> float:

@@ -17,7 +17,9 @@ from __future__ import annotations
 import csv
 import math
 import re
-from collections.abc import Collection
+import subprocess
+import sys
+from collections.abc import Collection, Sequence
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -351,6 +353,30 @@ def _job_stats(dry_run: str) -> dict[str, int]:
             break
         out[m.group(1)] = int(m.group(2))
     return out
+
+
+def dry_run(targets: Sequence[str], config: Sequence[str] = (), cwd=None) -> str:
+    """Snakemake's printout of the whole plan of ``targets``: ``snakemake -n --forceall``, run in
+    ``cwd`` (the workflow's folder; default the current one) whatever its ``results/`` holds.
+
+    Args:
+        targets: the targets (``["all"]``, or files).
+        config: ``--config`` items (``["profile=quick"]``).
+        cwd (str | Path | None): the workflow's folder.
+
+    Returns:
+        The printout ([`plan_jobs`][physgs.experiments.cost.plan_jobs] and
+            [`plan_outputs`][physgs.experiments.cost.plan_outputs] read it).
+
+    Raises:
+        RuntimeError: with the command and the end of Snakemake's error when it cannot plan.
+    """
+    cmd = [sys.executable, "-m", "snakemake", "-n", "--forceall", "--nolock"]
+    cmd += [*(["--config", *config] if config else []), "--", *targets]
+    r = subprocess.run(cmd, cwd=cwd, capture_output=True, text=True)
+    if r.returncode:
+        raise RuntimeError(f"`{' '.join(cmd[1:])}` failed:\n{r.stderr[-2000:]}")
+    return r.stdout
 
 
 def plan_jobs(dry_run: str) -> list[tuple[str, str | None]]:
