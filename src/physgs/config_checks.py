@@ -15,6 +15,7 @@ import json
 import math
 from typing import Callable, Iterator
 
+from physgs.device import check_setting  # imports torch only when cuda is asked for
 from physgs.experiments.kselect import selected_models, settings_for
 from physgs.models.omega_search import search_problem
 from physgs.models.registry import (
@@ -507,8 +508,6 @@ def device_is_available(cfg: dict) -> Iterator[Problem]:
     Yields:
         ``(key path, message)`` per problem (the module docstring); none when the config passes.
     """
-    from physgs.train.device import check_setting  # torch only when cuda is asked for
-
     try:
         check_setting(cfg["train"]["device"])
     except (ValueError, RuntimeError) as e:

@@ -4,7 +4,7 @@ from physgs.evaluate.run import evaluate_checkpoint
 from physgs.jobs import job
 from physgs.models.registry import load_checkpoint
 from physgs.testbed.dataset import load_observed, load_truth
-from physgs.train.device import resolve_device
+from physgs.device import resolve_device
 
 sm = snakemake  # noqa: F821 (injected by Snakemake)
 with job(sm) as log:

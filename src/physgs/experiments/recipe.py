@@ -193,7 +193,7 @@ def fit(
         hooks: ``on_iteration`` callbacks ``(iteration, model, optimiser)`` run after the
             recipe's own (a benchmark's recorder of the fit curve); they must not change the model.
         device (str | torch.device | None): where to train; None: ``train.device`` of the job
-            resolved on this machine ([`resolve_device`][physgs.train.device.resolve_device]:
+            resolved on this machine ([`resolve_device`][physgs.device.resolve_device]:
             auto takes CUDA where torch sees a GPU).
 
     Returns:
@@ -204,7 +204,7 @@ def fit(
         TrainingError: the fit diverged or the model failed (no result).
     """
     # here: the training machinery loads torch (module docstring)
-    from physgs.train.device import resolve_device
+    from physgs.device import resolve_device
     from physgs.train.loop import condition_indices, train_model
     from physgs.train.seeding import seed_everything
 
@@ -397,14 +397,14 @@ def train_and_save(
         truth (Truth | None): as in ``fit`` (references only).
         resources (Mapping | None): the job's resources (``snakemake.resources``): a GPU asked
             for there trains on CUDA, whatever ``train.device`` says
-            ([`resolve_device`][physgs.train.device.resolve_device]); the checkpoint is saved
+            ([`resolve_device`][physgs.device.resolve_device]); the checkpoint is saved
             device-free either way.
 
     Returns:
         The [`TrainResult`][physgs.train.loop.TrainResult].
     """
     # here: torch (module docstring)
-    from physgs.train.device import resolve_device
+    from physgs.device import resolve_device
     from physgs.train.loop import write_loss_log
 
     job = Job.from_dict(job) if isinstance(job, dict) else job

@@ -128,7 +128,7 @@ def train_model(
             recipe's last change to the model: freezing, the end of the search over omega).
         device (str | torch.device | None): where to train: the model (moved there before its
             optimiser is built), its optimiser state, the targets, winds and background; None:
-            where the model's parameters are ([`resolve_device`][physgs.train.device.resolve_device]
+            where the model's parameters are ([`resolve_device`][physgs.device.resolve_device]
             turns ``train.device`` into one). ``holdout`` must be built for the same device.
 
     Returns:
