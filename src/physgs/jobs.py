@@ -22,7 +22,9 @@ import fcntl
 import hashlib
 import logging
 import os
+import signal
 import sys
+import threading
 import time
 import traceback
 from pathlib import Path
@@ -165,6 +167,36 @@ def _keep_log(log, path: str) -> None:
         tmp.write_text(text)
 
 
+@contextlib.contextmanager
+def stop_on_signals():
+    """For the body, turn SIGTERM and SIGINT into ``KeyboardInterrupt`` in this process, once.
+
+    Python's default for SIGTERM ends the process at once: no ``finally`` runs, so a temporary
+    file of [`physgs.atomic.atomic_path`][] stays beside its output and the log gets no line. Raised
+    as an exception, the job's clean-up runs and its log says why it stopped. A second signal
+    while it cleans up (Ctrl-C sends SIGINT to the whole process group, then Snakemake sends
+    SIGTERM to its jobs: [`physgs.scheduling.stop_child_processes`][]) is ignored, so the clean-up
+    is not cut short. A process that does not end soon is killed by whoever stopped it. The
+    previous handlers are back after the body. Does nothing outside the main thread (where Python
+    runs signal handlers).
+    """
+    if threading.current_thread() is not threading.main_thread():
+        yield
+        return
+
+    def stop(signum, frame):
+        for sig in (signal.SIGTERM, signal.SIGINT):
+            signal.signal(sig, signal.SIG_IGN)
+        raise KeyboardInterrupt(f"stopped by {signal.Signals(signum).name}")
+
+    previous = {sig: signal.signal(sig, stop) for sig in (signal.SIGTERM, signal.SIGINT)}
+    try:
+        yield
+    finally:
+        for sig, handler in previous.items():
+            signal.signal(sig, handler)
+
+
 def set_threads(threads: int) -> None:
     """Set the thread count of torch, numba and OpenMP to ``threads``, whatever is imported yet.
 
@@ -235,7 +267,9 @@ def job(sm):
     ([`run_by_snakemake`][physgs.jobs.run_by_snakemake]) and whose body ended without an error
     ends its process when the block ends ([`end_process`][physgs.jobs.end_process]): nothing
     after the ``with`` block runs, so a workflow script does all its work inside it
-    (`tests/test_job_exit.py` checks every script).
+    (`tests/test_job_exit.py` checks every script). SIGTERM and SIGINT raise in the body
+    ([`stop_on_signals`][physgs.jobs.stop_on_signals]), so a stopped job cleans up and its log
+    says why it ended.
 
     Args:
         sm (snakemake.script.Snakemake): the script's ``snakemake`` object (reads ``threads``,
@@ -251,7 +285,7 @@ def job(sm):
     """
     set_threads(max(1, int(getattr(sm, "threads", 1))))
     retain_freed_memory()  # no page faults of fresh memory every training iteration
-    with output_locks(list(sm.output), key=job_key(sm)) as made_by:
+    with stop_on_signals(), output_locks(list(sm.output), key=job_key(sm)) as made_by:
         if made_by is not None:
             with open(sm.log[0], "a") as log:
                 print(f"outputs made for this same job by {made_by}; taken as made", file=log)
