@@ -18,6 +18,7 @@ itself. The kernel drops the lock when the holder exits, even on SIGKILL.
 from __future__ import annotations
 
 import contextlib
+import errno
 import fcntl
 import hashlib
 import logging
@@ -30,7 +31,7 @@ import traceback
 from pathlib import Path
 
 from physgs.allocator import retain_freed_memory
-from physgs.atomic import atomic_path
+from physgs.atomic import FULL_BELOW, atomic_path, disk_full_error, free_bytes
 
 #: where the output locks live, relative to the workflow's working directory (not Snakemake's
 #: own ``.snakemake/locks``, which a finishing run deletes whole)
@@ -149,13 +150,49 @@ def job_key(sm) -> str:
     return hashlib.sha256(repr(parts).encode()).hexdigest()[:24]
 
 
+def _report_failure(log, path: str, error: BaseException) -> BaseException:
+    """Write the traceback of ``error`` to the log, or to the console if the log cannot take it;
+    return the error to raise.
+
+    A log on a full disk cannot hold the traceback: then the console gets it, rather than a
+    "see" pointing at an empty log. A write to the log that failed for want of space raised an
+    ``OSError`` naming no file; the error returned names the log
+    ([`physgs.atomic.disk_full_error`][]).
+    """
+    try:
+        traceback.print_exception(error, file=log)
+        log.flush()
+        print(f"job failed; see {path}", file=sys.__stderr__)
+    except OSError as e:
+        print(
+            f"job failed, and its log {path} could not be written ({e}); its traceback:",
+            file=sys.__stderr__,
+        )
+        traceback.print_exception(error, file=sys.__stderr__)
+    if (
+        isinstance(error, OSError)
+        and error.errno == errno.ENOSPC
+        and error.filename is None
+        and free_bytes(path) < FULL_BELOW
+    ):
+        return disk_full_error(path, error)
+    return error
+
+
 def _keep_log(log, path: str) -> None:
     """Put this job's log back at ``path`` if the path no longer names it.
 
     Snakemake deletes a job's log file before the job starts (``Job.remove_existing_output``),
     so a second job of the same rule started while this one runs unlinks the log this one writes.
+    A log that cannot be written for want of space raises an ``OSError`` naming ENOSPC and it.
     """
-    log.flush()
+    try:
+        log.flush()
+    except OSError as e:
+        full = disk_full_error(path, e)
+        if full is None:
+            raise
+        raise full from e
     try:
         if os.path.samestat(os.fstat(log.fileno()), os.stat(path)):
             return
@@ -291,19 +328,27 @@ def job(sm):
                 print(f"outputs made for this same job by {made_by}; taken as made", file=log)
             print(f"{sm.rule}: outputs made by {made_by}; taken as made", file=sys.stderr)
         else:
-            with (
-                open(sm.log[0], "w+") as log,
-                contextlib.redirect_stderr(log),
-                contextlib.redirect_stdout(log),
-            ):
-                try:
-                    yield log
-                except BaseException:
-                    traceback.print_exc(file=log)
-                    print(f"job failed; see {sm.log[0]}", file=sys.__stderr__)
-                    raise
-                finally:
-                    _keep_log(log, sm.log[0])
+            log = open(sm.log[0], "w+")
+            failed = False
+            try:
+                with contextlib.redirect_stderr(log), contextlib.redirect_stdout(log):
+                    try:
+                        yield log
+                    except BaseException as e:
+                        failed = True
+                        err = _report_failure(log, sm.log[0], e)
+                        if err is e:
+                            raise
+                        raise err from e
+                    finally:
+                        try:
+                            _keep_log(log, sm.log[0])
+                        except OSError:
+                            if not failed:  # else the failure's own error says it all
+                                raise
+            finally:
+                with contextlib.suppress(OSError):  # a full disk: reported above
+                    log.close()
     if made_by is not None:
         raise SystemExit(0)  # after the locks are released: nothing left to do
     if run_by_snakemake(sm):
