@@ -121,4 +121,4 @@ def test_sigint_to_snakemake_ends_the_running_job_in_seconds_and_keeps_finished_
     )
     assert plan.returncode == 0, plan.stdout + plan.stderr
     jobs = [line.split()[-1] for line in plan.stdout.splitlines() if line.startswith("rule ")]
-    assert jobs == ["long:", "all:"] or sorted(jobs) == ["all:", "long:"], plan.stdout
+    assert sorted(jobs) == ["all:", "long:"], plan.stdout  # not `done`: it had finished

@@ -8,6 +8,7 @@ import os
 import signal
 import subprocess
 import sys
+import threading
 import time
 
 import pytest
@@ -82,15 +83,13 @@ def test_a_working_holder_is_waited_for(holder):
     out, locks, log, proc = holder
     done = []
 
-    def stop_holder():
-        time.sleep(4)
-        proc.kill()
+    def stop_holder():  # after twice the silence limit: the wait outlasts the limit
+        time.sleep(8)
         done.append(True)
-
-    import threading
+        proc.kill()
 
     threading.Thread(target=stop_holder).start()
-    with output_locks([out], locks, key="k", log=str(log), silent_s=2.0) as made_by:
+    with output_locks([out], locks, key="k", log=str(log), silent_s=4.0) as made_by:
         assert done, "the wait ended while the holder still logged"
         assert made_by is None
 
@@ -111,8 +110,7 @@ def test_taking_over_from_a_killed_holder_keeps_its_log(holder):
     out, locks, log, proc = holder
     time.sleep(0.5)
     log.unlink()  # Snakemake, as the second job starts
-    threading_timer = __import__("threading").Timer(1.0, proc.kill)
-    threading_timer.start()
+    threading.Timer(1.0, proc.kill).start()
     notes = []
     with output_locks([out], locks, key="k", log=str(log), notes=notes) as made_by:
         assert made_by is None  # the holder made nothing: this job makes it
