@@ -10,6 +10,8 @@ min_version("9.0")
 # Snakemake's loop adds a re-evaluation timer chain per finished job, and a long run's loop then
 # takes most of a core from the jobs: keep one pending timer (physgs.scheduling)
 physgs.scheduling.install()
+# Snakemake's own message for a YAML syntax error names no file, line or column: parse it first
+physgs.config.check_yaml_syntax("config/trees.yaml")
 
 
 configfile: "config/trees.yaml"

@@ -77,3 +77,36 @@ def test_current_umask_reads_the_process_umask_without_changing_it(umask, monkey
     monkeypatch.setattr(physgs.atomic, "open", no_proc, raising=False)
     assert current_umask() == 0o027
     assert os.umask(0o027) == 0o027  # restored
+
+
+@pytest.mark.parametrize("writer", sorted(WRITERS))
+def test_the_file_is_on_the_disk_before_the_rename_and_the_rename_after(
+    tmp_path, monkeypatch, writer
+):
+    """Each writer flushes the written file before the rename and the directory after it: a
+    power loss can then leave the old output or the new one, never an empty one."""
+    path = tmp_path / ("out.npz" if writer == "npz" else "out.bin")
+    events = []
+    real_fsync, real_replace = os.fsync, os.replace
+
+    def fsync(fd):
+        st = os.fstat(fd)
+        what = "dir" if stat.S_ISDIR(st.st_mode) else f"file of {st.st_size} bytes"
+        events.append(("fsync", what, st.st_ino))
+        real_fsync(fd)
+
+    def replace(src, dst):
+        events.append(("rename", os.stat(src).st_ino))
+        real_replace(src, dst)
+
+    monkeypatch.setattr(os, "fsync", fsync)
+    monkeypatch.setattr(os, "replace", replace)
+    WRITERS[writer](path)
+    ino = os.stat(path).st_ino
+    size = os.stat(path).st_size
+    assert size > 0
+    assert events == [
+        ("fsync", f"file of {size} bytes", ino),
+        ("rename", ino),
+        ("fsync", "dir", os.stat(tmp_path).st_ino),
+    ], events

@@ -6,7 +6,8 @@ and every output must equal the same slice run locally with the same threads (bi
 wall-time columns aside, as for any rerun).
 
 Marker `slurm`: deselected from the suite (pyproject addopts) and run by the README's test
-command as a second pytest invocation (`python -m pytest -q -m slurm`)."""
+command as a second pytest invocation (`python -m pytest -q -m slurm`). The daemons the test
+booted are stopped after it (tools/slurm_down.sh); a SLURM that was up before is left up."""
 
 from __future__ import annotations
 
@@ -24,12 +25,47 @@ import torch
 
 from workflow_helpers import ROOT, snakemake, workflow_copy
 
-pytestmark = pytest.mark.slurm
+# one worker, in file order: the last test checks what the first one left
+pytestmark = [pytest.mark.slurm, pytest.mark.xdist_group("slurm")]
 
 TARGETS = ["results/tables/tab_testbed.csv", "results/eval/sparse/seed0/static_single.npz"]
 CONFIG = ["--config", "profile=quick", 'trees=["sparse"]']
 #: wall-time fields: the only values a rerun may change
 WALL = {"seconds", "train_s", "wall_s", "s_per_iter", "holdout_s"}
+
+
+#: the daemons tools/slurm_up.sh starts that outlive a test unless stopped (MariaDB and munged
+#: are stopped with them by tools/slurm_down.sh)
+DAEMONS = ("slurmdbd", "slurmctld", "slurmd")
+
+
+def _running(name: str) -> list[int]:
+    """The pids of the processes named ``name`` (their ``comm``)."""
+    pids = []
+    for d in Path("/proc").iterdir():
+        if d.name.isdigit():
+            try:
+                if (d / "comm").read_text().strip() == name:
+                    pids.append(int(d.name))
+            except OSError:  # ended meanwhile
+                pass
+    return pids
+
+
+#: the daemons running before this module booted anything (read when it is collected)
+BEFORE = {d: _running(d) for d in DAEMONS}
+
+
+@pytest.fixture
+def slurm_cluster():
+    """A one-node SLURM for the test; stopped after it unless one was running before."""
+    _boot()
+    yield
+    if not any(BEFORE.values()):
+        down = subprocess.run(
+            [str(ROOT / "tools" / "slurm_down.sh")], capture_output=True, text=True, timeout=120
+        )
+        assert down.returncode == 0, f"tools/slurm_down.sh failed:\n{down.stdout}\n{down.stderr}"
 
 
 def _boot() -> None:
@@ -103,8 +139,7 @@ def _same(a: Path, b: Path) -> None:
         assert a.read_bytes() == b.read_bytes(), name
 
 
-def test_slice_on_slurm_completes_and_equals_the_local_run(tmp_path):
-    _boot()
+def test_slice_on_slurm_completes_and_equals_the_local_run(tmp_path, slurm_cluster):
     local = workflow_copy(tmp_path / "local")
     slurm = workflow_copy(tmp_path / "slurm")
     # the local run beside the SLURM one (results do not depend on timing)
@@ -153,3 +188,11 @@ def test_slice_on_slurm_completes_and_equals_the_local_run(tmp_path):
     assert sorted(a) == sorted(b) and len(a) >= 8, (sorted(a), sorted(b))
     for k in a:
         _same(a[k], b[k])
+
+
+def test_the_daemons_it_started_are_stopped():
+    """Runs after the test above (same worker, file order): no daemon it booted is left."""
+    if any(BEFORE.values()):
+        pytest.skip(f"SLURM was running before these tests ({BEFORE}): left as it was")
+    left = {d: _running(d) for d in DAEMONS}
+    assert not any(left.values()), f"left running after the SLURM test: {left}"

@@ -222,6 +222,33 @@ def scalars(value):
     return scalar(value)
 
 
+def check_yaml_syntax(path: Path | str) -> None:
+    """Parse a YAML file and refuse it, naming the file, line and column, if it is not YAML.
+
+    Snakemake reads a ``configfile:`` as JSON, then as YAML, and a file that is neither stops with
+    "Config file is not valid JSON or YAML ... do not mix whitespace and tab indentation": no
+    file, no line, and often not the problem. The Snakefile calls this first, so the error is
+    the YAML parser's own, where it found it.
+
+    Args:
+        path: the YAML file.
+
+    Raises:
+        ConfigError: the file is not valid YAML: ``FILE:LINE:COLUMN`` (from 1) of the problem,
+            then the parser's own message, which names the file and quotes the line.
+        FileNotFoundError: the file does not exist.
+    """
+    with open(path, encoding="utf-8") as f:
+        try:
+            yaml.safe_load(f)  # the parser names the file from the stream
+        except yaml.MarkedYAMLError as e:
+            mark = e.problem_mark or e.context_mark
+            line = f"{path}:{mark.line + 1}:{mark.column + 1}" if mark else f"{path}"
+            raise ConfigError(f"{line}: not valid YAML (fix the file there):\n{e}") from None
+        except yaml.YAMLError as e:
+            raise ConfigError(f"{path}: not valid YAML:\n{e}") from None
+
+
 def read_yaml(path: Path | str):
     """A config file's contents, numbers read as YAML 1.2 reads them
     ([`scalars`][physgs.config.scalars]).

@@ -1,4 +1,5 @@
-"""Snakemake's scheduling loop with one pending re-evaluation timer instead of a chain per event.
+"""Snakemake's scheduling loop with one pending re-evaluation timer instead of a chain per event,
+and a stop that stops the running jobs.
 
 Snakemake 9 (9.27.1 here, the newest release) always sets a job-rate limit
 (``--max-jobs-per-timespan`` defaults to ``100/1s``), and its scheduling loop ends every pass
@@ -17,7 +18,10 @@ the class so that a request is dropped when a timer that fires no later
 is already pending; an earlier request replaces the pending one. The timer is a daemon thread,
 so a finished run exits at once instead of waiting out the last timespan.
 
-The Snakefile installs it when the workflow loads (Snakemake imports the Snakefile in the
+A SIGINT to Snakemake's own process used to leave its running jobs to their end, marked
+incomplete; [`stop_jobs_on_cancel`][physgs.scheduling.stop_jobs_on_cancel] stops them first.
+
+The Snakefile installs both when the workflow loads (Snakemake imports the Snakefile in the
 process that runs the loop). A Snakemake whose method is missing, or no longer arms a timer that
 releases ``_open_jobs`` (what the replacement does), stops the workflow with a message rather
 than running either loop silently.
@@ -26,13 +30,20 @@ than running either loop silently.
 from __future__ import annotations
 
 import inspect
+import signal
+import sys
 import threading
 import time
 
+from snakemake.executors.local import Executor as LocalExecutor
 from snakemake.scheduling.job_scheduler import JobScheduler
 
 #: marks a class whose method is already replaced (a Snakefile can be loaded more than once)
 _MARK = "_physgs_single_timer"
+_STOP_MARK = "_physgs_stops_jobs"
+#: seconds a job has to end after SIGTERM before it is killed (its handler raises at once; what
+#: can delay it is a long call into compiled code, which no signal interrupts)
+STOP_GRACE_S = 4.0
 
 
 def single_reevaluation_timer(scheduler_cls: type) -> None:
@@ -92,7 +103,86 @@ def single_reevaluation_timer(scheduler_cls: type) -> None:
     setattr(scheduler_cls, _MARK, True)
 
 
+def stop_child_processes(grace_s: float = STOP_GRACE_S) -> list[int]:
+    """Stop every process this one started, and theirs: SIGTERM, then SIGKILL after ``grace_s``.
+
+    Children are not reaped here: a job's thread waits on its own child (``Popen.wait``), and a
+    child reaped by another would read as a success to it.
+
+    Args:
+        grace_s: seconds the processes have to end after SIGTERM.
+
+    Returns:
+        The pids signalled (empty when there were none).
+    """
+    import psutil  # a dependency of Snakemake's; imported only when a run is stopped
+
+    procs = psutil.Process().children(recursive=True)
+    if not procs:
+        return []
+    print(
+        f"stopping {len(procs)} job process(es): SIGTERM, SIGKILL after {grace_s:g} s "
+        "(docs/reliability.md, Interrupted runs)",
+        file=sys.stderr,
+        flush=True,
+    )
+
+    def alive() -> list:
+        left = []
+        for p in procs:
+            try:
+                if p.is_running() and p.status() != psutil.STATUS_ZOMBIE:
+                    left.append(p)
+            except psutil.NoSuchProcess:
+                pass
+        return left
+
+    def send(sig: int, to: list) -> None:
+        for p in to:
+            try:
+                p.send_signal(sig)  # psutil checks that the pid was not reused
+            except psutil.NoSuchProcess:
+                pass
+
+    send(signal.SIGTERM, procs)
+    end = time.monotonic() + grace_s
+    while alive() and time.monotonic() < end:
+        time.sleep(0.05)
+    send(signal.SIGKILL, alive())
+    return [p.pid for p in procs]
+
+
+def stop_jobs_on_cancel(executor_cls: type) -> None:
+    """Make ``executor_cls.cancel`` stop the running jobs before it waits for them.
+
+    Snakemake 9.27.1 turns a SIGINT to its own process into ``KeyboardInterrupt`` in the
+    scheduling loop, prints "Terminating processes on user request" and calls the executor's
+    ``cancel``. The local executor's is ``self.pool.shutdown()``: it waits for the running jobs'
+    threads, and each waits for its job's process, which got no signal (only a SIGINT to the
+    whole process group, a terminal's Ctrl-C, reaches it). So a training ran to its end, and since
+    the loop had stopped, Snakemake never recorded it as finished: its outputs stayed marked
+    incomplete and the next run (``rerun-incomplete``) trained it again. The replacement stops
+    the job processes first ([`stop_child_processes`][physgs.scheduling.stop_child_processes]);
+    a job ends within the grace, recorded as incomplete, as it is.
+
+    Args:
+        executor_cls: Snakemake's local ``Executor`` (a class whose ``cancel`` waits for its jobs).
+    """
+    if getattr(executor_cls, _STOP_MARK, False):
+        return
+    wait_for_jobs = executor_cls.cancel
+
+    def cancel(self) -> None:
+        stop_child_processes()
+        wait_for_jobs(self)
+
+    executor_cls.cancel = cancel
+    setattr(executor_cls, _STOP_MARK, True)
+
+
 def install() -> None:
     """Install [`single_reevaluation_timer`][physgs.scheduling.single_reevaluation_timer] on
-    Snakemake's ``JobScheduler``."""
+    Snakemake's ``JobScheduler`` and [`stop_jobs_on_cancel`][physgs.scheduling.stop_jobs_on_cancel]
+    on its local executor."""
     single_reevaluation_timer(JobScheduler)
+    stop_jobs_on_cancel(LocalExecutor)
