@@ -134,7 +134,7 @@ def test_scoring_the_held_out_frames_leaves_the_training_unchanged(swaying):
 
 
 def test_a_fit_curve_hook_sees_every_iteration_and_changes_nothing(swaying):
-    """``fit(hooks=...)``, as benchmarks/window_curves.py records its curves: the hook runs at
+    """``fit(hooks=...)``, as benchmarks/stopping.py curves records its curves: the hook runs at
     every iteration after the recipe's, and scoring the held-out frames in it leaves the
     training bitwise as it is without."""
     cfg = _stop_cfg(enabled=False, every=0)

@@ -1,6 +1,6 @@
 """Agreement of modes identified from independent records of one system.
 
-Used to choose SSI's settings on training data alone (``benchmarks/oma_settings.py``): the
+Used to choose SSI's settings on training data alone (``benchmarks/oma.py settings``): the
 three winds' training videos of a tree are three records of the same structure, so a setting
 whose modes come back from every record is preferred to one whose modes do not.
 """

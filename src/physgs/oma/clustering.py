@@ -6,7 +6,7 @@ uncertainty propagated as in [`physgs.oma.uncertainty`][]), so they are handed t
 object as its result and its clustering runs on them unchanged: the presets after Reynders,
 Neu, Kvaale and Dederichs (hard and soft criteria, a pre-clustering of stable from spurious
 poles, then hierarchical or HDBSCAN clustering, then post-processing), each choosing its
-representative pole or average. ``benchmarks/oma_clustering.py`` measures them beside
+representative pole or average. ``benchmarks/oma.py clustering`` measures them beside
 [`group_stable_poles`][physgs.oma.ssi.group_stable_poles] (docs/blind.md).
 """
 

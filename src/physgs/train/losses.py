@@ -11,7 +11,7 @@ from physgs.train.fused_loss import SSIM_C1, SSIM_C2, fused_photometric_loss, ga
 
 #: Image side (pixels) from which SSIM's blur runs in block-Toeplitz tiles rather than as one
 #: banded [n, n] matmul per side: the banded matmul does O(n) work per output pixel, the tiles
-#: O(TILE + window). Measured (benchmarks/ssim_blur.py) forward + backward of the 15 blurred maps,
+#: O(TILE + window). Measured (benchmarks/passes.py blur) forward + backward of the 15 blurred maps,
 #: one thread (banded / tiles of 32): 128 px 4.1 / 5.8 ms, 256 px 25 / 23 ms, 384 px 80 / 54 ms,
 #: 512 px 180 / 106 ms. Below this side the banded matmul is kept. (The torch path's blur: a
 #: training on the CPU takes the fused pass of physgs.train.fused_loss, 30 ms at 512 px.)

@@ -1,0 +1,372 @@
+"""The stopping rule's data: held-out-window curves, the rule chosen on them, what scoring costs.
+
+    PYTHONPATH=src nice -n 10 env OMP_NUM_THREADS=1 python benchmarks/stopping.py curves \
+        --tree sparse --out curves/sparse.csv [--models static,mlp,...] [--every 50]
+    python benchmarks/stopping.py choose curves/sparse.csv curves/medium.csv curves/dense.csv \
+        [--every 100 --tol 0.005 --patience 3]   # one setting, per model and tree
+    PYTHONPATH=src python benchmarks/stopping.py overhead results/testbed/sparse [--models ...]
+
+``curves``: held-out-window fit curves: each model's loss on the frames its training window holds
+out (every ``train.holdout_every``-th, of the trained wind) every ``--every`` iterations of one
+full-budget training (the profile's). What the stopping rule's N, tolerance and patience are
+chosen on (docs/models.md); never the views, the tail or another wind. Writes one CSV row per
+(model, iteration): the held-out loss (the training loss, L1 + D-SSIM), its PSNR (dB), the
+training loss (mean of the last ``--every`` iterations), the wall time. ``--rule`` instead trains
+each model as the pipeline does (``recipe.fit``, the config's ``train.stopping``, overridable
+with ``--stop-every/--tol/--patience/--anneal``) and writes one row per model: the iterations
+used, why it stopped, the held-out loss and PSNR at its end, its wall time and the time its
+held-out scores took: the real cost of the chosen setting.
+
+``choose``: where the stopping rule would stop each model, from its held-out-window curve
+(``curves``), for a grid of N (every), tol and P (patience), and what it would cost: the
+held-out loss at the trigger against the loss at the cap (a bound: the final anneal after the
+trigger only lowers the rates further) and the iterations and training time kept.
+
+``overhead``: what scoring the held-out window frames costs against a training iteration, per
+model: the mean wall time of a training iteration (``--iterations`` after the warm-up, the
+profile's settings otherwise) and of one score of the held-out window frames
+(``physgs.train.holdout.HoldoutEval``, ``--repeats`` times), side by side in one process, and
+the share of a 3000-iteration training that scores every N iterations would add. Timings on a
+shared machine compare only within one run.
+"""
+
+from __future__ import annotations
+
+import argparse
+import contextlib
+import csv
+import itertools
+import os
+import time
+from pathlib import Path
+
+import numpy as np
+import pandas as pd
+import torch
+
+from physgs.config import load
+from physgs.experiments.recipe import Job, earliest_stop, fit, heldout_split, job_spec
+from physgs.models.registry import BLIND_PRIORS, build_model, is_prior, is_reference, training_jobs
+from physgs.testbed.dataset import load_observed, load_truth
+from physgs.train.holdout import HoldoutEval
+from physgs.train.loop import condition_indices, train_model
+from physgs.train.seeding import seed_everything
+from physgs.train.stopping import plateau_iteration
+
+RULE_OFF = {"enabled": False, "every": 0, "patience": 1, "tol": 0.0, "anneal": 1}
+FIELDS = (
+    "model",
+    "tree",
+    "seed",
+    "iteration",
+    "holdout_loss",
+    "holdout_psnr",
+    "train_loss",
+    "seconds",
+)
+
+
+def models_that_train(cfg: dict) -> list[str]:
+    """Every model kind trained in `single`: the methods, the forcing-free priors, the parts
+    study's variants and the ceiling."""
+    ms = [m for m, c in training_jobs(cfg["models"]["configs"]) if c == "single"]
+    ms += [m for m in BLIND_PRIORS] + [m for m in cfg["parts_study"]["models"] if m not in ms]
+    return [*ms, "truth_motion"]
+
+
+@contextlib.contextmanager
+def appending(path: str, fields: tuple[str, ...]):
+    """A CSV writer appending to ``path`` (the header only when the file is new): one output
+    file gathers the runs of several trees and models."""
+    new = not os.path.exists(path)
+    with open(path, "a", newline="") as fh:
+        w = csv.DictWriter(fh, fieldnames=fields)
+        if new:
+            w.writeheader()
+        yield w, fh
+
+
+def window_holdout(obs, job: Job) -> HoldoutEval:
+    """The evaluator of the frames ``job``'s training window holds out, of its trained winds."""
+    held = heldout_split(int(obs.n_train), int(job.train["holdout_every"]))[1]
+    conds = condition_indices(job.conditions, len(obs.conditions))
+    return HoldoutEval.build(obs, held, conds, job.train)
+
+
+RULE_FIELDS = (
+    "model",
+    "tree",
+    "seed",
+    "every",
+    "patience",
+    "tol",
+    "anneal",
+    "iterations",
+    "stopped",
+    "stop_trigger",
+    "holdout_loss",
+    "holdout_psnr",
+    "wall_s",
+    "holdout_s",
+    "holdout_evals",
+)
+
+
+def run_rule(a, cfg: dict, obs, truth, models: list[str]) -> None:
+    """Train each model with the stopping rule on and append its row to ``a.out``."""
+    st = dict(cfg["train"]["stopping"], enabled=True)
+    for k, v in (
+        ("every", a.stop_every),
+        ("tol", a.tol),
+        ("patience", a.patience),
+        ("anneal", a.anneal),
+    ):
+        if v is not None:
+            st[k] = v
+    cfg["train"]["stopping"] = st
+    with appending(a.out, RULE_FIELDS) as (w, fh):
+        for m in models:
+            job = Job.from_dict(job_spec(cfg, m, "single", seed=a.seed))
+            res = fit(obs, job, truth=truth if is_reference(m) else None, progress=False)
+            loss, p = window_holdout(obs, job).evaluate(res.model)
+            s = res.stats
+            w.writerow(
+                dict(
+                    model=m,
+                    tree=a.tree,
+                    seed=a.seed,
+                    every=st["every"],
+                    patience=st["patience"],
+                    tol=st["tol"],
+                    anneal=st["anneal"],
+                    iterations=s["iterations"],
+                    stopped=s["stopped"],
+                    stop_trigger=s["stop_trigger"],
+                    holdout_loss=loss,
+                    holdout_psnr=p,
+                    wall_s=s["wall_s"],
+                    holdout_s=s["holdout_s"],
+                    holdout_evals=s["holdout_evals"],
+                )
+            )
+            fh.flush()
+            print(
+                f"{a.tree} {m}: {s['iterations']} it ({s['stopped']}), {s['wall_s']:.0f} s "
+                f"(scores {s['holdout_s']:.1f} s), holdout loss {loss:.4f}, {p:.2f} dB",
+                flush=True,
+            )
+
+
+def curves(a: argparse.Namespace) -> None:
+    """Write each model's held-out-window curve (or, with ``--rule``, its rule-on row)."""
+    cfg = load("config/trees.yaml", a.profile)
+    obs = load_observed(f"results/testbed/{a.tree}/observed.npz")
+    truth = load_truth(f"results/testbed/{a.tree}/truth.npz")
+    models = a.models.split(",") if a.models else models_that_train(cfg)
+    if a.rule:
+        run_rule(a, cfg, obs, truth, models)
+        return
+    with appending(a.out, FIELDS) as (w, fh):
+        for m in models:
+            job = Job.from_dict(job_spec(cfg, m, "single", seed=a.seed))
+            # the full budget, scored by the hook below: the curve the rule is chosen on
+            train = {**job.train, "stopping": {**RULE_OFF}}
+            if a.budget:  # a per-model budget: the schedule and the recipe's fractions over it
+                frac = train["warmup"] / train["iterations"]
+                train.update(iterations=a.budget, warmup=int(round(frac * a.budget)))
+            job = job.replace(train=train)
+            ev = window_holdout(obs, job)
+            t0 = time.perf_counter()
+            rows = []
+
+            warmup = int(job.train["warmup"])
+
+            def record(it, mdl, opt, _ev=ev, _rows=rows, _m=m, _t0=t0, _w=warmup):
+                if it % a.every == 0 and it > 0:
+                    loss, p = _ev.evaluate(mdl, warm=it < _w)
+                    _rows.append(
+                        dict(
+                            model=_m,
+                            tree=a.tree,
+                            seed=a.seed,
+                            iteration=it,
+                            holdout_loss=loss,
+                            holdout_psnr=p,
+                            seconds=time.perf_counter() - _t0,
+                        )
+                    )
+
+            truth_m = truth if is_reference(m) else None
+            res = fit(obs, job, truth=truth_m, progress=False, name=m, hooks=(record,))
+            loss, p = ev.evaluate(res.model, warm=False)
+            rows.append(
+                dict(
+                    model=m,
+                    tree=a.tree,
+                    seed=a.seed,
+                    iteration=len(res.log),
+                    holdout_loss=loss,
+                    holdout_psnr=p,
+                    seconds=time.perf_counter() - t0,
+                )
+            )
+            tl = np.array([r["loss"] for r in res.log])
+            for r in rows:
+                i = r["iteration"]
+                r["train_loss"] = float(tl[max(0, i - a.every) : i].mean())
+                w.writerow(r)
+            fh.flush()
+            print(
+                f"{a.tree} {m}: {len(res.log)} it, {res.stats['wall_s']:.0f} s, "
+                f"holdout loss {loss:.4f}, {p:.2f} dB",
+                flush=True,
+            )
+
+
+CAP, ANNEAL, FREEZE = 3000, 300, 1500  # the default profile: train.iterations, the anneal,
+# models.ours.freeze_at x iterations (the priors' recipe changes the model there)
+
+
+def stops(df: pd.DataFrame, every: int, tol: float, patience: int, anneal: int = ANNEAL, start=0.0):
+    """One row per (tree, model): trigger, iterations used, loss at the trigger / at the cap."""
+    out = []
+    for (t, m), g in df.groupby(["tree", "model"]):
+        g = g.sort_values("iteration")
+        g = g[g["iteration"] % every == 0]
+        its, loss = g["iteration"].to_numpy(), g["holdout_loss"].to_numpy()
+        earliest = max(FREEZE if is_prior(m) else 0, int(start * CAP))
+        trig = plateau_iteration(its[its < CAP], loss[its < CAP], patience, tol, earliest)
+        if trig is not None and trig + anneal >= CAP:
+            trig = None
+        used = CAP if trig is None else trig + anneal
+        at = loss[its == (trig if trig is not None else CAP)][0]
+        cap = loss[its == CAP][0]
+        psnr = g["holdout_psnr"].to_numpy()
+        out.append(
+            {
+                "tree": t,
+                "model": m,
+                "trigger": -1 if trig is None else trig,
+                "used": used,
+                "loss_at_trigger": at,
+                "loss_cap": cap,
+                "lost_pct": 100 * (at / cap - 1),
+                "psnr_lost_db": psnr[its == CAP][0]
+                - psnr[its == (trig if trig is not None else CAP)][0],
+                "wall_cap_s": g["seconds"].iloc[-1],
+            }
+        )
+    return pd.DataFrame(out)
+
+
+def choose(a: argparse.Namespace) -> None:
+    """Print where the rule stops each curve, for one setting or over the grid."""
+    df = pd.concat([pd.read_csv(p).assign(src=i) for i, p in enumerate(a.curves)])
+    # a model recorded by two processes on one tree: the first file's record
+    df = df[df["src"] == df.groupby(["tree", "model"])["src"].transform("min")]
+    if a.every:
+        r = stops(df, a.every, a.tol, a.patience, start=a.start)
+        print(r.to_string(index=False, float_format=lambda x: f"{x:.4g}"))
+        kept = (r["used"] / CAP * r["wall_cap_s"]).sum() / r["wall_cap_s"].sum()
+        print(f"iterations kept {r['used'].sum() / (CAP * len(r)):.3f}, time kept {kept:.3f}")
+        return
+    rows = []
+    for every, tol, p in itertools.product(
+        (100, 200, 300), (0.0, 0.0025, 0.005, 0.01, 0.02), (1, 2, 3, 4, 5)
+    ):
+        r = stops(df, every, tol, p, start=a.start)
+        rows.append(
+            {
+                "every": every,
+                "tol": tol,
+                "patience": p,
+                "window": every * p,
+                "stopped": int((r["trigger"] >= 0).sum()),
+                "it_kept": r["used"].sum() / (CAP * len(r)),
+                "time_kept": (r["used"] / CAP * r["wall_cap_s"]).sum() / r["wall_cap_s"].sum(),
+                "lost_max_pct": r["lost_pct"].max(),
+                "lost_mean_pct": r["lost_pct"].mean(),
+                "psnr_lost_max_db": r["psnr_lost_db"].max(),
+            }
+        )
+    g = pd.DataFrame(rows)
+    print(f"{len(df.groupby(['tree', 'model']))} curves")
+    print(g.to_string(index=False, float_format=lambda x: f"{x:.3f}"))
+    np.seterr(all="ignore")
+
+
+def overhead(a: argparse.Namespace) -> None:
+    """Print, per model, ms per iteration and per held-out score, and the share."""
+    cfg = load("config/trees.yaml", "default")
+    obs = load_observed(a.testbed / "observed.npz")
+    truth = load_truth(a.testbed / "truth.npz")
+    every = a.every
+    print(
+        f"{'model':>12} {'ms/iter':>8} {'ms/score':>9} {'frames':>6} {'share':>6} (every {every})"
+    )
+    for m in a.models.split(","):
+        job = Job.from_dict(job_spec(cfg, m, "single"))
+        w = 10
+        tcfg = {**job.train, "iterations": w + a.iterations, "warmup": w}
+        tcfg["stopping"] = {**tcfg["stopping"], "enabled": False, "every": 0}
+        seed_everything(0)
+        model = build_model(m, obs, job.settings, K=job.K, truth=truth if is_reference(m) else None)
+        res = train_model(model, obs, tcfg, conditions=[0], seed=0, progress=False)
+        secs = np.array([r["seconds"] for r in res.log])
+        it_ms = 1e3 * float(np.diff(secs[w:]).mean())
+        held = heldout_split(int(obs.n_train), int(job.train["holdout_every"]))[1]
+        ev = HoldoutEval.build(obs, held, [0], job.train)
+        t = []
+        for _ in range(a.repeats):
+            t0 = time.perf_counter()
+            ev.evaluate(res.model)
+            t.append(time.perf_counter() - t0)
+        sc_ms = 1e3 * float(np.median(t))
+        # the scores of an enabled rule: every N from the recipe's last change, while a trigger
+        # (+ the anneal) could still end the run before the cap
+        anneal, cap = int(job.train["stopping"]["anneal"]), 3000
+        first = max(earliest_stop(job), 1)
+        n_scores = len([i for i in range(first, cap - anneal) if i % every == 0])
+        share = n_scores * sc_ms / (3000 * it_ms)
+        print(f"{m:>12} {it_ms:8.1f} {sc_ms:9.0f} {len(ev.pairs):6d} {100 * share:5.1f}%")
+
+
+def main() -> None:
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    sub = ap.add_subparsers(dest="command", required=True)
+    p = sub.add_parser("curves", help="held-out-window fit curves (--rule: rule-on trainings)")
+    p.add_argument("--tree", required=True)
+    p.add_argument("--out", required=True)
+    p.add_argument("--models", default="")
+    p.add_argument("--every", type=int, default=50)
+    p.add_argument("--seed", type=int, default=0)
+    p.add_argument("--profile", default="default")
+    p.add_argument("--rule", action="store_true", help="train with the stopping rule on")
+    p.add_argument("--budget", type=int, default=None, help="train this many iterations")
+    p.add_argument("--stop-every", type=int, default=None)
+    p.add_argument("--tol", type=float, default=None)
+    p.add_argument("--patience", type=int, default=None)
+    p.add_argument("--anneal", type=int, default=None)
+    p.set_defaults(run=curves, threads=1)
+    p = sub.add_parser("choose", help="where the rule would stop each curve, over a grid")
+    p.add_argument("curves", nargs="+")
+    p.add_argument("--every", type=int)
+    p.add_argument("--tol", type=float)
+    p.add_argument("--patience", type=int)
+    p.add_argument("--start", type=float, default=0.0)
+    p.set_defaults(run=choose, threads=None)
+    p = sub.add_parser("overhead", help="a held-out score's cost against a training iteration")
+    p.add_argument("testbed", type=Path)
+    p.add_argument("--models", default="static,ours,mlp,mlp_wind,d3dgs,d3dgs_wind")
+    p.add_argument("--iterations", type=int, default=60)
+    p.add_argument("--repeats", type=int, default=3)
+    p.add_argument("--every", type=int, default=300, help="N: iterations between scores")
+    p.set_defaults(run=overhead, threads=1)
+    args = ap.parse_args()
+    if args.threads:
+        torch.set_num_threads(args.threads)
+    args.run(args)
+
+
+if __name__ == "__main__":
+    main()
