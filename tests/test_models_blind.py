@@ -128,7 +128,8 @@ def test_evaluation_says_not_defined_beyond_the_window_and_under_other_winds():
     from types import SimpleNamespace
 
     from physgs.evaluate.adapter import model_render_fn
-    from physgs.evaluate.splits import NotDefined, evaluate
+    from physgs.evaluate.splits import evaluate
+    from physgs.models.undefined import NotDefined
 
     m = _model()
     fn = model_render_fn(

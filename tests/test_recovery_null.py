@@ -4,7 +4,8 @@ import numpy as np
 import pytest
 from scipy import stats
 
-from physgs.recovery.null import draw_null_omegas, nearest_bone_gap, null_control
+from physgs.recovery.null import draw_null_omegas, null_control
+from physgs.testbed.stats import nearest_bone_gap
 from oracles import forced_lsim
 
 

@@ -9,7 +9,8 @@ import torch
 import physgs.config
 from physgs.models.oscillator import integrate
 from physgs.recovery.matcher import match_parts, training_window
-from physgs.recovery.null import draw_null_omegas, nearest_bone_gap
+from physgs.recovery.null import draw_null_omegas
+from physgs.testbed.stats import nearest_bone_gap
 from physgs.recovery.record import bone_window, run_null, score_recovery
 from physgs.testbed.dataset import simulate_tree
 

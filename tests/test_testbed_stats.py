@@ -8,7 +8,7 @@ import pytest
 
 from physgs.camera import look_at
 from physgs.config import load
-from physgs.recovery.null import nearest_bone_gap
+from physgs.testbed.stats import nearest_bone_gap
 from physgs.testbed import stats
 from physgs.testbed.dataset import load_observed, load_truth, simulate_tree
 from oracles import simulate_trees, tiny_testbed

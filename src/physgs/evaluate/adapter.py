@@ -6,7 +6,7 @@ from __future__ import annotations
 import numpy as np
 import torch
 
-from physgs.evaluate.splits import NotDefined
+from physgs.models.undefined import NotDefined
 
 
 def model_render_fn(model, observed, *, backend: str = "auto", means_seen: dict | None = None):
@@ -27,7 +27,7 @@ def model_render_fn(model, observed, *, backend: str = "auto", means_seen: dict 
 
     Returns:
         (Callable): The callback, float64 arrays; it raises
-            [`NotDefined`][physgs.evaluate.splits.NotDefined] where the model makes no prediction.
+            [`NotDefined`][physgs.models.undefined.NotDefined] where the model makes no prediction.
     """
     # here: the rasterizer loads numba, which the evaluate job should load only once
     # physgs.jobs.job has set the rule's threads (its pool then starts at that size)

@@ -11,7 +11,8 @@ import numpy as np
 from physgs.evaluate.adapter import model_means_fn, model_render_fn
 from physgs.atomic import save_npz
 from physgs.evaluate.metrics import psnr
-from physgs.evaluate.splits import NotDefined, evaluate
+from physgs.evaluate.splits import evaluate
+from physgs.models.undefined import NotDefined
 from physgs.evaluate.trajectories import tip_trajectories
 
 

@@ -16,12 +16,7 @@ import numpy as np
 from physgs.atomic import save_npz
 from physgs.evaluate.metrics import centroid_error, psnr, to_float_image
 from physgs.intermediate import read_npz
-
-
-class NotDefined(Exception):
-    """A model makes no prediction for this frame or condition (a prior with a learned forcing
-    beyond its window or under another wind): the evaluation records NaN, "not defined", never
-    a score."""
+from physgs.models.undefined import NotDefined
 
 
 RenderFn = Callable[[int, int, object], tuple[np.ndarray, np.ndarray]]
@@ -125,7 +120,7 @@ def evaluate(
 
     Renders C x F frames at the training camera (every condition, window and tail) and A x M
     held-out views (training condition). A frame the callback refuses with
-    [`NotDefined`][physgs.evaluate.splits.NotDefined] (a learned forcing beyond its window or under
+    [`NotDefined`][physgs.models.undefined.NotDefined] (a learned forcing beyond its window or under
     another wind) scores NaN: its split means are NaN, "not defined", never a number.
 
     Args:

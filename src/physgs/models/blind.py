@@ -32,7 +32,7 @@ import numpy as np
 import torch
 from torch import nn
 
-from physgs.evaluate.splits import NotDefined
+from physgs.models.undefined import NotDefined
 from physgs.models.oscillator import integrate_forcing
 from physgs.models.ours import OscillatorPrior
 

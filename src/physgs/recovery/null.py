@@ -13,6 +13,7 @@ from dataclasses import asdict, dataclass
 import numpy as np
 
 from physgs.recovery.matcher import TRUST_THRESHOLD, match_parts, restricted, training_window
+from physgs.testbed.stats import nearest_bone_gap  # the testbed's own definition
 
 N_DRAWS = 8
 
@@ -32,21 +33,6 @@ def draw_null_omegas(omega_bones: np.ndarray, n_parts: int, n_draws: int, seed: 
     lo, hi = np.log(np.min(omega_bones)), np.log(np.max(omega_bones))
     rng = np.random.default_rng(seed)
     return np.exp(rng.uniform(lo, hi, size=(n_draws, n_parts)))
-
-
-def nearest_bone_gap(omega: np.ndarray, omega_bones: np.ndarray) -> np.ndarray:
-    """Relative distance of each frequency to the nearest bone's, min_b |omega - omega_b| / omega_b.
-
-    Args:
-        omega: [...] natural frequencies, rad/s.
-        omega_bones: [B] the bones' natural frequencies, rad/s (> 0).
-
-    Returns:
-        [...] the gaps, fractions.
-    """
-    omega = np.asarray(omega, dtype=np.float64)
-    ob = np.asarray(omega_bones, dtype=np.float64)
-    return np.min(np.abs(omega[..., None] - ob) / ob, axis=-1)
 
 
 @dataclass(frozen=True)

@@ -10,7 +10,7 @@ condition 0, unless said otherwise):
 
 - distinct frequencies: ``distinct_count(omega)``, values equal to a relative 1e-9 count once.
 - nearest-bone gap: for a frequency omega drawn log-uniformly on [min omega_b, max omega_b], the
-  relative distance to the nearest bone, [`physgs.recovery.null.nearest_bone_gap`][] (the quantity
+  relative distance to the nearest bone, [`nearest_bone_gap`][physgs.testbed.stats.nearest_bone_gap] (the quantity
   the null control reports); its median over the draw is taken on a dense log grid (so it is the
   expectation, not one seed's estimate).
 - swing: each bone's own angle theta_b(t) (not its ancestors'), RMS over the window, degrees.
@@ -35,7 +35,6 @@ import numpy as np
 
 from physgs.atomic import write_json
 from physgs.intermediate import read_json
-from physgs.recovery.null import nearest_bone_gap  # the null control's own definition
 from physgs.testbed import kinematics
 
 
@@ -96,6 +95,21 @@ def distinct_count(values, rtol: float = 1e-9) -> int:
         return 0
     step = np.diff(v) > rtol * np.maximum(np.abs(v[1:]), np.abs(v[:-1]))
     return int(1 + step.sum())
+
+
+def nearest_bone_gap(omega: np.ndarray, omega_bones: np.ndarray) -> np.ndarray:
+    """Relative distance of each frequency to the nearest bone's, min_b |omega - omega_b| / omega_b.
+
+    Args:
+        omega: [...] natural frequencies, rad/s.
+        omega_bones: [B] the bones' natural frequencies, rad/s (> 0).
+
+    Returns:
+        [...] the gaps, fractions.
+    """
+    omega = np.asarray(omega, dtype=np.float64)
+    ob = np.asarray(omega_bones, dtype=np.float64)
+    return np.min(np.abs(omega[..., None] - ob) / ob, axis=-1)
 
 
 def median_nearest_bone_gap(omega, n_grid: int = 200_001) -> float:
