@@ -46,10 +46,17 @@ import torch
 
 from physgs.config import load
 from physgs.experiments.recipe import Job, earliest_stop, fit, heldout_split, job_spec
-from physgs.models.registry import BLIND_PRIORS, build_model, is_prior, is_reference, training_jobs
+from physgs.models.registry import (
+    BLIND_PRIORS,
+    build_model,
+    condition_indices,
+    is_prior,
+    is_reference,
+    training_jobs,
+)
 from physgs.testbed.dataset import load_observed, load_truth
 from physgs.train.holdout import HoldoutEval
-from physgs.train.loop import condition_indices, train_model
+from physgs.train.loop import train_model
 from physgs.train.seeding import seed_everything
 from physgs.train.stopping import plateau_iteration
 

@@ -24,14 +24,13 @@ Both choices are recorded whichever ``method`` picks the K used.
 from __future__ import annotations
 
 import time
-from dataclasses import asdict, dataclass
+from dataclasses import dataclass
 
 import numpy as np
 
-from physgs.atomic import write_json
 from physgs.experiments.recipe import Job, fit, heldout_split  # noqa: F401 (re-exported)
-from physgs.intermediate import read_json, refuse
 from physgs.models.registry import AUTO_CONFIG
+from physgs.records import JsonRecord
 
 METHODS = ("heldout", "bic")
 PARAMS_PER_PART = 8  # omega, zeta, gain, swing axis (2), pivot (3)
@@ -150,12 +149,14 @@ def choose_bic(candidates, bics) -> int:
 
 
 @dataclass(frozen=True)
-class KSelection:
+class KSelection(JsonRecord):
     """Scores per candidate K (lists aligned with ``candidates``) and the choices.
 
     heldout_psnr dB; train_mse on [0, 1] images; bic dimensionless; frozen parts per run;
     wall_s seconds of training per candidate; chosen_k is k_heldout or k_bic per ``method``.
     """
+
+    RECORD_NAME = "K selection"
 
     candidates: list
     method: str
@@ -171,26 +172,6 @@ class KSelection:
     k_bic: int
     chosen_k: int
 
-    def to_dict(self) -> dict:
-        """The selection as a plain JSON-serialisable dict (field name -> value).
-
-        Returns:
-            Field name -> value.
-        """
-        return asdict(self)
-
-    @staticmethod
-    def from_dict(d: dict) -> "KSelection":
-        """The selection that [to_dict][physgs.experiments.kselect.KSelection.to_dict] wrote.
-
-        Args:
-            d: field name -> value (extra keys are ignored).
-
-        Returns:
-            The selection.
-        """
-        return KSelection(**{k: d[k] for k in KSelection.__dataclass_fields__})
-
 
 def save_selection(path, sel: KSelection) -> None:
     """Write the K selection to ``path`` as JSON, atomically.
@@ -199,7 +180,7 @@ def save_selection(path, sel: KSelection) -> None:
         path (str | os.PathLike): the ``.json`` file to write.
         sel: the selection.
     """
-    write_json(path, sel.to_dict())
+    sel.save(path)
 
 
 def load_selection(path) -> KSelection:
@@ -215,11 +196,7 @@ def load_selection(path) -> KSelection:
         IntermediateFileError: the file is missing or not a K selection (it is removed, so rule
             ``kselect`` rebuilds it).
     """
-    d = read_json(path, rule="kselect")
-    try:
-        return KSelection.from_dict(d)
-    except (KeyError, TypeError) as e:
-        raise refuse(path, f"is not a K selection ({type(e).__name__}: {e})", "kselect") from None
+    return KSelection.load(path, rule="kselect")
 
 
 def _check_cfg(ks: dict, n_gaussians: int, where: str = "models/kselect") -> list[int]:

@@ -14,6 +14,7 @@ import numpy as np
 from physgs.models.omega_search import OmegaSearch, omega_search_callback, search_iteration
 from physgs.models.registry import (
     build_model,
+    condition_indices,
     configs_for,
     is_prior,
     is_reference,
@@ -205,7 +206,7 @@ def fit(
     """
     # here: the training machinery loads torch (module docstring)
     from physgs.device import resolve_device
-    from physgs.train.loop import condition_indices, train_model
+    from physgs.train.loop import train_model
     from physgs.train.seeding import seed_everything
 
     job = Job.from_dict(job) if isinstance(job, dict) else job

@@ -386,6 +386,26 @@ def config_label(name: str, spec: dict, tex: bool = True) -> str:
     return rf"{kind} ($K{{=}}{int(spec['K'])}$)" if tex else f"{kind} (K={int(spec['K'])})"
 
 
+def condition_indices(spec: str, n_conditions: int) -> list[int]:
+    """Wind conditions a configuration trains on: 'train' -> [0], 'all' -> every condition.
+
+    Args:
+        spec: ``'train'`` or ``'all'`` (a configuration's ``conditions``).
+        n_conditions: the dataset's condition count.
+
+    Returns:
+        The condition indices.
+
+    Raises:
+        ValueError: for any other ``spec``.
+    """
+    if spec == "train":
+        return [0]
+    if spec == "all":
+        return list(range(n_conditions))
+    raise ValueError(f"unknown conditions {spec!r} in models.configs; use 'train' or 'all'")
+
+
 def configs_for(model: str, configs) -> tuple[str, ...]:
     """Configurations a model is trained in: every model (references too) `single`, ours (and
     its wind-driven variants) every configuration; a prior with a learned forcing `single`

@@ -5,9 +5,8 @@ The workflow imports this module to plan jobs, so it imports neither pyOMA-2 nor
 
 from __future__ import annotations
 
-from physgs.models.registry import section_k
+from physgs.models.registry import condition_indices, section_k
 from physgs.recovery.run import null_settings
-from physgs.tracks.settings import condition_indices
 
 
 def identify_params(cfg: dict, config: str) -> dict:

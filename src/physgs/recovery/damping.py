@@ -7,13 +7,15 @@ and log-log exponent ~ 0 (the paper's finding).
 
 from __future__ import annotations
 
-from dataclasses import asdict, dataclass
+from dataclasses import dataclass
 
 import numpy as np
 
+from physgs.records import JsonRecord
+
 
 @dataclass(frozen=True)
-class DampingResult:
+class DampingResult(JsonRecord):
     """zeta [K] (dimensionless), omega [K] and gamma [K] in rad/s (gamma in 1/s).
 
     median_zeta: median of zeta_hat. slope, intercept: least-squares gamma = intercept +
@@ -29,37 +31,6 @@ class DampingResult:
     intercept: float
     loglog_exponent: float
     zeta_true: float
-
-    def to_dict(self) -> dict:
-        """The result as a JSON-ready dict (arrays as lists).
-
-        Returns:
-            Field name -> value, arrays as lists.
-        """
-        return {
-            k: (v.tolist() if isinstance(v, np.ndarray) else v) for k, v in asdict(self).items()
-        }
-
-    @staticmethod
-    def from_dict(d: dict) -> "DampingResult":
-        """The result that [to_dict][physgs.recovery.damping.DampingResult.to_dict] wrote.
-
-        Args:
-            d: field name -> value (arrays as lists).
-
-        Returns:
-            The result.
-        """
-        return DampingResult(
-            np.asarray(d["zeta"]),
-            np.asarray(d["omega"]),
-            np.asarray(d["gamma"]),
-            float(d["median_zeta"]),
-            float(d["slope"]),
-            float(d["intercept"]),
-            float(d["loglog_exponent"]),
-            float(d["zeta_true"]),
-        )
 
 
 def damping_summary(

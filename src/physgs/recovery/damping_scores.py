@@ -21,10 +21,11 @@ omega_hat): a model that does not beat it has not recovered damping.
 from __future__ import annotations
 
 import zlib
-from dataclasses import asdict, dataclass
+from dataclasses import dataclass
 
 import numpy as np
 
+from physgs.records import JsonRecord, floats
 from physgs.recovery.matcher import pearson_matrix
 from physgs.recovery.null import N_DRAWS
 
@@ -37,7 +38,7 @@ NULL_STREAM = zlib.crc32(b"damping_null")
 
 
 @dataclass(frozen=True)
-class DampingScores:
+class DampingScores(JsonRecord):
     """Per-part damping scores over the trusted parts of one matching.
 
     n_trusted: parts scored. median_rel_err: median |zeta_hat - zeta_b| / zeta_b (fraction; NaN
@@ -53,32 +54,6 @@ class DampingScores:
     log_corr: float
     gamma_exponent: float
     gamma_exponent_true: float
-
-    def to_dict(self) -> dict:
-        """The scores as a plain dict (field name -> value).
-
-        Returns:
-            Field name -> value.
-        """
-        return asdict(self)
-
-    @staticmethod
-    def from_dict(d: dict) -> "DampingScores":
-        """The scores that [to_dict][physgs.recovery.damping_scores.DampingScores.to_dict] wrote.
-
-        Args:
-            d: field name -> value.
-
-        Returns:
-            The scores.
-        """
-        return DampingScores(
-            int(d["n_trusted"]),
-            *(
-                float(d[k])
-                for k in ("median_rel_err", "log_corr", "gamma_exponent", "gamma_exponent_true")
-            ),
-        )
 
 
 def _positive(name: str, x) -> np.ndarray:
@@ -222,13 +197,13 @@ def draw_null_zetas(zeta_range, n_parts: int, n_draws: int, seed: int) -> np.nda
 
 
 @dataclass(frozen=True)
-class DampingNull:
+class DampingNull(JsonRecord):
     """Damping null: per-draw scores [D] (as DampingScores) and the drawn zeta [D, K]."""
 
-    median_rel_err: np.ndarray
-    log_corr: np.ndarray
-    gamma_exponent: np.ndarray
-    zeta: np.ndarray
+    median_rel_err: np.ndarray = floats()
+    log_corr: np.ndarray = floats()
+    gamma_exponent: np.ndarray = floats()
+    zeta: np.ndarray = floats()
     n_trusted: int
     seed: int
 
@@ -252,35 +227,6 @@ class DampingNull:
     def median_gamma_exponent(self) -> float:
         """Median over draws of each draw's gamma exponent (NaN draws skipped)."""
         return self._median(self.gamma_exponent)
-
-    def to_dict(self) -> dict:
-        """The null as a JSON-ready dict (arrays as lists).
-
-        Returns:
-            Field name -> value, arrays as lists.
-        """
-        return {
-            k: (v.tolist() if isinstance(v, np.ndarray) else v) for k, v in asdict(self).items()
-        }
-
-    @staticmethod
-    def from_dict(d: dict) -> "DampingNull":
-        """The null that [to_dict][physgs.recovery.damping_scores.DampingNull.to_dict] wrote.
-
-        Args:
-            d: field name -> value (arrays as lists).
-
-        Returns:
-            The null.
-        """
-        return DampingNull(
-            *(
-                np.asarray(d[k], float)
-                for k in ("median_rel_err", "log_corr", "gamma_exponent", "zeta")
-            ),
-            int(d["n_trusted"]),
-            int(d["seed"]),
-        )
 
 
 def damping_null(

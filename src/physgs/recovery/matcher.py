@@ -6,9 +6,11 @@ recovered its bone reproduces the bone's theta(t); the match reads omega off tha
 
 from __future__ import annotations
 
-from dataclasses import asdict, dataclass
+from dataclasses import dataclass
 
 import numpy as np
+
+from physgs.records import JsonRecord
 
 TRUST_THRESHOLD = 0.7  # |corr| at or above which a match is trusted (the paper and the protocol)
 
@@ -86,7 +88,7 @@ def loglog_r2(omega_hat: np.ndarray, omega_true: np.ndarray) -> float:
 
 
 @dataclass(frozen=True)
-class MatchResult:
+class MatchResult(JsonRecord):
     """Part-to-bone match. omega in rad/s; rel_err = |omega_hat - omega_true| / omega_true.
 
     bone [K]: best-|corr| bone index; corr [K]: that |corr|; trusted [K]: corr >= threshold.
@@ -104,38 +106,6 @@ class MatchResult:
     n_parts: int
     median_rel_err: float
     loglog_r2: float
-
-    def to_dict(self) -> dict:
-        """The result as a JSON-ready dict (arrays as lists).
-
-        Returns:
-            Field name -> value, arrays as lists.
-        """
-        return {
-            k: (v.tolist() if isinstance(v, np.ndarray) else v) for k, v in asdict(self).items()
-        }
-
-    @staticmethod
-    def from_dict(d: dict) -> "MatchResult":
-        """The result that [to_dict][physgs.recovery.matcher.MatchResult.to_dict] wrote.
-
-        Args:
-            d: field name -> value (arrays as lists).
-
-        Returns:
-            The result.
-        """
-        arr = {
-            k: np.asarray(d[k])
-            for k in ("bone", "corr", "trusted", "omega_hat", "omega_true", "rel_err")
-        }
-        return MatchResult(
-            **arr,
-            n_trusted=int(d["n_trusted"]),
-            n_parts=int(d["n_parts"]),
-            median_rel_err=float(d["median_rel_err"]),
-            loglog_r2=float(d["loglog_r2"]),
-        )
 
 
 def match_parts(

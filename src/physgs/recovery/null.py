@@ -8,10 +8,11 @@ whether recovery happened (dense skeletons tile the frequency axis too finely).
 
 from __future__ import annotations
 
-from dataclasses import asdict, dataclass
+from dataclasses import dataclass
 
 import numpy as np
 
+from physgs.records import JsonRecord, floats
 from physgs.recovery.matcher import TRUST_THRESHOLD, match_parts, restricted, training_window
 from physgs.testbed.stats import nearest_bone_gap  # the testbed's own definition
 
@@ -36,18 +37,18 @@ def draw_null_omegas(omega_bones: np.ndarray, n_parts: int, n_draws: int, seed: 
 
 
 @dataclass(frozen=True)
-class NullResult:
+class NullResult(JsonRecord):
     """Null control: per-draw scores [D] and their medians; rel. errors and gaps as fractions."""
 
     n_trusted: np.ndarray  # [D]
-    median_rel_err: np.ndarray  # [D] (NaN in a draw with no trusted part)
-    loglog_r2: np.ndarray  # [D]
-    omega: np.ndarray  # [D, K] rad/s drawn
+    median_rel_err: np.ndarray = floats()  # [D] (NaN in a draw with no trusted part)
+    loglog_r2: np.ndarray = floats()  # [D]
+    omega: np.ndarray = floats()  # [D, K] rad/s drawn
     n_parts: int
     nearest_bone_gap: float  # median over draws and parts
     seed: int
-    n_trusted_visible: np.ndarray | None = None  # [D] restricted to visible bones (or None)
-    median_rel_err_visible: np.ndarray | None = None  # [D]
+    n_trusted_visible: np.ndarray | None = floats(default=None)  # [D] restricted to visible bones
+    median_rel_err_visible: np.ndarray | None = floats(default=None)  # [D]
 
     @property
     def median_n_trusted(self) -> float:
@@ -78,41 +79,6 @@ class NullResult:
         """Median over draws of the log-log R^2 of omega against the bones' (NaN draws skipped)."""
         v = self.loglog_r2[np.isfinite(self.loglog_r2)]
         return float(np.median(v)) if v.size else float("nan")
-
-    def to_dict(self) -> dict:
-        """The result as a JSON-ready dict (arrays as lists).
-
-        Returns:
-            Field name -> value, arrays as lists.
-        """
-        return {
-            k: (v.tolist() if isinstance(v, np.ndarray) else v) for k, v in asdict(self).items()
-        }
-
-    @staticmethod
-    def from_dict(d: dict) -> "NullResult":
-        """The result that [to_dict][physgs.recovery.null.NullResult.to_dict] wrote.
-
-        Args:
-            d: field name -> value (arrays as lists; the visible-bone scores may be absent or None).
-
-        Returns:
-            The result.
-        """
-        opt = {
-            k: (np.asarray(d[k], float) if d.get(k) is not None else None)
-            for k in ("n_trusted_visible", "median_rel_err_visible")
-        }
-        return NullResult(
-            np.asarray(d["n_trusted"]),
-            np.asarray(d["median_rel_err"], float),
-            np.asarray(d["loglog_r2"], float),
-            np.asarray(d["omega"], float),
-            int(d["n_parts"]),
-            float(d["nearest_bone_gap"]),
-            int(d["seed"]),
-            **opt,
-        )
 
 
 def null_control(

@@ -195,7 +195,7 @@ def save_null(path, res: NullResult) -> None:
         path (str | os.PathLike): the ``.json`` file to write.
         res: the result.
     """
-    write_json(path, res.to_dict())
+    res.save(path)
 
 
 def load_null(path) -> NullResult:
@@ -210,7 +210,7 @@ def load_null(path) -> NullResult:
     Raises:
         IntermediateFileError: the file is missing or unreadable (rule ``null_control``).
     """
-    return NullResult.from_dict(read_json(path, rule="null_control"))
+    return NullResult.load(path, rule="null_control")
 
 
 def run_null(

@@ -14,7 +14,7 @@ initialisation, RK4 substeps and guard) and ``train.lr.physics`` (Adam's rate on
 
 from __future__ import annotations
 
-from physgs.models.registry import SAME_K, configs_for, section_k
+from physgs.models.registry import SAME_K, condition_indices, configs_for, section_k
 from physgs.testbed.variant import FAITHFUL, parse_id
 
 #: ours' settings the oscillator fit reads (``physgs.tracks.fit.Oscillators.from_config``)
@@ -31,26 +31,6 @@ def tracker_settings(cfg: dict) -> dict:
         A copy of ``tracks.tracker``.
     """
     return dict(cfg["tracks"]["tracker"])
-
-
-def condition_indices(spec: str, n_conditions: int) -> list[int]:
-    """Conditions a configuration fits: 'train' -> [0], 'all' -> every one (as ours trains).
-
-    Args:
-        spec: ``'train'`` or ``'all'``.
-        n_conditions: the dataset's condition count.
-
-    Returns:
-        The condition indices.
-
-    Raises:
-        ValueError: for any other ``spec``.
-    """
-    if spec == "train":
-        return [0]
-    if spec == "all":
-        return list(range(n_conditions))
-    raise ValueError(f"unknown conditions {spec!r} in models.configs; use 'train' or 'all'")
 
 
 def parts(cfg: dict, config: str) -> tuple[int, str]:

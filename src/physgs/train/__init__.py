@@ -5,7 +5,6 @@ The recipe that seeds, builds and trains a job is [`physgs.experiments.recipe`][
 from physgs.train.loop import (
     TrainingError,
     TrainResult,
-    condition_indices,
     train_model,
     write_loss_log,
 )
@@ -14,7 +13,6 @@ from physgs.train.losses import photometric_loss, ssim
 __all__ = [
     "TrainingError",
     "TrainResult",
-    "condition_indices",
     "train_model",
     "write_loss_log",
     "photometric_loss",

@@ -61,26 +61,6 @@ class TrainResult:
     log: list[dict]
 
 
-def condition_indices(spec: str, n_conditions: int) -> list[int]:
-    """Wind conditions a configuration trains on: 'train' -> [0], 'all' -> every condition.
-
-    Args:
-        spec: ``'train'`` or ``'all'`` (a configuration's ``conditions``).
-        n_conditions: the dataset's condition count.
-
-    Returns:
-        The condition indices.
-
-    Raises:
-        ValueError: for any other ``spec``.
-    """
-    if spec == "train":
-        return [0]
-    if spec == "all":
-        return list(range(n_conditions))
-    raise ValueError(f"unknown conditions {spec!r} in models.configs; use 'train' or 'all'")
-
-
 def train_model(
     model: BaseModel,
     observed,
