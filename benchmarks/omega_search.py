@@ -27,7 +27,8 @@ from physgs.evaluate.run import training_camera_scores
 from physgs.experiments import job_spec
 from physgs.experiments.recipe import Job, heldout_split, training_hooks
 from physgs.models.omega_search import SearchHook
-from physgs.models.registry import build_model, condition_indices, save_checkpoint
+from physgs.models.checkpoint import save_checkpoint
+from physgs.models.registry import build_model, condition_indices
 from physgs.testbed.dataset import load_observed
 from physgs.train.loop import train_model
 from physgs.train.seeding import seed_everything

@@ -20,7 +20,7 @@ from physgs.config_checks import device_is_available
 from physgs.experiments import job_spec, train_and_save
 from physgs.experiments.recipe import heldout_split
 from physgs.models import build_model, load_checkpoint
-from physgs.models.registry import _device_free
+from physgs.models.checkpoint import _device_free
 from physgs.train import train_model
 from physgs.device import asks_for_gpu, check_setting, resolve_device
 from physgs.train.holdout import HoldoutEval

@@ -37,7 +37,7 @@ def full_fs(tmp_path):
 def _checkpoint(path):
     import torch
 
-    with atomic_path(path) as tmp:  # as physgs.models.registry.save_checkpoint writes
+    with atomic_path(path) as tmp:  # as physgs.models.checkpoint.save_checkpoint writes
         torch.save({"state_dict": {"w": torch.zeros(1_000_000)}}, tmp)
 
 

@@ -362,7 +362,7 @@ def test_frame0_offset_turns_the_rest_pose_by_a_learned_angle():
 
 def test_canonical_pose_is_validated_and_old_checkpoints_keep_theirs():
     import physgs.config
-    from physgs.models.registry import canonical_pose_of
+    from physgs.models.families import canonical_pose_of
 
     with pytest.raises(physgs.config.ConfigError, match="canonical_pose"):
         physgs.config.apply_overrides(quick_config(), ["models.topology.canonical_pose=frame1"])

@@ -21,7 +21,8 @@ from physgs.models.omega_search import (
     unit_responses,
 )
 from physgs.models.oscillator_params import condition_vbar
-from physgs.models.registry import model_settings, searches_omega
+from physgs.models.families import searches_omega
+from physgs.models.registry import model_settings
 from oracles import gusty_wind, model_context, quick_config, quick_models_cfg, wind_lsim
 
 DT = 1 / 24

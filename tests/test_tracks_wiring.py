@@ -14,6 +14,7 @@ import numpy as np
 import pandas as pd
 import pytest
 
+from physgs.models.families import OSCILLATOR_KEYS
 from physgs.recovery.damping import damping_summary
 from physgs.recovery.damping_scores import damping_null, damping_scores
 from physgs.recovery.matcher import MatchResult
@@ -65,7 +66,7 @@ def test_fit_params_are_the_configurations_k_and_conditions_or_the_override():
     assert job["K"] == 2 and job["K_key"] == "tracks/K"
     assert job["conditions"] == list(range(len(cfg["testbed"]["conditions"])))
     assert job["seed"] == 3 and job["lr"] == cfg["train"]["lr"]["physics"]
-    assert set(job["ours"]) == set(tsettings.OURS_KEYS)
+    assert set(job["ours"]) == set(OSCILLATOR_KEYS)
     cfg["tracks"]["K"] = "same"
     job = tsettings.fit_job(cfg, "single", seed=0)
     assert job["K"] == cfg["models"]["configs"]["single"]["K"] and job["conditions"] == [0]

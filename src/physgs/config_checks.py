@@ -16,14 +16,15 @@ import math
 from typing import Callable, Iterator
 
 from physgs.device import check_setting  # imports torch only when cuda is asked for
-from physgs.experiments.kselect import selected_models, settings_for
+from physgs.experiments.kselect import BASE_MODEL, selected_models, settings_for
 from physgs.models.omega_search import search_problem
+from physgs.models.families import searches_omega
 from physgs.models.registry import (
+    FIELD_FAMILIES,
     MODEL_NAMES,
     MODELS,
     PRIOR_VARIANT_NAMES,
     is_prior,
-    searches_omega,
     spec_of,
 )
 from physgs.models.timescale import WINDOW_TIME
@@ -403,7 +404,7 @@ def field_time_scales_valid(cfg: dict) -> Iterator[Problem]:
         ``(key path, message)`` per problem (the module docstring); none when the config passes.
     """
     nyquist = 0.5 * float(cfg["testbed"]["fps"])
-    for family in ("mlp", "d3dgs"):
+    for family in FIELD_FAMILIES:
         tops = cfg["models"][family]["time_top_hz"]
         ids = [m for m, spec in MODELS.items() if spec.family == family]
         for m in ids:
@@ -464,8 +465,8 @@ def _kselect_runs(cfg: dict, *own_keys: str) -> Iterator[tuple[str, tuple, dict]
     ours', reported once under ours' key)."""
     ks = cfg["models"]["kselect"]
     for m in selected_models(ks):
-        where = ("models", "kselect") if m == "ours" else ("models", "kselect", "priors", m)
-        if m == "ours" or not own_keys or set(own_keys) & set(ks["priors"][m]):
+        where = ("models", "kselect") if m == BASE_MODEL else ("models", "kselect", "priors", m)
+        if m == BASE_MODEL or not own_keys or set(own_keys) & set(ks["priors"][m]):
             yield m, where, settings_for(ks, m)
 
 
@@ -638,7 +639,7 @@ def kselect_priors_are_runnable(cfg: dict) -> Iterator[Problem]:
     Yields:
         ``(key path, message)`` per problem; none when the config passes.
     """
-    valid = [m for m in MODELS if m != "ours" and is_prior(m) and spec_of(m).forcing == "wind"]
+    valid = [m for m in MODELS if m != BASE_MODEL and is_prior(m) and spec_of(m).forcing == "wind"]
     own = cfg["models"]["kselect"].get("priors") or {}
     for m in own:
         if m not in valid:

@@ -2,7 +2,7 @@
 
 from physgs.evaluate.run import evaluate_checkpoint
 from physgs.jobs import job
-from physgs.models.registry import load_checkpoint
+from physgs.models.checkpoint import load_checkpoint
 from physgs.testbed.dataset import load_observed, load_truth
 from physgs.device import resolve_device
 

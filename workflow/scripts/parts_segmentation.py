@@ -3,7 +3,7 @@ against the ground-truth bones (an evaluation check; reads truth.npz)."""
 
 from physgs.evaluate.parts import gaussian_bone, save_segmentations, segmentation_record
 from physgs.jobs import job
-from physgs.models.registry import load_checkpoint
+from physgs.models.checkpoint import load_checkpoint
 from physgs.testbed.dataset import load_truth
 
 sm = snakemake  # noqa: F821 (injected by Snakemake)

@@ -1,7 +1,7 @@
 """Snakemake script of rule `recovery`: match ours' parts to bones and summarise damping."""
 
 from physgs.jobs import job
-from physgs.models.registry import load_checkpoint
+from physgs.models.checkpoint import load_checkpoint
 from physgs.recovery.record import save_recovery
 from physgs.recovery.run import recover_model
 from physgs.testbed.dataset import load_observed, load_truth

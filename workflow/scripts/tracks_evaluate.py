@@ -5,7 +5,7 @@ evaluation: reads truth.npz."""
 
 from physgs.atomic import write_json
 from physgs.jobs import job
-from physgs.models.registry import load_checkpoint
+from physgs.models.checkpoint import load_checkpoint
 from physgs.testbed.dataset import load_observed, load_truth
 from physgs.testbed.stats import load_stats
 from physgs.tracks.recover import save_tracks_recovery

@@ -4,7 +4,7 @@ evaluation: reads truth.npz."""
 
 from physgs.atomic import write_json
 from physgs.jobs import job
-from physgs.models.registry import load_checkpoint
+from physgs.models.checkpoint import load_checkpoint
 from physgs.testbed.dataset import load_observed, load_truth
 from physgs.tracks.run import models_at_tracks
 from physgs.tracks.store import load_fit, load_tracks

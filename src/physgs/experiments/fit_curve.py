@@ -23,7 +23,7 @@ import pandas as pd
 from physgs.evaluate.metrics import ceiling_fraction as _fraction
 from physgs.experiments.recipe import fit, heldout_split, job_spec
 from physgs.experiments.sweep import with_knob
-from physgs.models.registry import BASE_CONFIG, FIELDS, MODELS
+from physgs.models.registry import BASE_CONFIG, FIELD_FAMILIES, MODELS
 from physgs.models.timescale import WINDOW_TIME
 
 #: suffix of a fit-curve series trained with the window-normalised time encoding
@@ -70,7 +70,7 @@ def window_models(cfg: dict) -> list[str]:
     out = []
     for m in cfg["speed_accuracy"]["fit_curve"]["models"]:
         family = MODELS[m].family
-        if family in FIELDS and cfg["models"][family]["time_top_hz"][m] != WINDOW_TIME:
+        if family in FIELD_FAMILIES and cfg["models"][family]["time_top_hz"][m] != WINDOW_TIME:
             out.append(m)
     return out
 
@@ -98,7 +98,7 @@ def point_job(
     pcfg = with_knob(cfg, tree, "iterations", iterations)
     if window_time:
         family = MODELS[model].family
-        if family not in FIELDS:
+        if family not in FIELD_FAMILIES:
             raise ValueError(f"{model!r} has no time encoding; the window series is for fields")
         pcfg["models"][family]["time_top_hz"] = {
             **pcfg["models"][family]["time_top_hz"],

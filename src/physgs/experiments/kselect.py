@@ -29,13 +29,13 @@ from dataclasses import dataclass
 import numpy as np
 
 from physgs.experiments.recipe import Job, fit, heldout_split  # noqa: F401 (re-exported)
-from physgs.models.registry import AUTO_CONFIG
+from physgs.models.registry import AUTO_CONFIG, PAPER_MODEL
 from physgs.records import JsonRecord
 
 METHODS = ("heldout", "bic")
 PARAMS_PER_PART = 8  # omega, zeta, gain, swing axis (2), pivot (3)
 #: the prior whose K the section's own keys choose (an entry of its own under ``priors`` is refused)
-BASE_MODEL = "ours"
+BASE_MODEL = PAPER_MODEL
 #: what a prior's entry under ``models.kselect.priors`` may set: its candidates and its short
 #: runs' schedule (the criterion, held-out frames and conditions stay shared, so the choices
 #: compare)

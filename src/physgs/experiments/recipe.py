@@ -11,16 +11,16 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
+from physgs.models.checkpoint import save_checkpoint
+from physgs.models.families import searches_omega
 from physgs.models.omega_search import OmegaSearch, omega_search_callback, search_iteration
 from physgs.models.registry import (
+    FIELD_FAMILIES,
     build_model,
     condition_indices,
     configs_for,
     is_prior,
-    is_reference,
     model_settings,
-    save_checkpoint,
-    searches_omega,
     spec_of,
 )
 
@@ -210,16 +210,12 @@ def fit(
     from physgs.train.seeding import seed_everything
 
     job = Job.from_dict(job) if isinstance(job, dict) else job
-    spec_of(job.model)  # unknown ids raise, naming the valid ones
-    if truth is not None and not is_reference(job.model):
-        raise ValueError(
-            f"model {job.model!r} is a method: its training may not read the ground "
-            "truth (truth.npz); only references (truth_motion) do"
-        )
-    _check_precision(job)
+    spec = spec_of(job.model)  # the job's one look-up: an unknown id raises, naming the valid ones
+    check_precision_supported(job.settings, families=(spec.family,))
     dev = resolve_device(job.train.get("device", "auto")) if device is None else device
     seed_everything(job.seed)
-    # a reference without a truth raises here, saying it needs truth.npz
+    # build_model checks the rest: the configuration, a truth given to a method (refused) or
+    # missing for a reference (it says it needs truth.npz)
     model = build_model(
         job.model,
         observed,
@@ -227,7 +223,7 @@ def fit(
         config=job.config,
         K=job.K,
         seed=job.seed,
-        truth=truth if is_reference(job.model) else None,
+        truth=truth,
     )
     conds = condition_indices(job.conditions, len(observed.conditions))
     every = int(job.train.get("holdout_every", 0))
@@ -249,7 +245,7 @@ def fit(
         earliest_stop=earliest_stop(job),
         device=dev,
     )
-    if is_prior(job.model):
+    if spec.role == "prior":
         result.stats["frozen_parts"] = int(result.model.frozen.sum())
     return result
 
@@ -335,12 +331,7 @@ def training_hooks(observed, job: Job, conditions: list[int]) -> list:
     return [h for h in hooks if h is not None]
 
 
-def _check_precision(job: Job) -> None:
-    """Stop before training a bfloat16 field on a CPU that would emulate bf16."""
-    check_precision_supported(job.settings, families=(spec_of(job.model).family,))
-
-
-def check_precision_supported(settings: dict, families: tuple[str, ...] = ("mlp", "d3dgs")) -> None:
+def check_precision_supported(settings: dict, families: tuple[str, ...] = FIELD_FAMILIES) -> None:
     """Raise RuntimeError if any of ``families`` asks for ``precision: bfloat16`` in the models
     settings ``settings`` and this CPU has no native bf16 (autocast would emulate it, ~48x
     slower than float32: a default run would take days), naming the key and the way out. torch

@@ -19,11 +19,10 @@ __getattr__, __dir__, __all__ = lazy_loader.attach(
             "build_model",
             "configs_for",
             "is_reference",
-            "load_checkpoint",
             "model_settings",
-            "save_checkpoint",
             "training_jobs",
         ],
+        "checkpoint": ["load_checkpoint", "save_checkpoint"],
         "truth_motion": ["TrueMotion", "TruthMotionModel"],
     },
 )

@@ -159,7 +159,7 @@ class CanonicalGaussians(nn.Module):
             color: starting grey level, in (0, 1).
             knn: neighbours whose mean distance sets the starting scale; None: no starting
                 scale (every scale 1), for a set whose state a checkpoint then replaces
-                ([`load_checkpoint`][physgs.models.registry.load_checkpoint]), which so needs no
+                ([`load_checkpoint`][physgs.models.checkpoint.load_checkpoint]), which so needs no
                 neighbour search.
             scale_factor: factor on that distance.
 

@@ -1,31 +1,26 @@
-"""Model names, construction from the config, and checkpoints.
+"""Model ids and what each is: the planning data the workflow reads, and the one way to build one.
 
-Two kinds of model id: the methods (``MODELS``, what every table iterates) and the references
-(``REFERENCES``: ``truth_motion``, the ceiling, built from ``truth.npz`` and trained by its own
-workflow rule). ``build_model``, ``model_settings``, ``label``, ``configs_for`` and
-``load_checkpoint`` accept both; ``training_jobs`` lists the methods only.
+Two kinds of model id: the methods (``MODELS``, what every table iterates; ``PRIOR_VARIANTS``,
+the oscillator priors studied beside them) and the references (``REFERENCES``: ``truth_motion``,
+the ceiling, built from ``truth.npz`` and trained by its own workflow rule). Each id's
+[`ModelSpec`][physgs.models.registry.ModelSpec] names its family (``family``: its section under
+``models:``), and [`FAMILIES`][physgs.models.families.FAMILIES] says what that family reads
+(``model_settings``) and builds it (``build_model``). ``build_model``, ``model_settings``,
+``label``, ``configs_for`` and the checkpoints ([`physgs.models.checkpoint`][]) accept every id;
+``training_jobs`` lists the methods only.
 
-A checkpoint (torch.save of plain dicts and tensors, loadable with weights_only=True) holds:
-format, model name, training configuration name, seed, the ``models`` config section, the
-``train`` config section, the ModelContext (canonical positions, fps, frame counts, frozen wind
-statistics), the state dict and the training statistics.
-
-The ids and labels import nothing heavy: the workflow reads them to plan jobs. The model classes
-and torch load inside the functions that build, save or read a model.
+The ids, labels and settings import nothing heavy: the workflow reads them to plan jobs. The
+model classes and torch load when a model is built.
 """
 
 from __future__ import annotations
 
 from dataclasses import dataclass
-from pathlib import Path
-
 from typing import TYPE_CHECKING, Iterable
 
 import numpy as np
 
-from physgs.atomic import atomic_path
-from physgs.intermediate import remake_hint
-from physgs.models.omega_search import OmegaSearch
+from physgs.models.families import FAMILIES, Build
 
 if TYPE_CHECKING:  # the model classes load torch (module docstring)
     from physgs.models.base import BaseModel
@@ -46,6 +41,9 @@ class ModelSpec:
     # a forcing-free prior: the prior of ``MODELS`` whose measured wind it replaces (the
     # ledger's anemometer claim compares the two)
     blind_of: str | None = None
+    # the paper's method (ours): the prior the others vary, whose K the K selection's own keys
+    # choose (``PAPER_MODEL``)
+    paper: bool = False
 
 
 #: The roles a model plays in the comparison. A report output (``physgs.report.outputs``) declares
@@ -63,7 +61,7 @@ MODELS: dict[str, ModelSpec] = {
     "mlp_wind": ModelSpec("Deformation MLP + wind", r"+\,wind", "mlp", True, "field"),
     "d3dgs": ModelSpec("Deformable-3DGS", "no wind", "d3dgs", False, "field"),
     "d3dgs_wind": ModelSpec("Deformable-3DGS + wind", r"+\,wind", "d3dgs", True, "field"),
-    "ours": ModelSpec("Ours", "Ours", "ours", True, "prior"),
+    "ours": ModelSpec("Ours", "Ours", "ours", True, "prior", paper=True),
     # this project's prior, not the paper's : parts cut along the tree, each
     # part's transform composed with its parent's, omega searched before the descent
     "ours_chain": ModelSpec(
@@ -77,6 +75,8 @@ MODELS: dict[str, ModelSpec] = {
     ),
 }
 MODEL_NAMES = tuple(MODELS)
+#: the paper's method (``ModelSpec.paper``): the prior every other prior varies
+PAPER_MODEL = next(m for m, s in MODELS.items() if s.paper)
 #: Variants of the oscillator prior studied beside ours in tab_parts only:
 #: topology-aware parts (physgs.models.topology) without the chain. Ids of their own, not
 #: options of ``ours``, so one run can train them side by side under one recipe (``job_spec``/
@@ -144,12 +144,12 @@ def models_of(*roles: str) -> tuple[str, ...]:
     return tuple(m for m, s in (*MODELS.items(), *REFERENCES.items()) if s.role in roles)
 
 
-FIELDS = ("mlp", "d3dgs")  # learned deformation-field architectures
+#: the learned deformation-field architectures: the families of the ``field`` models
+FIELD_FAMILIES = tuple(dict.fromkeys(s.family for s in MODELS.values() if s.role == "field"))
 #: Every model is trained in this configuration; the priors also in every other one of the config.
 BASE_CONFIG = "single"
 #: the one configuration the forcing-free priors (``BLIND_PRIORS``) are trained in
 BLIND_CONFIG = BASE_CONFIG
-FORMAT = "physgs-model-v2"
 #: Ours with K chosen from the data (physgs.experiments.kselect); its K is passed explicitly.
 AUTO_CONFIG = "auto"
 
@@ -355,7 +355,7 @@ def is_prior(model: str) -> bool:
     Raises:
         ValueError: for an unknown id.
     """
-    return spec_of(model).family == "ours"
+    return spec_of(model).role == "prior"
 
 
 def label(model: str) -> str:
@@ -449,61 +449,19 @@ def model_settings(models_cfg: dict, model: str) -> dict:
         model: a model id.
 
     Returns:
-        ``canonical`` and, as the model needs them, its family's section (its own
-            ``time_top_hz`` only), ``topology``, ``blind``, ``omega_search`` (its own entry) and
-            ``wind_window``.
+        ``canonical`` and what its family reads (``Family.settings``): a field's section with its
+            own ``time_top_hz`` only and the ``wind_window`` when it reads the wind; a prior's
+            section, ``topology``, ``blind`` and ``omega_search`` (its own entry) as it needs
+            them; nothing more for the static pose and the references.
 
     Raises:
         ValueError: for an unknown id.
     """
     spec = spec_of(model)
-    out = {"canonical": models_cfg["canonical"]}
-    if spec.family in REFERENCES:  # the canonical set only: the motion comes from truth.npz
-        return out
-    if spec.family != "static":
-        out[spec.family] = models_cfg[spec.family]
-    if spec.family in FIELDS:  # its own time scale only: a sibling field's edit leaves it alone
-        section = models_cfg[spec.family]
-        out[spec.family] = {**section, "time_top_hz": {model: section["time_top_hz"][model]}}
-    if spec.parts == "topology":
-        out["topology"] = models_cfg["topology"]
-    if spec.forcing == "learned":
-        out["blind"] = models_cfg["blind"]
-    if searches_omega(models_cfg, model):  # its own entry only: another model's leaves it alone
-        out["omega_search"] = {**models_cfg["omega_search"], "models": [model]}
-    if spec.wind and spec.family in FIELDS:
-        out["wind_window"] = models_cfg["wind_window"]
-    return out
-
-
-def searches_omega(models_cfg: dict, model: str) -> bool:
-    """Whether ``model`` starts with the search over omega (``models.omega_search.models``;
-    [`physgs.models.omega_search`][]).
-
-    Args:
-        models_cfg: the ``models`` config section.
-        model: a model id.
-
-    Returns:
-        True when ``model`` is listed there.
-    """
-    return model in (models_cfg.get("omega_search") or {}).get("models", ())
-
-
-def canonical_pose_of(topology_cfg: dict) -> str:
-    """``models.topology.canonical_pose`` of a (possibly older) topology section: checkpoints
-    written before the key existed carry ``from_frame0`` (true: ``frame0_angles``) or neither
-    (``rest``).
-
-    Args:
-        topology_cfg: a ``models.topology`` section.
-
-    Returns:
-        ``'rest'``, ``'frame0_angles'`` or the section's own value.
-    """
-    if "canonical_pose" in topology_cfg:
-        return str(topology_cfg["canonical_pose"])
-    return "frame0_angles" if topology_cfg.get("from_frame0", False) else "rest"
+    return {
+        "canonical": models_cfg["canonical"],
+        **FAMILIES[spec.family].settings(models_cfg, model, spec),
+    }
 
 
 def build_model(
@@ -518,7 +476,7 @@ def build_model(
     parent: np.ndarray | None = None,
     truth=None,
 ) -> BaseModel:
-    """A freshly initialised model.
+    """A freshly initialised model, built by its family (``FAMILIES[spec.family].build``).
 
     A method given a truth raises (methods never read it).
 
@@ -548,19 +506,16 @@ def build_model(
             not have when K is not given, or a learned-forcing prior listed for the search over
             omega.
     """
-    # here: the model classes load torch, and the workflow plans with this module (docstring)
+    # here: the context loads torch, and the workflow plans with this module (docstring)
     from physgs.models.base import ModelContext, context_from_observed
-    from physgs.models.fields import FieldModel
-    from physgs.models.ours import OscillatorPrior
-    from physgs.models.static import StaticModel
-    from physgs.models.truth_motion import TrueMotion, TruthMotionModel
 
-    if not is_prior(name) and config != BASE_CONFIG:
+    spec = spec_of(name)
+    if spec.role != "prior" and config != BASE_CONFIG:
         raise ValueError(
             f"model {name!r} is not trained in configuration {config!r}; valid: "
             f"('{BASE_CONFIG}',) (joint configurations are ours only)"
         )
-    if truth is not None and not is_reference(name):
+    if truth is not None and spec.role != "reference":
         raise ValueError(
             f"model {name!r} is a method: it may not read the ground truth "
             f"(truth.npz); only the references {REFERENCE_NAMES} do"
@@ -568,226 +523,20 @@ def build_model(
     ctx = (  # a prior with a learned forcing never looks at the observed wind
         observed
         if isinstance(observed, ModelContext)
-        else context_from_observed(observed, wind=spec_of(name).forcing == "wind")
+        else context_from_observed(observed, wind=spec.forcing == "wind")
     )
-    canon = dict(cfg["canonical"])
-    if is_reference(name):
-        if truth is None:
-            raise ValueError(
-                f"the reference {name!r} moves the Gaussians by the ground truth: it "
-                "needs the dataset's truth.npz (pass truth=load_truth(<tree>/"
-                "truth.npz)); the dataset has no truth file or none was given"
-            )
-        if not isinstance(truth, TrueMotion):
-            if isinstance(observed, ModelContext):
-                raise ValueError(
-                    f"building {name!r} from truth.npz needs the Observed dataset "
-                    "(its per-condition winds), not a ModelContext"
-                )
-            truth = TrueMotion.from_truth(truth, observed)
-        return TruthMotionModel(ctx, canon, truth)
-    family = spec_of(name).family
-    if family == "static":
-        return StaticModel(ctx, canon)
-    if family in FIELDS:
-        a = cfg[family]
-        ww = cfg["wind_window"] if MODELS[name].wind else {"seconds": None, "values": None}
-        return FieldModel(
-            ctx,
-            canon,
-            arch=family,
-            pos_bands=a["pos_bands"],
-            time_bands=a["time_bands"],
-            depth=a["depth"],
-            width=a["width"],
-            skip=a.get("skip"),
-            wind=MODELS[name].wind,
-            window_seconds=ww["seconds"],
-            window_values=ww["values"],
-            name=name,
-            precision=a.get("precision", "float32"),
-            time_top_hz=a["time_top_hz"][name],
-        )
-    if K is None:
-        spec = cfg.get("configs", {}).get(config)
-        if spec is None:
-            raise ValueError(
-                f"ours has no configuration {config!r} and no K was given; valid: "
-                f"{sorted(cfg.get('configs', {}))}"
-            )
-        K = spec["K"]
-    o = cfg["ours"]
-    spec = spec_of(name)
-    options = {}
-    if searches_omega(cfg, name):
-        options["search"] = OmegaSearch.from_config(cfg["omega_search"])
-    if spec.parts == "topology":
-        t = cfg["topology"]
-        options.update(
-            segmentation="topology",
-            knn=int(t["knn"]),
-            parent=parent,
-            canonical_pose=canonical_pose_of(t),
-        )
-    if spec.forcing == "learned":
-        from physgs.models.blind import BlindOscillatorPrior  # here: torch, as above
-
-        if options.get("search") is not None:
-            raise ValueError(f"{name} has no search over omega: remove it from models/omega_search")
-        cls = BlindOscillatorPrior
-        options["forcing_hz"] = float(cfg["blind"]["forcing_hz"])
-    else:
-        cls = OscillatorPrior
-    return cls(
+    request = Build(
+        name,
+        spec,
         ctx,
-        canon,
-        K=int(K),
-        omega_hz=o["omega_hz"],
-        zeta=o["zeta"],
-        omega_init_hz=o["omega_init_hz"],
-        zeta_init=o["zeta_init"],
-        substeps=o["substeps"],
-        rk4_guard=o["rk4_guard"],
-        kmeans_n_init=o["kmeans_n_init"],
-        seed=seed,
-        labels=labels,
-        chain=spec.chain,
-        **options,
-    )
-
-
-def save_checkpoint(
-    path,
-    model: BaseModel,
-    *,
-    name: str,
-    config: str,
-    seed: int,
-    models_cfg: dict,
-    train_cfg: dict,
-    stats: dict,
-) -> None:
-    """Write the checkpoint atomically (temporary file in the same folder, then rename).
-
-    Args:
-        path (str | Path): the ``.pt`` file.
-        model: the trained model.
-        name: its model id.
-        config: its training configuration name.
-        seed: its training seed.
-        models_cfg: the settings the model was built from
-            ([`model_settings`][physgs.models.registry.model_settings] or the whole ``models``
-            section); ours' K is read off the model, so any configuration name reloads.
-        train_cfg: the ``train`` config section it was trained with.
-        stats: the training statistics.
-    """
-    import torch  # here: the workflow plans with this module (module docstring)
-
-    path = Path(path)
-    path.parent.mkdir(parents=True, exist_ok=True)
-    blob = {
-        "format": FORMAT,
-        "model": name,
-        "config": config,
-        "seed": int(seed),
-        "K": int(model.K) if hasattr(model, "K") else None,
-        "models_cfg": models_cfg,
-        "train_cfg": train_cfg,
-        "context": model.ctx.to_dict(),
-        "state_dict": _device_free(model.state_dict()),
-        "stats": stats,
-    }
-    with atomic_path(path) as tmp:
-        torch.save(blob, tmp)
-
-
-def _device_free(sd):
-    """``sd`` with its tensors on the CPU, so a model trained on a GPU reloads on any machine
-    (``read_checkpoint`` maps to the CPU); a CPU model's state is returned as it is, so its file
-    stays byte for byte what it was."""
-    if all(v.device.type == "cpu" for v in sd.values()):
-        return sd
-    out = type(sd)((k, v.cpu()) for k, v in sd.items())
-    out._metadata = getattr(sd, "_metadata", None)  # the modules' versions load_state_dict reads
-    return out
-
-
-def read_checkpoint(path) -> dict:
-    """The raw checkpoint dict; clear errors for a missing or corrupt file.
-
-    Args:
-        path (str | Path): the ``.pt`` file.
-
-    Returns:
-        The checkpoint's dict (loaded on the CPU, ``weights_only``).
-
-    Raises:
-        FileNotFoundError: when there is no file.
-        ValueError: when it does not unpickle or is not a checkpoint of this format.
-    """
-    import torch  # here: the workflow plans with this module (module docstring)
-
-    path = Path(path)
-    if not path.is_file():
-        raise FileNotFoundError(
-            f"no checkpoint at {path}; train it first (snakemake --cores 2 {path})"
-        )
-    try:
-        blob = torch.load(path, map_location="cpu", weights_only=True)
-    except Exception as e:  # noqa: BLE001 - any unpickling failure means a corrupt file
-        raise ValueError(
-            f"checkpoint {path} is corrupt or not a physgs checkpoint ({e}); to retrain it "
-            f"{remake_hint(path).removeprefix('to remake it ')}"
-        ) from None
-    if not isinstance(blob, dict) or blob.get("format") != FORMAT:
-        raise ValueError(
-            f"{path} is not a {FORMAT} checkpoint; to retrain it "
-            f"{remake_hint(path).removeprefix('to remake it ')}"
-        )
-    return blob
-
-
-def load_checkpoint(path) -> BaseModel:
-    """Rebuild the trained model (eval mode) from a checkpoint written by save_checkpoint.
-
-    The returned model also carries ``checkpoint_info`` (name, config, seed, stats, cfgs).
-
-    Args:
-        path (str | Path): the ``.pt`` file.
-
-    Returns:
-        The model in eval mode, its state loaded strictly.
-
-    Raises:
-        FileNotFoundError: when there is no file.
-        ValueError: for a corrupt checkpoint.
-    """
-    # here: torch, as in build_model
-    from physgs.models.base import ModelContext
-    from physgs.models.truth_motion import TrueMotion
-
-    blob = read_checkpoint(path)
-    sd = blob["state_dict"]
-    labels = sd["part_labels"].numpy() if "part_labels" in sd else None
-    parent = sd["part_parent"].numpy() if "part_parent" in sd else None
-    # a reference's motion is in its own buffers: no truth.npz needed to reload it
-    motion = TrueMotion.from_state_dict(sd) if is_reference(blob["model"]) else None
-    # the checkpoint's state replaces the starting scales: no neighbour search (nor scipy)
-    cfg = {**blob["models_cfg"], "canonical": {**blob["models_cfg"]["canonical"], "knn": None}}
-    model = build_model(
-        blob["model"],
-        ModelContext.from_dict(blob["context"]),
+        dict(cfg["canonical"]),
         cfg,
-        config=blob["config"],
-        K=blob["K"],
-        seed=blob["seed"],
-        labels=labels,
-        parent=parent,
-        truth=motion,
+        observed,
+        config,
+        K,
+        seed,
+        labels,
+        parent,
+        truth,
     )
-    model.load_state_dict(sd, strict=True)
-    model.eval()
-    model.checkpoint_info = {
-        k: blob[k] for k in ("model", "config", "seed", "stats", "models_cfg", "train_cfg")
-    }
-    return model
+    return FAMILIES[spec.family].build(request)

@@ -14,11 +14,9 @@ initialisation, RK4 substeps and guard) and ``train.lr.physics`` (Adam's rate on
 
 from __future__ import annotations
 
+from physgs.models.families import OSCILLATOR_KEYS
 from physgs.models.registry import SAME_K, condition_indices, configs_for, section_k
 from physgs.testbed.variant import FAITHFUL, parse_id
-
-#: ours' settings the oscillator fit reads (``physgs.tracks.fit.Oscillators.from_config``)
-OURS_KEYS = ("omega_hz", "zeta", "omega_init_hz", "zeta_init", "substeps", "rk4_guard")
 
 
 def tracker_settings(cfg: dict) -> dict:
@@ -100,5 +98,6 @@ def fit_job(cfg: dict, config: str, seed: int) -> dict:
         "min_tracks": int(tr["min_tracks"]),
         "kmeans_n_init": int(tr["kmeans_n_init"]),
         "seed": int(seed),
-        "ours": {k: cfg["models"]["ours"][k] for k in OURS_KEYS},
+        # ours' oscillator settings, what the fit reads (``Oscillators.from_config``)
+        "ours": {k: cfg["models"]["ours"][k] for k in OSCILLATOR_KEYS},
     }
