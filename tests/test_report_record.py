@@ -137,7 +137,10 @@ def test_write_record_copies_every_table_as_csv_and_summarises_it_over_seeds(tmp
     # the figures first, then the ledger, then the tables, then the run
     heads = [ln for ln in index.splitlines() if ln.startswith("## ")]
     assert heads == ["## Figures", "## The paper against the measured", "## Tables", "## The run"]
-    assert "4 claims: 2 hold, 1 fail, 1 undecided" in index and "(ledger.md)" in index
+    assert (
+        "4 claims: 3 findings (2 hold, 1 fail), 1 premise (1 undecided)" in index
+        and "(ledger.md)" in index
+    )
     stamp = json.loads((out / "stamp.json").read_text())
     assert stamp["seeds"] == [0, 1] and stamp["wall_s"] == 11285.0
     assert "3 h 8 min" in (out / "stamp.md").read_text()
@@ -205,6 +208,7 @@ def test_the_committed_record_re_renders_from_its_own_files(tmp_path):
 
     copy = tmp_path / "record"
     shutil.copytree(RECORD, copy)
+    assert not record.derive_claims(copy)  # the committed ledger has every derived column
     record.render_pages(copy)
     for page in (
         "index.md",
@@ -216,6 +220,27 @@ def test_the_committed_record_re_renders_from_its_own_files(tmp_path):
         assert (copy / page).read_text() == (RECORD / page).read_text(), (
             f"docs/record/{page} is stale: run `python tools/record.py --pages-only`"
         )
+
+
+def test_a_ledger_gains_its_kind_from_the_catalogue_and_keeps_every_number(tmp_path):
+    """A record written before the kind column gains it from its ids; nothing else moves, and
+    its claims.md is the claims rule's printer's (the committed one, kind and counts aside)."""
+    import shutil
+
+    copy = tmp_path / "record"
+    shutil.copytree(RECORD, copy)
+    committed = pd.read_csv(RECORD / "claims.csv", dtype=str, keep_default_na=False)
+    committed.drop(columns="kind").to_csv(copy / "claims.csv", index=False)
+    (copy / "claims.md").write_text("stale")
+    written = record.derive_claims(copy)
+    assert set(written) == {copy / "claims.csv", copy / "claims.md"}
+    again = pd.read_csv(copy / "claims.csv", dtype=str, keep_default_na=False)
+    pd.testing.assert_frame_equal(again, committed)  # text for text, kind where it was
+    premises = set(again.loc[again["kind"] == "premise", "id"].str.split("/").str[0])
+    assert premises == {"fits_window", "nearest_bone_gap"}
+    assert set(again["kind"]) == {"premise", "finding"}
+    assert (copy / "claims.md").read_text() == (RECORD / "claims.md").read_text()
+    assert not record.derive_claims(copy)  # once is enough
 
 
 def test_a_stamp_names_a_plain_commit_and_keeps_its_note_apart():
@@ -278,6 +303,38 @@ def test_a_missing_input_is_named_and_what_no_run_makes_outlives_a_new_record(tm
     assert not (out / "from_the_old_run.md").exists()
 
 
+def test_premises_are_counted_apart_and_a_failed_one_says_what_it_undermines():
+    claims = pd.DataFrame(
+        {
+            "id": [
+                "ours_above_static_beyond/sparse",
+                "fits_window/sparse/mlp",
+                "fits_window/dense/mlp",
+                "nearest_bone_gap/sparse",
+                "fits_window/dense/ours_chain",
+            ],
+            "measured": [1.99, 0.05, 0.1, 0.01, 0.6],
+            "ci_low": [1.2, 0.03, 0.08, np.nan, 0.55],
+            "ci_high": [2.77, 0.07, 0.12, np.nan, 0.65],
+            "unit": ["dB", "fraction", "fraction", "fraction", "fraction"],
+            "verdict": ["holds", "fails", "fails", "holds", "holds"],
+            "origin": ["paper", "paper", "paper", "paper", "project"],
+        }
+    )  # no kind column: a ledger written before it takes the kind from the catalogue
+    lines = record.headline_lines(claims)
+    assert lines[0].startswith(
+        "- **The paper's 4 claims: 1 finding (1 hold), 3 premises (1 hold, 2 fail)**; this "
+        "project's own 1 claim: 1 premise (1 hold)"
+    )
+    assert lines[1].startswith("- **Premises that fail**: the premise `fits_window` fails on ")
+    assert (
+        "sparse (mlp), dense (mlp): this undermines every comparison that model enters" in lines[1]
+    )
+    assert "nearest_bone_gap" not in lines[1]  # it holds
+    written = claims.assign(kind="finding")  # a written column is read, not the catalogue's
+    assert "premise" not in record.count_line(written).split("(95%")[0]
+
+
 def test_headline_counts_the_verdicts_and_gives_each_story_claim_its_interval():
     claims = pd.DataFrame(
         {
@@ -292,8 +349,8 @@ def test_headline_counts_the_verdicts_and_gives_each_story_claim_its_interval():
     )
     lines = record.headline_lines(claims)
     # the paper's claims counted apart from this project's, the paper's first
-    assert "The paper's 2 claims: 1 hold, 1 fail, 0 undecided" in lines[0]
-    assert "this project's own 2: 1 hold, 0 fail, 1 undecided" in lines[0]
+    assert "The paper's 2 claims: 2 findings (1 hold, 1 fail)" in lines[0]
+    assert "this project's own 2 claims: 2 findings (1 hold, 1 undecided)" in lines[0]
     # whether the paper's story stands, from its headline families' verdicts
     assert "stands in part**: 1 of its 2 headline claims hold" in lines[1]
     assert "fails on ours beats the untrained null by the paper's factor" in lines[1]

@@ -32,7 +32,7 @@ import pandas as pd
 from PIL import Image
 
 from physgs.experiments import cost
-from physgs.report import captions, catalogue, rerun
+from physgs.report import captions, catalogue, claims as ledger, rerun
 
 #: The commands whose cost the README states, keyed as ``tools/timed.py --name`` records them.
 COMMANDS: tuple[tuple[str, str], ...] = (
@@ -605,6 +605,45 @@ def summary_markdown(df: pd.DataFrame) -> str:
     )
 
 
+#: The ledger's columns the catalogue derives from a claim's id: a record written before one of
+#: them gains it from its own ids (``derive_claims``), placed after the column named.
+DERIVED_COLUMNS = {"kind": "origin"}
+
+
+def derive_claims(record_dir: str | Path) -> list[Path]:
+    """Give a record's ledger the columns the catalogue derives from its ids that it lacks
+    (``DERIVED_COLUMNS``: ``kind``), and print its ``claims.md`` again from that ``claims.csv``
+    (``claims.ledger_markdown``, the claims rule's own printer, with the CSV's stamp columns:
+    on a ledger of today's columns it prints the run's ``claims.md`` as the run did). No number
+    is touched: the CSV is read and written back as text.
+
+    Args:
+        record_dir: the record folder (``claims.csv``).
+
+    Returns:
+        The files that changed; none when the ledger and its page are up to date.
+    """
+    out = Path(record_dir)
+    path, page = out / "claims.csv", out / "claims.md"
+    written = []
+    text = pd.read_csv(path, dtype=str, keep_default_na=False)
+    missing = [c for c in DERIVED_COLUMNS if c not in text.columns]
+    for name in missing:
+        after = DERIVED_COLUMNS[name]
+        at = text.columns.get_loc(after) + 1 if after in text else len(text.columns)
+        text.insert(at, name, ledger.column(text, name))
+    if missing:
+        text.to_csv(path, index=False)
+        written.append(path)
+    df = pd.read_csv(path, dtype={"config_hash": str})
+    stamp = {c: str(df[c].iloc[0]) for c in STAMP_COLUMNS if c in df and len(df)}
+    printed = demote(ledger.ledger_markdown(df, stamp or None))
+    if not page.is_file() or page.read_text() != printed:
+        page.write_text(printed)
+        written.append(page)
+    return written
+
+
 def render_pages(record_dir: str | Path) -> list[Path]:
     """Lay out the record's pages from its own files: the Results page's parts.
 
@@ -722,15 +761,14 @@ def ledger_lines(claims_csv: str | Path) -> list[str]:
         The Markdown lines.
     """
     claims = pd.read_csv(claims_csv, dtype={"config_hash": str})
-    kind = claims["verdict"].astype(str).str.split(":").str[0]
-    origin = origins(claims)
-    paper, own = kind[origin == "paper"], kind[origin == "project"]
-    story = story_line(claims)
+    story, premise = story_line(claims), premise_line(claims)
     return [
-        f"The ledger holds the paper's {len(paper)} claims: {_counted(paper)}; and this "
-        f"project's own {len(own)}: {_counted(own)} (95% intervals over seeds). Each claim with "
-        "the paper's value beside the measured one, its threshold, verdict and the table cells "
-        "it comes from: [the paper against the measured](ledger.md).",
+        f"The ledger holds the paper's {ledger.counted(claims, 'paper')}; and this project's own "
+        f"{ledger.counted(claims, 'project')} (95% intervals over seeds; a premise is what the "
+        "comparison rests on, a finding what it says). Each claim with the paper's value beside "
+        "the measured one, its verdict and the table cells it comes from: "
+        "[the paper against the measured](ledger.md).",
+        *(["", premise[2:]] if premise else []),
         *(["", story[2:]] if story else []),
     ]
 
@@ -764,34 +802,38 @@ def origins(claims: pd.DataFrame) -> pd.Series:
     Returns:
         One origin per row.
     """
-    if "origin" in claims.columns:
-        return claims["origin"].astype(str)
-    return claims["id"].astype(str).map(catalogue.origin_of)
-
-
-def _counted(kind: pd.Series) -> str:
-    c = kind.value_counts()
-    return (
-        f"{int(c.get('holds', 0))} hold, {int(c.get('fails', 0))} fail, "
-        f"{int(c.get('undecided', 0))} undecided"
-    )
+    return ledger.column(claims, "origin")
 
 
 def count_line(claims: pd.DataFrame) -> str:
-    """The ledger's counts, the paper's claims first and this project's apart.
+    """The ledger's counts, the paper's claims first and this project's apart, each with its
+    findings apart from the premises of the comparison (``claims.counted``).
 
     Args:
-        claims: the ledger (``id``, ``verdict``; ``origin`` where written).
+        claims: the ledger (``id``, ``verdict``; ``origin``, ``kind`` where written).
 
     Returns:
         One Markdown bullet.
     """
-    kind = claims["verdict"].astype(str).str.split(":").str[0]
-    origin = origins(claims)
-    paper, own = kind[origin == "paper"], kind[origin == "project"]
     return (
-        f"- **The paper's {len(paper)} claims: {_counted(paper)}**; this project's own "
-        f"{len(own)}: {_counted(own)} (95% intervals over seeds)."
+        f"- **The paper's {ledger.counted(claims, 'paper')}**; this project's own "
+        f"{ledger.counted(claims, 'project')} (95% intervals over seeds; a *premise* is what the "
+        "comparison rests on, a *finding* what it says)."
+    )
+
+
+def premise_line(claims: pd.DataFrame) -> str:
+    """The premises that fail and what each undermines (``claims.failed_premises``).
+
+    Args:
+        claims: the ledger.
+
+    Returns:
+        One Markdown bullet; "" when every premise holds.
+    """
+    failed = ledger.failed_premises(claims)
+    return (
+        f"- **Premises that fail**: {'; '.join(f.rstrip('.') for f in failed)}." if failed else ""
     )
 
 
@@ -849,7 +891,8 @@ def headline_lines(claims: pd.DataFrame) -> list[str]:
     """
     kind = claims["verdict"].astype(str).str.split(":").str[0]
     story = story_line(claims)
-    lines = [count_line(claims), *([story] if story else [])]
+    premise = premise_line(claims)
+    lines = [count_line(claims), *([premise] if premise else []), *([story] if story else [])]
     for fam, words, _ in catalogue.headline():
         rows = _family_rows(claims, fam)
         if rows.empty:
