@@ -213,6 +213,7 @@ def test_the_committed_record_re_renders_from_its_own_files(tmp_path):
     for page in (
         "index.md",
         "figures.md",
+        "ledger.md",
         "tables.md",
         "stamp.md",
         *(f"tables/{t.stem}.md" for t in RECORD.glob("tables/*.csv")),
@@ -220,6 +221,60 @@ def test_the_committed_record_re_renders_from_its_own_files(tmp_path):
         assert (copy / page).read_text() == (RECORD / page).read_text(), (
             f"docs/record/{page} is stale: run `python tools/record.py --pages-only`"
         )
+
+
+def test_the_ledger_page_puts_the_papers_claims_first_one_row_each_filterable():
+    from html.parser import HTMLParser
+
+    claims = pd.read_csv(RECORD / "claims.csv", dtype={"config_hash": str})
+    page = record.ledger_page(RECORD / "claims.csv", ("sparse", "medium", "dense"))
+
+    class Rows(HTMLParser):
+        def __init__(self):
+            super().__init__()
+            self.rows, self.cells, self.cell = [], [], None
+
+        def handle_starttag(self, tag, attrs):
+            if tag == "tr" and dict(attrs).get("data-origin"):
+                self.rows.append(dict(attrs))
+                self.cells.append([])
+            elif tag == "td":
+                self.cell = ""
+
+        def handle_data(self, data):
+            if self.cell is not None:
+                self.cell += data
+
+        def handle_endtag(self, tag):
+            if tag == "td":
+                self.cells[-1].append(self.cell)
+                self.cell = None
+
+    p = Rows()
+    p.feed(page)
+    assert len(p.rows) == len(claims)
+    origins = [r["data-origin"] for r in p.rows]
+    n_paper = int((claims["origin"] == "paper").sum())
+    assert origins == ["paper"] * n_paper + ["project"] * (len(claims) - n_paper)
+    by_id = {r["id"]: (r, c) for r, c in zip(p.rows, p.cells)}
+    row, cells = by_id["claim-fits-window-dense-mlp"]
+    want = claims.set_index("id").loc["fits_window/dense/mlp"]
+    assert (row["data-verdict"], row["data-tree"], row["data-kind"]) == (
+        want["verdict"],
+        "dense",
+        "premise",
+    )
+    assert cells[1:] == [
+        "dense",
+        want["paper"],
+        f"{want['measured']:+.3g} [{want['ci_low']:+.3g}, {want['ci_high']:+.3g}] fraction",
+        want["verdict"],
+        "premise",
+        "paper",
+    ]
+    assert want["claim"] in cells[0] and want["source"] in cells[0]  # one click away
+    assert "if it fails, it undermines every comparison that model enters" in cells[0]
+    assert f'class="verdict-{want["verdict"]}"' in page.split('id="claim-fits-window-dense-mlp"')[1]
 
 
 def test_a_ledger_gains_its_kind_from_the_catalogue_and_keeps_every_number(tmp_path):

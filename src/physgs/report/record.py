@@ -19,6 +19,7 @@ Pure over paths: every function takes the files it reads and the folder it write
 
 from __future__ import annotations
 
+import html
 import json
 import math
 import re
@@ -50,6 +51,9 @@ VALUE_COLUMNS_SHOWN = 4
 #: Lines of a summary (its rows times its parts) up to which it shows open on the Results page;
 #: a longer one is folded, its heading and CSV link still shown.
 OPEN_TABLE_ROWS = 30
+#: Tables shown open whatever their length: the fit bar (the premise every comparison rests on)
+#: and the null control's (the table the README points a reviewer to).
+OPEN_TABLES = ("tab_fit", "tab_null")
 #: Columns every table carries that the record's stamp already states.
 STAMP_COLUMNS = ("profile", "config_hash", "physgs_version")
 #: Cells moved beyond their row's seed spread that the record lists, largest first.
@@ -685,7 +689,7 @@ def render_pages(record_dir: str | Path) -> list[Path]:
         )
         lines = len(summary) * (text.count("\n\n") + 1)  # rows of all its parts
         # a long summary folds away (Material's collapsible block), a short one shows open
-        fold = "???+" if lines <= OPEN_TABLE_ROWS else "???"
+        fold = "???+" if lines <= OPEN_TABLE_ROWS or t.stem in OPEN_TABLES else "???"
         index += [
             f"### `{t.stem}`",
             "",
@@ -707,6 +711,7 @@ def render_pages(record_dir: str | Path) -> list[Path]:
             "",
         ]
     put("figures.md", "\n".join(gallery))
+    put("ledger.md", ledger_page(out / "claims.csv", stamp.trees))
     put(
         "index.md",
         "\n".join(
@@ -748,6 +753,106 @@ def render_pages(record_dir: str | Path) -> list[Path]:
         ),
     )
     return written
+
+
+def _value_text(r: pd.Series) -> str:
+    """A ledger row's measured mean and 95% interval, ``+2.26 [+1.94, +2.57] dB`` (``--``
+    unmeasured, the value alone where one value gives no interval)."""
+    if not math.isfinite(r["measured"]):
+        return "--"
+    if math.isfinite(r["ci_low"]):
+        return f"{r['measured']:+.3g} [{r['ci_low']:+.3g}, {r['ci_high']:+.3g}] {r['unit']}"
+    return f"{r['measured']:+.3g} {r['unit']} (one value)"
+
+
+def _tree_and_claim(text: str, trees: Sequence[str]) -> tuple[str, str]:
+    """A claim's sentence as its tree and the rest (``sparse: ours is ...`` -> ``sparse``,
+    ``ours is ...``); no tree where the sentence does not start with one."""
+    for t in trees:
+        if text.startswith(t) and text[len(t) : len(t) + 1] in (":", ",", " "):
+            return t, text[len(t) :].lstrip(":, ")
+    return "", text
+
+
+def ledger_page(claims_csv: str | Path, trees: Sequence[str]) -> str:
+    """The ledger page's table (``docs/ledger.md`` includes it): one compact row per claim, the
+    paper's claims first, each with its tree, the paper's value, the measured mean and 95%
+    interval, the verdict (coloured by ``docs/stylesheets/ledger.css``) and its kind; the full
+    sentence, the threshold, the table cells it comes from and, for a premise, what its failure
+    undermines, one click away (the row's ``<details>``). Each row carries its origin, verdict,
+    tree and kind as data attributes, which ``docs/javascripts/ledger.js`` filters by.
+
+    Args:
+        claims_csv: the record's ``claims.csv``.
+        trees: the run's trees (a sentence's leading tree becomes the tree column).
+
+    Returns:
+        The page part: raw HTML, ending in a newline.
+    """
+    claims = pd.read_csv(claims_csv, dtype={"config_hash": str})
+    # a ledger of fewer columns (an older or a partial one) shows what it has
+    shown = {"paper": "--", "source": "--", "threshold": "", "unit": "", "seeds": 0}
+    shown |= {c: np.nan for c in ("measured", "ci_low", "ci_high")}
+    claims = claims.assign(**{c: v for c, v in shown.items() if c not in claims})
+    if "claim" not in claims:
+        claims["claim"] = claims["id"]
+    claims = claims.assign(
+        _origin=ledger.column(claims, "origin"),
+        _kind=ledger.column(claims, "kind"),
+        _verdict=claims["verdict"].astype(str).str.split(":").str[0],
+    )
+    order = {o: i for i, o in enumerate(catalogue.ORIGINS)}  # the paper's first
+    claims = claims.iloc[claims["_origin"].map(order).argsort(kind="stable")]
+    e = html.escape
+    rows = []
+    for _, r in claims.iterrows():
+        tree, short = _tree_and_claim(str(r["claim"]), trees)
+        more = [
+            f"<b>{e(str(r['claim']))}</b>",
+            f"id <code>{e(str(r['id']))}</code>; {e(r['_origin'])}'s {r['_kind']}",
+            f"holds when the value is {e(str(r['threshold']))} {e(str(r['unit']))}; "
+            f"{int(r['seeds'])} seed{'s' if int(r['seeds']) != 1 else ''}",
+            f"from {e(str(r['source']))}",
+        ]
+        if str(r["verdict"]) != r["_verdict"]:
+            more.append(e(str(r["verdict"])))
+        if ledger.decide_cell(r):
+            more.append(f"seeds that would decide it (est.): {e(ledger.decide_cell(r))}")
+        if r["_kind"] == "premise":
+            more.append(f"if it fails, it undermines {e(catalogue.undermines(str(r['id'])))}")
+        anchor = "claim-" + re.sub(r"[^a-z0-9]+", "-", str(r["id"]).lower()).strip("-")
+        rows.append(
+            f'<tr id="{anchor}" data-origin="{e(r["_origin"])}" data-verdict="{r["_verdict"]}" '
+            f'data-tree="{e(tree or "--")}" data-kind="{r["_kind"]}">'
+            f"<td><details><summary>{e(short)}</summary>{'<br>'.join(more)}</details></td>"
+            f"<td>{e(tree or '--')}</td><td>{e(str(r['paper']))}</td>"
+            f"<td>{e(_value_text(r))}</td>"
+            f'<td class="verdict-{r["_verdict"]}">{r["_verdict"]}</td>'
+            f"<td>{r['_kind']}</td><td>{e(r['_origin'])}</td></tr>"
+        )
+    head = "".join(
+        f"<th>{h}</th>"
+        for h in (
+            "claim (click for the full claim)",
+            "tree",
+            "the paper",
+            "measured: mean [95% interval]",
+            "verdict",
+            "kind",
+            "origin",
+        )
+    )
+    return "\n".join(
+        [
+            '<table class="ledger">',
+            f"<thead><tr>{head}</tr></thead>",
+            "<tbody>",
+            *rows,
+            "</tbody>",
+            "</table>",
+            "",
+        ]
+    )
 
 
 def ledger_lines(claims_csv: str | Path) -> list[str]:
