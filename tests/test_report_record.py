@@ -591,3 +591,24 @@ def test_a_new_record_says_what_moved_against_the_one_it_replaces(tmp_path):
     # the same run recorded again (say, with Snakemake's report) keeps its comparison
     _record(r, out, figures=[], stamp=stamp)
     assert (out / "rerun.md").read_text() == text
+
+
+def test_the_readme_s_first_screen_names_the_ledger_and_each_command_s_cost_from_the_record():
+    """The README's first 25 lines: the ledger linked, each command beside its cost as the
+    record measured it, the paper profile's CPU-hours as its estimate computed them; the home
+    page links the ledger in its first lines."""
+    head = (ROOT / "README.md").read_text().splitlines()[:25]
+    assert any("(docs/ledger.md)" in ln for ln in head)
+    costs = record.read_costs(RECORD / "costs.csv").set_index("name")
+    for name, command in (
+        ("all", "snakemake --cores 2 all`"),
+        ("tests", "`python -m pytest -q`"),
+        ("quick_all", "snakemake --cores 2 all --config profile=quick`"),
+    ):
+        (line,) = [ln for ln in head if command in ln]
+        assert record.format_duration(float(costs.loc[name, "wall_s"])) in line, (name, line)
+    hours = re.search(r"\*\*(\d[\d,]*) CPU-hours\*\*", (RECORD / "paper_estimate.md").read_text())
+    text = " ".join(" ".join(head).split())
+    assert f"{hours.group(1)} CPU-hours" in text and "paper_estimate.md" in text
+    home = [ln for ln in (ROOT / "docs" / "index.md").read_text().splitlines() if ln.strip()]
+    assert any("(ledger.md)" in ln for ln in home[:3])

@@ -277,6 +277,20 @@ def column(claims: pd.DataFrame, name: str) -> pd.Series:
     return claims["id"].astype(str).map({"origin": origin_of, "kind": kind_of}[name])
 
 
+def number(x: float, unit: str) -> str:
+    """A measured value as the ledger prints it: signed (a difference's side of 0 is its news),
+    except a ratio's, which is always positive.
+
+    Args:
+        x: the value.
+        unit: its unit (``RATIO``: unsigned).
+
+    Returns:
+        Three significant digits.
+    """
+    return f"{x:.3g}" if unit == RATIO else f"{x:+.3g}"
+
+
 #: A kind as the counts name it (plural: ``counted``).
 KIND_WORDS = {"finding": ("finding", "findings"), "premise": ("premise", "premises")}
 
@@ -375,9 +389,10 @@ def ledger_markdown(df: pd.DataFrame, stamp: Mapping[str, str] | None = None) ->
     ]
     kinds = column(df, "kind")
     for (_, r), k in zip(df.iterrows(), kinds):
-        meas = "--" if not np.isfinite(r.measured) else f"{r.measured:+.3g} {r.unit}"
+        meas = "--" if not np.isfinite(r.measured) else f"{number(r.measured, r.unit)} {r.unit}"
         if np.isfinite(r.ci_low):
-            meas += f" [{r.ci_low:+.3g}, {r.ci_high:+.3g}], {r.seeds} seeds"
+            lo, hi = number(r.ci_low, r.unit), number(r.ci_high, r.unit)
+            meas += f" [{lo}, {hi}], {r.seeds} seeds"
         elif np.isfinite(r.measured):
             meas += f", {r.seeds} seed"
         lines.append(

@@ -761,8 +761,9 @@ def _value_text(r: pd.Series) -> str:
     if not math.isfinite(r["measured"]):
         return "--"
     if math.isfinite(r["ci_low"]):
-        return f"{r['measured']:+.3g} [{r['ci_low']:+.3g}, {r['ci_high']:+.3g}] {r['unit']}"
-    return f"{r['measured']:+.3g} {r['unit']} (one value)"
+        n = [ledger.number(r[c], r["unit"]) for c in ("measured", "ci_low", "ci_high")]
+        return f"{n[0]} [{n[1]}, {n[2]}] {r['unit']}"
+    return f"{ledger.number(r['measured'], r['unit'])} {r['unit']} (one value)"
 
 
 def _tree_and_claim(text: str, trees: Sequence[str]) -> tuple[str, str]:
@@ -1005,11 +1006,7 @@ def headline_lines(claims: pd.DataFrame) -> list[str]:
         cells = []
         for (_, r), k in zip(rows.iterrows(), kind[rows.index]):
             where = str(r["id"])[len(fam) + 1 :] or "all"
-            value = (
-                f"{r['measured']:+.3g} [{r['ci_low']:+.3g}, {r['ci_high']:+.3g}] {r['unit']}"
-                if math.isfinite(r["ci_low"])
-                else (f"{r['measured']:+.3g} {r['unit']}" if math.isfinite(r["measured"]) else "--")
-            )
+            value = _value_text(r).replace(" (one value)", "")
             cells.append(f"{where} **{k}** ({value.strip()})")
         lines.append(f"- {words[0].upper() + words[1:]}: " + "; ".join(cells) + ".")
     return lines

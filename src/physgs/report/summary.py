@@ -21,7 +21,7 @@ from physgs.experiments.cost import read_costs, summarise, wall_spans
 from physgs.models.registry import label
 from physgs.report.thresholds import FIT_BAR
 from physgs.report.catalogue import AHEAD
-from physgs.report.claims import counted, decide_cell, failed_premises
+from physgs.report.claims import counted, decide_cell, failed_premises, number
 from physgs.report.record import origins, story_line
 from physgs.report.seeds import interval
 
@@ -80,9 +80,13 @@ def claims_section(claims: pd.DataFrame) -> list[str]:
         "|---|---|---|---|---|",
     ]
     for _, r in claims.iterrows():
-        meas = "--" if not np.isfinite(r["measured"]) else f"{r['measured']:+.3g} {r['unit']}"
+        meas = (
+            "--"
+            if not np.isfinite(r["measured"])
+            else f"{number(r['measured'], r['unit'])} {r['unit']}"
+        )
         if np.isfinite(r["ci_low"]):
-            meas += f" [{r['ci_low']:+.3g}, {r['ci_high']:+.3g}]"
+            meas += f" [{number(r['ci_low'], r['unit'])}, {number(r['ci_high'], r['unit'])}]"
         lines.append(
             f"| `{r['id']}` | {meas} | {r['threshold']} | {r['verdict']} | {decide_cell(r)} |"
         )
