@@ -287,8 +287,13 @@ def test_a_ledger_gains_its_kind_from_the_catalogue_and_keeps_every_number(tmp_p
     committed = pd.read_csv(RECORD / "claims.csv", dtype=str, keep_default_na=False)
     committed.drop(columns="kind").to_csv(copy / "claims.csv", index=False)
     (copy / "claims.md").write_text("stale")
+    summary = (RECORD / "summary.md").read_text()
+    a, b = summary.index(record.SUMMARY_CLAIMS), summary.index("### Fit to the training window")
+    (copy / "summary.md").write_text(summary[:a] + "### Claims ledger\n\nstale\n\n" + summary[b:])
     written = record.derive_claims(copy)
-    assert set(written) == {copy / "claims.csv", copy / "claims.md"}
+    assert set(written) == {copy / "claims.csv", copy / "claims.md", copy / "summary.md"}
+    # the claims section printed again, the rest (made from the benchmarks) as it was
+    assert (copy / "summary.md").read_text() == summary
     again = pd.read_csv(copy / "claims.csv", dtype=str, keep_default_na=False)
     pd.testing.assert_frame_equal(again, committed)  # text for text, kind where it was
     premises = set(again.loc[again["kind"] == "premise", "id"].str.split("/").str[0])

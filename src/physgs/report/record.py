@@ -616,10 +616,11 @@ DERIVED_COLUMNS = {"kind": "origin"}
 
 def derive_claims(record_dir: str | Path) -> list[Path]:
     """Give a record's ledger the columns the catalogue derives from its ids that it lacks
-    (``DERIVED_COLUMNS``: ``kind``), and print its ``claims.md`` again from that ``claims.csv``
-    (``claims.ledger_markdown``, the claims rule's own printer, with the CSV's stamp columns:
-    on a ledger of today's columns it prints the run's ``claims.md`` as the run did). No number
-    is touched: the CSV is read and written back as text.
+    (``DERIVED_COLUMNS``: ``kind``), and print its ``claims.md`` and the claims section of its
+    ``summary.md`` again from that ``claims.csv`` with the rules' own printers
+    (``claims.ledger_markdown`` with the CSV's stamp columns, ``summary.claims_section``): on a
+    ledger of today's columns and today's printers they print what the run printed. No number is
+    touched: the CSV is read and written back as text.
 
     Args:
         record_dir: the record folder (``claims.csv``).
@@ -645,7 +646,33 @@ def derive_claims(record_dir: str | Path) -> list[Path]:
     if not page.is_file() or page.read_text() != printed:
         page.write_text(printed)
         written.append(page)
+    summary = out / "summary.md"
+    if summary.is_file():
+        text = summary.read_text()
+        again = _claims_section_again(text, df)
+        if again != text:
+            summary.write_text(again)
+            written.append(summary)
     return written
+
+
+#: The heading of the run summary's claims section as the record holds it (demoted).
+SUMMARY_CLAIMS = "### Claims ledger"
+
+
+def _claims_section_again(text: str, claims: pd.DataFrame) -> str:
+    """The record's ``summary.md`` with its claims section printed again from ``claims``
+    (``summary.claims_section``, the summary rule's own printer); the rest, made from files the
+    record does not keep (the benchmarks), as it was. Unchanged without the section."""
+    from physgs.report.summary import claims_section  # summary imports this module
+
+    lines = text.split("\n")
+    if SUMMARY_CLAIMS not in lines:
+        return text
+    a = lines.index(SUMMARY_CLAIMS)
+    b = next((i for i in range(a + 1, len(lines)) if lines[i].startswith("### ")), len(lines))
+    section = demote("\n".join(claims_section(claims))).split("\n")
+    return "\n".join([*lines[:a], *section, *lines[b:]])
 
 
 def render_pages(record_dir: str | Path) -> list[Path]:

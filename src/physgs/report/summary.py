@@ -69,7 +69,7 @@ def claims_section(claims: pd.DataFrame) -> list[str]:
         f"The paper's {counted(claims, 'paper')}. This project's own "
         f"{counted(claims, 'project')}. A premise is what the comparison rests on, a finding what "
         "it says. The claims, the paper's figures and the cells each verdict comes from: "
-        "[claims.md](claims.md).",
+        "`claims.md` beside this summary (on the documentation site: [the ledger](ledger.md)).",
         "",
         *[f"- {s[0].upper() + s[1:]}" for s in failed_premises(claims)],
         "",
