@@ -683,6 +683,8 @@ def markdown() -> str:
         fam = f"`{s.family}`" if s.of == "ours" else f"`<prior>/{s.family}`"
         if s.headline:
             fam += " (headline)"
+        if s.family in PREMISES:
+            fam += " (premise)"
         over = ("ours" if s.of == "ours" else "every other prior") + ", " + _doc(SCOPES[s.over])
         thr = s.threshold.lstrip("-")
         sign = "-" if s.threshold.startswith("-") else ""
