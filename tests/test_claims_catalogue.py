@@ -33,6 +33,19 @@ def test_the_page_lists_every_family_with_its_origin_and_threshold():
         assert f"`{spec.threshold.lstrip('-')}` = {spec.value:g}" in row
 
 
+def test_kinds_by_id_and_the_page_marks_the_premises():
+    """The fit bar and the testbed's gap are premises, whoever the id names; the rest findings."""
+    assert catalogue.kind_of("fits_window/dense/ours_chain") == "premise"
+    assert catalogue.kind_of("fits_window/sparse/mlp") == "premise"
+    assert catalogue.kind_of("nearest_bone_gap/medium") == "premise"
+    assert catalogue.kind_of("null_factor/sparse") == "finding"
+    assert catalogue.kind_of("ours_chain/above_static_beyond/sparse") == "finding"
+    assert "training window" in catalogue.undermines("fits_window/dense/mlp")
+    assert catalogue.undermines("null_factor/sparse") == ""
+    marked = {ln.split("`")[1] for ln in catalogue.markdown().splitlines() if "(premise)" in ln}
+    assert marked == set(catalogue.PREMISES) == {"fits_window", "nearest_bone_gap"}
+
+
 def test_a_spec_refuses_what_it_cannot_decide():
     base = CATALOGUE[0]
     kw = {f: getattr(base, f) for f in base.__dataclass_fields__}

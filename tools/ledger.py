@@ -51,10 +51,10 @@ def main() -> None:
     print(md)
     print(f"not found under {args.results} ({len(missing)}): {', '.join(missing) or 'none'}")
     measured = df[df["seeds"] > 0]
-    counts = measured["verdict"].str.split(":").str[0].value_counts().to_dict()
     print(
-        f"{len(measured)} of {len(df)} claims measured: "
-        + ", ".join(f"{k} {v}" for k, v in sorted(counts.items()))
+        f"{len(measured)} of {len(df)} claims measured: the paper's "
+        f"{claims.counted(measured, 'paper')}; this project's own "
+        f"{claims.counted(measured, 'project')}"
     )
     if args.out:
         args.out.write_text(md)

@@ -2,6 +2,7 @@
 
     python tools/record.py [results] [--out docs/record] [--wall-s S] [--commit HASH] [--note TEXT]
     python tools/record.py --pages-only      # lay the record's pages out again from its own files
+                                             # (and add the ledger's catalogue-derived columns)
     python tools/record.py --readme-only     # rewrite the README's block from the record
     python tools/record.py --report-html [results/report.html]   # Snakemake's report, on demand
 
@@ -111,6 +112,8 @@ def main() -> None:
         print(f"{args.report_html}: Snakemake's report of the run (not part of the record)")
         return
     if args.pages_only:
+        for p in record.derive_claims(args.out):  # the catalogue's columns, the ledger's page
+            print(f"{p}: derived again from the record's claims.csv")
         print(f"{args.out}: {len(record.render_pages(args.out))} pages laid out again")
     elif not args.readme_only:
         r = args.results

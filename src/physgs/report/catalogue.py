@@ -36,6 +36,10 @@ ORIGINS = ("paper", "project")
 #: The models the paper itself compared: a claim about any other model is this project's.
 PAPER_MODELS = (*models_of("control", "field"), "ours")
 
+#: The kinds of a claim: a premise of the comparison (the testbed is the paper's, the models fit
+#: their window) or a finding the comparison makes. Every family is a finding but ``PREMISES``'.
+KINDS = ("premise", "finding")
+
 #: The family the summary's line on the other priors counts (``physgs.report.summary``).
 AHEAD = "ahead_of_fields"
 #: Names a sentence may use: every threshold, and the ledger's recovery configuration.
@@ -489,6 +493,18 @@ CATALOGUE: tuple[ClaimSpec, ...] = (
 )  # fmt: skip
 
 
+#: The families that are premises of the comparison, each with what its failure undermines (the
+#: claims' ``kind``: ``kind_of``); every other family is a finding.
+PREMISES: dict[str, str] = {
+    "nearest_bone_gap": "the frequency-recovery claims set beside the paper's (how near an "
+    "untrained null's omega lands to some bone's depends on how far apart the bones' "
+    "frequencies lie)",
+    "fits_window": "every comparison that model enters on that tree (beyond the window, on "
+    "held-out views, under unseen wind): a model that does not fit its own training window says "
+    "little about what lies beyond it",
+}
+
+
 # ---- derived from the catalogue ----------------------------------------------------------------
 def tables(optional: bool = True) -> tuple[str, ...]:
     """The tables the ledger reads, in catalogue order.
@@ -562,6 +578,9 @@ def headline(priors: Sequence[str] | None = None) -> list[tuple[str, str, str]]:
 
 
 _MODEL_IDS = set(MODELS) | set(PRIOR_VARIANTS)
+# a premise names a family of the catalogue (a renamed family must not turn it into a finding)
+if not set(PREMISES) <= {s.family for s in CATALOGUE}:
+    raise ValueError(f"PREMISES: no family {sorted(set(PREMISES) - {s.family for s in CATALOGUE})}")
 
 
 def origin_of(claim_id: str) -> str:
@@ -585,6 +604,37 @@ def origin_of(claim_id: str) -> str:
         if s.family == fam and (s.of == "priors") == (parts[0] in _MODEL_IDS):
             return s.origin
     raise ValueError(f"claim {claim_id!r}: no family {fam!r} in the catalogue")
+
+
+def _family(claim_id: str) -> str:
+    """The family of a claim id (``[<prior>/]<family>[/<cell>]``)."""
+    parts = claim_id.split("/")
+    return parts[1] if parts[0] in _MODEL_IDS and len(parts) > 1 else parts[0]
+
+
+def kind_of(claim_id: str) -> str:
+    """Whether a claim is a premise of the comparison or a finding (``KINDS``): its family's
+    entry in ``PREMISES``.
+
+    Args:
+        claim_id: a ledger id (``[<prior>/]<family>[/<cell>]``).
+
+    Returns:
+        ``"premise"`` or ``"finding"``.
+    """
+    return "premise" if _family(claim_id) in PREMISES else "finding"
+
+
+def undermines(claim_id: str) -> str:
+    """What a premise's failure undermines.
+
+    Args:
+        claim_id: a ledger id.
+
+    Returns:
+        The words (``PREMISES``); "" for a finding.
+    """
+    return PREMISES.get(_family(claim_id), "")
 
 
 def _template(text: str, table: str = "") -> str:
@@ -633,6 +683,8 @@ def markdown() -> str:
         fam = f"`{s.family}`" if s.of == "ours" else f"`<prior>/{s.family}`"
         if s.headline:
             fam += " (headline)"
+        if s.family in PREMISES:
+            fam += " (premise)"
         over = ("ours" if s.of == "ours" else "every other prior") + ", " + _doc(SCOPES[s.over])
         thr = s.threshold.lstrip("-")
         sign = "-" if s.threshold.startswith("-") else ""

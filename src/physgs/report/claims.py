@@ -24,7 +24,7 @@ import numpy as np
 import pandas as pd
 
 from physgs.models.registry import label, models_of
-from physgs.report.catalogue import CATALOGUE, origin_of, prior_tables
+from physgs.report.catalogue import CATALOGUE, KINDS, kind_of, origin_of, prior_tables, undermines
 from physgs.report.claim_cells import RECOVERY, Run
 from physgs.report.seeds import MAX_SEEDS, finite, interval, log_interval, seeds_to_decide  # noqa: F401
 
@@ -223,8 +223,9 @@ def to_decide(claim: Claim, values: Sequence[float]) -> tuple[float, float]:
 def ledger(measured: Sequence[tuple[Claim, list[float]]]) -> pd.DataFrame:
     """One row per claim: the claim, the paper's figure, the measured mean (a ratio's geometric
     mean), sd (a ratio's: of its logs, ``scale`` "log"), 95% interval and number of seeds, the
-    threshold and side, the verdict, where it comes from, its origin, and for an undecided claim
-    the seeds that would decide it (an estimate: ``to_decide``).
+    threshold and side, the verdict, where it comes from, its origin, its kind (a premise of the
+    comparison or a finding: ``catalogue.kind_of``), and for an undecided claim the seeds that
+    would decide it (an estimate: ``to_decide``).
 
     Args:
         measured: [`measure`][physgs.report.claims.measure]'s pairs.
@@ -251,12 +252,103 @@ def ledger(measured: Sequence[tuple[Claim, list[float]]]) -> pd.DataFrame:
                 "verdict": verdict(c, values),
                 "source": c.source,
                 "origin": c.origin,
+                "kind": kind_of(c.id),
                 "scale": "log" if log_scale(c) else "linear",
                 "seeds_to_decide_t_est": n_t,
                 "seeds_to_decide_power80_est": n_power,
             }
         )
     return pd.DataFrame(rows)
+
+
+def column(claims: pd.DataFrame, name: str) -> pd.Series:
+    """A catalogue-derived column of the ledger (``origin``, ``kind``): as written, or the
+    catalogue's word for each id in a ledger written before the column.
+
+    Args:
+        claims: the ledger (``claims.csv``: ``id`` at least).
+        name: ``"origin"`` or ``"kind"``.
+
+    Returns:
+        One value per row.
+    """
+    if name in claims.columns:
+        return claims[name].astype(str)
+    return claims["id"].astype(str).map({"origin": origin_of, "kind": kind_of}[name])
+
+
+def number(x: float, unit: str) -> str:
+    """A measured value as the ledger prints it: signed (a difference's side of 0 is its news),
+    except a ratio's, which is always positive.
+
+    Args:
+        x: the value.
+        unit: its unit (``RATIO``: unsigned).
+
+    Returns:
+        Three significant digits.
+    """
+    return f"{x:.3g}" if unit == RATIO else f"{x:+.3g}"
+
+
+#: A kind as the counts name it (plural: ``counted``).
+KIND_WORDS = {"finding": ("finding", "findings"), "premise": ("premise", "premises")}
+
+
+def counted(claims: pd.DataFrame, origin: str) -> str:
+    """The claims of one origin counted, the findings apart from the premises of the comparison
+    (``catalogue.PREMISES``), each by verdict: ``52 claims: 34 findings (20 hold, 10 fail, 4
+    undecided), 18 premises (4 hold, 14 fail)``; a verdict none has is left out.
+
+    Args:
+        claims: the ledger (``id``, ``verdict``; ``origin``, ``kind`` where written).
+        origin: ``"paper"`` or ``"project"``.
+
+    Returns:
+        The words.
+    """
+    verdicts = claims["verdict"].astype(str).str.split(":").str[0]
+    mine = column(claims, "origin") == origin
+    kinds = column(claims, "kind")
+    parts = []
+    for k in reversed(KINDS):  # findings first: they are what the comparison says
+        v = verdicts[mine & (kinds == k)].value_counts()
+        if not v.sum():
+            continue
+        by = ", ".join(
+            f"{int(v[w])} {w[:-1] if w != 'undecided' else w}"
+            for w in ("holds", "fails", "undecided")
+            if v.get(w, 0)
+        )
+        parts.append(f"{int(v.sum())} {KIND_WORDS[k][int(v.sum()) != 1]} ({by})")
+    n = int(mine.sum())
+    return f"{n} claim{'s' if n != 1 else ''}: " + (", ".join(parts) or "none")
+
+
+def failed_premises(claims: pd.DataFrame) -> list[str]:
+    """Each premise family with a failed claim: where it fails and what that undermines
+    (``catalogue.undermines``).
+
+    Args:
+        claims: the ledger.
+
+    Returns:
+        One sentence per family, in the ledger's order; none when every premise holds.
+    """
+    verdicts = claims["verdict"].astype(str).str.split(":").str[0]
+    failed = claims[(column(claims, "kind") == "premise") & (verdicts == "fails")]
+    # the family is the id's first part: no premise family is asked of the priors
+    by_family: dict[str, dict[str, list[str]]] = {}
+    for cid in failed["id"].astype(str):
+        fam, _, cell = cid.partition("/")
+        where, _, what = (cell or "all").partition("/")  # tree, then the model where it has one
+        by_family.setdefault(fam, {}).setdefault(where, []).extend([what] if what else [])
+    return [
+        f"the premise `{fam}` fails on "
+        + ", ".join(f"{w} ({', '.join(m)})" if m else w for w, m in cells.items())
+        + f": this undermines {undermines(fam)}."
+        for fam, cells in by_family.items()
+    ]
 
 
 def ledger_markdown(df: pd.DataFrame, stamp: Mapping[str, str] | None = None) -> str:
@@ -269,12 +361,6 @@ def ledger_markdown(df: pd.DataFrame, stamp: Mapping[str, str] | None = None) ->
     Returns:
         The page's Markdown, ending in a newline.
     """
-    kind = df["verdict"].astype(str).str.split(":").str[0]
-
-    def counted(who: str) -> str:
-        c = kind[df["origin"] == who].value_counts().to_dict()
-        return ", ".join(f"{k} {v}" for k, v in sorted(c.items())) or "none"
-
     lines = [
         "# Claims ledger",
         "",
@@ -290,23 +376,27 @@ def ledger_markdown(df: pd.DataFrame, stamp: Mapping[str, str] | None = None) ->
     ]
     if stamp:
         lines += ["Made by: " + ", ".join(f"{k}={v}" for k, v in stamp.items()), ""]
-    paper, own = (df["origin"] == "paper").sum(), (df["origin"] == "project").sum()
     lines += [
-        f"The paper's {paper} claims: {counted('paper')}. This project's own {own}: "
-        f"{counted('project')}.",
+        f"The paper's {counted(df, 'paper')}. This project's own {counted(df, 'project')}. "
+        "A premise is what the comparison rests on (the testbed is the paper's, the models fit "
+        "their window); a finding is what it says.",
         "",
-        "| claim | origin | paper | measured | threshold | verdict | seeds to decide (est.) "
-        "| from |",
-        "|---|---|---|---|---|---|---|---|",
+        *[f"- {s[0].upper() + s[1:]}" for s in failed_premises(df)],
+        "",
+        "| claim | origin | paper | measured | threshold | verdict | kind "
+        "| seeds to decide (est.) | from |",
+        "|---|---|---|---|---|---|---|---|---|",
     ]
-    for _, r in df.iterrows():
-        meas = "--" if not np.isfinite(r.measured) else f"{r.measured:+.3g} {r.unit}"
+    kinds = column(df, "kind")
+    for (_, r), k in zip(df.iterrows(), kinds):
+        meas = "--" if not np.isfinite(r.measured) else f"{number(r.measured, r.unit)} {r.unit}"
         if np.isfinite(r.ci_low):
-            meas += f" [{r.ci_low:+.3g}, {r.ci_high:+.3g}], {r.seeds} seeds"
+            lo, hi = number(r.ci_low, r.unit), number(r.ci_high, r.unit)
+            meas += f" [{lo}, {hi}], {r.seeds} seeds"
         elif np.isfinite(r.measured):
             meas += f", {r.seeds} seed"
         lines.append(
-            f"| {r.claim} | {r.origin} | {r.paper} | {meas} | {r.threshold} | **{r.verdict}** | "
+            f"| {r.claim} | {r.origin} | {r.paper} | {meas} | {r.threshold} | **{r.verdict}** | {k} | "
             f"{decide_cell(r)} | {r.source} |"
         )
     return "\n".join(lines) + "\n"
