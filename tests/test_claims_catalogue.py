@@ -93,6 +93,7 @@ def test_a_new_family_is_one_entry(monkeypatch):
         "FIT_BAR", ">", "fraction",
         "{tree}: {fit_label} fits its window", "tab_fit: ceiling fraction",
         "this project", origin="project", headline="every model fits its window",
+        one_sided="a bar",
     )  # fmt: skip
     monkeypatch.setattr(catalogue, "CATALOGUE", (*CATALOGUE, new))
     monkeypatch.setattr(claims, "CATALOGUE", catalogue.CATALOGUE)
@@ -159,3 +160,21 @@ def test_moving_a_family_to_another_table_is_its_table_field(monkeypatch):
     pd.testing.assert_frame_equal(before[cols], after[cols])
     assert after["source"].str.startswith("tab_other").all()
     assert "tab_other" in catalogue.tables()
+
+
+def test_a_one_sided_claim_says_why_and_a_band_has_no_side():
+    """Every family is an equivalence test (a band) or one-sided with its stated reason."""
+    for spec in CATALOGUE:
+        assert (spec.side == catalogue.WITHIN) != bool(spec.one_sided), spec.family
+    base = next(s for s in CATALOGUE if s.side != catalogue.WITHIN)
+    kw = {f: getattr(base, f) for f in base.__dataclass_fields__}
+    with pytest.raises(ValueError, match="one_sided"):
+        ClaimSpec(**{**kw, "one_sided": ""})
+    with pytest.raises(ValueError, match="one_sided"):
+        ClaimSpec(**{**kw, "side": catalogue.WITHIN})
+
+
+def test_flatness_is_a_band_in_every_family_that_claims_it():
+    """A claim of flatness is tested inside (-t, +t), for ours and every other prior."""
+    flat = [s for s in CATALOGUE if s.family == "decay_rate_flat"]
+    assert len(flat) == 2 and all(s.side == catalogue.WITHIN for s in flat)

@@ -4,7 +4,10 @@ computed by code (never written by hand).
 A claim is a measured quantity (one value per training seed), a threshold and a side: the
 claim **holds** when the 95% interval of the mean over seeds lies entirely on the claimed side
 of the threshold, **fails** when it lies entirely on the other side, and is **undecided** when it
-straddles it. A claim about a comparison between trained models needs seed variance: with a
+straddles it. A claim of flatness, equality or match (side ``WITHIN``) is an equivalence test,
+two one-sided tests: it **holds** when the interval lies inside the band (-threshold,
++threshold), **fails** when it lies entirely outside it (beyond either edge), and is
+**undecided** when it straddles either edge. A claim about a comparison between trained models needs seed variance: with a
 single seed it is "undecided: one seed" (the point estimate is still shown, with the side it
 falls on). A claim about the fixed testbed (the nearest-bone gap) needs none.
 
@@ -24,7 +27,7 @@ import numpy as np
 import pandas as pd
 
 from physgs.models.registry import label, models_of
-from physgs.report.catalogue import CATALOGUE, origin_of, prior_tables
+from physgs.report.catalogue import CATALOGUE, WITHIN, origin_of, prior_tables
 from physgs.report.claim_cells import RECOVERY, Run
 from physgs.report.seeds import MAX_SEEDS, finite, interval, log_interval, seeds_to_decide  # noqa: F401
 
@@ -35,7 +38,7 @@ RATIO = "ratio"
 @dataclass(frozen=True)
 class Claim:
     """One claim: id, the claim in one line, the paper's figure, where it is measured, the
-    threshold and side ('>' or '<'), the unit, whether a verdict needs seed variance, and its
+    threshold and side ('>', '<', or ``WITHIN``: inside (-threshold, +threshold)), the unit, whether a verdict needs seed variance, and its
     origin (the paper's or this project's)."""
 
     id: str
@@ -47,6 +50,31 @@ class Claim:
     unit: str
     needs_variance: bool = True
     origin: str = "paper"
+    paper_value: tuple[float, float] = (float("nan"), float("nan"))
+
+    @property
+    def threshold_text(self) -> str:
+        """The threshold and side as the ledger prints them: ``> 0``, ``within ±0.5``."""
+        if self.side == WITHIN:
+            return f"within ±{self.threshold:g}"
+        return f"{self.side} {self.threshold:g}"
+
+
+def on_claim(claim: Claim, x: float) -> bool:
+    """Whether a value lies on the claimed side of the threshold (inside the band for
+    ``WITHIN``).
+
+    Args:
+        claim: the claim (threshold, side).
+        x: a value in the claim's unit.
+
+    Returns:
+        True on the claimed side.
+    """
+    t = claim.threshold
+    if claim.side == WITHIN:
+        return -t < x < t
+    return x > t if claim.side == ">" else x < t
 
 
 def log_scale(claim: Claim) -> bool:
@@ -91,7 +119,10 @@ def verdict(claim: Claim, values: Sequence[float]) -> str:
     m, _, lo, hi = estimate(claim, values)
     if not np.isfinite(m):
         return "undecided: not measured"
-    on = (lambda x: x > claim.threshold) if claim.side == ">" else (lambda x: x < claim.threshold)
+
+    def on(x: float) -> bool:
+        return on_claim(claim, x)
+
     if not claim.needs_variance:
         return "holds" if on(m) else "fails"
     n = int(np.isfinite(np.asarray(values, dtype=np.float64)).sum())
@@ -99,6 +130,8 @@ def verdict(claim: Claim, values: Sequence[float]) -> str:
         return f"undecided: one seed (point estimate {'on' if on(m) else 'against'} the claim)"
     if on(lo) and on(hi):
         return "holds"
+    if claim.side == WITHIN:  # outside the band: wholly beyond one edge
+        return "fails" if hi <= -claim.threshold or lo >= claim.threshold else "undecided"
     if not on(lo) and not on(hi):
         return "fails"
     return "undecided"
@@ -196,6 +229,7 @@ def measure(
                     spec.unit,
                     spec.needs_variance,
                     origin_of(cid),
+                    spec.value_of_paper(cell),
                 )
                 out.append((claim, [spec.measure(d, cell) for d in seeds]))
     return out
@@ -217,14 +251,39 @@ def to_decide(claim: Claim, values: Sequence[float]) -> tuple[float, float]:
         return np.nan, np.nan
     v = finite(values)
     v, thr = (np.log(v), np.log(claim.threshold)) if log_scale(claim) else (v, claim.threshold)
-    return seeds_to_decide(float(v.mean()) - thr, float(v.std(ddof=1)))
+    m = float(v.mean())
+    if claim.side == WITHIN:  # the interval straddles an edge: the nearer one decides it
+        thr = min((-thr, thr), key=lambda e: abs(m - e))
+    return seeds_to_decide(m - thr, float(v.std(ddof=1)))
+
+
+def paper_in_interval(claim: Claim, low: float, high: float) -> str:
+    """Whether the paper's figure lies inside the measured 95% interval: the claim reproduced
+    in size, beside its verdict (a direction, or a bar). A paper's range (``low < high``)
+    counts as inside when it meets the interval.
+
+    Args:
+        claim: the claim (``paper_value``, in its unit).
+        low: the interval's low end.
+        high: its high end.
+
+    Returns:
+        ``"inside"`` or ``"outside"``; ``""`` where the paper gives no number or there is no
+            interval (one seed, nothing measured).
+    """
+    p_lo, p_hi = claim.paper_value
+    if not (np.isfinite(p_lo) and np.isfinite(low) and np.isfinite(high)):
+        return ""
+    return "inside" if p_lo <= high and p_hi >= low else "outside"
 
 
 def ledger(measured: Sequence[tuple[Claim, list[float]]]) -> pd.DataFrame:
     """One row per claim: the claim, the paper's figure, the measured mean (a ratio's geometric
     mean), sd (a ratio's: of its logs, ``scale`` "log"), 95% interval and number of seeds, the
     threshold and side, the verdict, where it comes from, its origin, and for an undecided claim
-    the seeds that would decide it (an estimate: ``to_decide``).
+    the seeds that would decide it (an estimate: ``to_decide``); last (added columns, so older
+    readers keep theirs), the paper's figure as a number (``paper_low``, ``paper_high``) and
+    whether it lies inside the interval (``paper_in_interval``).
 
     Args:
         measured: [`measure`][physgs.report.claims.measure]'s pairs.
@@ -247,13 +306,16 @@ def ledger(measured: Sequence[tuple[Claim, list[float]]]) -> pd.DataFrame:
                 "ci_high": hi,
                 "seeds": int(np.isfinite(values).sum()),
                 "unit": c.unit,
-                "threshold": f"{c.side} {c.threshold:g}",
+                "threshold": c.threshold_text,
                 "verdict": verdict(c, values),
                 "source": c.source,
                 "origin": c.origin,
                 "scale": "log" if log_scale(c) else "linear",
                 "seeds_to_decide_t_est": n_t,
                 "seeds_to_decide_power80_est": n_power,
+                "paper_low": c.paper_value[0],
+                "paper_high": c.paper_value[1],
+                "paper_in_interval": paper_in_interval(c, lo, hi),
             }
         )
     return pd.DataFrame(rows)
@@ -281,7 +343,10 @@ def ledger_markdown(df: pd.DataFrame, stamp: Mapping[str, str] | None = None) ->
         "Each claim, measured by this pipeline: the paper's claims and this project's own, "
         "counted apart; verdicts are computed by `physgs.report.claims` (holds / fails when "
         "the seed interval lies on one side of the threshold, undecided when it straddles it "
-        "or when one seed gives no interval). A ratio's estimate is the geometric mean over "
+        "or when one seed gives no interval; a claim of flatness, equality or match, "
+        "'within ±t', holds inside the band, fails wholly outside it and is undecided across "
+        "either edge). Beside a figure of the paper: whether it lies inside the measured "
+        "interval (reproduced in size; the verdict is a direction or a bar). A ratio's estimate is the geometric mean over "
         "seeds and its interval the per-seed log-ratios' t-interval, exponentiated (it stays "
         "positive). For an undecided claim, the seeds that would decide it if its effect and "
         "sd stayed as observed, an estimate: the plug-in t half-width / a t-test at 80% power "
@@ -305,8 +370,10 @@ def ledger_markdown(df: pd.DataFrame, stamp: Mapping[str, str] | None = None) ->
             meas += f" [{r.ci_low:+.3g}, {r.ci_high:+.3g}], {r.seeds} seeds"
         elif np.isfinite(r.measured):
             meas += f", {r.seeds} seed"
+        size = r.get("paper_in_interval", "")
+        size = f" ({size} the interval)" if isinstance(size, str) and size else ""
         lines.append(
-            f"| {r.claim} | {r.origin} | {r.paper} | {meas} | {r.threshold} | **{r.verdict}** | "
+            f"| {r.claim} | {r.origin} | {r.paper}{size} | {meas} | {r.threshold} | **{r.verdict}** | "
             f"{decide_cell(r)} | {r.source} |"
         )
     return "\n".join(lines) + "\n"

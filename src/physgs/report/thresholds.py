@@ -4,7 +4,7 @@ pages quote these names. Never move one to make a claim pass."""
 
 #: |median zeta_hat - zeta| / zeta above this: damping not recovered (below: recovered).
 DAMPING_OFF = 0.10
-#: gamma ~ omega^p with p below this: the decay rate is nearly frequency-independent.
+#: gamma ~ omega^p with |p| below this: the decay rate is nearly frequency-independent (a band).
 RATE_EXPONENT = 0.5
 #: the trained model beats the null by less than this (points): "matches".
 NULL_MATCH_PP = 0.5
