@@ -79,6 +79,9 @@ class ClaimSpec:
             inside a band, never one-sided without a stated reason.
         paper_value: the paper's figure in the claim's unit, ``(low, high)`` (equal ends for
             one figure); None where the paper gives no number.
+        requires: a family whose claim on the same cell must hold for this one to hold (a
+            coverage holds only where its intervals also beat the null's interval score); ""
+            for none.
     """
 
     family: str
@@ -98,6 +101,7 @@ class ClaimSpec:
     optional: bool = False
     one_sided: str = ""
     paper_value: Callable[[Cell], tuple[float, float]] | None = None
+    requires: str = ""
 
     def __post_init__(self):
         """Refuse an unknown side, origin, scope, reader or threshold name, a one-sided claim
@@ -149,17 +153,19 @@ class ClaimSpec:
         """
         return float(READERS[self.read](rows, cell))
 
-    def claim_id(self, cell: Cell) -> str:
+    def claim_id(self, cell: Cell, family: str = "") -> str:
         """The id of the claim of ``cell``.
 
         Args:
             cell: the claim's cell (``model``: the prior asked; ``prefix``, ``suffix``).
+            family: another family's id on the same cell (``requires``); "": this one's.
 
         Returns:
             ``[<prior>/]<family>[/<suffix>]``.
         """
         prefix = cell.get("prefix", "" if cell["model"] == "ours" else f"{cell['model']}/")
-        return prefix + self.family + (f"/{cell['suffix']}" if cell.get("suffix") else "")
+        fam = family or self.family
+        return prefix + fam + (f"/{cell['suffix']}" if cell.get("suffix") else "")
 
     def words(self, template: str, cell: Cell) -> str:
         """A sentence of the claim of ``cell``.
@@ -546,6 +552,7 @@ CATALOGUE: tuple[ClaimSpec, ...] = (
         origin="project",
         optional=True,
         one_sided=COVER,
+        requires="oma_frequency_interval_score",
     ),
     ClaimSpec(
         "oma_damping_interval_covers", "ours", "oma_interval_trees", "tab_damping",
@@ -557,6 +564,57 @@ CATALOGUE: tuple[ClaimSpec, ...] = (
         origin="project",
         optional=True,
         one_sided=COVER,
+        requires="oma_damping_interval_score",
+    ),
+    ClaimSpec(
+        "oma_frequency_interval_score", "ours", "oma_interval_trees", "tab_damping",
+        "oma_omega_score", "RATIO_EVEN", ">", "ratio",
+        "{tree} (damping testbed): the output-only analysis' 95% intervals for omega score "
+        "better than the untrained null's draw range (interval score, Gneiting and Raftery "
+        "2007: width plus 2/alpha times the miss, per part, relative to the truth)",
+        "{table}, {config}: omega_null_interval_score / omega_interval_score",
+        "not in the paper (this project's)",
+        origin="project",
+        optional=True,
+        one_sided=DIRECTION,
+    ),
+    ClaimSpec(
+        "oma_frequency_interval_informative", "ours", "oma_interval_trees", "tab_damping",
+        "oma_omega_halfwidth", "INFORMATIVE_HALFWIDTH", "<", "fraction",
+        "{tree} (damping testbed): the output-only analysis' 95% intervals for omega are "
+        "informative (median half-width below {INFORMATIVE_HALFWIDTH:.0%} of the value: the "
+        "interval excludes zero)",
+        "{table}, {config}: 1.96 x output-only omega_rel_sd",
+        "not in the paper (this project's)",
+        origin="project",
+        optional=True,
+        one_sided="a bar: an interval at most this wide says something; narrower never hurts "
+        "(its misses are the interval score's)",
+    ),
+    ClaimSpec(
+        "oma_damping_interval_score", "ours", "oma_interval_trees", "tab_damping",
+        "oma_zeta_score", "RATIO_EVEN", ">", "ratio",
+        "{tree} (damping testbed): the output-only analysis' 95% intervals for zeta score "
+        "better than the untrained null's draw range (interval score, Gneiting and Raftery "
+        "2007: width plus 2/alpha times the miss, per part, relative to the truth)",
+        "{table}, {config}: zeta_null_interval_score / zeta_interval_score",
+        "not in the paper (this project's)",
+        origin="project",
+        optional=True,
+        one_sided=DIRECTION,
+    ),
+    ClaimSpec(
+        "oma_damping_interval_informative", "ours", "oma_interval_trees", "tab_damping",
+        "oma_zeta_halfwidth", "INFORMATIVE_HALFWIDTH", "<", "fraction",
+        "{tree} (damping testbed): the output-only analysis' 95% intervals for zeta are "
+        "informative (median half-width below {INFORMATIVE_HALFWIDTH:.0%} of the value: the "
+        "interval excludes zero)",
+        "{table}, {config}: 1.96 x output-only zeta_rel_sd",
+        "not in the paper (this project's)",
+        origin="project",
+        optional=True,
+        one_sided="a bar: an interval at most this wide says something; narrower never hurts "
+        "(its misses are the interval score's)",
     ),
     # this project's: the paper's two hypotheses about its prior (section 6), tested
     ClaimSpec(

@@ -461,6 +461,41 @@ def _oma_zeta_cover(d: pd.DataFrame, c: Cell) -> float:
     return value(d, _oma_damping_row(d, c), "zeta_interval_cover")
 
 
+def _score_ratio(d: pd.DataFrame, c: Cell, q: str) -> float:
+    row = _oma_damping_row(d, c)
+    return value(d, row, f"{q}_null_interval_score") / value(d, row, f"{q}_interval_score")
+
+
+def _oma_omega_score(d: pd.DataFrame, c: Cell) -> float:
+    """tab_damping (damping testbed): the null's draw range over the output-only analysis'
+    omega intervals, mean relative interval score (null / output-only)"""
+    return _score_ratio(d, c, "omega")
+
+
+def _oma_zeta_score(d: pd.DataFrame, c: Cell) -> float:
+    """tab_damping (damping testbed): the null's draw range over the output-only analysis'
+    zeta intervals, mean relative interval score (null / output-only)"""
+    return _score_ratio(d, c, "zeta")
+
+
+def _halfwidth(d: pd.DataFrame, c: Cell, q: str) -> float:
+    from physgs.oma.intervals import Z95  # here: scipy, which planning never loads
+
+    return Z95 * value(d, _oma_damping_row(d, c), f"{q}_rel_sd")
+
+
+def _oma_omega_halfwidth(d: pd.DataFrame, c: Cell) -> float:
+    """tab_damping (damping testbed): the output-only analysis' median relative half-width of
+    its omega intervals, 1.96 sigma / omega"""
+    return _halfwidth(d, c, "omega")
+
+
+def _oma_zeta_halfwidth(d: pd.DataFrame, c: Cell) -> float:
+    """tab_damping (damping testbed): the output-only analysis' median relative half-width of
+    its zeta intervals, 1.96 sigma / zeta"""
+    return _halfwidth(d, c, "zeta")
+
+
 #: A reader: one seed's rows and a cell -> the claim's value.
 Reader = Callable[[pd.DataFrame, Cell], float]
 #: A scope: the run -> the family's cells.
@@ -514,4 +549,8 @@ READERS: dict[str, Reader] = {
     "oma_zeta_gain": _oma_zeta_gain,
     "oma_omega_cover": _oma_omega_cover,
     "oma_zeta_cover": _oma_zeta_cover,
+    "oma_omega_score": _oma_omega_score,
+    "oma_zeta_score": _oma_zeta_score,
+    "oma_omega_halfwidth": _oma_omega_halfwidth,
+    "oma_zeta_halfwidth": _oma_zeta_halfwidth,
 }

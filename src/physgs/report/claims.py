@@ -51,6 +51,7 @@ class Claim:
     needs_variance: bool = True
     origin: str = "paper"
     paper_value: tuple[float, float] = (float("nan"), float("nan"))
+    requires: str = ""
 
     @property
     def threshold_text(self) -> str:
@@ -230,6 +231,7 @@ def measure(
                     spec.needs_variance,
                     origin_of(cid),
                     spec.value_of_paper(cell),
+                    spec.claim_id(cell, spec.requires) if spec.requires else "",
                 )
                 out.append((claim, [spec.measure(d, cell) for d in seeds]))
     return out
@@ -277,13 +279,38 @@ def paper_in_interval(claim: Claim, low: float, high: float) -> str:
     return "inside" if p_lo <= high and p_hi >= low else "outside"
 
 
+def gated(claim: Claim, own: str, verdicts: Mapping[str, str]) -> str:
+    """A claim's verdict where it holds only if its companion (``Claim.requires``) holds too: a
+    coverage whose intervals do not beat the null's interval score does not hold.
+
+    Args:
+        claim: the claim.
+        own: its verdict on its own values.
+        verdicts: claim id -> verdict, the companion's among them.
+
+    Returns:
+        ``own`` where it does not hold or there is no companion; otherwise ``own`` when the
+            companion holds, "fails: ..." when it fails and "undecided: ..." when it is
+            undecided or absent, naming the companion's verdict.
+    """
+    if not claim.requires or own != "holds":
+        return own
+    comp = verdicts.get(claim.requires, "undecided: not measured")
+    kind = comp.split(":")[0]
+    if kind == "holds":
+        return own
+    word = "fails" if kind == "fails" else "undecided"
+    return f"{word}: covers, but {claim.requires} {comp}"
+
+
 def ledger(measured: Sequence[tuple[Claim, list[float]]]) -> pd.DataFrame:
     """One row per claim: the claim, the paper's figure, the measured mean (a ratio's geometric
     mean), sd (a ratio's: of its logs, ``scale`` "log"), 95% interval and number of seeds, the
     threshold and side, the verdict, where it comes from, its origin, and for an undecided claim
     the seeds that would decide it (an estimate: ``to_decide``); last (added columns, so older
     readers keep theirs), the paper's figure as a number (``paper_low``, ``paper_high``) and
-    whether it lies inside the interval (``paper_in_interval``).
+    whether it lies inside the interval (``paper_in_interval``), and the companion a claim
+    needs to hold (``requires``: [`gated`][physgs.report.claims.gated]).
 
     Args:
         measured: [`measure`][physgs.report.claims.measure]'s pairs.
@@ -292,7 +319,9 @@ def ledger(measured: Sequence[tuple[Claim, list[float]]]) -> pd.DataFrame:
         The ledger, one row per claim.
     """
     rows = []
-    for c, values in measured:
+    own = [verdict(c, values) for c, values in measured]
+    alone = {c.id: v for (c, _), v in zip(measured, own)}  # the companions' (``requires``)
+    for (c, values), v in zip(measured, own):
         m, sd, lo, hi = estimate(c, values)
         n_t, n_power = to_decide(c, values)
         rows.append(
@@ -307,7 +336,7 @@ def ledger(measured: Sequence[tuple[Claim, list[float]]]) -> pd.DataFrame:
                 "seeds": int(np.isfinite(values).sum()),
                 "unit": c.unit,
                 "threshold": c.threshold_text,
-                "verdict": verdict(c, values),
+                "verdict": gated(c, v, alone),
                 "source": c.source,
                 "origin": c.origin,
                 "scale": "log" if log_scale(c) else "linear",
@@ -316,6 +345,7 @@ def ledger(measured: Sequence[tuple[Claim, list[float]]]) -> pd.DataFrame:
                 "paper_low": c.paper_value[0],
                 "paper_high": c.paper_value[1],
                 "paper_in_interval": paper_in_interval(c, lo, hi),
+                "requires": c.requires,
             }
         )
     return pd.DataFrame(rows)

@@ -674,7 +674,9 @@ def method_rows(
 #: tab_null / tab_damping's CSV columns of a method's own intervals (the output-only analysis';
 #: NaN for a method without them): the coverage of its trusted parts' 95% intervals for omega
 #: and zeta, the parts they cover, the median relative standard deviations (sigma / value) over
-#: those parts, and the parts its sigma rule keeps (alone, and with ours')
+#: those parts, and the parts its sigma rule keeps (alone, and with ours'); last, the mean
+#: relative interval scores of its intervals and of the untrained null's draw range on the same
+#: parts (``physgs.oma.intervals.relative_scores``; NaN in a record made before them)
 INTERVAL_COLUMNS = (
     "omega_rel_sd",
     "zeta_rel_sd",
@@ -683,6 +685,10 @@ INTERVAL_COLUMNS = (
     "interval_parts",
     "sigma_parts_trusted",
     "sigma_and_corr_parts_trusted",
+    "omega_interval_score",
+    "omega_null_interval_score",
+    "zeta_interval_score",
+    "zeta_null_interval_score",
 )
 
 
@@ -700,6 +706,11 @@ def interval_cells(rec) -> dict:
     if not iv:
         return dict.fromkeys(INTERVAL_COLUMNS, float("nan"))
     cov = iv["coverage"]
+    score = iv.get("interval_score", {})  # absent in a record made before the scores
+
+    def sc(q: str, key: str) -> float:
+        return float(score.get(q, {}).get(key, float("nan")))
+
     return {
         "omega_rel_sd": float(iv["median_rel_std"]["omega"]),
         "zeta_rel_sd": float(iv["median_rel_std"]["zeta"]),
@@ -708,6 +719,10 @@ def interval_cells(rec) -> dict:
         "interval_parts": float(cov["omega"]["n"]),
         "sigma_parts_trusted": float(iv["n_sigma_trusted"]),
         "sigma_and_corr_parts_trusted": float(iv["n_both_trusted"]),
+        "omega_interval_score": sc("omega", "score"),
+        "omega_null_interval_score": sc("omega", "null_score"),
+        "zeta_interval_score": sc("zeta", "score"),
+        "zeta_null_interval_score": sc("zeta", "null_score"),
     }
 
 

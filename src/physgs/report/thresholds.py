@@ -14,6 +14,10 @@ GAP_RTOL = 0.25
 FIT_BAR = 0.5
 #: the output-only analysis' 95% intervals hold the truth on at least this share of its parts.
 INTERVAL_COVER = 0.8
+#: a 95% interval's median half-width over its value below this: informative. At 1 the interval
+#: reaches zero: a damping ratio's cannot tell the mode from an undamped pole (the modal
+#: analyst's trust rule, ``physgs.oma.intervals.REL_SIGMA_MAX`` = 1 / 1.96, per part).
+INFORMATIVE_HALFWIDTH = 1.0
 #: the paper's factor: the untrained null's median omega error over the trained model's.
 NULL_FACTOR = 2.5
 #: a ratio above this: the one above it is better (null / trained errors).
