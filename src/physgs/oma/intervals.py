@@ -56,7 +56,7 @@ def sigma_trusted(value, std, rel_max: float = REL_SIGMA_MAX) -> np.ndarray:
 
 def interval_score(lower, upper, truth, alpha: float = ALPHA) -> np.ndarray:
     """The interval score of central (1 - alpha) intervals (Gneiting and Raftery 2007, JASA
-    102(477), eq. 43): the width plus 2 / alpha times the distance by which the truth misses
+    102(477), 359-378, section 6.2): the width plus 2 / alpha times the distance by which the truth misses
     the interval. Lower is better; a proper score: wide intervals pay their width, narrow ones
     their misses.
 
