@@ -10,6 +10,7 @@ import pytest
 
 from physgs.report import catalogue
 from physgs.report.catalogue import CATALOGUE, ClaimSpec, origin_of
+from roles import ROLES
 
 ROOT = Path(__file__).resolve().parents[1]
 
@@ -104,7 +105,9 @@ def test_a_new_family_is_one_entry(monkeypatch):
             for m in ("mlp", "mlp_wind", "d3dgs", "d3dgs_wind", "ours")
         ]
     )
-    led = claims.ledger(claims.measure({"tab_fit": fit}, {}, ["sparse"])).set_index("id")
+    led = claims.ledger(claims.measure({"tab_fit": fit}, {}, ["sparse"], roles=ROLES)).set_index(
+        "id"
+    )
     row = led.loc["fits_window_strictly/sparse/mlp"]
     assert row["verdict"] == "holds" and row["origin"] == "project"
     assert origin_of("fits_window_strictly/sparse/mlp") == "project"
@@ -145,7 +148,7 @@ def test_moving_a_family_to_another_table_is_its_table_field(monkeypatch):
     )
 
     def tracks(tables):
-        got = claims.ledger(claims.measure(tables, {}, ["sparse"])).set_index("id")
+        got = claims.ledger(claims.measure(tables, {}, ["sparse"], roles=ROLES)).set_index("id")
         return got.loc[["tracks_beats_null/sparse", "tracks_match_ours/sparse"]]
 
     before = tracks({"tab_recovery": rows})

@@ -14,6 +14,7 @@ from physgs.oma.intervals import interval_score, relative_scores
 from physgs.oma.run import interval_block
 from physgs.report import claims
 from physgs.report.tables import interval_cells
+from roles import ROLES
 
 
 @pytest.mark.parametrize(
@@ -78,7 +79,7 @@ def _tab_damping(sd_factor: float) -> pd.DataFrame:
 
 def _ledger(sd_factor: float) -> pd.DataFrame:
     tabs = {"tab_damping": _tab_damping(sd_factor)}
-    return claims.ledger(claims.measure(tabs, {}, ["sparse"])).set_index("id")
+    return claims.ledger(claims.measure(tabs, {}, ["sparse"], roles=ROLES)).set_index("id")
 
 
 def test_honest_intervals_cover_and_beat_the_null():
@@ -115,6 +116,8 @@ def test_a_record_without_scores_leaves_coverage_undecided():
     """A table made before the scores (NaN columns): the coverage no longer holds on its own."""
     d = _tab_damping(0.1)
     d[[c for c in d.columns if c.endswith("interval_score")]] = np.nan
-    df = claims.ledger(claims.measure({"tab_damping": d}, {}, ["sparse"])).set_index("id")
+    df = claims.ledger(claims.measure({"tab_damping": d}, {}, ["sparse"], roles=ROLES)).set_index(
+        "id"
+    )
     v = df.loc["oma_damping_interval_covers/sparse", "verdict"]
     assert v.startswith("undecided: covers, but oma_damping_interval_score/sparse undecided")

@@ -7,6 +7,7 @@ import pytest
 from physgs.models.registry import models_of
 from physgs.report import claims as C
 from physgs.report import paper
+from roles import ROLES
 
 CLAIM = C.Claim("x", "x is positive", "--", "--", 0.0, ">", "dB")
 
@@ -107,7 +108,7 @@ def _tables(seeds=(0,)):
 
 def test_claims_measured_from_the_tables():
     damping = {"sparse": [{"median_zeta": 0.12, "zeta_true": 0.08, "loglog_exponent": 0.1}]}
-    df = C.ledger(C.measure(_tables(seeds=(0, 1, 2)), damping, ["sparse", "medium"]))
+    df = C.ledger(C.measure(_tables(seeds=(0, 1, 2)), damping, ["sparse", "medium"], roles=ROLES))
     v = df.set_index("id")
     assert v.loc["baselines_below_static_beyond/sparse", "measured"] == pytest.approx(-1.0)
     assert v.loc["baselines_below_static_beyond/sparse", "verdict"] == "holds"
@@ -142,15 +143,17 @@ def test_claims_measured_from_the_tables():
 
 def test_a_single_seed_table_gives_one_seed_verdicts():
     t = {k: d.drop(columns=["seed"], errors="ignore") for k, d in _tables().items()}
-    df = C.ledger(C.measure(t, {}, ["sparse"]))
+    df = C.ledger(C.measure(t, {}, ["sparse"], roles=ROLES))
     needs = df[~df["id"].str.startswith("nearest_bone_gap")]
     assert needs["verdict"].str.startswith("undecided: one seed").all()
 
 
 def test_a_partial_run_gives_a_partial_ledger():
     full_tables = _tables(seeds=(0, 1, 2))
-    full = C.ledger(C.measure(full_tables, {}, ["sparse", "medium"])).set_index("id")
-    part = C.ledger(C.measure({"tab_null": full_tables["tab_null"]}, {}, ["sparse", "medium"]))
+    full = C.ledger(C.measure(full_tables, {}, ["sparse", "medium"], roles=ROLES)).set_index("id")
+    part = C.ledger(
+        C.measure({"tab_null": full_tables["tab_null"]}, {}, ["sparse", "medium"], roles=ROLES)
+    )
     part = part.set_index("id")
     measured = part[part["seeds"] > 0]
     # what tab_null holds is measured exactly as in the whole ledger
@@ -310,7 +313,7 @@ def test_every_claim_points_the_right_way(claims_true):
     is false, every claim fails. Flipping the side of any claim, or the sign of what it
     measures, breaks one of the two."""
     tables, damping = _world(claims_true)
-    df = C.ledger(C.measure(tables, damping, list(TREES))).set_index("id")
+    df = C.ledger(C.measure(tables, damping, list(TREES), roles=ROLES)).set_index("id")
     assert {i.split("/")[0] for i in df.index} == FAMILIES  # a new claim needs its world here
     want = "holds" if claims_true else "fails"
     wrong = df[df["verdict"] != want]
@@ -474,7 +477,7 @@ def test_the_ledger_says_whether_the_papers_figure_is_reproduced():
     paper's sparse figure is 25.42 - 25.16 = +0.26 dB (tab:psnr): outside; the margin grows by
     2 dB, the paper's sparse by -0.61 + 1.42 = +0.81 dB: outside too."""
     tables, damping = _world(True)
-    df = C.ledger(C.measure(tables, damping, list(TREES))).set_index("id")
+    df = C.ledger(C.measure(tables, damping, list(TREES), roles=ROLES)).set_index("id")
     r = df.loc["ours_above_static_beyond/sparse"]
     assert r["paper_low"] == pytest.approx(0.26) and r["paper_in_interval"] == "outside"
     assert df.loc["margin_grows/sparse", "paper_low"] == pytest.approx(0.81)

@@ -185,6 +185,7 @@ def measure(
     damping: Mapping[str, Sequence[Mapping[str, float]]],
     trees: Sequence[str],
     prior_damping: Mapping[str, Mapping[str, Sequence[Mapping[str, float]]]] | None = None,
+    roles: Mapping[str, Mapping[str, str]] | None = None,
 ) -> list[tuple[Claim, list[float]]]:
     """Every claim of the catalogue with its per-seed values, from the tables' CSVs and the
     priors' damping summaries.
@@ -202,6 +203,9 @@ def measure(
             zeta_true), for the joint K=32 configuration.
         trees: the trees.
         prior_damping: model -> tree -> per-seed summaries, as ``damping``, of the other priors.
+        roles: tree -> its preset's role (``claim_cells.roles_of``: ``frequencies``, ``paper``);
+            None or a tree left out: no role, so none of the role-scoped claims and no paper
+            figure for it.
 
     Returns:
         ``(claim, per-seed values)`` pairs, in the ledger's order (the catalogue's).
@@ -217,7 +221,8 @@ def measure(
             continue
         seeds = _per_seed(tabs[spec.table]) if spec.table in tabs else []
         for model in ("ours",) if spec.of == "ours" else others:
-            for cell in spec.cells(Run(tabs, trees, model, others, spec.table)):
+            run = Run(tabs, trees, model, others, spec.table, dict(roles or {}))
+            for cell in spec.cells(run):
                 cell = {"model": model, "name": label(model), "table": spec.table, **cell}
                 cid = spec.claim_id(cell)
                 claim = Claim(
