@@ -105,6 +105,7 @@ NEED_PATHS = {
     "kselect": KSELECT,
     "prior_kselect": PRIOR_KSELECT,
     "stats": STATS,
+    "instance_stats": SEEDED_STATS,
     "table": TABLE.replace("{ext}", "csv"),
     "tracks_eval": TRACKS_EVAL,
     "tracks_fields": TRACKS_FIELDS,
