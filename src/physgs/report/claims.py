@@ -118,6 +118,25 @@ def verdict(claim: Claim, values: Sequence[float]) -> str:
             verdict says on which side the point estimate lies.
     """
     m, _, lo, hi = estimate(claim, values)
+    n = int(np.isfinite(np.asarray(values, dtype=np.float64)).sum())
+    return decide(claim, m, lo, hi, n)
+
+
+def decide(claim: Claim, m: float, lo: float, hi: float, n: int) -> str:
+    """The verdict of an estimate and its 95% interval ([`verdict`][physgs.report.claims.verdict]
+    from the per-seed values; this from a ledger's own columns, e.g. a committed record's
+    ``measured``, ``ci_low``, ``ci_high`` and ``seeds``).
+
+    Args:
+        claim: the claim (threshold, side, whether it needs seed variance).
+        m: the estimate.
+        lo: the interval's low end.
+        hi: its high end.
+        n: the seeds measured.
+
+    Returns:
+        The verdict, as ``verdict``'s.
+    """
     if not np.isfinite(m):
         return "undecided: not measured"
 
@@ -126,7 +145,6 @@ def verdict(claim: Claim, values: Sequence[float]) -> str:
 
     if not claim.needs_variance:
         return "holds" if on(m) else "fails"
-    n = int(np.isfinite(np.asarray(values, dtype=np.float64)).sum())
     if n < 2:
         return f"undecided: one seed (point estimate {'on' if on(m) else 'against'} the claim)"
     if on(lo) and on(hi):
