@@ -839,7 +839,9 @@ def story_line(claims: pd.DataFrame) -> str:
 def headline_lines(claims: pd.DataFrame) -> list[str]:
     """What the run found, in a few lines: the ledger's counts (the paper's claims apart from
     this project's), whether the paper's story stands, then each headline family's
-    (``catalogue.headline``) verdict per cell with its measured value and 95% interval.
+    (``catalogue.headline``) verdict per cell with its measured value and 95% interval, and,
+    where the paper gives a number, whether it lies inside that interval (the direction and the
+    size both: ``paper_in_interval``).
 
     Args:
         claims: the ledger (``claims.csv``: id, measured, ci_low, ci_high, unit, verdict).
@@ -862,6 +864,11 @@ def headline_lines(claims: pd.DataFrame) -> list[str]:
                 if math.isfinite(r["ci_low"])
                 else (f"{r['measured']:+.3g} {r['unit']}" if math.isfinite(r["measured"]) else "--")
             )
+            size = r.get("paper_in_interval")  # a record made before the column has none
+            if isinstance(size, str) and size:
+                p_lo, p_hi = r["paper_low"], r["paper_high"]
+                fig = f"{p_lo:+.3g}" if p_lo == p_hi else f"{p_lo:+.3g} to {p_hi:+.3g}"
+                value = f"{value.strip()}; the paper's {fig} {size}"
             cells.append(f"{where} **{k}** ({value.strip()})")
         lines.append(f"- {words[0].upper() + words[1:]}: " + "; ".join(cells) + ".")
     return lines
