@@ -279,12 +279,14 @@ def _paper_ours_behind(c: Cell) -> str:
 
 def _paper_null_ratio(c: Cell) -> str:
     """null / trained median omega error, tab:null"""
-    return f"null / trained = {_value_null_ratio(c)[0]:.2f}"
+    v = _value_null_ratio(c)[0]
+    return f"null / trained = {v:.2f}" if np.isfinite(v) else "--"
 
 
 def _paper_null_difference(c: Cell) -> str:
     """trained - null median omega error, tab:null"""
-    return f"trained - null = {_value_null_difference(c)[0]:+.2f} points"
+    v = _value_null_difference(c)[0]
+    return f"trained - null = {v:+.2f} points" if np.isfinite(v) else "--"
 
 
 def _paper_gap(c: Cell) -> str:
