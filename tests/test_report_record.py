@@ -328,6 +328,23 @@ def test_headline_says_the_direction_and_whether_the_papers_size_is_reproduced()
     )
 
 
+def test_the_stamp_names_the_tree_instances():
+    """Five instances per tree (testbed_seeds): the training seeds' testbed seeds; one (the
+    paper's protocol, or a table made before the column): the config's testbed seed."""
+    tb = pd.DataFrame({"tree": ["sparse", "medium"], "instances": [5, 1]})
+    got = record.instances_of(tb, [4, 3, 2, 1, 0], 0)
+    assert got == {"sparse": [0, 1, 2, 3, 4], "medium": [0]}
+    assert record.instances_of(tb.drop(columns="instances"), [0, 1], 7) == {
+        "sparse": [7],
+        "medium": [7],
+    }
+    s = record.Stamp(**{**asdict(_stamp()), "instances": got})
+    assert "- **Tree instances**: sparse: testbed seeds 0, 1, 2, 3, 4; medium: testbed seed 0" in (
+        s.markdown()
+    )
+    assert "Tree instances" not in _stamp().markdown()  # a record made before the field
+
+
 def test_a_ledger_without_origins_takes_them_from_the_catalogue():
     claims = pd.DataFrame(
         {
