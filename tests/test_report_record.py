@@ -420,6 +420,48 @@ def test_headline_counts_the_verdicts_and_gives_each_story_claim_its_interval():
     assert "sparse **fails** (+1.27 [+0.56, +1.97] x)" in lines[3]
 
 
+def test_headline_says_the_direction_and_whether_the_papers_size_is_reproduced():
+    """The record's medium tree: ours above static by +6.27 [+6.13, +6.42] dB holds, where the
+    paper reported +2.80: outside the interval; a range of the paper's that meets it: inside."""
+    claims = pd.DataFrame(
+        {
+            "id": ["ours_above_static_beyond/medium", "damping_not_recovered/dense"],
+            "measured": [6.27, 0.498],
+            "ci_low": [6.13, 0.237],
+            "ci_high": [6.42, 0.759],
+            "unit": ["dB", "fraction"],
+            "verdict": ["holds", "holds"],
+            "origin": ["paper", "paper"],
+            "paper_low": [2.80, 0.5625],
+            "paper_high": [2.80, 0.775],
+            "paper_in_interval": ["outside", "inside"],
+        }
+    )
+    lines = record.headline_lines(claims)
+    assert "medium **holds** (+6.27 [+6.13, +6.42] dB; the paper's +2.8 outside)" in lines[2]
+    assert (
+        "dense **holds** (+0.498 [+0.237, +0.759] fraction; the paper's +0.562 to +0.775 inside)"
+        in lines[3]
+    )
+
+
+def test_the_stamp_names_the_tree_instances():
+    """Five instances per tree (testbed_seeds): the training seeds' testbed seeds; one (the
+    paper's protocol, or a table made before the column): the config's testbed seed."""
+    tb = pd.DataFrame({"tree": ["sparse", "medium"], "instances": [5, 1]})
+    got = record.instances_of(tb, [4, 3, 2, 1, 0], 0)
+    assert got == {"sparse": [0, 1, 2, 3, 4], "medium": [0]}
+    assert record.instances_of(tb.drop(columns="instances"), [0, 1], 7) == {
+        "sparse": [7],
+        "medium": [7],
+    }
+    s = record.Stamp(**{**asdict(_stamp()), "instances": got})
+    assert "- **Tree instances**: sparse: testbed seeds 0, 1, 2, 3, 4; medium: testbed seed 0" in (
+        s.markdown()
+    )
+    assert "Tree instances" not in _stamp().markdown()  # a record made before the field
+
+
 def test_a_ledger_without_origins_takes_them_from_the_catalogue():
     claims = pd.DataFrame(
         {

@@ -19,6 +19,7 @@ from pathlib import Path
 
 import physgs.config
 from physgs.report import build, claims
+from physgs.report.claim_cells import roles_of
 
 
 def main() -> None:
@@ -46,7 +47,7 @@ def main() -> None:
         if path.exists():
             inputs[build.key(need)] = str(path)
     missing = sorted({build.key(n) for n in needs} - set(inputs))
-    df = build.claims_frame(inputs, trees)
+    df = build.claims_frame(inputs, trees, roles_of(cfg["presets"], trees))
     md = claims.ledger_markdown(df, {"seeds": " ".join(map(str, seeds)), "partial": "yes"})
     print(md)
     print(f"not found under {args.results} ({len(missing)}): {', '.join(missing) or 'none'}")

@@ -136,6 +136,11 @@ def main() -> None:
             job_min_by_stage={k: sum(v.values()) / 60 for k, v in sorted(by_stage.items())},
             note=args.note,
             jobs=len(run.jobs),
+            instances=record.instances_of(
+                pd.read_csv(r / "tables" / "tab_testbed.csv"),
+                fit["seed"].unique(),
+                int(physgs.config.load("config/trees.yaml", str(fit["profile"].iloc[0]))["seed"]),
+            ),
         )
         written = record.write_record(
             args.out,

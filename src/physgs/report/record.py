@@ -106,6 +106,8 @@ class Stamp:
         job_min_by_stage: job-minutes per stage, from the run's benchmark files.
         note: what a reader should know about how the run was made (apart from the commit).
         jobs: the run's benchmarked jobs (one benchmark file each; light jobs have none).
+        instances: tree -> the testbed seeds of its tree instances (``testbed_seeds``: one per
+            training seed; without, the one of ``seed``); {} in a record made before it.
     """
 
     date: str
@@ -119,6 +121,7 @@ class Stamp:
     job_min_by_stage: dict[str, float] = field(default_factory=dict)
     note: str = ""
     jobs: int = 0
+    instances: dict[str, list[int]] = field(default_factory=dict)
 
     def __post_init__(self):
         """Refuse a commit that is not a plain hash (a sentence, or a tag a clone lacks)."""
@@ -127,6 +130,22 @@ class Stamp:
                 f"stamp commit {self.commit!r}: a plain commit hash (7-40 hex digits); say the "
                 "rest in the stamp's note"
             )
+
+    def instances_words(self) -> str:
+        """The trees' instances in words: ``sparse, medium: testbed seeds 0-4``.
+
+        Returns:
+            One phrase per set of testbed seeds, "; "-joined.
+        """
+        by: dict[tuple[int, ...], list[str]] = {}
+        for t, seeds in self.instances.items():
+            by.setdefault(tuple(seeds), []).append(t)
+        words = [
+            f"{', '.join(trees)}: {'testbed seed' if len(s) == 1 else 'testbed seeds'} "
+            + ", ".join(map(str, s))
+            for s, trees in by.items()
+        ]
+        return "; ".join(words)
 
     def markdown(self) -> str:
         """The stamp as a short Markdown list.
@@ -142,6 +161,7 @@ class Stamp:
             [
                 f"- **Run**: profile `{self.profile}`, config hash `{self.config_hash}`, "
                 f"seeds {', '.join(map(str, self.seeds))}, trees {', '.join(self.trees)}",
+                *([f"- **Tree instances**: {self.instances_words()}"] if self.instances else []),
                 f"- **Made at** commit `{self.commit}`; record written {self.date}",
                 *([f"- **Note**: {self.note}"] if self.note else []),
                 f"- **Machine**: {self.cpu}, 2 cores",
@@ -151,6 +171,27 @@ class Stamp:
                 "",
             ]
         )
+
+
+def instances_of(testbed: pd.DataFrame, seeds, seed: int) -> dict[str, list[int]]:
+    """Each tree's instances as a run's ``tab_testbed.csv`` says (its ``instances`` column): the
+    training seeds' testbed seeds where a tree has one per seed, else the one of ``seed``.
+
+    Args:
+        testbed: the run's tab_testbed CSV (``tree``, ``instances``; a table made before the
+            column: one instance each).
+        seeds: the run's training seeds.
+        seed: the config's testbed seed (the one instance of the paper's protocol).
+
+    Returns:
+        tree -> testbed seeds.
+    """
+    seeds = sorted(int(x) for x in seeds)
+    out = {}
+    for _, r in testbed.iterrows():
+        n = int(r["instances"]) if "instances" in testbed.columns else 1
+        out[str(r["tree"])] = seeds if n > 1 and n == len(seeds) else [int(seed)]
+    return out
 
 
 def format_duration(seconds: float) -> str:
@@ -1016,7 +1057,9 @@ def story_line(claims: pd.DataFrame) -> str:
 def headline_lines(claims: pd.DataFrame) -> list[str]:
     """What the run found, in a few lines: the ledger's counts (the paper's claims apart from
     this project's), whether the paper's story stands, then each headline family's
-    (``catalogue.headline``) verdict per cell with its measured value and 95% interval.
+    (``catalogue.headline``) verdict per cell with its measured value and 95% interval, and,
+    where the paper gives a number, whether it lies inside that interval (the direction and the
+    size both: ``paper_in_interval``).
 
     Args:
         claims: the ledger (``claims.csv``: id, measured, ci_low, ci_high, unit, verdict).
@@ -1036,6 +1079,11 @@ def headline_lines(claims: pd.DataFrame) -> list[str]:
         for (_, r), k in zip(rows.iterrows(), kind[rows.index]):
             where = str(r["id"])[len(fam) + 1 :] or "all"
             value = _value_text(r).replace(" (one value)", "")
+            size = r.get("paper_in_interval")  # a record made before the column has none
+            if isinstance(size, str) and size:
+                p_lo, p_hi = r["paper_low"], r["paper_high"]
+                fig = f"{p_lo:+.3g}" if p_lo == p_hi else f"{p_lo:+.3g} to {p_hi:+.3g}"
+                value = f"{value.strip()}; the paper's {fig} {size}"
             cells.append(f"{where} **{k}** ({value.strip()})")
         lines.append(f"- {words[0].upper() + words[1:]}: " + "; ".join(cells) + ".")
     return lines
