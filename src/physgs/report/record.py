@@ -173,7 +173,7 @@ class Stamp:
         )
 
 
-def instances_of(testbed: pd.DataFrame, seeds, seed: int) -> dict[str, list[int]]:
+def instances_of(testbed: pd.DataFrame, seeds: Sequence[int], seed: int) -> dict[str, list[int]]:
     """Each tree's instances as a run's ``tab_testbed.csv`` says (its ``instances`` column): the
     training seeds' testbed seeds where a tree has one per seed, else the one of ``seed``.
 
