@@ -6,6 +6,7 @@ import pandas as pd
 import pytest
 
 from physgs.report import claims
+from roles import ROLES
 
 
 BLIND = (
@@ -21,7 +22,11 @@ def _blind_claims(null, damping, trees):
     """The forcing-free methods' claims of the ledger measured on tab_recovery (and
     tab_damping)."""
     tabs = {"tab_recovery": null, **({"tab_damping": damping} if damping is not None else {})}
-    return [(c, v) for c, v in claims.measure(tabs, {}, trees) if set(BLIND) & set(c.id.split("/"))]
+    return [
+        (c, v)
+        for c, v in claims.measure(tabs, {}, trees, roles=ROLES)
+        if set(BLIND) & set(c.id.split("/"))
+    ]
 
 
 def _null(ours, blind, oma, null_oma):

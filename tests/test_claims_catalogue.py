@@ -10,6 +10,7 @@ import pytest
 
 from physgs.report import catalogue
 from physgs.report.catalogue import CATALOGUE, ClaimSpec, origin_of
+from roles import ROLES
 
 ROOT = Path(__file__).resolve().parents[1]
 
@@ -31,6 +32,19 @@ def test_the_page_lists_every_family_with_its_origin_and_threshold():
     for spec, row in zip(CATALOGUE, rows):
         assert spec.family in row and row.endswith(f"| {spec.origin} |")
         assert f"`{spec.threshold.lstrip('-')}` = {spec.value:g}" in row
+
+
+def test_kinds_by_id_and_the_page_marks_the_premises():
+    """The fit bar and the testbed's gap are premises, whoever the id names; the rest findings."""
+    assert catalogue.kind_of("fits_window/dense/ours_chain") == "premise"
+    assert catalogue.kind_of("fits_window/sparse/mlp") == "premise"
+    assert catalogue.kind_of("nearest_bone_gap/medium") == "premise"
+    assert catalogue.kind_of("null_factor/sparse") == "finding"
+    assert catalogue.kind_of("ours_chain/above_static_beyond/sparse") == "finding"
+    assert "training window" in catalogue.undermines("fits_window/dense/mlp")
+    assert catalogue.undermines("null_factor/sparse") == ""
+    marked = {ln.split("`")[1] for ln in catalogue.markdown().splitlines() if "(premise)" in ln}
+    assert marked == set(catalogue.PREMISES) == {"fits_window", "nearest_bone_gap"}
 
 
 def test_a_spec_refuses_what_it_cannot_decide():
@@ -93,6 +107,7 @@ def test_a_new_family_is_one_entry(monkeypatch):
         "FIT_BAR", ">", "fraction",
         "{tree}: {fit_label} fits its window", "tab_fit: ceiling fraction",
         "this project", origin="project", headline="every model fits its window",
+        one_sided="a bar",
     )  # fmt: skip
     monkeypatch.setattr(catalogue, "CATALOGUE", (*CATALOGUE, new))
     monkeypatch.setattr(claims, "CATALOGUE", catalogue.CATALOGUE)
@@ -103,7 +118,9 @@ def test_a_new_family_is_one_entry(monkeypatch):
             for m in ("mlp", "mlp_wind", "d3dgs", "d3dgs_wind", "ours")
         ]
     )
-    led = claims.ledger(claims.measure({"tab_fit": fit}, {}, ["sparse"])).set_index("id")
+    led = claims.ledger(claims.measure({"tab_fit": fit}, {}, ["sparse"], roles=ROLES)).set_index(
+        "id"
+    )
     row = led.loc["fits_window_strictly/sparse/mlp"]
     assert row["verdict"] == "holds" and row["origin"] == "project"
     assert origin_of("fits_window_strictly/sparse/mlp") == "project"
@@ -144,7 +161,7 @@ def test_moving_a_family_to_another_table_is_its_table_field(monkeypatch):
     )
 
     def tracks(tables):
-        got = claims.ledger(claims.measure(tables, {}, ["sparse"])).set_index("id")
+        got = claims.ledger(claims.measure(tables, {}, ["sparse"], roles=ROLES)).set_index("id")
         return got.loc[["tracks_beats_null/sparse", "tracks_match_ours/sparse"]]
 
     before = tracks({"tab_recovery": rows})
@@ -159,3 +176,21 @@ def test_moving_a_family_to_another_table_is_its_table_field(monkeypatch):
     pd.testing.assert_frame_equal(before[cols], after[cols])
     assert after["source"].str.startswith("tab_other").all()
     assert "tab_other" in catalogue.tables()
+
+
+def test_a_one_sided_claim_says_why_and_a_band_has_no_side():
+    """Every family is an equivalence test (a band) or one-sided with its stated reason."""
+    for spec in CATALOGUE:
+        assert (spec.side == catalogue.WITHIN) != bool(spec.one_sided), spec.family
+    base = next(s for s in CATALOGUE if s.side != catalogue.WITHIN)
+    kw = {f: getattr(base, f) for f in base.__dataclass_fields__}
+    with pytest.raises(ValueError, match="one_sided"):
+        ClaimSpec(**{**kw, "one_sided": ""})
+    with pytest.raises(ValueError, match="one_sided"):
+        ClaimSpec(**{**kw, "side": catalogue.WITHIN})
+
+
+def test_flatness_is_a_band_in_every_family_that_claims_it():
+    """A claim of flatness is tested inside (-t, +t), for ours and every other prior."""
+    flat = [s for s in CATALOGUE if s.family == "decay_rate_flat"]
+    assert len(flat) == 2 and all(s.side == catalogue.WITHIN for s in flat)

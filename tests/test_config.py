@@ -153,7 +153,7 @@ def test_unknown_profile_is_refused_with_the_choices():
 
 def test_load_rejects_a_bad_file(tmp_path):
     base = _base()
-    base["trees"] = ["sparse", "oak"]
+    base["trees"] = ["sparse", "Oak"]  # not a tree name (a preset's: lower case, no underscore)
     bad = tmp_path / "trees.yaml"
     bad.write_text(yaml.safe_dump(base))
     with pytest.raises(pconfig.ConfigError, match="trees/1"):
@@ -203,16 +203,6 @@ def test_missing_section_is_named():
         ),
         (lambda c: c.update(seds=[0, 1]), "seds", "seeds"),
         (lambda c: c["train"]["lr"].update(mens=1e-4), "train/lr/mens", "train/lr/means"),
-        (
-            lambda c: c["testbed"]["vertices"].update(sprase=400),
-            "testbed/vertices/sprase",
-            "testbed/vertices/sparse",
-        ),
-        (
-            lambda c: c["presets"].update(mediun=c["presets"]["medium"]),
-            "presets/mediun",
-            "presets/medium",
-        ),
         (lambda c: c["testbed"]["wind"].update(v_0=5.0), "testbed/wind/v_0", "testbed/wind/v0"),
     ],
 )
@@ -221,6 +211,33 @@ def test_unknown_key_is_refused_with_the_nearest_valid_key(edit, key, suggestion
     assert f"unknown config key '{key}'" in msg
     assert f"did you mean '{suggestion}'" in msg
     assert "Fix config/trees.yaml" in msg
+
+
+@pytest.mark.parametrize(
+    "edit, key, suggestion",
+    [
+        (
+            lambda c: c["testbed"]["vertices"].update(sprase=400),
+            "testbed/vertices/sprase",
+            "sparse",
+        ),
+        (lambda c: c["presets"].update(mediun=c["presets"]["medium"]), "presets/mediun", "medium"),
+    ],
+)
+def test_a_tree_named_like_another_is_refused_as_a_typo(edit, key, suggestion):
+    """Presets are an open set (a new tree has its own); a name no tree lists, close to
+    another's, is still refused with the nearest."""
+    msg = _refused(edit)
+    assert key in msg and f"did you mean '{suggestion}'" in msg
+
+
+def test_a_fourth_preset_with_its_own_name_and_role_is_accepted():
+    raw = _base()
+    raw["presets"]["oak"] = {**raw["presets"]["sparse"], "role": {"frequencies": "tiled"}}
+    raw["testbed"]["vertices"]["oak"] = 400
+    raw["trees"] = [*raw["trees"], "oak"]
+    cfg = pconfig.resolve(raw, "default")
+    assert cfg["presets"]["oak"]["role"] == {"frequencies": "tiled"}
 
 
 def test_a_profile_cannot_name_a_profile():

@@ -116,3 +116,14 @@ def test_an_unmarked_verdict_is_caught():
     assert not unmarked_verdicts("`anemometer_needed` is measured per tree.", ledger)
     assert not unmarked_verdicts("`min_stable` holds poles.", ledger)
     assert not unmarked_verdicts(f"`anemometer_needed` holds when it grows. {NONE}", ledger)
+
+
+def test_no_page_cites_a_tracker_no_reader_has():
+    """The changelog and the pages say what was done, not "issue NN" of a private tracker."""
+    pages = [*_pages(), ROOT / "CHANGELOG.md"]
+    found = [
+        f"{p.name}: {m.group(0)}"
+        for p in pages
+        for m in re.finditer(r"\bissues? #?\d+", p.read_text(), flags=re.I)
+    ]
+    assert not found, found

@@ -17,6 +17,7 @@ from physgs.report.build import Plan, needs
 from physgs.report.parts import row, tab_parts
 from oracles import model_context, quick_models_cfg
 from test_config import _refused
+from roles import ROLES
 
 
 def _majority_share(labels, bone):
@@ -110,7 +111,7 @@ def test_tab_parts_without_a_damping_testbed_shows_no_damping_cell():
 def _parts_claims(parts, trees):
     """The parts study's claims of the ledger, measured on tab_parts."""
     fams = ("coupling_lifts_sparse_fit", "topology_parts_reduce_damping_error")
-    measured = claims.measure({"tab_parts": parts}, {}, trees)
+    measured = claims.measure({"tab_parts": parts}, {}, trees, roles=ROLES)
     return [(c, v) for c, v in measured if c.id.split("/")[0] in fams]
 
 

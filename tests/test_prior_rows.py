@@ -13,6 +13,7 @@ from physgs.report import claims as C
 from physgs.report import tables as T
 from physgs.report.summary import prior_lines
 from test_report_tables import BONES, null, paired, record
+from roles import ROLES
 
 CONFIGS = {"single": {"K": 32}, "joint32": {"K": 32}, "joint96": {"K": 96}}
 PLAN = build.Plan(
@@ -208,7 +209,7 @@ def _tables(ahead: float, seeds=(0, 1, 2)):
 
 def prior_claims(model, tables, damping, trees):
     """The ledger's claims asked of ``model`` (ids ``<model>/...``) measured on ``tables``."""
-    measured = C.measure(tables, {}, trees, {model: damping})
+    measured = C.measure(tables, {}, trees, {model: damping}, roles=ROLES)
     return [(c, v) for c, v in measured if c.id.startswith(f"{model}/")]
 
 
@@ -243,7 +244,7 @@ def test_ours_claims_read_ours_rows_only_and_the_chain_joins_the_ledger():
     """ours' margin and null claims keep reading ours' rows where the chain's follow; the
     ledger asks the chain's claims only of a run whose tables hold it."""
     tabs = _tables(1.0)
-    v = C.ledger(C.measure(tabs, {}, ["sparse"])).set_index("id")
+    v = C.ledger(C.measure(tabs, {}, ["sparse"], roles=ROLES)).set_index("id")
     assert v.loc["margin_grows/sparse", "measured"] == pytest.approx(-0.95)  # ours': -1 + jitter
     assert "ours_chain/beats_null/sparse" in v.index
     old = {
@@ -252,7 +253,10 @@ def test_ours_claims_read_ours_rows_only_and_the_chain_joins_the_ledger():
     }
     old["tab_psnr"] = tabs["tab_psnr"][tabs["tab_psnr"].model != "ours_chain"]
     old["tab_transfer"] = tabs["tab_transfer"].drop(columns="ours_chain")
-    assert not any(i.startswith("ours_chain/") for i in C.ledger(C.measure(old, {}, ["sparse"])).id)
+    assert not any(
+        i.startswith("ours_chain/")
+        for i in C.ledger(C.measure(old, {}, ["sparse"], roles=ROLES)).id
+    )
 
 
 def test_the_summary_counts_the_splits_where_the_chain_beats_every_field():
@@ -261,7 +265,7 @@ def test_the_summary_counts_the_splits_where_the_chain_beats_every_field():
     assert "**4 of 4**" in line and "sparse/view" in line and label("ours_chain") in line
     behind = C.ledger(prior_claims("ours_chain", _tables(-1.0), {}, ["sparse"]))
     assert "**0 of 4**" in prior_lines(behind)[0]
-    assert prior_lines(C.ledger(C.measure({}, {}, ["sparse"]))) == []
+    assert prior_lines(C.ledger(C.measure({}, {}, ["sparse"], roles=ROLES))) == []
 
 
 def test_tab_damping_sets_each_prior_beside_ours_on_both_testbeds():

@@ -7,6 +7,7 @@ import pytest
 from physgs.models.registry import models_of
 from physgs.report import claims as C
 from physgs.report import paper
+from roles import ROLES
 
 CLAIM = C.Claim("x", "x is positive", "--", "--", 0.0, ">", "dB")
 
@@ -107,7 +108,7 @@ def _tables(seeds=(0,)):
 
 def test_claims_measured_from_the_tables():
     damping = {"sparse": [{"median_zeta": 0.12, "zeta_true": 0.08, "loglog_exponent": 0.1}]}
-    df = C.ledger(C.measure(_tables(seeds=(0, 1, 2)), damping, ["sparse", "medium"]))
+    df = C.ledger(C.measure(_tables(seeds=(0, 1, 2)), damping, ["sparse", "medium"], roles=ROLES))
     v = df.set_index("id")
     assert v.loc["baselines_below_static_beyond/sparse", "measured"] == pytest.approx(-1.0)
     assert v.loc["baselines_below_static_beyond/sparse", "verdict"] == "holds"
@@ -142,15 +143,17 @@ def test_claims_measured_from_the_tables():
 
 def test_a_single_seed_table_gives_one_seed_verdicts():
     t = {k: d.drop(columns=["seed"], errors="ignore") for k, d in _tables().items()}
-    df = C.ledger(C.measure(t, {}, ["sparse"]))
+    df = C.ledger(C.measure(t, {}, ["sparse"], roles=ROLES))
     needs = df[~df["id"].str.startswith("nearest_bone_gap")]
     assert needs["verdict"].str.startswith("undecided: one seed").all()
 
 
 def test_a_partial_run_gives_a_partial_ledger():
     full_tables = _tables(seeds=(0, 1, 2))
-    full = C.ledger(C.measure(full_tables, {}, ["sparse", "medium"])).set_index("id")
-    part = C.ledger(C.measure({"tab_null": full_tables["tab_null"]}, {}, ["sparse", "medium"]))
+    full = C.ledger(C.measure(full_tables, {}, ["sparse", "medium"], roles=ROLES)).set_index("id")
+    part = C.ledger(
+        C.measure({"tab_null": full_tables["tab_null"]}, {}, ["sparse", "medium"], roles=ROLES)
+    )
     part = part.set_index("id")
     measured = part[part["seeds"] > 0]
     # what tab_null holds is measured exactly as in the whole ledger
@@ -310,7 +313,7 @@ def test_every_claim_points_the_right_way(claims_true):
     is false, every claim fails. Flipping the side of any claim, or the sign of what it
     measures, breaks one of the two."""
     tables, damping = _world(claims_true)
-    df = C.ledger(C.measure(tables, damping, list(TREES))).set_index("id")
+    df = C.ledger(C.measure(tables, damping, list(TREES), roles=ROLES)).set_index("id")
     assert {i.split("/")[0] for i in df.index} == FAMILIES  # a new claim needs its world here
     want = "holds" if claims_true else "fails"
     wrong = df[df["verdict"] != want]
@@ -398,3 +401,84 @@ def test_only_an_undecided_claim_gets_an_estimate():
     assert list(rows["scale"]) == ["linear", "linear", "linear", "log"]
     md = C.ledger_markdown(rows.assign(origin="paper"))
     assert f"t {int(est[1][0])} / power {int(est[1][1])}" in md
+
+
+# --- equivalence: a claim of flatness holds inside its band, fails outside it ----------------------
+
+FLAT = C.Claim("p", "gamma ~ omega^p is flat", "--", "--", 0.5, C.WITHIN, "exponent")
+
+
+def _seeds_with(mean: float, sd: float, n: int = 5) -> np.ndarray:
+    """n values with exactly this mean and sample sd (a fixed pattern, rescaled)."""
+    z = np.array([-1.2, -0.4, 0.1, 0.5, 1.0])[:n]
+    z = (z - z.mean()) / z.std(ddof=1)
+    return mean + sd * z
+
+
+def test_p_of_minus_six_is_not_flat():
+    """The record's medium tree: p = -6.07 [-9.70, -2.44] over five seeds (sd 2.92). Its
+    interval (scipy's t interval, the oracle) lies wholly below -0.5: not flat, it fails; the old
+    one-sided test (p < 0.5) called it flat."""
+    from scipy import stats
+
+    v = _seeds_with(-6.07445, 2.92339)
+    lo, hi = stats.t.interval(0.95, 4, loc=v.mean(), scale=stats.sem(v))
+    assert (lo, hi) == (pytest.approx(-9.704, abs=2e-3), pytest.approx(-2.445, abs=2e-3))
+    assert C.verdict(FLAT, v) == "fails"
+    one_sided = C.Claim("p", "", "--", "--", 0.5, "<", "exponent")
+    assert C.verdict(one_sided, v) == "holds"  # the fault the band removes
+
+
+@pytest.mark.parametrize(
+    "mean, sd, want",
+    [
+        (0.0, 0.1, "holds"),  # [-0.12, 0.12]: inside (-0.5, 0.5)
+        (1.4, 0.29, "fails"),  # [1.04, 1.76]: wholly above +0.5
+        (0.13, 0.41, "undecided"),  # [-0.38, 0.64]: across +0.5
+        (-0.06, 0.43, "undecided"),  # [-0.59, 0.48]: across -0.5
+        (0.0, 3.0, "undecided"),  # wider than the band: across both edges
+    ],
+)
+def test_a_band_holds_inside_fails_outside_and_is_undecided_across_an_edge(mean, sd, want):
+    assert C.verdict(FLAT, _seeds_with(mean, sd)) == want
+
+
+def test_a_bands_one_seed_verdict_and_its_threshold_text():
+    assert C.verdict(FLAT, [0.2]).endswith("(point estimate on the claim)")
+    assert C.verdict(FLAT, [-0.7]).endswith("(point estimate against the claim)")
+    assert FLAT.threshold_text == "within ±0.5"
+
+
+def test_an_undecided_bands_seeds_to_decide_read_the_nearer_edge():
+    """Mean 0.13 lies 0.37 from +0.5 and 0.63 from -0.5: the estimate is the one-sided claim's
+    at +0.5 (the same numbers through the same function)."""
+    v = _seeds_with(0.13, 0.41)
+    assert C.to_decide(FLAT, v) == C.seeds_to_decide(0.13 - 0.5, float(np.std(v, ddof=1)))
+
+
+@pytest.mark.parametrize(
+    "paper_value, want",
+    [
+        ((2.8, 2.8), "outside"),  # the record's medium: +2.80 dB against [6.13, 6.42]
+        ((6.2, 6.2), "inside"),
+        ((6.0, 6.2), "inside"),  # a range that meets the interval
+        ((5.0, 6.0), "outside"),
+        ((np.nan, np.nan), ""),  # no number in the paper
+    ],
+)
+def test_the_papers_value_inside_the_interval(paper_value, want):
+    c = C.Claim("x", "", "--", "--", 0.0, ">", "dB", paper_value=paper_value)
+    assert C.paper_in_interval(c, 6.12509, 6.41767) == want
+    assert C.paper_in_interval(c, np.nan, np.nan) == ""
+
+
+def test_the_ledger_says_whether_the_papers_figure_is_reproduced():
+    """Ours 2 dB above static beyond the window in the world where every claim holds; the
+    paper's sparse figure is 25.42 - 25.16 = +0.26 dB (tab:psnr): outside; the margin grows by
+    2 dB, the paper's sparse by -0.61 + 1.42 = +0.81 dB: outside too."""
+    tables, damping = _world(True)
+    df = C.ledger(C.measure(tables, damping, list(TREES), roles=ROLES)).set_index("id")
+    r = df.loc["ours_above_static_beyond/sparse"]
+    assert r["paper_low"] == pytest.approx(0.26) and r["paper_in_interval"] == "outside"
+    assert df.loc["margin_grows/sparse", "paper_low"] == pytest.approx(0.81)
+    assert df.loc["transfer_ours_ahead/sparse/0.84", "paper_in_interval"] == ""  # no number

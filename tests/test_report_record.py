@@ -137,7 +137,10 @@ def test_write_record_copies_every_table_as_csv_and_summarises_it_over_seeds(tmp
     # the figures first, then the ledger, then the tables, then the run
     heads = [ln for ln in index.splitlines() if ln.startswith("## ")]
     assert heads == ["## Figures", "## The paper against the measured", "## Tables", "## The run"]
-    assert "4 claims: 2 hold, 1 fail, 1 undecided" in index and "(ledger.md)" in index
+    assert (
+        "4 claims: 3 findings (2 hold, 1 fail), 1 premise (1 undecided)" in index
+        and "(ledger.md)" in index
+    )
     stamp = json.loads((out / "stamp.json").read_text())
     assert stamp["seeds"] == [0, 1] and stamp["wall_s"] == 11285.0
     assert "3 h 8 min" in (out / "stamp.md").read_text()
@@ -205,10 +208,12 @@ def test_the_committed_record_re_renders_from_its_own_files(tmp_path):
 
     copy = tmp_path / "record"
     shutil.copytree(RECORD, copy)
+    assert not record.derive_claims(copy)  # the committed ledger has every derived column
     record.render_pages(copy)
     for page in (
         "index.md",
         "figures.md",
+        "ledger.md",
         "tables.md",
         "stamp.md",
         *(f"tables/{t.stem}.md" for t in RECORD.glob("tables/*.csv")),
@@ -216,6 +221,86 @@ def test_the_committed_record_re_renders_from_its_own_files(tmp_path):
         assert (copy / page).read_text() == (RECORD / page).read_text(), (
             f"docs/record/{page} is stale: run `python tools/record.py --pages-only`"
         )
+
+
+def test_the_ledger_page_puts_the_papers_claims_first_one_row_each_filterable():
+    from html.parser import HTMLParser
+
+    claims = pd.read_csv(RECORD / "claims.csv", dtype={"config_hash": str})
+    page = record.ledger_page(RECORD / "claims.csv", ("sparse", "medium", "dense"))
+
+    class Rows(HTMLParser):
+        def __init__(self):
+            super().__init__()
+            self.rows, self.cells, self.cell = [], [], None
+
+        def handle_starttag(self, tag, attrs):
+            if tag == "tr" and dict(attrs).get("data-origin"):
+                self.rows.append(dict(attrs))
+                self.cells.append([])
+            elif tag == "td":
+                self.cell = ""
+
+        def handle_data(self, data):
+            if self.cell is not None:
+                self.cell += data
+
+        def handle_endtag(self, tag):
+            if tag == "td":
+                self.cells[-1].append(self.cell)
+                self.cell = None
+
+    p = Rows()
+    p.feed(page)
+    assert len(p.rows) == len(claims)
+    origins = [r["data-origin"] for r in p.rows]
+    n_paper = int((claims["origin"] == "paper").sum())
+    assert origins == ["paper"] * n_paper + ["project"] * (len(claims) - n_paper)
+    by_id = {r["id"]: (r, c) for r, c in zip(p.rows, p.cells)}
+    row, cells = by_id["claim-fits-window-dense-mlp"]
+    want = claims.set_index("id").loc["fits_window/dense/mlp"]
+    assert (row["data-verdict"], row["data-tree"], row["data-kind"]) == (
+        want["verdict"],
+        "dense",
+        "premise",
+    )
+    assert cells[1:] == [
+        "dense",
+        want["paper"],
+        f"{want['measured']:+.3g} [{want['ci_low']:+.3g}, {want['ci_high']:+.3g}] fraction",
+        want["verdict"],
+        "premise",
+        "paper",
+    ]
+    assert want["claim"] in cells[0] and want["source"] in cells[0]  # one click away
+    assert "if it fails, it undermines every comparison that model enters" in cells[0]
+    assert f'class="verdict-{want["verdict"]}"' in page.split('id="claim-fits-window-dense-mlp"')[1]
+
+
+def test_a_ledger_gains_its_kind_from_the_catalogue_and_keeps_every_number(tmp_path):
+    """A record written before the kind column gains it from its ids; nothing else moves, and
+    its claims.md is the claims rule's printer's (the committed one, kind and counts aside)."""
+    import shutil
+
+    copy = tmp_path / "record"
+    shutil.copytree(RECORD, copy)
+    committed = pd.read_csv(RECORD / "claims.csv", dtype=str, keep_default_na=False)
+    committed.drop(columns="kind").to_csv(copy / "claims.csv", index=False)
+    (copy / "claims.md").write_text("stale")
+    summary = (RECORD / "summary.md").read_text()
+    a, b = summary.index(record.SUMMARY_CLAIMS), summary.index("### Fit to the training window")
+    (copy / "summary.md").write_text(summary[:a] + "### Claims ledger\n\nstale\n\n" + summary[b:])
+    written = record.derive_claims(copy)
+    assert set(written) == {copy / "claims.csv", copy / "claims.md", copy / "summary.md"}
+    # the claims section printed again, the rest (made from the benchmarks) as it was
+    assert (copy / "summary.md").read_text() == summary
+    again = pd.read_csv(copy / "claims.csv", dtype=str, keep_default_na=False)
+    pd.testing.assert_frame_equal(again, committed)  # text for text, kind where it was
+    premises = set(again.loc[again["kind"] == "premise", "id"].str.split("/").str[0])
+    assert premises == {"fits_window", "nearest_bone_gap"}
+    assert set(again["kind"]) == {"premise", "finding"}
+    assert (copy / "claims.md").read_text() == (RECORD / "claims.md").read_text()
+    assert not record.derive_claims(copy)  # once is enough
 
 
 def test_a_stamp_names_a_plain_commit_and_keeps_its_note_apart():
@@ -278,6 +363,38 @@ def test_a_missing_input_is_named_and_what_no_run_makes_outlives_a_new_record(tm
     assert not (out / "from_the_old_run.md").exists()
 
 
+def test_premises_are_counted_apart_and_a_failed_one_says_what_it_undermines():
+    claims = pd.DataFrame(
+        {
+            "id": [
+                "ours_above_static_beyond/sparse",
+                "fits_window/sparse/mlp",
+                "fits_window/dense/mlp",
+                "nearest_bone_gap/sparse",
+                "fits_window/dense/ours_chain",
+            ],
+            "measured": [1.99, 0.05, 0.1, 0.01, 0.6],
+            "ci_low": [1.2, 0.03, 0.08, np.nan, 0.55],
+            "ci_high": [2.77, 0.07, 0.12, np.nan, 0.65],
+            "unit": ["dB", "fraction", "fraction", "fraction", "fraction"],
+            "verdict": ["holds", "fails", "fails", "holds", "holds"],
+            "origin": ["paper", "paper", "paper", "paper", "project"],
+        }
+    )  # no kind column: a ledger written before it takes the kind from the catalogue
+    lines = record.headline_lines(claims)
+    assert lines[0].startswith(
+        "- **The paper's 4 claims: 1 finding (1 hold), 3 premises (1 hold, 2 fail)**; this "
+        "project's own 1 claim: 1 premise (1 hold)"
+    )
+    assert lines[1].startswith("- **Premises that fail**: the premise `fits_window` fails on ")
+    assert (
+        "sparse (mlp), dense (mlp): this undermines every comparison that model enters" in lines[1]
+    )
+    assert "nearest_bone_gap" not in lines[1]  # it holds
+    written = claims.assign(kind="finding")  # a written column is read, not the catalogue's
+    assert "premise" not in record.count_line(written).split("(95%")[0]
+
+
 def test_headline_counts_the_verdicts_and_gives_each_story_claim_its_interval():
     claims = pd.DataFrame(
         {
@@ -292,8 +409,8 @@ def test_headline_counts_the_verdicts_and_gives_each_story_claim_its_interval():
     )
     lines = record.headline_lines(claims)
     # the paper's claims counted apart from this project's, the paper's first
-    assert "The paper's 2 claims: 1 hold, 1 fail, 0 undecided" in lines[0]
-    assert "this project's own 2: 1 hold, 0 fail, 1 undecided" in lines[0]
+    assert "The paper's 2 claims: 2 findings (1 hold, 1 fail)" in lines[0]
+    assert "this project's own 2 claims: 2 findings (1 hold, 1 undecided)" in lines[0]
     # whether the paper's story stands, from its headline families' verdicts
     assert "stands in part**: 1 of its 2 headline claims hold" in lines[1]
     assert "fails on ours beats the untrained null by the paper's factor" in lines[1]
@@ -301,6 +418,48 @@ def test_headline_counts_the_verdicts_and_gives_each_story_claim_its_interval():
     assert lines[2].startswith("- Ours above the static pose")
     assert "sparse **holds** (+1.99 [+1.2, +2.77] dB)" in lines[2]
     assert "sparse **fails** (+1.27 [+0.56, +1.97] x)" in lines[3]
+
+
+def test_headline_says_the_direction_and_whether_the_papers_size_is_reproduced():
+    """The record's medium tree: ours above static by +6.27 [+6.13, +6.42] dB holds, where the
+    paper reported +2.80: outside the interval; a range of the paper's that meets it: inside."""
+    claims = pd.DataFrame(
+        {
+            "id": ["ours_above_static_beyond/medium", "damping_not_recovered/dense"],
+            "measured": [6.27, 0.498],
+            "ci_low": [6.13, 0.237],
+            "ci_high": [6.42, 0.759],
+            "unit": ["dB", "fraction"],
+            "verdict": ["holds", "holds"],
+            "origin": ["paper", "paper"],
+            "paper_low": [2.80, 0.5625],
+            "paper_high": [2.80, 0.775],
+            "paper_in_interval": ["outside", "inside"],
+        }
+    )
+    lines = record.headline_lines(claims)
+    assert "medium **holds** (+6.27 [+6.13, +6.42] dB; the paper's +2.8 outside)" in lines[2]
+    assert (
+        "dense **holds** (+0.498 [+0.237, +0.759] fraction; the paper's +0.562 to +0.775 inside)"
+        in lines[3]
+    )
+
+
+def test_the_stamp_names_the_tree_instances():
+    """Five instances per tree (testbed_seeds): the training seeds' testbed seeds; one (the
+    paper's protocol, or a table made before the column): the config's testbed seed."""
+    tb = pd.DataFrame({"tree": ["sparse", "medium"], "instances": [5, 1]})
+    got = record.instances_of(tb, [4, 3, 2, 1, 0], 0)
+    assert got == {"sparse": [0, 1, 2, 3, 4], "medium": [0]}
+    assert record.instances_of(tb.drop(columns="instances"), [0, 1], 7) == {
+        "sparse": [7],
+        "medium": [7],
+    }
+    s = record.Stamp(**{**asdict(_stamp()), "instances": got})
+    assert "- **Tree instances**: sparse: testbed seeds 0, 1, 2, 3, 4; medium: testbed seed 0" in (
+        s.markdown()
+    )
+    assert "Tree instances" not in _stamp().markdown()  # a record made before the field
 
 
 def test_a_ledger_without_origins_takes_them_from_the_catalogue():
@@ -479,3 +638,25 @@ def test_a_new_record_says_what_moved_against_the_one_it_replaces(tmp_path):
     # the same run recorded again (say, with Snakemake's report) keeps its comparison
     _record(r, out, figures=[], stamp=stamp)
     assert (out / "rerun.md").read_text() == text
+
+
+def test_the_readme_s_first_screen_names_the_ledger_and_each_command_s_cost_from_the_record():
+    """The README's first 25 lines: the ledger linked, each command beside its cost as the
+    record measured it, the paper profile's CPU-hours as its estimate computed them; the home
+    page links the ledger in its first lines."""
+    head = (ROOT / "README.md").read_text().splitlines()[:25]
+    assert any("(docs/ledger.md)" in ln for ln in head)  # the site's page
+    assert any("(docs/record/claims.md)" in ln for ln in head)  # the one GitHub renders
+    costs = record.read_costs(RECORD / "costs.csv").set_index("name")
+    for name, command in (
+        ("all", "snakemake --cores 2 all`"),
+        ("tests", "`python -m pytest -q`"),
+        ("quick_all", "snakemake --cores 2 all --config profile=quick`"),
+    ):
+        (line,) = [ln for ln in head if command in ln]
+        assert record.format_duration(float(costs.loc[name, "wall_s"])) in line, (name, line)
+    hours = re.search(r"\*\*(\d[\d,]*) CPU-hours\*\*", (RECORD / "paper_estimate.md").read_text())
+    text = " ".join(" ".join(head).split())
+    assert f"{hours.group(1)} CPU-hours" in text and "paper_estimate.md" in text
+    home = [ln for ln in (ROOT / "docs" / "index.md").read_text().splitlines() if ln.strip()]
+    assert any("(ledger.md)" in ln for ln in home[:3])

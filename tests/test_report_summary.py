@@ -106,8 +106,11 @@ def test_verdict_counts_and_each_verdict_come_from_the_ledger(run):
     text, claims, _ = run
     kinds = claims["verdict"].str.split(":").str[0]
     assert set(kinds) == {"holds", "fails", "undecided"}  # the fixture exercises all three
-    for v in ("holds", "fails", "undecided"):
-        assert f"**{v}** {int((kinds == v).sum())}" in text
+    words = {"holds": "hold", "fails": "fail", "undecided": "undecided"}
+    for who, kind in {tuple(x) for x in claims[["origin", "kind"]].to_numpy()}:
+        mine = kinds[(claims["origin"] == who) & (claims["kind"] == kind)]
+        by = ", ".join(f"{(mine == v).sum()} {w}" for v, w in words.items() if (mine == v).any())
+        assert f"{len(mine)} {kind}{'s' if len(mine) > 1 else ''} ({by})" in text
     for _, r in claims.iterrows():
         row = next(line for line in text.splitlines() if line.startswith(f"| `{r['id']}` |"))
         assert row.split(" | ")[3] == r["verdict"]  # the verdict column, before the estimate
@@ -198,8 +201,8 @@ def test_the_paper_apart_and_the_seeds_that_would_decide():
     ]
     df = C.ledger(measured)
     text = "\n".join(claims_section(df))
-    assert "The paper's 3 claims: **holds** 1, **fails** 0, **undecided** 2" in text
-    assert "This project's own 2 claims: **holds** 0, **fails** 1, **undecided** 1" in text
+    assert "The paper's 3 claims: 3 findings (1 hold, 2 undecided)" in text
+    assert "This project's own 2 claims: 2 findings (1 fail, 1 undecided)" in text
     # by hand (t half-width 2.776 sd / sqrt(3) > effect now): claim 2 decides at
     # t_{0.975, n-1} 0.4 / sqrt(n) < 0.6, first at n = 5 (2.776 * 0.4 / 2.236 = 0.497)
     assert df.loc[2, "seeds_to_decide_t_est"] == 5

@@ -29,6 +29,7 @@ from oracles import quick_config
 from test_config import _refused
 from test_report_tables import ours as ours_rows
 from workflow_helpers import ROOT
+from roles import ROLES
 
 BONES = {"sparse": 22, "medium": 224}
 
@@ -458,7 +459,7 @@ def _tracks_csv(diffs):
 def _tracks_claims(null, tracks, trees):
     """The 2D-track control's claims of the ledger measured on these two tables (its recovery
     rows beside ours' in tab_recovery)."""
-    measured = claims.measure({"tab_recovery": null, "tab_tracks": tracks}, {}, trees)
+    measured = claims.measure({"tab_recovery": null, "tab_tracks": tracks}, {}, trees, roles=ROLES)
     return [(c, v) for c, v in measured if c.id.startswith("tracks_")]
 
 
@@ -497,7 +498,7 @@ def test_a_tracks_fit_at_another_k_is_not_compared_with_ours():
 def test_ours_claims_read_ours_rows_of_a_table_with_tracks_rows():
     """null_loses/sparse reads ours' row even where the tracks row comes first."""
     df = _null_csv([1.0, 1.0]).iloc[::-1]
-    got = {c.id: v for c, v in claims.measure({"tab_null": df}, {}, ["sparse"])}
+    got = {c.id: v for c, v in claims.measure({"tab_null": df}, {}, ["sparse"], roles=ROLES)}
     # ours' errors 2.0, 2.01 against the null's 5.0 (the tracks' 1.0 would give 5.0)
     assert got["null_loses/sparse"] == pytest.approx([5.0 / 2.0, 5.0 / 2.01])
 

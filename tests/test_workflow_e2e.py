@@ -359,11 +359,22 @@ def test_summary_is_printed_from_the_run(run):
     paper = kinds[ledger["origin"] == "paper"]
     own = kinds[ledger["origin"] == "project"]
     assert len(paper) + len(own) == len(ledger)
-    counts = lambda k: ", ".join(
-        f"**{v}** {int((k == v).sum())}" for v in ("holds", "fails", "undecided")
-    )  # noqa: E731
-    assert f"The paper's {len(paper)} claims: {counts(paper)}." in text
-    assert f"This project's own {len(own)} claims: {counts(own)}." in text
+    words = {"holds": "hold", "fails": "fail", "undecided": "undecided"}
+
+    def counts(k, who):  # findings, then premises, each by verdict (a verdict none has left out)
+        parts = []
+        for kind in ("finding", "premise"):
+            mine = k[ledger.loc[k.index, "kind"] == kind]
+            by = ", ".join(
+                f"{(mine == v).sum()} {w}" for v, w in words.items() if (mine == v).any()
+            )
+            parts += (
+                [f"{len(mine)} {kind}{'s' if len(mine) != 1 else ''} ({by})"] if len(mine) else []
+            )
+        return f"{len(k)} claim{'s' if len(k) != 1 else ''}: " + (", ".join(parts) or "none")
+
+    assert f"The paper's {counts(paper, 'paper')}." in text
+    assert f"This project's own {counts(own, 'project')}." in text
     assert text.index("The paper's") < text.index("This project's own")
     assert "| model | sparse |" in text and "Warning" not in text
     for stage in ("testbed", "train", "evaluate"):

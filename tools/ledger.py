@@ -19,6 +19,7 @@ from pathlib import Path
 
 import physgs.config
 from physgs.report import build, claims
+from physgs.report.claim_cells import roles_of
 
 
 def main() -> None:
@@ -46,15 +47,15 @@ def main() -> None:
         if path.exists():
             inputs[build.key(need)] = str(path)
     missing = sorted({build.key(n) for n in needs} - set(inputs))
-    df = build.claims_frame(inputs, trees)
+    df = build.claims_frame(inputs, trees, roles_of(cfg["presets"], trees))
     md = claims.ledger_markdown(df, {"seeds": " ".join(map(str, seeds)), "partial": "yes"})
     print(md)
     print(f"not found under {args.results} ({len(missing)}): {', '.join(missing) or 'none'}")
     measured = df[df["seeds"] > 0]
-    counts = measured["verdict"].str.split(":").str[0].value_counts().to_dict()
     print(
-        f"{len(measured)} of {len(df)} claims measured: "
-        + ", ".join(f"{k} {v}" for k, v in sorted(counts.items()))
+        f"{len(measured)} of {len(df)} claims measured: the paper's "
+        f"{claims.counted(measured, 'paper')}; this project's own "
+        f"{claims.counted(measured, 'project')}"
     )
     if args.out:
         args.out.write_text(md)

@@ -2,6 +2,7 @@
 
     python tools/record.py [results] [--out docs/record] [--wall-s S] [--commit HASH] [--note TEXT]
     python tools/record.py --pages-only      # lay the record's pages out again from its own files
+                                             # (and add the ledger's catalogue-derived columns)
     python tools/record.py --readme-only     # rewrite the README's block from the record
     python tools/record.py --report-html [results/report.html]   # Snakemake's report, on demand
 
@@ -111,6 +112,8 @@ def main() -> None:
         print(f"{args.report_html}: Snakemake's report of the run (not part of the record)")
         return
     if args.pages_only:
+        for p in record.derive_claims(args.out):  # the catalogue's columns, the ledger's page
+            print(f"{p}: derived again from the record's claims.csv")
         print(f"{args.out}: {len(record.render_pages(args.out))} pages laid out again")
     elif not args.readme_only:
         r = args.results
@@ -133,6 +136,11 @@ def main() -> None:
             job_min_by_stage={k: sum(v.values()) / 60 for k, v in sorted(by_stage.items())},
             note=args.note,
             jobs=len(run.jobs),
+            instances=record.instances_of(
+                pd.read_csv(r / "tables" / "tab_testbed.csv"),
+                fit["seed"].unique(),
+                int(physgs.config.load("config/trees.yaml", str(fit["profile"].iloc[0]))["seed"]),
+            ),
         )
         written = record.write_record(
             args.out,

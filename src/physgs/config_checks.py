@@ -62,6 +62,37 @@ def trees_have_settings(cfg: dict) -> Iterator[Problem]:
             )
 
 
+def tree_names_distinct(cfg: dict) -> Iterator[Problem]:
+    """A preset or vertex count for a tree no run lists, named like another tree's, is a typo.
+
+    The presets are an open set (a new tree is a preset of its own, with its role), so the
+    schema cannot refuse ``presets/mediun``; a name that no tree lists and that is close to
+    another preset's is refused here, naming the nearest.
+
+    Args:
+        cfg: The resolved config (profile merged, schema-valid).
+
+    Yields:
+        ``(key path, message)`` per problem (the module docstring); none when the config passes.
+    """
+    import difflib
+
+    listed = set(cfg["trees"]) | set(cfg["damping_benchmark"]["trees"])
+    for section, names in (
+        (("presets",), cfg["presets"]),
+        (("testbed", "vertices"), cfg["testbed"]["vertices"]),
+    ):
+        for name in names:
+            others = [n for n in names if n != name]
+            near = difflib.get_close_matches(name, others, n=1, cutoff=0.75)
+            if name not in listed and near:
+                yield (
+                    (*section, name),
+                    f"'{name}' is listed by no tree and is close to '{near[0]}': did you mean "
+                    f"'{near[0]}'? A new tree needs a name of its own",
+                )
+
+
 def conditions_have_unseen_wind(cfg: dict) -> Iterator[Problem]:
     """conditions[0] is the training wind (1.0) and at least one unseen condition follows.
 
@@ -867,6 +898,7 @@ def fit_curve_is_runnable(cfg: dict) -> Iterator[Problem]:
 #: Every cross-key check, in the order their problems are reported.
 CHECKS: list[Check] = [
     trees_have_settings,
+    tree_names_distinct,
     conditions_have_unseen_wind,
     band_ordered,
     lead_in_fits_wind_period,

@@ -17,6 +17,7 @@ from physgs.experiments.recipe import canonical as _canonical
 from physgs.experiments.recipe import job_spec as _job_spec
 from physgs.recovery.run import null_settings as _null_settings
 from physgs.report import build as _build
+from physgs.report import claim_cells as _claim_cells
 
 # Torch's OpenMP threads spin-wait by default, which starves the other job on a 2-core machine
 # (measured: 20x slower projection); jobs inherit this environment.
@@ -104,6 +105,7 @@ NEED_PATHS = {
     "kselect": KSELECT,
     "prior_kselect": PRIOR_KSELECT,
     "stats": STATS,
+    "instance_stats": SEEDED_STATS,
     "table": TABLE.replace("{ext}", "csv"),
     "tracks_eval": TRACKS_EVAL,
     "tracks_fields": TRACKS_FIELDS,
@@ -295,7 +297,8 @@ def testbed_params(wildcards):
     return _canonical(
         {
             "testbed": _variant.effective_settings(tb),
-            "preset": CFG["presets"][t],
+            # its role picks claims, not geometry: editing it reruns the ledger, not the testbed
+            "preset": {k: v for k, v in CFG["presets"][t].items() if k != "role"},
             "seed": seed,
             "tree": t,
         }

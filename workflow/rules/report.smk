@@ -81,5 +81,6 @@ rule claims:
     params:
         trees=TREES,
         stamp=STAMP,
+        roles=_claim_cells.roles_of(CFG["presets"], TREES),
     script:
         "../scripts/claims.py"

@@ -13,6 +13,8 @@ import numpy as np
 from scipy import stats
 
 Z95 = float(stats.norm.ppf(0.975))  # 1.96: the half-width of a 95% interval, in sigmas
+#: the miss rate of a central 95% interval: the interval score's penalty is 2 / ALPHA per unit
+ALPHA = 0.05
 #: a mode whose damping's relative standard deviation exceeds this is not trusted: its 95%
 #: interval reaches zero damping (1 / 1.96), i.e. the record cannot tell it from an undamped
 #: pole. Chosen on the lsim oracle (docs/blind.md), never on the testbeds' truth.
@@ -50,6 +52,62 @@ def sigma_trusted(value, std, rel_max: float = REL_SIGMA_MAX) -> np.ndarray:
     with np.errstate(invalid="ignore", divide="ignore"):
         rel = std / np.abs(value)
     return np.isfinite(rel) & (rel <= rel_max)
+
+
+def interval_score(lower, upper, truth, alpha: float = ALPHA) -> np.ndarray:
+    """The interval score of central (1 - alpha) intervals (Gneiting and Raftery 2007, JASA
+    102(477), 359-378, section 6.2): the width plus 2 / alpha times the distance by which the truth misses
+    the interval. Lower is better; a proper score: wide intervals pay their width, narrow ones
+    their misses.
+
+    Args:
+        lower (ArrayLike): [n] the intervals' low ends.
+        upper (ArrayLike): [n] their high ends.
+        truth (ArrayLike): [n] the true values, same unit.
+        alpha: the intervals' nominal miss rate.
+
+    Returns:
+        [n] scores, in the values' unit.
+    """
+    lo, hi, x = (np.asarray(v, np.float64) for v in (lower, upper, truth))
+    miss = np.maximum(lo - x, 0.0) + np.maximum(x - hi, 0.0)
+    return (hi - lo) + (2.0 / alpha) * miss
+
+
+def relative_scores(est, std, truth, null_range, alpha: float = ALPHA) -> dict:
+    """The mean relative interval score of ``est +- 1.96 std`` and of the untrained null's
+    interval, its draw range, on the same parts: each part's score over its true value (parts of
+    different size weigh alike).
+
+    A part without a standard deviation (NaN) is scored as a point, ``est +- 0``: it has an
+    estimate and no interval, and pays its miss.
+
+    Args:
+        est (ArrayLike): [n] estimates.
+        std (ArrayLike): [n] their standard deviations.
+        truth (ArrayLike): [n] the true values (> 0).
+        null_range (tuple[float, float] | None): ``(lo, hi)`` the null draws from, same unit;
+            None: no null score.
+        alpha: the intervals' nominal miss rate (0.05: ``Z95``).
+
+    Returns:
+        ``score`` and ``null_score`` (means over the parts, fractions of the truth; NaN with no
+            part or no null range), ``n`` parts.
+    """
+    est, std, x = (np.asarray(v, np.float64).ravel() for v in (est, std, truth))
+    nan = float("nan")
+    if x.size == 0:
+        return {"score": nan, "null_score": nan, "n": 0}
+    z = float(stats.norm.ppf(1.0 - alpha / 2.0))
+    half = z * np.where(np.isfinite(std), std, 0.0)
+    score = float(np.mean(interval_score(est - half, est + half, x, alpha) / x))
+    null = nan
+    if null_range is not None:
+        lo, hi = (float(v) for v in null_range)
+        null = float(
+            np.mean(interval_score(np.full_like(x, lo), np.full_like(x, hi), x, alpha) / x)
+        )
+    return {"score": score, "null_score": null, "n": int(x.size)}
 
 
 @dataclass(frozen=True)

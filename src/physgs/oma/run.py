@@ -19,7 +19,7 @@ import numpy as np
 
 from physgs.atomic import atomic_path, write_json
 from physgs.oma.channels import Channels, FlowSettings, flow_channels, principal_channels
-from physgs.oma.intervals import coverage, interval_hits, sigma_trusted
+from physgs.oma.intervals import coverage, interval_hits, relative_scores, sigma_trusted
 from physgs.oma.parts import PartModes, assign_modes, cell_parts
 from physgs.oma.ssi import (
     Modes,
@@ -322,7 +322,11 @@ def recover_oma(
         rec = rec.with_visibility(bone_visible)
     if damping is not None:
         rec = with_damping_scores(rec, zeta, truth, damping)
-    rec = dataclasses.replace(rec, intervals=interval_block(pm, rec.match, truth))
+    null_ranges = {  # the untrained nulls' draw ranges: omega over the bones', zeta the testbed's
+        "omega": (float(np.min(truth.omega)), float(np.max(truth.omega))),
+        "zeta": tuple(damping["zeta_range"]) if damping is not None else None,
+    }
+    rec = dataclasses.replace(rec, intervals=interval_block(pm, rec.match, truth, null_ranges))
     block = {
         "n_parts": int(K),
         "n_modes": int(pm.mode_part.size),
@@ -334,7 +338,7 @@ def recover_oma(
     return rec, block
 
 
-def interval_block(pm: PartModes, match, truth) -> dict:
+def interval_block(pm: PartModes, match, truth, null_ranges: dict | None = None) -> dict:
     """Each part's estimate with its standard deviations, the coverage of the trusted parts'
     95% intervals (evaluation: the matched bones' true omega and zeta), and how many parts
     each trust rule keeps (the matcher's trajectory correlation; the modes' own relative
@@ -344,13 +348,17 @@ def interval_block(pm: PartModes, match, truth) -> dict:
         pm: the parts' modes (zeta before ours' bounds clip it).
         match (MatchResult): the matcher's result (``bone``, ``trusted``).
         truth (Truth): the ground truth (``omega`` [B] rad/s, ``zeta`` [B]).
+        null_ranges: ``omega`` (rad/s) and ``zeta``: the ``(lo, hi)`` the untrained nulls draw
+            from (None: not drawn), for the interval scores; None: no null scores.
 
     Returns:
         ``omega``, ``zeta``, ``omega_std``, ``zeta_std`` (per part, NaN where none),
             ``sigma_trusted`` (per part), ``n_sigma_trusted``, ``n_both_trusted``,
             ``median_rel_std`` (``omega``, ``zeta``: sigma / value over the trusted parts) and
             ``coverage`` (``omega`` and ``zeta``: k, n, fraction and its 95% interval over the
-            matcher's trusted parts with an estimate).
+            matcher's trusted parts with an estimate) and ``interval_score`` (``omega`` and
+            ``zeta``: the mean relative interval score of the same parts' 95% intervals and of
+            the null's draw range, [`relative_scores`][physgs.oma.intervals.relative_scores]).
     """
     bone = np.asarray(match.bone)
     scored = np.asarray(match.trusted) & pm.estimated
@@ -372,6 +380,15 @@ def interval_block(pm: PartModes, match, truth) -> dict:
         "median_rel_std": {  # over the trusted parts with an estimate (NaN: none)
             "omega": _median_or_nan(pm.omega_std[scored] / pm.omega[scored]),
             "zeta": _median_or_nan(pm.zeta_std[scored] / pm.zeta[scored]),
+        },
+        "interval_score": {
+            q: relative_scores(
+                getattr(pm, q)[scored],
+                getattr(pm, f"{q}_std")[scored],
+                t[scored],
+                (null_ranges or {}).get(q),
+            )
+            for q, t in (("omega", w_true), ("zeta", z_true))
         },
         "coverage": {
             "omega": coverage(

@@ -106,7 +106,11 @@ def read_table(name: str, path) -> pd.DataFrame:
     return df
 
 
-def claims_frame(inputs: Mapping[str, str], trees: Sequence[str]) -> pd.DataFrame:
+def claims_frame(
+    inputs: Mapping[str, str],
+    trees: Sequence[str],
+    roles: Mapping[str, Mapping[str, str]] | None = None,
+) -> pd.DataFrame:
     """The claims ledger ([`physgs.report.claims`][physgs.report.claims]) from the files in
     ``inputs``.
 
@@ -116,6 +120,7 @@ def claims_frame(inputs: Mapping[str, str], trees: Sequence[str]) -> pd.DataFram
     Args:
         inputs: need key -> path ([`claims_needs`][physgs.report.build.claims_needs]).
         trees: the trees.
+        roles: tree -> its preset's role (``claim_cells.roles_of``); None: no tree has one.
 
     Returns:
         The ledger, one row per claim.
@@ -138,10 +143,17 @@ def claims_frame(inputs: Mapping[str, str], trees: Sequence[str]) -> pd.DataFram
             }
         )
     ours = damping.pop("ours", {})  # the paper's claims; the other priors' are asked again
-    return claims.ledger(claims.measure(tabs, ours, trees, damping))
+    return claims.ledger(claims.measure(tabs, ours, trees, damping, roles))
 
 
-def make_claims(inputs: Mapping[str, str], trees: Sequence[str], md_path, csv_path, stamp=None):
+def make_claims(
+    inputs: Mapping[str, str],
+    trees: Sequence[str],
+    md_path,
+    csv_path,
+    stamp=None,
+    roles: Mapping[str, Mapping[str, str]] | None = None,
+):
     """Build the claims ledger from the files in ``inputs``
     ([`claims_frame`][physgs.report.build.claims_frame]) and write results/claims.md and .csv.
 
@@ -151,11 +163,12 @@ def make_claims(inputs: Mapping[str, str], trees: Sequence[str], md_path, csv_pa
         md_path (str | Path): the Markdown ledger to write.
         csv_path (str | Path): the CSV ledger to write.
         stamp (Stamp | None): written into every CSV row and the Markdown.
+        roles: tree -> its preset's role (``claim_cells.roles_of``); None: no tree has one.
 
     Returns:
         (pd.DataFrame): The ledger (without the stamp's columns).
     """
-    df = claims_frame(inputs, trees)
+    df = claims_frame(inputs, trees, roles)
     sd = stamp.to_dict() if stamp is not None else None
     write_text(md_path, claims.ledger_markdown(df, sd))
     with atomic_path(csv_path) as tmp:

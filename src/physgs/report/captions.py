@@ -90,7 +90,10 @@ FIGURES: tuple[Caption, ...] = (
         "The damping benchmark. Left: each part's recovered damping ratio (no unit) per tree "
         "(colour), configuration (marker) and prior (filled: ours; hollow: the chained prior), "
         "jittered sideways for display; the black bar is the median of its group, the dashed line "
-        "the true damping ratio. Right: each part's decay rate (damping ratio times natural "
+        "the true damping ratio, a row of points at the top sits on the fitting bound (the largest "
+        "damping ratio the fit may take, `models.ours.zeta` in config/trees.yaml; dotted, its "
+        "value in the key): those parts ran into the bound, so their damping is not estimated. "
+        "Right: each part's decay rate (damping ratio times natural "
         "frequency, 1/s) against its natural frequency (rad/s), both axes logarithmic; the dashed "
         "line is the truth (decay rate = true damping ratio x frequency).",
         "Points on the dashed lines recover damping; a cloud above them over-damps. A cloud "
@@ -100,7 +103,7 @@ FIGURES: tuple[Caption, ...] = (
     Caption(
         "fig_parts",
         "The priors' parts",
-        "Each tree's canonical Gaussians seen from the side (x right, z up, world units), coloured "
+        "Each tree's canonical Gaussians seen from the side (x right, height z up, metres), coloured "
         "by their part in each prior's segmentation (one panel per prior); each part's pivot is a "
         "black dot, joined to its parent's pivot where the prior chains its parts. Each panel's "
         "title gives the segmentation's purity (share of Gaussians in their part's majority "

@@ -10,6 +10,12 @@ and its reader use (``tree``, ``config``, ``method``, ...) and, where the id is 
 prior's, ``prefix``. A reader takes one seed's rows and a cell and returns a float, NaN where
 the rows are not there (a model the run's table does not hold: "undecided: not measured").
 
+Which trees a role-scoped family asks (the tree whose bones' frequencies the untrained null
+cannot fake, the trees where it is expected to match) is declared in each tree's preset
+(``presets.<tree>.role`` in config/trees.yaml: ``frequencies`` separated or tiled, and
+``paper``, the paper's tree it stands for and whose figures it is read against), never by a
+tree's name: a tree without a role gets the claims of every tree and none of a role's.
+
 A table without a ``method`` (``model``) column is ours' alone (a table made before another
 prior joined it). Cells read by id or by display label alike where a table holds labels
 (``tab_psnr``).
@@ -17,7 +23,7 @@ prior joined it). Cells read by id or by display label alike where a table holds
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from typing import Any, Callable, Mapping, Sequence
 
 import numpy as np
@@ -48,6 +54,8 @@ class Run:
         model: the prior the claim is asked of (``ours``, or another prior of the registry).
         others: the priors other than ours that the run's tables hold.
         table: the family's table (``ClaimSpec.table``): the one its scope reads.
+        roles: tree -> its preset's ``role`` (``frequencies``, ``paper``); a tree not in it has
+            none.
     """
 
     tables: Mapping[str, pd.DataFrame]
@@ -55,11 +63,43 @@ class Run:
     model: str = "ours"
     others: tuple[str, ...] = ()
     table: str = ""
+    roles: Mapping[str, Mapping[str, str]] = field(default_factory=dict)
 
     @property
     def own(self) -> pd.DataFrame | None:
         """The family's table, None where the run did not make it."""
         return self.tables.get(self.table)
+
+    def role(self, tree: str, key: str) -> str | None:
+        """A tree's declared role.
+
+        Args:
+            tree: the tree.
+            key: ``frequencies`` or ``paper``.
+
+        Returns:
+            The preset's value; None where it declares none.
+        """
+        return (self.roles.get(tree) or {}).get(key)
+
+
+#: The role of a tree whose bones' frequencies the untrained null cannot fake (the null loses).
+SEPARATED = "separated"
+#: The role of a tree whose bones' frequencies tile the axis (the null is expected to match).
+TILED = "tiled"
+
+
+def roles_of(presets: Mapping[str, Mapping], trees: Sequence[str]) -> dict[str, dict[str, str]]:
+    """Each tree's role as its preset declares it (config ``presets.<tree>.role``).
+
+    Args:
+        presets: tree -> its preset.
+        trees: the trees.
+
+    Returns:
+        tree -> ``{frequencies, paper}`` (only what the preset declares; {} for none).
+    """
+    return {t: dict((presets.get(t) or {}).get("role") or {}) for t in trees}
 
 
 def fields() -> tuple[str, ...]:
@@ -109,22 +149,26 @@ def _recovery(d: pd.DataFrame, c: Cell, col: str) -> float:
 # ---- scopes: what a family ranges over --------------------------------------------------------
 def _trees(run: Run) -> list[Cell]:
     """each tree"""
-    return [{"suffix": t, "tree": t} for t in run.trees]
+    return [{"suffix": t, "tree": t, "paper": run.role(t, "paper")} for t in run.trees]
 
 
-def _sparse(run: Run) -> list[Cell]:
-    """the sparse tree"""
-    return [{"suffix": "sparse", "tree": "sparse"}] if "sparse" in run.trees else []
+def _with_role(run: Run, role: str) -> list[Cell]:
+    return [c for c in _trees(run) if run.role(c["tree"], "frequencies") == role]
 
 
-def _dense_trees(run: Run) -> list[Cell]:
-    """each tree but the sparse one"""
-    return [c for c in _trees(run) if c["tree"] != "sparse"]
+def _separated(run: Run) -> list[Cell]:
+    """each tree whose preset declares its frequencies separated (the null cannot fake them)"""
+    return _with_role(run, SEPARATED)
+
+
+def _tiled(run: Run) -> list[Cell]:
+    """each tree whose preset declares its frequencies tiled (the null expected to match)"""
+    return _with_role(run, TILED)
 
 
 def _gap_trees(run: Run) -> list[Cell]:
-    """each tree whose nearest-bone gap the paper states"""
-    return [c for c in _trees(run) if c["tree"] in paper.NEAREST_BONE_GAP_PCT]
+    """each tree standing for a paper's tree whose nearest-bone gap the paper states"""
+    return [c for c in _trees(run) if c["paper"] in paper.NEAREST_BONE_GAP_PCT]
 
 
 def _recovered_trees(run: Run) -> list[Cell]:
@@ -199,14 +243,15 @@ def _recovery_trees(run: Run) -> list[Cell]:
     return [{**c, "config": CONFIG, "method": run.model} for c in _trees(run)]
 
 
-def _null_trees_sparse(run: Run) -> list[Cell]:
-    """the sparse tree, in the ledger's recovery configuration (joint K = 32)"""
-    return [c for c in _recovery_trees(run) if c["tree"] == "sparse"]
+def _null_trees_separated(run: Run) -> list[Cell]:
+    """each tree of separated frequencies, in the ledger's recovery configuration (joint K =
+    32)"""
+    return [{**c, "config": CONFIG, "method": run.model} for c in _separated(run)]
 
 
-def _null_trees_dense(run: Run) -> list[Cell]:
-    """each tree but the sparse one, in the ledger's recovery configuration (joint K = 32)"""
-    return [c for c in _recovery_trees(run) if c["tree"] != "sparse"]
+def _null_trees_tiled(run: Run) -> list[Cell]:
+    """each tree of tiled frequencies, in the ledger's recovery configuration (joint K = 32)"""
+    return [{**c, "config": CONFIG, "method": run.model} for c in _tiled(run)]
 
 
 def _parts(run: Run) -> tuple[pd.DataFrame | None, set, str]:
@@ -230,25 +275,27 @@ def _parts_damping_trees(run: Run) -> list[Cell]:
 
 
 def _parts_coupling(run: Run) -> list[Cell]:
-    """the sparse tree in tab_parts (its first configuration), when it holds both topology
-    priors"""
+    """each tree of separated frequencies in tab_parts (its first configuration), when it holds
+    both topology priors (no id suffix for a single such tree: the family's id as before)"""
     df, models, c0 = _parts(run)
-    if df is None or not {"ours_topo", "ours_chain"} <= models or "sparse" not in run.trees:
+    if df is None or not {"ours_topo", "ours_chain"} <= models:
         return []
-    return [{"suffix": "", "tree": "sparse", "config": c0}]
+    cells = _separated(run)
+    one = len(cells) == 1
+    return [{**c, "suffix": "" if one else c["tree"], "config": c0} for c in cells]
 
 
-def _tracks_sparse(run: Run) -> list[Cell]:
-    """the sparse tree, the 2D-track control's recovery in joint K = 32 (else its first
-    configuration)"""
+def _tracks_separated(run: Run) -> list[Cell]:
+    """each tree of separated frequencies, the 2D-track control's recovery in joint K = 32
+    (else its first configuration)"""
     null = run.own
-    if null is None or "method" not in null.columns or "sparse" not in run.trees:
+    if null is None or "method" not in null.columns:
         return []
     cfgs = list(dict.fromkeys(null.loc[null["method"] == "tracks", "config"]))
     if not cfgs:
         return []
     c = CONFIG if CONFIG in cfgs else cfgs[0]
-    return [{"suffix": "sparse", "tree": "sparse", "config": c, "method": "tracks"}]
+    return [{**x, "config": c, "method": "tracks"} for x in _separated(run)]
 
 
 def _tracks_trees(run: Run) -> list[Cell]:
@@ -288,12 +335,12 @@ def _blind_trees(run: Run) -> list[Cell]:
     return out
 
 
-def _oma_sparse(run: Run) -> list[Cell]:
-    """the sparse tree, when tab_recovery holds the output-only analysis"""
+def _oma_separated(run: Run) -> list[Cell]:
+    """each tree of separated frequencies, when tab_recovery holds the output-only analysis"""
     null = run.own
     if null is None or "method" not in null.columns or OMA not in set(null["method"]):
         return []
-    return [{**c, "config": BLIND_CONFIG, "method": OMA} for c in _sparse(run)]
+    return [{**c, "config": BLIND_CONFIG, "method": OMA} for c in _separated(run)]
 
 
 def _oma_damping_trees(run: Run) -> list[Cell]:
@@ -374,8 +421,8 @@ def _trained_minus_null(d: pd.DataFrame, c: Cell) -> float:
 
 
 def _gap_off(d: pd.DataFrame, c: Cell) -> float:
-    """tab_testbed: |nearest-bone gap - the paper's| / the paper's"""
-    g = paper.NEAREST_BONE_GAP_PCT[c["tree"]]
+    """tab_testbed: |nearest-bone gap - the paper's tree's| / the paper's"""
+    g = paper.NEAREST_BONE_GAP_PCT[c["paper"]]
     return abs(value(d, d["tree"] == c["tree"], "nearest_bone_gap_pct") - g) / g
 
 
@@ -461,6 +508,41 @@ def _oma_zeta_cover(d: pd.DataFrame, c: Cell) -> float:
     return value(d, _oma_damping_row(d, c), "zeta_interval_cover")
 
 
+def _score_ratio(d: pd.DataFrame, c: Cell, q: str) -> float:
+    row = _oma_damping_row(d, c)
+    return value(d, row, f"{q}_null_interval_score") / value(d, row, f"{q}_interval_score")
+
+
+def _oma_omega_score(d: pd.DataFrame, c: Cell) -> float:
+    """tab_damping (damping testbed): the null's draw range over the output-only analysis'
+    omega intervals, mean relative interval score (null / output-only)"""
+    return _score_ratio(d, c, "omega")
+
+
+def _oma_zeta_score(d: pd.DataFrame, c: Cell) -> float:
+    """tab_damping (damping testbed): the null's draw range over the output-only analysis'
+    zeta intervals, mean relative interval score (null / output-only)"""
+    return _score_ratio(d, c, "zeta")
+
+
+def _halfwidth(d: pd.DataFrame, c: Cell, q: str) -> float:
+    from physgs.oma.intervals import Z95  # here: scipy, which planning never loads
+
+    return Z95 * value(d, _oma_damping_row(d, c), f"{q}_rel_sd")
+
+
+def _oma_omega_halfwidth(d: pd.DataFrame, c: Cell) -> float:
+    """tab_damping (damping testbed): the output-only analysis' median relative half-width of
+    its omega intervals, 1.96 sigma / omega"""
+    return _halfwidth(d, c, "omega")
+
+
+def _oma_zeta_halfwidth(d: pd.DataFrame, c: Cell) -> float:
+    """tab_damping (damping testbed): the output-only analysis' median relative half-width of
+    its zeta intervals, 1.96 sigma / zeta"""
+    return _halfwidth(d, c, "zeta")
+
+
 #: A reader: one seed's rows and a cell -> the claim's value.
 Reader = Callable[[pd.DataFrame, Cell], float]
 #: A scope: the run -> the family's cells.
@@ -470,8 +552,8 @@ Scope = Callable[[Run], list[Cell]]
 #: ranges over (the claims page prints it).
 SCOPES: dict[str, Scope] = {
     "trees": _trees,
-    "sparse": _sparse,
-    "dense_trees": _dense_trees,
+    "separated": _separated,
+    "tiled": _tiled,
     "gap_trees": _gap_trees,
     "recovered_trees": _recovered_trees,
     "fit_models": _fit_models,
@@ -480,14 +562,14 @@ SCOPES: dict[str, Scope] = {
     "winds": _winds,
     "margin_trees": _margin_trees,
     "recovery_trees": _recovery_trees,
-    "null_trees_sparse": _null_trees_sparse,
-    "null_trees_dense": _null_trees_dense,
+    "null_trees_separated": _null_trees_separated,
+    "null_trees_tiled": _null_trees_tiled,
     "parts_damping_trees": _parts_damping_trees,
     "parts_coupling": _parts_coupling,
-    "tracks_sparse": _tracks_sparse,
+    "tracks_separated": _tracks_separated,
     "tracks_trees": _tracks_trees,
     "blind_trees": _blind_trees,
-    "oma_sparse": _oma_sparse,
+    "oma_separated": _oma_separated,
     "oma_damping_trees": _oma_damping_trees,
     "oma_interval_trees": _oma_interval_trees,
 }
@@ -514,4 +596,8 @@ READERS: dict[str, Reader] = {
     "oma_zeta_gain": _oma_zeta_gain,
     "oma_omega_cover": _oma_omega_cover,
     "oma_zeta_cover": _oma_zeta_cover,
+    "oma_omega_score": _oma_omega_score,
+    "oma_zeta_score": _oma_zeta_score,
+    "oma_omega_halfwidth": _oma_omega_halfwidth,
+    "oma_zeta_halfwidth": _oma_zeta_halfwidth,
 }

@@ -4,7 +4,10 @@ computed by code (never written by hand).
 A claim is a measured quantity (one value per training seed), a threshold and a side: the
 claim **holds** when the 95% interval of the mean over seeds lies entirely on the claimed side
 of the threshold, **fails** when it lies entirely on the other side, and is **undecided** when it
-straddles it. A claim about a comparison between trained models needs seed variance: with a
+straddles it. A claim of flatness, equality or match (side ``WITHIN``) is an equivalence test,
+two one-sided tests: it **holds** when the interval lies inside the band (-threshold,
++threshold), **fails** when it lies entirely outside it (beyond either edge), and is
+**undecided** when it straddles either edge. A claim about a comparison between trained models needs seed variance: with a
 single seed it is "undecided: one seed" (the point estimate is still shown, with the side it
 falls on). A claim about the fixed testbed (the nearest-bone gap) needs none.
 
@@ -24,7 +27,15 @@ import numpy as np
 import pandas as pd
 
 from physgs.models.registry import label, models_of
-from physgs.report.catalogue import CATALOGUE, origin_of, prior_tables
+from physgs.report.catalogue import (
+    CATALOGUE,
+    KINDS,
+    WITHIN,
+    kind_of,
+    origin_of,
+    prior_tables,
+    undermines,
+)
 from physgs.report.claim_cells import RECOVERY, Run
 from physgs.report.seeds import MAX_SEEDS, finite, interval, log_interval, seeds_to_decide  # noqa: F401
 
@@ -35,7 +46,7 @@ RATIO = "ratio"
 @dataclass(frozen=True)
 class Claim:
     """One claim: id, the claim in one line, the paper's figure, where it is measured, the
-    threshold and side ('>' or '<'), the unit, whether a verdict needs seed variance, and its
+    threshold and side ('>', '<', or ``WITHIN``: inside (-threshold, +threshold)), the unit, whether a verdict needs seed variance, and its
     origin (the paper's or this project's)."""
 
     id: str
@@ -47,6 +58,32 @@ class Claim:
     unit: str
     needs_variance: bool = True
     origin: str = "paper"
+    paper_value: tuple[float, float] = (float("nan"), float("nan"))
+    requires: str = ""
+
+    @property
+    def threshold_text(self) -> str:
+        """The threshold and side as the ledger prints them: ``> 0``, ``within ±0.5``."""
+        if self.side == WITHIN:
+            return f"within ±{self.threshold:g}"
+        return f"{self.side} {self.threshold:g}"
+
+
+def on_claim(claim: Claim, x: float) -> bool:
+    """Whether a value lies on the claimed side of the threshold (inside the band for
+    ``WITHIN``).
+
+    Args:
+        claim: the claim (threshold, side).
+        x: a value in the claim's unit.
+
+    Returns:
+        True on the claimed side.
+    """
+    t = claim.threshold
+    if claim.side == WITHIN:
+        return -t < x < t
+    return x > t if claim.side == ">" else x < t
 
 
 def log_scale(claim: Claim) -> bool:
@@ -89,16 +126,39 @@ def verdict(claim: Claim, values: Sequence[float]) -> str:
             verdict says on which side the point estimate lies.
     """
     m, _, lo, hi = estimate(claim, values)
+    n = int(np.isfinite(np.asarray(values, dtype=np.float64)).sum())
+    return decide(claim, m, lo, hi, n)
+
+
+def decide(claim: Claim, m: float, lo: float, hi: float, n: int) -> str:
+    """The verdict of an estimate and its 95% interval ([`verdict`][physgs.report.claims.verdict]
+    from the per-seed values; this from a ledger's own columns, e.g. a committed record's
+    ``measured``, ``ci_low``, ``ci_high`` and ``seeds``).
+
+    Args:
+        claim: the claim (threshold, side, whether it needs seed variance).
+        m: the estimate.
+        lo: the interval's low end.
+        hi: its high end.
+        n: the seeds measured.
+
+    Returns:
+        The verdict, as ``verdict``'s.
+    """
     if not np.isfinite(m):
         return "undecided: not measured"
-    on = (lambda x: x > claim.threshold) if claim.side == ">" else (lambda x: x < claim.threshold)
+
+    def on(x: float) -> bool:
+        return on_claim(claim, x)
+
     if not claim.needs_variance:
         return "holds" if on(m) else "fails"
-    n = int(np.isfinite(np.asarray(values, dtype=np.float64)).sum())
     if n < 2:
         return f"undecided: one seed (point estimate {'on' if on(m) else 'against'} the claim)"
     if on(lo) and on(hi):
         return "holds"
+    if claim.side == WITHIN:  # outside the band: wholly beyond one edge
+        return "fails" if hi <= -claim.threshold or lo >= claim.threshold else "undecided"
     if not on(lo) and not on(hi):
         return "fails"
     return "undecided"
@@ -151,6 +211,7 @@ def measure(
     damping: Mapping[str, Sequence[Mapping[str, float]]],
     trees: Sequence[str],
     prior_damping: Mapping[str, Mapping[str, Sequence[Mapping[str, float]]]] | None = None,
+    roles: Mapping[str, Mapping[str, str]] | None = None,
 ) -> list[tuple[Claim, list[float]]]:
     """Every claim of the catalogue with its per-seed values, from the tables' CSVs and the
     priors' damping summaries.
@@ -168,6 +229,9 @@ def measure(
             zeta_true), for the joint K=32 configuration.
         trees: the trees.
         prior_damping: model -> tree -> per-seed summaries, as ``damping``, of the other priors.
+        roles: tree -> its preset's role (``claim_cells.roles_of``: ``frequencies``, ``paper``);
+            None or a tree left out: no role, so none of the role-scoped claims and no paper
+            figure for it.
 
     Returns:
         ``(claim, per-seed values)`` pairs, in the ledger's order (the catalogue's).
@@ -183,7 +247,8 @@ def measure(
             continue
         seeds = _per_seed(tabs[spec.table]) if spec.table in tabs else []
         for model in ("ours",) if spec.of == "ours" else others:
-            for cell in spec.cells(Run(tabs, trees, model, others, spec.table)):
+            run = Run(tabs, trees, model, others, spec.table, dict(roles or {}))
+            for cell in spec.cells(run):
                 cell = {"model": model, "name": label(model), "table": spec.table, **cell}
                 cid = spec.claim_id(cell)
                 claim = Claim(
@@ -196,6 +261,8 @@ def measure(
                     spec.unit,
                     spec.needs_variance,
                     origin_of(cid),
+                    spec.value_of_paper(cell),
+                    spec.claim_id(cell, spec.requires) if spec.requires else "",
                 )
                 out.append((claim, [spec.measure(d, cell) for d in seeds]))
     return out
@@ -217,14 +284,65 @@ def to_decide(claim: Claim, values: Sequence[float]) -> tuple[float, float]:
         return np.nan, np.nan
     v = finite(values)
     v, thr = (np.log(v), np.log(claim.threshold)) if log_scale(claim) else (v, claim.threshold)
-    return seeds_to_decide(float(v.mean()) - thr, float(v.std(ddof=1)))
+    m = float(v.mean())
+    if claim.side == WITHIN:  # the interval straddles an edge: the nearer one decides it
+        thr = min((-thr, thr), key=lambda e: abs(m - e))
+    return seeds_to_decide(m - thr, float(v.std(ddof=1)))
+
+
+def paper_in_interval(claim: Claim, low: float, high: float) -> str:
+    """Whether the paper's figure lies inside the measured 95% interval: the claim reproduced
+    in size, beside its verdict (a direction, or a bar). A paper's range (``low < high``)
+    counts as inside when it meets the interval.
+
+    Args:
+        claim: the claim (``paper_value``, in its unit).
+        low: the interval's low end.
+        high: its high end.
+
+    Returns:
+        ``"inside"`` or ``"outside"``; ``""`` where the paper gives no number or there is no
+            interval (one seed, nothing measured).
+    """
+    p_lo, p_hi = claim.paper_value
+    if not (np.isfinite(p_lo) and np.isfinite(low) and np.isfinite(high)):
+        return ""
+    return "inside" if p_lo <= high and p_hi >= low else "outside"
+
+
+def gated(claim: Claim, own: str, verdicts: Mapping[str, str]) -> str:
+    """A claim's verdict where it holds only if its companion (``Claim.requires``) holds too: a
+    coverage whose intervals do not beat the null's interval score does not hold.
+
+    Args:
+        claim: the claim.
+        own: its verdict on its own values.
+        verdicts: claim id -> verdict, the companion's among them.
+
+    Returns:
+        ``own`` where it does not hold or there is no companion; otherwise ``own`` when the
+            companion holds, "fails: ..." when it fails and "undecided: ..." when it is
+            undecided or absent, naming the companion's verdict.
+    """
+    if not claim.requires or own != "holds":
+        return own
+    comp = verdicts.get(claim.requires, "undecided: not measured")
+    kind = comp.split(":")[0]
+    if kind == "holds":
+        return own
+    word = "fails" if kind == "fails" else "undecided"
+    return f"{word}: covers, but {claim.requires} {comp}"
 
 
 def ledger(measured: Sequence[tuple[Claim, list[float]]]) -> pd.DataFrame:
     """One row per claim: the claim, the paper's figure, the measured mean (a ratio's geometric
     mean), sd (a ratio's: of its logs, ``scale`` "log"), 95% interval and number of seeds, the
-    threshold and side, the verdict, where it comes from, its origin, and for an undecided claim
-    the seeds that would decide it (an estimate: ``to_decide``).
+    threshold and side, the verdict, where it comes from, its origin, its kind (a premise of the
+    comparison or a finding: ``catalogue.kind_of``), and for an undecided claim the seeds that
+    would decide it (an estimate: ``to_decide``); last (added columns, so older readers keep
+    theirs), the paper's figure as a number (``paper_low``, ``paper_high``) and whether it lies
+    inside the interval (``paper_in_interval``), and the companion a claim needs to hold
+    (``requires``: [`gated`][physgs.report.claims.gated]).
 
     Args:
         measured: [`measure`][physgs.report.claims.measure]'s pairs.
@@ -233,7 +351,9 @@ def ledger(measured: Sequence[tuple[Claim, list[float]]]) -> pd.DataFrame:
         The ledger, one row per claim.
     """
     rows = []
-    for c, values in measured:
+    own = [verdict(c, values) for c, values in measured]
+    alone = {c.id: v for (c, _), v in zip(measured, own)}  # the companions' (``requires``)
+    for (c, values), v in zip(measured, own):
         m, sd, lo, hi = estimate(c, values)
         n_t, n_power = to_decide(c, values)
         rows.append(
@@ -247,16 +367,111 @@ def ledger(measured: Sequence[tuple[Claim, list[float]]]) -> pd.DataFrame:
                 "ci_high": hi,
                 "seeds": int(np.isfinite(values).sum()),
                 "unit": c.unit,
-                "threshold": f"{c.side} {c.threshold:g}",
-                "verdict": verdict(c, values),
+                "threshold": c.threshold_text,
+                "verdict": gated(c, v, alone),
                 "source": c.source,
                 "origin": c.origin,
+                "kind": kind_of(c.id),
                 "scale": "log" if log_scale(c) else "linear",
                 "seeds_to_decide_t_est": n_t,
                 "seeds_to_decide_power80_est": n_power,
+                "paper_low": c.paper_value[0],
+                "paper_high": c.paper_value[1],
+                "paper_in_interval": paper_in_interval(c, lo, hi),
+                "requires": c.requires,
             }
         )
     return pd.DataFrame(rows)
+
+
+def column(claims: pd.DataFrame, name: str) -> pd.Series:
+    """A catalogue-derived column of the ledger (``origin``, ``kind``): as written, or the
+    catalogue's word for each id in a ledger written before the column.
+
+    Args:
+        claims: the ledger (``claims.csv``: ``id`` at least).
+        name: ``"origin"`` or ``"kind"``.
+
+    Returns:
+        One value per row.
+    """
+    if name in claims.columns:
+        return claims[name].astype(str)
+    return claims["id"].astype(str).map({"origin": origin_of, "kind": kind_of}[name])
+
+
+def number(x: float, unit: str) -> str:
+    """A measured value as the ledger prints it: signed (a difference's side of 0 is its news),
+    except a ratio's, which is always positive.
+
+    Args:
+        x: the value.
+        unit: its unit (``RATIO``: unsigned).
+
+    Returns:
+        Three significant digits.
+    """
+    return f"{x:.3g}" if unit == RATIO else f"{x:+.3g}"
+
+
+#: A kind as the counts name it (plural: ``counted``).
+KIND_WORDS = {"finding": ("finding", "findings"), "premise": ("premise", "premises")}
+
+
+def counted(claims: pd.DataFrame, origin: str) -> str:
+    """The claims of one origin counted, the findings apart from the premises of the comparison
+    (``catalogue.PREMISES``), each by verdict: ``52 claims: 34 findings (20 hold, 10 fail, 4
+    undecided), 18 premises (4 hold, 14 fail)``; a verdict none has is left out.
+
+    Args:
+        claims: the ledger (``id``, ``verdict``; ``origin``, ``kind`` where written).
+        origin: ``"paper"`` or ``"project"``.
+
+    Returns:
+        The words.
+    """
+    verdicts = claims["verdict"].astype(str).str.split(":").str[0]
+    mine = column(claims, "origin") == origin
+    kinds = column(claims, "kind")
+    parts = []
+    for k in reversed(KINDS):  # findings first: they are what the comparison says
+        v = verdicts[mine & (kinds == k)].value_counts()
+        if not v.sum():
+            continue
+        by = ", ".join(
+            f"{int(v[w])} {w[:-1] if w != 'undecided' else w}"
+            for w in ("holds", "fails", "undecided")
+            if v.get(w, 0)
+        )
+        parts.append(f"{int(v.sum())} {KIND_WORDS[k][int(v.sum()) != 1]} ({by})")
+    n = int(mine.sum())
+    return f"{n} claim{'s' if n != 1 else ''}: " + (", ".join(parts) or "none")
+
+
+def failed_premises(claims: pd.DataFrame) -> list[str]:
+    """Each premise family with a failed claim: where it fails and what that undermines
+    (``catalogue.undermines``).
+
+    Args:
+        claims: the ledger.
+
+    Returns:
+        One sentence per family, in the ledger's order; none when every premise holds.
+    """
+    verdicts = claims["verdict"].astype(str).str.split(":").str[0]
+    failed = claims[(column(claims, "kind") == "premise") & (verdicts == "fails")]
+    # the family is the id's first part: no premise family is asked of the priors
+    by_family: dict[str, dict[str, list[str]]] = {}
+    for cid in failed["id"].astype(str):
+        fam, _, cell = cid.partition("/")
+        where, _, what = (cell or "all").partition("/")  # tree, then the model where it has one
+        by_family.setdefault(fam, {}).setdefault(where, []).extend([what] if what else [])
+    return [
+        f"the premise `{fam}` fails on "
+        + ", ".join(f"{w} ({', '.join(m)})" if m else w for w, m in cells.items())
+        + f": this undermines {undermines(fam)}."
+        for fam, cells in by_family.items()
+    ]
 
 
 def ledger_markdown(df: pd.DataFrame, stamp: Mapping[str, str] | None = None) -> str:
@@ -269,19 +484,16 @@ def ledger_markdown(df: pd.DataFrame, stamp: Mapping[str, str] | None = None) ->
     Returns:
         The page's Markdown, ending in a newline.
     """
-    kind = df["verdict"].astype(str).str.split(":").str[0]
-
-    def counted(who: str) -> str:
-        c = kind[df["origin"] == who].value_counts().to_dict()
-        return ", ".join(f"{k} {v}" for k, v in sorted(c.items())) or "none"
-
     lines = [
         "# Claims ledger",
         "",
         "Each claim, measured by this pipeline: the paper's claims and this project's own, "
         "counted apart; verdicts are computed by `physgs.report.claims` (holds / fails when "
         "the seed interval lies on one side of the threshold, undecided when it straddles it "
-        "or when one seed gives no interval). A ratio's estimate is the geometric mean over "
+        "or when one seed gives no interval; a claim of flatness, equality or match, "
+        "'within ±t', holds inside the band, fails wholly outside it and is undecided across "
+        "either edge). Beside a figure of the paper: whether it lies inside the measured "
+        "interval (reproduced in size; the verdict is a direction or a bar). A ratio's estimate is the geometric mean over "
         "seeds and its interval the per-seed log-ratios' t-interval, exponentiated (it stays "
         "positive). For an undecided claim, the seeds that would decide it if its effect and "
         "sd stayed as observed, an estimate: the plug-in t half-width / a t-test at 80% power "
@@ -290,23 +502,29 @@ def ledger_markdown(df: pd.DataFrame, stamp: Mapping[str, str] | None = None) ->
     ]
     if stamp:
         lines += ["Made by: " + ", ".join(f"{k}={v}" for k, v in stamp.items()), ""]
-    paper, own = (df["origin"] == "paper").sum(), (df["origin"] == "project").sum()
     lines += [
-        f"The paper's {paper} claims: {counted('paper')}. This project's own {own}: "
-        f"{counted('project')}.",
+        f"The paper's {counted(df, 'paper')}. This project's own {counted(df, 'project')}. "
+        "A premise is what the comparison rests on (the testbed is the paper's, the models fit "
+        "their window); a finding is what it says.",
         "",
-        "| claim | origin | paper | measured | threshold | verdict | seeds to decide (est.) "
-        "| from |",
-        "|---|---|---|---|---|---|---|---|",
+        *[f"- {s[0].upper() + s[1:]}" for s in failed_premises(df)],
+        "",
+        "| claim | origin | paper | measured | threshold | verdict | kind "
+        "| seeds to decide (est.) | from |",
+        "|---|---|---|---|---|---|---|---|---|",
     ]
-    for _, r in df.iterrows():
-        meas = "--" if not np.isfinite(r.measured) else f"{r.measured:+.3g} {r.unit}"
+    kinds = column(df, "kind")
+    for (_, r), k in zip(df.iterrows(), kinds):
+        meas = "--" if not np.isfinite(r.measured) else f"{number(r.measured, r.unit)} {r.unit}"
         if np.isfinite(r.ci_low):
-            meas += f" [{r.ci_low:+.3g}, {r.ci_high:+.3g}], {r.seeds} seeds"
+            lo, hi = number(r.ci_low, r.unit), number(r.ci_high, r.unit)
+            meas += f" [{lo}, {hi}], {r.seeds} seeds"
         elif np.isfinite(r.measured):
             meas += f", {r.seeds} seed"
+        size = r.get("paper_in_interval", "")
+        size = f" ({size} the interval)" if isinstance(size, str) and size else ""
         lines.append(
-            f"| {r.claim} | {r.origin} | {r.paper} | {meas} | {r.threshold} | **{r.verdict}** | "
+            f"| {r.claim} | {r.origin} | {r.paper}{size} | {meas} | {r.threshold} | **{r.verdict}** | {k} | "
             f"{decide_cell(r)} | {r.source} |"
         )
     return "\n".join(lines) + "\n"

@@ -405,8 +405,10 @@ def fig_damping(
     configs: Sequence[str],
     zeta_true: float,
     outputs: Sequence[str | Path],
+    zeta_bound: float | None = None,
 ) -> None:
-    """Left: zeta_hat per part for each tree and config against the true ratio (line).
+    """Left: zeta_hat per part for each tree and config against the true ratio (line) and the
+    fit's upper bound on zeta (dotted: a part there is pinned to the bound, not estimated).
     Right: decay rate gamma_hat = zeta_hat * omega_hat (1/s) against omega_hat (rad/s), log-log,
     with the ground-truth line gamma = zeta_true * omega.
 
@@ -418,6 +420,8 @@ def fig_damping(
         configs (Sequence[str]): the configurations, in column order.
         zeta_true (float): the testbed's damping ratio.
         outputs (Sequence[str | Path]): the files to write (PDF, PNG).
+        zeta_bound (float | None): the largest zeta the fit may take (``models.ours.zeta``);
+            None draws no bound.
 
     Raises:
         KeyError: naming a ``(tree, config)`` (and model) without a result.
@@ -454,6 +458,8 @@ def fig_damping(
                 a1.scatter(d.omega, d.gamma, s=9, marker=markers[c], alpha=0.6, **style(model, t))
                 allw.append(d.omega)
     a0.axhline(zeta_true, color="k", ls="--", lw=0.8)
+    if zeta_bound is not None:
+        a0.axhline(zeta_bound, color="0.4", ls=":", lw=1.0)
     a0.set_xticks(centres)
     a0.set_xticklabels(trees, fontsize=FONT_PT)
     a0.set_ylabel(r"$\hat\zeta_p$ (damping ratio, no unit)", fontsize=FONT_PT)
@@ -478,16 +484,12 @@ def fig_damping(
     handles += [
         Line2D([], [], ls="", marker=markers[c], color=grey, label=c, markersize=5) for c in configs
     ]
+    # the prior's key is a swatch, not a marker: a filled circle would also read as a config's
     handles += [
-        Line2D(
-            [],
-            [],
-            ls="",
-            marker="o",
-            markersize=5,
-            markerfacecolor=grey if m == models[0] else "none",
-            markeredgecolor=grey,
-            label=label(m) + (" (filled)" if m == models[0] else " (hollow)"),
+        Patch(
+            facecolor=grey if m == models[0] else "none",
+            edgecolor=grey,
+            label=label(m) + (": filled markers" if m == models[0] else ": hollow markers"),
         )
         for m in models
     ]
@@ -500,6 +502,10 @@ def fig_damping(
             label=rf"truth $\zeta$ = {zeta_true} ($\gamma = \zeta\omega$)",
         )
     )
+    if zeta_bound is not None:
+        handles.append(
+            Line2D([], [], color="0.4", ls=":", label=rf"fitting bound $\zeta$ = {zeta_bound:g}")
+        )
     _legend_below(fig, handles, ncol=4, top=0.15)
     save_figure(fig, outputs)
 

@@ -47,3 +47,7 @@ MARGIN = {
 }
 #: Section 4: the median fitted zeta per tree (the truth is 0.08).
 ZETA = {"sparse": "0.095-0.102", "medium": "0.125-0.142", "dense": "0.125-0.142"}
+#: The tree the paper's teaser figure shows (its clearest case).
+TEASER_TREE = "medium"
+#: Section 4: the true zeta of every bone.
+ZETA_TRUE = 0.08

@@ -17,7 +17,6 @@ from typing import Mapping, Sequence
 import numpy as np
 import pandas as pd
 
-from physgs.atomic import atomic_path
 from physgs.evaluate.metrics import ceiling_fraction
 from physgs.experiments.kmatch import matched_k
 from physgs.models.registry import label
@@ -244,9 +243,12 @@ def fig_parts(
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
 
+    from physgs.report.figures import FONT_PT, PAGE_WIDTH_IN, save_figure
+
     cols = max(len(records[t]["models"]) for t in trees)
+    # drawn at the page's width, so FONT_PT text reads at FONT_PT px
     fig, axes = plt.subplots(
-        len(trees), cols, figsize=(3.2 * cols, 3.4 * len(trees)), squeeze=False
+        len(trees), cols, figsize=(PAGE_WIDTH_IN, 3.0 * len(trees)), squeeze=False
     )
     cmap = plt.get_cmap("tab20")
     for r, t in enumerate(trees):
@@ -262,19 +264,19 @@ def fig_parts(
             ax.plot(piv[:, 0], piv[:, 2], "k.", ms=3)
             ax.set_title(
                 f"{t}: {label(m)}\nK={lab.max() + 1}, purity {float(rec[f'{m}/overall']):.2f}",
-                fontsize=8,
+                fontsize=FONT_PT,
             )
             ax.set_aspect("equal")
-            ax.tick_params(labelsize=6)
+            ax.tick_params(labelsize=FONT_PT)
+            ax.set_xlabel("x (m)", fontsize=FONT_PT)
+            if j == 0:
+                ax.set_ylabel("height z (m)", fontsize=FONT_PT)
         for j in range(len(rec["models"]), cols):
             axes[r, j].axis("off")
     if title:
-        fig.suptitle(title, fontsize=9)
+        fig.suptitle(title, fontsize=FONT_PT)
     fig.tight_layout()
-    for out in outputs:
-        with atomic_path(out) as tmp:
-            fig.savefig(tmp, dpi=150)
-    plt.close(fig)
+    save_figure(fig, outputs, dpi=150)
 
 
 def tab_parts_k(

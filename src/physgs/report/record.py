@@ -19,6 +19,7 @@ Pure over paths: every function takes the files it reads and the folder it write
 
 from __future__ import annotations
 
+import html
 import json
 import math
 import re
@@ -32,7 +33,7 @@ import pandas as pd
 from PIL import Image
 
 from physgs.experiments import cost
-from physgs.report import captions, catalogue, rerun
+from physgs.report import captions, catalogue, claims as ledger, rerun
 
 #: The commands whose cost the README states, keyed as ``tools/timed.py --name`` records them.
 COMMANDS: tuple[tuple[str, str], ...] = (
@@ -50,6 +51,9 @@ VALUE_COLUMNS_SHOWN = 4
 #: Lines of a summary (its rows times its parts) up to which it shows open on the Results page;
 #: a longer one is folded, its heading and CSV link still shown.
 OPEN_TABLE_ROWS = 30
+#: Tables shown open whatever their length: the fit bar (the premise every comparison rests on)
+#: and the null control's (the table the README points a reviewer to).
+OPEN_TABLES = ("tab_fit", "tab_null")
 #: Columns every table carries that the record's stamp already states.
 STAMP_COLUMNS = ("profile", "config_hash", "physgs_version")
 #: Cells moved beyond their row's seed spread that the record lists, largest first.
@@ -71,7 +75,9 @@ WORDS = (
     "points (pp): percentage points of relative error; fraction: a share of the true value; "
     "ratio: a quotient of errors (its interval on the log scale, so it stays positive); "
     "`sparse/0.84`: a tree under an unseen wind of 0.84 times the training speed. "
-    "*Static pose*: the Gaussians frozen at rest; *learned field*: a neural deformation field "
+    "*Headline claim*: one of the paper's claims that carry its story (the lines below the "
+    "counts); *premise*: what the comparison rests on (the fit bar, the testbed's nearest-bone "
+    "gap), *finding*: what it says. *Static pose*: the Gaussians frozen at rest; *learned field*: a neural deformation field "
     "(the baselines); *untrained null*: oscillators with ω drawn over the true range, not "
     "fitted; *chained prior*: ours with each part riding on its parent; *learned forcing*: "
     "ours with the wind learned instead of measured; *from nothing*: after `rm -rf results`; "
@@ -100,6 +106,8 @@ class Stamp:
         job_min_by_stage: job-minutes per stage, from the run's benchmark files.
         note: what a reader should know about how the run was made (apart from the commit).
         jobs: the run's benchmarked jobs (one benchmark file each; light jobs have none).
+        instances: tree -> the testbed seeds of its tree instances (``testbed_seeds``: one per
+            training seed; without, the one of ``seed``); {} in a record made before it.
     """
 
     date: str
@@ -113,6 +121,7 @@ class Stamp:
     job_min_by_stage: dict[str, float] = field(default_factory=dict)
     note: str = ""
     jobs: int = 0
+    instances: dict[str, list[int]] = field(default_factory=dict)
 
     def __post_init__(self):
         """Refuse a commit that is not a plain hash (a sentence, or a tag a clone lacks)."""
@@ -121,6 +130,22 @@ class Stamp:
                 f"stamp commit {self.commit!r}: a plain commit hash (7-40 hex digits); say the "
                 "rest in the stamp's note"
             )
+
+    def instances_words(self) -> str:
+        """The trees' instances in words: ``sparse, medium: testbed seeds 0-4``.
+
+        Returns:
+            One phrase per set of testbed seeds, "; "-joined.
+        """
+        by: dict[tuple[int, ...], list[str]] = {}
+        for t, seeds in self.instances.items():
+            by.setdefault(tuple(seeds), []).append(t)
+        words = [
+            f"{', '.join(trees)}: {'testbed seed' if len(s) == 1 else 'testbed seeds'} "
+            + ", ".join(map(str, s))
+            for s, trees in by.items()
+        ]
+        return "; ".join(words)
 
     def markdown(self) -> str:
         """The stamp as a short Markdown list.
@@ -136,6 +161,7 @@ class Stamp:
             [
                 f"- **Run**: profile `{self.profile}`, config hash `{self.config_hash}`, "
                 f"seeds {', '.join(map(str, self.seeds))}, trees {', '.join(self.trees)}",
+                *([f"- **Tree instances**: {self.instances_words()}"] if self.instances else []),
                 f"- **Made at** commit `{self.commit}`; record written {self.date}",
                 *([f"- **Note**: {self.note}"] if self.note else []),
                 f"- **Machine**: {self.cpu}, 2 cores",
@@ -145,6 +171,27 @@ class Stamp:
                 "",
             ]
         )
+
+
+def instances_of(testbed: pd.DataFrame, seeds: Sequence[int], seed: int) -> dict[str, list[int]]:
+    """Each tree's instances as a run's ``tab_testbed.csv`` says (its ``instances`` column): the
+    training seeds' testbed seeds where a tree has one per seed, else the one of ``seed``.
+
+    Args:
+        testbed: the run's tab_testbed CSV (``tree``, ``instances``; a table made before the
+            column: one instance each).
+        seeds: the run's training seeds.
+        seed: the config's testbed seed (the one instance of the paper's protocol).
+
+    Returns:
+        tree -> testbed seeds.
+    """
+    seeds = sorted(int(x) for x in seeds)
+    out = {}
+    for _, r in testbed.iterrows():
+        n = int(r["instances"]) if "instances" in testbed.columns else 1
+        out[str(r["tree"])] = seeds if n > 1 and n == len(seeds) else [int(seed)]
+    return out
 
 
 def format_duration(seconds: float) -> str:
@@ -605,6 +652,72 @@ def summary_markdown(df: pd.DataFrame) -> str:
     )
 
 
+#: The ledger's columns the catalogue derives from a claim's id: a record written before one of
+#: them gains it from its own ids (``derive_claims``), placed after the column named.
+DERIVED_COLUMNS = {"kind": "origin"}
+
+
+def derive_claims(record_dir: str | Path) -> list[Path]:
+    """Give a record's ledger the columns the catalogue derives from its ids that it lacks
+    (``DERIVED_COLUMNS``: ``kind``), and print its ``claims.md`` and the claims section of its
+    ``summary.md`` again from that ``claims.csv`` with the rules' own printers
+    (``claims.ledger_markdown`` with the CSV's stamp columns, ``summary.claims_section``): on a
+    ledger of today's columns and today's printers they print what the run printed. No number is
+    touched: the CSV is read and written back as text.
+
+    Args:
+        record_dir: the record folder (``claims.csv``).
+
+    Returns:
+        The files that changed; none when the ledger and its page are up to date.
+    """
+    out = Path(record_dir)
+    path, page = out / "claims.csv", out / "claims.md"
+    written = []
+    text = pd.read_csv(path, dtype=str, keep_default_na=False)
+    missing = [c for c in DERIVED_COLUMNS if c not in text.columns]
+    for name in missing:
+        after = DERIVED_COLUMNS[name]
+        at = text.columns.get_loc(after) + 1 if after in text else len(text.columns)
+        text.insert(at, name, ledger.column(text, name))
+    if missing:
+        text.to_csv(path, index=False)
+        written.append(path)
+    df = pd.read_csv(path, dtype={"config_hash": str})
+    stamp = {c: str(df[c].iloc[0]) for c in STAMP_COLUMNS if c in df and len(df)}
+    printed = demote(ledger.ledger_markdown(df, stamp or None))
+    if not page.is_file() or page.read_text() != printed:
+        page.write_text(printed)
+        written.append(page)
+    summary = out / "summary.md"
+    if summary.is_file():
+        text = summary.read_text()
+        again = _claims_section_again(text, df)
+        if again != text:
+            summary.write_text(again)
+            written.append(summary)
+    return written
+
+
+#: The heading of the run summary's claims section as the record holds it (demoted).
+SUMMARY_CLAIMS = "### Claims ledger"
+
+
+def _claims_section_again(text: str, claims: pd.DataFrame) -> str:
+    """The record's ``summary.md`` with its claims section printed again from ``claims``
+    (``summary.claims_section``, the summary rule's own printer); the rest, made from files the
+    record does not keep (the benchmarks), as it was. Unchanged without the section."""
+    from physgs.report.summary import claims_section  # summary imports this module
+
+    lines = text.split("\n")
+    if SUMMARY_CLAIMS not in lines:
+        return text
+    a = lines.index(SUMMARY_CLAIMS)
+    b = next((i for i in range(a + 1, len(lines)) if lines[i].startswith("### ")), len(lines))
+    section = demote("\n".join(claims_section(claims))).split("\n")
+    return "\n".join([*lines[:a], *section, *lines[b:]])
+
+
 def render_pages(record_dir: str | Path) -> list[Path]:
     """Lay out the record's pages from its own files: the Results page's parts.
 
@@ -646,7 +759,7 @@ def render_pages(record_dir: str | Path) -> list[Path]:
         )
         lines = len(summary) * (text.count("\n\n") + 1)  # rows of all its parts
         # a long summary folds away (Material's collapsible block), a short one shows open
-        fold = "???+" if lines <= OPEN_TABLE_ROWS else "???"
+        fold = "???+" if lines <= OPEN_TABLE_ROWS or t.stem in OPEN_TABLES else "???"
         index += [
             f"### `{t.stem}`",
             "",
@@ -668,6 +781,7 @@ def render_pages(record_dir: str | Path) -> list[Path]:
             "",
         ]
     put("figures.md", "\n".join(gallery))
+    put("ledger.md", ledger_page(out / "claims.csv", stamp.trees))
     put(
         "index.md",
         "\n".join(
@@ -711,6 +825,107 @@ def render_pages(record_dir: str | Path) -> list[Path]:
     return written
 
 
+def _value_text(r: pd.Series) -> str:
+    """A ledger row's measured mean and 95% interval, ``+2.26 [+1.94, +2.57] dB`` (``--``
+    unmeasured, the value alone where one value gives no interval)."""
+    if not math.isfinite(r["measured"]):
+        return "--"
+    if math.isfinite(r["ci_low"]):
+        n = [ledger.number(r[c], r["unit"]) for c in ("measured", "ci_low", "ci_high")]
+        return f"{n[0]} [{n[1]}, {n[2]}] {r['unit']}"
+    return f"{ledger.number(r['measured'], r['unit'])} {r['unit']} (one value)"
+
+
+def _tree_and_claim(text: str, trees: Sequence[str]) -> tuple[str, str]:
+    """A claim's sentence as its tree and the rest (``sparse: ours is ...`` -> ``sparse``,
+    ``ours is ...``); no tree where the sentence does not start with one."""
+    for t in trees:
+        if text.startswith(t) and text[len(t) : len(t) + 1] in (":", ",", " "):
+            return t, text[len(t) :].lstrip(":, ")
+    return "", text
+
+
+def ledger_page(claims_csv: str | Path, trees: Sequence[str]) -> str:
+    """The ledger page's table (``docs/ledger.md`` includes it): one compact row per claim, the
+    paper's claims first, each with its tree, the paper's value, the measured mean and 95%
+    interval, the verdict (coloured by ``docs/stylesheets/ledger.css``) and its kind; the full
+    sentence, the threshold, the table cells it comes from and, for a premise, what its failure
+    undermines, one click away (the row's ``<details>``). Each row carries its origin, verdict,
+    tree and kind as data attributes, which ``docs/javascripts/ledger.js`` filters by.
+
+    Args:
+        claims_csv: the record's ``claims.csv``.
+        trees: the run's trees (a sentence's leading tree becomes the tree column).
+
+    Returns:
+        The page part: raw HTML, ending in a newline.
+    """
+    claims = pd.read_csv(claims_csv, dtype={"config_hash": str})
+    # a ledger of fewer columns (an older or a partial one) shows what it has
+    shown = {"paper": "--", "source": "--", "threshold": "", "unit": "", "seeds": 0}
+    shown |= {c: np.nan for c in ("measured", "ci_low", "ci_high")}
+    claims = claims.assign(**{c: v for c, v in shown.items() if c not in claims})
+    if "claim" not in claims:
+        claims["claim"] = claims["id"]
+    claims = claims.assign(
+        _origin=ledger.column(claims, "origin"),
+        _kind=ledger.column(claims, "kind"),
+        _verdict=claims["verdict"].astype(str).str.split(":").str[0],
+    )
+    order = {o: i for i, o in enumerate(catalogue.ORIGINS)}  # the paper's first
+    claims = claims.iloc[claims["_origin"].map(order).argsort(kind="stable")]
+    e = html.escape
+    rows = []
+    for _, r in claims.iterrows():
+        tree, short = _tree_and_claim(str(r["claim"]), trees)
+        more = [
+            f"<b>{e(str(r['claim']))}</b>",
+            f"id <code>{e(str(r['id']))}</code>; {e(r['_origin'])}'s {r['_kind']}",
+            f"holds when the value is {e(str(r['threshold']))} {e(str(r['unit']))}; "
+            f"{int(r['seeds'])} seed{'s' if int(r['seeds']) != 1 else ''}",
+            f"from {e(str(r['source']))}",
+        ]
+        if str(r["verdict"]) != r["_verdict"]:
+            more.append(e(str(r["verdict"])))
+        if ledger.decide_cell(r):
+            more.append(f"seeds that would decide it (est.): {e(ledger.decide_cell(r))}")
+        if r["_kind"] == "premise":
+            more.append(f"if it fails, it undermines {e(catalogue.undermines(str(r['id'])))}")
+        anchor = "claim-" + re.sub(r"[^a-z0-9]+", "-", str(r["id"]).lower()).strip("-")
+        rows.append(
+            f'<tr id="{anchor}" data-origin="{e(r["_origin"])}" data-verdict="{r["_verdict"]}" '
+            f'data-tree="{e(tree or "--")}" data-kind="{r["_kind"]}">'
+            f"<td><details><summary>{e(short)}</summary>{'<br>'.join(more)}</details></td>"
+            f"<td>{e(tree or '--')}</td><td>{e(str(r['paper']))}</td>"
+            f"<td>{e(_value_text(r))}</td>"
+            f'<td class="verdict-{r["_verdict"]}">{r["_verdict"]}</td>'
+            f"<td>{r['_kind']}</td><td>{e(r['_origin'])}</td></tr>"
+        )
+    head = "".join(
+        f"<th>{h}</th>"
+        for h in (
+            "claim (click for the full claim)",
+            "tree",
+            "the paper",
+            "measured: mean [95% interval]",
+            "verdict",
+            "kind",
+            "origin",
+        )
+    )
+    return "\n".join(
+        [
+            '<table class="ledger">',
+            f"<thead><tr>{head}</tr></thead>",
+            "<tbody>",
+            *rows,
+            "</tbody>",
+            "</table>",
+            "",
+        ]
+    )
+
+
 def ledger_lines(claims_csv: str | Path) -> list[str]:
     """The Results page's pointer to the ledger: its verdicts counted, and where the paper's value
     stands beside the measured one.
@@ -722,15 +937,14 @@ def ledger_lines(claims_csv: str | Path) -> list[str]:
         The Markdown lines.
     """
     claims = pd.read_csv(claims_csv, dtype={"config_hash": str})
-    kind = claims["verdict"].astype(str).str.split(":").str[0]
-    origin = origins(claims)
-    paper, own = kind[origin == "paper"], kind[origin == "project"]
-    story = story_line(claims)
+    story, premise = story_line(claims), premise_line(claims)
     return [
-        f"The ledger holds the paper's {len(paper)} claims: {_counted(paper)}; and this "
-        f"project's own {len(own)}: {_counted(own)} (95% intervals over seeds). Each claim with "
-        "the paper's value beside the measured one, its threshold, verdict and the table cells "
-        "it comes from: [the paper against the measured](ledger.md).",
+        f"The ledger holds the paper's {ledger.counted(claims, 'paper')}; and this project's own "
+        f"{ledger.counted(claims, 'project')} (95% intervals over seeds; a premise is what the "
+        "comparison rests on, a finding what it says). Each claim with the paper's value beside "
+        "the measured one, its verdict and the table cells it comes from: "
+        "[the paper against the measured](ledger.md).",
+        *(["", premise[2:]] if premise else []),
         *(["", story[2:]] if story else []),
     ]
 
@@ -764,34 +978,38 @@ def origins(claims: pd.DataFrame) -> pd.Series:
     Returns:
         One origin per row.
     """
-    if "origin" in claims.columns:
-        return claims["origin"].astype(str)
-    return claims["id"].astype(str).map(catalogue.origin_of)
-
-
-def _counted(kind: pd.Series) -> str:
-    c = kind.value_counts()
-    return (
-        f"{int(c.get('holds', 0))} hold, {int(c.get('fails', 0))} fail, "
-        f"{int(c.get('undecided', 0))} undecided"
-    )
+    return ledger.column(claims, "origin")
 
 
 def count_line(claims: pd.DataFrame) -> str:
-    """The ledger's counts, the paper's claims first and this project's apart.
+    """The ledger's counts, the paper's claims first and this project's apart, each with its
+    findings apart from the premises of the comparison (``claims.counted``).
 
     Args:
-        claims: the ledger (``id``, ``verdict``; ``origin`` where written).
+        claims: the ledger (``id``, ``verdict``; ``origin``, ``kind`` where written).
 
     Returns:
         One Markdown bullet.
     """
-    kind = claims["verdict"].astype(str).str.split(":").str[0]
-    origin = origins(claims)
-    paper, own = kind[origin == "paper"], kind[origin == "project"]
     return (
-        f"- **The paper's {len(paper)} claims: {_counted(paper)}**; this project's own "
-        f"{len(own)}: {_counted(own)} (95% intervals over seeds)."
+        f"- **The paper's {ledger.counted(claims, 'paper')}**; this project's own "
+        f"{ledger.counted(claims, 'project')} (95% intervals over seeds; a *premise* is what the "
+        "comparison rests on, a *finding* what it says)."
+    )
+
+
+def premise_line(claims: pd.DataFrame) -> str:
+    """The premises that fail and what each undermines (``claims.failed_premises``).
+
+    Args:
+        claims: the ledger.
+
+    Returns:
+        One Markdown bullet; "" when every premise holds.
+    """
+    failed = ledger.failed_premises(claims)
+    return (
+        f"- **Premises that fail**: {'; '.join(f.rstrip('.') for f in failed)}." if failed else ""
     )
 
 
@@ -839,7 +1057,9 @@ def story_line(claims: pd.DataFrame) -> str:
 def headline_lines(claims: pd.DataFrame) -> list[str]:
     """What the run found, in a few lines: the ledger's counts (the paper's claims apart from
     this project's), whether the paper's story stands, then each headline family's
-    (``catalogue.headline``) verdict per cell with its measured value and 95% interval.
+    (``catalogue.headline``) verdict per cell with its measured value and 95% interval, and,
+    where the paper gives a number, whether it lies inside that interval (the direction and the
+    size both: ``paper_in_interval``).
 
     Args:
         claims: the ledger (``claims.csv``: id, measured, ci_low, ci_high, unit, verdict).
@@ -849,7 +1069,8 @@ def headline_lines(claims: pd.DataFrame) -> list[str]:
     """
     kind = claims["verdict"].astype(str).str.split(":").str[0]
     story = story_line(claims)
-    lines = [count_line(claims), *([story] if story else [])]
+    premise = premise_line(claims)
+    lines = [count_line(claims), *([premise] if premise else []), *([story] if story else [])]
     for fam, words, _ in catalogue.headline():
         rows = _family_rows(claims, fam)
         if rows.empty:
@@ -857,11 +1078,12 @@ def headline_lines(claims: pd.DataFrame) -> list[str]:
         cells = []
         for (_, r), k in zip(rows.iterrows(), kind[rows.index]):
             where = str(r["id"])[len(fam) + 1 :] or "all"
-            value = (
-                f"{r['measured']:+.3g} [{r['ci_low']:+.3g}, {r['ci_high']:+.3g}] {r['unit']}"
-                if math.isfinite(r["ci_low"])
-                else (f"{r['measured']:+.3g} {r['unit']}" if math.isfinite(r["measured"]) else "--")
-            )
+            value = _value_text(r).replace(" (one value)", "")
+            size = r.get("paper_in_interval")  # a record made before the column has none
+            if isinstance(size, str) and size:
+                p_lo, p_hi = r["paper_low"], r["paper_high"]
+                fig = f"{p_lo:+.3g}" if p_lo == p_hi else f"{p_lo:+.3g} to {p_hi:+.3g}"
+                value = f"{value.strip()}; the paper's {fig} {size}"
             cells.append(f"{where} **{k}** ({value.strip()})")
         lines.append(f"- {words[0].upper() + words[1:]}: " + "; ".join(cells) + ".")
     return lines

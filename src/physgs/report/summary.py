@@ -21,7 +21,7 @@ from physgs.experiments.cost import read_costs, summarise, wall_spans
 from physgs.models.registry import label
 from physgs.report.thresholds import FIT_BAR
 from physgs.report.catalogue import AHEAD
-from physgs.report.claims import decide_cell
+from physgs.report.claims import counted, decide_cell, failed_premises, number
 from physgs.report.record import origins, story_line
 from physgs.report.seeds import interval
 
@@ -63,18 +63,15 @@ def claims_section(claims: pd.DataFrame) -> list[str]:
     bad = sorted(set(kind) - set(VERDICTS))
     if bad:
         raise ValueError(f"claims: unknown verdicts {bad} (expected one of {VERDICTS})")
-    origin = origins(claims)
-
-    def counted(who: str) -> str:
-        mine = kind[origin == who]
-        c = mine.value_counts()
-        return f"{len(mine)} claims: " + ", ".join(f"**{v}** {int(c.get(v, 0))}" for v in VERDICTS)
-
     lines = [
         "## Claims ledger",
         "",
-        f"The paper's {counted('paper')}. This project's own {counted('project')}. The claims, "
-        "the paper's figures and the cells each verdict comes from: [claims.md](claims.md).",
+        f"The paper's {counted(claims, 'paper')}. This project's own "
+        f"{counted(claims, 'project')}. A premise is what the comparison rests on, a finding what "
+        "it says. The claims, the paper's figures and the cells each verdict comes from: "
+        "`claims.md` beside this summary (on the documentation site: [the ledger](ledger.md)).",
+        "",
+        *[f"- {s[0].upper() + s[1:]}" for s in failed_premises(claims)],
         "",
         *([story_line(claims), ""] if story_line(claims) else []),
         *prior_lines(claims),
@@ -83,9 +80,13 @@ def claims_section(claims: pd.DataFrame) -> list[str]:
         "|---|---|---|---|---|",
     ]
     for _, r in claims.iterrows():
-        meas = "--" if not np.isfinite(r["measured"]) else f"{r['measured']:+.3g} {r['unit']}"
+        meas = (
+            "--"
+            if not np.isfinite(r["measured"])
+            else f"{number(r['measured'], r['unit'])} {r['unit']}"
+        )
         if np.isfinite(r["ci_low"]):
-            meas += f" [{r['ci_low']:+.3g}, {r['ci_high']:+.3g}]"
+            meas += f" [{number(r['ci_low'], r['unit'])}, {number(r['ci_high'], r['unit'])}]"
         lines.append(
             f"| `{r['id']}` | {meas} | {r['threshold']} | {r['verdict']} | {decide_cell(r)} |"
         )

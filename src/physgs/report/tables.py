@@ -674,7 +674,9 @@ def method_rows(
 #: tab_null / tab_damping's CSV columns of a method's own intervals (the output-only analysis';
 #: NaN for a method without them): the coverage of its trusted parts' 95% intervals for omega
 #: and zeta, the parts they cover, the median relative standard deviations (sigma / value) over
-#: those parts, and the parts its sigma rule keeps (alone, and with ours')
+#: those parts, and the parts its sigma rule keeps (alone, and with ours'); last, the mean
+#: relative interval scores of its intervals and of the untrained null's draw range on the same
+#: parts (``physgs.oma.intervals.relative_scores``; NaN in a record made before them)
 INTERVAL_COLUMNS = (
     "omega_rel_sd",
     "zeta_rel_sd",
@@ -683,6 +685,10 @@ INTERVAL_COLUMNS = (
     "interval_parts",
     "sigma_parts_trusted",
     "sigma_and_corr_parts_trusted",
+    "omega_interval_score",
+    "omega_null_interval_score",
+    "zeta_interval_score",
+    "zeta_null_interval_score",
 )
 
 
@@ -700,6 +706,11 @@ def interval_cells(rec) -> dict:
     if not iv:
         return dict.fromkeys(INTERVAL_COLUMNS, float("nan"))
     cov = iv["coverage"]
+    score = iv.get("interval_score", {})  # absent in a record made before the scores
+
+    def sc(q: str, key: str) -> float:
+        return float(score.get(q, {}).get(key, float("nan")))
+
     return {
         "omega_rel_sd": float(iv["median_rel_std"]["omega"]),
         "zeta_rel_sd": float(iv["median_rel_std"]["zeta"]),
@@ -708,6 +719,10 @@ def interval_cells(rec) -> dict:
         "interval_parts": float(cov["omega"]["n"]),
         "sigma_parts_trusted": float(iv["n_sigma_trusted"]),
         "sigma_and_corr_parts_trusted": float(iv["n_both_trusted"]),
+        "omega_interval_score": sc("omega", "score"),
+        "omega_null_interval_score": sc("omega", "null_score"),
+        "zeta_interval_score": sc("zeta", "score"),
+        "zeta_null_interval_score": sc("zeta", "null_score"),
     }
 
 
@@ -925,7 +940,51 @@ def write_table(table: Table, tex_path: str | Path, csv_path: str | Path, stamp=
 
 
 # --------------------------------------------------------------------------------------------
-def tab_testbed(stats: Mapping[str, Mapping], trees: Sequence[str], digits: int = 2) -> Table:
+#: tab_testbed's statistics that vary from one tree instance to the next: each gets a
+#: ``<col>_sd`` column, its spread over the instances (``testbed_seeds``)
+INSTANCE_SPREAD = (
+    "distinct_frequencies",
+    "f_min_hz",
+    "f_median_hz",
+    "f_max_hz",
+    "f_span",
+    "clamped",
+    "nearest_bone_gap_pct",
+    "swing_deg_median",
+    "visible_px_median",
+    "visible_below_px_pct",
+    "height_fill_pct",
+    "coverage_pct",
+)
+
+
+def _testbed_row(s: Mapping) -> dict:
+    """One instance's statistics in tab_testbed's columns (percentages as percent)."""
+    return {
+        "distinct_frequencies": int(s["distinct_frequencies"]),
+        "f_min_hz": s["f_min_hz"],
+        "f_median_hz": s["f_median_hz"],
+        "f_max_hz": s["f_max_hz"],
+        "f_span": s["f_span"],
+        "clamped": int(s["clamped"]),
+        "nearest_bone_gap_pct": 100 * s["nearest_bone_gap"],
+        "swing_deg_median": s["swing_deg_median"],
+        "visible_px_median": s["visible_px_median"],
+        "visible_below_px_pct": 100 * s["visible_below_px_fraction"],
+        "height_fill_pct": 100 * s["height_fill"],
+        "coverage_pct": 100 * s["coverage"],
+        "order_share": s["order_share"],
+        "order_share_random": s["order_share_random"],
+    }
+
+
+def tab_testbed(
+    stats: Mapping[str, Mapping],
+    trees: Sequence[str],
+    digits: int = 2,
+    instances: Mapping[str, Sequence[Mapping]] | None = None,
+    paper_trees: Mapping[str, str | None] | None = None,
+) -> Table:
     """The testbed's statistics per tree
     ([`testbed_stats`][physgs.testbed.stats.testbed_stats]), beside the paper's figures where it
     gives them ([`physgs.report.paper`][physgs.report.paper]).
@@ -933,13 +992,20 @@ def tab_testbed(stats: Mapping[str, Mapping], trees: Sequence[str], digits: int 
     Columns: bones; distinct natural frequencies; f min / median / max (Hz) and span; bones
     clamped into the band; median nearest-bone gap (%); median per-bone swing (degrees); how
     visible each bone's own motion is in the training camera (median pixels, % under 1 px);
-    the training frame's height filled by the swept tree and pixels covered (%).
+    the training frame's height filled by the swept tree and pixels covered (%). With tree
+    instances (``testbed_seeds``: one per training seed), each is the mean over a tree's
+    instances, ``<col>_sd`` its spread (sample sd; ``INSTANCE_SPREAD``) and ``instances`` their
+    number; without, the one instance's (sd NaN, ``instances`` 1).
 
     Args:
         stats: tree -> its statistics (as [`load_stats`][physgs.testbed.stats.load_stats] reads
-            them).
+            them): the one instance's.
         trees: the trees, in row order.
         digits: decimals shown in the .tex.
+        instances: tree -> each instance's statistics (``testbed_seeds``); None or a tree left
+            out: the one instance of ``stats``.
+        paper_trees: tree -> the paper's tree it stands for (its preset's ``role.paper``), whose
+            figures go beside it; None or a tree left out: none.
 
     Returns:
         The [`Table`][physgs.report.tables.Table].
@@ -947,28 +1013,24 @@ def tab_testbed(stats: Mapping[str, Mapping], trees: Sequence[str], digits: int 
     _check(list(trees), stats, "tab_testbed")
     rows = []
     for t in trees:
-        s = stats[t]
+        per = [_testbed_row(x) for x in ((instances or {}).get(t) or [stats[t]])]
+        inst = pd.DataFrame(per)
+        mean = {c: float(inst[c].mean()) for c in inst.columns}
+        sd = {
+            f"{c}_sd": float(inst[c].std(ddof=1)) if len(inst) > 1 else np.nan
+            for c in INSTANCE_SPREAD
+        }
+        pt = (paper_trees or {}).get(t)
         rows.append(
             {
                 "tree": t,
-                "bones": int(s["bones"]),
-                "paper_bones": paper.BONES.get(t),
-                "distinct_frequencies": int(s["distinct_frequencies"]),
-                "f_min_hz": s["f_min_hz"],
-                "f_median_hz": s["f_median_hz"],
-                "f_max_hz": s["f_max_hz"],
-                "f_span": s["f_span"],
+                "bones": int(stats[t]["bones"]),
+                "paper_bones": paper.BONES.get(pt),
+                **mean,
                 "paper_f_span": paper.FREQUENCY_SPAN,
-                "clamped": int(s["clamped"]),
-                "nearest_bone_gap_pct": 100 * s["nearest_bone_gap"],
-                "paper_nearest_bone_gap_pct": paper.NEAREST_BONE_GAP_PCT.get(t, np.nan),
-                "swing_deg_median": s["swing_deg_median"],
-                "visible_px_median": s["visible_px_median"],
-                "visible_below_px_pct": 100 * s["visible_below_px_fraction"],
-                "height_fill_pct": 100 * s["height_fill"],
-                "coverage_pct": 100 * s["coverage"],
-                "order_share": s["order_share"],
-                "order_share_random": s["order_share_random"],
+                "paper_nearest_bone_gap_pct": paper.NEAREST_BONE_GAP_PCT.get(pt, np.nan),
+                "instances": len(per),
+                **sd,
             }
         )
     df = pd.DataFrame(rows)
@@ -981,7 +1043,13 @@ def tab_testbed(stats: Mapping[str, Mapping], trees: Sequence[str], digits: int 
         "    \\midrule",
     ]
     for _, r in df.iterrows():
-        gap = f"{r.nearest_bone_gap_pct:{fmt}}\\% ({_fmt(r.paper_nearest_bone_gap_pct, fmt)}\\%)"
+        spread = (  # over the tree's instances, where there are several
+            f" $\\pm$ {r.nearest_bone_gap_pct_sd:{fmt}}" if r.instances > 1 else ""
+        )
+        gap = (
+            f"{r.nearest_bone_gap_pct:{fmt}}{spread}\\% "
+            f"({_fmt(r.paper_nearest_bone_gap_pct, fmt)}\\%)"
+        )
         lines.append(
             "    "
             + " & ".join(
@@ -1010,5 +1078,12 @@ def tab_testbed(stats: Mapping[str, Mapping], trees: Sequence[str], digits: int 
         r"Visible: median image displacement caused by a bone's own angle alone, acting on its "
         r"subtree, in training-camera pixels, and the share of bones under 1\,px (no method "
         r"can recover those); Height: training-image height spanned by the swept tree."
+        + (
+            f" Each value is the mean over a tree's {int(df['instances'].max())} instances "
+            r"(one per training seed), the gap $\pm$ its sd over them (the CSV: every "
+            r"statistic's)."
+            if (df["instances"] > 1).any()
+            else " One instance per tree (the paper's protocol)."
+        )
     )
     return Table("tab_testbed", df, _wrap("\n".join(lines), cap, "tab:testbed"))

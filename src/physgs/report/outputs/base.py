@@ -41,6 +41,7 @@ NEED_FIELDS = {
     "kselect": ("tree", "seed"),  # ours' K selection
     "prior_kselect": ("tree", "model", "seed"),  # another prior's (models.kselect.priors)
     "stats": ("tree",),
+    "instance_stats": ("tree", "seed"),  # a tree instance's (testbed_seeds: testbed seed = seed)
     "table": ("name",),
     # the 2D-track control (physgs.tracks): its evaluation record, its fit, one condition's
     # tracks, and the observed dataset (fig_tracks' frame)
@@ -100,7 +101,8 @@ class Plan:
     tracked points; parts_models/parts_configs: the parts study's variants and configurations
     ({} without a study); study_seeds/k_candidates: the K match's; kselect_priors: the priors
     besides ours whose K is chosen from the data (``models.kselect.priors``); sweep_tree: the
-    speed-accuracy sweep's tree (``speed_accuracy.tree``)."""
+    speed-accuracy sweep's tree (``speed_accuracy.tree``); testbed_seeds: whether each training
+    seed has its own tree instance (``testbed_seeds``)."""
 
     trees: Sequence[str]
     configs: Mapping[str, dict]
@@ -115,6 +117,7 @@ class Plan:
     k_candidates: Sequence[int] = ()
     kselect_priors: Sequence[str] = ()
     sweep_tree: str = ""
+    testbed_seeds: bool = False
 
     def __post_init__(self):
         """Default the recovery methods to the wind-driven priors in every configuration."""
@@ -162,6 +165,7 @@ class Plan:
             k_candidates=[int(k) for k in cfg["parts_study"]["k_candidates"]],
             kselect_priors=list(selected_models(cfg["models"]["kselect"])[1:]),
             sweep_tree=str(cfg["speed_accuracy"]["tree"]),
+            testbed_seeds=bool(cfg["testbed_seeds"]),
         )
 
 

@@ -239,7 +239,10 @@ def _fig_damping(path, settings, inputs, out):
         }
         for m in models_of("prior")
     }
-    figures.fig_damping(damping, trees, configs, float(settings["zeta"]), out)
+    bound = settings.get("zeta_bound")  # settings made before the bound was drawn lack it
+    figures.fig_damping(
+        damping, trees, configs, float(settings["zeta"]), out, None if bound is None else bound
+    )
 
 
 FIG_DAMPING = Output(
@@ -253,7 +256,11 @@ FIG_DAMPING = Output(
         for c in plan.configs
     ],
     _fig_damping,
-    settings=lambda cfg: {**_configs(cfg), "zeta": float(cfg["testbed"]["zeta"])},
+    settings=lambda cfg: {
+        **_configs(cfg),
+        "zeta": float(cfg["testbed"]["zeta"]),
+        "zeta_bound": float(max(cfg["models"]["ours"]["zeta"])),
+    },
     seeds="first",
 )
 
