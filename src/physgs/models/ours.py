@@ -92,6 +92,24 @@ def prior_substeps(omega_hz, zeta, substeps: int, dt: float, guard: float = STAB
     return max(int(substeps), required_substeps(rate, dt, guard))
 
 
+def settings_substeps(settings: dict, dt: float) -> int:
+    """[`prior_substeps`][physgs.models.ours.prior_substeps] of a settings dict that holds ours'
+    ``omega_hz``, ``zeta``, ``substeps`` and optionally ``rk4_guard`` (default
+    ``STABILITY_GUARD``): ``models.ours``, or a null's solver settings. Every method that
+    integrates ours' oscillators from settings (the null, the 2D-track control, the output-only
+    analysis) takes its step from here, so each integrates with the trained prior's step.
+
+    Args:
+        settings: the settings.
+        dt: the wind's sample interval, s.
+
+    Returns:
+        The substep count.
+    """
+    guard = float(settings.get("rk4_guard", STABILITY_GUARD))
+    return prior_substeps(settings["omega_hz"], settings["zeta"], settings["substeps"], dt, guard)
+
+
 class OscillatorPrior(BaseModel):
     """Per-part wind-driven oscillators with rigid rotation (see module docstring)."""
 

@@ -289,12 +289,10 @@ def recover_oma(
     import torch
 
     from physgs.models.oscillator import integrate
-    from physgs.models.ours import prior_substeps
+    from physgs.models.ours import settings_substeps
 
     dt = 1.0 / float(observed.fps)
-    sub = prior_substeps(
-        solver["omega_hz"], solver["zeta"], solver["substeps"], dt, solver["rk4_guard"]
-    )
+    sub = settings_substeps(solver, dt)
     est = pm.estimated
     K = est.size
     omega = np.where(est, pm.omega, 2 * np.pi * float(np.sqrt(np.prod(solver["omega_hz"]))))

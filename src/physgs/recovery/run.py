@@ -105,18 +105,10 @@ def null_control(observed, truth, settings: dict, bone_visible=None) -> NullResu
     Returns:
         The [`NullResult`][physgs.recovery.null.NullResult].
     """
-    # here: these load torch, and the workflow imports this module to plan jobs
-    from physgs.models.oscillator import STABILITY_GUARD
-    from physgs.models.ours import prior_substeps
+    # here: this loads torch, and the workflow imports this module to plan jobs
+    from physgs.models.ours import settings_substeps
 
-    dt = 1.0 / observed.fps
-    substeps = prior_substeps(
-        settings["omega_hz"],
-        settings["zeta"],
-        settings["substeps"],
-        dt,
-        float(settings.get("rk4_guard", STABILITY_GUARD)),
-    )
+    substeps = settings_substeps(settings, 1.0 / observed.fps)
     return run_null(
         truth,
         observed,

@@ -38,7 +38,7 @@ import torch
 
 from physgs.models.oscillator import STABILITY_GUARD, integrate
 from physgs.models.oscillator_params import OscillatorBounds, condition_vbar
-from physgs.models.ours import prior_substeps
+from physgs.models.ours import settings_substeps
 from physgs.tracks.track import Tracks
 from physgs.train.adam import FusedAdam
 from physgs.train.divergence import pinned
@@ -108,7 +108,7 @@ class Oscillators:
         w = np.asarray(observed.wind[0], np.float64)
         return Oscillators(
             b,
-            prior_substeps(ours_cfg["omega_hz"], ours_cfg["zeta"], ours_cfg["substeps"], dt, guard),
+            settings_substeps(ours_cfg, dt),
             int(observed.fps),
             int(observed.lead_in_frames),
             float(np.asarray(observed.vbar)[0] / w.mean()),
