@@ -460,6 +460,34 @@ def run_files(
     )
 
 
+def _remove(path: Path) -> None:
+    """Remove ``path``, a folder or a file, if it is there."""
+    if path.is_dir() and not path.is_symlink():
+        shutil.rmtree(path)
+    elif path.exists() or path.is_symlink():
+        path.unlink()
+
+
+def _settle_swap(final: Path) -> None:
+    """Finish what a write of the record at ``final`` left undone when it stopped.
+
+    A write swaps the records by two renames (``final`` to ``final.old``, ``final.partial`` to
+    ``final``) and then removes ``final.old``. Stopped between the renames, it leaves the last
+    record as ``final.old`` and no ``final``: that record is put back. Stopped after them, or
+    unable to remove it, it leaves a ``final.old`` beside a ``final`` that is the newer record:
+    it is removed (a rename onto a folder that is not empty fails, ``OSError`` 39).
+    """
+    old = final.with_name(final.name + ".old")
+    if not (old.exists() or old.is_symlink()):
+        return
+    if final.exists():
+        print(f"{old}: left by an earlier write of the record after its swap; removed")
+        _remove(old)
+    else:
+        print(f"{old}: the last record, left there by a write that stopped; put back at {final}")
+        old.rename(final)
+
+
 def write_record(
     out_dir: str | Path,
     *,
@@ -473,7 +501,10 @@ def write_record(
     """Write a run's record into ``out_dir`` (replacing the record there).
 
     Snakemake's report of a run is not part of the record (it is ~10 MB: every clone would
-    carry each record's); ``tools/record.py --report-html`` makes it into ``results/``.
+    carry each record's); ``tools/record.py --report-html`` makes it into ``results/``. What an
+    earlier write left when it stopped is settled first, and said: a ``<out_dir>.partial`` is
+    removed, a ``<out_dir>.old`` beside the record is removed, and one without a record beside
+    it (the last record, stopped between the swap's renames) is put back.
 
     Args:
         out_dir: the record's folder (the project keeps it at ``docs/record``).
@@ -496,6 +527,7 @@ def write_record(
         if not p.is_file():
             raise FileNotFoundError(f"{p}: missing; finish the run first (snakemake --cores 2 all)")
     final = Path(out_dir)
+    _settle_swap(final)
     kept = {n: (final / n).read_bytes() for n in OUTLIVE if (final / n).is_file()}
     # against the record this one replaces; the same run recorded again keeps its comparison
     old_stamp = final / "stamp.json"
@@ -508,8 +540,7 @@ def write_record(
     else:
         against = "\n".join(rerun_lines(final, stamp, claims_csv, tables))
     out = final.with_name(final.name + ".partial")  # the old record stands until this is whole
-    if out.exists():
-        shutil.rmtree(out)
+    _remove(out)  # an earlier write that stopped before its swap
     (out / "tables").mkdir(parents=True)
     (out / "figures").mkdir()
     written: list[Path] = []
@@ -538,7 +569,7 @@ def write_record(
     if final.exists():
         final.rename(old)
     out.rename(final)
-    shutil.rmtree(old, ignore_errors=True)
+    _remove(old)
     return sorted({final / p.relative_to(out) for p in written})
 
 
