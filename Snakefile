@@ -4,12 +4,17 @@ from snakemake.utils import min_version
 
 import physgs.config
 import physgs.experiments.recipe
+import physgs.provenance
 import physgs.scheduling
 
 min_version("9.0")
 # Snakemake's loop adds a re-evaluation timer chain per finished job, and a long run's loop then
 # takes most of a core from the jobs: keep one pending timer (physgs.scheduling)
 physgs.scheduling.install()
+# a results folder without Snakemake's metadata (copied, or older) is taken as up to date whatever
+# settings made it: every plan checks each file it reads as made against the provenance record
+# beside it (physgs.provenance), and names the file and the key that differs
+physgs.provenance.install(workflow)
 
 
 configfile: "config/trees.yaml"

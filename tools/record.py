@@ -40,6 +40,7 @@ from __future__ import annotations
 
 import argparse
 import datetime
+import shlex
 import subprocess
 from pathlib import Path
 
@@ -49,28 +50,74 @@ import physgs.config
 from physgs.experiments.cost import dry_run, plan_jobs, plan_outputs, summarise
 from physgs.provenance import config_hash, git_commit, machine_cpu
 from physgs.report import record
+from snakemake.cli import parse_config
 
 
 #: the run's folder as the workflow's paths name it: every output and benchmark file is below it
 RUN_ROOT = Path("results")
 TARGET = "all"  # the record is of the run of `all`
+CONFIGFILE = "config/trees.yaml"  # the Snakefile's configfile
 
 
-def _plan(profile: str, run_hash: str) -> tuple[list[str], list[str]]:
-    """`all`'s outputs and benchmark files at ``profile``, relative to the run's folder, from
-    Snakemake's dry run in this checkout; refused unless this checkout's config is the run's."""
-    here = config_hash(physgs.config.load("config/trees.yaml", profile))
+def _run_config(profile: str, config: list[str], configfiles: list[str]) -> tuple[list[str], str]:
+    """The run's ``--config`` items (``profile=P`` first unless they set it: P the profile of the
+    run's tables) and this checkout's config hash under them and ``configfiles``, resolved as
+    the Snakefile resolves them."""
+    command_line = parse_config(config)
+    if "profile" not in command_line:
+        config = [f"profile={profile}", *config]
+        command_line = parse_config(config)
+    raw = physgs.config.read_yaml(CONFIGFILE) or {}
+    for f in configfiles:
+        raw = physgs.config.deep_merge(raw, physgs.config.read_yaml(f) or {})
+    raw = physgs.config.deep_merge(raw, command_line)
+    cfg = physgs.config.load_workflow_config(
+        raw, command_line=command_line, configfiles=configfiles
+    )
+    return config, config_hash(cfg)
+
+
+def _plan(
+    config: list[str], configfiles: list[str], run_hash: str, here: str, overrides: str
+) -> tuple[list[str], list[str]]:
+    """`all`'s outputs and benchmark files under the run's config, relative to the run's folder,
+    from Snakemake's dry run in this checkout; refused unless this checkout's config with the
+    run's overrides is the run's, and unless `all` has nothing left to do (every file of its
+    plan made with the plan's settings: Snakemake's metadata and each file's provenance record
+    agree)."""
     if here != run_hash:
         raise SystemExit(
-            f"this checkout's {profile} config hashes to {here}, the run's tables to {run_hash}: "
-            "its plan is another run's; record from the checkout and config the run was made with"
+            f"this checkout's config with {overrides} hashes to {here}, the run's tables to "
+            f"{run_hash}: its plan is another run's; record from the checkout the run was made "
+            "with, giving the run's own overrides (`--config KEY=VALUE ...`, `--configfile FILE`)"
         )
-    dry = dry_run([TARGET], [f"profile={profile}"])
+    try:
+        pending = dry_run([TARGET], config, configfiles=configfiles, forceall=False)
+    except RuntimeError as e:  # the plan's provenance check refused a file, or Snakemake did
+        raise SystemExit(f"{TARGET}'s plan under {overrides} is not this run's: {e}") from None
+    remade = [o for o in plan_outputs(pending) if RUN_ROOT in Path(o).parents]
+    if remade:
+        shown = ", ".join(remade[:12]) + (
+            f" and {len(remade) - 12} more" if len(remade) > 12 else ""
+        )
+        raise SystemExit(
+            f"{TARGET} under {overrides} is not finished: Snakemake would make {len(remade)} of "
+            f"its files again ({shown}); finish the run (snakemake --cores 2 {TARGET}"
+            f"{_words(config, configfiles)}) and record it then"
+        )
+    dry = dry_run([TARGET], config, configfiles=configfiles)
 
     def below(paths):
         return [str(Path(p).relative_to(RUN_ROOT)) for p in paths if RUN_ROOT in Path(p).parents]
 
     return below(plan_outputs(dry)), below(b for _, b in plan_jobs(dry) if b)
+
+
+def _words(config: list[str], configfiles: list[str]) -> str:
+    """The overrides as Snakemake's command line words (a leading space when any)."""
+    words = [*(["--configfile", *configfiles] if configfiles else [])]
+    words += ["--config", *config] if config else []
+    return "".join(" " + shlex.quote(w) for w in words)
 
 
 def _wall_s(args, commit: str) -> float:
@@ -96,6 +143,20 @@ def main() -> None:
     ap.add_argument("--wall-s", type=float, help="the run's wall time (tools/timed.py), s")
     ap.add_argument("--commit", help="the commit the run was made at (default: HEAD's hash)")
     ap.add_argument("--note", default="", help="what a reader should know of how it was made")
+    ap.add_argument(
+        "--config",
+        nargs="+",
+        default=[],
+        metavar="KEY=VALUE",
+        help="the run's --config overrides, as given to snakemake (profile: its tables')",
+    )
+    ap.add_argument(
+        "--configfile",
+        nargs="+",
+        default=[],
+        metavar="FILE",
+        help="the run's --configfile overrides, as given to snakemake",
+    )
     ap.add_argument("--readme-only", action="store_true")
     ap.add_argument("--pages-only", action="store_true", help="lay out the record's pages again")
     ap.add_argument(
@@ -115,8 +176,20 @@ def main() -> None:
     elif not args.readme_only:
         r = args.results
         fit = pd.read_csv(r / "tables" / "tab_fit.csv", dtype={"config_hash": str})
-        outputs, benchmarks = _plan(str(fit["profile"].iloc[0]), fit["config_hash"].iloc[0])
+        config, here = _run_config(str(fit["profile"].iloc[0]), args.config, args.configfile)
+        overrides = _words(config, args.configfile).strip()
+        outputs, benchmarks = _plan(
+            config, args.configfile, str(fit["config_hash"].iloc[0]), here, overrides
+        )
         run = record.run_files(r, outputs, benchmarks, target=TARGET)
+        others = record.other_configs([*run.tables, r / "claims.csv"], here)
+        if others:
+            raise SystemExit(
+                f"{r}: {len(others)} file(s) of {TARGET}'s plan were made under another config "
+                f"than {here} ({overrides}):\n"
+                + "\n".join(f"- {line}" for line in others)
+                + f"\nremake them: snakemake --cores 2 {TARGET}{_words(config, args.configfile)}"
+            )
         print(f"{r}: {len(run.jobs)} benchmarked jobs of {TARGET}'s plan")
         print(run.left_out_line())
         by_stage = summarise(list(run.jobs))["by_stage"]
@@ -133,6 +206,7 @@ def main() -> None:
             job_min_by_stage={k: sum(v.values()) / 60 for k, v in sorted(by_stage.items())},
             note=args.note,
             jobs=len(run.jobs),
+            overrides=tuple(shlex.split(_words(args.config, args.configfile))),
         )
         written = record.write_record(
             args.out,

@@ -29,6 +29,7 @@ from pathlib import Path
 
 from physgs.allocator import retain_freed_memory
 from physgs.atomic import atomic_path
+from physgs.provenance import clear_provenance, write_provenance
 
 #: where the output locks live, relative to the workflow's working directory (not Snakemake's
 #: own ``.snakemake/locks``, which a finishing run deletes whole)
@@ -230,7 +231,10 @@ def job(sm):
     ([`physgs.allocator.retain_freed_memory`][]), sets the thread counts to the rule's
     ``threads`` ([`set_threads`][physgs.jobs.set_threads]), sends stdout and stderr (progress
     bars included) to ``sm.log[0]``, and writes the traceback of a failure there too (not only
-    to the console) before re-raising it. The log is put back if another job of the rule
+    to the console) before re-raising it. When the body ends well, each output gets its
+    provenance record ([`physgs.provenance.write_provenance`][]: the rule, its params, the
+    commit, the settings of each input); an output's old record is removed before the body
+    runs. The log is put back if another job of the rule
     started meanwhile (Snakemake deletes a job's log before it starts). A job that Snakemake runs
     ([`run_by_snakemake`][physgs.jobs.run_by_snakemake]) and whose body ended without an error
     ends its process when the block ends ([`end_process`][physgs.jobs.end_process]): nothing
@@ -257,6 +261,7 @@ def job(sm):
                 print(f"outputs made for this same job by {made_by}; taken as made", file=log)
             print(f"{sm.rule}: outputs made by {made_by}; taken as made", file=sys.stderr)
         else:
+            clear_provenance(sm.output)  # a record never outlives the output it describes
             with (
                 open(sm.log[0], "w+") as log,
                 contextlib.redirect_stderr(log),
@@ -264,6 +269,10 @@ def job(sm):
             ):
                 try:
                     yield log
+                    start = time.perf_counter()
+                    write_provenance(sm.output, sm.rule, sm.params, sm.input)
+                    ms = (time.perf_counter() - start) * 1e3
+                    print(f"provenance recorded beside {len(sm.output)} outputs ({ms:.1f} ms)")
                 except BaseException:
                     traceback.print_exc(file=log)
                     print(f"job failed; see {sm.log[0]}", file=sys.__stderr__)

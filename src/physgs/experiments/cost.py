@@ -355,7 +355,14 @@ def _job_stats(dry_run: str) -> dict[str, int]:
     return out
 
 
-def dry_run(targets: Sequence[str], config: Sequence[str] = (), cwd=None) -> str:
+def dry_run(
+    targets: Sequence[str],
+    config: Sequence[str] = (),
+    cwd=None,
+    *,
+    configfiles: Sequence[str] = (),
+    forceall: bool = True,
+) -> str:
     """Snakemake's printout of the whole plan of ``targets``: ``snakemake -n --forceall``, run in
     ``cwd`` (the workflow's folder; default the current one) whatever its ``results/`` holds.
 
@@ -363,6 +370,9 @@ def dry_run(targets: Sequence[str], config: Sequence[str] = (), cwd=None) -> str
         targets: the targets (``["all"]``, or files).
         config: ``--config`` items (``["profile=quick"]``).
         cwd (str | Path | None): the workflow's folder.
+        configfiles: ``--configfile`` paths, after ``config/trees.yaml`` (the Snakefile's).
+        forceall: plan every job (the default); False: the jobs that would run now, after the
+            plan's provenance check ([`physgs.provenance.check_plan`][]), which stops it.
 
     Returns:
         The printout ([`plan_jobs`][physgs.experiments.cost.plan_jobs] and
@@ -371,7 +381,15 @@ def dry_run(targets: Sequence[str], config: Sequence[str] = (), cwd=None) -> str
     Raises:
         RuntimeError: with the command and the end of Snakemake's error when it cannot plan.
     """
-    cmd = [sys.executable, "-m", "snakemake", "-n", "--forceall", "--nolock"]
+    cmd = [
+        sys.executable,
+        "-m",
+        "snakemake",
+        "-n",
+        *(["--forceall"] if forceall else []),
+        "--nolock",
+    ]
+    cmd += ["--configfile", *configfiles] if configfiles else []
     cmd += [*(["--config", *config] if config else []), "--", *targets]
     r = subprocess.run(cmd, cwd=cwd, capture_output=True, text=True)
     if r.returncode:

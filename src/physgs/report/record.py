@@ -22,6 +22,7 @@ from __future__ import annotations
 import json
 import math
 import re
+import shlex
 import shutil
 from collections.abc import Iterable, Mapping, Sequence
 from dataclasses import asdict, dataclass, field
@@ -100,6 +101,9 @@ class Stamp:
         job_min_by_stage: job-minutes per stage, from the run's benchmark files.
         note: what a reader should know about how the run was made (apart from the commit).
         jobs: the run's benchmarked jobs (one benchmark file each; light jobs have none).
+        overrides: the ``--configfile`` and ``--config`` words the run was made with, as
+            Snakemake's command line takes them (none: the config file as committed, at the
+            stamp's profile).
     """
 
     date: str
@@ -113,6 +117,7 @@ class Stamp:
     job_min_by_stage: dict[str, float] = field(default_factory=dict)
     note: str = ""
     jobs: int = 0
+    overrides: tuple[str, ...] = ()
 
     def __post_init__(self):
         """Refuse a commit that is not a plain hash (a sentence, or a tag a clone lacks)."""
@@ -136,6 +141,11 @@ class Stamp:
             [
                 f"- **Run**: profile `{self.profile}`, config hash `{self.config_hash}`, "
                 f"seeds {', '.join(map(str, self.seeds))}, trees {', '.join(self.trees)}",
+                *(
+                    [f"- **Overrides**: `{overrides_words(self.overrides)}`"]
+                    if self.overrides
+                    else []
+                ),
                 f"- **Made at** commit `{self.commit}`; record written {self.date}",
                 *([f"- **Note**: {self.note}"] if self.note else []),
                 f"- **Machine**: {self.cpu}, 2 cores",
@@ -145,6 +155,43 @@ class Stamp:
                 "",
             ]
         )
+
+
+def overrides_words(overrides: Iterable[str]) -> str:
+    """A run's overrides as one command-line fragment, each word quoted as a shell needs.
+
+    Args:
+        overrides: the words (``["--configfile", "config/float32.yaml"]``).
+
+    Returns:
+        The fragment (``--configfile config/float32.yaml``).
+    """
+    return " ".join(shlex.quote(w) for w in overrides)
+
+
+def other_configs(files: Iterable[str | Path], config_hash: str) -> list[str]:
+    """The files of a run, among ``files``, whose rows were made under another config.
+
+    Every table's CSV and the ledger carry the config hash of the run that wrote them: a table
+    rebuilt alone under an edited config carries the new one while the rest keep the old, and
+    such a folder is no one run.
+
+    Args:
+        files: CSVs (a file without a ``config_hash`` column is not judged).
+        config_hash: the run's config hash.
+
+    Returns:
+        One phrase per file that disagrees: its path and the hashes it holds.
+    """
+    out = []
+    for f in files:
+        df = pd.read_csv(f, dtype={"config_hash": str})
+        if "config_hash" not in df.columns:
+            continue
+        found = sorted({str(h) for h in df["config_hash"].dropna()})
+        if found != [config_hash]:
+            out.append(f"{f}: config_hash {', '.join(found) or 'none'}, not {config_hash}")
+    return out
 
 
 def format_duration(seconds: float) -> str:
@@ -977,8 +1024,10 @@ def found_lines(record_dir: str | Path) -> list[str]:
     if (record / "claims.csv").is_file():
         stamp = json.loads((record / "stamp.json").read_text())
         claims = pd.read_csv(record / "claims.csv", dtype={"config_hash": str})
+        overrides = stamp.get("overrides") or []
+        made_with = f", made with `{overrides_words(overrides)}`" if overrides else ""
         lines += [
-            f"Profile `{stamp['profile']}`, seeds {', '.join(map(str, stamp['seeds']))}, "
+            f"Profile `{stamp['profile']}`{made_with}, seeds {', '.join(map(str, stamp['seeds']))}, "
             f"commit `{stamp['commit']}`:",
             "",
             *headline_lines(claims),
