@@ -48,7 +48,7 @@ import pandas as pd
 
 import physgs.config
 from physgs.experiments.cost import dry_run, plan_jobs, plan_outputs, summarise
-from physgs.provenance import config_hash, git_commit, machine_cpu
+from physgs.provenance import EVERY_JOB_ENV, config_hash, git_commit, machine_cpu
 from physgs.report import record
 from snakemake.cli import parse_config
 
@@ -59,14 +59,16 @@ TARGET = "all"  # the record is of the run of `all`
 CONFIGFILE = "config/trees.yaml"  # the Snakefile's configfile
 
 
-def _run_config(profile: str, config: list[str], configfiles: list[str]) -> tuple[list[str], str]:
-    """The run's ``--config`` items (``profile=P`` first unless they set it: P the profile of the
-    run's tables) and this checkout's config hash under them and ``configfiles``, resolved as
-    the Snakefile resolves them."""
+def _run_items(profile: str, config: list[str]) -> list[str]:
+    """The run's ``--config`` items: ``config``, with ``profile=P`` first unless it sets the
+    profile (P: the profile of the run's tables)."""
+    return config if "profile" in parse_config(config) else [f"profile={profile}", *config]
+
+
+def _config_hash(config: list[str], configfiles: list[str]) -> str:
+    """This checkout's config hash under ``--configfile configfiles --config config``, resolved
+    as the Snakefile resolves them (the hash its tables carry)."""
     command_line = parse_config(config)
-    if "profile" not in command_line:
-        config = [f"profile={profile}", *config]
-        command_line = parse_config(config)
     raw = physgs.config.read_yaml(CONFIGFILE) or {}
     for f in configfiles:
         raw = physgs.config.deep_merge(raw, physgs.config.read_yaml(f) or {})
@@ -74,36 +76,20 @@ def _run_config(profile: str, config: list[str], configfiles: list[str]) -> tupl
     cfg = physgs.config.load_workflow_config(
         raw, command_line=command_line, configfiles=configfiles
     )
-    return config, config_hash(cfg)
+    return config_hash(cfg)
 
 
-def _plan(
-    config: list[str], configfiles: list[str], run_hash: str, here: str, overrides: str
-) -> tuple[list[str], list[str]]:
-    """`all`'s outputs and benchmark files under the run's config, relative to the run's folder,
-    from Snakemake's dry run in this checkout; refused unless this checkout's config with the
-    run's overrides is the run's, and unless `all` has nothing left to do (every file of its
-    plan made with the plan's settings: Snakemake's metadata and each file's provenance record
-    agree)."""
+def _plan(config: list[str], configfiles: list[str], run_hash: str) -> tuple[list[str], list[str]]:
+    """`all`'s outputs and benchmark files under the run's overrides, relative to the run's
+    folder, from Snakemake's dry run in this checkout; refused unless this checkout's config
+    with those overrides is the run's."""
+    here = _config_hash(config, configfiles)
     if here != run_hash:
         raise SystemExit(
-            f"this checkout's config with {overrides} hashes to {here}, the run's tables to "
-            f"{run_hash}: its plan is another run's; record from the checkout the run was made "
-            "with, giving the run's own overrides (`--config KEY=VALUE ...`, `--configfile FILE`)"
-        )
-    try:
-        pending = dry_run([TARGET], config, configfiles=configfiles, forceall=False)
-    except RuntimeError as e:  # the plan's provenance check refused a file, or Snakemake did
-        raise SystemExit(f"{TARGET}'s plan under {overrides} is not this run's: {e}") from None
-    remade = [o for o in plan_outputs(pending) if RUN_ROOT in Path(o).parents]
-    if remade:
-        shown = ", ".join(remade[:12]) + (
-            f" and {len(remade) - 12} more" if len(remade) > 12 else ""
-        )
-        raise SystemExit(
-            f"{TARGET} under {overrides} is not finished: Snakemake would make {len(remade)} of "
-            f"its files again ({shown}); finish the run (snakemake --cores 2 {TARGET}"
-            f"{_words(config, configfiles)}) and record it then"
+            f"this checkout's config with `{_words(config, configfiles).strip()}` hashes to "
+            f"{here}, the run's tables to {run_hash}: its plan is another run's; record from "
+            "the checkout the run was made with, giving the run's own overrides (`--config "
+            "KEY=VALUE ...`, `--configfile FILE ...`)"
         )
     dry = dry_run([TARGET], config, configfiles=configfiles)
 
@@ -111,6 +97,35 @@ def _plan(
         return [str(Path(p).relative_to(RUN_ROOT)) for p in paths if RUN_ROOT in Path(p).parents]
 
     return below(plan_outputs(dry)), below(b for _, b in plan_jobs(dry) if b)
+
+
+def _finished(config: list[str], configfiles: list[str]) -> None:
+    """Refuse the run unless `all` has nothing left to do under its overrides and every file of
+    its plan was made with the plan's settings (its provenance record, checked for every job,
+    physgs.provenance.EVERY_JOB_ENV), naming each file that disagrees and the key."""
+    words = _words(config, configfiles)
+    try:
+        pending = dry_run(
+            [TARGET],
+            config,
+            configfiles=configfiles,
+            forceall=False,
+            env={EVERY_JOB_ENV: "1"},
+        )
+    except RuntimeError as e:  # the plan's provenance check refused files, or Snakemake did
+        raise SystemExit(
+            f"{TARGET}'s plan under `{words.strip()}` is not this run's: {e}"
+        ) from None
+    remade = [o for o in plan_outputs(pending) if RUN_ROOT in Path(o).parents]
+    if remade:
+        shown = ", ".join(remade[:12]) + (
+            f" and {len(remade) - 12} more" if len(remade) > 12 else ""
+        )
+        raise SystemExit(
+            f"{TARGET} under `{words.strip()}` is not finished: Snakemake would make "
+            f"{len(remade)} of its files again ({shown}); finish the run (snakemake --cores 2 "
+            f"{TARGET}{words}) and record it then"
+        )
 
 
 def _words(config: list[str], configfiles: list[str]) -> str:
@@ -176,20 +191,21 @@ def main() -> None:
     elif not args.readme_only:
         r = args.results
         fit = pd.read_csv(r / "tables" / "tab_fit.csv", dtype={"config_hash": str})
-        config, here = _run_config(str(fit["profile"].iloc[0]), args.config, args.configfile)
-        overrides = _words(config, args.configfile).strip()
-        outputs, benchmarks = _plan(
-            config, args.configfile, str(fit["config_hash"].iloc[0]), here, overrides
-        )
+        config = _run_items(str(fit["profile"].iloc[0]), args.config)
+        here = str(fit["config_hash"].iloc[0])
+        outputs, benchmarks = _plan(config, args.configfile, here)
         run = record.run_files(r, outputs, benchmarks, target=TARGET)
-        others = record.other_configs([*run.tables, r / "claims.csv"], here)
-        if others:
-            raise SystemExit(
-                f"{r}: {len(others)} file(s) of {TARGET}'s plan were made under another config "
-                f"than {here} ({overrides}):\n"
-                + "\n".join(f"- {line}" for line in others)
-                + f"\nremake them: snakemake --cores 2 {TARGET}{_words(config, args.configfile)}"
-            )
+        problems = [
+            f"- {line}" for line in record.other_configs([*run.tables, r / "claims.csv"], here)
+        ]
+        if problems:
+            problems.insert(0, f"{r}: files of {TARGET}'s plan made under another config:")
+        try:
+            _finished(config, args.configfile)
+        except SystemExit as e:
+            problems.append(str(e))
+        if problems:
+            raise SystemExit("\n".join(problems))
         print(f"{r}: {len(run.jobs)} benchmarked jobs of {TARGET}'s plan")
         print(run.left_out_line())
         by_stage = summarise(list(run.jobs))["by_stage"]

@@ -29,7 +29,7 @@ from pathlib import Path
 
 from physgs.allocator import retain_freed_memory
 from physgs.atomic import atomic_path
-from physgs.provenance import clear_provenance, write_provenance
+from physgs.provenance import take_provenance, write_provenance
 
 #: where the output locks live, relative to the workflow's working directory (not Snakemake's
 #: own ``.snakemake/locks``, which a finishing run deletes whole)
@@ -261,7 +261,7 @@ def job(sm):
                 print(f"outputs made for this same job by {made_by}; taken as made", file=log)
             print(f"{sm.rule}: outputs made by {made_by}; taken as made", file=sys.stderr)
         else:
-            clear_provenance(sm.output)  # a record never outlives the output it describes
+            previous = take_provenance(sm.output)  # no record outlives what it describes
             with (
                 open(sm.log[0], "w+") as log,
                 contextlib.redirect_stderr(log),
@@ -270,7 +270,7 @@ def job(sm):
                 try:
                     yield log
                     start = time.perf_counter()
-                    write_provenance(sm.output, sm.rule, sm.params, sm.input)
+                    write_provenance(sm.output, sm.rule, sm.params, sm.input, previous=previous)
                     ms = (time.perf_counter() - start) * 1e3
                     print(f"provenance recorded beside {len(sm.output)} outputs ({ms:.1f} ms)")
                 except BaseException:

@@ -23,6 +23,7 @@ from __future__ import annotations
 
 import hashlib
 import json
+import os
 import platform
 import subprocess
 import shlex
@@ -160,6 +161,12 @@ TRACKED = (type(None), bool, int, float, str, complex, range, list, tuple, dict)
 KEYS_SHOWN = 3
 #: files named in a refusal; the rest counted
 FILES_SHOWN = 12
+#: set (to anything but "" or "0") in Snakemake's environment, the plan's check reads the record
+#: of every file of the plan that is there, of the jobs Snakemake would run again as well (what
+#: ``tools/record.py`` asks: a finished run, every file made with the plan's settings)
+EVERY_JOB_ENV = "PHYSGS_PROVENANCE_EVERY_JOB"
+#: Snakemake's dry-run flags, left out of the command a refusal gives
+DRY_RUN_FLAGS = ("-n", "--dry-run", "--dryrun")
 
 
 class ProvenanceError(RuntimeError):
@@ -243,6 +250,7 @@ def write_provenance(
     params,
     inputs: Iterable[str | Path] = (),
     commit: str | None = None,
+    previous: Mapping | None = None,
 ) -> dict:
     """Write the provenance record beside each of a job's outputs.
 
@@ -255,6 +263,9 @@ def write_provenance(
         commit: the commit of the code that made them (default: the commit of the checkout
             physgs is imported from, [`git_commit`][physgs.provenance.git_commit]; the
             workflow's own checkout in a run).
+        previous: the record the outputs had before this job (read before it cleared it):
+            when its settings were others, they are kept (``replaced``), so a file made from
+            the old outputs can name the key that changed.
 
     Returns:
         The record written.
@@ -271,9 +282,31 @@ def write_provenance(
         "inputs": read,
         "made": time.strftime("%Y-%m-%dT%H:%M:%S%z"),
     }
+    if previous and previous.get("settings_hash") != record["settings_hash"]:
+        record["replaced"] = {k: previous.get(k) for k in ("settings_hash", "settings")}
     for out in outputs:
         write_json(sidecar(out), record)
     return record
+
+
+def take_provenance(outputs: Iterable[str | Path]) -> dict | None:
+    """Remove the records of ``outputs`` (a job about to make them: an output it leaves
+    half-made never pairs with the record of the job that made it before), returning the
+    first one's, for [`write_provenance`][physgs.provenance.write_provenance]'s ``previous``.
+
+    Args:
+        outputs: the job's outputs.
+
+    Returns:
+        The record the first output had (None: none, or unreadable).
+    """
+    outputs = list(outputs)
+    try:
+        previous = read_provenance(outputs[0]) if outputs else None
+    except ProvenanceError:
+        previous = None
+    clear_provenance(outputs)
+    return previous
 
 
 def clear_provenance(outputs: Iterable[str | Path]) -> None:
@@ -287,21 +320,23 @@ def clear_provenance(outputs: Iterable[str | Path]) -> None:
         sidecar(out).unlink(missing_ok=True)
 
 
-def _differences(made, now, key: str = "") -> list[str]:
-    """The dotted keys at which two settings differ, with both values."""
+def _differences(
+    made, now, key: str = "", was: str = "when it was made", is_: str = "in this plan"
+) -> list[str]:
+    """The dotted keys at which two settings differ, each with both values."""
     if isinstance(made, dict) and isinstance(now, dict):
         out = []
         for k in sorted(set(made) | set(now), key=str):
             sub = f"{key}.{k}" if key else str(k)
             if k not in made:
-                out.append(f"`{sub}` absent when it was made, {now[k]!r} in this plan")
+                out.append(f"`{sub}` absent {was}, {now[k]!r} {is_}")
             elif k not in now:
-                out.append(f"`{sub}` {made[k]!r} when it was made, absent in this plan")
+                out.append(f"`{sub}` {made[k]!r} {was}, absent {is_}")
             else:
-                out += _differences(made[k], now[k], sub)
+                out += _differences(made[k], now[k], sub, was, is_)
         return out
     if made != now:
-        return [f"`{key}` {made!r} when it was made, {now!r} in this plan"]
+        return [f"`{key}` {made!r} {was}, {now!r} {is_}"]
     return []
 
 
@@ -339,7 +374,12 @@ def disagreement(output: str | Path, rule: str, params, inputs: Iterable[str | P
             continue  # that input is named on its own
         h = irec["settings_hash"] if irec else None
         if h != made_from[i]:
-            return f"made from {i} as it was before that was made with other settings"
+            old = (irec or {}).get("replaced") or {}
+            keys = ""
+            if old.get("settings_hash") == made_from[i]:
+                diff = _differences(old.get("settings", {}), irec["settings"], "", "then", "now")
+                keys = " (" + "; ".join(diff[:KEYS_SHOWN]) + ")"
+            return f"made from {i} before that was made again with other settings{keys}"
     return None
 
 
@@ -383,22 +423,33 @@ def check_plan(jobs: Iterable, command: str) -> int:
             "without .snakemake/, or made before provenance records were kept):\n"
             + "\n".join(lines)
             + "\nremake them (and what is made from them) with: "
-            + f"{command} --forcerun {' '.join(shlex.quote(t) for t in targets)}"
+            + _with_forcerun(command, targets)
         )
     return checked
 
 
-def plan_jobs(dag) -> Iterable[tuple]:
-    """The jobs of a Snakemake DAG that will not run, as [`check_plan`][physgs.provenance.check_plan] reads them.
+def _with_forcerun(command: str, targets: list[str]) -> str:
+    """``command`` with ``--forcerun targets`` where its ``{forcerun}`` is (else at its end)."""
+    flag = "--forcerun " + " ".join(shlex.quote(t) for t in targets)
+    if "{forcerun}" in command:
+        return command.replace("{forcerun}", flag)
+    return f"{command} {flag}"
+
+
+def plan_jobs(dag, every: bool = False) -> Iterable[tuple]:
+    """The jobs of a Snakemake DAG whose outputs a run takes as made, as
+    [`check_plan`][physgs.provenance.check_plan] reads them.
 
     Args:
         dag (snakemake.dag.DAG): the built DAG.
+        every: the jobs Snakemake would run again too (their outputs, where present, are
+            checked all the same).
 
     Yields:
         (tuple[str, Namedlist, list[str], list[str]]): rule, params, outputs, inputs.
     """
     for job in dag.jobs:
-        if dag.needrun(job) or not job.output:
+        if (dag.needrun(job) and not every) or not job.output:
             continue
         yield job.rule.name, job.params, list(job.output), list(job.input)
 
@@ -446,7 +497,8 @@ def install(workflow) -> None:
 
         start = time.perf_counter()
         try:
-            n = check_plan(plan_jobs(workflow.dag), _command())
+            every = os.environ.get(EVERY_JOB_ENV, "") not in ("", "0")
+            n = check_plan(plan_jobs(workflow.dag, every=every), _command())
         except ProvenanceError as e:
             raise WorkflowError(str(e)) from None  # Snakemake prints its message, no traceback
         if n:
@@ -462,8 +514,11 @@ def install(workflow) -> None:
 
 
 def _command() -> str:
-    """The command line that planned the run, as a person would type it again."""
-    argv = list(sys.argv)
+    """The command line that planned the run, as a person would type it again to run it, with
+    ``{forcerun}`` where the files to remake go (before a ``--`` that ends the options)."""
+    argv = [a for a in sys.argv if a not in DRY_RUN_FLAGS]
     if argv and Path(argv[0]).name in ("__main__.py", "snakemake"):
         argv[0] = "snakemake"
-    return " ".join(shlex.quote(a) for a in argv)
+    words = [shlex.quote(a) for a in argv]
+    at = words.index("--") if "--" in words else len(words)
+    return " ".join([*words[:at], "{forcerun}", *words[at:]])
