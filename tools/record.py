@@ -1,6 +1,7 @@
 """The committed record of a finished default-profile run, and the README lines read from it.
 
     python tools/record.py [results] [--out docs/record] [--wall-s S] [--commit HASH] [--note TEXT]
+                           [--configfile FILE ...] [--config KEY=VALUE ...]   # the run's overrides
     python tools/record.py --pages-only      # lay the record's pages out again from its own files
     python tools/record.py --readme-only     # rewrite the README's block from the record
     python tools/record.py --report-html [results/report.html]   # Snakemake's report, on demand
@@ -23,8 +24,14 @@ states). A table, figure or benchmark file of the plan that the folder lacks sto
 what the folder holds beyond the plan (a `snakemake studies` run's tables and figures, whose
 jobs keep their benchmark files under `results/studies/benchmarks/`, or an earlier run's files)
 is left out and listed. Run it in the
-checkout and config the run was made with: a config whose hash is not the run's (its tables'
-`config_hash`) is refused, since its plan is another run's.
+checkout the run was made with, giving the `--configfile` and `--config` words the run was given
+(`profile=P` is added, P the profile of the run's `tab_fit.csv`, unless they set it): they are
+written into the stamp and the README's block. A config whose hash is not the run's (its tables'
+`config_hash`) is refused, since its plan is another run's. It takes one run of one config: every
+table of the plan and the ledger must carry the run's hash, and `all` must have nothing left to do
+under the overrides, with every file of its plan carrying the provenance record of its job's
+settings in this plan (`physgs.provenance.check_plan` on every job: `EVERY_JOB_ENV`); otherwise it
+stops, naming each file that disagrees and the key that differs.
 
 The wall time is the run's command's, measured by `tools/timed.py --name all` (summed over the
 segments of a resumed run): `--wall-s` gives it, else the `all` row of `costs.csv` when it was
