@@ -397,7 +397,8 @@ def dry_run(
     full_env = {**os.environ, **env} if env else None
     r = subprocess.run(cmd, cwd=cwd, capture_output=True, text=True, env=full_env)
     if r.returncode:
-        raise RuntimeError(f"`{' '.join(cmd[1:])}` failed:\n{r.stderr[-6000:]}")
+        # a dry run prints its error to stdout, a real one to stderr
+        raise RuntimeError(f"`{' '.join(cmd[1:])}` failed:\n{(r.stdout + r.stderr)[-6000:]}")
     return r.stdout
 
 
