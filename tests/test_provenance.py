@@ -95,7 +95,31 @@ def test_the_plan_check_names_each_file_and_the_command_that_remakes_them(tmp_pa
     assert f"{stale} (rule `testbed_dataset`)" in msg and "resolution` 32" in msg
     assert f"--forcerun {stale} -- x" in msg
     assert f"- {good}" not in msg
-    assert check_plan(jobs[:1], cmd) == 1
+    assert check_plan(jobs[:1], cmd).checked == 1
+
+
+def test_a_file_without_a_record_that_snakemake_s_metadata_vouches_for_is_adopted(tmp_path):
+    now = {"settings": {"tree": "sparse"}}
+    bare = tmp_path / "made_before.npz"
+    bare.write_text("x")
+    cmd = "snakemake all {forcerun}"
+    with pytest.raises(ProvenanceError, match="carries no provenance record"):
+        check_plan([("testbed_dataset", now, [bare], [], False)], cmd)
+    found = check_plan([("testbed_dataset", now, [bare], [], True)], cmd)
+    assert found.checked == 0 and [j[2] for j in found.adopted] == [[str(bare)]]
+    assert provenance.adopt(found.adopted) == 1
+    assert disagreement(bare, "testbed_dataset", now, []) is None
+    # a job adopted with its input in one pass records the input's settings, in any order
+    up, down = tmp_path / "up.npz", tmp_path / "down.npz"
+    up.write_text("x")
+    down.write_text("y")
+    pair = [("evaluate", {"a": 1}, [str(down)], [str(up)]), ("train", {"b": 2}, [str(up)], [])]
+    provenance.adopt(pair)
+    assert check_plan([(*j, False) for j in pair], cmd).checked == 2
+    # a record that is there is read whatever the metadata says
+    other = {"settings": {"tree": "medium"}}
+    with pytest.raises(ProvenanceError, match="'sparse' when it was made, 'medium'"):
+        check_plan([("testbed_dataset", other, [bare], [], True)], cmd)
 
 
 def test_the_command_given_back_is_the_run_s_without_dry_run_flags(monkeypatch):

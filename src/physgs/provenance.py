@@ -30,7 +30,7 @@ import shlex
 import sys
 import time
 from collections.abc import Iterable, Mapping
-from dataclasses import asdict, dataclass
+from dataclasses import asdict, dataclass, field
 from importlib.metadata import PackageNotFoundError, version
 from pathlib import Path
 
@@ -251,6 +251,7 @@ def write_provenance(
     inputs: Iterable[str | Path] = (),
     commit: str | None = None,
     previous: Mapping | None = None,
+    known: Mapping[str, str] | None = None,
 ) -> dict:
     """Write the provenance record beside each of a job's outputs.
 
@@ -266,6 +267,8 @@ def write_provenance(
         previous: the record the outputs had before this job (read before it cleared it):
             when its settings were others, they are kept (``replaced``), so a file made from
             the old outputs can name the key that changed.
+        known: input -> settings hash, for inputs whose records are being written in the same
+            pass (taken before their records on disk).
 
     Returns:
         The record written.
@@ -273,6 +276,9 @@ def write_provenance(
     settings = job_settings(rule, params)
     read = {}
     for i in dict.fromkeys(str(i) for i in inputs):
+        if known and i in known:
+            read[i] = known[i]
+            continue
         rec = read_provenance(i)
         read[i] = rec["settings_hash"] if rec else None
     record = {
@@ -376,37 +382,57 @@ def disagreement(output: str | Path, rule: str, params, inputs: Iterable[str | P
         if h != made_from[i]:
             old = (irec or {}).get("replaced") or {}
             keys = ""
-            if old.get("settings_hash") == made_from[i]:
+            if old.get("settings_hash") and old["settings_hash"] == made_from[i]:
                 diff = _differences(old.get("settings", {}), irec["settings"], "", "then", "now")
                 keys = " (" + "; ".join(diff[:KEYS_SHOWN]) + ")"
             return f"made from {i} before that was made again with other settings{keys}"
     return None
 
 
-def check_plan(jobs: Iterable, command: str) -> int:
+@dataclass
+class PlanCheck:
+    """What [`check_plan`][physgs.provenance.check_plan] found in a plan that agrees.
+
+    Attributes:
+        checked: the files whose records were read.
+        adopted: the jobs (rule, params, outputs, inputs) whose outputs carry no record but
+            whose params Snakemake's metadata records as this plan's: made before records were
+            kept, by the settings the plan has ([`adopt`][physgs.provenance.adopt] writes them).
+    """
+
+    checked: int = 0
+    adopted: list = field(default_factory=list)
+
+
+def check_plan(jobs: Iterable, command: str) -> PlanCheck:
     """Refuse a plan that would read files made with other settings than its own.
 
     Args:
-        jobs (Iterable[tuple[str, Namedlist, list[str], list[str]]]): the plan's jobs that
-            will not run (their outputs taken as made): rule, params, outputs, inputs. A job
+        jobs (Iterable[tuple]): the plan's jobs whose outputs it takes as made: rule, params,
+            outputs, inputs and, optionally, whether Snakemake's metadata vouches for the
+            outputs (it records them with this plan's params, and the job will not run). A job
             with an output missing is left out (Snakemake makes it).
-        command: the command that planned it (named in the refusal, with ``--forcerun``).
+        command: the command that planned it (named in the refusal, with ``{forcerun}`` where
+            ``--forcerun`` and the files go).
 
     Returns:
-        The number of files checked.
+        The [`PlanCheck`][physgs.provenance.PlanCheck].
 
     Raises:
         ProvenanceError: naming each file that disagrees (its rule and what differs) and the
             command that remakes them.
     """
     bad: list[tuple[str, str, str]] = []
-    checked = 0
-    for rule, params, outputs, inputs in jobs:
+    found = PlanCheck()
+    for rule, params, outputs, inputs, *vouched in jobs:
         outputs = [str(o) for o in outputs]
         if not outputs or not all(Path(o).exists() for o in outputs):
             continue
+        if vouched and vouched[0] and not any(sidecar(o).exists() for o in outputs):
+            found.adopted.append((rule, params, outputs, inputs))
+            continue
         for out in outputs:
-            checked += 1
+            found.checked += 1
             why = disagreement(out, rule, params, inputs)
             if why:
                 bad.append((out, rule, why))
@@ -418,14 +444,39 @@ def check_plan(jobs: Iterable, command: str) -> int:
         rules = sorted({r for _, r, _ in bad})
         targets = [o for o, _, _ in bad] if len(bad) <= FILES_SHOWN else rules
         raise ProvenanceError(
-            f"{len(bad)} file(s) this plan would read as made were made with other settings "
-            "than this run's, and Snakemake's metadata does not say so (a results folder copied "
-            "without .snakemake/, or made before provenance records were kept):\n"
+            f"{len(bad)} file(s) this plan would read as made do not carry its settings "
+            "(Snakemake takes a file as made when no metadata of its own says otherwise: a "
+            "results folder copied without .snakemake/, or made before provenance records "
+            "were kept):\n"
             + "\n".join(lines)
             + "\nremake them (and what is made from them) with: "
             + _with_forcerun(command, targets)
         )
-    return checked
+    return found
+
+
+def adopt(jobs: Iterable) -> int:
+    """Write the records of outputs made before records were kept, with the settings that
+    Snakemake's metadata says made them (``PlanCheck.adopted``).
+
+    Args:
+        jobs (Iterable[tuple]): rule, params, outputs, inputs of each job.
+
+    Returns:
+        The number of outputs given a record.
+    """
+    jobs = list(jobs)
+    # each job's inputs may be another's outputs given records in this pass: take their hashes
+    known = {
+        str(o): settings_hash(job_settings(rule, params))
+        for rule, params, outputs, _ in jobs
+        for o in outputs
+    }
+    n = 0
+    for rule, params, outputs, inputs in jobs:
+        write_provenance(outputs, rule, params, inputs, known=known)
+        n += len(outputs)
+    return n
 
 
 def _with_forcerun(command: str, targets: list[str]) -> str:
@@ -446,12 +497,24 @@ def plan_jobs(dag, every: bool = False) -> Iterable[tuple]:
             checked all the same).
 
     Yields:
-        (tuple[str, Namedlist, list[str], list[str]]): rule, params, outputs, inputs.
+        (tuple[str, Namedlist, list[str], list[str], bool]): rule, params, outputs, inputs, and
+            whether Snakemake's metadata vouches for the outputs (it records this plan's params
+            for each, and the job will not run).
     """
+    persistence = dag.workflow.persistence
     for job in dag.jobs:
-        if (dag.needrun(job) and not every) or not job.output:
+        needrun = dag.needrun(job)
+        if (needrun and not every) or not job.output:
             continue
-        yield job.rule.name, job.params, list(job.output), list(job.input)
+        # metadata that records these params vouches for outputs made before records were kept
+        # (Snakemake stores params reliably from its record format 6 on)
+        vouched = (
+            not needrun
+            and all((persistence.record_format_version(o) or 0) >= 6 for o in job.output)
+            and all(persistence.params(o) is not None for o in job.output)
+            and not persistence.params_changed(job)
+        )
+        yield job.rule.name, job.params, list(job.output), list(job.input), vouched
 
 
 def install(workflow) -> None:
@@ -498,13 +561,26 @@ def install(workflow) -> None:
         start = time.perf_counter()
         try:
             every = os.environ.get(EVERY_JOB_ENV, "") not in ("", "0")
-            n = check_plan(plan_jobs(workflow.dag, every=every), _command())
+            found = check_plan(plan_jobs(workflow.dag, every=every), _command())
         except ProvenanceError as e:
             raise WorkflowError(str(e)) from None  # Snakemake prints its message, no traceback
-        if n:
+        if found.checked:
             print(
-                f"provenance: the {n} files this plan reads as made agree with its settings "
-                f"({time.perf_counter() - start:.2f} s)",
+                f"provenance: the {found.checked} files this plan reads as made agree with its "
+                f"settings ({time.perf_counter() - start:.2f} s)",
+                file=sys.stderr,
+            )
+        if found.adopted:
+            outs = sum(len(j[2]) for j in found.adopted)
+            if workflow.dryrun:
+                what = "would be written (a run writes them)"
+            else:
+                adopt(found.adopted)
+                what = "written"
+            print(
+                f"provenance: {outs} files made before provenance records were kept, with the "
+                "params Snakemake's metadata records for them (this plan's): their records "
+                f"{what}",
                 file=sys.stderr,
             )
 
