@@ -285,8 +285,7 @@ def write_provenance(
         "settings_hash": settings_hash(settings),
         "settings": settings,
         "commit": commit or git_commit(Path(__file__).parent),
-        "inputs": read,
-        "made": time.strftime("%Y-%m-%dT%H:%M:%S%z"),
+        "inputs": read,  # no time: two runs of one job write the same record (its mtime says when)
     }
     if previous and previous.get("settings_hash") != record["settings_hash"]:
         record["replaced"] = {k: previous.get(k) for k in ("settings_hash", "settings")}
