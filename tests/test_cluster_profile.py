@@ -4,6 +4,7 @@ submission (a stand-in `sinfo` describes the partitions). The real SLURM run: te
 
 from __future__ import annotations
 
+import base64
 import os
 import re
 import stat
@@ -109,6 +110,10 @@ def test_train_on_a_gpu_partition_sends_gres_and_partition(tmp_path):
     assert "--gres=gpu:1" in args and args[args.index("-p") + 1] == "gpu", args
     assert args[args.index("--mem") + 1] == "4000" and "--cpus-per-task=1" in args, args
     assert "-A" not in args  # the account is the cluster's default
+    # the job on the node sees its GPU request (physgs.device.resolve_device reads it there)
+    wrap = calls[0].split(" --wrap=", 1)[1]
+    sent = [base64.b64decode(t).decode() for t in re.findall(r"base64//([A-Za-z0-9+/=]+)", wrap)]
+    assert any(re.fullmatch(r"(train:)?gres=.?gpu:1.?", t) for t in sent), sent
 
 
 @pytest.mark.slow

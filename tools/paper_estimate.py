@@ -1,7 +1,7 @@
 """What a profile's run would cost in CPU-hours, priced from today's plan and measured rates.
 
     python tools/paper_estimate.py [--profile paper] [--rates docs/record/rates_paper.csv]
-        [--out docs/record/paper_estimate.md]
+        [--gpu-rates FILE] [--out docs/record/paper_estimate.md]
 
 Lists the profile's plan (`snakemake -n --forceall all --config profile=PROFILE`), prices each
 planned training at the measured CPU seconds per iteration of its tree, model and configuration
@@ -9,6 +9,10 @@ planned training at the measured CPU seconds per iteration of its tree, model an
 `physgs.experiments.cost.training_estimate`, and writes the paragraph the cluster page includes.
 A training without a measured rate is named and left out of the total, never guessed; jobs that
 do not train (K selection, evaluation, recovery) are not priced.
+
+With ``--gpu-rates FILE`` (written by ``benchmarks/gpu_check.py --rates FILE`` on a GPU) a second
+paragraph prices the same plan on one GPU: each training at the device's wall seconds per
+iteration at the profile's resolution, one training after another.
 """
 
 from __future__ import annotations
@@ -27,6 +31,7 @@ def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--profile", default="paper")
     ap.add_argument("--rates", default="docs/record/rates_paper.csv", type=Path)
+    ap.add_argument("--gpu-rates", default=None, type=Path, help="benchmarks/gpu_check.py's CSV")
     ap.add_argument("--out", default="docs/record/paper_estimate.md", type=Path)
     args = ap.parse_args()
     planned = plan_jobs(dry_run(["all"], [f"profile={args.profile}"]))
@@ -44,12 +49,7 @@ def main() -> None:
     per_seed = sorted(set(est["per_seed"].values()))
     longest = max(rates_df["cpu_s_per_iter"]) * it
     r0 = rates_df.iloc[0]
-    groups: dict[str, int] = {}  # by model and configuration, over trees
-    for (_, m, c), n in est["unrated"].items():
-        groups[f"`{m}`" + (f" {c}" if c else "")] = (
-            groups.get(f"`{m}`" + (f" {c}" if c else ""), 0) + n
-        )
-    unrated = ", ".join(f"{k} {n}" for k, n in sorted(groups.items()))
+    unrated = ", ".join(f"{k} {n}" for k, n in _by_model(est["unrated"]).items())
     lines = [
         f"The `{args.profile}` profile ({cfg['testbed']['resolution']} px, {it:,} iterations of "
         f"which {warm:,} static warm-up, seeds {', '.join(map(str, seeds))}) plans "
@@ -69,8 +69,48 @@ def main() -> None:
         "measured.",
         "",
     ]
+    if args.gpu_rates is not None:
+        lines += gpu_paragraph(args.gpu_rates, planned, cfg, configs, args.profile)
     args.out.write_text("\n".join(lines))
     print(args.out.read_text())
+
+
+def _by_model(unrated: dict) -> dict[str, int]:
+    """Unrated trainings counted by model and configuration, over trees."""
+    groups: dict[str, int] = {}
+    for (_, m, c), n in unrated.items():
+        key = f"`{m}`" + (f" {c}" if c else "")
+        groups[key] = groups.get(key, 0) + n
+    return dict(sorted(groups.items()))
+
+
+def gpu_paragraph(path: Path, planned, cfg: dict, configs, profile: str) -> list[str]:
+    """The plan priced on one GPU at ``path``'s rates of the profile's resolution."""
+    df = pd.read_csv(path, dtype={"commit": str})
+    res = int(cfg["testbed"]["resolution"])
+    at = df[df["resolution"] == res]
+    if at.empty:
+        raise SystemExit(
+            f"{path}: rates at {sorted(set(df['resolution']))} px, none at the {profile} "
+            f"profile's {res} px (benchmarks/gpu_check.py --resolutions {res})"
+        )
+    rates = {(r.tree, r.model, r.config): r.wall_s_per_iter for r in at.itertuples()}
+    it, warm = cfg["train"]["iterations"], cfg["train"]["warmup"]
+    est = training_estimate(planned, rates, configs, it, warm)
+    r0 = at.iloc[0]
+    unrated = ", ".join(f"{k} {n}" for k, n in _by_model(est["unrated"]).items())
+    where = "one GPU" if r0["device"] == "cuda" else f"one {r0['device']} device"
+    return [
+        f"On {where} ({r0['device_name']}), at the wall seconds per iteration "
+        f"`benchmarks/gpu_check.py` measured {r0['date']} at commit `{r0['commit']}` ({res} px, "
+        f"the real training loop), the {est['jobs']} rated trainings take "
+        f"**{est['cpu_s'] / 3600:,.1f} {'GPU-hours' if r0['device'] == 'cuda' else 'hours'}** "
+        "one after another "
+        f"({est['cpu_s'] / max(est['jobs'], 1) / 60:,.1f} min a training; slowest "
+        f"{format_duration(at['wall_s_per_iter'].max() * it)}). Not priced: "
+        f"{sum(est['unrated'].values())} trainings ({unrated or 'none'}).",
+        "",
+    ]
 
 
 if __name__ == "__main__":

@@ -15,6 +15,7 @@ import json
 import math
 from typing import Callable, Iterator
 
+from physgs.device import check_setting  # imports torch only when cuda is asked for
 from physgs.experiments.kselect import selected_models, settings_for
 from physgs.models.omega_search import search_problem
 from physgs.models.registry import (
@@ -495,6 +496,24 @@ def warmup_below_iterations(cfg: dict) -> Iterator[Problem]:
             )
 
 
+def device_is_available(cfg: dict) -> Iterator[Problem]:
+    """``train.device: cuda`` only where torch sees a GPU (torch is imported only then).
+
+    A cluster run that trains on GPU nodes leaves the setting ``auto`` and asks for the GPU
+    through the rule's resources (docs/cluster.md), so a login node without one plans it.
+
+    Args:
+        cfg: The resolved config (profile merged, schema-valid).
+
+    Yields:
+        ``(key path, message)`` per problem (the module docstring); none when the config passes.
+    """
+    try:
+        check_setting(cfg["train"]["device"])
+    except (ValueError, RuntimeError) as e:
+        yield ("train", "device"), str(e)
+
+
 def holdout_leaves_training_frames(cfg: dict) -> Iterator[Problem]:
     """Held-out training frames (train.holdout_every) leave most of the window to train on.
 
@@ -853,6 +872,7 @@ CHECKS: list[Check] = [
     damping_range_valid,
     damping_transient_fits,
     warmup_below_iterations,
+    device_is_available,
     holdout_leaves_training_frames,
     stopping_has_held_out_frames,
     freeze_inside_deformation_phase,

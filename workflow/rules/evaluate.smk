@@ -23,5 +23,6 @@ rule evaluate:
         runtime=30,
     params:
         backend=CFG["train"]["backend"],
+        device=CFG["train"]["device"],
     script:
         "../scripts/evaluate.py"

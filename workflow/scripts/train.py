@@ -11,5 +11,6 @@ with job(sm) as log:
         sm.params.job,
         checkpoint_path=sm.output.ckpt,
         loss_path=sm.output.loss,
+        resources=sm.resources,
     )
     print(f"done: {res.stats}", file=log)

@@ -13,5 +13,6 @@ with job(sm) as log:
         spec,
         checkpoint_path=sm.output.ckpt,
         loss_path=sm.output.loss,
+        resources=sm.resources,
     )
     print(f"done: K {spec['K']}, {res.stats}", file=log)

@@ -13,5 +13,6 @@ with job(sm) as log:
         truth=load_truth(sm.input.truth),
         checkpoint_path=sm.output.ckpt,
         loss_path=sm.output.loss,
+        resources=sm.resources,
     )
     print(f"done: {res.stats}", file=log)

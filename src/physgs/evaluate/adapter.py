@@ -33,8 +33,9 @@ def model_render_fn(model, observed, *, backend: str = "auto", means_seen: dict 
     # physgs.jobs.job has set the rule's threads (its pool then starts at that size)
     from physgs.render import render_state
 
-    winds = [torch.as_tensor(w, dtype=torch.float32) for w in observed.wind]  # C x [L+F] m/s
-    bg = torch.as_tensor(np.asarray(observed.background), dtype=torch.float32)
+    dev = _device_of(model)
+    winds = [torch.as_tensor(w, dtype=torch.float32).to(dev) for w in observed.wind]  # C x [L+F]
+    bg = torch.as_tensor(np.asarray(observed.background), dtype=torch.float32).to(dev)  # [3]
     reads_wind = bool(getattr(model, "use_wind", True))
     last: dict = {}  # the last deformed frame: one deformation serves every camera and, for
     # models blind to the wind, every condition (the evaluation visits frames in that order)
@@ -73,7 +74,8 @@ def model_means_fn(model, observed, seen: dict | None = None):
     Returns:
         (Callable): ``means_fn``; NaN means [N, 3] where the model makes no prediction.
     """
-    winds = [torch.as_tensor(w, dtype=torch.float32) for w in observed.wind]
+    dev = _device_of(model)
+    winds = [torch.as_tensor(w, dtype=torch.float32).to(dev) for w in observed.wind]  # m/s
 
     def means_fn(frame_idx: int, condition: int) -> np.ndarray:
         if seen is not None and (int(frame_idx), int(condition)) in seen:
@@ -84,3 +86,9 @@ def model_means_fn(model, observed, seen: dict | None = None):
             return model.gaussians_at(int(frame_idx), winds[condition]).means.cpu().numpy()
 
     return means_fn
+
+
+def _device_of(model) -> torch.device:
+    """Where the model's parameters live: the renders and winds go there too."""
+    p = next(model.parameters(), None)
+    return torch.device("cpu") if p is None else p.device

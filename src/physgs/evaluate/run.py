@@ -133,6 +133,7 @@ def evaluate_checkpoint(
     panels_path,
     backend: str = "auto",
     progress=None,
+    device=None,
 ) -> dict[str, float]:
     """Score ``model`` on every split and write three files atomically.
 
@@ -146,6 +147,8 @@ def evaluate_checkpoint(
         panels_path (str | Path): the qualitative renders.
         backend: the rasterizer backend.
         progress (Callable[[str], None] | None): receives progress lines.
+        device (str | torch.device | None): where to deform and render (the model is moved
+            there); None: where it is.
 
     Returns:
         The split means ([`EvalResult.summary`][physgs.evaluate.splits.EvalResult.summary]).
@@ -154,6 +157,8 @@ def evaluate_checkpoint(
         FloatingPointError: when a split the model predicts scores non-finite (a corrupt
             checkpoint); nothing is written then.
     """
+    if device is not None:
+        model = model.to(device)
     seen: dict = {}  # the evaluation's deformations under the training wind, for the tips
     render_fn = model_render_fn(model, observed, backend=backend, means_seen=seen)
     res = evaluate(render_fn, observed, progress=progress)

@@ -171,6 +171,7 @@ def fit(
     progress: bool = True,
     name: str | None = None,
     hooks: tuple = (),
+    device=None,
 ) -> TrainResult:
     """Seed, build and train one model.
 
@@ -191,15 +192,19 @@ def fit(
         name: the name the progress and errors use; None: the job's.
         hooks: ``on_iteration`` callbacks ``(iteration, model, optimiser)`` run after the
             recipe's own (a benchmark's recorder of the fit curve); they must not change the model.
+        device (str | torch.device | None): where to train; None: ``train.device`` of the job
+            resolved on this machine ([`resolve_device`][physgs.device.resolve_device]:
+            auto takes CUDA where torch sees a GPU).
 
     Returns:
-        The [`TrainResult`][physgs.train.loop.TrainResult] (model in eval mode).
+        The [`TrainResult`][physgs.train.loop.TrainResult] (model in eval mode, on the device).
 
     Raises:
         ValueError: an unknown model, or a truth given to a method.
         TrainingError: the fit diverged or the model failed (no result).
     """
     # here: the training machinery loads torch (module docstring)
+    from physgs.device import resolve_device
     from physgs.train.loop import condition_indices, train_model
     from physgs.train.seeding import seed_everything
 
@@ -211,6 +216,7 @@ def fit(
             "truth (truth.npz); only references (truth_motion) do"
         )
     _check_precision(job)
+    dev = resolve_device(job.train.get("device", "auto")) if device is None else device
     seed_everything(job.seed)
     # a reference without a truth raises here, saying it needs truth.npz
     model = build_model(
@@ -238,15 +244,16 @@ def fit(
         progress=progress,
         frame_pool=frame_pool,
         on_iteration=[*training_hooks(observed, job, conds), *hooks],
-        holdout=holdout_eval(observed, job, held, conds),
+        holdout=holdout_eval(observed, job, held, conds, device=dev),
         earliest_stop=earliest_stop(job),
+        device=dev,
     )
     if is_prior(job.model):
         result.stats["frozen_parts"] = int(result.model.frozen.sum())
     return result
 
 
-def holdout_eval(observed, job: Job, held, conditions: list[int]):
+def holdout_eval(observed, job: Job, held, conditions: list[int], device=None):
     """The evaluator of the held-out window frames the stopping rule reads, or None when the
     rule neither evaluates (``train.stopping.every`` 0) nor has frames to read.
 
@@ -255,6 +262,7 @@ def holdout_eval(observed, job: Job, held, conditions: list[int]):
         job: the training job.
         held (np.ndarray | None): the held-out frame indices (``heldout_split``), or None.
         conditions: the trained conditions' indices (their winds' held-out frames only).
+        device (str | torch.device | None): the training's device (None: the CPU).
 
     Returns:
         (HoldoutEval | None): the evaluator.
@@ -273,7 +281,9 @@ def holdout_eval(observed, job: Job, held, conditions: list[int]):
                 "train.holdout_every > 0, or train.stopping.enabled: false"
             )
         return None
-    return HoldoutEval.build(observed, held, conditions, job.train) if rule.every > 0 else None
+    if rule.every <= 0:
+        return None
+    return HoldoutEval.build(observed, held, conditions, job.train, device=device)
 
 
 def earliest_stop(job: Job) -> int:
@@ -364,7 +374,14 @@ def check_precision_supported(settings: dict, families: tuple[str, ...] = ("mlp"
 
 
 def train_and_save(
-    observed, job: Job | dict, *, checkpoint_path, loss_path, progress: bool = True, truth=None
+    observed,
+    job: Job | dict,
+    *,
+    checkpoint_path,
+    loss_path,
+    progress: bool = True,
+    truth=None,
+    resources=None,
 ) -> TrainResult:
     """[`fit`][physgs.experiments.recipe.fit], then write the loss log and the checkpoint.
 
@@ -378,14 +395,21 @@ def train_and_save(
         loss_path (str | os.PathLike): where the per-iteration loss log goes.
         progress: show a progress bar.
         truth (Truth | None): as in ``fit`` (references only).
+        resources (Mapping | None): the job's resources (``snakemake.resources``): a GPU asked
+            for there trains on CUDA, whatever ``train.device`` says
+            ([`resolve_device`][physgs.device.resolve_device]); the checkpoint is saved
+            device-free either way.
 
     Returns:
         The [`TrainResult`][physgs.train.loop.TrainResult].
     """
-    from physgs.train.loop import write_loss_log  # here: torch (module docstring)
+    # here: torch (module docstring)
+    from physgs.device import resolve_device
+    from physgs.train.loop import write_loss_log
 
     job = Job.from_dict(job) if isinstance(job, dict) else job
-    result = fit(observed, job, truth=truth, progress=progress)
+    device = resolve_device(job.train.get("device", "auto"), resources)
+    result = fit(observed, job, truth=truth, progress=progress, device=device)
     write_loss_log(loss_path, result.log)
     save_checkpoint(
         checkpoint_path,

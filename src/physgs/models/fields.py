@@ -202,7 +202,9 @@ class FieldModel(BaseModel):
         """
         xn = (self.canonical.means.detach() - self.xyz_center) / self.xyz_half  # [N, 3]
         n = xn.shape[0]
-        t = torch.tensor([self.time_scale * self.t_norm(frame_idx)], dtype=xn.dtype)
+        t = torch.tensor(
+            [self.time_scale * self.t_norm(frame_idx)], dtype=xn.dtype, device=xn.device
+        )
         parts = [fourier(xn, self.pos_bands), fourier(t, self.time_bands).expand(n, -1)]
         if self.use_wind:
             w = wind_window(

@@ -237,7 +237,7 @@ class OscillatorPrior(BaseModel):
         Raises:
             ValueError: when the mask is not [K].
         """
-        mask = torch.as_tensor(np.asarray(mask, dtype=bool))
+        mask = torch.as_tensor(np.asarray(mask, dtype=bool), device=self.frozen.device)
         if mask.shape != (self.K,):
             raise ValueError(f"freeze mask must be [K = {self.K}], got shape {tuple(mask.shape)}")
         self.frozen |= mask
@@ -311,7 +311,7 @@ class OscillatorPrior(BaseModel):
 
     def _bank_responses(self, wind: torch.Tensor) -> torch.Tensor:
         """The bank's responses [M, L+F] to wind [L+F] (m/s), scaled to quasi-static radians."""
-        key = wind.numpy().tobytes()
+        key = wind.cpu().numpy().tobytes()
         if key not in self._bank_memo:
             vbar = condition_vbar(self.vbar_ratio, wind)
             om = self.bank_omega
@@ -319,7 +319,9 @@ class OscillatorPrior(BaseModel):
                 om, np.full_like(om, self.search.bank_zeta), wind, vbar, self.dt, self.substeps
             )  # [M, L+F]
             scale = self.search.bank_scale * om**2 / float(self.ctx.wind_force_std)
-            self._bank_memo[key] = torch.as_tensor(r * scale[:, None], dtype=torch.float32)
+            self._bank_memo[key] = torch.as_tensor(
+                r * scale[:, None], dtype=torch.float32, device=self.bank_weights.device
+            )
         return self._bank_memo[key]
 
     def end_bank_phase(self, windows) -> dict:
@@ -353,7 +355,7 @@ class OscillatorPrior(BaseModel):
         with torch.no_grad():
             for wind, samples in windows:
                 w = torch.as_tensor(np.asarray(wind), dtype=torch.float64)
-                theta = (self.bank_weights @ self._bank_responses(w)).double().numpy()
+                theta = (self.bank_weights @ self._bank_responses(w)).double().cpu().numpy()
                 vbar = condition_vbar(self.vbar_ratio, w)
                 r = unit_responses(om_all, ze_all, w, vbar, self.dt, self.substeps)
                 theta, r = theta[:, samples], r[:, samples]  # [K, S], [G, S]

@@ -674,11 +674,22 @@ def save_checkpoint(
         "models_cfg": models_cfg,
         "train_cfg": train_cfg,
         "context": model.ctx.to_dict(),
-        "state_dict": model.state_dict(),
+        "state_dict": _device_free(model.state_dict()),
         "stats": stats,
     }
     with atomic_path(path) as tmp:
         torch.save(blob, tmp)
+
+
+def _device_free(sd):
+    """``sd`` with its tensors on the CPU, so a model trained on a GPU reloads on any machine
+    (``read_checkpoint`` maps to the CPU); a CPU model's state is returned as it is, so its file
+    stays byte for byte what it was."""
+    if all(v.device.type == "cpu" for v in sd.values()):
+        return sd
+    out = type(sd)((k, v.cpu()) for k, v in sd.items())
+    out._metadata = getattr(sd, "_metadata", None)  # the modules' versions load_state_dict reads
+    return out
 
 
 def read_checkpoint(path) -> dict:

@@ -58,17 +58,18 @@ def part_image_swing(
     lab = model.part_labels.cpu().numpy()
     K = int(model.K)
     with torch.no_grad():
+        # the projections run in numpy: the geometry comes to the CPU once (a no-op there)
         c = model.canonical_state()
-        means0 = c.means.double()
-        axis = model.axis.double()[model.part_labels]  # [N, 3]
-        pivot = model.pivot.double()[model.part_labels]  # [N, 3]
+        means0 = c.means.double().cpu()
+        axis = model.axis.double()[model.part_labels].cpu()  # [N, 3]
+        pivot = model.pivot.double()[model.part_labels].cpu()  # [N, 3]
         if probe_rad is not None:
             if not probe_rad > 0:
                 raise ValueError(f"probe_rad must be > 0 rad, got {probe_rad}")
             angles = torch.tensor([[probe_rad], [-probe_rad]], dtype=torch.float64).expand(2, K)
         else:
             wind = torch.as_tensor(np.asarray(observed.wind[condition]), dtype=torch.float64)
-            theta = model.part_theta(wind).double()  # [K, L+F]
+            theta = model.part_theta(wind.to(model.omega_raw.device)).double().cpu()  # [K, L+F]
             idx = np.arange(observed.n_train) if frames is None else np.asarray(frames)
             angles = theta[:, int(observed.lead_in_frames) + idx].T  # [M, K]
     uv0, _ = cam.project(means0.numpy())  # [N, 2] pixels
@@ -97,7 +98,7 @@ def _chain_swing(model, means0, uv0, cam, angles) -> np.ndarray:
     swing = np.zeros(K)
     q0 = torch.tensor([[1.0, 0.0, 0.0, 0.0]], dtype=torch.float64)
     with torch.no_grad():
-        axis, pivot = model.axis.double(), model.pivot.double()  # [K, 3]
+        axis, pivot = model.axis.double().cpu(), model.pivot.double().cpu()  # [K, 3]
     for p in range(K):
         idx = np.nonzero(sub[p][lab])[0]
         for a in {float(angles[:, p].max()), float(angles[:, p].min())}:

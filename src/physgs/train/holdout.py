@@ -33,7 +33,7 @@ class HoldoutEval:
     ssim_weight: float
 
     @staticmethod
-    def build(observed, frames, conditions, train_cfg: dict) -> "HoldoutEval":
+    def build(observed, frames, conditions, train_cfg: dict, device=None) -> "HoldoutEval":
         """The evaluator of ``frames`` (held-out recorded-frame indices) under each trained wind.
 
         Args:
@@ -41,6 +41,8 @@ class HoldoutEval:
             frames (ArrayLike): [M] held-out frame indices (< n_train).
             conditions (list[int]): the trained conditions.
             train_cfg: the ``train`` section (backend, ssim_weight).
+            device (str | torch.device | None): where the targets, winds and background live
+                (the training's device); None: the CPU.
 
         Returns:
             The evaluator.
@@ -54,14 +56,17 @@ class HoldoutEval:
                 f"held-out frames must be training-window indices in [0, {observed.n_train}); "
                 f"got {frames.size} frames (train.holdout_every = 0 holds none out)"
             )
+        dev = torch.device("cpu" if device is None else device)
         pairs = tuple((int(c), int(j)) for c in conditions for j in frames)
         imgs = np.stack([np.asarray(observed.frames[c, j]) for c, j in pairs])
         return HoldoutEval(
             pairs=pairs,
-            targets=torch.from_numpy(imgs).float() / 255.0,
-            winds=torch.as_tensor(np.asarray(observed.wind), dtype=torch.float32),
+            targets=torch.from_numpy(imgs).to(dev).float() / 255.0,
+            winds=torch.as_tensor(np.asarray(observed.wind), dtype=torch.float32).to(dev),
             camera=observed.train_camera,
-            background=torch.as_tensor(np.asarray(observed.background), dtype=torch.float32),
+            background=torch.as_tensor(np.asarray(observed.background), dtype=torch.float32).to(
+                dev
+            ),
             backend=str(train_cfg.get("backend", "auto")),
             ssim_weight=float(train_cfg["ssim_weight"]),
         )
@@ -85,5 +90,5 @@ class HoldoutEval:
                 loss, _, _ = photometric_loss(out.rgb, target, self.ssim_weight)
                 losses.append(float(loss))
                 rgb = out.rgb.clamp(0, 1).float().cpu().numpy()
-                psnrs.append(float(psnr(rgb, target.float().cpu().numpy())))
+                psnrs.append(float(psnr(rgb, target.cpu().numpy())))
         return float(np.mean(losses)), float(np.mean(psnrs))

@@ -94,6 +94,7 @@ def train_model(
     on_iteration=None,
     holdout: HoldoutEval | None = None,
     earliest_stop: int = 0,
+    device=None,
 ) -> TrainResult:
     """Fit ``model`` to the training-camera frames of ``observed``.
 
@@ -125,6 +126,10 @@ def train_model(
         holdout: the held-out window frames' evaluator (None: no scores, no early stop).
         earliest_stop: the stopping rule counts no evaluation before this iteration (the
             recipe's last change to the model: freezing, the end of the search over omega).
+        device (str | torch.device | None): where to train: the model (moved there before its
+            optimiser is built), its optimiser state, the targets, winds and background; None:
+            where the model's parameters are ([`resolve_device`][physgs.device.resolve_device]
+            turns ``train.device`` into one). ``holdout`` must be built for the same device.
 
     Returns:
         The [`TrainResult`][physgs.train.loop.TrainResult]: the model in eval mode, its statistics
@@ -164,6 +169,14 @@ def train_model(
         hooks = [on_iteration]
     else:
         hooks = list(on_iteration)
+    dev = torch.device(device) if device is not None else next(model.parameters()).device
+    if dev.type != "cpu":  # the CPU path stays exactly as it was (no copies, same tensors)
+        model.to(dev)
+    if holdout is not None and holdout.targets.device != dev:
+        raise ValueError(
+            f"the held-out evaluator's targets are on {holdout.targets.device}, the training on "
+            f"{dev}: build it with HoldoutEval.build(..., device={str(dev)!r})"
+        )
     rng = np.random.default_rng(seed)
     torch.manual_seed(seed)
     groups = model.param_groups(train_cfg["lr"])
@@ -194,8 +207,10 @@ def train_model(
             "no checkpoint written"
         )
 
-    winds = torch.as_tensor(np.asarray(observed.wind), dtype=torch.float32)  # [C, L+F]
-    bg = torch.as_tensor(np.asarray(observed.background), dtype=torch.float32)
+    winds = torch.as_tensor(np.asarray(observed.wind), dtype=torch.float32).to(dev)  # [C, L+F]
+    bg = torch.as_tensor(np.asarray(observed.background), dtype=torch.float32).to(dev)  # [3]
+    # off the CPU each recorded frame crosses the bus once, as uint8, then stays on the device
+    on_device: dict[tuple[int, int], torch.Tensor] = {}
     cam = observed.train_camera
     backend = train_cfg.get("backend", "auto")
     w_ssim = float(train_cfg["ssim_weight"])
@@ -224,7 +239,12 @@ def train_model(
             if frame_pool is None
             else frame_pool[rng.integers(frame_pool.size)]
         )
-        target = torch.from_numpy(np.array(observed.frames[c, j])).float() / 255.0  # [H, W, 3]
+        if dev.type == "cpu":
+            target = torch.from_numpy(np.array(observed.frames[c, j])).float() / 255.0  # [H, W, 3]
+        else:
+            if (c, j) not in on_device:
+                on_device[c, j] = torch.from_numpy(np.array(observed.frames[c, j])).to(dev)
+            target = on_device[c, j].float() / 255.0  # [H, W, 3]
         warm = it < warmup
         # the groups that shape this iteration's Gaussians, most grown first
         shaping = guard.suspects(_STATE_GROUP.values()) if warm else guard.deformation_suspects()
@@ -326,6 +346,7 @@ def train_model(
         "conditions": list(conditions),
         "seed": int(seed),
         "backend": backend,
+        "device": str(dev),
         "n_gaussians": int(model.canonical.n),
         "wind_mean": float(model.ctx.wind_mean),
         "wind_std": float(model.ctx.wind_std),
