@@ -4,6 +4,7 @@ from snakemake.utils import min_version
 
 import physgs.config
 import physgs.experiments.recipe
+import physgs.provenance
 import physgs.scheduling
 
 min_version("9.0")
@@ -12,6 +13,10 @@ min_version("9.0")
 physgs.scheduling.install()
 # Snakemake's own message for a YAML syntax error names no file, line or column: parse it first
 physgs.config.check_yaml_syntax("config/trees.yaml")
+# a results folder without Snakemake's metadata (copied, or older) is taken as up to date whatever
+# settings made it: every plan checks each file it reads as made against the provenance record
+# beside it (physgs.provenance), and names the file and the key that differs
+physgs.provenance.install(workflow)
 
 
 configfile: "config/trees.yaml"

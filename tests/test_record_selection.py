@@ -180,9 +180,9 @@ def test_alls_real_plan_leaves_the_studies_tables_figures_and_jobs_out(tmp_path,
     tool = _record_tool()
     monkeypatch.chdir(ROOT)
     with pytest.raises(SystemExit, match="another run's"):
-        tool._plan("quick", "000000000000")
+        tool._plan(["profile=quick"], [], "000000000000")
     quick = config_hash(physgs.config.load(ROOT / "config" / "trees.yaml", "quick"))
-    a_out, a_bench = tool._plan("quick", quick)
+    a_out, a_bench = tool._plan(["profile=quick"], [], quick)
     s_dry = dry_run(["studies"], ["profile=quick"], cwd=ROOT)
     s_out = _below_results(plan_outputs(s_dry))
     s_bench = _below_results(b for _, b in plan_jobs(s_dry) if b)

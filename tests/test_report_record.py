@@ -660,3 +660,25 @@ def test_the_readme_s_first_screen_names_the_ledger_and_each_command_s_cost_from
     assert f"{hours.group(1)} CPU-hours" in text and "paper_estimate.md" in text
     home = [ln for ln in (ROOT / "docs" / "index.md").read_text().splitlines() if ln.strip()]
     assert any("(ledger.md)" in ln for ln in home[:3])
+
+
+def test_leftovers_of_a_write_that_stopped_are_settled_not_an_oserror(tmp_path):
+    r, _, _ = _run(tmp_path)
+    out = tmp_path / "record"
+    _record(r, out)
+    # stopped after the swap: an old record beside the new one, and a half-written one
+    (tmp_path / "record.old" / "tables").mkdir(parents=True)
+    (tmp_path / "record.old" / "tables" / "stale.csv").write_text("a\n1\n")
+    (tmp_path / "record.partial").mkdir()
+    (tmp_path / "record.partial" / "stamp.json").write_text("{")
+    _record(r, out)
+    assert not (tmp_path / "record.old").exists()
+    assert not (tmp_path / "record.partial").exists()
+    assert json.loads((out / "stamp.json").read_text())["commit"] == "abc1234"
+    # stopped between the renames: the last record is only record.old; it is put back, and what
+    # no run makes (its costs) outlives the new record
+    (out / "costs.csv").write_text("name,wall_s\nall,5\n")
+    out.rename(tmp_path / "record.old")
+    _record(r, out)
+    assert (out / "costs.csv").read_text() == "name,wall_s\nall,5\n"
+    assert not (tmp_path / "record.old").exists()

@@ -1,6 +1,7 @@
 """The committed record of a finished default-profile run, and the README lines read from it.
 
     python tools/record.py [results] [--out docs/record] [--wall-s S] [--commit HASH] [--note TEXT]
+                           [--configfile FILE ...] [--config KEY=VALUE ...]   # the run's overrides
     python tools/record.py --pages-only      # lay the record's pages out again from its own files
                                              # (and add the ledger's catalogue-derived columns)
     python tools/record.py --readme-only     # rewrite the README's block from the record
@@ -24,8 +25,14 @@ states). A table, figure or benchmark file of the plan that the folder lacks sto
 what the folder holds beyond the plan (a `snakemake studies` run's tables and figures, whose
 jobs keep their benchmark files under `results/studies/benchmarks/`, or an earlier run's files)
 is left out and listed. Run it in the
-checkout and config the run was made with: a config whose hash is not the run's (its tables'
-`config_hash`) is refused, since its plan is another run's.
+checkout the run was made with, giving the `--configfile` and `--config` words the run was given
+(`profile=P` is added, P the profile of the run's `tab_fit.csv`, unless they set it): they are
+written into the stamp and the README's block. A config whose hash is not the run's (its tables'
+`config_hash`) is refused, since its plan is another run's. It takes one run of one config: every
+table of the plan and the ledger must carry the run's hash, and `all` must have nothing left to do
+under the overrides, with every file of its plan carrying the provenance record of its job's
+settings in this plan (`physgs.provenance.check_plan` on every job: `EVERY_JOB_ENV`); otherwise it
+stops, naming each file that disagrees and the key that differs.
 
 The wall time is the run's command's, measured by `tools/timed.py --name all` (summed over the
 segments of a resumed run): `--wall-s` gives it, else the `all` row of `costs.csv` when it was
@@ -41,6 +48,7 @@ from __future__ import annotations
 
 import argparse
 import datetime
+import shlex
 import subprocess
 from pathlib import Path
 
@@ -48,30 +56,91 @@ import pandas as pd
 
 import physgs.config
 from physgs.experiments.cost import dry_run, plan_jobs, plan_outputs, summarise
-from physgs.provenance import config_hash, git_commit, machine_cpu
+from physgs.provenance import EVERY_JOB_ENV, config_hash, git_commit, machine_cpu
 from physgs.report import record
+from snakemake.cli import parse_config
 
 
 #: the run's folder as the workflow's paths name it: every output and benchmark file is below it
 RUN_ROOT = Path("results")
 TARGET = "all"  # the record is of the run of `all`
+CONFIGFILE = "config/trees.yaml"  # the Snakefile's configfile
 
 
-def _plan(profile: str, run_hash: str) -> tuple[list[str], list[str]]:
-    """`all`'s outputs and benchmark files at ``profile``, relative to the run's folder, from
-    Snakemake's dry run in this checkout; refused unless this checkout's config is the run's."""
-    here = config_hash(physgs.config.load("config/trees.yaml", profile))
+def _run_items(profile: str, config: list[str]) -> list[str]:
+    """The run's ``--config`` items: ``config``, with ``profile=P`` first unless it sets the
+    profile (P: the profile of the run's tables)."""
+    return config if "profile" in parse_config(config) else [f"profile={profile}", *config]
+
+
+def _config_hash(config: list[str], configfiles: list[str]) -> str:
+    """This checkout's config hash under ``--configfile configfiles --config config``, resolved
+    as the Snakefile resolves them (the hash its tables carry)."""
+    command_line = parse_config(config)
+    raw = physgs.config.read_yaml(CONFIGFILE) or {}
+    for f in configfiles:
+        raw = physgs.config.deep_merge(raw, physgs.config.read_yaml(f) or {})
+    raw = physgs.config.deep_merge(raw, command_line)
+    cfg = physgs.config.load_workflow_config(
+        raw, command_line=command_line, configfiles=configfiles
+    )
+    return config_hash(cfg)
+
+
+def _plan(config: list[str], configfiles: list[str], run_hash: str) -> tuple[list[str], list[str]]:
+    """`all`'s outputs and benchmark files under the run's overrides, relative to the run's
+    folder, from Snakemake's dry run in this checkout; refused unless this checkout's config
+    with those overrides is the run's."""
+    here = _config_hash(config, configfiles)
     if here != run_hash:
         raise SystemExit(
-            f"this checkout's {profile} config hashes to {here}, the run's tables to {run_hash}: "
-            "its plan is another run's; record from the checkout and config the run was made with"
+            f"this checkout's config with `{_words(config, configfiles).strip()}` hashes to "
+            f"{here}, the run's tables to {run_hash}: its plan is another run's; record from "
+            "the checkout the run was made with, giving the run's own overrides (`--config "
+            "KEY=VALUE ...`, `--configfile FILE ...`)"
         )
-    dry = dry_run([TARGET], [f"profile={profile}"])
+    dry = dry_run([TARGET], config, configfiles=configfiles)
 
     def below(paths):
         return [str(Path(p).relative_to(RUN_ROOT)) for p in paths if RUN_ROOT in Path(p).parents]
 
     return below(plan_outputs(dry)), below(b for _, b in plan_jobs(dry) if b)
+
+
+def _finished(config: list[str], configfiles: list[str]) -> None:
+    """Refuse the run unless `all` has nothing left to do under its overrides and every file of
+    its plan was made with the plan's settings (its provenance record, checked for every job,
+    physgs.provenance.EVERY_JOB_ENV), naming each file that disagrees and the key."""
+    words = _words(config, configfiles)
+    try:
+        pending = dry_run(
+            [TARGET],
+            config,
+            configfiles=configfiles,
+            forceall=False,
+            env={EVERY_JOB_ENV: "1"},
+        )
+    except RuntimeError as e:  # the plan's provenance check refused files, or Snakemake did
+        raise SystemExit(
+            f"{TARGET}'s plan under `{words.strip()}` is not this run's: {e}"
+        ) from None
+    remade = [o for o in plan_outputs(pending) if RUN_ROOT in Path(o).parents]
+    if remade:
+        shown = ", ".join(remade[:12]) + (
+            f" and {len(remade) - 12} more" if len(remade) > 12 else ""
+        )
+        raise SystemExit(
+            f"{TARGET} under `{words.strip()}` is not finished: Snakemake would make "
+            f"{len(remade)} of its files again ({shown}); finish the run (snakemake --cores 2 "
+            f"{TARGET}{words}) and record it then"
+        )
+
+
+def _words(config: list[str], configfiles: list[str]) -> str:
+    """The overrides as Snakemake's command line words (a leading space when any)."""
+    words = [*(["--configfile", *configfiles] if configfiles else [])]
+    words += ["--config", *config] if config else []
+    return "".join(" " + shlex.quote(w) for w in words)
 
 
 def _wall_s(args, commit: str) -> float:
@@ -97,6 +166,20 @@ def main() -> None:
     ap.add_argument("--wall-s", type=float, help="the run's wall time (tools/timed.py), s")
     ap.add_argument("--commit", help="the commit the run was made at (default: HEAD's hash)")
     ap.add_argument("--note", default="", help="what a reader should know of how it was made")
+    ap.add_argument(
+        "--config",
+        nargs="+",
+        default=[],
+        metavar="KEY=VALUE",
+        help="the run's --config overrides, as given to snakemake (profile: its tables')",
+    )
+    ap.add_argument(
+        "--configfile",
+        nargs="+",
+        default=[],
+        metavar="FILE",
+        help="the run's --configfile overrides, as given to snakemake",
+    )
     ap.add_argument("--readme-only", action="store_true")
     ap.add_argument("--pages-only", action="store_true", help="lay out the record's pages again")
     ap.add_argument(
@@ -118,8 +201,21 @@ def main() -> None:
     elif not args.readme_only:
         r = args.results
         fit = pd.read_csv(r / "tables" / "tab_fit.csv", dtype={"config_hash": str})
-        outputs, benchmarks = _plan(str(fit["profile"].iloc[0]), fit["config_hash"].iloc[0])
+        config = _run_items(str(fit["profile"].iloc[0]), args.config)
+        here = str(fit["config_hash"].iloc[0])
+        outputs, benchmarks = _plan(config, args.configfile, here)
         run = record.run_files(r, outputs, benchmarks, target=TARGET)
+        problems = [
+            f"- {line}" for line in record.other_configs([*run.tables, r / "claims.csv"], here)
+        ]
+        if problems:
+            problems.insert(0, f"{r}: files of {TARGET}'s plan made under another config:")
+        try:
+            _finished(config, args.configfile)
+        except SystemExit as e:
+            problems.append(str(e))
+        if problems:
+            raise SystemExit("\n".join(problems))
         print(f"{r}: {len(run.jobs)} benchmarked jobs of {TARGET}'s plan")
         print(run.left_out_line())
         by_stage = summarise(list(run.jobs))["by_stage"]
@@ -141,6 +237,7 @@ def main() -> None:
                 fit["seed"].unique(),
                 int(physgs.config.load("config/trees.yaml", str(fit["profile"].iloc[0]))["seed"]),
             ),
+            overrides=tuple(shlex.split(_words(args.config, args.configfile))),
         )
         written = record.write_record(
             args.out,

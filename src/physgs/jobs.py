@@ -36,6 +36,7 @@ from pathlib import Path
 
 from physgs.allocator import retain_freed_memory
 from physgs.atomic import FULL_BELOW, atomic_path, disk_full_error, free_bytes
+from physgs.provenance import take_provenance, write_provenance
 
 #: where the output locks live, relative to the workflow's working directory (not Snakemake's
 #: own ``.snakemake/locks``, which a finishing run deletes whole)
@@ -471,6 +472,9 @@ def job(sm):
     ``threads`` ([`set_threads`][physgs.jobs.set_threads]), sends stdout and stderr (progress
     bars included) to ``sm.log[0]``, and writes the traceback of a failure there too (not only
     to the console; only to the console when the log cannot be written) before re-raising it.
+    When the body ends well, each output gets its provenance record
+    ([`physgs.provenance.write_provenance`][]: the rule, its params, the commit, the settings of
+    each input); an output's old record is removed before the body runs.
     A waiting job's own lines go to ``<log>.waiting`` until the wait ends, then to the log
     (`output_locks`' ``log`` and ``notes``). The log is put back if another job of the rule
     started meanwhile (Snakemake deletes a job's log before it starts). A job that Snakemake runs
@@ -507,6 +511,7 @@ def job(sm):
                 print(f"outputs made for this same job by {made_by}; taken as made", file=log)
             print(f"{sm.rule}: outputs made by {made_by}; taken as made", file=sys.stderr)
         else:
+            previous = take_provenance(sm.output)  # no record outlives what it describes
             log = open(sm.log[0], "w+")
             for line in notes:
                 print(line, file=log, flush=True)
@@ -515,6 +520,8 @@ def job(sm):
                 with contextlib.redirect_stderr(log), contextlib.redirect_stdout(log):
                     try:
                         yield log
+                        made = [o for o in sm.output if os.path.exists(o)]  # Snakemake: the rest
+                        write_provenance(made, sm.rule, sm.params, sm.input, previous=previous)
                     except BaseException as e:
                         failed = True
                         err = _report_failure(log, sm.log[0], e)

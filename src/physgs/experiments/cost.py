@@ -16,10 +16,11 @@ from __future__ import annotations
 
 import csv
 import math
+import os
 import re
 import subprocess
 import sys
-from collections.abc import Collection, Sequence
+from collections.abc import Collection, Mapping, Sequence
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -355,7 +356,15 @@ def _job_stats(dry_run: str) -> dict[str, int]:
     return out
 
 
-def dry_run(targets: Sequence[str], config: Sequence[str] = (), cwd=None) -> str:
+def dry_run(
+    targets: Sequence[str],
+    config: Sequence[str] = (),
+    cwd=None,
+    *,
+    configfiles: Sequence[str] = (),
+    forceall: bool = True,
+    env: Mapping[str, str] | None = None,
+) -> str:
     """Snakemake's printout of the whole plan of ``targets``: ``snakemake -n --forceall``, run in
     ``cwd`` (the workflow's folder; default the current one) whatever its ``results/`` holds.
 
@@ -363,6 +372,10 @@ def dry_run(targets: Sequence[str], config: Sequence[str] = (), cwd=None) -> str
         targets: the targets (``["all"]``, or files).
         config: ``--config`` items (``["profile=quick"]``).
         cwd (str | Path | None): the workflow's folder.
+        configfiles: ``--configfile`` paths, after ``config/trees.yaml`` (the Snakefile's).
+        forceall: plan every job (the default); False: the jobs that would run now, after the
+            plan's provenance check ([`physgs.provenance.check_plan`][]), which stops it.
+        env: variables added to Snakemake's environment.
 
     Returns:
         The printout ([`plan_jobs`][physgs.experiments.cost.plan_jobs] and
@@ -371,11 +384,21 @@ def dry_run(targets: Sequence[str], config: Sequence[str] = (), cwd=None) -> str
     Raises:
         RuntimeError: with the command and the end of Snakemake's error when it cannot plan.
     """
-    cmd = [sys.executable, "-m", "snakemake", "-n", "--forceall", "--nolock"]
+    cmd = [
+        sys.executable,
+        "-m",
+        "snakemake",
+        "-n",
+        *(["--forceall"] if forceall else []),
+        "--nolock",
+    ]
+    cmd += ["--configfile", *configfiles] if configfiles else []
     cmd += [*(["--config", *config] if config else []), "--", *targets]
-    r = subprocess.run(cmd, cwd=cwd, capture_output=True, text=True)
+    full_env = {**os.environ, **env} if env else None
+    r = subprocess.run(cmd, cwd=cwd, capture_output=True, text=True, env=full_env)
     if r.returncode:
-        raise RuntimeError(f"`{' '.join(cmd[1:])}` failed:\n{r.stderr[-2000:]}")
+        # a dry run prints its error to stdout, a real one to stderr
+        raise RuntimeError(f"`{' '.join(cmd[1:])}` failed:\n{(r.stdout + r.stderr)[-6000:]}")
     return r.stdout
 
 

@@ -23,6 +23,7 @@ import html
 import json
 import math
 import re
+import shlex
 import shutil
 from collections.abc import Iterable, Mapping, Sequence
 from dataclasses import asdict, dataclass, field
@@ -108,6 +109,9 @@ class Stamp:
         jobs: the run's benchmarked jobs (one benchmark file each; light jobs have none).
         instances: tree -> the testbed seeds of its tree instances (``testbed_seeds``: one per
             training seed; without, the one of ``seed``); {} in a record made before it.
+        overrides: the ``--configfile`` and ``--config`` words the run was made with, as
+            Snakemake's command line takes them (none: the config file as committed, at the
+            stamp's profile).
     """
 
     date: str
@@ -122,6 +126,7 @@ class Stamp:
     note: str = ""
     jobs: int = 0
     instances: dict[str, list[int]] = field(default_factory=dict)
+    overrides: tuple[str, ...] = ()
 
     def __post_init__(self):
         """Refuse a commit that is not a plain hash (a sentence, or a tag a clone lacks)."""
@@ -162,6 +167,11 @@ class Stamp:
                 f"- **Run**: profile `{self.profile}`, config hash `{self.config_hash}`, "
                 f"seeds {', '.join(map(str, self.seeds))}, trees {', '.join(self.trees)}",
                 *([f"- **Tree instances**: {self.instances_words()}"] if self.instances else []),
+                *(
+                    [f"- **Overrides**: `{overrides_words(self.overrides)}`"]
+                    if self.overrides
+                    else []
+                ),
                 f"- **Made at** commit `{self.commit}`; record written {self.date}",
                 *([f"- **Note**: {self.note}"] if self.note else []),
                 f"- **Machine**: {self.cpu}, 2 cores",
@@ -191,6 +201,43 @@ def instances_of(testbed: pd.DataFrame, seeds: Sequence[int], seed: int) -> dict
     for _, r in testbed.iterrows():
         n = int(r["instances"]) if "instances" in testbed.columns else 1
         out[str(r["tree"])] = seeds if n > 1 and n == len(seeds) else [int(seed)]
+    return out
+
+
+def overrides_words(overrides: Iterable[str]) -> str:
+    """A run's overrides as one command-line fragment, each word quoted as a shell needs.
+
+    Args:
+        overrides: the words (``["--configfile", "config/float32.yaml"]``).
+
+    Returns:
+        The fragment (``--configfile config/float32.yaml``).
+    """
+    return " ".join(shlex.quote(w) for w in overrides)
+
+
+def other_configs(files: Iterable[str | Path], config_hash: str) -> list[str]:
+    """The files of a run, among ``files``, whose rows were made under another config.
+
+    Every table's CSV and the ledger carry the config hash of the run that wrote them: a table
+    rebuilt alone under an edited config carries the new one while the rest keep the old, and
+    such a folder is no one run.
+
+    Args:
+        files: CSVs (a file without a ``config_hash`` column is not judged).
+        config_hash: the run's config hash.
+
+    Returns:
+        One phrase per file that disagrees: its path and the hashes it holds.
+    """
+    out = []
+    for f in files:
+        df = pd.read_csv(f, dtype={"config_hash": str})
+        if "config_hash" not in df.columns:
+            continue
+        found = sorted({str(h) for h in df["config_hash"].dropna()})
+        if found != [config_hash]:
+            out.append(f"{f}: config_hash {', '.join(found) or 'none'}, not {config_hash}")
     return out
 
 
@@ -507,6 +554,34 @@ def run_files(
     )
 
 
+def _remove(path: Path) -> None:
+    """Remove ``path``, a folder or a file, if it is there."""
+    if path.is_dir() and not path.is_symlink():
+        shutil.rmtree(path)
+    elif path.exists() or path.is_symlink():
+        path.unlink()
+
+
+def _settle_swap(final: Path) -> None:
+    """Finish what a write of the record at ``final`` left undone when it stopped.
+
+    A write swaps the records by two renames (``final`` to ``final.old``, ``final.partial`` to
+    ``final``) and then removes ``final.old``. Stopped between the renames, it leaves the last
+    record as ``final.old`` and no ``final``: that record is put back. Stopped after them, or
+    unable to remove it, it leaves a ``final.old`` beside a ``final`` that is the newer record:
+    it is removed (a rename onto a folder that is not empty fails, ``OSError`` 39).
+    """
+    old = final.with_name(final.name + ".old")
+    if not (old.exists() or old.is_symlink()):
+        return
+    if final.exists():
+        print(f"{old}: left by an earlier write of the record after its swap; removed")
+        _remove(old)
+    else:
+        print(f"{old}: the last record, left there by a write that stopped; put back at {final}")
+        old.rename(final)
+
+
 def write_record(
     out_dir: str | Path,
     *,
@@ -520,7 +595,10 @@ def write_record(
     """Write a run's record into ``out_dir`` (replacing the record there).
 
     Snakemake's report of a run is not part of the record (it is ~10 MB: every clone would
-    carry each record's); ``tools/record.py --report-html`` makes it into ``results/``.
+    carry each record's); ``tools/record.py --report-html`` makes it into ``results/``. What an
+    earlier write left when it stopped is settled first, and said: a ``<out_dir>.partial`` is
+    removed, a ``<out_dir>.old`` beside the record is removed, and one without a record beside
+    it (the last record, stopped between the swap's renames) is put back.
 
     Args:
         out_dir: the record's folder (the project keeps it at ``docs/record``).
@@ -543,6 +621,7 @@ def write_record(
         if not p.is_file():
             raise FileNotFoundError(f"{p}: missing; finish the run first (snakemake --cores 2 all)")
     final = Path(out_dir)
+    _settle_swap(final)
     kept = {n: (final / n).read_bytes() for n in OUTLIVE if (final / n).is_file()}
     # against the record this one replaces; the same run recorded again keeps its comparison
     old_stamp = final / "stamp.json"
@@ -555,8 +634,7 @@ def write_record(
     else:
         against = "\n".join(rerun_lines(final, stamp, claims_csv, tables))
     out = final.with_name(final.name + ".partial")  # the old record stands until this is whole
-    if out.exists():
-        shutil.rmtree(out)
+    _remove(out)  # an earlier write that stopped before its swap
     (out / "tables").mkdir(parents=True)
     (out / "figures").mkdir()
     written: list[Path] = []
@@ -585,7 +663,7 @@ def write_record(
     if final.exists():
         final.rename(old)
     out.rename(final)
-    shutil.rmtree(old, ignore_errors=True)
+    _remove(old)
     return sorted({final / p.relative_to(out) for p in written})
 
 
@@ -1168,8 +1246,10 @@ def found_lines(record_dir: str | Path) -> list[str]:
     if (record / "claims.csv").is_file():
         stamp = json.loads((record / "stamp.json").read_text())
         claims = pd.read_csv(record / "claims.csv", dtype={"config_hash": str})
+        overrides = stamp.get("overrides") or []
+        made_with = f", made with `{overrides_words(overrides)}`" if overrides else ""
         lines += [
-            f"Profile `{stamp['profile']}`, seeds {', '.join(map(str, stamp['seeds']))}, "
+            f"Profile `{stamp['profile']}`{made_with}, seeds {', '.join(map(str, stamp['seeds']))}, "
             f"commit `{stamp['commit']}`:",
             "",
             *headline_lines(claims),
