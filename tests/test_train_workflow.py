@@ -129,5 +129,8 @@ def test_tab_damping_plans_ours_on_both_testbeds_of_each_tree():
         for m in BLIND_PRIORS
     }
     assert trained == want
-    built = [b for b in _blocks(r.stdout, "testbed_dataset") if "_damping/observed" in b]
-    assert len(built) == len(db["trees"])
+    # with testbed_seeds each seed builds its own damping instance (testbed_dataset_seeded)
+    rule = "testbed_dataset_seeded" if cfg["testbed_seeds"] else "testbed_dataset"
+    built = [b for b in _blocks(r.stdout, rule) if "_damping/" in b and "observed.npz" in b]
+    per_tree = len(cfg["seeds"]) if cfg["testbed_seeds"] else 1
+    assert len(built) == len(db["trees"]) * per_tree

@@ -129,6 +129,10 @@ def _wait_for_holder(fd: int, log_link: Path, out: str, silent_s: float) -> None
             pid, on, log = int(m.group(1)), m.group(2), m.group(3)
             why = None
             if on == host and not _pid_alive(pid):
+                # it may have ended between the try above and this check: its lock is then free
+                with contextlib.suppress(BlockingIOError):
+                    fcntl.flock(fd, fcntl.LOCK_EX | fcntl.LOCK_NB)
+                    return
                 why = f"its process (pid {pid}) is gone, yet its lock is still held"
             elif log is not None:
                 quiet = None  # not linked yet (a moment after the lock is taken), or no link
