@@ -94,6 +94,10 @@ def holder_silent_s() -> float:
     return value
 
 
+#: seconds a holder's process may be gone while its lock is still held before the wait ends
+GONE_GRACE_S = 3.0
+
+
 def _pid_alive(pid: int) -> bool:
     try:
         os.kill(pid, 0)
@@ -117,6 +121,7 @@ def _wait_for_holder(fd: int, log_link: Path, out: str, silent_s: float) -> None
     log (an ``output_locks`` user without a job) is waited for as long as it lives.
     """
     host = os.uname().nodename
+    gone_since = None
     while True:
         try:
             fcntl.flock(fd, fcntl.LOCK_EX | fcntl.LOCK_NB)
@@ -129,12 +134,13 @@ def _wait_for_holder(fd: int, log_link: Path, out: str, silent_s: float) -> None
             pid, on, log = int(m.group(1)), m.group(2), m.group(3)
             why = None
             if on == host and not _pid_alive(pid):
-                # it may have ended between the try above and this check: its lock is then free
-                with contextlib.suppress(BlockingIOError):
-                    fcntl.flock(fd, fcntl.LOCK_EX | fcntl.LOCK_NB)
-                    return
-                why = f"its process (pid {pid}) is gone, yet its lock is still held"
+                # a process that is ending releases its lock a moment after it is gone (seen on a
+                # loaded machine): only a lock still held GONE_GRACE_S later is a child's
+                gone_since = gone_since or time.monotonic()
+                if time.monotonic() - gone_since > GONE_GRACE_S:
+                    why = f"its process (pid {pid}) is gone, yet its lock is still held"
             elif log is not None:
+                gone_since = None
                 quiet = None  # not linked yet (a moment after the lock is taken), or no link
                 for path in (log_link, log):
                     with contextlib.suppress(FileNotFoundError):
