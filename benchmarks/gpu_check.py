@@ -54,14 +54,8 @@ from physgs.models import build_model
 from physgs.models.registry import BASE_CONFIG, PRIOR_VARIANT_NAMES, training_jobs
 from physgs.provenance import git_commit, machine_cpu
 from physgs.render import BACKENDS, _gsplat_available, render_state
-from physgs.testbed import scene
-from physgs.testbed.dataset import (
-    build_dataset,
-    load_observed,
-    save_dataset,
-    simulate_tree,
-    swept_points,
-)
+from physgs.testbed.dataset import build_dataset, load_observed, save_dataset
+from physgs.testbed.standin import geometry_stand_in
 from physgs.train.holdout import HoldoutEval
 
 FIELDS = ("means", "quats", "scales", "opacities", "colors")
@@ -72,39 +66,6 @@ def sync(device: torch.device) -> None:
     """Wait for the device's queued work, so a wall-clock read covers it."""
     if device.type == "cuda":
         torch.cuda.synchronize(device)
-
-
-def stand_in(cfg: dict, tree: str, resolution: int):
-    """An observed-like dataset with the tree's real canonical set, wind and training camera at
-    ``resolution`` px, and flat grey frames (rates and parity need no rendered testbed)."""
-    from types import SimpleNamespace
-
-    tb = dict(cfg["testbed"], resolution=resolution)
-    sim = simulate_tree(tb, cfg["presets"][tree], seed=cfg["seed"], tree=tree)
-    cam = scene.frame_cameras(
-        swept_points(sim.truth),
-        [0.0],
-        fov_deg=tb["fov_deg"],
-        resolution=resolution,
-        fill_height=tb["fill_height"],
-    )[0]
-    F = tb["n_train"] + tb["n_tail"]
-    frames = np.broadcast_to(
-        np.full((resolution, resolution, 3), 128, np.uint8),
-        (sim.wind.shape[0], F, resolution, resolution, 3),
-    )
-    return SimpleNamespace(
-        fps=tb["fps"],
-        n_train=tb["n_train"],
-        n_tail=tb["n_tail"],
-        lead_in_frames=sim.truth.lead_in_frames,
-        conditions=sim.conditions,
-        wind=sim.wind,
-        frames=frames,
-        train_camera=cam,
-        background=np.asarray(tb["background"]),
-        canonical_xyz=sim.truth.rest_vertices.astype(np.float32),
-    )
 
 
 # ---------------------------------------------------------------------------------------------
@@ -135,7 +96,7 @@ def parity(cfg: dict, tree: str, resolutions: list[int], device: torch.device) -
     """Every backend on ``device`` against the CPU fast path in float64, per resolution."""
     rows = []
     for res in resolutions:
-        data = stand_in(cfg, tree, res)
+        data = geometry_stand_in(cfg, tree, res)
         model = build_model("static", data, cfg["models"], seed=0)
         with torch.no_grad():
             s = model.canonical_state()
@@ -345,7 +306,7 @@ def rates(cfg: dict, trees, resolutions, jobs, iters: int, device) -> pd.DataFra
     rows = []
     for tree in trees:
         for res in resolutions:
-            data = stand_in(cfg, tree, res)
+            data = geometry_stand_in(cfg, tree, res)
             for model, config in jobs:
                 r = time_model(data, cfg, model, config, iters, device)
                 rows.append(dict(tree=tree, model=model, config=config, resolution=res, **r))

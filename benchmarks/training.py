@@ -24,7 +24,6 @@ import argparse
 import contextlib
 import time
 from collections import defaultdict
-from types import SimpleNamespace
 
 import numba
 import numpy as np
@@ -37,43 +36,11 @@ import physgs.train.loop
 from physgs.models import build_model, training_jobs
 from physgs.models.registry import BASE_CONFIG, PRIOR_VARIANT_NAMES
 from physgs.models.oscillator import integrate
-from physgs.testbed import scene
-from physgs.testbed.dataset import simulate_tree, swept_points
+from physgs.testbed.standin import geometry_stand_in
 from physgs.train import train_model
 from physgs.train.divergence import DivergenceGuard
 
 PARTS = ("raster_fwd", "raster_bwd", "field", "loss", "optimiser", "guard", "other")
-
-
-def tree_dataset(cfg: dict, tree: str) -> SimpleNamespace:
-    """Observed-like stand-in with the tree's real canonical set, wind and training camera."""
-    tb = cfg["testbed"]
-    sim = simulate_tree(tb, cfg["presets"][tree], seed=cfg["seed"], tree=tree)
-    xyz = sim.truth.rest_vertices.astype(np.float32)
-    # the testbed's own framing (swept extent of every frame and condition)
-    cam = scene.frame_cameras(
-        swept_points(sim.truth),
-        [0.0],
-        fov_deg=tb["fov_deg"],
-        resolution=tb["resolution"],
-        fill_height=tb["fill_height"],
-    )[0]
-    R = tb["resolution"]
-    F = tb["n_train"] + tb["n_tail"]
-    frame = np.full((R, R, 3), 128, np.uint8)
-    frames = np.broadcast_to(frame, (sim.wind.shape[0], F, R, R, 3))
-    return SimpleNamespace(
-        fps=tb["fps"],
-        n_train=tb["n_train"],
-        n_tail=tb["n_tail"],
-        lead_in_frames=sim.truth.lead_in_frames,
-        conditions=sim.conditions,
-        wind=sim.wind,
-        frames=frames,
-        train_camera=cam,
-        background=np.asarray(tb["background"]),
-        canonical_xyz=xyz,
-    )
 
 
 class Parts:
@@ -279,7 +246,7 @@ def main() -> None:
     cpu_total = 0.0
     breakdown = {}
     for tree in trees:
-        data = tree_dataset(cfg, tree)
+        data = geometry_stand_in(cfg, tree)
         t = {job: time_model(data, cfg, *job, args.iters) for job in jobs}
         breakdown[tree] = t
         static = t.get(("static", "single"), (0.0,))[0]

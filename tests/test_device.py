@@ -23,6 +23,7 @@ from physgs.models import build_model, load_checkpoint
 from physgs.models.checkpoint import _device_free
 from physgs.train import train_model
 from physgs.device import asks_for_gpu, check_setting, resolve_device
+from physgs.testbed.standin import geometry_stand_in
 from physgs.train.holdout import HoldoutEval
 from oracles import quick_train_cfg
 
@@ -161,7 +162,7 @@ def test_the_gpu_check_runs_on_the_cpu_and_holds_the_reference_to_the_numba_kern
     assert ref64.image_max_abs < 1e-12
     assert max(ref64[f"grad_{k}"] for k in gc.FIELDS) < 1e-10
     assert (par[par.dtype == "float32"].image_max_abs < 1e-5).all()
-    data = gc.stand_in(cfg, "sparse", 24)
+    data = geometry_stand_in(cfg, "sparse", 24)
     _, summary = gc.curves(cfg, _observed_like(data), ["static"], 6, cpu, points=3)
     assert bool(summary.identical.iloc[0]) and np.isfinite(summary.heldout_psnr_cpu.iloc[0])
     r = gc.rates(cfg, ["sparse"], [24], [("ours", "single")], 2, cpu)
