@@ -42,6 +42,7 @@ import tempfile
 import time
 from collections import defaultdict
 from pathlib import Path
+from unittest import mock
 
 import numpy as np
 import pandas as pd
@@ -237,28 +238,19 @@ class SyncedParts:
 
     @contextlib.contextmanager
     def patched(self, model, optimiser_cls):
-        saved = []
-
-        def patch(obj, name, value):
-            saved.append((obj, name, obj.__dict__.get(name, _MISSING)))
-            setattr(obj, name, value)
-
-        patch(loop, "render_state", self.wrap("raster", loop.render_state))
-        patch(loop, "photometric_loss", self.wrap("loss", loop.photometric_loss))
-        patch(torch.Tensor, "backward", self.wrap("backward", torch.Tensor.backward))
-        patch(optimiser_cls, "step", self.wrap("optimiser", optimiser_cls.step))
-        patch(model, "gaussians_at", self.wrap("field", model.gaussians_at))
-        try:
+        """The loop's parts wrapped while the block runs (unittest.mock restores each)."""
+        parts = (
+            (loop, "render_state", "raster"),
+            (loop, "photometric_loss", "loss"),
+            (torch.Tensor, "backward", "backward"),
+            (optimiser_cls, "step", "optimiser"),
+            (model, "gaussians_at", "field"),
+        )
+        with contextlib.ExitStack() as stack:
+            for obj, name, part in parts:
+                wrapped = self.wrap(part, getattr(obj, name))
+                stack.enter_context(mock.patch.object(obj, name, wrapped))
             yield self
-        finally:
-            for obj, name, old in reversed(saved):
-                if old is _MISSING:
-                    delattr(obj, name)
-                else:
-                    setattr(obj, name, old)
-
-
-_MISSING = object()
 
 
 def time_model(data, cfg: dict, model: str, config: str, iters: int, device) -> dict:
