@@ -177,6 +177,51 @@ def test_a_partial_run_gives_a_partial_ledger():
     assert set(part.index) <= set(full.index)
 
 
+def test_the_headline_split_by_kind_of_field():
+    """Beyond the window and under unseen wind, the wind-blind fields 1 dB below static and the
+    wind-conditioned ones 0.5 dB above it: the paper's headline fails (its best field is above
+    static), and split by kind it holds for the blind fields and fails for the wind ones."""
+    tables = _tables(seeds=(0, 1, 2))
+    psnr = tables["tab_psnr"].copy()
+    for t in ("sparse", "medium"):
+        wind = psnr["model"].isin(["mlp_wind", "d3dgs_wind"])
+        psnr.loc[wind, f"{t}_time"] = 20.5 + 0.01 * psnr.loc[wind, "seed"]
+    tr = tables["tab_transfer"].copy()  # static 20; mlp 19, d3dgs 18; the wind fields 20.5, 20.3
+    tr["mlp_wind"], tr["d3dgs_wind"] = 20.5, 20.3
+    tr["mlp"] = 19.0 + 0.01 * tr["seed"]
+    tables.update(tab_psnr=psnr, tab_transfer=tr)
+    df = C.ledger(C.measure(tables, {}, ["sparse", "medium"], roles=ROLES)).set_index("id")
+    for t in ("sparse", "medium"):
+        assert df.loc[f"baselines_below_static_beyond/{t}", "verdict"] == "fails"
+        blind = df.loc[f"kind_below_static_beyond/{t}/blind"]
+        wind = df.loc[f"kind_below_static_beyond/{t}/wind"]
+        assert blind["measured"] == pytest.approx(-1.0) and blind["verdict"] == "holds"
+        assert wind["measured"] == pytest.approx(0.5) and wind["verdict"] == "fails"
+        assert blind["origin"] == wind["origin"] == "project"
+        assert "wind-blind" in blind["claim"] and "Deformable-3DGS + wind" in wind["claim"]
+        for c in ("0.84", "0.71"):
+            assert df.loc[f"transfer_baselines_below_static/{t}/{c}", "verdict"] == "fails"
+            b = df.loc[f"transfer_kind_below_static/{t}/blind/{c}"]
+            w = df.loc[f"transfer_kind_below_static/{t}/wind/{c}"]
+            assert b["measured"] == pytest.approx(-0.99) and b["verdict"] == "holds"
+            assert w["measured"] == pytest.approx(0.5) and w["verdict"] == "fails"
+
+
+def test_the_kinds_of_field_come_from_the_registry(monkeypatch):
+    """A field's kind is its registry entry's ``wind``: flipping it moves the field."""
+    import dataclasses
+
+    from physgs.models import registry
+    from physgs.report.claim_cells import fields_of_kind
+
+    assert set(fields_of_kind("blind")) | set(fields_of_kind("wind")) == set(models_of("field"))
+    assert not set(fields_of_kind("blind")) & set(fields_of_kind("wind"))
+    monkeypatch.setitem(
+        registry.MODELS, "mlp", dataclasses.replace(registry.MODELS["mlp"], wind=True)
+    )
+    assert "mlp" in fields_of_kind("wind") and "mlp" not in fields_of_kind("blind")
+
+
 # --- every claim's direction, on worlds where the answer is known --------------------------------
 
 TREES = ("sparse", "medium")
@@ -193,6 +238,8 @@ FAMILIES = {
     "fits_window",
     "transfer_ours_ahead",
     "transfer_baselines_below_static",
+    "kind_below_static_beyond",
+    "transfer_kind_below_static",
     "topology_parts_reduce_damping_error",
     "coupling_lifts_sparse_fit",
     "tracks_beats_null",

@@ -326,6 +326,52 @@ def test_tab_fit_fraction_of_the_ceiling():
     assert static.rstrip(" \\").endswith("& 12 & 1800")
 
 
+def test_tab_fit_held_out_fraction_beside_the_trained_one(tmp_path):
+    """The held-out window frames' fraction of the ceiling's gain, against the static pose's and
+    the ceiling's held-out frames, beside the trained frames' (a memorising field: the gap)."""
+    from physgs.report.build import read_table
+
+    models = ("static", "mlp", "ours")
+    # (fit, heldout) per model; the ceiling last
+    psnr = {"static": (20.0, 19.0), "mlp": (28.0, 21.0), "ours": (26.0, 24.0)}
+    psnr["truth_motion"] = (30.0, 29.0)
+    per_seed = {}
+    for s in (0, 1):
+        per_seed[s] = {
+            (t, m): {
+                "fit": f,
+                "heldout": h + (0.5 if (m == "ours" and s == 1) else 0.0),
+                "view": 21.0,
+                "time": 21.5,
+                "train_s": 12.0,
+                "iterations": 3000.0,
+            }
+            for t in TREES
+            for m, (f, h) in psnr.items()
+        }
+    tab = T.tab_fit(per_seed, TREES, BONES, models, "truth_motion")
+    d = tab.df[tab.df.tree == TREES[0]].set_index(["seed", "model"])
+    # trained: (28 - 20) / (30 - 20) = 0.8, (26 - 20) / 10 = 0.6
+    assert d.loc[(0, "mlp"), "ceiling_frac"] == pytest.approx(0.8)
+    assert d.loc[(0, "ours"), "ceiling_frac"] == pytest.approx(0.6)
+    # held out: (21 - 19) / (29 - 19) = 0.2; ours (24 - 19) / 10 = 0.5, seed 1 (24.5 - 19) / 10
+    assert d.loc[(0, "mlp"), "heldout_ceiling_frac"] == pytest.approx(0.2)
+    assert d.loc[(0, "ours"), "heldout_ceiling_frac"] == pytest.approx(0.5)
+    assert d.loc[(1, "ours"), "heldout_ceiling_frac"] == pytest.approx(0.55)
+    assert d.loc[(0, "static"), "heldout_ceiling_frac"] == pytest.approx(0.0)
+    assert d.loc[(0, "truth_motion"), "heldout_ceiling_frac"] == pytest.approx(1.0)
+    # the .tex: the held-out fraction right after the trained one
+    assert "& Of ceiling & Held-out of ceiling &" in tab.tex
+    mlp = next(ln for ln in tab.tex.splitlines() if f"& {T.label('mlp')} &" in ln)
+    cells = [c.strip() for c in mlp.split("&")]
+    i = cells.index(T.label("mlp"))
+    assert cells[i + 3].startswith("80") and cells[i + 4].startswith("20")
+    # the CSV holds it, and reads back through the table's declared columns
+    T.write_table(tab, tmp_path / "tab_fit.tex", tmp_path / "tab_fit.csv")
+    back = read_table("tab_fit", tmp_path / "tab_fit.csv")
+    assert back["heldout_ceiling_frac"].tolist() == pytest.approx(tab.df.heldout_ceiling_frac)
+
+
 def test_fit_row_splits_trained_and_held_out_frames(tmp_path):
     from physgs.evaluate.splits import EvalResult
     from physgs.report.build import fit_row

@@ -228,6 +228,12 @@ def _value_best_field_minus_static(c: Cell) -> tuple[float, float]:
     return _point(max(pp[m][1] - pp["static"][1] for m in cc.fields())) if pp else NO_VALUE
 
 
+def _value_kind_minus_static(c: Cell) -> tuple[float, float]:
+    pp = _pp(c)
+    ms = cc.fields_of_kind(c["kind"])
+    return _point(max(pp[m][1] - pp["static"][1] for m in ms)) if pp else NO_VALUE
+
+
 def _value_ours_minus_static(c: Cell) -> tuple[float, float]:
     pp = _pp(c)
     return _point(pp["ours"][1] - pp["static"][1]) if pp else NO_VALUE
@@ -266,6 +272,12 @@ def _paper_best_field_minus_static(c: Cell) -> str:
     """best learned field - static beyond the window, tab:psnr"""
     v = _value_best_field_minus_static(c)[0]
     return f"best baseline - static = {v:+.2f} dB" if np.isfinite(v) else "--"
+
+
+def _paper_kind_minus_static(c: Cell) -> str:
+    """the kind's best learned field - static beyond the window, tab:psnr"""
+    v = _value_kind_minus_static(c)[0]
+    return f"best {c['kind_words']} baseline - static = {v:+.2f} dB" if np.isfinite(v) else "--"
 
 
 def _paper_ours_minus_static(c: Cell) -> str:
@@ -322,6 +334,12 @@ ABSOLUTE = (
 #: a coverage floor: more coverage is never against it; its width is judged apart (the
 #: interval score against the null's, ``*_interval_score``)
 COVER = "a floor: coverage of at least the bar; width is judged by its interval-score companion"
+#: the paper's headline split by kind of field: one-sided as its parent, a direction (the
+#: question is which kind of field contradicts the paper's sign, not by how much)
+KIND_DIRECTION = (
+    "a direction, as the paper's claim it splits: which kind of field is below static (and so "
+    "which contradicts the paper's sign), not by how much"
+)
 #: not worse by more than a margin: the better side supports the claim too
 NON_INFERIOR = (
     "non-inferiority: the claim is that the other does not lose, and its winning supports it too"
@@ -377,6 +395,30 @@ CATALOGUE: tuple[ClaimSpec, ...] = (
         "tab_transfer (beyond): max learned - static",
         "below static in all 24 cells, by 0.10-2.79 dB",
         one_sided=DIRECTION,
+    ),
+    # this project's: the two headlines above split by kind of field (wind-blind,
+    # wind-conditioned: the registry's ``ModelSpec.wind``), so the ledger says which kind
+    # contradicts the paper
+    ClaimSpec(
+        "kind_below_static_beyond", "ours", "kind_trees", "tab_psnr", "kind_minus_static",
+        "EVEN", "<", "dB",
+        "{tree}: every {kind_words} learned field ({kind_fields}) is below the static pose "
+        "beyond the window",
+        "tab_psnr, time column: max over the {kind_words} fields of (model - static)",
+        _paper_kind_minus_static,
+        origin="project",
+        one_sided=KIND_DIRECTION,
+        paper_value=_value_kind_minus_static,
+    ),
+    ClaimSpec(
+        "transfer_kind_below_static", "ours", "kind_winds_beyond", "tab_transfer",
+        "wind_kind_minus_static", "EVEN", "<", "dB",
+        "{tree}, {cond} v0, beyond the window: every {kind_words} learned field "
+        "({kind_fields}) below static",
+        "tab_transfer (beyond): max {kind_words} learned - static",
+        "every baseline below static in all 24 cells",
+        origin="project",
+        one_sided=KIND_DIRECTION,
     ),
     ClaimSpec(
         "margin_grows", "ours", "margin_trees", "tab_margin", "margin_growth",

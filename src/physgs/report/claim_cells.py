@@ -111,6 +111,25 @@ def fields() -> tuple[str, ...]:
     return models_of("field")
 
 
+#: The kinds of learned field, by whether the field's registry entry reads the wind
+#: (``ModelSpec.wind``): kind id -> its words. The paper's headline lumps both kinds; the
+#: project's split families (``physgs.report.catalogue``) ask it of each.
+FIELD_KINDS = {"blind": "wind-blind", "wind": "wind-conditioned"}
+
+
+def fields_of_kind(kind: str) -> tuple[str, ...]:
+    """The learned fields of one kind, from the registry (never from their names).
+
+    Args:
+        kind: a key of ``FIELD_KINDS``.
+
+    Returns:
+        The model ids of role "field" whose spec reads the wind (``"wind"``) or does not
+            (``"blind"``), in registry order.
+    """
+    return tuple(m for m in fields() if spec_of(m).wind == (kind == "wind"))
+
+
 # ---- helpers --------------------------------------------------------------------------------
 def value(df: pd.DataFrame, mask: pd.Series, col: str) -> float:
     """The single cell of ``col`` where ``mask`` holds.
@@ -187,6 +206,40 @@ def _fit_models(run: Run) -> list[Cell]:
         for t in run.trees
         for m in (*fields(), "ours", *run.others)
     ]
+
+
+def _kind_cells(cells: list[Cell]) -> list[Cell]:
+    """``cells`` x each kind of learned field the registry holds, the kind in the suffix after
+    the tree."""
+    out = []
+    for c in cells:
+        for k, words in FIELD_KINDS.items():
+            ms = fields_of_kind(k)
+            if not ms:  # a registry without fields of this kind asks nothing of it
+                continue
+            rest = c["suffix"].split("/", 1)[1:]  # what follows the tree (a wind), if anything
+            out.append(
+                {
+                    **c,
+                    "suffix": "/".join([c["tree"], k, *rest]),
+                    "kind": k,
+                    "kind_words": words,
+                    "kind_fields": ", ".join(label(m) for m in ms),
+                }
+            )
+    return out
+
+
+def _kind_trees(run: Run) -> list[Cell]:
+    """each tree x each kind of learned field (wind-blind, wind-conditioned: whether its
+    registry entry reads the wind)"""
+    return _kind_cells(_trees(run))
+
+
+def _kind_winds_beyond(run: Run) -> list[Cell]:
+    """each tree x each kind of learned field (wind-blind, wind-conditioned: whether its
+    registry entry reads the wind) x unseen wind of tab_transfer, beyond the window"""
+    return _kind_cells(_winds_beyond(run))
 
 
 def _splits(run: Run) -> list[Cell]:
@@ -366,6 +419,12 @@ def _best_field_minus_static(d: pd.DataFrame, c: Cell) -> float:
     return best - _psnr(d, c["tree"], "static", "time")
 
 
+def _kind_minus_static(d: pd.DataFrame, c: Cell) -> float:
+    """tab_psnr, time column: max over the kind's learned fields of (model - static)"""
+    best = max(_psnr(d, c["tree"], m, "time") for m in fields_of_kind(c["kind"]))
+    return best - _psnr(d, c["tree"], "static", "time")
+
+
 def _above_static(d: pd.DataFrame, c: Cell) -> float:
     """tab_psnr, time column: the prior - static"""
     return _psnr(d, c["tree"], c["model"], "time") - _psnr(d, c["tree"], "static", "time")
@@ -395,6 +454,12 @@ def _wind_fields_minus_static(d: pd.DataFrame, c: Cell) -> float:
     """tab_transfer: max over learned fields - static"""
     row = _wind_row(d, c)
     return max(value(d, row, m) for m in fields()) - value(d, row, "static")
+
+
+def _wind_kind_minus_static(d: pd.DataFrame, c: Cell) -> float:
+    """tab_transfer: max over the kind's learned fields - static"""
+    row = _wind_row(d, c)
+    return max(value(d, row, m) for m in fields_of_kind(c["kind"])) - value(d, row, "static")
 
 
 def _margin_growth(d: pd.DataFrame, c: Cell) -> float:
@@ -559,6 +624,8 @@ SCOPES: dict[str, Scope] = {
     "fit_models": _fit_models,
     "splits": _splits,
     "winds_beyond": _winds_beyond,
+    "kind_trees": _kind_trees,
+    "kind_winds_beyond": _kind_winds_beyond,
     "winds": _winds,
     "margin_trees": _margin_trees,
     "recovery_trees": _recovery_trees,
@@ -581,6 +648,8 @@ READERS: dict[str, Reader] = {
     "ahead_of_fields": _ahead_of_fields,
     "wind_ahead": _wind_ahead,
     "wind_fields_minus_static": _wind_fields_minus_static,
+    "kind_minus_static": _kind_minus_static,
+    "wind_kind_minus_static": _wind_kind_minus_static,
     "margin_growth": _margin_growth,
     "null_over_trained": _null_over_trained,
     "trained_minus_null": _trained_minus_null,

@@ -221,6 +221,7 @@ FIT_COLUMNS = Columns(
         "fit_psnr_db",
         "heldout_psnr_db",
         "ceiling_frac",
+        "heldout_ceiling_frac",
         "view_psnr_db",
         "time_psnr_db",
         "iterations",
