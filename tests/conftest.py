@@ -69,42 +69,20 @@ def swaying_dataset(seed: int = 0) -> SimpleNamespace:
     )
 
 
-#: the DAG's readers that run Snakemake jobs of their own (17-26 s each in the suite; the rest of
-#: the DAG's readers take 4 s or less): they start before the short ones
-LONG_DAG_READERS = frozenset(
-    {
-        "test_a_run_made_with_overrides_is_recorded_with_them",
-        "test_a_record_of_tables_of_two_configs_is_refused_naming_each_and_the_key",
-        "test_quick_dag_through_cluster_generic_executor",
-        "test_a_second_seed_pairs_with_the_first",
-    }
-)
-
-
 @pytest.hookimpl(tryfirst=True)  # before pytest-xdist reads the groups
 def pytest_collection_modifyitems(items):
     """Order and group the tests for the suite's two workers (``--dist loadgroup``, order kept).
 
     One test that reads the quick DAG goes first, so one worker builds the DAG on both cores
     while the other runs the tests that need no DAG; the rest of the DAG's readers go last and
-    are shared by both workers, the longest first (the module-groups, then the slow ones), so the
-    run does not end with one worker in a long one while the other has nothing left. A module
-    with a module-scoped fixture stays on one worker, so its fixture is built once."""
-
-    def grouped(it) -> bool:
-        defs = it._fixtureinfo.name2fixturedefs.values()
-        return any(d[-1].scope == "module" for d in defs)
-
+    are shared by both workers. A module with a module-scoped fixture stays on one worker, so
+    its fixture is built once."""
     dag = [it for it in items if "quick_dag" in it.fixturenames]
     rest = [it for it in items if "quick_dag" not in it.fixturenames]
-
-    def cost(it) -> tuple:  # the longest first
-        return (not grouped(it), it.originalname not in LONG_DAG_READERS, "slow" not in it.keywords)
-
-    tail = sorted(dag[1:], key=cost)
-    items[:] = dag[:1] + rest + tail
+    items[:] = dag[:1] + rest + dag[1:]
     for it in items:
-        if grouped(it):
+        defs = it._fixtureinfo.name2fixturedefs.values()
+        if any(d[-1].scope == "module" for d in defs):
             it.add_marker(pytest.mark.xdist_group(it.module.__name__))
 
 
