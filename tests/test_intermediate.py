@@ -131,7 +131,10 @@ def test_the_command_in_the_message_remakes_the_file_and_what_is_made_from_it(tm
     env = {**os.environ, "PYTHONPATH": str(ROOT / "src")}
 
     def snakemake(*args):
-        cmd = [sys.executable, "-m", "snakemake", "--cores", "1", "out.txt", *args]
+        # run: blocks in Snakemake's own process (--force-use-threads), not in a Snakemake
+        # started again for each job (~3 s each); the block reads the file all the same
+        cmd = [sys.executable, "-m", "snakemake", "--cores", "1", "--force-use-threads"]
+        cmd += ["out.txt", *args]
         r = subprocess.run(cmd, cwd=tmp_path, env=env, capture_output=True, text=True, timeout=120)
         return r.returncode, r.stdout + r.stderr
 

@@ -84,12 +84,12 @@ def test_a_working_holder_is_waited_for(holder):
     done = []
 
     def stop_holder():  # after twice the silence limit: the wait outlasts the limit
-        time.sleep(8)
+        time.sleep(4)
         done.append(True)
         proc.kill()
 
     threading.Thread(target=stop_holder).start()
-    with output_locks([out], locks, key="k", log=str(log), silent_s=4.0) as made_by:
+    with output_locks([out], locks, key="k", log=str(log), silent_s=2.0) as made_by:
         assert done, "the wait ended while the holder still logged"
         assert made_by is None
 
