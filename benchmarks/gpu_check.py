@@ -54,7 +54,7 @@ from physgs.experiments.recipe import fit, heldout_split, job_spec
 from physgs.models import build_model
 from physgs.models.registry import BASE_CONFIG, PRIOR_VARIANT_NAMES, training_jobs
 from physgs.provenance import git_commit, machine_cpu
-from physgs.render import BACKENDS, _gsplat_available, render_state
+from physgs.render import BACKENDS, _gsplat_available, rasterization
 from physgs.testbed.dataset import build_dataset, load_observed, save_dataset
 from physgs.testbed.standin import geometry_stand_in
 from physgs.train.holdout import HoldoutEval
@@ -80,8 +80,8 @@ def _render_grads(state: dict, cam, bg, backend: str, device, dtype, probe: np.n
     leaves = {
         k: torch.tensor(v, dtype=dtype, device=device, requires_grad=True) for k, v in state.items()
     }
-    out = render_state(
-        type("S", (), leaves)(),
+    out = rasterization(
+        *(leaves[k] for k in FIELDS),
         cam,
         torch.as_tensor(bg, dtype=dtype, device=device),
         backend=backend,
