@@ -50,6 +50,7 @@ include: "workflow/rules/oma.smk"
 include: "workflow/rules/report.smk"
 include: "workflow/rules/speed_accuracy.smk"
 include: "workflow/rules/kselect.smk"
+include: "workflow/rules/search.smk"
 
 
 # everything `all` makes besides the summary, which reads these runs' benchmark files: the

@@ -37,6 +37,7 @@ import jsonschema
 import yaml
 
 from physgs import config_checks
+from physgs.mappings import deep_merge  # noqa: F401 (re-exported: profiles merge with it)
 
 #: The packaged schema (a Traversable; a plain file in any regular install).
 SCHEMA = resources.files("physgs").joinpath("schemas", "config.schema.yaml")
@@ -46,26 +47,6 @@ DEFAULT_SOURCE = "config/trees.yaml"
 
 class ConfigError(ValueError):
     """A configuration that cannot be used; the message names the key and the fix."""
-
-
-def deep_merge(base: dict, override: dict) -> dict:
-    """Return ``base`` with ``override`` merged in recursively (override wins on leaves).
-
-    Args:
-        base: the mapping merged into (not modified: a deep copy is returned).
-        override: the mapping whose values win; a dict under a key that is a dict in ``base`` too
-            is merged key by key, anything else replaces ``base``'s value.
-
-    Returns:
-        A new dict: ``base`` deep-copied with ``override`` merged in.
-    """
-    out = copy.deepcopy(base)
-    for k, v in override.items():
-        if isinstance(v, dict) and isinstance(out.get(k), dict):
-            out[k] = deep_merge(out[k], v)
-        else:
-            out[k] = copy.deepcopy(v)
-    return out
 
 
 # --------------------------------------------------------------------------------------------

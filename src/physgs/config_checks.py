@@ -16,6 +16,7 @@ import math
 from typing import Callable, Iterator
 
 from physgs.device import check_setting  # imports torch only when cuda is asked for
+from physgs.mappings import deep_merge
 from physgs.experiments.kselect import BASE_MODEL, selected_models, settings_for
 from physgs.models.omega_search import search_problem
 from physgs.models.families import searches_omega
@@ -24,8 +25,11 @@ from physgs.models.registry import (
     MODEL_NAMES,
     MODELS,
     PRIOR_VARIANT_NAMES,
+    BLIND_PRIORS,
     is_prior,
+    model_settings,
     spec_of,
+    training_jobs,
 )
 from physgs.models.timescale import WINDOW_TIME
 from physgs.oma.ssi import RecordError, SSISettings, check_record
@@ -501,10 +505,24 @@ def _kselect_runs(cfg: dict, *own_keys: str) -> Iterator[tuple[str, tuple, dict]
             yield m, where, settings_for(ks, m)
 
 
+def _recipes(cfg: dict) -> Iterator[tuple[tuple, str, str, dict]]:
+    """(config path, tree, model, recipe) of every tree's recipe (``recipes``)."""
+    for tree, models in (cfg.get("recipes") or {}).items():
+        for model, recipe in (models or {}).items():
+            yield ("recipes", tree, model), tree, model, recipe or {}
+
+
 def _schedules(cfg: dict) -> Iterator[tuple[tuple, str, dict]]:
-    """(config path, its name in messages, iterations/warmup node) of train and of every K
-    selection's short runs."""
+    """(config path, its name in messages, iterations/warmup node) of train, of every tree's
+    recipe that changes it and of every K selection's short runs."""
     yield ("train",), "train", cfg["train"]
+    for where, _, _, recipe in _recipes(cfg):
+        if recipe.get("train"):
+            yield (
+                where + ("train",),
+                "/".join(where + ("train",)),
+                deep_merge(cfg["train"], recipe["train"]),
+            )
     for _, where, node in _kselect_runs(cfg, "iterations", "warmup"):
         yield where, "/".join(where), node
 
@@ -526,6 +544,65 @@ def warmup_below_iterations(cfg: dict) -> Iterator[Problem]:
                 f"{warm} must lie in [0, {key}/iterations = {it}); lower {key}/warmup or raise "
                 f"{key}/iterations",
             )
+
+
+def _unknown_paths(over: dict, base: dict, path: tuple = ()) -> Iterator[tuple[tuple, list]]:
+    """(key path, the keys ``base`` holds there) of each key of ``over`` that ``base`` lacks (a
+    nested dict is walked where both hold one)."""
+    for k, v in over.items():
+        if k not in base:
+            yield path + (k,), sorted(base)
+        elif isinstance(v, dict) and isinstance(base[k], dict):
+            yield from _unknown_paths(v, base[k], path + (k,))
+
+
+def recipes_are_known(cfg: dict) -> Iterator[Problem]:
+    """A tree's recipe names a listed tree and a trained model, and sets only keys the shared
+    settings hold: a misspelt key would otherwise be merged in and read by nothing.
+
+    Args:
+        cfg: The resolved config (profile merged, schema-valid).
+
+    Yields:
+        ``(key path, message)`` per problem (the module docstring); none when the config passes.
+    """
+    trained = {m for m, _ in training_jobs(cfg["models"]["configs"])} | set(BLIND_PRIORS)
+    trained |= set(cfg["parts_study"]["models"])
+    for where, tree, model, recipe in _recipes(cfg):
+        if tree not in cfg["trees"]:
+            yield where[:2], f"tree {tree!r} is not in trees {cfg['trees']}"
+            continue
+        if model not in trained:
+            yield where, f"model {model!r} is not trained; trained models: {sorted(trained)}"
+            continue
+        bases = {"train": cfg["train"], "settings": model_settings(cfg["models"], model)}
+        for part, base in bases.items():
+            for p, holds in _unknown_paths(recipe.get(part) or {}, base):
+                yield (
+                    where + (part, *p),
+                    f"{'/'.join(p)} is not a setting of {model}'s {part} (there: {holds})",
+                )
+
+
+def search_is_runnable(cfg: dict) -> Iterator[Problem]:
+    """The recipe search's trees are listed and its trials are scored before they end.
+
+    Args:
+        cfg: The resolved config (profile merged, schema-valid).
+
+    Yields:
+        ``(key path, message)`` per problem (the module docstring); none when the config passes.
+    """
+    search = cfg["search"]
+    for t in search.get("trees", []):
+        if t not in cfg["trees"]:
+            yield ("search", "trees"), f"{t!r} is not in trees {cfg['trees']}"
+    if search["every"] >= cfg["train"]["iterations"]:
+        yield (
+            ("search", "every"),
+            f"{search['every']} must be below train/iterations ({cfg['train']['iterations']}): "
+            "the pruner reads no score otherwise",
+        )
 
 
 def device_is_available(cfg: dict) -> Iterator[Problem]:
@@ -905,6 +982,8 @@ CHECKS: list[Check] = [
     damping_range_valid,
     damping_transient_fits,
     warmup_below_iterations,
+    recipes_are_known,
+    search_is_runnable,
     device_is_available,
     holdout_leaves_training_frames,
     stopping_has_held_out_frames,

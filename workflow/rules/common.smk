@@ -80,6 +80,9 @@ SWEEP_POINT = "results/speed_accuracy/seed{seed}/{point}.json"
 FIT_POINT = "results/fit_curve/{tree}/seed{seed}/{model}_it{iterations}.json"
 # a field trained with the window-normalised time encoding (the fit curve's diagnostic series)
 FIT_WINDOW_POINT = "results/fit_curve/{tree}/seed{seed}/{model}_it{iterations}_windowtime.json"
+# the recipe search of one model on one tree (target search, outside all): its trials, every
+# held-out score they reported, and the best recipe as a config block
+SEARCH = "results/search/{tree}/{model}.{what}"
 TABLE = "results/tables/{name}.{ext}"
 FIGURE = "results/figures/{name}.{ext}"
 # the tracks control: one condition's tracks (observed only; per instance like the testbed), the
@@ -206,7 +209,24 @@ def report_inputs(wildcards):
 
 # ---- narrow params: each job sees only the settings it reads -------------------------------
 def train_params(wildcards):
-    return _job_spec(CFG, wildcards.model, wildcards.config, seed=int(wildcards.seed))
+    """The job's narrow settings, its tree's recipe (``recipes``) merged in."""
+    return _job_spec(
+        CFG, wildcards.model, wildcards.config, seed=int(wildcards.seed), tree=wildcards.tree
+    )
+
+
+def train_runtime(wildcards):
+    """Minutes: generous (about 1 s per iteration of the job's own budget) so a cluster never
+    kills a default job."""
+    return 10 + train_params(wildcards)["train"]["iterations"] // 60
+
+
+def search_job(wildcards):
+    """The searched model's single job on the tree (its recipe the base; the paper's instance,
+    the config's seed): every trial of the search is this job with the trial's recipe over it."""
+    return _job_spec(
+        CFG, wildcards.model, _models.BASE_CONFIG, seed=CFG["seed"], tree=wildcards.tree
+    )
 
 
 def kselect_params(wildcards):
@@ -214,7 +234,9 @@ def kselect_params(wildcards):
     model = getattr(wildcards, "model", _kselect.BASE_MODEL)
     return _canonical(
         {
-            "job": _job_spec(CFG, model, _models.BASE_CONFIG, seed=int(wildcards.seed)),
+            "job": _job_spec(
+                CFG, model, _models.BASE_CONFIG, seed=int(wildcards.seed), tree=wildcards.tree
+            ),
             "kselect": _kselect.settings_for(CFG["models"]["kselect"], model),
         }
     )
@@ -329,7 +351,9 @@ def parts_jobs():
 
 
 def kmatch_params(wildcards):
-    job = _job_spec(CFG, "ours_chain", _models.BASE_CONFIG, seed=int(wildcards.seed))
+    job = _job_spec(
+        CFG, "ours_chain", _models.BASE_CONFIG, seed=int(wildcards.seed), tree=wildcards.tree
+    )
     return _kmatch.point_job(job, int(wildcards.K))
 
 

@@ -47,7 +47,7 @@ rule train_auto:
         mem_mb=4000,
         runtime=10 + CFG["train"]["iterations"] // 60,
     params:
-        job=lambda wc: _job_spec(CFG, "ours", _models.BASE_CONFIG, seed=int(wc.seed)),
+        job=lambda wc: _job_spec(CFG, "ours", _models.BASE_CONFIG, seed=int(wc.seed), tree=wc.tree),
         conditions=CFG["models"]["kselect"]["conditions"],
     script:
         "../scripts/train_auto.py"
@@ -81,5 +81,7 @@ use rule train_auto as train_auto_prior with:
     wildcard_constraints:
         model="|".join(KSELECT_PRIORS) or "^$",
     params:
-        job=lambda wc: _job_spec(CFG, wc.model, _models.BASE_CONFIG, seed=int(wc.seed)),
+        job=lambda wc: _job_spec(
+            CFG, wc.model, _models.BASE_CONFIG, seed=int(wc.seed), tree=wc.tree
+        ),
         conditions=CFG["models"]["kselect"]["conditions"],

@@ -23,8 +23,7 @@ rule train:
     threads: 1  # two 1-thread jobs side by side beat one 2-thread job on 2 cores (benchmarks/training.py)
     resources:
         mem_mb=4000,
-        # minutes; generous (about 1 s per iteration) so a cluster never kills a default job
-        runtime=10 + CFG["train"]["iterations"] // 60,
+        runtime=train_runtime,
     params:
         job=train_params,
     script:
@@ -53,7 +52,9 @@ rule train_reference:
         mem_mb=4000,
         runtime=10 + CFG["train"]["iterations"] // 60,
     params:
-        job=lambda wc: _job_spec(CFG, wc.model, _models.BASE_CONFIG, seed=int(wc.seed)),
+        job=lambda wc: _job_spec(
+            CFG, wc.model, _models.BASE_CONFIG, seed=int(wc.seed), tree=wc.tree
+        ),
     script:
         "../scripts/train_reference.py"
 

@@ -11,7 +11,9 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
+from physgs.mappings import deep_merge
 from physgs.models.checkpoint import save_checkpoint
+from physgs.testbed.variant import parse_id
 from physgs.models.families import searches_omega
 from physgs.models.omega_search import OmegaSearch, omega_search_callback, search_iteration
 from physgs.models.registry import (
@@ -102,18 +104,23 @@ class Job:
         return Job.from_dict({**asdict(self), **kw})
 
 
-def job_spec(cfg: dict, model: str, config: str, seed: int | None = None) -> dict:
+def job_spec(
+    cfg: dict, model: str, config: str, seed: int | None = None, tree: str | None = None
+) -> dict:
     """The narrow settings of one (model, configuration) training job, as a sorted plain dict.
 
     What the workflow passes as the train rule's params: editing a key outside it (another model's
     architecture, a table's format, the sweep) leaves the job up to date. References
-    (``truth_motion``) are trained in ``single`` only.
+    (``truth_motion``) are trained in ``single`` only. A tree's recipe (``recipes.<tree>.<model>``:
+    the settings a search on that tree's held-out window frames chose, [`tree_recipe`][physgs.
+    experiments.recipe.tree_recipe]) is merged over the shared ``train`` and ``models`` sections.
 
     Args:
         cfg: the resolved config.
         model: a registry id.
         config: a configuration name (``models.configs``).
         seed: the job's seed; None: the config's.
+        tree: the tree the job trains on (its recipe applies); None: the shared settings only.
 
     Returns:
         The job's fields ([`Job`][physgs.experiments.recipe.Job]) as a canonical dict.
@@ -128,15 +135,36 @@ def job_spec(cfg: dict, model: str, config: str, seed: int | None = None) -> dic
             f"{configs_for(model, configs)} (joint configurations are ours only)"
         )
     spec = configs[config]
+    recipe = tree_recipe(cfg, tree, model)
     return Job(
         model=model,
         config=config,
         conditions=spec["conditions"],
         seed=int(cfg["seed"] if seed is None else seed),
-        settings=model_settings(cfg["models"], model),
-        train=cfg["train"],
+        settings=deep_merge(model_settings(cfg["models"], model), recipe.get("settings", {})),
+        train=deep_merge(cfg["train"], recipe.get("train", {})),
         K=int(spec["K"]) if is_prior(model) else None,
     ).to_dict()
+
+
+def tree_recipe(cfg: dict, tree: str | None, model: str) -> dict:
+    """The settings chosen for ``model`` on ``tree`` (``recipes``), over the shared ones.
+
+    A damping testbed (``<tree>_damping``) takes its tree's recipe: the same tree, another
+    damping.
+
+    Args:
+        cfg: the resolved config.
+        tree: a tree name, or None (no recipe).
+        model: a registry id.
+
+    Returns:
+        ``{"train": {...}, "settings": {...}}``, each a partial section (empty: none chosen).
+    """
+    if tree is None:
+        return {}
+    recipes = cfg.get("recipes") or {}
+    return (recipes.get(tree) or recipes.get(parse_id(tree)[0]) or {}).get(model) or {}
 
 
 def heldout_split(n_train: int, every: int) -> tuple[np.ndarray, np.ndarray]:

@@ -1,0 +1,317 @@
+"""Recipe search: a model's learning rates, size and time encoding chosen per tree on the frames
+its training window holds out, as its authors would tune it (issue "Opponents that fit").
+
+Optuna's TPE sampler (a fixed seed) proposes a recipe, the recipe's training reports its held-out
+window loss every ``every`` iterations and a median pruner stops a trial that falls behind the
+trials before it at the same iteration. The objective is the held-out window loss (L1 + D-SSIM,
+the training loss) at the end of the trial's training: never the held-out views, the tail beyond
+the window, another wind or the true physics, which are the test. Every trial trains from the
+same seed, so two trials differ by their settings only.
+
+The space per model family (``SPACES``) is what the family's authors would tune: a field's
+deformation learning rate, width, depth and top time band; a prior's physics and pivot learning
+rates. A trial's recipe has the shape of ``recipes.<tree>.<model>``
+in the config (``{"train": {...}, "settings": {...}}``), so the best one is pasted there.
+"""
+
+from __future__ import annotations
+
+import time
+from dataclasses import dataclass
+from typing import Callable
+
+import pandas as pd
+
+from physgs.experiments.recipe import Job, fit, heldout_split
+from physgs.mappings import deep_merge
+from physgs.models.registry import condition_indices, spec_of
+from physgs.models.timescale import WINDOW_TIME
+
+#: the columns of a search's steps file: every held-out score a trial reported
+STEP_FIELDS = ("trial", "iteration", "holdout_loss", "holdout_psnr")
+
+
+@dataclass(frozen=True)
+class FieldSpace:
+    """A learned field's space: its deformation learning rate, width, depth and top time band.
+
+    Attributes:
+        family: the field's settings section (``mlp``, ``d3dgs``).
+        depths: the depths tried.
+    """
+
+    family: str
+    depths: tuple[int, ...]
+
+    def suggest(self, trial, model: str) -> dict:
+        """The trial's recipe (``recipes.<tree>.<model>``'s shape)."""
+        top = trial.suggest_categorical("time_top_hz", list(TIME_TOPS))
+        return {
+            "train": {"lr": {"deform": trial.suggest_float("lr_deform", 2e-4, 4e-3, log=True)}},
+            "settings": {
+                self.family: {
+                    "width": trial.suggest_categorical("width", [64, 128, 256]),
+                    "depth": trial.suggest_categorical("depth", list(self.depths)),
+                    "time_top_hz": {model: top if top == WINDOW_TIME else float(top)},
+                }
+            },
+        }
+
+    def params(self, job: Job) -> dict:
+        """The parameters of ``job``'s own recipe (the search's first trial)."""
+        s = job.settings[self.family]
+        top = s["time_top_hz"][job.model]
+        return {
+            "time_top_hz": top if top == WINDOW_TIME else f"{float(top):g}",
+            "lr_deform": float(job.train["lr"]["deform"]),
+            "width": int(s["width"]),
+            "depth": int(s["depth"]),
+        }
+
+
+class PriorSpace:
+    """A physical prior's space: its physics and pivot learning rates (freezing stays the
+    config's: where it acts is tied to the schedule, so a trial turning it on could clash with
+    the search over omega, config_checks)."""
+
+    def suggest(self, trial, model: str) -> dict:
+        """The trial's recipe (``recipes.<tree>.<model>``'s shape)."""
+        return {
+            "train": {
+                "lr": {
+                    "physics": trial.suggest_float("lr_physics", 1e-2, 2e-1, log=True),
+                    "pivot": trial.suggest_float("lr_pivot", 5e-5, 5e-4, log=True),
+                }
+            }
+        }
+
+    def params(self, job: Job) -> dict:
+        """The parameters of ``job``'s own recipe (the search's first trial)."""
+        return {
+            "lr_physics": float(job.train["lr"]["physics"]),
+            "lr_pivot": float(job.train["lr"]["pivot"]),
+        }
+
+
+#: a field's top time bands tried (Hz, or the window-normalised time): the grid the defaults
+#: were chosen from (docs/models.md, Time encoding); strings, so Optuna stores one type
+TIME_TOPS = (WINDOW_TIME, "0.75", "1.5", "3")
+
+#: model family -> its space (Deformable-3DGS keeps its skip connection at layer 4, so its depth
+#: stays above it)
+SPACES = {
+    "mlp": FieldSpace("mlp", (2, 4, 6)),
+    "d3dgs": FieldSpace("d3dgs", (6, 8)),
+    "ours": PriorSpace(),
+}
+
+
+@dataclass(frozen=True)
+class SearchSettings:
+    """One search's budget.
+
+    Attributes:
+        trials: trials run (pruned ones included).
+        every: iterations between a trial's held-out scores (what the pruner reads).
+        startup: trials never pruned (the median needs them) and sampled at random before TPE.
+        seed: the sampler's seed (the trainings use the job's seed).
+    """
+
+    trials: int
+    every: int
+    startup: int
+    seed: int
+
+    @staticmethod
+    def from_config(search: dict) -> "SearchSettings":
+        """The settings of the config's ``search`` section.
+
+        Args:
+            search: ``{trials, every, startup, seed, ...}``.
+
+        Returns:
+            The settings.
+        """
+        return SearchSettings(*(int(search[k]) for k in ("trials", "every", "startup", "seed")))
+
+
+def space_of(model: str) -> FieldSpace | PriorSpace:
+    """The search space of ``model``'s family.
+
+    Args:
+        model: a registry id.
+
+    Returns:
+        Its space.
+
+    Raises:
+        ValueError: a model whose family has no space (the static pose, the references).
+    """
+    family = spec_of(model).family
+    if family not in SPACES:
+        raise ValueError(
+            f"{model!r} ({family}) has no recipe to search; searched: {sorted(SPACES)}"
+        )
+    return SPACES[family]
+
+
+def trial_job(base: dict, recipe: dict) -> Job:
+    """The job ``base`` with a trial's ``recipe`` merged over it.
+
+    Args:
+        base: the model's single-configuration job on the tree
+            ([`job_spec`][physgs.experiments.recipe.job_spec] with its tree: the tree's recipe,
+            ``recipes``, is the base).
+        recipe: ``{"train": {...}, "settings": {...}}``, partial sections.
+
+    Returns:
+        The job.
+    """
+    return Job.from_dict(
+        dict(
+            base,
+            train=deep_merge(base["train"], recipe.get("train", {})),
+            settings=deep_merge(base["settings"], recipe.get("settings", {})),
+        )
+    )
+
+
+def window_scorer(observed, job: Job):
+    """The held-out window frames' evaluator of ``job`` (its trained winds only).
+
+    Args:
+        observed (Observed): the testbed's observed dataset.
+        job: the training job (``train.holdout_every`` > 0).
+
+    Returns:
+        A [`HoldoutEval`][physgs.train.holdout.HoldoutEval] on the CPU.
+
+    Raises:
+        ValueError: ``train.holdout_every`` is 0 (no frame held out: nothing to search on).
+    """
+    from physgs.train.holdout import HoldoutEval  # torch: the planning side imports this module
+
+    every = int(job.train.get("holdout_every", 0))
+    if not every:
+        raise ValueError("train.holdout_every is 0: no held-out window frame to search on")
+    held = heldout_split(int(observed.n_train), every)[1]
+    conds = condition_indices(job.conditions, len(observed.conditions))
+    return HoldoutEval.build(observed, held, conds, job.train)
+
+
+def run_search(
+    observed,
+    base: dict,
+    settings: SearchSettings,
+    *,
+    tree: str = "",
+    log: Callable[[str], None] = print,
+) -> tuple[pd.DataFrame, pd.DataFrame, dict]:
+    """Search a model's recipe on a tree's held-out window frames.
+
+    Args:
+        observed (Observed): the tree's observed dataset (the training camera's video).
+        base: the model's single-configuration job on the tree (``job_spec`` with its tree), a
+            registry id with a space (``SPACES``): every trial is this job with its recipe over it.
+        settings: the budget.
+        tree: the tree's name (the rows' and the log lines' label).
+        log: where one line per trial goes (progress).
+
+    Returns:
+        ``(trials, steps, best)``: one row per trial (number, state, the objective, held-out
+        PSNR, the parameters, seconds; trial 0 is the config's own recipe), every reported score
+        (``STEP_FIELDS``), and the best complete trial's recipe.
+
+    Raises:
+        ValueError: no space for the model, or no trial completed.
+    """
+    import optuna
+
+    model = base["model"]
+    space = space_of(model)
+    steps: list[dict] = []
+    recipes: dict[int, dict] = {}
+
+    def objective(trial) -> float:
+        recipe = space.suggest(trial, model)
+        recipes[trial.number] = recipe
+        job = trial_job(base, recipe)
+        scorer = window_scorer(observed, job)
+        warmup = int(job.train["warmup"])
+
+        def report(it, mdl, opt):
+            if it <= warmup or it % settings.every:
+                return None
+            loss, psnr = scorer.evaluate(mdl)
+            steps.append(
+                dict(trial=trial.number, iteration=it, holdout_loss=loss, holdout_psnr=psnr)
+            )
+            trial.report(loss, it)
+            if trial.should_prune():
+                raise optuna.TrialPruned(f"held-out window loss {loss:.4f} at iteration {it}")
+            return None
+
+        res = fit(observed, job, progress=False, hooks=(report,))
+        loss, psnr = scorer.evaluate(res.model)
+        steps.append(
+            dict(trial=trial.number, iteration=len(res.log), holdout_loss=loss, holdout_psnr=psnr)
+        )
+        trial.set_user_attr("holdout_psnr", psnr)
+        return loss
+
+    def progress(study, trial) -> None:
+        value = "pruned" if trial.value is None else f"{trial.value:.4f}"
+        log(f"{tree} {model}: trial {trial.number + 1}/{settings.trials} {value} {trial.params}")
+
+    optuna.logging.set_verbosity(optuna.logging.WARNING)
+    study = optuna.create_study(
+        direction="minimize",
+        sampler=optuna.samplers.TPESampler(seed=settings.seed, n_startup_trials=settings.startup),
+        pruner=optuna.pruners.MedianPruner(n_startup_trials=settings.startup),
+    )
+    # the first trial is the recipe the config holds: the search is measured against it
+    study.enqueue_trial(space.params(trial_job(base, {})))
+    t0 = time.perf_counter()
+    study.optimize(objective, n_trials=settings.trials, callbacks=[progress])
+    done = [t for t in study.trials if t.state == optuna.trial.TrialState.COMPLETE]
+    if not done:
+        raise ValueError(f"{tree} {model}: no trial of {settings.trials} completed")
+    trials = study.trials_dataframe(
+        attrs=("number", "state", "value", "params", "duration", "user_attrs")
+    )
+    trials = trials.rename(
+        columns={"value": "holdout_loss", "user_attrs_holdout_psnr": "holdout_psnr"}
+    )
+    trials.insert(0, "model", model)
+    trials.insert(0, "tree", tree)
+    trials["seconds"] = trials.pop("duration").dt.total_seconds()
+    log(
+        f"{tree} {model}: {len(done)} of {settings.trials} trials complete, {time.perf_counter() - t0:.0f} s"
+    )
+    return trials, pd.DataFrame(steps, columns=list(STEP_FIELDS)), recipes[study.best_trial.number]
+
+
+def recipe_yaml(tree: str, model: str, trials: pd.DataFrame, recipe: dict) -> str:
+    """The best recipe as a ``recipes`` block for config/trees.yaml, its evidence in a comment.
+
+    Args:
+        tree: the tree's name.
+        model: the model's id.
+        trials: ``run_search``'s trials (trial 0: the config's own recipe).
+        recipe: the best complete trial's recipe.
+
+    Returns:
+        YAML text: ``{tree: {model: recipe}}`` under a comment with the best trial's and the
+        config's own held-out window PSNR (dB) and the trials run.
+    """
+    import yaml
+
+    done = trials[trials["state"] == "COMPLETE"]
+    best = done.loc[done["holdout_loss"].idxmin()]
+    own = trials.loc[trials["number"] == 0, "holdout_psnr"].iloc[0]
+    head = (
+        f"# {tree} {model}: trial {int(best['number'])} of {len(trials)} ({len(done)} complete), "
+        f"held-out window frames {best['holdout_psnr']:.2f} dB against the config's "
+        f"{own:.2f} dB (trial 0)\n"
+    )
+    return head + yaml.safe_dump({tree: {model: recipe}}, sort_keys=True)

@@ -1,0 +1,144 @@
+"""The recipe search (physgs.experiments.search) and a tree's recipe (``recipes``) in its jobs."""
+
+import copy
+import re
+import subprocess
+import sys
+
+import optuna
+import pytest
+
+from physgs.config_checks import recipes_are_known, search_is_runnable, warmup_below_iterations
+from physgs.experiments.recipe import fit, job_spec, tree_recipe
+from physgs.experiments.search import (
+    SearchSettings,
+    recipe_yaml,
+    run_search,
+    space_of,
+    trial_job,
+    window_scorer,
+)
+from oracles import quick_config, quick_train_cfg
+from workflow_helpers import workflow_copy
+
+
+def test_a_trees_recipe_reaches_its_jobs_and_its_damping_variant_only():
+    cfg = quick_config()
+    cfg["recipes"] = {
+        "medium": {
+            "d3dgs_wind": {"train": {"iterations": 60}, "settings": {"d3dgs": {"width": 32}}}
+        }
+    }
+    shared = job_spec(cfg, "d3dgs_wind", "single")
+    for tree in ("medium", "medium_damping"):
+        j = job_spec(cfg, "d3dgs_wind", "single", tree=tree)
+        assert j["train"]["iterations"] == 60 and j["settings"]["d3dgs"]["width"] == 32
+        # everything the recipe does not set is the shared job's
+        assert j["settings"]["d3dgs"]["depth"] == shared["settings"]["d3dgs"]["depth"]
+        assert j["train"]["lr"] == shared["train"]["lr"]
+    assert job_spec(cfg, "d3dgs_wind", "single", tree="dense") == shared
+    assert job_spec(cfg, "d3dgs", "single", tree="medium") == job_spec(cfg, "d3dgs", "single")
+    assert tree_recipe(cfg, None, "d3dgs_wind") == {}
+
+
+def test_a_misspelt_or_misplaced_recipe_is_refused_naming_its_key():
+    cfg = quick_config()
+    cfg["recipes"] = {
+        "medium": {
+            "d3dgs_wind": {"settings": {"d3dgs": {"widht": 32}}, "train": {"lr": {"deformm": 1}}},
+            "tree_of_life": {},
+        },
+        "oak": {"mlp": {}},
+    }
+    paths = {p for p, _ in recipes_are_known(cfg)}
+    assert paths == {
+        ("recipes", "medium", "d3dgs_wind", "settings", "d3dgs", "widht"),
+        ("recipes", "medium", "d3dgs_wind", "train", "lr", "deformm"),
+        ("recipes", "medium", "tree_of_life"),
+        ("recipes", "oak"),
+    }
+    cfg["recipes"] = {"medium": {"mlp": {"train": {"iterations": 20, "warmup": 25}}}}
+    assert [p for p, _ in warmup_below_iterations(cfg)] == [
+        ("recipes", "medium", "mlp", "train", "warmup")
+    ]
+
+
+def test_a_search_scored_never_is_refused():
+    cfg = quick_config()
+    cfg["search"]["every"] = cfg["train"]["iterations"]
+    cfg["search"]["trees"] = ["oak"]
+    assert {p for p, _ in search_is_runnable(cfg)} == {("search", "every"), ("search", "trees")}
+
+
+@pytest.mark.parametrize("model", ["mlp_wind", "d3dgs", "ours_chain"])
+def test_the_first_trial_is_the_configs_own_recipe(model):
+    """The space's parameters of a job, suggested back, rebuild that job exactly."""
+    base = job_spec(quick_config(), model, "single", tree="sparse")
+    space = space_of(model)
+    trial = optuna.trial.FixedTrial(space.params(trial_job(base, {})))
+    assert trial_job(base, space.suggest(trial, model)).to_dict() == base
+
+
+def test_a_model_without_a_recipe_to_search_is_refused():
+    with pytest.raises(ValueError, match="static"):
+        space_of("static")
+
+
+def test_search_scores_every_trial_on_its_held_out_window_frames_and_keeps_the_best(swaying):
+    cfg = quick_train_cfg(18, 4)
+    base = job_spec(cfg, "mlp_wind", "single", tree="sparse")
+    settings = SearchSettings(trials=3, every=6, startup=1, seed=3)
+    lines = []
+    trials, steps, best = run_search(swaying, base, settings, tree="sparse", log=lines.append)
+    assert len(trials) == 3 and len(lines) == 4
+    assert list(trials["number"]) == [0, 1, 2]
+    # trial 0 is the config's recipe: its objective is that job's held-out window loss (an
+    # independent training and scoring of the job)
+    own = fit(swaying, trial_job(base, {}), progress=False)
+    loss0, psnr0 = window_scorer(swaying, trial_job(base, {})).evaluate(own.model)
+    row0 = trials.iloc[0]
+    assert row0["state"] == "COMPLETE"
+    assert row0["holdout_loss"] == pytest.approx(loss0, rel=1e-6)
+    assert row0["holdout_psnr"] == pytest.approx(psnr0, rel=1e-6)
+    # the best recipe is the recipe of the complete trial of the lowest held-out loss
+    done = trials[trials["state"] == "COMPLETE"]
+    row = done.loc[done["holdout_loss"].idxmin()]
+    params = {k[len("params_") :]: row[k] for k in trials if k.startswith("params_")}
+    params = {k: (int(v) if k in ("width", "depth") else v) for k, v in params.items()}
+    fixed = optuna.trial.FixedTrial(params)
+    assert best == space_of("mlp_wind").suggest(fixed, "mlp_wind")
+    # every score a trial reported is in the steps, after the warm-up, every `every` iterations
+    # and at the end of a complete trial
+    assert set(steps["trial"]) == set(trials["number"])
+    ends = steps.groupby("trial")["iteration"].max()
+    assert (ends[done["number"]] == 18).all()
+    assert set(steps["iteration"]) <= {6, 12, 18}
+    pruned = trials[trials["state"] == "PRUNED"]
+    assert (ends[pruned["number"]] < 18).all()
+    text = recipe_yaml("sparse", "mlp_wind", trials, best)
+    assert text.startswith("# sparse mlp_wind: trial ") and "mlp_wind:" in text
+
+
+def test_a_trial_that_fails_stops_the_search_naming_it(swaying):
+    cfg = quick_train_cfg(24, 4)
+    base = copy.deepcopy(job_spec(cfg, "mlp", "single", tree="sparse"))
+    base["train"]["holdout_every"] = 0
+    with pytest.raises(ValueError, match="holdout_every"):
+        run_search(swaying, base, SearchSettings(2, 6, 1, 0), log=lambda _: None)
+
+
+def test_the_search_is_a_target_of_its_own_over_every_tree(tmp_path):
+    """``search`` plans one search per tree of the run and model of the config."""
+    wd = workflow_copy(tmp_path)
+    r = subprocess.run(
+        [sys.executable, "-m", "snakemake", "-n", "--cores", "1", "search"]
+        + ["--config", "profile=quick", "trees=[sparse,dense]"],
+        cwd=wd,
+        capture_output=True,
+        text=True,
+        timeout=300,
+    )
+    assert r.returncode == 0, r.stderr[-3000:] + r.stdout[-3000:]
+    planned = set(re.findall(r"output: results/search/(\w+)/(\w+)\.trials\.csv", r.stdout))
+    models = quick_config()["search"]["models"]
+    assert planned == {(t, m) for t in ("sparse", "dense") for m in models}
