@@ -79,7 +79,11 @@ rule studies:
     input:
         rules.speed_accuracy.output,
         rules.fit_curve.output,
-        expand(FIGURE, name=("fig_speed_accuracy", "fig_fit_curve"), ext=("pdf", "png")),
+        expand(
+            FIGURE,
+            name=("fig_speed_accuracy", "fig_fit_curve", "fig_fit_vs_extrapolation"),
+            ext=("pdf", "png"),
+        ),
         expand(TABLE, name="tab_parts_k", ext=("tex", "csv"))
         if "ours_chain" in PARTS_MODELS
         else [],

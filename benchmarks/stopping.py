@@ -202,6 +202,9 @@ def curves(a: argparse.Namespace) -> None:
                             seconds=time.perf_counter() - _t0,
                         )
                     )
+                    # a long curve is read while it runs: each score as it comes (without the
+                    # training loss, which the log gives at the end)
+                    print(",".join(str(v) for v in _rows[-1].values()), flush=True)
 
             truth_m = truth if is_reference(m) else None
             res = fit(obs, job, truth=truth_m, progress=False, name=m, hooks=(record,))

@@ -306,8 +306,9 @@ def test_fit_curve_passes_through_the_tables_numbers(run):
     for _, r in df[df["is_profile"]].iterrows():
         cell = fit[(fit["tree"] == fc["tree"]) & (fit["model"] == r["model"])]
         assert cell["fit_psnr_db"].item() == pytest.approx(r["fit"], abs=1e-4)
-    for ext in ("pdf", "png"):
-        assert (run / "results" / "figures" / f"fig_fit_curve.{ext}").stat().st_size > 1000
+    for name in ("fig_fit_curve", "fig_fit_vs_extrapolation"):
+        for ext in ("pdf", "png"):
+            assert (run / "results" / "figures" / f"{name}.{ext}").stat().st_size > 1000
 
 
 def test_a_second_seed_pairs_with_the_first(run, tmp_path):

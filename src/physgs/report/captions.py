@@ -171,6 +171,18 @@ FIGURES: tuple[Caption, ...] = (
         "one flat across budgets has converged.",
     ),
     Caption(
+        "fig_fit_vs_extrapolation",
+        "Fitting the window against extrapolating beyond it",
+        "Along each model's fit curve, one panel per tree: its gain over the static pose beyond "
+        "the window (time-split PSNR minus static's, dB) against its in-window fraction of the "
+        "true-motion ceiling's gain over static (trained frames); one line through its budgets "
+        "(seed means; each seed's points faint), the profile's budget starred. Dotted: the fit "
+        "bar; dashed: no gain over static.",
+        "A line falling to the right means fitting the window more made that model extrapolate "
+        "worse: the trade the paper's headline hinges on; a line rising to the right means the "
+        "opposite.",
+    ),
+    Caption(
         "testbed_{tree}_damping",
         "The {tree} damping testbed",
         "The damping benchmark's variant of the {tree} tree, drawn as its testbed (bones by "

@@ -14,7 +14,11 @@ from physgs.report.outputs.recovery import (
 )
 from physgs.report.outputs.studies import FIG_PARTS, TAB_PARTS, TAB_PARTS_K
 from physgs.report.outputs.testbed import TAB_TESTBED
-from physgs.report.outputs.trade import FIG_FIT_CURVE, FIG_SPEED_ACCURACY
+from physgs.report.outputs.trade import (
+    FIG_FIT_CURVE,
+    FIG_FIT_VS_EXTRAPOLATION,
+    FIG_SPEED_ACCURACY,
+)
 from physgs.report.outputs.tracks import FIG_TRACKS, TAB_TRACKS
 from physgs.report.outputs.views import (
     FIG_RESULTS,
@@ -51,6 +55,7 @@ OUTPUTS: dict[str, Output] = {
         FIG_STABILISATION,
         FIG_SPEED_ACCURACY,
         FIG_FIT_CURVE,
+        FIG_FIT_VS_EXTRAPOLATION,
     )
 }
 

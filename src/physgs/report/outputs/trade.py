@@ -1,10 +1,12 @@
 """The studies of the trade's figures (the `studies` target): fig_speed_accuracy (the
-speed-accuracy sweep beside the untrained null's chance level) and fig_fit_curve (each model's
-fit against its training budget), each drawn from its study's CSV (rules ``speed_accuracy`` and
-``fit_curve`` collect the points into ``results/tables/<study>.csv``)."""
+speed-accuracy sweep beside the untrained null's chance level), fig_fit_curve (each model's
+fit against its training budget) and fig_fit_vs_extrapolation (along each field's fit curve, its
+gain beyond the window against its in-window fit), each drawn from its study's CSV (rules
+``speed_accuracy`` and ``fit_curve`` collect the points into ``results/tables/<study>.csv``)."""
 
 from __future__ import annotations
 
+import numpy as np
 import pandas as pd
 
 from physgs.experiments.sweep import null_level
@@ -64,5 +66,91 @@ FIG_FIT_CURVE = Output(
     lambda plan, seeds: [("table", FIT_CURVE)],
     _fig_fit_curve,
     seeds="studies",  # its CSV holds the studies' seeds' points
+    in_report=_studies_only,
+)
+
+
+# ---- fig_fit_vs_extrapolation --------------------------------------------------------------
+def fit_vs_extrapolation(df: pd.DataFrame, static: str = "static") -> pd.DataFrame:
+    """Each fit-curve point's in-window fraction of the ceiling and its gain over the static pose
+    beyond the window.
+
+    Args:
+        df: the fit curve's CSV ([`fit_curve.collect`][physgs.experiments.fit_curve.collect]
+            with ``of_ceiling``): one row per tree, seed, model and budget.
+        static: the static pose's id.
+
+    Returns:
+        The rows of the models other than the static pose and the references that have both
+        numbers, with ``beyond_gain``: time-split PSNR minus the same tree's and seed's static
+        pose at the profile's budget (dB).
+    """
+    prof = df[df["is_profile"] & (df["model"] == static)].set_index(["tree", "seed"])["time"]
+    out = df[df["of_ceiling"].notna() & (df["model"] != static)].copy()
+    out["beyond_gain"] = [
+        r.time - prof.get((r.tree, r.seed), np.nan) for r in out.itertuples(index=False)
+    ]
+    return out[out["beyond_gain"].notna() & (out["of_ceiling"] < np.inf)]
+
+
+def draw_fit_vs_extrapolation(df: pd.DataFrame, outputs) -> None:
+    """One panel per tree: each model's gain over static beyond the window (dB) against its
+    in-window fraction of the ceiling's gain, one line through its budgets (seed means, the
+    seeds' own points faint), the profile's budget starred, the fit bar and zero gain marked.
+
+    Args:
+        df: [`fit_vs_extrapolation`][physgs.report.outputs.trade.fit_vs_extrapolation]'s rows.
+        outputs: the paths to write.
+    """
+    import matplotlib.pyplot as plt  # matplotlib: not for the workflow's planning imports
+
+    from physgs.models.registry import REFERENCE_NAMES, label
+    from physgs.report.figures import COLORS, save_figure
+    from physgs.report.thresholds import FIT_BAR
+
+    trees = list(dict.fromkeys(df["tree"]))
+    fig, axes = plt.subplots(1, len(trees), figsize=(4.6 * len(trees), 3.9), squeeze=False)
+    for ax, tree in zip(axes[0], trees):
+        t = df[(df["tree"] == tree) & ~df["model"].isin(REFERENCE_NAMES)]
+        for m, g in t.groupby("model", sort=False):
+            color = COLORS.get(m.partition("@")[0])
+            ax.plot(g["of_ceiling"], g["beyond_gain"], ".", color=color, alpha=0.3, ms=4)
+            mean = g.groupby("iterations")[["of_ceiling", "beyond_gain"]].mean()
+            ax.plot(
+                mean["of_ceiling"],
+                mean["beyond_gain"],
+                "-o",
+                color=color,
+                ms=3.5,
+                label=label(m.partition("@")[0]) + (" (window time)" if "@" in m else ""),
+            )
+            prof = g[g["is_profile"]][["of_ceiling", "beyond_gain"]].mean()
+            ax.plot(prof["of_ceiling"], prof["beyond_gain"], "*", color=color, ms=10)
+        ax.axhline(0.0, color="0.55", ls="--", lw=1.0)
+        ax.axvline(FIT_BAR, color="k", ls=":", lw=1.0)
+        ax.set_title(f"{tree} ({t['seed'].nunique()} seed(s))")
+        ax.set_xlabel("in-window fraction of the ceiling's gain")
+        ax.set_ylabel("gain over static beyond the window (dB)")
+        ax.grid(alpha=0.3)
+    axes[0][0].legend(fontsize=7)
+    fig.suptitle(
+        "Does fitting the window more make a field extrapolate worse? (line: the budgets, star: "
+        "the profile's; dotted: the fit bar; dashed: static)",
+        fontsize=9,
+    )
+    fig.tight_layout()
+    save_figure(fig, outputs)
+
+
+def _fig_fit_vs_extrapolation(path, settings, inputs, out):
+    draw_fit_vs_extrapolation(fit_vs_extrapolation(pd.read_csv(path("table", FIT_CURVE))), out)
+
+
+FIG_FIT_VS_EXTRAPOLATION = Output(
+    "fig_fit_vs_extrapolation",
+    "figure",
+    lambda plan, seeds: [("table", FIT_CURVE)],
+    _fig_fit_vs_extrapolation,
+    seeds="studies",
     in_report=_studies_only,
 )
