@@ -93,3 +93,51 @@ def test_stability_guard_names_the_fix():
     integrate(om, z, z, gusty_wind(10), 6.0, DT, n)  # no error
     with pytest.raises(ValueError, match="omega must be > 0"):
         integrate(torch.tensor([-1.0]), z[:1], z[:1], gusty_wind(10), 6.0, DT, 1)
+
+
+# ---- the closed-form path (backend "lti": the GPU's) --------------------------------------------
+@pytest.mark.parametrize("substeps", [1, 2, 3])
+def test_lti_is_rk4s_own_scheme_against_lsim_and_the_reference(substeps):
+    """The closed form solves the same discrete RK4 scheme: it equals the plain-torch RK4 to
+    rounding (and so sits at RK4's own distance from scipy's exact lsim), an over-damped part
+    included, for T not a power of two."""
+    wind = gusty_wind(203, seed=3)
+    om, ze, g = (
+        t64([2 * np.pi * 0.4, 2 * np.pi * 1.2, 6.0]),
+        t64([0.03, 0.08, 1.4]),
+        t64([0.05] * 3),
+    )
+    lti = integrate(om, ze, g, wind, 6.0, DT, substeps, backend="lti")
+    ref = integrate(om, ze, g, wind, 6.0, DT, substeps, backend="reference")
+    assert lti.shape == (3, 203) and torch.all(lti[:, 0] == 0)
+    assert torch.allclose(lti, ref, rtol=0, atol=1e-13 * float(ref.abs().max()))
+    exact = np.stack([wind_lsim(o, z, 0.05, wind, 6.0, DT) for o, z in zip(om.numpy(), ze.numpy())])
+    rk4_err = np.abs(ref.numpy() - exact).max()
+    assert np.abs(lti.numpy() - exact).max() == pytest.approx(rk4_err, rel=1e-6, abs=1e-15)
+
+
+def test_lti_gradients_are_autograds_through_the_reference():
+    wind = gusty_wind(90, seed=4)
+    weights = torch.randn(3, 90, dtype=torch.float64, generator=torch.Generator().manual_seed(2))
+    grads = {}
+    for backend in ("lti", "reference"):
+        p = [
+            t64(a).requires_grad_()
+            for a in ([3.0, 7.0, 11.0], [0.05, 0.1, 0.3], [0.01, -0.02, 0.03])
+        ]
+        (integrate(*p, wind, 6.0, DT, 2, backend=backend) * weights).sum().backward()
+        grads[backend] = [q.grad for q in p]
+    for a, b in zip(grads["lti"], grads["reference"]):
+        assert torch.allclose(a, b, rtol=1e-10, atol=1e-14)
+
+
+def test_auto_takes_numba_on_the_cpu_and_keeps_the_dtype():
+    om, ze, g = torch.tensor([5.0, 9.0]), torch.tensor([0.1, 0.2]), torch.tensor([0.1, 0.1])
+    wind = gusty_wind(50)
+    auto = integrate(om, ze, g, wind, 6.0, DT, 2, backend="auto")
+    assert torch.equal(auto, integrate(om, ze, g, wind, 6.0, DT, 2, backend="fast"))
+    lti = integrate(om, ze, g, wind, 6.0, DT, 2, backend="lti")
+    assert lti.dtype == torch.float32
+    assert torch.allclose(lti, auto, rtol=0, atol=1e-5 * float(auto.abs().max()))
+    with pytest.raises(ValueError, match="backend must be one of"):
+        integrate(om, ze, g, wind, 6.0, DT, 2, backend="gpu")

@@ -169,7 +169,9 @@ class BlindOscillatorPrior(OscillatorPrior):
             m = max(1, min(int(upto), m))
         om, ze, g = self.omega.double(), self.zeta.double(), self.gain.double()
         r0, r1 = (
-            integrate_forcing(om, ze, g, u, self.dt, self.substeps, guard=self.guard)
+            integrate_forcing(
+                om, ze, g, u, self.dt, self.substeps, guard=self.guard, backend="auto"
+            )
             for u in (self.unit0[:m], self.unit1[: m + 1])
         )  # [K, m] the response to a unit sample 0, [K, m + 1] to a unit sample 1
         theta = causal_convolve(r0, r1[:, 1:], self.forcing()[:m]).to(self.omega_raw.dtype)

@@ -12,6 +12,13 @@ Two paths compute the same numbers:
   the exact derivative of the discrete scheme, so gradients match autograd through the reference
   to rounding. Wrapped in a torch.autograd.Function.
 - ``backend="reference"``: plain torch operations, differentiated by autograd (slow; for tests).
+- ``backend="lti"``: the same discrete scheme solved in closed form on any device. The system is
+  linear and time-invariant, so one sample interval of RK4 (``substeps`` steps, forcing linear
+  between samples) is x_{j+1} = A x_j + G0 u_j + G1 u_{j+1} with per-part 2x2 A and 2-vectors
+  G0, G1 that RK4's stage algebra gives exactly; theta is then a causal convolution of the forcing
+  with e1' A^k G0 and e1' A^k G1 (powers by doubling, convolution by FFT), differentiated by
+  autograd. No loop over samples and no host copy: the path a GPU training takes.
+- ``backend="auto"``: ``fast`` for parameters on the CPU, ``lti`` elsewhere.
 """
 
 from __future__ import annotations
@@ -220,10 +227,75 @@ def _reference(omega, zeta, gain, u, dt, substeps):
     return torch.stack(out, dim=1)
 
 
+def _lti(omega, zeta, gain, u, dt, substeps):
+    """RK4's discrete scheme as a linear recurrence, solved by FFT convolution. u: [T] tensor on
+    omega's device and dtype -> theta [K, T]."""
+    K, T = omega.shape[0], u.shape[0]
+    h = dt / substeps
+    zero = torch.zeros_like(omega)
+    # N = h M for the state (theta, theta'), M = [[0, 1], [-omega^2, -2 zeta omega]]
+    N = torch.stack(
+        [
+            torch.stack([zero, zero + h], -1),
+            torch.stack([-h * omega**2, -2 * h * zeta * omega], -1),
+        ],
+        -2,
+    )  # [K, 2, 2]
+    eye = torch.eye(2, dtype=omega.dtype, device=omega.device).expand(K, 2, 2)
+    N2 = N @ N
+    N3 = N2 @ N
+    P = eye + N + N2 / 2 + N3 / 6 + N3 @ N / 24  # one step on the state
+    # one step's response to the forcing at its start (Ra) and end (Rc) for a unit gain (the
+    # mid-step stages read their mean): h/6 (k1 + 2 k2 + 2 k3 + k4)'s forcing terms
+    b = torch.stack([zero, torch.ones_like(omega)], -1)[..., None]  # [K, 2, 1]
+    Ra = (h / 6 * (3 * eye + 2 * N + 0.75 * N2 + 0.25 * N3) @ b)[..., 0]  # [K, 2]
+    Rc = (h / 6 * (3 * eye + N + 0.25 * N2) @ b)[..., 0]
+    A, G0, G1 = eye, torch.zeros_like(Ra), torch.zeros_like(Ra)
+    for m in range(substeps):  # the forcing at substep m's ends, between samples j and j + 1
+        a0, c0 = 1 - m / substeps, 1 - (m + 1) / substeps
+        G0 = (P @ G0[..., None])[..., 0] + a0 * Ra + c0 * Rc
+        G1 = (P @ G1[..., None])[..., 0] + (1 - a0) * Ra + (1 - c0) * Rc
+        A = P @ A
+    L = T - 1
+    if L == 0:
+        return omega.new_zeros((K, 1))
+    rows = eye[:, :1, :]  # e1' A^k for k < 1: [K, 1, 2]
+    step = A  # A^(rows' length)
+    while rows.shape[1] < L:  # doubling: e1' A^(k + n) = (e1' A^k) A^n
+        rows = torch.cat([rows, rows @ step], 1)
+        step = step @ step
+    rows = rows[:, :L]  # [K, L, 2]
+    a = (rows * G0[:, None, :]).sum(-1)  # [K, L] the response to u_j, k samples on
+    c = (rows * G1[:, None, :]).sum(-1)  # [K, L] the response to u_{j+1}
+    n = 2 * L
+    conv = torch.fft.irfft(
+        torch.fft.rfft(a, n=n) * torch.fft.rfft(u[:L], n=n)
+        + torch.fft.rfft(c, n=n) * torch.fft.rfft(u[1:], n=n),
+        n=n,
+    )[:, :L]  # theta at samples 1 .. T-1
+    return gain[:, None] * torch.cat([omega.new_zeros((K, 1)), conv], 1)
+
+
+#: the integrators ``integrate`` and ``integrate_forcing`` accept
+BACKENDS = ("fast", "reference", "lti", "auto")
+
+
+def _resolve(backend: str, omega: torch.Tensor) -> str:
+    """``auto``: numba for parameters on the CPU, the closed form elsewhere."""
+    if backend == "auto":
+        return "fast" if omega.device.type == "cpu" else "lti"
+    return backend
+
+
+def _home(backend: str, omega: torch.Tensor) -> torch.device:
+    """Where the forcing is kept: on omega's device for the closed form, else the host."""
+    return omega.device if backend == "lti" else torch.device("cpu")
+
+
 def _check_args(omega, zeta, gain, dt, substeps, backend) -> None:
     """The shape, step and backend checks ``integrate`` and ``integrate_forcing`` share."""
-    if backend not in ("fast", "reference"):
-        raise ValueError(f"integrate: backend must be 'fast' or 'reference', got {backend!r}")
+    if backend not in BACKENDS:
+        raise ValueError(f"integrate: backend must be one of {BACKENDS}, got {backend!r}")
     if not (omega.ndim == 1 and omega.shape == zeta.shape == gain.shape):
         raise ValueError(
             "integrate: omega, zeta and gain must be 1-D tensors of one length K; got shapes "
@@ -262,7 +334,8 @@ def integrate(
         dt: seconds between wind samples.
         substeps: RK4 steps per sample.
         guard: bound on |lambda| * h, rad.
-        backend: ``"fast"`` (numba with forward sensitivities) or ``"reference"`` (torch autograd).
+        backend: ``"fast"`` (numba with forward sensitivities), ``"reference"`` (torch autograd),
+            ``"lti"`` (closed form on omega's device) or ``"auto"`` (fast on the CPU, else lti).
 
     Returns:
         theta [K, T], rad, dtype of omega; theta[:, j] at sample j.
@@ -274,7 +347,9 @@ def integrate(
             wind that is not a finite [T] series, or an unknown backend.
     """
     _check_args(omega, zeta, gain, dt, substeps, backend)
-    w = torch.as_tensor(wind).detach().to("cpu", torch.float64)
+    backend = _resolve(backend, omega)
+    # the wind stays where its integrator runs: no host copy on a GPU
+    w = torch.as_tensor(wind).detach().to(_home(backend, omega), torch.float64)
     if w.ndim != 1 or w.shape[0] < 1 or not torch.isfinite(w).all():
         raise ValueError(
             f"integrate: wind must be a finite 1-D series [T] in m/s; got shape {tuple(w.shape)}"
@@ -312,7 +387,7 @@ def integrate_forcing(
         dt: seconds between samples.
         substeps: RK4 steps per sample.
         guard: bound on |lambda| * h, rad.
-        backend: ``"fast"`` or ``"reference"``.
+        backend: as ``integrate``.
         _checked: the arguments were already checked (``integrate`` passes True).
 
     Returns:
@@ -324,7 +399,8 @@ def integrate_forcing(
     """
     if not _checked:
         _check_args(omega, zeta, gain, dt, substeps, backend)
-    u = torch.as_tensor(u).detach().to("cpu", torch.float64)
+    backend = _resolve(backend, omega)
+    u = torch.as_tensor(u).detach().to(_home(backend, omega), torch.float64)
     if u.ndim != 1 or u.shape[0] < 1 or not torch.isfinite(u).all():
         raise ValueError(
             f"integrate: the forcing must be a finite 1-D series [T]; got {tuple(u.shape)}"
@@ -359,4 +435,7 @@ def integrate_forcing(
         )
     if backend == "reference":
         return _reference(omega, zeta, gain, u.to(omega.dtype), float(dt), int(substeps))
+    if backend == "lti":
+        u = u.to(device=omega.device, dtype=omega.dtype)
+        return _lti(omega, zeta, gain, u, float(dt), int(substeps))
     return _RK4Sensitivity.apply(omega, zeta, gain, u.numpy(), float(dt), int(substeps))

@@ -409,6 +409,7 @@ class OscillatorPrior(BaseModel):
             self.dt,
             self.substeps,
             guard=self.guard,
+            backend="auto",  # numba on the CPU, the closed form on a GPU (no host round trip)
         )  # [K, upto]
         if not bool(self.frozen.any()):
             return theta
