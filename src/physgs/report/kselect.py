@@ -14,7 +14,7 @@ import pandas as pd
 
 from physgs.models.registry import spec_of
 from physgs.report import latex
-from physgs.report.tables import Table, _check, _seeds, _tree_index
+from physgs.report.tables import Table, _seeds, _tree_index
 
 ROWS = (("single", "fixed $K$"), ("auto", "chosen $K$"))
 
@@ -72,12 +72,10 @@ def tab_kselect(
             rest mean +- sd over seeds; the CSV also holds each seed's cost against the fixed
             K, ``cost_x`` = (train_s + select_s) / train_s of the fixed-K row.
     """
-    seeds = _seeds(per_seed, "tab_kselect")
+    keys = [(t, m, c) for t in trees for m in models for c, _ in ROWS]
+    seeds = _seeds(per_seed, "tab_kselect", keys)
     recs = []
     for s in seeds:
-        _check(
-            [(t, m, c) for t in trees for m in models for c, _ in ROWS], per_seed[s], "tab_kselect"
-        )
         for t in trees:
             for m in models:
                 fixed_s = float(per_seed[s][(t, m, "single")]["train_s"])

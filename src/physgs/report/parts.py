@@ -22,7 +22,7 @@ from physgs.experiments.kmatch import matched_k
 from physgs.models.registry import label
 from physgs.report import latex
 from physgs.report import seeds as seedstats
-from physgs.report.tables import Table, _check, _seeds, tree_label
+from physgs.report.tables import Table, _seeds, tree_label
 
 COLUMNS = (
     "purity",
@@ -121,11 +121,10 @@ def tab_parts(
     Returns:
         The [`Table`][physgs.report.tables.Table].
     """
-    seeds = _seeds(per_seed, "tab_parts")
     keys = [(t, m, c) for t in trees for c in configs for m in models]
+    seeds = _seeds(per_seed, "tab_parts", keys)
     recs = []
     for s in seeds:
-        _check(keys, per_seed[s], f"tab_parts (seed {s})")
         for t, m, c in keys:
             recs.append(
                 {
@@ -277,10 +276,9 @@ def tab_parts_k(
     Returns:
         The [`Table`][physgs.report.tables.Table].
     """
-    seeds = _seeds(per_seed, "tab_parts_k")
+    seeds = _seeds(per_seed, "tab_parts_k", trees)
     recs = []
     for s in seeds:
-        _check(trees, per_seed[s], f"tab_parts_k (seed {s})")
         for t in trees:
             r = per_seed[s][t]
             chain = {int(k): float(v) for k, v in r["chain"].items()}

@@ -107,7 +107,8 @@ def _check(keys: Sequence, have: Mapping, what: str) -> None:
 # difference to the runner-up is decided.
 
 
-def _seeds(per_seed: Mapping[int, Mapping], what: str) -> list[int]:
+def _seeds(per_seed: Mapping[int, Mapping], what: str, keys: Sequence = ()) -> list[int]:
+    """The training seeds of ``per_seed``, sorted, each checked to hold every one of ``keys``."""
     if not per_seed:
         raise ValueError(f"{what}: no seeds given")
     bad = [s for s in per_seed if not isinstance(s, (int, np.integer))]
@@ -116,7 +117,10 @@ def _seeds(per_seed: Mapping[int, Mapping], what: str) -> list[int]:
             f"{what}: results must be keyed by training seed first ({{seed: {{...}}}}), "
             f"got key {bad[0]!r}"
         )
-    return sorted(int(s) for s in per_seed)
+    seeds = sorted(int(s) for s in per_seed)
+    for s in seeds:
+        _check(keys, per_seed[s], f"{what} (seed {s})")
+    return seeds
 
 
 def _best_cols(V: np.ndarray, rows: np.ndarray, higher: bool = True) -> np.ndarray:
@@ -185,13 +189,7 @@ def tab_psnr(
         The [`Table`][physgs.report.tables.Table].
     """
     fmt = f".{int(digits)}f"
-    seeds = _seeds(per_seed, "tab_psnr")
-    for s in seeds:
-        _check(
-            [(t, m) for t in trees for m in (*models, *references)],
-            per_seed[s],
-            f"tab_psnr (seed {s})",
-        )
+    seeds = _seeds(per_seed, "tab_psnr", [(t, m) for t in trees for m in (*models, *references)])
     learned = [m for m in models if spec_of(m).role == "field"]
     priors = [m for m in models if spec_of(m).role == "prior"]
     cols = [f"{t}_{sp}" for t in trees for sp in ("view", "time")]
@@ -298,11 +296,10 @@ def tab_fit(
     Returns:
         The [`Table`][physgs.report.tables.Table].
     """
-    seeds = _seeds(per_seed, "tab_fit")
+    seeds = _seeds(per_seed, "tab_fit", [(t, m) for t in trees for m in (*models, reference)])
     recs = []
     for s in seeds:
         rows = per_seed[s]
-        _check([(t, m) for t in trees for m in (*models, reference)], rows, f"tab_fit (seed {s})")
         for t in trees:
             ceil, stat = rows[(t, reference)]["fit"], rows[(t, static)]["fit"]
             hceil, hstat = rows[(t, reference)]["heldout"], rows[(t, static)]["heldout"]
@@ -635,11 +632,10 @@ def tab_transfer(
     Returns:
         The [`Table`][physgs.report.tables.Table].
     """
-    seeds = _seeds(per_seed, "tab_transfer")
+    seeds = _seeds(per_seed, "tab_transfer", [(t, m) for t in trees for m in models])
     rows = []
     for s in seeds:
         S = per_seed[s]
-        _check([(t, m) for t in trees for m in models], S, f"tab_transfer (seed {s})")
         for split, key in (("train", "train_c"), ("beyond", "beyond_c")):
             for t in trees:
                 for c in range(1, len(conditions)):
@@ -721,11 +717,10 @@ def tab_margin(
     Returns:
         The [`Table`][physgs.report.tables.Table].
     """
-    seeds = _seeds(per_seed, "tab_margin")
+    seeds = _seeds(per_seed, "tab_margin", [(t, m) for t in trees for m in (*priors, baseline)])
     rows = []
     for s in seeds:
         S = per_seed[s]
-        _check([(t, m) for t in trees for m in (*priors, baseline)], S, f"tab_margin (seed {s})")
         for p in priors:
             for t in trees:
                 r = {"seed": s, "model": p, "tree": t, "bones": bones[t]}

@@ -23,7 +23,7 @@ import pandas as pd
 
 from physgs.models.registry import recovery_label
 from physgs.report import latex
-from physgs.report.tables import TRACKS, Table, _check, _seeds, condition_label, tree_label
+from physgs.report.tables import TRACKS, Table, _seeds, condition_label, tree_label
 
 #: the method id of the tracks control's rows in tab_recovery and tab_damping (column ``method``)
 METHOD = TRACKS
@@ -132,11 +132,10 @@ def tab_tracks(
     Returns:
         The [`Table`][physgs.report.tables.Table].
     """
-    seeds = _seeds(per_seed, "tab_tracks")
     keys = [(t, c) for t in trees for c in configs]
+    seeds = _seeds(per_seed, "tab_tracks", keys)
     recs = []
     for s in seeds:
-        _check(keys, per_seed[s], f"tab_tracks (seed {s})")
         for t, c in keys:
             recs.append(
                 {
