@@ -19,7 +19,7 @@ import pandas as pd
 
 from physgs.report import latex
 from physgs.report import seeds as seedstats
-from physgs.report.tables import MethodRows, Table, _check, _seeds, _who, interval_cells, tree_label
+from physgs.report.tables import MethodRows, Table, _method_seeds, _who, interval_cells, tree_label
 from physgs.testbed.variant import DAMPING, FAITHFUL
 
 VARIANTS = (FAITHFUL, DAMPING)
@@ -65,17 +65,11 @@ def tab_damping(
         KeyError: when a seed lacks a record.
     """
     methods = {m: mr for m, mr in methods.items() if mr.configs}
-    seeds = _seeds(next(iter(methods.values())).per_seed if methods else {}, "tab_damping")
     block = [(c, m) for m, mr in methods.items() for c in mr.configs]
     keys = [(t, v, c, m) for t in trees for v in VARIANTS for c, m in block]
+    seeds = _method_seeds(methods, "tab_damping", keys)
     rows = []
     for s in seeds:
-        for m, mr in methods.items():
-            _check(
-                [k[:3] for k in keys if k[3] == m],
-                mr.per_seed.get(s, {}),
-                f"tab_damping ({_who(m)}, seed {s})",
-            )
         for t, v, c, method in keys:
             rec = methods[method].per_seed[s][(t, v, c)]
             sc, nl = rec.damping_scores, rec.damping_null

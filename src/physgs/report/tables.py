@@ -449,16 +449,10 @@ def recovery_table(
         The [`Table`][physgs.report.tables.Table].
     """
     methods = {m: mr for m, mr in methods.items() if mr.configs}
-    seeds = _seeds(next(iter(methods.values())).per_seed if methods else {}, name)
     keys = [(t, c, m) for t in trees for m, mr in methods.items() for c in mr.configs]
+    seeds = _method_seeds(methods, name, keys)
     rows = []
     for s in seeds:
-        for m, mr in methods.items():
-            _check(
-                [k[:2] for k in keys if k[2] == m],
-                mr.per_seed.get(s, {}),
-                f"{name} ({_who(m)}, seed {s})",
-            )
         for t, c, method in keys:
             rec, nl = methods[method].per_seed[s][(t, c)]
             m = rec.match
@@ -523,6 +517,17 @@ def recovery_table(
         r"counts)." + "".join(mr.note for mr in methods.values()) + latex.seed_note(len(seeds))
     )
     return Table(name, df, latex.render(cells, cap, "tab:" + name.removeprefix("tab_")))
+
+
+def _method_seeds(methods: Mapping[str, MethodRows], what: str, keys: Sequence[tuple]) -> list[int]:
+    """The training seeds of a recovery table (its first method's), each method checked to hold
+    its ``keys`` (``(..., method)``) at every seed."""
+    seeds = _seeds(next(iter(methods.values())).per_seed if methods else {}, what)
+    for s in seeds:
+        for m, mr in methods.items():
+            have = mr.per_seed.get(s, {})
+            _check([k[:-1] for k in keys if k[-1] == m], have, f"{what} ({_who(m)}, seed {s})")
+    return seeds
 
 
 def _who(method: str) -> str:
