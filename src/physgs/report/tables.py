@@ -145,18 +145,6 @@ PSNR_MINUS = "-"
 BEST_FIELD = "best_field"
 
 
-def psnr_row_label(row_id: str) -> str:
-    """The label of one side of a tab_psnr difference row: a model's, or the best field's.
-
-    Args:
-        row_id: a model id or ``BEST_FIELD``.
-
-    Returns:
-        Its label.
-    """
-    return "best learned field" if row_id == BEST_FIELD else label(row_id)
-
-
 def tab_psnr(
     per_seed: Mapping[int, Mapping[tuple[str, str], Mapping[str, float]]],
     trees: Sequence[str],
@@ -222,7 +210,9 @@ def tab_psnr(
     first = latex.rows(df)
     ref, diff = first["reference"].to_numpy(bool), first["difference"].to_numpy(bool)
     names = [
-        " $-$ ".join(psnr_row_label(x) for x in m.split(PSNR_MINUS))
+        " $-$ ".join(
+            "best learned field" if x == BEST_FIELD else label(x) for x in m.split(PSNR_MINUS)
+        )
         if d
         else (rf"\emph{{{label(m)}}}" if r else label(m))
         for m, r, d in zip(first["model"], ref, diff)
