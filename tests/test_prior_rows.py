@@ -290,6 +290,6 @@ def test_tab_damping_sets_each_prior_beside_ours_on_both_testbeds():
     # |1.1 zeta - zeta| / zeta = 10 %, |1.02 zeta - zeta| / zeta = 2 %: by hand
     np.testing.assert_allclose(df[df.method == "ours"].rel_err_pct, 10.0)
     np.testing.assert_allclose(df[df.method == "ours_chain"].rel_err_pct, 2.0)
-    assert f"{label('ours_chain')}, B" in tab.tex and r"\multirow{8}{*}" in tab.tex
+    assert f"{label('ours_chain')}, B" in tab.tex and r"\multirow[c]{8}{*}" in tab.tex
     with pytest.raises(KeyError, match="ours_chain"):
         tab_damping(methods({0: {}}), ["sparse"], {"sparse": 22})

@@ -397,3 +397,27 @@ def test_fit_row_splits_trained_and_held_out_frames(tmp_path):
     assert r["fit"] == pytest.approx(10.0) and r["heldout"] == pytest.approx(20.0)
     assert r["train_s"] == 42.5 and r["view"] == pytest.approx(7.0)
     assert r["iterations"] == 3  # the loss log's rows: iterations 0, 1, 2
+
+
+def test_render_is_one_booktabs_table_grouped_and_bold_where_asked():
+    from physgs.report import latex
+
+    cells = pd.DataFrame(
+        {("A", "x"): ["1", "2"], ("A", "y"): ["3", "4"]},
+        index=pd.MultiIndex.from_tuples([("g", "r1"), ("g", "r2")]),
+    )
+    tex = latex.render(cells, "Cap.", "tab:t", bold=np.array([[False, True], [False, False]]))
+    assert tex.count(r"\toprule") == tex.count(r"\midrule") == tex.count(r"\bottomrule") == 1
+    assert r"\caption{Cap.}" in tex and r"\label{tab:t}" in tex
+    assert r"\multicolumn{2}{c}{A}" in tex  # the heading spans its two columns
+    assert r"\multirow[c]{2}{*}{g} & r1 & 1 & \textbf{3} \\" in tex
+    assert " & r2 & 2 & 4 \\\\" in tex  # the group's label once; nothing else bold
+    assert "\\textbf{" not in latex.render(cells, "Cap.", "tab:t")
+
+
+def test_cells_summarise_each_row_over_the_seed_blocks():
+    from physgs.report import latex
+
+    df = pd.DataFrame({"seed": [0, 0, 1, 1], "x": [1.0, np.nan, 3.0, np.nan]})
+    assert latex.cells(df, "x", ".1f", r"\%") == [r"2.0 $\pm$ 1.4\%", "--"]  # sd of (1, 3)
+    assert latex.cells(df, "x", ".0f", cell=latex.mean, scale=10) == ["20", "--"]

@@ -311,7 +311,7 @@ def test_tab_damping_adds_the_tracks_rows_with_their_own_scores():
     np.testing.assert_allclose(df[df.method == "ours"].rel_err_pct, 10.0)
     np.testing.assert_allclose(df[df.method == "tracks"].rel_err_pct, 50.0)
     assert list(df[df.seed == 0].method) == ["ours", "ours", "tracks"] * 2
-    assert r"\multirow{6}{*}" in tab.tex and r"\emph{2D tracks}, A" in tab.tex
+    assert r"\multirow[c]{6}{*}" in tab.tex and r"\emph{2D tracks}, A" in tab.tex
     none = {
         s: {k: dataclasses.replace(r, damping_scores=None) for k, r in d.items()}
         for s, d in mine.items()

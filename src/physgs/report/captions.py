@@ -3,8 +3,8 @@ seeds it draws.
 
 What a figure shows and how to read it is written here once per figure (it describes the drawing
 code, not a result); which seeds it draws comes from the output's declaration
-(``physgs.report.outputs.OUTPUTS[name].seeds``; ``SCOPES`` for the figures the workflow draws
-outside the report's outputs) and the record's stamp, so a caption never retypes a number of the
+(``physgs.report.outputs.OUTPUTS[name].seeds``; the caption's own ``seeds`` for the figures the
+workflow draws outside the report's outputs) and the record's stamp, so a caption never retypes a number of the
 run. ``FIGURES`` orders the figures as a results section reads them: the headline comparison
 first, the testbed last.
 """
@@ -27,12 +27,15 @@ class Caption:
         title: a few words naming the figure.
         shows: what is drawn, every colour, band, line and unit.
         read: how to read it: what a reader looks for.
+        seeds: which training seeds it draws when it is not one of the report's outputs
+            (``physgs.report.outputs.base.SEEDS``; the testbed figures: ``none``).
     """
 
     pattern: str
     title: str
     shows: str
     read: str
+    seeds: str = "first"
 
     def match(self, name: str) -> str | None:
         """The tree of ``name`` when it is this figure ('' for a figure of all trees).
@@ -144,6 +147,7 @@ FIGURES: tuple[Caption, ...] = (
         "from two unseen views. The title line gives the testbed's statistics.",
         "A wide spread of frequencies is what a recovery must resolve; bones under 1 px of motion "
         "cannot be recovered from the video.",
+        seeds="none",
     ),
     Caption(
         "fig_speed_accuracy",
@@ -189,13 +193,9 @@ FIGURES: tuple[Caption, ...] = (
         "natural frequency in Hz, the frequency histogram, three bones' true angles in deg over "
         "time in s, renders).",
         "The same reading as the testbed's; this variant is the one damping is recovered on.",
+        seeds="none",
     ),
 )
-
-#: Which seeds a figure draws when it is not one of the report's outputs: the testbed figures
-#: draw the testbed (no training seed).
-SCOPES = {"testbed_{tree}": "none", "testbed_{tree}_damping": "none"}
-SCOPES_DEFAULT = "first"
 
 
 def find(name: str) -> tuple[int, Caption, str]:
@@ -230,11 +230,9 @@ def scope(caption: Caption) -> str:
         caption: the figure's caption.
 
     Returns:
-        The output's declared scope, or ``SCOPES``' for a figure drawn outside the outputs.
+        The output's declared scope, or the caption's for a figure drawn outside the outputs.
     """
-    if caption.pattern in OUTPUTS:
-        return OUTPUTS[caption.pattern].seeds
-    return SCOPES.get(caption.pattern, SCOPES_DEFAULT)
+    return OUTPUTS[caption.pattern].seeds if caption.pattern in OUTPUTS else caption.seeds
 
 
 def seeds_phrase(what: str, seeds: Sequence[int]) -> str:

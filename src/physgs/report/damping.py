@@ -15,21 +15,11 @@ from __future__ import annotations
 
 from typing import Mapping, Sequence
 
-import numpy as np
 import pandas as pd
 
+from physgs.report import latex
 from physgs.report import seeds as seedstats
-from physgs.report.tables import (
-    MethodRows,
-    Table,
-    _by_seed,
-    _check,
-    _seeds,
-    _who,
-    _wrap,
-    interval_cells,
-    tree_label,
-)
+from physgs.report.tables import MethodRows, Table, _method_seeds, _who, interval_cells, tree_label
 from physgs.testbed.variant import DAMPING, FAITHFUL
 
 VARIANTS = (FAITHFUL, DAMPING)
@@ -75,17 +65,11 @@ def tab_damping(
         KeyError: when a seed lacks a record.
     """
     methods = {m: mr for m, mr in methods.items() if mr.configs}
-    seeds = _seeds(next(iter(methods.values())).per_seed if methods else {}, "tab_damping")
     block = [(c, m) for m, mr in methods.items() for c in mr.configs]
     keys = [(t, v, c, m) for t in trees for v in VARIANTS for c, m in block]
+    seeds = _method_seeds(methods, "tab_damping", keys)
     rows = []
     for s in seeds:
-        for m, mr in methods.items():
-            _check(
-                [k[:3] for k in keys if k[3] == m],
-                mr.per_seed.get(s, {}),
-                f"tab_damping ({_who(m)}, seed {s})",
-            )
         for t, v, c, method in keys:
             rec = methods[method].per_seed[s][(t, v, c)]
             sc, nl = rec.damping_scores, rec.damping_null
@@ -116,49 +100,30 @@ def tab_damping(
                 }
             )
     df = pd.DataFrame(rows)
-    V = {c: _by_seed(df, c, len(seeds)) for c in COLUMNS}
-    fmt, pct = f".{int(digits)}f", lambda x: x if x == "--" else x + r"\%"
-    lines = [
-        "  \\begin{tabular}{lllccccccc}",
-        "    \\toprule",
-        r"    & & & & \multicolumn{3}{c}{Med.\ rel.\ err.\ of $\hat\zeta$} & "
-        r"\multicolumn{2}{c}{corr($\log\hat\zeta$, $\log\zeta$)} & $\hat\gamma\propto\hat\omega^p$ \\",
-        r"    \cmidrule(lr){5-7}\cmidrule(lr){8-9}",
-        r"    Tree & Testbed & Config & Trusted & Trained & Null & Trained $-$ null & Trained "
-        r"& Null & $p$ (truth) \\",
-        "    \\midrule",
-    ]
-    per_tree = 2 * len(block)
-    for i in range(len(keys)):
-        t, v, c, method = keys[i]
-        head = (
-            rf"\multirow{{{per_tree}}}{{*}}{{{tree_label(t, bones[t])}}}"
-            if i % per_tree == 0
-            else ""
-        )
-        p = seedstats.pm(V["gamma_exponent"][:, i], ".2f")
-        p_true = np.nanmean(V["gamma_exponent_true"][:, i])
-        lines.append(
-            "    "
-            + " & ".join(
-                [
-                    head,
-                    v if i % len(block) == 0 else "",
-                    methods[method].row_label(c),
-                    seedstats.pm(V["trusted"][:, i], ".1f"),  # a mean count: one decimal
-                    pct(seedstats.pm(V["rel_err_pct"][:, i], ".0f")),
-                    pct(seedstats.pm(V["null_rel_err_pct"][:, i], ".0f")),
-                    seedstats.difference(V["trained_minus_null_pp"][:, i], ".0f"),
-                    seedstats.pm(V["log_corr"][:, i], fmt),
-                    seedstats.pm(V["null_log_corr"][:, i], fmt),
-                    f"{p} ({p_true:.2f})" if np.isfinite(p_true) else p,
-                ]
-            )
-            + r" \\"
-        )
-        if (i + 1) % per_tree == 0 and i + 1 < len(keys):
-            lines.append("    \\midrule")
-    lines += ["    \\bottomrule", "  \\end{tabular}", ""]
+    fmt = f".{int(digits)}f"
+    p = latex.cells(df, "gamma_exponent", ".2f")
+    p_true = latex.cells(df, "gamma_exponent_true", ".2f", cell=latex.mean)
+    err = r"Med.\ rel.\ err.\ of $\hat\zeta$"
+    corr = r"corr($\log\hat\zeta$, $\log\zeta$)"
+    cells = pd.DataFrame(
+        {
+            ("", "Trusted"): latex.cells(df, "trusted", ".1f"),  # a mean count: one decimal
+            (err, "Trained"): latex.cells(df, "rel_err_pct", ".0f", r"\%"),
+            (err, "Null"): latex.cells(df, "null_rel_err_pct", ".0f", r"\%"),
+            (err, r"Trained $-$ null"): latex.cells(
+                df, "trained_minus_null_pp", ".0f", cell=seedstats.difference
+            ),
+            (corr, "Trained"): latex.cells(df, "log_corr", fmt),
+            (corr, "Null"): latex.cells(df, "null_log_corr", fmt),
+            (r"$\hat\gamma\propto\hat\omega^p$", "$p$ (truth)"): [
+                a if b == "--" else f"{a} ({b})" for a, b in zip(p, p_true)
+            ],
+        },
+        index=pd.MultiIndex.from_tuples(
+            [(tree_label(t, bones[t]), v, methods[m].row_label(c)) for t, v, c, m in keys],
+            names=["Tree", "Testbed", "Config"],
+        ),
+    )
     cap = (
         r"Damping recovery on the faithful testbed ($\zeta$ fixed on every bone, no deliberate "
         r"transient) and on its damping variant ($\zeta$ per bone, log-uniform, and a gust "
@@ -171,11 +136,6 @@ def tab_damping(
         r"\hat\omega^p$ ($p\approx0$: a frequency-independent rate fitted in place of a "
         r"ratio), the truth's own $p$ on the matched bones in brackets."
         + "".join(mr.note for mr in methods.values())
-        + (
-            rf" Mean $\pm$ sd over {len(seeds)} training seeds; differences bold when their 95\% "
-            r"interval excludes 0, $^{\dagger}$ when not."
-            if len(seeds) > 1
-            else r" One training seed: no interval, nothing decided."
-        )
+        + latex.seed_note(len(seeds))
     )
-    return Table("tab_damping", df, _wrap("\n".join(lines), cap, "tab:damping"))
+    return Table("tab_damping", df, latex.render(cells, cap, "tab:damping"))

@@ -13,22 +13,10 @@ import numpy as np
 import pandas as pd
 
 from physgs.models.registry import spec_of
-from physgs.report import seeds as seedstats
-from physgs.report.tables import Table, _by_seed, _check, _first, _seeds, _tree_blocks, _wrap
+from physgs.report import latex
+from physgs.report.tables import Table, _seeds, _tree_index
 
 ROWS = (("single", "fixed $K$"), ("auto", "chosen $K$"))
-#: the per-seed values averaged in the .tex (K is shown as each seed chose it)
-_AVERAGED = (
-    "K",
-    "view_psnr_db",
-    "time_psnr_db",
-    "median_rel_err_pct",
-    "parts_trusted",
-    "parts_frozen",
-    "train_s",
-    "select_s",
-    "cost_x",
-)
 
 
 def row_label(model: str, config: str) -> str:
@@ -84,12 +72,10 @@ def tab_kselect(
             rest mean +- sd over seeds; the CSV also holds each seed's cost against the fixed
             K, ``cost_x`` = (train_s + select_s) / train_s of the fixed-K row.
     """
-    seeds = _seeds(per_seed, "tab_kselect")
+    keys = [(t, m, c) for t in trees for m in models for c, _ in ROWS]
+    seeds = _seeds(per_seed, "tab_kselect", keys)
     recs = []
     for s in seeds:
-        _check(
-            [(t, m, c) for t in trees for m in models for c, _ in ROWS], per_seed[s], "tab_kselect"
-        )
         for t in trees:
             for m in models:
                 fixed_s = float(per_seed[s][(t, m, "single")]["train_s"])
@@ -119,38 +105,26 @@ def tab_kselect(
                         }
                     )
     df = pd.DataFrame(recs)
-    first = _first(df)
-    first["_i"] = np.arange(len(first))
-    V = {c: _by_seed(df, c, len(seeds)) for c in _AVERAGED}
+    first = latex.rows(df)
     fmt = f".{digits}f"
-
-    def cells(r):
-        i = r._i
-        ks = "/".join(str(k) for k in dict.fromkeys(V["K"][:, i].astype(int)))
-        err = seedstats.pm(V["median_rel_err_pct"][:, i], fmt)
-        cost = seedstats.pm(V["cost_x"][:, i], ".2g")
-        return [
-            row_label(r.model, r.config),
-            ks,
-            seedstats.pm(V["view_psnr_db"][:, i], fmt),
-            seedstats.pm(V["time_psnr_db"][:, i], fmt),
-            err if err == "--" else err + r"\%",
-            f"{seedstats.pm(V['parts_trusted'][:, i], '.3g')}/{ks}",
-            seedstats.pm(V["parts_frozen"][:, i], ".3g"),
-            seedstats.pm(V["train_s"][:, i], ".0f"),
-            seedstats.pm(V["select_s"][:, i], ".0f"),
-            cost if cost == "--" else cost + r"$\times$",
-        ]
-
-    lines = [
-        "  \\begin{tabular}{llcccccccccc}",
-        "    \\toprule",
-        r"    Tree & Model & $K$ & PSNR views & PSNR time & Med.\ rel.\ err. & Trusted & Frozen"
-        r" & Train (s) & Select (s) & Cost \\",
-        "    \\midrule",
-    ]
-    lines += _tree_blocks(first, trees, cells)
-    lines += ["    \\bottomrule", "  \\end{tabular}", ""]
+    # K as each seed chose it; the rest mean +- sd
+    ks = ["/".join(str(k) for k in dict.fromkeys(v.astype(int))) for v in latex.by_seed(df, "K").T]
+    trusted = latex.cells(df, "parts_trusted", ".3g")
+    labels = [row_label(m, c) for m, c in zip(first["model"], first["config"])]
+    cells = pd.DataFrame(
+        {
+            "$K$": ks,
+            "PSNR views": latex.cells(df, "view_psnr_db", fmt),
+            "PSNR time": latex.cells(df, "time_psnr_db", fmt),
+            r"Med.\ rel.\ err.": latex.cells(df, "median_rel_err_pct", fmt, r"\%"),
+            "Trusted": [f"{n}/{k}" for n, k in zip(trusted, ks)],
+            "Frozen": latex.cells(df, "parts_frozen", ".3g"),
+            "Train (s)": latex.cells(df, "train_s", ".0f"),
+            "Select (s)": latex.cells(df, "select_s", ".0f"),
+            "Cost": latex.cells(df, "cost_x", ".2g", r"$\times$"),
+        },
+        index=_tree_index(first, labels, "Model"),
+    )
     cap = (
         rf"Each prior with fixed $K$ against $K$ chosen from the data (method: {method}, on "
         r"held-out training-window frames; the CSV also lists the choice by held-out frames and "
@@ -158,11 +132,7 @@ def tab_kselect(
         r"median relative frequency error over trusted parts; Frozen: parts whose swing stayed "
         r"under a pixel. Train: seconds of the model's training; Select: seconds of the "
         r"selection's short runs; Cost: (train + select) over the fixed-$K$ training."
-        + (
-            rf" Mean $\pm$ sd over {len(seeds)} training seeds; $K$ as each "
-            r"seed chose it."
-            if len(seeds) > 1
-            else " One training seed."
-        )
+        + latex.seed_note(len(seeds), decides=False)
+        + r" $K$: as each seed chose it."
     )
-    return Table("tab_kselect", df, _wrap("\n".join(lines), cap, "tab:kselect"))
+    return Table("tab_kselect", df, latex.render(cells, cap, "tab:kselect"))

@@ -20,8 +20,9 @@ import pandas as pd
 from physgs.evaluate.metrics import ceiling_fraction
 from physgs.experiments.kmatch import matched_k
 from physgs.models.registry import label
+from physgs.report import latex
 from physgs.report import seeds as seedstats
-from physgs.report.tables import Table, _by_seed, _check, _seeds, _wrap, tree_label
+from physgs.report.tables import Table, _seeds, tree_label
 
 COLUMNS = (
     "purity",
@@ -120,11 +121,10 @@ def tab_parts(
     Returns:
         The [`Table`][physgs.report.tables.Table].
     """
-    seeds = _seeds(per_seed, "tab_parts")
     keys = [(t, m, c) for t in trees for c in configs for m in models]
+    seeds = _seeds(per_seed, "tab_parts", keys)
     recs = []
     for s in seeds:
-        _check(keys, per_seed[s], f"tab_parts (seed {s})")
         for t, m, c in keys:
             recs.append(
                 {
@@ -137,69 +137,45 @@ def tab_parts(
                 }
             )
     df = pd.DataFrame(recs)
-    V = {c: _by_seed(df, c, len(seeds)) for c in COLUMNS}
-    base = {
-        (t, c): keys.index((t, BASELINE, c)) for t in trees for c in configs if BASELINE in models
-    }
     fmt = f".{int(digits)}f"
-
-    def pct(x):
-        return x if x == "--" else x + r"\%"
-
-    lines = [
-        "  \\begin{tabular}{lllcccccccr}",
-        "    \\toprule",
-        r"    & & & & \multicolumn{2}{c}{Of ceiling} & & & Med.\ rel.\ err.\ $\hat\omega$ & "
-        r"Med.\ rel.\ err.\ $\hat\zeta$ & \\",
-        r"    \cmidrule(lr){5-6}",
-        r"    Tree & Config & Parts & Purity & Fit & $-$ ours (pp) & View & Time & trained / null "
-        r"& damping testbed: trained / null & Train (s) \\",
-        "    \\midrule",
+    # each variant's fit fraction less ours' in the same tree and configuration, per seed
+    frac = latex.by_seed(df, "ceiling_frac")
+    vs_ours = [
+        seedstats.difference(100 * (frac[:, i] - frac[:, keys.index((t, BASELINE, c))]), ".0f")
+        if m != BASELINE and BASELINE in models
+        else ""
+        for i, (t, m, c) in enumerate(keys)
     ]
-    per_tree = len(configs) * len(models)
-    for i, (t, m, c) in enumerate(keys):
-        head = (
-            rf"\multirow{{{per_tree}}}{{*}}{{{tree_label(t, bones[t])}}}"
-            if i % per_tree == 0
-            else ""
+    omega, omega_null, zeta, zeta_null = (
+        latex.cells(df, col, f, r"\%")
+        for col, f in (
+            ("omega_rel_err_pct", ".1f"),
+            ("omega_null_rel_err_pct", ".1f"),
+            ("zeta_rel_err_pct", ".0f"),
+            ("zeta_null_rel_err_pct", ".0f"),
         )
-        b = base.get((t, c))
-        diff = (
-            seedstats.difference(100 * (V["ceiling_frac"][:, i] - V["ceiling_frac"][:, b]), ".0f")
-            if b is not None and m != BASELINE
-            else ""
-        )
-        zeta = (
-            pct(seedstats.pm(V["zeta_rel_err_pct"][:, i], ".0f"))
-            + " / "
-            + pct(seedstats.pm(V["zeta_null_rel_err_pct"][:, i], ".0f"))
-            if np.isfinite(V["zeta_rel_err_pct"][:, i]).any()
-            else "--"
-        )
-        lines.append(
-            "    "
-            + " & ".join(
-                [
-                    head,
-                    configs[c] if i % len(models) == 0 else "",
-                    label(m),
-                    seedstats.pm(V["purity"][:, i], ".2f"),
-                    pct(seedstats.pm(100 * V["ceiling_frac"][:, i], ".0f")),
-                    diff,
-                    seedstats.pm(V["view_psnr_db"][:, i], fmt),
-                    seedstats.pm(V["time_psnr_db"][:, i], fmt),
-                    pct(seedstats.pm(V["omega_rel_err_pct"][:, i], ".1f"))
-                    + " / "
-                    + pct(seedstats.pm(V["omega_null_rel_err_pct"][:, i], ".1f")),
-                    zeta,
-                    seedstats.pm(V["train_s"][:, i], ".0f"),
-                ]
-            )
-            + r" \\"
-        )
-        if (i + 1) % per_tree == 0 and i + 1 < len(keys):
-            lines.append("    \\midrule")
-    lines += ["    \\bottomrule", "  \\end{tabular}", ""]
+    )
+    ceiling = r"Of ceiling"
+    cells = pd.DataFrame(
+        {
+            ("", "Purity"): latex.cells(df, "purity", ".2f"),
+            (ceiling, "Fit"): latex.cells(df, "ceiling_frac", ".0f", r"\%", scale=100),
+            (ceiling, r"$-$ ours (pp)"): vs_ours,
+            ("", "View"): latex.cells(df, "view_psnr_db", fmt),
+            ("", "Time"): latex.cells(df, "time_psnr_db", fmt),
+            (r"Med.\ rel.\ err.\ $\hat\omega$", "trained / null"): [
+                f"{a} / {b}" for a, b in zip(omega, omega_null)
+            ],
+            (r"Med.\ rel.\ err.\ $\hat\zeta$", "damping testbed: trained / null"): [
+                "--" if a == "--" else f"{a} / {b}" for a, b in zip(zeta, zeta_null)
+            ],
+            ("", "Train (s)"): latex.cells(df, "train_s", ".0f"),
+        },
+        index=pd.MultiIndex.from_tuples(
+            [(tree_label(t, bones[t]), configs[c], label(m)) for t, m, c in keys],
+            names=["Tree", "Config", "Parts"],
+        ),
+    )
     cap = (
         r"The oscillator prior with the paper's spatial k-means parts beside parts cut along the "
         r"tree (topology), independent or each riding on its parent (chained). \emph{Purity}: "
@@ -208,15 +184,9 @@ def tab_parts(
         r"motion $-$ static), and its paired difference from ours (percentage points). "
         r"$\hat\omega$: median relative error over trusted parts on the faithful testbed, beside "
         r"the untrained null of the same $K$; $\hat\zeta$: the same on the damping testbed "
-        r"(tab\_damping's measure)."
-        + (
-            rf" Mean $\pm$ sd over {len(seeds)} training seeds; differences bold when their 95\% "
-            r"interval excludes 0, $^{\dagger}$ when not."
-            if len(seeds) > 1
-            else r" One training seed: no interval, nothing decided."
-        )
+        r"(tab\_damping's measure)." + latex.seed_note(len(seeds))
     )
-    return Table("tab_parts", df, _wrap("\n".join(lines), cap, "tab:parts"))
+    return Table("tab_parts", df, latex.render(cells, cap, "tab:parts"))
 
 
 def fig_parts(
@@ -306,10 +276,9 @@ def tab_parts_k(
     Returns:
         The [`Table`][physgs.report.tables.Table].
     """
-    seeds = _seeds(per_seed, "tab_parts_k")
+    seeds = _seeds(per_seed, "tab_parts_k", trees)
     recs = []
     for s in seeds:
-        _check(trees, per_seed[s], f"tab_parts_k (seed {s})")
         for t in trees:
             r = per_seed[s][t]
             chain = {int(k): float(v) for k, v in r["chain"].items()}
@@ -339,37 +308,27 @@ def tab_parts_k(
                     }
                 )
     df = pd.DataFrame(recs)
-    first = df[df["seed"] == seeds[0]]
+    first = latex.rows(df)
     ks = sorted(int(k) for k in first.loc[first["model"] == "ours_chain", "K"].unique())
-    V = _by_seed(df, "heldout_psnr_db", len(seeds))
-    fmt = f".{int(digits)}f"
-    head = " & ".join(rf"$K{{=}}{k}$" for k in ks)
-    lines = [
-        "  \\begin{tabular}{l" + "c" * (len(ks) + 2) + "}",
-        "    \\toprule",
-        rf"    & Ours ($K{{=}}{base_k}$) & \multicolumn{{{len(ks)}}}{{c}}{{Chained topology "
-        r"parts} & \\",
-        rf"    \cmidrule(lr){{3-{len(ks) + 2}}}",
-        rf"    Tree & held-out (dB) & {head} & matched $K$ \\",
-        "    \\midrule",
+    psnr = np.reshape(latex.cells(df, "heldout_psnr_db", f".{int(digits)}f"), (len(trees), -1))
+    matched = [  # each seed's
+        ", ".join("--" if not np.isfinite(x) else str(int(x)) for x in mk)
+        for mk in latex.by_seed(df, "matched_k")[:, :: 1 + len(ks)].T
     ]
-    n = 1 + len(ks)
-    for i, t in enumerate(trees):
-        cols = [seedstats.pm(V[:, i * n + j], fmt) for j in range(n)]
-        mk = df[(df["tree"] == t) & (df["model"] == "ours")]["matched_k"].to_numpy()
-        matched = ", ".join("--" if not np.isfinite(x) else str(int(x)) for x in mk)
-        lines.append("    " + " & ".join([tree_label(t, bones[t]), *cols, matched]) + r" \\")
-    lines += ["    \\bottomrule", "  \\end{tabular}", ""]
+    heads = [(rf"Ours ($K{{=}}{base_k}$)", "held-out (dB)")]
+    heads += [("Chained topology parts", rf"$K{{=}}{k}$") for k in ks]
+    cells = pd.DataFrame(
+        psnr,
+        index=pd.Index([tree_label(t, bones[t]) for t in trees], name="Tree"),
+        columns=pd.MultiIndex.from_tuples(heads),
+    )
+    cells[("", "matched $K$")] = matched
     cap = (
         r"How few parts the chained prior needs: held-out PSNR (dB) on the every-"
         r"$k$-th training-window frames never trained on, at the training camera and wind, of ours "
         rf"(k-means parts, $K{{=}}{base_k}$) and of the chained topology-aware prior at each $K$. "
         rf"\emph{{Matched $K$}}: per seed, the smallest $K$ whose held-out PSNR lies within "
         rf"{tie_db:g} dB of ours' (-- where none does)."
-        + (
-            rf" Mean $\pm$ sd over {len(seeds)} training seeds."
-            if len(seeds) > 1
-            else " One training seed."
-        )
+        + latex.seed_note(len(seeds), decides=False)
     )
-    return Table("tab_parts_k", df, _wrap("\n".join(lines), cap, "tab:parts_k"))
+    return Table("tab_parts_k", df, latex.render(cells, cap, "tab:parts_k"))

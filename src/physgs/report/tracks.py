@@ -22,17 +22,8 @@ import numpy as np
 import pandas as pd
 
 from physgs.models.registry import recovery_label
-from physgs.report import seeds as seedstats
-from physgs.report.tables import (
-    TRACKS,
-    Table,
-    _by_seed,
-    _check,
-    _seeds,
-    _wrap,
-    condition_label,
-    tree_label,
-)
+from physgs.report import latex
+from physgs.report.tables import TRACKS, Table, _seeds, condition_label, tree_label
 
 #: the method id of the tracks control's rows in tab_recovery and tab_damping (column ``method``)
 METHOD = TRACKS
@@ -141,11 +132,10 @@ def tab_tracks(
     Returns:
         The [`Table`][physgs.report.tables.Table].
     """
-    seeds = _seeds(per_seed, "tab_tracks")
     keys = [(t, c) for t in trees for c in configs]
+    seeds = _seeds(per_seed, "tab_tracks", keys)
     recs = []
     for s in seeds:
-        _check(keys, per_seed[s], f"tab_tracks (seed {s})")
         for t, c in keys:
             recs.append(
                 {
@@ -158,61 +148,40 @@ def tab_tracks(
                 }
             )
     df = pd.DataFrame(recs)
-    stems = ["tail", *(case_label(f"wind{c}", conditions) for c in range(1, len(conditions)))]
-    num = [c for c in df.columns if c not in ("seed", "tree", "bones", "config", "conditions")]
-    V = {c: _by_seed(df, c, len(seeds)) for c in num}
     fmt = f".{int(digits)}f"
-    heads = ["beyond the window"] + [
-        f"wind {condition_label(float(conditions[c]))}" for c in range(1, len(conditions))
-    ]
-    ncol = 8 + 4 * len(stems)
-    lines = [
-        "  \\begin{tabular}{ll" + "c" * (ncol - 2) + "}",
-        "    \\toprule",
-        r"    & & \multicolumn{3}{c}{Tracker} & \multicolumn{3}{c}{Fit} & "
-        + " & ".join(rf"\multicolumn{{4}}{{c}}{{{h} (px)}}" for h in heads)
-        + r" \\",
-        "    "
-        + r"\cmidrule(lr){3-5}\cmidrule(lr){6-8}"
-        + "".join(rf"\cmidrule(lr){{{9 + 4 * i}-{12 + 4 * i}}}" for i in range(len(stems))),
-        r"    Tree & Config & Tracks (kept) & Error (px) & Displ.\ (px) & Parts & s & ours (s) & "
-        + " & ".join(["Tracks & Ours & Field & Still"] * len(stems))
-        + r" \\",
-        "    \\midrule",
-    ]
-    for i, (t, c) in enumerate(keys):
-        head = (
-            rf"\multirow{{{len(configs)}}}{{*}}{{{tree_label(t, bones[t])}}}"
-            if i % len(configs) == 0
-            else ""
-        )
-        n = np.nanmean(V["n_tracks"][:, i])
-        kept = np.nanmean(V["share_kept"][:, i])
-        cells = [
-            head,
-            configs[c]["label"],
-            f"{n:.0f} ({100 * kept:.0f}\\%)",
-            seedstats.pm(V["track_median_px"][:, i], fmt)
-            + " / "
-            + seedstats.pm(V["track_p90_px"][:, i], fmt),
-            seedstats.pm(V["disp_median_px"][:, i], fmt)
-            + " / "
-            + seedstats.pm(V["disp_p90_px"][:, i], fmt),
-            f"{np.nanmean(V['parts_estimated'][:, i]):.0f}/{np.nanmean(V['K'][:, i]):.0f}",
-            seedstats.pm(V["fit_s"][:, i], ".0f"),
-            seedstats.pm(V["ours_train_s"][:, i], ".0f"),
-        ]
-        for stem in stems:
-            cells += [
-                seedstats.pm(V[f"{stem}_px"][:, i], fmt),
-                seedstats.pm(V[f"{stem}_ours_px"][:, i], fmt),
-                seedstats.pm(V[f"{stem}_best_field_px"][:, i], fmt),
-                seedstats.pm(V[f"{stem}_static_px"][:, i], fmt),
-            ]
-        lines.append("    " + " & ".join(cells) + r" \\")
-        if (i + 1) % len(configs) == 0 and i + 1 < len(keys):
-            lines.append("    \\midrule")
-    lines += ["    \\bottomrule", "  \\end{tabular}", ""]
+
+    def both(a: str, b: str) -> list[str]:  # 'median / 90th percentile'
+        return [f"{x} / {y}" for x, y in zip(latex.cells(df, a, fmt), latex.cells(df, b, fmt))]
+
+    n, kept, est, k = (
+        latex.cells(df, c, ".0f", cell=latex.mean, scale=f)
+        for c, f in (("n_tracks", 1), ("share_kept", 100), ("parts_estimated", 1), ("K", 1))
+    )
+    columns = {
+        ("Tracker", "Tracks (kept)"): [f"{a} ({b}\\%)" for a, b in zip(n, kept)],
+        ("Tracker", "Error (px)"): both("track_median_px", "track_p90_px"),
+        ("Tracker", r"Displ.\ (px)"): both("disp_median_px", "disp_p90_px"),
+        ("Fit", "Parts"): [f"{a}/{b}" for a, b in zip(est, k)],
+        ("Fit", "s"): latex.cells(df, "fit_s", ".0f"),
+        ("Fit", "ours (s)"): latex.cells(df, "ours_train_s", ".0f"),
+    }
+    winds = [f"wind {condition_label(float(c))}" for c in conditions[1:]]
+    stems = ["tail", *(case_label(f"wind{c}", conditions) for c in range(1, len(conditions)))]
+    for head, stem in zip(["beyond the window", *winds], stems):
+        for who, suffix in (
+            ("Tracks", ""),
+            ("Ours", "_ours"),
+            ("Field", "_best_field"),
+            ("Still", "_static"),
+        ):
+            columns[(f"{head} (px)", who)] = latex.cells(df, f"{stem}{suffix}_px", fmt)
+    cells = pd.DataFrame(
+        columns,
+        index=pd.MultiIndex.from_tuples(
+            [(tree_label(t, bones[t]), configs[c]["label"]) for t, c in keys],
+            names=["Tree", "Config"],
+        ),
+    )
     joint = [c for c in configs if configs[c]["conditions"] != "train"]
     cap = (
         r"The 2D-track control: ours' oscillators fitted to Lucas--Kanade point tracks of the "
@@ -234,13 +203,9 @@ def tab_tracks(
             if joint
             else ""
         )
-        + (
-            rf" Mean $\pm$ sd over {len(seeds)} training seeds."
-            if len(seeds) > 1
-            else " One training seed."
-        )
+        + latex.seed_note(len(seeds), decides=False)
     )
-    return Table("tab_tracks", df, _wrap("\n".join(lines), cap, "tab:tracks"))
+    return Table("tab_tracks", df, latex.render(cells, cap, "tab:tracks"))
 
 
 def fig_tracks(
