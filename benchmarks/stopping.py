@@ -17,6 +17,11 @@ with ``--stop-every/--tol/--patience/--anneal``) and writes one row per model: t
 used, why it stopped, the held-out loss and PSNR at its end, its wall time and the time its
 held-out scores took: the real cost of the chosen setting.
 
+``plateau``: each curve's plateau by the rule's criterion (P scores without a ``tol`` relative
+improvement of the held-out loss), its PSNR there, at 3000 iterations and at the end, the slope
+over the last quarter (where it is heading), and with the static pose's and the ceiling's curves
+the end's fraction of the ceiling's held-out gain; ``--markdown``/``--figure`` write them.
+
 ``choose``: where the stopping rule would stop each model, from its held-out-window curve
 (``curves``), for a grid of N (every), tol and P (patience), and what it would cost: the
 held-out loss at the trigger against the loss at the cap (a bound: the final anneal after the
@@ -269,6 +274,93 @@ def stops(df: pd.DataFrame, every: int, tol: float, patience: int, anneal: int =
     return pd.DataFrame(out)
 
 
+def plateaus(df: pd.DataFrame, patience: int, tol: float, refs: pd.DataFrame | None = None):
+    """Per (tree, model) curve: where the rule's criterion finds its plateau and where it heads.
+
+    Args:
+        df: curve rows (``FIELDS``), one or more curves.
+        patience: P of the rule (scores without an improvement of ``tol``).
+        tol: the relative improvement that counts.
+        refs: the static pose's and the ceiling's curves (their last score is the held-out
+            window's reference), or None.
+
+    Returns:
+        One row per curve: its budget, the plateau iteration (empty: none before the end), the
+        held-out PSNR there, at 3000 and at the end (dB), the slope over the last quarter (dB per
+        1000 iterations: where it is heading) and, with ``refs``, the end's fraction of the
+        ceiling's held-out gain over static.
+    """
+    out = []
+    for (tree, m), g in df.groupby(["tree", "model"], sort=False):
+        g = g.sort_values("iteration")
+        it, psnr = g["iteration"].to_numpy(), g["holdout_psnr"].to_numpy()
+        trig = plateau_iteration(it, g["holdout_loss"], patience, tol)
+        tail = it >= it[-1] * 0.75
+        slope = np.polyfit(it[tail], psnr[tail], 1)[0] * 1000 if tail.sum() > 1 else np.nan
+        row = {
+            "tree": tree,
+            "model": m,
+            "budget": int(it[-1]),
+            "plateau_at": trig,
+            "psnr_plateau": psnr[it == trig][0] if trig is not None else np.nan,
+            "psnr_3000": psnr[it == 3000][0] if (it == 3000).any() else np.nan,
+            "psnr_end": psnr[-1],
+            "best_at": int(it[np.argmax(psnr)]),
+            "slope_db_per_1000": slope,
+        }
+        if refs is not None:
+            r = refs[refs["tree"] == tree].sort_values("iteration").groupby("model").last()
+            if {"static", "truth_motion"} <= set(r.index):
+                st, ce = r.loc["static", "holdout_psnr"], r.loc["truth_motion", "holdout_psnr"]
+                row["heldout_of_ceiling_end"] = (psnr[-1] - st) / (ce - st)
+        out.append(row)
+    return pd.DataFrame(out)
+
+
+def plateau(a: argparse.Namespace) -> None:
+    """Print (and with ``--markdown`` write) each curve's plateau; ``--figure`` draws them."""
+    df = pd.concat([pd.read_csv(p) for p in a.curves], ignore_index=True)
+    refs = df[df["model"].isin(["static", "truth_motion"])]
+    curves_ = df[~df["model"].isin(["static", "truth_motion"])]
+    r = plateaus(curves_, a.patience, a.tol, refs if len(refs) else None)
+    print(r.to_string(index=False, float_format=lambda x: f"{x:.3g}"))
+    if a.markdown:
+        Path(a.markdown).write_text(r.to_markdown(index=False, floatfmt=".3g") + "\n")
+    if a.figure:
+        import matplotlib
+
+        matplotlib.use("Agg")
+        import matplotlib.pyplot as plt
+
+        trees = list(dict.fromkeys(curves_["tree"]))
+        fig, axes = plt.subplots(1, len(trees), figsize=(4.8 * len(trees), 3.8), squeeze=False)
+        for ax, t in zip(axes[0], trees):
+            for m, g in curves_[curves_["tree"] == t].groupby("model", sort=False):
+                ax.plot(g["iteration"], g["holdout_psnr"], label=m, lw=1.2)
+                row = r[(r["tree"] == t) & (r["model"] == m)].iloc[0]
+                if row["plateau_at"] == row["plateau_at"] and row["plateau_at"] is not None:
+                    ax.plot(row["plateau_at"], row["psnr_plateau"], "kx", ms=6)
+            for m, ls in (("static", "--"), ("truth_motion", ":")):
+                g = refs[(refs["tree"] == t) & (refs["model"] == m)]
+                if len(g):
+                    ax.axhline(
+                        g.sort_values("iteration")["holdout_psnr"].iloc[-1],
+                        color="0.4",
+                        ls=ls,
+                        lw=1,
+                        label=f"{m} (end)",
+                    )
+            ax.axvline(3000, color="0.7", lw=0.8)
+            ax.set(title=t, xlabel="iteration", ylabel="held-out window PSNR (dB)")
+            ax.grid(alpha=0.3)
+        axes[0][0].legend(fontsize=7)
+        fig.suptitle(
+            "Held-out window curves (x: the rule's plateau; grey: today's budget)", fontsize=9
+        )
+        fig.tight_layout()
+        fig.savefig(a.figure, dpi=150)
+
+
 def choose(a: argparse.Namespace) -> None:
     """Print where the rule stops each curve, for one setting or over the grid."""
     df = pd.concat([pd.read_csv(p).assign(src=i) for i, p in enumerate(a.curves)])
@@ -365,6 +457,13 @@ def main() -> None:
     p.add_argument("--patience", type=int)
     p.add_argument("--start", type=float, default=0.0)
     p.set_defaults(run=choose, threads=None)
+    p = sub.add_parser("plateau", help="each curve's plateau by the rule's criterion, its heading")
+    p.add_argument("curves", nargs="+")
+    p.add_argument("--patience", type=int, default=2)
+    p.add_argument("--tol", type=float, default=0.005)
+    p.add_argument("--markdown", default=None, help="write the table here")
+    p.add_argument("--figure", default=None, help="draw the curves here (PNG)")
+    p.set_defaults(run=plateau, threads=None)
     p = sub.add_parser("overhead", help="a held-out score's cost against a training iteration")
     p.add_argument("testbed", type=Path)
     p.add_argument("--models", default="static,ours,mlp,mlp_wind,d3dgs,d3dgs_wind")

@@ -191,3 +191,42 @@ def test_scores_only_where_a_trigger_could_still_stop_the_run():
         2700,
         3000,
     ]
+
+
+def test_a_curves_plateau_and_heading_are_read_as_worked_by_hand():
+    """benchmarks/stopping.py plateau: the rule's trigger on a recorded curve, the PSNR there and
+    at 3000, the last quarter's slope and the end's fraction of the ceiling's held-out gain."""
+    import importlib.util
+    from pathlib import Path
+
+    path = Path(__file__).resolve().parents[1] / "benchmarks" / "stopping.py"
+    spec = importlib.util.spec_from_file_location("stopping_bench", path)
+    bench = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(bench)
+    its = np.arange(300, 6001, 300)  # 20 scores
+    # improving 10% a score up to 2400, then flat: P = 2 flat scores trigger at 3000
+    loss = np.where(its <= 2400, 0.1 * 0.9 ** (its / 300), 0.1 * 0.9**8)
+    psnr = 20.0 + its / 1000.0  # rising 1 dB per 1000 iterations throughout
+    curve = pd.DataFrame(
+        {
+            "tree": "medium",
+            "model": "mlp",
+            "iteration": its,
+            "holdout_loss": loss,
+            "holdout_psnr": psnr,
+        }
+    )
+    refs = pd.DataFrame(
+        {
+            "tree": "medium",
+            "model": ["static", "truth_motion"],
+            "iteration": [3000, 3000],
+            "holdout_loss": [0.2, 0.01],
+            "holdout_psnr": [18.0, 38.0],
+        }
+    )
+    r = bench.plateaus(curve, patience=2, tol=0.005, refs=refs).iloc[0]
+    assert r["plateau_at"] == 3000 and r["psnr_plateau"] == pytest.approx(23.0)
+    assert r["psnr_3000"] == pytest.approx(23.0) and r["psnr_end"] == pytest.approx(26.0)
+    assert r["slope_db_per_1000"] == pytest.approx(1.0)
+    assert r["heldout_of_ceiling_end"] == pytest.approx((26.0 - 18.0) / 20.0)
