@@ -248,7 +248,7 @@ def measure(
         seeds = _per_seed(tabs[spec.table]) if spec.table in tabs else []
         for model in ("ours",) if spec.of == "ours" else others:
             run = Run(tabs, trees, model, others, spec.table, dict(roles or {}))
-            for cell in spec.cells(run):
+            for cell in spec.over(run):
                 cell = {"model": model, "name": label(model), "table": spec.table, **cell}
                 cid = spec.claim_id(cell)
                 claim = Claim(
@@ -264,7 +264,7 @@ def measure(
                     spec.value_of_paper(cell),
                     spec.claim_id(cell, spec.requires) if spec.requires else "",
                 )
-                out.append((claim, [spec.measure(d, cell) for d in seeds]))
+                out.append((claim, [float(spec.read(d, cell)) for d in seeds]))
     return out
 
 
