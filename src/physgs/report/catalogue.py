@@ -1208,7 +1208,7 @@ def origin_of(claim_id: str) -> str:
     parts = claim_id.split("/")
     if any(p in _MODEL_IDS and p not in PAPER_MODELS for p in parts):
         return "project"
-    fam = parts[1] if parts[0] in _MODEL_IDS and len(parts) > 1 else parts[0]
+    fam = _family(claim_id)
     for s in CATALOGUE:
         if s.family == fam and (s.of == "priors") == (parts[0] in _MODEL_IDS):
             return s.origin

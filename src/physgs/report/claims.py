@@ -62,6 +62,11 @@ class Claim:
     requires: str = ""
 
     @property
+    def log_scale(self) -> bool:
+        """Whether its interval is taken on the log scale: a ratio's (unit ``RATIO``)."""
+        return self.unit == RATIO
+
+    @property
     def threshold_text(self) -> str:
         """The threshold and side as the ledger prints them: ``> 0``, ``within ±0.5``."""
         if self.side == WITHIN:
@@ -86,18 +91,6 @@ def on_claim(claim: Claim, x: float) -> bool:
     return x > t if claim.side == ">" else x < t
 
 
-def log_scale(claim: Claim) -> bool:
-    """Whether a claim's interval is taken on the log scale.
-
-    Args:
-        claim: the claim.
-
-    Returns:
-        True for a ratio (unit ``RATIO``).
-    """
-    return claim.unit == RATIO
-
-
 def estimate(claim: Claim, values: Sequence[float]) -> tuple[float, float, float, float]:
     """(estimate, sd, low, high) of a claim over seeds: Student's t on the mean
     ([`interval`][physgs.report.seeds.interval]); for a ratio, on the mean of the per-seed
@@ -111,7 +104,7 @@ def estimate(claim: Claim, values: Sequence[float]) -> tuple[float, float, float
     Returns:
         ``(estimate, sd, low, high)``.
     """
-    return log_interval(values) if log_scale(claim) else interval(values)
+    return log_interval(values) if claim.log_scale else interval(values)
 
 
 def verdict(claim: Claim, values: Sequence[float]) -> str:
@@ -283,7 +276,7 @@ def to_decide(claim: Claim, values: Sequence[float]) -> tuple[float, float]:
     if verdict(claim, values) != "undecided":
         return np.nan, np.nan
     v = finite(values)
-    v, thr = (np.log(v), np.log(claim.threshold)) if log_scale(claim) else (v, claim.threshold)
+    v, thr = (np.log(v), np.log(claim.threshold)) if claim.log_scale else (v, claim.threshold)
     m = float(v.mean())
     if claim.side == WITHIN:  # the interval straddles an edge: the nearer one decides it
         thr = min((-thr, thr), key=lambda e: abs(m - e))
@@ -372,7 +365,7 @@ def ledger(measured: Sequence[tuple[Claim, list[float]]]) -> pd.DataFrame:
                 "source": c.source,
                 "origin": c.origin,
                 "kind": kind_of(c.id),
-                "scale": "log" if log_scale(c) else "linear",
+                "scale": "log" if c.log_scale else "linear",
                 "seeds_to_decide_t_est": n_t,
                 "seeds_to_decide_power80_est": n_power,
                 "paper_low": c.paper_value[0],
@@ -414,10 +407,6 @@ def number(x: float, unit: str) -> str:
     return f"{x:.3g}" if unit == RATIO else f"{x:+.3g}"
 
 
-#: A kind as the counts name it (plural: ``counted``).
-KIND_WORDS = {"finding": ("finding", "findings"), "premise": ("premise", "premises")}
-
-
 def counted(claims: pd.DataFrame, origin: str) -> str:
     """The claims of one origin counted, the findings apart from the premises of the comparison
     (``catalogue.PREMISES``), each by verdict: ``52 claims: 34 findings (20 hold, 10 fail, 4
@@ -443,7 +432,7 @@ def counted(claims: pd.DataFrame, origin: str) -> str:
             for w in ("holds", "fails", "undecided")
             if v.get(w, 0)
         )
-        parts.append(f"{int(v.sum())} {KIND_WORDS[k][int(v.sum()) != 1]} ({by})")
+        parts.append(f"{int(v.sum())} {k}{'s' if v.sum() != 1 else ''} ({by})")
     n = int(mine.sum())
     return f"{n} claim{'s' if n != 1 else ''}: " + (", ".join(parts) or "none")
 
