@@ -128,8 +128,8 @@ class ClaimSpec:
         text: the claim's sentence (``str.format`` fields: the cell's, ``name`` of the prior,
             ``WORDS``).
         source: where it is measured (same fields, and ``table``).
-        paper: the paper's figure: words (same fields), or a [`Figure`][physgs.report.catalogue.Figure]
-            (its value in the claim's unit too).
+        paper: the paper's figure: words (same fields), or a
+            [`Figure`][physgs.report.catalogue.Figure] (its value in the claim's unit too).
         origin: ``"paper"`` or ``"project"`` (``ORIGINS``).
         headline: the words the README tells the family with; "" when it is not a headline.
         needs_variance: False for a claim about the fixed testbed (a verdict from one value).
@@ -381,7 +381,7 @@ def _decay_exponent(d: pd.DataFrame, c: Cell) -> float:
     return value(d, (d["model"] == c["model"]) & (d["tree"] == c["tree"]), "loglog_exponent")
 
 
-# ---- the paper's figures (``ClaimSpec.paper``) ----------------------------------------------------
+# ---- the paper's figures (``ClaimSpec.paper``) ---------------------------------------------------
 def _point(x: float) -> tuple[float, float]:
     """A single figure as ``(low, high)``."""
     return (float(x), float(x))
@@ -566,7 +566,7 @@ _KINDS = (
 )  # fmt: skip
 
 
-# ---- the paper's: recovery against the untrained null (tab:null, section 4) -----------------------
+# ---- the paper's: recovery against the untrained null (tab:null, section 4) ----------------------
 def _null_trees_tiled(run: Run) -> list[Cell]:
     """each tree of tiled frequencies, in the ledger's recovery configuration (joint K = 32)"""
     return [{**c, "config": CONFIG, "method": run.model} for c in _with_role(run, TILED)]
@@ -945,7 +945,7 @@ _BLIND = (
 )  # fmt: skip
 
 
-# ---- this project's: the paper's two hypotheses about its prior (section 6), tested ---------------
+# ---- this project's: the paper's two hypotheses about its prior (section 6), tested --------------
 def _parts(run: Run) -> tuple[pd.DataFrame | None, set, str]:
     """tab_parts, its models and its first configuration (None, empty where it is not there)."""
     df = run.own
@@ -1013,7 +1013,7 @@ _PARTS = (
 )  # fmt: skip
 
 
-# ---- this project's: the 2D-track control (docs/tracks.md) ----------------------------------------
+# ---- this project's: the 2D-track control (docs/tracks.md) ---------------------------------------
 def _tracks_separated(run: Run) -> list[Cell]:
     """each tree of separated frequencies, the 2D-track control's recovery in joint K = 32
     (else its first configuration)"""

@@ -7,9 +7,10 @@ of the threshold, **fails** when it lies entirely on the other side, and is **un
 straddles it. A claim of flatness, equality or match (side ``WITHIN``) is an equivalence test,
 two one-sided tests: it **holds** when the interval lies inside the band (-threshold,
 +threshold), **fails** when it lies entirely outside it (beyond either edge), and is
-**undecided** when it straddles either edge. A claim about a comparison between trained models needs seed variance: with a
-single seed it is "undecided: one seed" (the point estimate is still shown, with the side it
-falls on). A claim about the fixed testbed (the nearest-bone gap) needs none.
+**undecided** when it straddles either edge. A claim about a comparison between trained models
+needs seed variance: with a single seed it is "undecided: one seed" (the point estimate is still
+shown, with the side it falls on). A claim about the fixed testbed (the nearest-bone gap) needs
+none.
 
 The tables give one value per seed: a table whose CSV has a ``seed`` column contributes one
 value per seed, one without it (today's single-seed pipeline) contributes one value.
@@ -37,7 +38,7 @@ from physgs.report.catalogue import (
     undermines,
 )
 from physgs.report.claim_cells import RECOVERY, Run
-from physgs.report.seeds import MAX_SEEDS, finite, interval, log_interval, seeds_to_decide  # noqa: F401
+from physgs.report.seeds import MAX_SEEDS, finite, interval, log_interval, seeds_to_decide
 
 #: The unit of a ratio: its interval is taken on the log scale (``estimate``).
 RATIO = "ratio"
@@ -46,8 +47,8 @@ RATIO = "ratio"
 @dataclass(frozen=True)
 class Claim:
     """One claim: id, the claim in one line, the paper's figure, where it is measured, the
-    threshold and side ('>', '<', or ``WITHIN``: inside (-threshold, +threshold)), the unit, whether a verdict needs seed variance, and its
-    origin (the paper's or this project's)."""
+    threshold and side ('>', '<', or ``WITHIN``: inside (-threshold, +threshold)), the unit,
+    whether a verdict needs seed variance, and its origin (the paper's or this project's)."""
 
     id: str
     text: str
@@ -476,17 +477,16 @@ def ledger_markdown(df: pd.DataFrame, stamp: Mapping[str, str] | None = None) ->
     lines = [
         "# Claims ledger",
         "",
-        "Each claim, measured by this pipeline: the paper's claims and this project's own, "
-        "counted apart; verdicts are computed by `physgs.report.claims` (holds / fails when "
-        "the seed interval lies on one side of the threshold, undecided when it straddles it "
-        "or when one seed gives no interval; a claim of flatness, equality or match, "
-        "'within ±t', holds inside the band, fails wholly outside it and is undecided across "
-        "either edge). Beside a figure of the paper: whether it lies inside the measured "
-        "interval (reproduced in size; the verdict is a direction or a bar). A ratio's estimate is the geometric mean over "
-        "seeds and its interval the per-seed log-ratios' t-interval, exponentiated (it stays "
-        "positive). For an undecided claim, the seeds that would decide it if its effect and "
-        "sd stayed as observed, an estimate: the plug-in t half-width / a t-test at 80% power "
-        "(`tt_solve_power`).",
+        "Each claim, measured by this pipeline: the paper's claims and this project's own, counted "
+        "apart; verdicts are computed by `physgs.report.claims` (holds / fails when the seed "
+        "interval lies on one side of the threshold, undecided when it straddles it or when one "
+        "seed gives no interval; a claim of flatness, equality or match, 'within ±t', holds inside "
+        "the band, fails wholly outside it and is undecided across either edge). Beside a figure "
+        "of the paper: whether it lies inside the measured interval (reproduced in size; the verdict "
+        "is a direction or a bar). A ratio's estimate is the geometric mean over seeds and its "
+        "interval the per-seed log-ratios' t-interval, exponentiated (it stays positive). For an "
+        "undecided claim, the seeds that would decide it if its effect and sd stayed as observed, "
+        "an estimate: the plug-in t half-width / a t-test at 80% power (`tt_solve_power`).",
         "",
     ]
     if stamp:
@@ -513,8 +513,8 @@ def ledger_markdown(df: pd.DataFrame, stamp: Mapping[str, str] | None = None) ->
         size = r.get("paper_in_interval", "")
         size = f" ({size} the interval)" if isinstance(size, str) and size else ""
         lines.append(
-            f"| {r.claim} | {r.origin} | {r.paper}{size} | {meas} | {r.threshold} | **{r.verdict}** | {k} | "
-            f"{decide_cell(r)} | {r.source} |"
+            f"| {r.claim} | {r.origin} | {r.paper}{size} | {meas} | {r.threshold} "
+            f"| **{r.verdict}** | {k} | {decide_cell(r)} | {r.source} |"
         )
     return "\n".join(lines) + "\n"
 
