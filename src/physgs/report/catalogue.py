@@ -420,8 +420,7 @@ NULL_RATIO = Figure(
 )
 
 
-# ---- the paper's: beyond the window and on held-out views (tab:psnr), unseen wind (tab:transfer,
-# tab:margin) ------------------------------------------------------------------------------------
+# ---- the paper's: beyond the window and on held-out views (tab:psnr), unseen wind (tab:transfer)
 _MOTION = (
     ClaimSpec(
         family="ours_above_static_beyond", over=_trees, table="tab_psnr",
