@@ -5,8 +5,8 @@ declares what it needs as *need tuples* (``needs``): ``("eval" | "traj" | "panel
 model, config, seed)``, ``("recovery", tree, method, config, seed)``, ``("null", tree, K, seed)``,
 ``("kselect", tree, seed)``, ``("stats", tree)``, ``("table", name)`` and the rest of
 ``NEED_FIELDS``; seed is a training seed. The workflow maps each tuple to a path
-(``workflow/rules/common.smk``) and hands the builders a mapping ``key(need) -> path``; the
-builders read only those paths. ``settings_for`` gives the narrow settings an output reads, so
+(``workflow/rules/common.smk``) and hands the builders a mapping ``key(need) -> path`` (the
+claims ledger: ``need -> path``, the tuples as they are); the builders read only those paths. ``settings_for`` gives the narrow settings an output reads, so
 editing one table's format rebuilds that table only.
 """
 
