@@ -60,6 +60,8 @@ def test_a_spec_refuses_what_it_cannot_decide():
     ):
         with pytest.raises(ValueError, match=base.family):
             ClaimSpec(**{**kw, **bad})
+    with pytest.raises(TypeError):  # keyword fields only: an entry names what each value is
+        ClaimSpec(*kw.values())
 
 
 def test_origins_by_id():

@@ -162,19 +162,6 @@ def _per_seed(df: pd.DataFrame) -> list[pd.DataFrame]:
     return [g for _, g in df.groupby("seed")] if "seed" in df.columns else [df]
 
 
-def damping_offsets(summaries: Sequence[Mapping[str, float]]) -> list[float]:
-    """How far each seed's median zeta_hat is from the truth, |median - true| / true: what the
-    damping claims of every prior measure (ours' "not recovered", the others' "recovered").
-
-    Args:
-        summaries (Sequence[Mapping[str, float]]): per-seed ``median_zeta`` and ``zeta_true``.
-
-    Returns:
-        list[float]: one fraction per seed.
-    """
-    return [abs(v["median_zeta"] - v["zeta_true"]) / v["zeta_true"] for v in summaries]
-
-
 def _recovery_table(
     damping: Mapping[str, Mapping[str, Sequence[Mapping[str, float]]]],
 ) -> pd.DataFrame | None:
