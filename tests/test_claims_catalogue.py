@@ -55,11 +55,13 @@ def test_a_spec_refuses_what_it_cannot_decide():
         {"origin": "both"},
         {"of": "fields"},
         {"threshold": "NOPE"},
-        {"over": "every_leaf"},
+        {"over": "every_leaf"},  # a name, not the scope itself
         {"read": "a_cell"},
     ):
         with pytest.raises(ValueError, match=base.family):
             ClaimSpec(**{**kw, **bad})
+    with pytest.raises(TypeError):  # keyword fields only: an entry names what each value is
+        ClaimSpec(*kw.values())
 
 
 def test_origins_by_id():
@@ -102,11 +104,12 @@ def test_a_new_family_is_one_entry(monkeypatch):
 
     from physgs.report import claims, record
 
+    fits = next(s for s in CATALOGUE if s.family == "fits_window")
     new = ClaimSpec(
-        "fits_window_strictly", "ours", "fit_models", "tab_fit", "fit_fraction",
-        "FIT_BAR", ">", "fraction",
-        "{tree}: {fit_label} fits its window", "tab_fit: ceiling fraction",
-        "this project", origin="project", headline="every model fits its window",
+        family="fits_window_strictly", over=fits.over, table="tab_fit", read=fits.read,
+        threshold="FIT_BAR", side=">", unit="fraction",
+        text="{tree}: {fit_label} fits its window", source="tab_fit: ceiling fraction",
+        paper="this project", origin="project", headline="every model fits its window",
         one_sided="a bar",
     )  # fmt: skip
     monkeypatch.setattr(catalogue, "CATALOGUE", (*CATALOGUE, new))

@@ -529,3 +529,49 @@ def test_the_ledger_says_whether_the_papers_figure_is_reproduced():
     assert r["paper_low"] == pytest.approx(0.26) and r["paper_in_interval"] == "outside"
     assert df.loc["margin_grows/sparse", "paper_low"] == pytest.approx(0.81)
     assert df.loc["transfer_ours_ahead/sparse/0.84", "paper_in_interval"] == ""  # no number
+
+
+def test_the_ledger_reads_its_files_by_need_tuple(monkeypatch, tmp_path):
+    """claims_frame takes need tuples to paths (never a joined name split again): each prior's
+    recovery records reach its damping claims, one per seed, and tab_fit its fit claims."""
+    from types import SimpleNamespace
+
+    from physgs.report import build
+
+    zeta = {
+        ("ours", 0): 0.10,
+        ("ours", 1): 0.12,
+        ("ours_chain", 0): 0.081,
+        ("ours_chain", 1): 0.079,
+    }
+    records = {}
+    inputs = {}
+    for (model, seed), z in zeta.items():
+        path = str(tmp_path / f"{model}_{seed}.json")
+        records[path] = SimpleNamespace(
+            damping=SimpleNamespace(median_zeta=z, zeta_true=0.08, loglog_exponent=0.0)
+        )
+        inputs[("recovery", "sparse", model, "joint32", seed)] = path
+    monkeypatch.setattr(build, "load_recovery", records.__getitem__)
+    fit = pd.DataFrame(
+        [
+            {"seed": s, "tree": "sparse", "model": m, "ceiling_frac": 0.9}
+            for s in (0, 1)
+            for m in (*models_of("field"), "ours")
+        ]
+    )
+    # the chain's tab_psnr row makes it a prior of the run (its claims are asked)
+    psnr = pd.DataFrame(
+        [{"seed": 0, "model": "ours_chain", "sparse_view": 25.0, "sparse_time": 24.0}]
+    )
+    for name, df in (("tab_fit", fit), ("tab_psnr", psnr)):
+        df.to_csv(tmp_path / f"{name}.csv", index=False)
+        inputs[("table", name)] = str(tmp_path / f"{name}.csv")
+    led = build.claims_frame(inputs, ["sparse"], ROLES).set_index("id")
+    # |zeta_hat - 0.08| / 0.08 per seed, averaged by hand
+    ours = led.loc["damping_not_recovered/sparse"]
+    assert ours["seeds"] == 2 and ours["measured"] == pytest.approx((0.25 + 0.5) / 2)
+    chain = led.loc["ours_chain/damping_recovered/sparse"]
+    assert chain["measured"] == pytest.approx((0.001 + 0.001) / 0.08 / 2)
+    assert led.loc["fits_window/sparse/ours", "measured"] == pytest.approx(0.9)
+    assert led.loc["null_factor/sparse", "verdict"] == "undecided: not measured"

@@ -45,8 +45,8 @@ def main() -> None:
         fields = dict(zip(build.NEED_FIELDS[need[0]], need[1:]))
         path = args.results / paths[need[0]].format(**fields)
         if path.exists():
-            inputs[build.key(need)] = str(path)
-    missing = sorted({build.key(n) for n in needs} - set(inputs))
+            inputs[need] = str(path)
+    missing = sorted(build.key(n) for n in needs if n not in inputs)
     df = build.claims_frame(inputs, trees, roles_of(cfg["presets"], trees))
     md = claims.ledger_markdown(df, {"seeds": " ".join(map(str, seeds)), "partial": "yes"})
     print(md)

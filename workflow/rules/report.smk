@@ -63,10 +63,14 @@ rule report:
 
 # The claims ledger: every claim of the catalogue (physgs.report.catalogue) with its measured
 # value, seed interval and a verdict computed by code (physgs.report.claims); the tables it reads
-# are the catalogue's.
+# are the catalogue's. The script gets the need tuples too: the ledger reads by tuple, never by
+# a name split apart again.
+CLAIMS_NEEDS = _build.claims_needs(REPORT_PLAN)
+
+
 rule claims:
     input:
-        unpack(lambda wc: need_paths(_build.claims_needs(REPORT_PLAN))),
+        unpack(lambda wc: need_paths(CLAIMS_NEEDS)),
     output:
         md=report("results/claims.md", category="5. Claims"),
         csv="results/claims.csv",
@@ -82,5 +86,6 @@ rule claims:
         trees=TREES,
         stamp=STAMP,
         roles=_claim_cells.roles_of(CFG["presets"], TREES),
+        needs=CLAIMS_NEEDS,
     script:
         "../scripts/claims.py"

@@ -5,8 +5,8 @@ declares what it needs as *need tuples* (``needs``): ``("eval" | "traj" | "panel
 model, config, seed)``, ``("recovery", tree, method, config, seed)``, ``("null", tree, K, seed)``,
 ``("kselect", tree, seed)``, ``("stats", tree)``, ``("table", name)`` and the rest of
 ``NEED_FIELDS``; seed is a training seed. The workflow maps each tuple to a path
-(``workflow/rules/common.smk``) and hands the builders a mapping ``key(need) -> path``; the
-builders read only those paths. ``settings_for`` gives the narrow settings an output reads, so
+(``workflow/rules/common.smk``) and hands the builders a mapping ``key(need) -> path`` (the
+claims ledger: ``need -> path``, the tuples as they are); the builders read only those paths. ``settings_for`` gives the narrow settings an output reads, so
 editing one table's format rebuilds that table only.
 """
 
@@ -107,7 +107,7 @@ def read_table(name: str, path) -> pd.DataFrame:
 
 
 def claims_frame(
-    inputs: Mapping[str, str],
+    inputs: Mapping[tuple, str],
     trees: Sequence[str],
     roles: Mapping[str, Mapping[str, str]] | None = None,
 ) -> pd.DataFrame:
@@ -118,24 +118,21 @@ def claims_frame(
     measured" (a partial run's ledger, ``tools/ledger.py``).
 
     Args:
-        inputs: need key -> path ([`claims_needs`][physgs.report.build.claims_needs]).
+        inputs: need tuple -> path ([`claims_needs`][physgs.report.build.claims_needs]).
         trees: the trees.
         roles: tree -> its preset's role (``claim_cells.roles_of``); None: no tree has one.
 
     Returns:
         The ledger, one row per claim.
     """
-    names = catalogue.tables()
     tabs = {
-        n: read_table(n, inputs[key(("table", n))]) for n in names if key(("table", n)) in inputs
+        n: read_table(n, inputs[("table", n)]) for n in catalogue.tables() if ("table", n) in inputs
     }
     damping: dict[str, dict[str, list]] = {}  # model -> tree -> one summary per seed
-    for k, p in sorted(inputs.items()):  # recovery/<tree>/<model>/<config>/<seed>
-        kind, tree, *rest = k.split("/")
-        if kind != "recovery":
-            continue
-        d = load_recovery(p).damping
-        damping.setdefault(rest[0], {}).setdefault(tree, []).append(
+    for need in sorted(n for n in inputs if n[0] == "recovery"):
+        _, tree, model, _, _ = need  # ("recovery", tree, model, config, seed)
+        d = load_recovery(inputs[need]).damping
+        damping.setdefault(model, {}).setdefault(tree, []).append(
             {
                 "median_zeta": d.median_zeta,
                 "zeta_true": d.zeta_true,
@@ -147,7 +144,7 @@ def claims_frame(
 
 
 def make_claims(
-    inputs: Mapping[str, str],
+    inputs: Mapping[tuple, str],
     trees: Sequence[str],
     md_path,
     csv_path,
@@ -158,7 +155,7 @@ def make_claims(
     ([`claims_frame`][physgs.report.build.claims_frame]) and write results/claims.md and .csv.
 
     Args:
-        inputs: need key -> path.
+        inputs: need tuple -> path.
         trees: the trees.
         md_path (str | Path): the Markdown ledger to write.
         csv_path (str | Path): the CSV ledger to write.

@@ -2,15 +2,16 @@
 
 An entry ([`ClaimSpec`][physgs.report.catalogue.ClaimSpec]) says what the family ranges over
 (its scope: trees, cells of a table, and, for ``of="priors"``, every prior of the registry other
-than ours that the run's tables hold), the table and the cells it reads, its threshold (a name
-of [`physgs.report.thresholds`][physgs.report.thresholds]) and side, its unit, its sentence, the
-paper's figure, whether it carries the story (a headline, with the words the README uses), and
-its origin: the paper's claim, or this project's own. [`physgs.report.claims.measure`][] loops
-over it; the tables the ledger reads, the README's headline families and the list of claims on
-the claims page ([`markdown`][physgs.report.catalogue.markdown]) are derived from it.
+than ours that the run's tables hold), the table and how one seed's value is read from it (its
+reader), its threshold (a name of [`physgs.report.thresholds`][physgs.report.thresholds]) and
+side, its unit, its sentence, the paper's figure, whether it carries the story (a headline, with
+the words the README uses), and its origin: the paper's claim, or this project's own.
+[`physgs.report.claims.measure`][] loops over it; the tables the ledger reads, the README's
+headline families and the list of claims on the claims page
+([`markdown`][physgs.report.catalogue.markdown]) are derived from it.
 
-Adding a claim family is one entry here (and, when no reader or scope fits, one function in
-[`physgs.report.claim_cells`][physgs.report.claim_cells]).
+Adding a claim family is one entry here, with its scope and reader beside it (the shared ones
+come first; a scope's docstring is what the claims page says the family ranges over).
 
 Entries are Python, not YAML: a family's scope and reader are functions over the tables, and a
 frozen dataclass keeps them typed and importable where a YAML file would need a small language
@@ -26,10 +27,33 @@ from typing import Callable, Sequence
 import numpy as np
 import pandas as pd
 
-from physgs.models.registry import MODELS, PRIOR_VARIANTS, label, models_of
-from physgs.report import claim_cells as cc
+from physgs.models.registry import (
+    BLIND_CONFIG,
+    BLIND_PRIORS,
+    MODELS,
+    PRIOR_VARIANTS,
+    label,
+    models_of,
+    spec_of,
+)
 from physgs.report import paper, thresholds
-from physgs.report.claim_cells import CONFIG, READERS, RECOVERY, SCOPES, Cell
+from physgs.report.claim_cells import (
+    CONFIG,
+    FIELD_KINDS,
+    RECOVERY,
+    SEPARATED,
+    TILED,
+    Cell,
+    Reader,
+    Run,
+    Scope,
+    fields,
+    fields_of_kind,
+    rows_of,
+    value,
+)
+from physgs.report.tables import OMA
+from physgs.testbed.variant import DAMPING
 
 #: The origins of a claim: stated by the source paper, or this project's own.
 ORIGINS = ("paper", "project")
@@ -50,9 +74,43 @@ SIDES = (">", "<", WITHIN)
 AHEAD = "ahead_of_fields"
 #: Names a sentence may use: every threshold, and the ledger's recovery configuration.
 WORDS = {k: v for k, v in vars(thresholds).items() if k.isupper()} | {"CONFIG": CONFIG}
+#: A paper's value in a claim's unit: (low, high), equal ends for a single figure; NaN: none.
+NO_VALUE = (float("nan"), float("nan"))
 
 
 @dataclass(frozen=True)
+class Figure:
+    """A figure the paper states ([`physgs.report.paper`][physgs.report.paper]), for one cell.
+
+    Attributes:
+        what: what the figure is and where the paper gives it (the claims page prints it).
+        value: the cell -> ``(low, high)`` in the claim's unit (equal ends for one figure);
+            ``NO_VALUE`` where the paper gives none.
+        words: the figure as the ledger prints it: a ``str.format`` template of the cell's
+            fields and ``v`` (``value``'s low end; "--" where it is NaN), or a function of the
+            cell.
+    """
+
+    what: str
+    value: Callable[[Cell], tuple[float, float]]
+    words: str | Callable[[Cell], str]
+
+    def text(self, cell: Cell) -> str:
+        """The figure of ``cell`` as the ledger prints it.
+
+        Args:
+            cell: the claim's cell.
+
+        Returns:
+            The words; "--" where the paper gives no number.
+        """
+        if callable(self.words):
+            return self.words(cell)
+        v = self.value(cell)[0]
+        return self.words.format(v=v, **cell) if np.isfinite(v) else "--"
+
+
+@dataclass(frozen=True, kw_only=True)
 class ClaimSpec:
     """One claim family of the ledger.
 
@@ -60,10 +118,9 @@ class ClaimSpec:
         family: the claim id's family (ids are ``[<prior>/]<family>[/<cell>]``).
         of: ``"ours"`` (asked once) or ``"priors"`` (asked of every prior of the registry other
             than ours that the run's tables hold, ids prefixed by the prior's).
-        over: its scope, a name of ``claim_cells.SCOPES`` (the run -> the family's cells).
+        over: its scope (the run -> the family's cells; ``claim_cells.Scope``).
         table: the table it reads (``claim_cells.RECOVERY``: the priors' damping summaries).
-        read: its reader, a name of ``claim_cells.READERS`` (one seed's rows and a cell -> the
-            value).
+        read: its reader (one seed's rows and a cell -> the value; ``claim_cells.Reader``).
         threshold: a name of ``physgs.report.thresholds``, ``-`` in front to negate it.
         side: ``">"`` or ``"<"``: the side of the threshold the claim holds on; ``WITHIN``: an
             equivalence claim (flat, equal, matching), inside (-threshold, +threshold).
@@ -71,7 +128,8 @@ class ClaimSpec:
         text: the claim's sentence (``str.format`` fields: the cell's, ``name`` of the prior,
             ``WORDS``).
         source: where it is measured (same fields, and ``table``).
-        paper: the paper's figure, or a function of the cell giving it.
+        paper: the paper's figure: words (same fields), or a
+            [`Figure`][physgs.report.catalogue.Figure] (its value in the claim's unit too).
         origin: ``"paper"`` or ``"project"`` (``ORIGINS``).
         headline: the words the README tells the family with; "" when it is not a headline.
         needs_variance: False for a claim about the fixed testbed (a verdict from one value).
@@ -80,35 +138,33 @@ class ClaimSpec:
         one_sided: why a one-sided test (``">"``, ``"<"``) is the claim's own test; required
             for every side but ``WITHIN``: a claim of flatness, equality or match is tested
             inside a band, never one-sided without a stated reason.
-        paper_value: the paper's figure in the claim's unit, ``(low, high)`` (equal ends for
-            one figure); None where the paper gives no number.
         requires: a family whose claim on the same cell must hold for this one to hold (a
             coverage holds only where its intervals also beat the null's interval score); ""
             for none.
     """
 
     family: str
-    of: str
-    over: str
+    of: str = "ours"
+    over: Scope
     table: str
-    read: str
+    read: Reader
     threshold: str
     side: str
     unit: str
     text: str
     source: str
-    paper: str | Callable[[Cell], str] = "--"
+    paper: str | Figure = "--"
     origin: str = "paper"
     headline: str = ""
     needs_variance: bool = True
     optional: bool = False
     one_sided: str = ""
-    paper_value: Callable[[Cell], tuple[float, float]] | None = None
     requires: str = ""
 
     def __post_init__(self):
-        """Refuse an unknown side, origin, scope, reader or threshold name, a one-sided claim
-        without its reason, and an equivalence band on a ratio, naming the family."""
+        """Refuse an unknown side, origin or threshold name, a scope or reader that is not a
+        function, a one-sided claim without its reason, and an equivalence band on a ratio,
+        naming the family."""
         if self.side not in SIDES or self.origin not in ORIGINS:
             raise ValueError(f"claim {self.family!r}: side in {SIDES}, origin in {ORIGINS}")
         if (self.side == WITHIN) == bool(self.one_sided):
@@ -122,39 +178,14 @@ class ClaimSpec:
             raise ValueError(f"claim {self.family!r}: of must be 'ours' or 'priors'")
         if self.threshold.lstrip("-") not in WORDS:
             raise ValueError(f"claim {self.family!r}: no threshold {self.threshold!r}")
-        if self.over not in SCOPES or self.read not in READERS:
-            raise ValueError(
-                f"claim {self.family!r}: no scope {self.over!r} or reader {self.read!r}"
-            )
+        if not (callable(self.over) and callable(self.read)):
+            raise ValueError(f"claim {self.family!r}: its scope and reader are functions")
 
     @property
     def value(self) -> float:
         """The threshold's value."""
         v = float(WORDS[self.threshold.lstrip("-")])
         return -v if self.threshold.startswith("-") else v
-
-    def cells(self, run: cc.Run) -> list[Cell]:
-        """The family's cells in ``run`` (its scope).
-
-        Args:
-            run: what the family is asked of.
-
-        Returns:
-            One cell per claim.
-        """
-        return SCOPES[self.over](run)
-
-    def measure(self, rows: pd.DataFrame, cell: Cell) -> float:
-        """One seed's value of the claim of ``cell`` (its reader).
-
-        Args:
-            rows: one seed's rows of the family's table.
-            cell: the claim's cell.
-
-        Returns:
-            The value, in ``unit``; NaN where the rows are not there.
-        """
-        return float(READERS[self.read](rows, cell))
 
     def claim_id(self, cell: Cell, family: str = "") -> str:
         """The id of the claim of ``cell``.
@@ -191,7 +222,7 @@ class ClaimSpec:
         Returns:
             ``(low, high)``; NaN ends where the paper gives no number.
         """
-        return self.paper_value(cell) if self.paper_value else NO_VALUE
+        return self.paper.value(cell) if isinstance(self.paper, Figure) else NO_VALUE
 
     def figure(self, cell: Cell) -> str:
         """The paper's figure for the claim of ``cell``.
@@ -202,126 +233,10 @@ class ClaimSpec:
         Returns:
             ``paper``, filled in or computed.
         """
-        return self.paper(cell) if callable(self.paper) else self.words(self.paper, cell)
+        if isinstance(self.paper, Figure):
+            return self.paper.text(cell)
+        return self.words(self.paper, cell)
 
-
-# ---- the paper's figures ---------------------------------------------------------------------
-#: A paper's value in a claim's unit: (low, high), equal ends for a single figure; NaN: none.
-NO_VALUE = (float("nan"), float("nan"))
-
-
-def _paper_tree(c: Cell) -> str | None:
-    """The paper's tree the cell's tree stands for (its preset's ``role.paper``)."""
-    return c.get("paper")
-
-
-def _pp(c: Cell):
-    return paper.PSNR.get(_paper_tree(c))
-
-
-def _point(x: float) -> tuple[float, float]:
-    return (float(x), float(x))
-
-
-def _value_best_field_minus_static(c: Cell) -> tuple[float, float]:
-    pp = _pp(c)
-    return _point(max(pp[m][1] - pp["static"][1] for m in cc.fields())) if pp else NO_VALUE
-
-
-def _value_kind_minus_static(c: Cell) -> tuple[float, float]:
-    pp = _pp(c)
-    ms = cc.fields_of_kind(c["kind"])
-    return _point(max(pp[m][1] - pp["static"][1] for m in ms)) if pp else NO_VALUE
-
-
-def _value_ours_minus_static(c: Cell) -> tuple[float, float]:
-    pp = _pp(c)
-    return _point(pp["ours"][1] - pp["static"][1]) if pp else NO_VALUE
-
-
-def _value_ours_behind(c: Cell) -> tuple[float, float]:
-    pp = _pp(c)
-    return _point(pp["ours"][0] - max(pp[m][0] for m in cc.fields())) if pp else NO_VALUE
-
-
-def _value_null_ratio(c: Cell) -> tuple[float, float]:
-    tr, nl = paper.NULL.get(_paper_tree(c), (np.nan, np.nan))
-    return _point(nl / tr)
-
-
-def _value_null_difference(c: Cell) -> tuple[float, float]:
-    tr, nl = paper.NULL.get(_paper_tree(c), (np.nan, np.nan))
-    return _point(tr - nl)
-
-
-def _value_margin(c: Cell) -> tuple[float, float]:
-    p = paper.MARGIN.get(_paper_tree(c))
-    return _point(p[-1] - p[0]) if p else NO_VALUE
-
-
-def _value_zeta_off(c: Cell) -> tuple[float, float]:
-    """The paper's median zeta_hat range as |zeta_hat - 0.08| / 0.08 (its truth)."""
-    z = paper.ZETA.get(_paper_tree(c))
-    if not z:
-        return NO_VALUE
-    ends = sorted(abs(float(x) - paper.ZETA_TRUE) / paper.ZETA_TRUE for x in z.split("-"))
-    return (ends[0], ends[-1])
-
-
-def _paper_best_field_minus_static(c: Cell) -> str:
-    """best learned field - static beyond the window, tab:psnr"""
-    v = _value_best_field_minus_static(c)[0]
-    return f"best baseline - static = {v:+.2f} dB" if np.isfinite(v) else "--"
-
-
-def _paper_kind_minus_static(c: Cell) -> str:
-    """the kind's best learned field - static beyond the window, tab:psnr"""
-    v = _value_kind_minus_static(c)[0]
-    return f"best {c['kind_words']} baseline - static = {v:+.2f} dB" if np.isfinite(v) else "--"
-
-
-def _paper_ours_minus_static(c: Cell) -> str:
-    """ours - static beyond the window, tab:psnr"""
-    v = _value_ours_minus_static(c)[0]
-    return f"{v:+.2f} dB" if np.isfinite(v) else "--"
-
-
-def _paper_ours_behind(c: Cell) -> str:
-    """ours - best learned field on held-out views, tab:psnr"""
-    v = _value_ours_behind(c)[0]
-    return f"{v:+.2f} dB" if np.isfinite(v) else "--"
-
-
-def _paper_null_ratio(c: Cell) -> str:
-    """null / trained median omega error, tab:null"""
-    v = _value_null_ratio(c)[0]
-    return f"null / trained = {v:.2f}" if np.isfinite(v) else "--"
-
-
-def _paper_null_difference(c: Cell) -> str:
-    """trained - null median omega error, tab:null"""
-    v = _value_null_difference(c)[0]
-    return f"trained - null = {v:+.2f} points" if np.isfinite(v) else "--"
-
-
-def _paper_gap(c: Cell) -> str:
-    """the median nearest-bone gap, section 4"""
-    return f"{paper.NEAREST_BONE_GAP_PCT[c['paper']]:.2f}%"
-
-
-def _paper_zeta(c: Cell) -> str:
-    """the median fitted zeta, section 4"""
-    z = paper.ZETA.get(_paper_tree(c))
-    return f"median zeta_hat {z} vs {paper.ZETA_TRUE:g}" if z else "--"
-
-
-def _paper_margin(c: Cell) -> str:
-    """the margin's growth from the training wind to the farthest, tab:margin"""
-    v = _value_margin(c)[0]
-    return f"{v:+.2f} dB" if np.isfinite(v) else "--"
-
-
-TRACKS_PROPOSAL = "not run (the paper's closing proposal)"
 
 # ---- why a family is one-sided (``ClaimSpec.one_sided``) -----------------------------------------
 #: a sign: the claim says which is ahead, not by how much (its size: ``paper_in_interval``)
@@ -344,228 +259,652 @@ KIND_DIRECTION = (
 NON_INFERIOR = (
     "non-inferiority: the claim is that the other does not lose, and its winning supports it too"
 )
+#: a margin's growth: its sign
+GROWS = "a direction: the margin grows, not by how much"
+#: an interval's width bar
+INFORMATIVE = (
+    "a bar: an interval at most this wide says something; narrower never hurts "
+    "(its misses are the interval score's)"
+)
 
-# ---- the catalogue ---------------------------------------------------------------------------
-#: Every claim family, in the ledger's order.
-CATALOGUE: tuple[ClaimSpec, ...] = (
-    # the paper's: beyond the window and on held-out views (tab:psnr)
+#: The paper's figure of a family the paper does not state.
+PROJECT_ONLY = "not in the paper (this project's)"
+TRACKS_PROPOSAL = "not run (the paper's closing proposal)"
+
+
+# ---- scopes and readers several families share ---------------------------------------------------
+def _trees(run: Run) -> list[Cell]:
+    """each tree"""
+    return [{"suffix": t, "tree": t, "paper": run.role(t, "paper")} for t in run.trees]
+
+
+def _with_role(run: Run, role: str) -> list[Cell]:
+    """The trees whose preset declares their frequencies ``role``."""
+    return [c for c in _trees(run) if run.role(c["tree"], "frequencies") == role]
+
+
+def _recovered_trees(run: Run) -> list[Cell]:
+    """each tree with the asked prior's recovery records (joint K = 32)"""
+    rec = run.own
+    if rec is None:
+        return []
+    have = set(rec.loc[rec["model"] == run.model, "tree"])
+    return [{**c, "config": CONFIG} for c in _trees(run) if c["tree"] in have]
+
+
+def _psnr(d: pd.DataFrame, c: Cell, models: Sequence[str], split: str = "time") -> float:
+    """tab_psnr: the best of ``models``' ``<tree>_<split>`` cells (by model id)."""
+    return max(value(d, d["model"].astype(str) == m, f"{c['tree']}_{split}") for m in models)
+
+
+def _ahead_of_fields(d: pd.DataFrame, c: Cell) -> float:
+    """tab_psnr, the cell's split: the prior - max over learned fields"""
+    sp = c.get("split", "view")
+    return _psnr(d, c, [c["model"]], sp) - _psnr(d, c, fields(), sp)
+
+
+def _winds_beyond(run: Run) -> list[Cell]:
+    """each tree x unseen wind of tab_transfer, beyond the window"""
+    tr = run.own
+    if tr is None:
+        return []
+    beyond = tr[tr["split"] == "beyond"] if "split" in tr.columns else tr
+    return [
+        {"suffix": f"{t}/{c:.2f}", "tree": t, "condition": c, "cond": f"{c:.2f}", "split": "beyond"}
+        for (t, c), _ in beyond.groupby(["tree", "condition"], sort=False)
+    ]
+
+
+def _transfer(d: pd.DataFrame, c: Cell, models: Sequence[str]) -> float:
+    """tab_transfer: the best of ``models`` in the cell's split, tree and wind."""
+    row = (
+        (d["split"] == c["split"])
+        & (d["tree"] == c["tree"])
+        & np.isclose(d["condition"], c["condition"])
+    )
+    return max(value(d, row, m) for m in models)
+
+
+def _wind_ahead(d: pd.DataFrame, c: Cell) -> float:
+    """tab_transfer: the prior - max over learned fields"""
+    return _transfer(d, c, [c["model"]]) - _transfer(d, c, fields())
+
+
+def _margin_trees(run: Run) -> list[Cell]:
+    """each tree, tab_margin's first and last wind"""
+    mg = run.own
+    cols = [c for c in mg.columns if c.startswith("margin_")] if mg is not None else []
+    first, last = (cols[0], cols[-1]) if cols else ("first", "last")
+    return [{**c, "first": first, "last": last} for c in _trees(run)]
+
+
+def _margin_growth(d: pd.DataFrame, c: Cell) -> float:
+    """tab_margin: the prior's last wind's margin - its first's"""
+    mine = (d["tree"] == c["tree"]) & rows_of(d, c["model"], "model")
+    return value(d, mine, c["last"]) - value(d, mine, c["first"])
+
+
+def _null_trees_separated(run: Run) -> list[Cell]:
+    """each tree of separated frequencies, in the ledger's recovery configuration (joint K =
+    32)"""
+    return [{**c, "config": CONFIG, "method": run.model} for c in _with_role(run, SEPARATED)]
+
+
+def _null_row(d: pd.DataFrame, c: Cell, who: str = "") -> pd.Series:
+    """tab_null / tab_recovery: the row of method ``who`` (default: the cell's) in the cell's
+    tree and configuration."""
+    who = who or c.get("method", c["model"])
+    return rows_of(d, who) & (d["tree"] == c["tree"]) & (d["config"] == c["config"])
+
+
+def _null_over_trained(d: pd.DataFrame, c: Cell) -> float:
+    """tab_null / tab_recovery: null / trained median omega error of the cell's method"""
+    row = _null_row(d, c)
+    return value(d, row, "null_median_rel_err_pct") / value(d, row, "trained_median_rel_err_pct")
+
+
+def _trained_minus_null(d: pd.DataFrame, c: Cell) -> float:
+    """tab_null / tab_recovery: trained - null median omega error of the cell's method (points)"""
+    row = _null_row(d, c)
+    return value(d, row, "trained_median_rel_err_pct") - value(d, row, "null_median_rel_err_pct")
+
+
+def _damping_off(d: pd.DataFrame, c: Cell) -> float:
+    """the prior's recovery: |median zeta_hat - zeta| / zeta"""
+    row = (d["model"] == c["model"]) & (d["tree"] == c["tree"])
+    z = value(d, row, "zeta_true")
+    return abs(value(d, row, "median_zeta") - z) / z
+
+
+def _decay_exponent(d: pd.DataFrame, c: Cell) -> float:
+    """the prior's recovery: the exponent p of gamma ~ omega^p"""
+    return value(d, (d["model"] == c["model"]) & (d["tree"] == c["tree"]), "loglog_exponent")
+
+
+# ---- the paper's figures (``ClaimSpec.paper``) ---------------------------------------------------
+def _point(x: float) -> tuple[float, float]:
+    """A single figure as ``(low, high)``."""
+    return (float(x), float(x))
+
+
+def _tab_psnr(c: Cell, f: Callable[[dict], float]) -> tuple[float, float]:
+    """``f`` of the cell's paper tree's tab:psnr ((view, time) dB per model); none without."""
+    pp = paper.PSNR.get(c.get("paper"))
+    return _point(f(pp)) if pp else NO_VALUE
+
+
+def _tab_null(c: Cell, f: Callable[[float, float], float]) -> tuple[float, float]:
+    """``f`` of the cell's paper tree's tab:null (trained, null median omega error, %)."""
+    return _point(f(*paper.NULL.get(c.get("paper"), (np.nan, np.nan))))
+
+
+def _zeta_off(c: Cell) -> tuple[float, float]:
+    """The paper's median zeta_hat range as |zeta_hat - 0.08| / 0.08 (its truth)."""
+    z = paper.ZETA.get(c.get("paper"))
+    if not z:
+        return NO_VALUE
+    ends = sorted(abs(float(x) - paper.ZETA_TRUE) / paper.ZETA_TRUE for x in z.split("-"))
+    return (ends[0], ends[-1])
+
+
+def _margin(c: Cell) -> tuple[float, float]:
+    """tab:margin's last wind - its first (dB)."""
+    p = paper.MARGIN.get(c.get("paper"))
+    return _point(p[-1] - p[0]) if p else NO_VALUE
+
+
+NULL_RATIO = Figure(
+    "null / trained median omega error, tab:null",
+    lambda c: _tab_null(c, lambda tr, nl: nl / tr),
+    "null / trained = {v:.2f}",
+)
+
+
+# ---- the paper's: beyond the window and on held-out views (tab:psnr), unseen wind (tab:transfer)
+_MOTION = (
     ClaimSpec(
-        "ours_above_static_beyond", "ours", "trees", "tab_psnr", "above_static",
-        "EVEN", ">", "dB",
-        "{tree}: ours is above the static pose beyond the window",
-        "tab_psnr, time column: ours - static",
-        _paper_ours_minus_static,
+        family="ours_above_static_beyond", over=_trees, table="tab_psnr",
+        read=lambda d, c: _psnr(d, c, [c["model"]]) - _psnr(d, c, ["static"]),
+        threshold="EVEN", side=">", unit="dB",
+        text="{tree}: ours is above the static pose beyond the window",
+        source="tab_psnr, time column: ours - static",
+        paper=Figure(
+            "ours - static beyond the window, tab:psnr",
+            lambda c: _tab_psnr(c, lambda pp: pp["ours"][1] - pp["static"][1]),
+            "{v:+.2f} dB",
+        ),
         headline="ours above the static pose beyond the training window",
         one_sided=DIRECTION,
-        paper_value=_value_ours_minus_static,
     ),
     ClaimSpec(
-        "baselines_below_static_beyond", "ours", "trees", "tab_psnr",
-        "best_field_minus_static", "EVEN", "<", "dB",
-        "{tree}: every learned baseline is below the static pose beyond the window",
-        "tab_psnr, time column: max over learned fields of (model - static)",
-        _paper_best_field_minus_static,
+        family="baselines_below_static_beyond", over=_trees, table="tab_psnr",
+        read=lambda d, c: _psnr(d, c, fields()) - _psnr(d, c, ["static"]),
+        threshold="EVEN", side="<", unit="dB",
+        text="{tree}: every learned baseline is below the static pose beyond the window",
+        source="tab_psnr, time column: max over learned fields of (model - static)",
+        paper=Figure(
+            "best learned field - static beyond the window, tab:psnr",
+            lambda c: _tab_psnr(c, lambda pp: max(pp[m][1] - pp["static"][1] for m in fields())),
+            "best baseline - static = {v:+.2f} dB",
+        ),
         headline="every learned field below static beyond the window",
         one_sided=DIRECTION,
-        paper_value=_value_best_field_minus_static,
     ),
     ClaimSpec(
-        "ours_behind_on_views", "ours", "trees", "tab_psnr", "ahead_of_fields",
-        "EVEN", "<", "dB",
-        "{tree}: ours is behind the best learned field on held-out views",
-        "tab_psnr, view column: ours - max over learned fields",
-        _paper_ours_behind,
+        family="ours_behind_on_views", over=_trees, table="tab_psnr", read=_ahead_of_fields,
+        threshold="EVEN", side="<", unit="dB",
+        text="{tree}: ours is behind the best learned field on held-out views",
+        source="tab_psnr, view column: ours - max over learned fields",
+        paper=Figure(
+            "ours - best learned field on held-out views, tab:psnr",
+            lambda c: _tab_psnr(c, lambda pp: pp["ours"][0] - max(pp[m][0] for m in fields())),
+            "{v:+.2f} dB",
+        ),
         one_sided=DIRECTION,
-        paper_value=_value_ours_behind,
     ),
-    # the paper's: unseen wind (tab:transfer, tab:margin)
     ClaimSpec(
-        "transfer_ours_ahead", "ours", "winds_beyond", "tab_transfer", "wind_ahead",
-        "EVEN", ">", "dB",
-        "{tree}, {cond} v0, beyond the window: ours ahead of the best baseline",
-        "tab_transfer (beyond): ours - max learned",
-        "ahead in every cell, by 0.38-4.68 dB",
+        family="transfer_ours_ahead", over=_winds_beyond, table="tab_transfer", read=_wind_ahead,
+        threshold="EVEN", side=">", unit="dB",
+        text="{tree}, {cond} v0, beyond the window: ours ahead of the best baseline",
+        source="tab_transfer (beyond): ours - max learned",
+        paper="ahead in every cell, by 0.38-4.68 dB",
         headline="ours ahead of the best learned field under unseen wind",
         one_sided=DIRECTION,
     ),
     ClaimSpec(
-        "transfer_baselines_below_static", "ours", "winds_beyond", "tab_transfer",
-        "wind_fields_minus_static", "EVEN", "<", "dB",
-        "{tree}, {cond} v0, beyond the window: every learned baseline below static",
-        "tab_transfer (beyond): max learned - static",
-        "below static in all 24 cells, by 0.10-2.79 dB",
+        family="transfer_baselines_below_static", over=_winds_beyond, table="tab_transfer",
+        read=lambda d, c: _transfer(d, c, fields()) - _transfer(d, c, ["static"]),
+        threshold="EVEN", side="<", unit="dB",
+        text="{tree}, {cond} v0, beyond the window: every learned baseline below static",
+        source="tab_transfer (beyond): max learned - static",
+        paper="below static in all 24 cells, by 0.10-2.79 dB",
         one_sided=DIRECTION,
     ),
-    # this project's: the two headlines above split by kind of field (wind-blind,
-    # wind-conditioned: the registry's ``ModelSpec.wind``), so the ledger says which kind
-    # contradicts the paper
+)  # fmt: skip
+
+
+# ---- this project's: the two headlines above split by kind of field (wind-blind,
+# wind-conditioned: the registry's ``ModelSpec.wind``), so the ledger says which kind contradicts
+# the paper --------------------------------------------------------------------------------------
+def _kind_cells(cells: list[Cell]) -> list[Cell]:
+    """``cells`` x each kind of learned field the registry holds, the kind in the suffix after
+    the tree."""
+    out = []
+    for c in cells:
+        for k, words in FIELD_KINDS.items():
+            ms = fields_of_kind(k)
+            if not ms:  # a registry without fields of this kind asks nothing of it
+                continue
+            rest = c["suffix"].split("/", 1)[1:]  # what follows the tree (a wind), if anything
+            out.append(
+                {
+                    **c,
+                    "suffix": "/".join([c["tree"], k, *rest]),
+                    "kind": k,
+                    "kind_words": words,
+                    "kind_fields": ", ".join(label(m) for m in ms),
+                }
+            )
+    return out
+
+
+def _kind_trees(run: Run) -> list[Cell]:
+    """each tree x each kind of learned field (wind-blind, wind-conditioned: whether its
+    registry entry reads the wind)"""
+    return _kind_cells(_trees(run))
+
+
+def _kind_winds_beyond(run: Run) -> list[Cell]:
+    """each tree x each kind of learned field (wind-blind, wind-conditioned: whether its
+    registry entry reads the wind) x unseen wind of tab_transfer, beyond the window"""
+    return _kind_cells(_winds_beyond(run))
+
+
+_KINDS = (
     ClaimSpec(
-        "kind_below_static_beyond", "ours", "kind_trees", "tab_psnr", "kind_minus_static",
-        "EVEN", "<", "dB",
-        "{tree}: every {kind_words} learned field ({kind_fields}) is below the static pose "
+        family="kind_below_static_beyond", over=_kind_trees, table="tab_psnr",
+        read=lambda d, c: _psnr(d, c, fields_of_kind(c["kind"])) - _psnr(d, c, ["static"]),
+        threshold="EVEN", side="<", unit="dB",
+        text="{tree}: every {kind_words} learned field ({kind_fields}) is below the static pose "
         "beyond the window",
-        "tab_psnr, time column: max over the {kind_words} fields of (model - static)",
-        _paper_kind_minus_static,
+        source="tab_psnr, time column: max over the {kind_words} fields of (model - static)",
+        paper=Figure(
+            "the kind's best learned field - static beyond the window, tab:psnr",
+            lambda c: _tab_psnr(
+                c, lambda pp: max(pp[m][1] - pp["static"][1] for m in fields_of_kind(c["kind"]))
+            ),
+            "best {kind_words} baseline - static = {v:+.2f} dB",
+        ),
         origin="project",
         one_sided=KIND_DIRECTION,
-        paper_value=_value_kind_minus_static,
     ),
     ClaimSpec(
-        "transfer_kind_below_static", "ours", "kind_winds_beyond", "tab_transfer",
-        "wind_kind_minus_static", "EVEN", "<", "dB",
-        "{tree}, {cond} v0, beyond the window: every {kind_words} learned field "
+        family="transfer_kind_below_static", over=_kind_winds_beyond, table="tab_transfer",
+        read=lambda d, c: _transfer(d, c, fields_of_kind(c["kind"])) - _transfer(d, c, ["static"]),
+        threshold="EVEN", side="<", unit="dB",
+        text="{tree}, {cond} v0, beyond the window: every {kind_words} learned field "
         "({kind_fields}) below static",
-        "tab_transfer (beyond): max {kind_words} learned - static",
-        "every baseline below static in all 24 cells",
+        source="tab_transfer (beyond): max {kind_words} learned - static",
+        paper="every baseline below static in all 24 cells",
         origin="project",
         one_sided=KIND_DIRECTION,
     ),
+    # the paper's: the margin under unseen wind (tab:margin)
     ClaimSpec(
-        "margin_grows", "ours", "margin_trees", "tab_margin", "margin_growth",
-        "EVEN", ">", "dB",
-        "{tree}: the margin against MLP + wind grows as the wind departs from training",
-        "tab_margin: {last} - {first}",
-        _paper_margin,
-        one_sided="a direction: the margin grows, not by how much",
-        paper_value=_value_margin,
+        family="margin_grows", over=_margin_trees, table="tab_margin", read=_margin_growth,
+        threshold="EVEN", side=">", unit="dB",
+        text="{tree}: the margin against MLP + wind grows as the wind departs from training",
+        source="tab_margin: {last} - {first}",
+        paper=Figure(
+            "the margin's growth from the training wind to the farthest, tab:margin",
+            _margin,
+            "{v:+.2f} dB",
+        ),
+        one_sided=GROWS,
     ),
-    # the paper's: recovery against the untrained null (tab:null, section 4)
+)  # fmt: skip
+
+
+# ---- the paper's: recovery against the untrained null (tab:null, section 4) ----------------------
+def _null_trees_tiled(run: Run) -> list[Cell]:
+    """each tree of tiled frequencies, in the ledger's recovery configuration (joint K = 32)"""
+    return [{**c, "config": CONFIG, "method": run.model} for c in _with_role(run, TILED)]
+
+
+def _gap_trees(run: Run) -> list[Cell]:
+    """each tree standing for a paper's tree whose nearest-bone gap the paper states"""
+    return [c for c in _trees(run) if c["paper"] in paper.NEAREST_BONE_GAP_PCT]
+
+
+def _gap_off(d: pd.DataFrame, c: Cell) -> float:
+    """tab_testbed: |nearest-bone gap - the paper's tree's| / the paper's"""
+    g = paper.NEAREST_BONE_GAP_PCT[c["paper"]]
+    return abs(value(d, d["tree"] == c["tree"], "nearest_bone_gap_pct") - g) / g
+
+
+def _zeta_words(c: Cell) -> str:
+    """The paper's median zeta_hat range beside the truth; "--" where it gives none."""
+    z = paper.ZETA.get(c.get("paper"))
+    return f"median zeta_hat {z} vs {paper.ZETA_TRUE:g}" if z else "--"
+
+
+def _fit_models(run: Run) -> list[Cell]:
+    """each tree x each learned field, ours and every other prior the tables hold"""
+    return [
+        {"suffix": f"{t}/{m}", "tree": t, "fit_model": m, "fit_label": label(m)}
+        for t in run.trees
+        for m in (*fields(), "ours", *run.others)
+    ]
+
+
+_RECOVERY = (
     ClaimSpec(
-        "null_factor", "ours", "null_trees_separated", "tab_null", "null_over_trained",
-        "NULL_FACTOR", ">", "ratio",
-        "{tree}: ... by the paper's factor of {NULL_FACTOR:g}",
-        "{table}, {config}: null / trained",
-        _paper_null_ratio,
+        family="null_factor", over=_null_trees_separated, table="tab_null",
+        read=_null_over_trained, threshold="NULL_FACTOR", side=">", unit="ratio",
+        text="{tree}: ... by the paper's factor of {NULL_FACTOR:g}",
+        source="{table}, {config}: null / trained",
+        paper=NULL_RATIO,
         headline="ours beats the untrained null by the paper's factor on frequency",
         one_sided="a lower bound: the paper's factor or more (a larger one supports it)",
-        paper_value=_value_null_ratio,
     ),
     ClaimSpec(
-        "null_loses", "ours", "null_trees_separated", "tab_null", "null_over_trained",
-        "RATIO_EVEN", ">", "ratio",
-        "{tree}: joint training beats the untrained null",
-        "{table}, {config}: null / trained median rel. error",
-        _paper_null_ratio,
+        family="null_loses", over=_null_trees_separated, table="tab_null",
+        read=_null_over_trained, threshold="RATIO_EVEN", side=">", unit="ratio",
+        text="{tree}: joint training beats the untrained null",
+        source="{table}, {config}: null / trained median rel. error",
+        paper=NULL_RATIO,
         one_sided=DIRECTION,
-        paper_value=_value_null_ratio,
     ),
     ClaimSpec(
-        "null_matches", "ours", "null_trees_tiled", "tab_null", "trained_minus_null",
-        "-NULL_MATCH_PP", ">", "points",
-        "{tree}: the untrained null matches the trained model (it is not beaten by "
+        family="null_matches", over=_null_trees_tiled, table="tab_null",
+        read=_trained_minus_null, threshold="-NULL_MATCH_PP", side=">", unit="points",
+        text="{tree}: the untrained null matches the trained model (it is not beaten by "
         "{NULL_MATCH_PP} points or more)",
-        "{table}, {config}: trained - null median rel. error (points)",
-        _paper_null_difference,
+        source="{table}, {config}: trained - null median rel. error (points)",
+        paper=Figure(
+            "trained - null median omega error, tab:null",
+            lambda c: _tab_null(c, lambda tr, nl: tr - nl),
+            "trained - null = {v:+.2f} points",
+        ),
         headline="the untrained null matches ours on frequency",
-        one_sided="non-inferiority of the null: the paper's point is that training adds nothing over it on these trees, which a null ahead of the trained model supports too",
-        paper_value=_value_null_difference,
+        one_sided="non-inferiority of the null: the paper's point is that training adds nothing "
+        "over it on these trees, which a null ahead of the trained model supports too",
     ),
     ClaimSpec(
-        "nearest_bone_gap", "ours", "gap_trees", "tab_testbed", "gap_off",
-        "GAP_RTOL", "<", "fraction",
-        "{tree}: the median nearest-bone gap is the paper's (within {GAP_RTOL:.0%} of it)",
-        "tab_testbed: |gap - paper| / paper",
-        _paper_gap,
+        family="nearest_bone_gap", over=_gap_trees, table="tab_testbed", read=_gap_off,
+        threshold="GAP_RTOL", side="<", unit="fraction",
+        text="{tree}: the median nearest-bone gap is the paper's (within {GAP_RTOL:.0%} of it)",
+        source="tab_testbed: |gap - paper| / paper",
+        paper=Figure(
+            "the median nearest-bone gap, section 4",
+            lambda c: NO_VALUE,  # a figure of the testbed, not in the claim's unit
+            lambda c: f"{paper.NEAREST_BONE_GAP_PCT[c['paper']]:.2f}%",
+        ),
         needs_variance=False,
         one_sided=ABSOLUTE,
     ),
     ClaimSpec(
-        "damping_not_recovered", "ours", "recovered_trees", RECOVERY, "damping_off",
-        "DAMPING_OFF", ">", "fraction",
-        "{tree}: damping is not recovered (median zeta_hat off the truth by more than "
+        family="damping_not_recovered", over=_recovered_trees, table=RECOVERY,
+        read=_damping_off, threshold="DAMPING_OFF", side=">", unit="fraction",
+        text="{tree}: damping is not recovered (median zeta_hat off the truth by more than "
         "{DAMPING_OFF:.0%})",
-        "recovery ({config}): |median zeta_hat - zeta| / zeta",
-        _paper_zeta,
+        source="recovery ({config}): |median zeta_hat - zeta| / zeta",
+        paper=Figure(
+            "the median fitted zeta, section 4",
+            _zeta_off,
+            _zeta_words,
+        ),
         headline="damping is not recovered",
         one_sided="|offset| above the bar on either side: off the truth, whichever way",
-        paper_value=_value_zeta_off,
     ),
     ClaimSpec(
-        "decay_rate_flat", "ours", "recovered_trees", RECOVERY, "decay_exponent",
-        "RATE_EXPONENT", WITHIN, "exponent",
-        "{tree}: the fitted decay rate gamma = zeta*omega is nearly frequency-independent "
+        family="decay_rate_flat", over=_recovered_trees, table=RECOVERY,
+        read=_decay_exponent, threshold="RATE_EXPONENT", side=WITHIN, unit="exponent",
+        text="{tree}: the fitted decay rate gamma = zeta*omega is nearly frequency-independent "
         "(gamma ~ omega^p, |p| < {RATE_EXPONENT})",
-        "recovery ({config}): exponent p",
-        "nearly frequency-independent",
+        source="recovery ({config}): exponent p",
+        paper="nearly frequency-independent",
     ),
     # the premise of every comparison: the fields fit their window (a model the paper did not
     # train makes its row this project's: ``origin_of``)
     ClaimSpec(
-        "fits_window", "ours", "fit_models", "tab_fit", "fit_fraction",
-        "FIT_BAR", ">", "fraction",
-        "{tree}: {fit_label} fits its training window (reaches {FIT_BAR:.0%} of the "
+        family="fits_window", over=_fit_models, table="tab_fit",
+        read=lambda d, c: value(
+            d, (d["tree"] == c["tree"]) & (d["model"] == c["fit_model"]), "ceiling_frac"
+        ),
+        threshold="FIT_BAR", side=">", unit="fraction",
+        text="{tree}: {fit_label} fits its training window (reaches {FIT_BAR:.0%} of the "
         "true-motion ceiling's in-window gain over static)",
-        "tab_fit: (fit - static) / (ceiling - static) on the trained frames",
-        "the fields 'fit the training window well'",
+        source="tab_fit: (fit - static) / (ceiling - static) on the trained frames",
+        paper="the fields 'fit the training window well'",
         one_sided="a bar: the premise is that a field fits at least this well",
     ),
-    # this project's: the paper's claims about ours asked again of every other prior
+)  # fmt: skip
+
+
+# ---- this project's: the paper's claims about ours asked again of every other prior -------------
+def _splits(run: Run) -> list[Cell]:
+    """each tree x held-out views and beyond the window"""
+    words = {"view": "held-out views", "time": "beyond the window"}
+    return [
+        {"suffix": f"{t}/{sp}", "tree": t, "split": sp, "where": w}
+        for t in run.trees
+        for sp, w in words.items()
+    ]
+
+
+def _winds(run: Run) -> list[Cell]:
+    """each split (training timestamps, beyond the window) x tree x unseen wind of tab_transfer"""
+    tr = run.own
+    if tr is None:
+        return []
+    where = {"beyond": "beyond the window"}
+    return [
+        {
+            "suffix": f"{t}/wind_{sp}/{c:.2f}",
+            "tree": t,
+            "condition": c,
+            "cond": f"{c:.2f}",
+            "split": sp,
+            "where": where.get(sp, "at training timestamps"),
+        }
+        for (sp, t, c), _ in tr.groupby(["split", "tree", "condition"], sort=False)
+    ]
+
+
+def _recovery_trees(run: Run) -> list[Cell]:
+    """each tree, in the ledger's recovery configuration (joint K = 32)"""
+    return [{**c, "config": CONFIG, "method": run.model} for c in _trees(run)]
+
+
+_PRIORS = (
     ClaimSpec(
-        "above_static_beyond", "priors", "trees", "tab_psnr", "above_static",
-        "EVEN", ">", "dB",
-        "{tree}: the {name} is above the static pose beyond the window",
-        "tab_psnr, time column: prior - static",
+        family="above_static_beyond", of="priors", over=_trees, table="tab_psnr",
+        read=lambda d, c: _psnr(d, c, [c["model"]]) - _psnr(d, c, ["static"]),
+        threshold="EVEN", side=">", unit="dB",
+        text="{tree}: the {name} is above the static pose beyond the window",
+        source="tab_psnr, time column: prior - static",
         origin="project",
         headline="the {name} above the static pose beyond the window",
         one_sided=DIRECTION,
     ),
     ClaimSpec(
-        AHEAD, "priors", "splits", "tab_psnr", "ahead_of_fields",
-        "EVEN", ">", "dB",
-        "{tree}: the {name} is ahead of the best learned field on {where}",
-        "tab_psnr, {split} column: prior - max over learned fields",
+        family=AHEAD, of="priors", over=_splits, table="tab_psnr", read=_ahead_of_fields,
+        threshold="EVEN", side=">", unit="dB",
+        text="{tree}: the {name} is ahead of the best learned field on {where}",
+        source="tab_psnr, {split} column: prior - max over learned fields",
         origin="project",
         one_sided=DIRECTION,
     ),
     ClaimSpec(
-        AHEAD, "priors", "winds", "tab_transfer", "wind_ahead",
-        "EVEN", ">", "dB",
-        "{tree}, {cond} v0, {where}: the {name} is ahead of the best learned field",
-        "tab_transfer ({split}): prior - max learned",
+        family=AHEAD, of="priors", over=_winds, table="tab_transfer", read=_wind_ahead,
+        threshold="EVEN", side=">", unit="dB",
+        text="{tree}, {cond} v0, {where}: the {name} is ahead of the best learned field",
+        source="tab_transfer ({split}): prior - max learned",
         origin="project",
         one_sided=DIRECTION,
     ),
     ClaimSpec(
-        "margin_grows", "priors", "margin_trees", "tab_margin", "margin_growth",
-        "EVEN", ">", "dB",
-        "{tree}: the {name}'s margin against MLP + wind grows as the wind departs",
-        "tab_margin ({model}): {last} - {first}",
+        family="margin_grows", of="priors", over=_margin_trees, table="tab_margin",
+        read=_margin_growth, threshold="EVEN", side=">", unit="dB",
+        text="{tree}: the {name}'s margin against MLP + wind grows as the wind departs",
+        source="tab_margin ({model}): {last} - {first}",
         origin="project",
-        one_sided="a direction: the margin grows, not by how much",
+        one_sided=GROWS,
     ),
     ClaimSpec(
-        "beats_null", "priors", "recovery_trees", "tab_recovery", "trained_minus_null",
-        "-NULL_MATCH_PP", "<", "points",
-        "{tree}: the {name} beats the untrained null on frequency recovery (by "
+        family="beats_null", of="priors", over=_recovery_trees, table="tab_recovery",
+        read=_trained_minus_null, threshold="-NULL_MATCH_PP", side="<", unit="points",
+        text="{tree}: the {name} beats the untrained null on frequency recovery (by "
         "{NULL_MATCH_PP} points or more)",
-        "{table}, {config}: trained - null median rel. error (points)",
+        source="{table}, {config}: trained - null median rel. error (points)",
         origin="project",
         one_sided="superiority by a margin: ahead of the null by the margin or more",
     ),
     ClaimSpec(
-        "damping_recovered", "priors", "recovered_trees", RECOVERY, "damping_off",
-        "DAMPING_OFF", "<", "fraction",
-        "{tree}: the {name} recovers damping (median zeta_hat within {DAMPING_OFF:.0%} of the "
-        "truth)",
-        "recovery ({config}): |median zeta_hat - zeta| / zeta",
+        family="damping_recovered", of="priors", over=_recovered_trees, table=RECOVERY,
+        read=_damping_off, threshold="DAMPING_OFF", side="<", unit="fraction",
+        text="{tree}: the {name} recovers damping (median zeta_hat within {DAMPING_OFF:.0%} of "
+        "the truth)",
+        source="recovery ({config}): |median zeta_hat - zeta| / zeta",
         origin="project",
         one_sided=ABSOLUTE,
     ),
     ClaimSpec(
-        "decay_rate_flat", "priors", "recovered_trees", RECOVERY, "decay_exponent",
-        "RATE_EXPONENT", WITHIN, "exponent",
-        "{tree}: the {name}'s fitted decay rate gamma = zeta*omega is nearly "
+        family="decay_rate_flat", of="priors", over=_recovered_trees, table=RECOVERY,
+        read=_decay_exponent, threshold="RATE_EXPONENT", side=WITHIN, unit="exponent",
+        text="{tree}: the {name}'s fitted decay rate gamma = zeta*omega is nearly "
         "frequency-independent (gamma ~ omega^p, |p| < {RATE_EXPONENT})",
-        "recovery ({config}): exponent p",
+        source="recovery ({config}): exponent p",
         origin="project",
     ),
-    # this project's: without the anemometer, and the output-only analysis (docs/blind.md)
+)  # fmt: skip
+
+
+# ---- this project's: without the anemometer, and the output-only analysis (docs/blind.md) ------
+def _blind_trees(run: Run) -> list[Cell]:
+    """each forcing-free prior in tab_recovery x each tree, against the prior whose measured wind it
+    replaces (ids ``<prior>/...`` for a prior other than ours)"""
+    null = run.own
+    if null is None or "method" not in null.columns:
+        return []
+    have, out = set(null["method"]), []
+    for blind in (m for m in BLIND_PRIORS if m in have):
+        wind = spec_of(blind).blind_of
+        who, prefix = ("ours", "") if wind == "ours" else (f"the {label(wind)}", f"{wind}/")
+        out += [
+            {
+                **c,
+                "prefix": prefix,
+                "blind": blind,
+                "wind": wind,
+                "who": who,
+                "config": BLIND_CONFIG,
+            }
+            for c in _trees(run)
+            if (null["tree"] == c["tree"]).any()
+        ]
+    return out
+
+
+def _oma_separated(run: Run) -> list[Cell]:
+    """each tree of separated frequencies, when tab_recovery holds the output-only analysis"""
+    null = run.own
+    if null is None or "method" not in null.columns or OMA not in set(null["method"]):
+        return []
+    return [{**c, "config": BLIND_CONFIG, "method": OMA} for c in _with_role(run, SEPARATED)]
+
+
+def _oma_damping_trees(run: Run) -> list[Cell]:
+    """each tree of tab_damping, when it holds the output-only analysis"""
+    dmp = run.own
+    if dmp is None or "method" not in dmp.columns or OMA not in set(dmp["method"]):
+        return []
+    return [{**c, "config": BLIND_CONFIG} for c in _trees(run) if (dmp["tree"] == c["tree"]).any()]
+
+
+def _oma_interval_trees(run: Run) -> list[Cell]:
+    """each tree of tab_damping, when it holds the output-only analysis' interval coverage"""
+    dmp = run.own
+    if dmp is None or "omega_interval_cover" not in dmp.columns:
+        return []
+    return _oma_damping_trees(run)
+
+
+def _oma(d: pd.DataFrame, c: Cell, col: str) -> float:
+    """tab_damping (damping testbed): the output-only analysis' ``col`` in the cell's tree and
+    configuration."""
+    row = (
+        (d["testbed"] == DAMPING)
+        & (d["tree"] == c["tree"])
+        & (d["config"] == c["config"])
+        & (d["method"] == OMA)
+    )
+    return value(d, row, col)
+
+
+def _halfwidth(d: pd.DataFrame, c: Cell, q: str) -> float:
+    """tab_damping: the output-only analysis' median relative half-width of its ``q``
+    intervals, 1.96 sigma / value."""
+    from physgs.oma.intervals import Z95  # here: scipy, which planning never loads
+
+    return Z95 * _oma(d, c, f"{q}_rel_sd")
+
+
+def _oma_intervals(q: str, name: str) -> dict[str, ClaimSpec]:
+    """The three families of the output-only analysis' 95% intervals for ``q`` (``omega``,
+    ``zeta``; ``name`` in the family ids: ``frequency``, ``damping``): they cover, they score
+    better than the null's, they are informative."""
+    intervals = f"{{tree}} (damping testbed): the output-only analysis' 95% intervals for {q}"
+    common = dict(over=_oma_interval_trees, table="tab_damping", paper=PROJECT_ONLY,
+                  origin="project", optional=True)  # fmt: skip
+    return {
+        "covers": ClaimSpec(
+            family=f"oma_{name}_interval_covers", **common,
+            read=lambda d, c: _oma(d, c, f"{q}_interval_cover"),
+            threshold="INTERVAL_COVER", side=">", unit="fraction",
+            text=f"{intervals} hold the matched bone's true {q} on at least "
+            "{INTERVAL_COVER:.0%} of its trusted parts",
+            source=f"{{table}}, {{config}}: output-only {q}_interval_cover",
+            one_sided=COVER, requires=f"oma_{name}_interval_score",
+        ),
+        "score": ClaimSpec(
+            family=f"oma_{name}_interval_score", **common,
+            read=lambda d, c: (
+                _oma(d, c, f"{q}_null_interval_score") / _oma(d, c, f"{q}_interval_score")
+            ),
+            threshold="RATIO_EVEN", side=">", unit="ratio",
+            text=f"{intervals} score better than the untrained null's draw range (interval "
+            "score, Gneiting and Raftery 2007: width plus 2/alpha times the miss, per part, "
+            "relative to the truth)",
+            source=f"{{table}}, {{config}}: {q}_null_interval_score / {q}_interval_score",
+            one_sided=DIRECTION,
+        ),
+        "informative": ClaimSpec(
+            family=f"oma_{name}_interval_informative", **common,
+            read=lambda d, c: _halfwidth(d, c, q),
+            threshold="INFORMATIVE_HALFWIDTH", side="<", unit="fraction",
+            text=f"{intervals} are informative (median half-width below "
+            "{INFORMATIVE_HALFWIDTH:.0%} of the value: the interval excludes zero)",
+            source=f"{{table}}, {{config}}: 1.96 x output-only {q}_rel_sd",
+            one_sided=INFORMATIVE,
+        ),
+    }  # fmt: skip
+
+
+_OMEGA, _ZETA = _oma_intervals("omega", "frequency"), _oma_intervals("zeta", "damping")
+
+_BLIND = (
     ClaimSpec(
-        "anemometer_needed", "ours", "blind_trees", "tab_recovery", "blind_minus_wind",
-        "EVEN", ">", "pp",
-        "{tree}: without the measured wind (a learned forcing) {who} recovers omega worse",
-        "{table}, {config}: {blind} - {wind} median rel. error (points)",
-        "the paper's closing limit: 'real footage needs an anemometer'",
+        family="anemometer_needed", over=_blind_trees, table="tab_recovery",
+        read=lambda d, c: (
+            value(d, _null_row(d, c, c["blind"]), "trained_median_rel_err_pct")
+            - value(d, _null_row(d, c, c["wind"]), "trained_median_rel_err_pct")
+        ),
+        threshold="EVEN", side=">", unit="pp",
+        text="{tree}: without the measured wind (a learned forcing) {who} recovers omega worse",
+        source="{table}, {config}: {blind} - {wind} median rel. error (points)",
+        paper="the paper's closing limit: 'real footage needs an anemometer'",
         origin="project",
         headline="without the anemometer (a learned forcing), ours' frequency error grows "
         "(points)",
@@ -573,158 +912,193 @@ CATALOGUE: tuple[ClaimSpec, ...] = (
         one_sided=DIRECTION,
     ),
     ClaimSpec(
-        "oma_beats_null", "ours", "oma_separated", "tab_recovery", "null_over_trained",
-        "RATIO_EVEN", ">", "ratio",
-        "{tree}: output-only modal analysis of the video recovers omega better than the "
+        family="oma_beats_null", over=_oma_separated, table="tab_recovery",
+        read=_null_over_trained, threshold="RATIO_EVEN", side=">", unit="ratio",
+        text="{tree}: output-only modal analysis of the video recovers omega better than the "
         "untrained null",
-        "{table}, {config}: null / output-only median rel. error",
-        "not run",
+        source="{table}, {config}: null / output-only median rel. error",
+        paper="not run",
         origin="project",
         headline="output-only modal analysis of the video beats the untrained null",
         optional=True,
         one_sided=DIRECTION,
     ),
     ClaimSpec(
-        "oma_recovers_zeta", "ours", "oma_damping_trees", "tab_damping", "oma_zeta_gain",
-        "EVEN", "<", "pp",
-        "{tree} (damping testbed): output-only modal analysis recovers zeta better than the "
-        "untrained null",
-        "tab_damping, {config}: output-only - null median zeta error (points)",
-        "no method here recovers zeta (the paper)",
+        family="oma_recovers_zeta", over=_oma_damping_trees, table="tab_damping",
+        read=lambda d, c: _oma(d, c, "trained_minus_null_pp"),
+        threshold="EVEN", side="<", unit="pp",
+        text="{tree} (damping testbed): output-only modal analysis recovers zeta better than "
+        "the untrained null",
+        source="tab_damping, {config}: output-only - null median zeta error (points)",
+        paper="no method here recovers zeta (the paper)",
+        origin="project",
+        optional=True,
+        one_sided=DIRECTION,
+    ),
+    _OMEGA["covers"],
+    _ZETA["covers"],
+    _OMEGA["score"],
+    _OMEGA["informative"],
+    _ZETA["score"],
+    _ZETA["informative"],
+)  # fmt: skip
+
+
+# ---- this project's: the paper's two hypotheses about its prior (section 6), tested --------------
+def _parts(run: Run) -> tuple[pd.DataFrame | None, set, str]:
+    """tab_parts, its models and its first configuration (None, empty where it is not there)."""
+    df = run.own
+    if df is None or df.empty:
+        return None, set(), ""
+    return df, set(df["model"]), str(df["config"].iloc[0])
+
+
+def _parts_damping_trees(run: Run) -> list[Cell]:
+    """each tree with a damping testbed in tab_parts (its first configuration), when it holds
+    the topology parts"""
+    df, models, c0 = _parts(run)
+    if df is None or "ours_topo" not in models:
+        return []
+    return [
+        {**c, "config": c0}
+        for c in _trees(run)
+        if np.isfinite(df.loc[df["tree"] == c["tree"], "zeta_rel_err_pct"]).any()
+    ]
+
+
+def _parts_coupling(run: Run) -> list[Cell]:
+    """each tree of separated frequencies in tab_parts (its first configuration), when it holds
+    both topology priors (no id suffix for a single such tree: the family's id as before)"""
+    df, models, c0 = _parts(run)
+    if df is None or not {"ours_topo", "ours_chain"} <= models:
+        return []
+    cells = _with_role(run, SEPARATED)
+    one = len(cells) == 1
+    return [{**c, "suffix": "" if one else c["tree"], "config": c0} for c in cells]
+
+
+def _parts_gain(d: pd.DataFrame, c: Cell, better: str, base: str, col: str) -> float:
+    """tab_parts: ``col`` of parts ``better`` - of parts ``base`` in the cell's tree and
+    configuration."""
+    row = (d["tree"] == c["tree"]) & (d["config"] == c["config"])
+    return value(d, row & (d["model"] == better), col) - value(d, row & (d["model"] == base), col)
+
+
+_PARTS = (
+    ClaimSpec(
+        family="topology_parts_reduce_damping_error", over=_parts_damping_trees,
+        table="tab_parts",
+        read=lambda d, c: _parts_gain(d, c, "ours_topo", "ours", "zeta_rel_err_pct"),
+        threshold="EVEN", side="<", unit="pp",
+        text="{tree}: topology-aware parts reduce the damping error (damping testbed)",
+        source="tab_parts ({config}): median rel. err. of zeta, topology - k-means parts",
+        paper="hypothesis (k-means parts 'plausibly feed the damping bias')",
         origin="project",
         optional=True,
         one_sided=DIRECTION,
     ),
     ClaimSpec(
-        "oma_frequency_interval_covers", "ours", "oma_interval_trees", "tab_damping",
-        "oma_omega_cover", "INTERVAL_COVER", ">", "fraction",
-        "{tree} (damping testbed): the output-only analysis' 95% intervals for omega hold the "
-        "matched bone's true omega on at least {INTERVAL_COVER:.0%} of its trusted parts",
-        "{table}, {config}: output-only omega_interval_cover",
-        "not in the paper (this project's)",
+        family="coupling_lifts_sparse_fit", over=_parts_coupling, table="tab_parts",
+        read=lambda d, c: _parts_gain(d, c, "ours_chain", "ours_topo", "ceiling_frac"),
+        threshold="EVEN", side=">", unit="fraction",
+        text="{tree}: parent-child coupling lifts the in-window fit",
+        source="tab_parts ({config}): fraction of the ceiling's gain, chained - independent "
+        "topology parts",
+        paper="hypothesis (independent parts 'represent no coupling')",
         origin="project",
         optional=True,
-        one_sided=COVER,
-        requires="oma_frequency_interval_score",
+        one_sided=DIRECTION,
     ),
+)  # fmt: skip
+
+
+# ---- this project's: the 2D-track control (docs/tracks.md) ---------------------------------------
+def _tracks_separated(run: Run) -> list[Cell]:
+    """each tree of separated frequencies, the 2D-track control's recovery in joint K = 32
+    (else its first configuration)"""
+    null = run.own
+    if null is None or "method" not in null.columns:
+        return []
+    cfgs = list(dict.fromkeys(null.loc[null["method"] == "tracks", "config"]))
+    if not cfgs:
+        return []
+    c = CONFIG if CONFIG in cfgs else cfgs[0]
+    return [{**x, "config": c, "method": "tracks"} for x in _with_role(run, SEPARATED)]
+
+
+def _tracks_minus_ours(d: pd.DataFrame, c: Cell) -> float:
+    """tab_recovery: 2D tracks - ours median omega error (points); NaN at another K than ours'"""
+    tracks, ours = _null_row(d, c), _null_row(d, c, "ours")
+    if value(d, tracks, "K") != value(d, ours, "K"):
+        return float("nan")  # another K: not the same question
+    col = "trained_median_rel_err_pct"
+    return value(d, tracks, col) - value(d, ours, col)
+
+
+def _tracks_trees(run: Run) -> list[Cell]:
+    """each tree in tab_tracks, its base configuration (else its first)"""
+    tr = run.own
+    if tr is None:
+        return []
+    tc = list(dict.fromkeys(tr["config"]))
+    if not tc:
+        return []
+    c = "single" if "single" in tc else tc[0]
+    return [{**x, "config": c} for x in _trees(run) if (tr["tree"] == x["tree"]).any()]
+
+
+def _tracks_tail(d: pd.DataFrame, c: Cell) -> float:
+    """tab_tracks: tail displacement error, 2D tracks - ours (px)"""
+    row = (d["tree"] == c["tree"]) & (d["config"] == c["config"])
+    return value(d, row, "tail_px") - value(d, row, "tail_ours_px")
+
+
+_TRACKS = (
     ClaimSpec(
-        "oma_damping_interval_covers", "ours", "oma_interval_trees", "tab_damping",
-        "oma_zeta_cover", "INTERVAL_COVER", ">", "fraction",
-        "{tree} (damping testbed): the output-only analysis' 95% intervals for zeta hold the "
-        "matched bone's true zeta on at least {INTERVAL_COVER:.0%} of its trusted parts",
-        "{table}, {config}: output-only zeta_interval_cover",
-        "not in the paper (this project's)",
-        origin="project",
-        optional=True,
-        one_sided=COVER,
-        requires="oma_damping_interval_score",
-    ),
-    ClaimSpec(
-        "oma_frequency_interval_score", "ours", "oma_interval_trees", "tab_damping",
-        "oma_omega_score", "RATIO_EVEN", ">", "ratio",
-        "{tree} (damping testbed): the output-only analysis' 95% intervals for omega score "
-        "better than the untrained null's draw range (interval score, Gneiting and Raftery "
-        "2007: width plus 2/alpha times the miss, per part, relative to the truth)",
-        "{table}, {config}: omega_null_interval_score / omega_interval_score",
-        "not in the paper (this project's)",
+        family="tracks_beats_null", over=_tracks_separated, table="tab_recovery",
+        read=_null_over_trained, threshold="RATIO_EVEN", side=">", unit="ratio",
+        text="{tree}: oscillators fitted to 2D tracks recover omega better than the untrained "
+        "null",
+        source="{table}, 2D tracks {config}: null / tracks median rel. error",
+        paper=TRACKS_PROPOSAL,
         origin="project",
         optional=True,
         one_sided=DIRECTION,
     ),
     ClaimSpec(
-        "oma_frequency_interval_informative", "ours", "oma_interval_trees", "tab_damping",
-        "oma_omega_halfwidth", "INFORMATIVE_HALFWIDTH", "<", "fraction",
-        "{tree} (damping testbed): the output-only analysis' 95% intervals for omega are "
-        "informative (median half-width below {INFORMATIVE_HALFWIDTH:.0%} of the value: the "
-        "interval excludes zero)",
-        "{table}, {config}: 1.96 x output-only omega_rel_sd",
-        "not in the paper (this project's)",
-        origin="project",
-        optional=True,
-        one_sided="a bar: an interval at most this wide says something; narrower never hurts "
-        "(its misses are the interval score's)",
-    ),
-    ClaimSpec(
-        "oma_damping_interval_score", "ours", "oma_interval_trees", "tab_damping",
-        "oma_zeta_score", "RATIO_EVEN", ">", "ratio",
-        "{tree} (damping testbed): the output-only analysis' 95% intervals for zeta score "
-        "better than the untrained null's draw range (interval score, Gneiting and Raftery "
-        "2007: width plus 2/alpha times the miss, per part, relative to the truth)",
-        "{table}, {config}: zeta_null_interval_score / zeta_interval_score",
-        "not in the paper (this project's)",
-        origin="project",
-        optional=True,
-        one_sided=DIRECTION,
-    ),
-    ClaimSpec(
-        "oma_damping_interval_informative", "ours", "oma_interval_trees", "tab_damping",
-        "oma_zeta_halfwidth", "INFORMATIVE_HALFWIDTH", "<", "fraction",
-        "{tree} (damping testbed): the output-only analysis' 95% intervals for zeta are "
-        "informative (median half-width below {INFORMATIVE_HALFWIDTH:.0%} of the value: the "
-        "interval excludes zero)",
-        "{table}, {config}: 1.96 x output-only zeta_rel_sd",
-        "not in the paper (this project's)",
-        origin="project",
-        optional=True,
-        one_sided="a bar: an interval at most this wide says something; narrower never hurts "
-        "(its misses are the interval score's)",
-    ),
-    # this project's: the paper's two hypotheses about its prior (section 6), tested
-    ClaimSpec(
-        "topology_parts_reduce_damping_error", "ours", "parts_damping_trees", "tab_parts",
-        "topology_damping_gain", "EVEN", "<", "pp",
-        "{tree}: topology-aware parts reduce the damping error (damping testbed)",
-        "tab_parts ({config}): median rel. err. of zeta, topology - k-means parts",
-        "hypothesis (k-means parts 'plausibly feed the damping bias')",
-        origin="project",
-        optional=True,
-        one_sided=DIRECTION,
-    ),
-    ClaimSpec(
-        "coupling_lifts_sparse_fit", "ours", "parts_coupling", "tab_parts", "coupling_gain",
-        "EVEN", ">", "fraction",
-        "{tree}: parent-child coupling lifts the in-window fit",
-        "tab_parts ({config}): fraction of the ceiling's gain, chained - independent topology "
-        "parts",
-        "hypothesis (independent parts 'represent no coupling')",
-        origin="project",
-        optional=True,
-        one_sided=DIRECTION,
-    ),
-    # this project's: the 2D-track control (docs/tracks.md)
-    ClaimSpec(
-        "tracks_beats_null", "ours", "tracks_separated", "tab_recovery", "null_over_trained",
-        "RATIO_EVEN", ">", "ratio",
-        "{tree}: oscillators fitted to 2D tracks recover omega better than the untrained null",
-        "{table}, 2D tracks {config}: null / tracks median rel. error",
-        TRACKS_PROPOSAL,
-        origin="project",
-        optional=True,
-        one_sided=DIRECTION,
-    ),
-    ClaimSpec(
-        "tracks_match_ours", "ours", "tracks_separated", "tab_recovery", "tracks_minus_ours",
-        "NULL_MATCH_PP", "<", "points",
-        "{tree}: oscillators fitted to 2D tracks match ours' omega recovery (ours does not "
+        family="tracks_match_ours", over=_tracks_separated, table="tab_recovery",
+        read=_tracks_minus_ours, threshold="NULL_MATCH_PP", side="<", unit="points",
+        text="{tree}: oscillators fitted to 2D tracks match ours' omega recovery (ours does not "
         "beat them by {NULL_MATCH_PP} points or more)",
-        "{table}, {config}: 2D tracks - ours median rel. error (points)",
-        TRACKS_PROPOSAL,
+        source="{table}, {config}: 2D tracks - ours median rel. error (points)",
+        paper=TRACKS_PROPOSAL,
         origin="project",
         optional=True,
         one_sided=NON_INFERIOR,
     ),
     ClaimSpec(
-        "tracks_extrapolate_as_ours", "ours", "tracks_trees", "tab_tracks", "tracks_tail",
-        "EVEN", "<", "px",
-        "{tree}: beyond the window, oscillators fitted to 2D tracks predict the tracked points "
-        "at least as well as ours' Gaussians",
-        "tab_tracks, {config}: tail displacement error, 2D tracks - ours (px)",
-        TRACKS_PROPOSAL,
+        family="tracks_extrapolate_as_ours", over=_tracks_trees, table="tab_tracks",
+        read=_tracks_tail, threshold="EVEN", side="<", unit="px",
+        text="{tree}: beyond the window, oscillators fitted to 2D tracks predict the tracked "
+        "points at least as well as ours' Gaussians",
+        source="tab_tracks, {config}: tail displacement error, 2D tracks - ours (px)",
+        paper=TRACKS_PROPOSAL,
         origin="project",
         optional=True,
         one_sided=NON_INFERIOR,
     ),
 )  # fmt: skip
+
+#: Every claim family, in the ledger's order.
+CATALOGUE: tuple[ClaimSpec, ...] = (
+    *_MOTION,
+    *_KINDS,
+    *_RECOVERY,
+    *_PRIORS,
+    *_BLIND,
+    *_PARTS,
+    *_TRACKS,
+)
 
 
 #: The families that are premises of the comparison, each with what its failure undermines (the
@@ -833,7 +1207,7 @@ def origin_of(claim_id: str) -> str:
     parts = claim_id.split("/")
     if any(p in _MODEL_IDS and p not in PAPER_MODELS for p in parts):
         return "project"
-    fam = parts[1] if parts[0] in _MODEL_IDS and len(parts) > 1 else parts[0]
+    fam = _family(claim_id)
     for s in CATALOGUE:
         if s.family == fam and (s.of == "priors") == (parts[0] in _MODEL_IDS):
             return s.origin
@@ -919,10 +1293,10 @@ def markdown() -> str:
             fam += " (headline)"
         if s.family in PREMISES:
             fam += " (premise)"
-        over = ("ours" if s.of == "ours" else "every other prior") + ", " + _doc(SCOPES[s.over])
+        over = ("ours" if s.of == "ours" else "every other prior") + ", " + _doc(s.over)
         thr = s.threshold.lstrip("-")
         sign = "-" if s.threshold.startswith("-") else ""
-        figure = _doc(s.paper) if callable(s.paper) else _template(s.paper)
+        figure = s.paper.what if isinstance(s.paper, Figure) else _template(s.paper)
         figure = "this project" if figure == "--" else figure
         cells = [
             fam,

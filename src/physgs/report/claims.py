@@ -7,9 +7,10 @@ of the threshold, **fails** when it lies entirely on the other side, and is **un
 straddles it. A claim of flatness, equality or match (side ``WITHIN``) is an equivalence test,
 two one-sided tests: it **holds** when the interval lies inside the band (-threshold,
 +threshold), **fails** when it lies entirely outside it (beyond either edge), and is
-**undecided** when it straddles either edge. A claim about a comparison between trained models needs seed variance: with a
-single seed it is "undecided: one seed" (the point estimate is still shown, with the side it
-falls on). A claim about the fixed testbed (the nearest-bone gap) needs none.
+**undecided** when it straddles either edge. A claim about a comparison between trained models
+needs seed variance: with a single seed it is "undecided: one seed" (the point estimate is still
+shown, with the side it falls on). A claim about the fixed testbed (the nearest-bone gap) needs
+none.
 
 The tables give one value per seed: a table whose CSV has a ``seed`` column contributes one
 value per seed, one without it (today's single-seed pipeline) contributes one value.
@@ -37,7 +38,7 @@ from physgs.report.catalogue import (
     undermines,
 )
 from physgs.report.claim_cells import RECOVERY, Run
-from physgs.report.seeds import MAX_SEEDS, finite, interval, log_interval, seeds_to_decide  # noqa: F401
+from physgs.report.seeds import MAX_SEEDS, finite, interval, log_interval, seeds_to_decide
 
 #: The unit of a ratio: its interval is taken on the log scale (``estimate``).
 RATIO = "ratio"
@@ -46,8 +47,8 @@ RATIO = "ratio"
 @dataclass(frozen=True)
 class Claim:
     """One claim: id, the claim in one line, the paper's figure, where it is measured, the
-    threshold and side ('>', '<', or ``WITHIN``: inside (-threshold, +threshold)), the unit, whether a verdict needs seed variance, and its
-    origin (the paper's or this project's)."""
+    threshold and side ('>', '<', or ``WITHIN``: inside (-threshold, +threshold)), the unit,
+    whether a verdict needs seed variance, and its origin (the paper's or this project's)."""
 
     id: str
     text: str
@@ -60,6 +61,11 @@ class Claim:
     origin: str = "paper"
     paper_value: tuple[float, float] = (float("nan"), float("nan"))
     requires: str = ""
+
+    @property
+    def log_scale(self) -> bool:
+        """Whether its interval is taken on the log scale: a ratio's (unit ``RATIO``)."""
+        return self.unit == RATIO
 
     @property
     def threshold_text(self) -> str:
@@ -86,18 +92,6 @@ def on_claim(claim: Claim, x: float) -> bool:
     return x > t if claim.side == ">" else x < t
 
 
-def log_scale(claim: Claim) -> bool:
-    """Whether a claim's interval is taken on the log scale.
-
-    Args:
-        claim: the claim.
-
-    Returns:
-        True for a ratio (unit ``RATIO``).
-    """
-    return claim.unit == RATIO
-
-
 def estimate(claim: Claim, values: Sequence[float]) -> tuple[float, float, float, float]:
     """(estimate, sd, low, high) of a claim over seeds: Student's t on the mean
     ([`interval`][physgs.report.seeds.interval]); for a ratio, on the mean of the per-seed
@@ -111,7 +105,7 @@ def estimate(claim: Claim, values: Sequence[float]) -> tuple[float, float, float
     Returns:
         ``(estimate, sd, low, high)``.
     """
-    return log_interval(values) if log_scale(claim) else interval(values)
+    return log_interval(values) if claim.log_scale else interval(values)
 
 
 def verdict(claim: Claim, values: Sequence[float]) -> str:
@@ -166,19 +160,6 @@ def decide(claim: Claim, m: float, lo: float, hi: float, n: int) -> str:
 
 def _per_seed(df: pd.DataFrame) -> list[pd.DataFrame]:
     return [g for _, g in df.groupby("seed")] if "seed" in df.columns else [df]
-
-
-def damping_offsets(summaries: Sequence[Mapping[str, float]]) -> list[float]:
-    """How far each seed's median zeta_hat is from the truth, |median - true| / true: what the
-    damping claims of every prior measure (ours' "not recovered", the others' "recovered").
-
-    Args:
-        summaries (Sequence[Mapping[str, float]]): per-seed ``median_zeta`` and ``zeta_true``.
-
-    Returns:
-        list[float]: one fraction per seed.
-    """
-    return [abs(v["median_zeta"] - v["zeta_true"]) / v["zeta_true"] for v in summaries]
 
 
 def _recovery_table(
@@ -248,7 +229,7 @@ def measure(
         seeds = _per_seed(tabs[spec.table]) if spec.table in tabs else []
         for model in ("ours",) if spec.of == "ours" else others:
             run = Run(tabs, trees, model, others, spec.table, dict(roles or {}))
-            for cell in spec.cells(run):
+            for cell in spec.over(run):
                 cell = {"model": model, "name": label(model), "table": spec.table, **cell}
                 cid = spec.claim_id(cell)
                 claim = Claim(
@@ -264,7 +245,7 @@ def measure(
                     spec.value_of_paper(cell),
                     spec.claim_id(cell, spec.requires) if spec.requires else "",
                 )
-                out.append((claim, [spec.measure(d, cell) for d in seeds]))
+                out.append((claim, [float(spec.read(d, cell)) for d in seeds]))
     return out
 
 
@@ -283,7 +264,7 @@ def to_decide(claim: Claim, values: Sequence[float]) -> tuple[float, float]:
     if verdict(claim, values) != "undecided":
         return np.nan, np.nan
     v = finite(values)
-    v, thr = (np.log(v), np.log(claim.threshold)) if log_scale(claim) else (v, claim.threshold)
+    v, thr = (np.log(v), np.log(claim.threshold)) if claim.log_scale else (v, claim.threshold)
     m = float(v.mean())
     if claim.side == WITHIN:  # the interval straddles an edge: the nearer one decides it
         thr = min((-thr, thr), key=lambda e: abs(m - e))
@@ -372,7 +353,7 @@ def ledger(measured: Sequence[tuple[Claim, list[float]]]) -> pd.DataFrame:
                 "source": c.source,
                 "origin": c.origin,
                 "kind": kind_of(c.id),
-                "scale": "log" if log_scale(c) else "linear",
+                "scale": "log" if c.log_scale else "linear",
                 "seeds_to_decide_t_est": n_t,
                 "seeds_to_decide_power80_est": n_power,
                 "paper_low": c.paper_value[0],
@@ -414,10 +395,6 @@ def number(x: float, unit: str) -> str:
     return f"{x:.3g}" if unit == RATIO else f"{x:+.3g}"
 
 
-#: A kind as the counts name it (plural: ``counted``).
-KIND_WORDS = {"finding": ("finding", "findings"), "premise": ("premise", "premises")}
-
-
 def counted(claims: pd.DataFrame, origin: str) -> str:
     """The claims of one origin counted, the findings apart from the premises of the comparison
     (``catalogue.PREMISES``), each by verdict: ``52 claims: 34 findings (20 hold, 10 fail, 4
@@ -443,7 +420,7 @@ def counted(claims: pd.DataFrame, origin: str) -> str:
             for w in ("holds", "fails", "undecided")
             if v.get(w, 0)
         )
-        parts.append(f"{int(v.sum())} {KIND_WORDS[k][int(v.sum()) != 1]} ({by})")
+        parts.append(f"{int(v.sum())} {k}{'s' if v.sum() != 1 else ''} ({by})")
     n = int(mine.sum())
     return f"{n} claim{'s' if n != 1 else ''}: " + (", ".join(parts) or "none")
 
@@ -487,17 +464,16 @@ def ledger_markdown(df: pd.DataFrame, stamp: Mapping[str, str] | None = None) ->
     lines = [
         "# Claims ledger",
         "",
-        "Each claim, measured by this pipeline: the paper's claims and this project's own, "
-        "counted apart; verdicts are computed by `physgs.report.claims` (holds / fails when "
-        "the seed interval lies on one side of the threshold, undecided when it straddles it "
-        "or when one seed gives no interval; a claim of flatness, equality or match, "
-        "'within ±t', holds inside the band, fails wholly outside it and is undecided across "
-        "either edge). Beside a figure of the paper: whether it lies inside the measured "
-        "interval (reproduced in size; the verdict is a direction or a bar). A ratio's estimate is the geometric mean over "
-        "seeds and its interval the per-seed log-ratios' t-interval, exponentiated (it stays "
-        "positive). For an undecided claim, the seeds that would decide it if its effect and "
-        "sd stayed as observed, an estimate: the plug-in t half-width / a t-test at 80% power "
-        "(`tt_solve_power`).",
+        "Each claim, measured by this pipeline: the paper's claims and this project's own, counted "
+        "apart; verdicts are computed by `physgs.report.claims` (holds / fails when the seed "
+        "interval lies on one side of the threshold, undecided when it straddles it or when one "
+        "seed gives no interval; a claim of flatness, equality or match, 'within ±t', holds inside "
+        "the band, fails wholly outside it and is undecided across either edge). Beside a figure "
+        "of the paper: whether it lies inside the measured interval (reproduced in size; the verdict "
+        "is a direction or a bar). A ratio's estimate is the geometric mean over seeds and its "
+        "interval the per-seed log-ratios' t-interval, exponentiated (it stays positive). For an "
+        "undecided claim, the seeds that would decide it if its effect and sd stayed as observed, "
+        "an estimate: the plug-in t half-width / a t-test at 80% power (`tt_solve_power`).",
         "",
     ]
     if stamp:
@@ -524,8 +500,8 @@ def ledger_markdown(df: pd.DataFrame, stamp: Mapping[str, str] | None = None) ->
         size = r.get("paper_in_interval", "")
         size = f" ({size} the interval)" if isinstance(size, str) and size else ""
         lines.append(
-            f"| {r.claim} | {r.origin} | {r.paper}{size} | {meas} | {r.threshold} | **{r.verdict}** | {k} | "
-            f"{decide_cell(r)} | {r.source} |"
+            f"| {r.claim} | {r.origin} | {r.paper}{size} | {meas} | {r.threshold} "
+            f"| **{r.verdict}** | {k} | {decide_cell(r)} | {r.source} |"
         )
     return "\n".join(lines) + "\n"
 

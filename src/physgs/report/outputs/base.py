@@ -57,7 +57,8 @@ NEED_FIELDS = {
 
 
 def key(need: tuple) -> str:
-    """The name of a need in the inputs mapping: its parts joined by '/'.
+    """The name of a need among a rule's inputs (Snakemake names them by strings): its parts
+    joined by '/'; never split again (a reader keeps the tuple).
 
     Args:
         need: a need tuple (kind, then its parts).
