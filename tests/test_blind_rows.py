@@ -11,6 +11,8 @@ import pytest
 
 from physgs.models.registry import BLIND_PRIORS, label, recovery_label
 from physgs.report import build
+from physgs.report import images as IM
+from physgs.report import recovery as R
 from physgs.report import tables as T
 from physgs.report.damping import tab_damping
 from test_report_damping import _record as damping_record
@@ -37,19 +39,19 @@ def _methods(oma_null=0.10):
     }
     blind = {s: {("sparse", "single"): (record(1, 0.06), null(0.0456))} for s in SEEDS}
     return {
-        T.OMA: T.method_rows(T.OMA, {"single": "single (K=2)", "joint32": "joint (K=2)"}, oma),
-        "ours_blind": T.method_rows("ours_blind", {"single": "single"}, blind),
+        R.OMA: R.method_rows(R.OMA, {"single": "single (K=2)", "joint32": "joint (K=2)"}, oma),
+        "ours_blind": R.method_rows("ours_blind", {"single": "single"}, blind),
     }
 
 
 def _tab_recovery(methods=None):
     rec, nl, tracks, chain = _null_inputs()
     priors = {
-        m: T.method_rows(m, CONFIGS, paired(d, nl))
+        m: R.method_rows(m, CONFIGS, paired(d, nl))
         for m, d in (("ours", rec), ("ours_chain", chain))
     }
-    rows = {**priors, T.TRACKS: T.method_rows(T.TRACKS, {"single": "single"}, tracks)}
-    return T.tab_recovery({**rows, **(methods or {})}, ["sparse"], BONES)
+    rows = {**priors, R.TRACKS: R.method_rows(R.TRACKS, {"single": "single"}, tracks)}
+    return R.recovery_table("tab_recovery", {**rows, **(methods or {})}, ["sparse"], BONES)
 
 
 def test_tab_recovery_adds_the_forcing_free_rows_with_their_own_null():
@@ -72,25 +74,25 @@ def test_tab_recovery_adds_the_forcing_free_rows_with_their_own_null():
     np.testing.assert_allclose(oma.trained_minus_null_pp, np.repeat([-8.0, -7.5, -7.0], 2))
     blind = tab.df[tab.df.method == "ours_blind"]
     np.testing.assert_allclose(blind.trained_minus_null_pp, 6.0 - 4.56)
-    assert rf"{recovery_label(T.OMA)}, joint (K=2)" in tab.tex
+    assert rf"{recovery_label(R.OMA)}, joint (K=2)" in tab.tex
     assert f"{label('ours_blind')}, single" in tab.tex
 
 
 def test_tab_recovery_leaves_the_other_rows_as_they_were():
     before, after = _tab_recovery().df, _tab_recovery(_methods()).df
-    kept = after[~after.method.isin([T.OMA, "ours_blind"])].reset_index(drop=True)
+    kept = after[~after.method.isin([R.OMA, "ours_blind"])].reset_index(drop=True)
     pd.testing.assert_frame_equal(kept, before)
 
 
 def test_tab_recovery_refuses_a_method_row_without_its_record_or_with_another_k():
     methods = _methods()
-    short = dataclasses.replace(methods[T.OMA], per_seed={s: {} for s in SEEDS})
+    short = dataclasses.replace(methods[R.OMA], per_seed={s: {} for s in SEEDS})
     with pytest.raises(KeyError, match="oma"):
-        _tab_recovery({T.OMA: short})
+        _tab_recovery({R.OMA: short})
     rec2 = {s: {k: (r, dataclasses.replace(n, n_parts=2)) for k, (r, n) in v.items()}
-            for s, v in methods[T.OMA].per_seed.items()}  # fmt: skip
+            for s, v in methods[R.OMA].per_seed.items()}  # fmt: skip
     with pytest.raises(ValueError, match="K=2"):
-        _tab_recovery({T.OMA: dataclasses.replace(methods[T.OMA], per_seed=rec2)})
+        _tab_recovery({R.OMA: dataclasses.replace(methods[R.OMA], per_seed=rec2)})
 
 
 def test_tab_damping_adds_the_forcing_free_rows_with_their_own_scores():
@@ -109,10 +111,10 @@ def test_tab_damping_adds_the_forcing_free_rows_with_their_own_scores():
     blind = {s: {("sparse", v, "single"): damping_record(zb * 0.9, zb, s) for v in ("faithful", "damping")}
              for s in SEEDS}  # fmt: skip
     methods = {
-        T.OMA: T.method_rows(T.OMA, {"single": "single"}, oma, damping=True),
-        "ours_blind": T.method_rows("ours_blind", {"single": "single"}, blind, damping=True),
+        R.OMA: R.method_rows(R.OMA, {"single": "single"}, oma, damping=True),
+        "ours_blind": R.method_rows("ours_blind", {"single": "single"}, blind, damping=True),
     }
-    mine = {"ours": T.method_rows("ours", CONFIGS, ours, damping=True)}
+    mine = {"ours": R.method_rows("ours", CONFIGS, ours, damping=True)}
     before = tab_damping(mine, ["sparse"], {"sparse": 22})
     tab = tab_damping({**mine, **methods}, ["sparse"], {"sparse": 22})
     d = tab.df[(tab.df.seed == 0) & (tab.df.testbed == "damping")]
@@ -121,7 +123,7 @@ def test_tab_damping_adds_the_forcing_free_rows_with_their_own_scores():
     np.testing.assert_allclose(tab.df[tab.df.method == "ours_blind"].rel_err_pct, 10.0, atol=1e-9)
     kept = tab.df[tab.df.method == "ours"].reset_index(drop=True)
     pd.testing.assert_frame_equal(kept, before.df)
-    assert rf"{recovery_label(T.OMA)}, single" in tab.tex and label("ours_blind") in tab.tex
+    assert rf"{recovery_label(R.OMA)}, single" in tab.tex and label("ours_blind") in tab.tex
 
 
 def test_tab_fit_writes_the_blind_priors_undefined_splits_as_not_defined(tmp_path):
@@ -144,14 +146,14 @@ def test_tab_fit_writes_the_blind_priors_undefined_splits_as_not_defined(tmp_pat
         }
         for s in SEEDS
     }
-    tab = T.tab_fit(rows, ["sparse"], BONES, ("static", "ours", "ours_blind"), "truth_motion")
+    tab = IM.tab_fit(rows, ["sparse"], BONES, ("static", "ours", "ours_blind"), "truth_motion")
     b = tab.df[tab.df.model == "ours_blind"]
     assert len(b) == len(SEEDS) and b.time_psnr_db.isna().all()
     # (23 + 0.1 s - 20) / (30 - 20): by hand
     np.testing.assert_allclose(b.ceiling_frac, [0.30, 0.31, 0.32])
     line = next(x for x in tab.tex.splitlines() if label("ours_blind") in x)
-    assert line.count(T.NOT_DEFINED) == 1 and "0.00" not in line
-    assert T.NOT_DEFINED not in next(
+    assert line.count(IM.NOT_DEFINED) == 1 and "0.00" not in line
+    assert IM.NOT_DEFINED not in next(
         x for x in tab.tex.splitlines() if x.strip().startswith("& Ours")
     )
     T.write_table(tab, tmp_path / "f.tex", tmp_path / "f.csv")

@@ -4,7 +4,7 @@ import numpy as np
 import pandas as pd
 import pytest
 
-from physgs.report.outputs.trade import draw_fit_vs_extrapolation, fit_vs_extrapolation
+from physgs.report.trade import draw_fit_vs_extrapolation, fit_vs_extrapolation
 
 
 def _curve() -> pd.DataFrame:

@@ -13,7 +13,7 @@ import pytest
 from physgs.oma.intervals import interval_score, relative_scores
 from physgs.oma.run import interval_block
 from physgs.report import claims
-from physgs.report.tables import interval_cells
+from physgs.report.recovery import interval_cells
 from roles import ROLES
 
 

@@ -10,7 +10,7 @@ from physgs.experiments.recipe import canonical
 from physgs.models.registry import MODELS, label, models_of, training_jobs
 from physgs.report import build
 from physgs.report import claims as C
-from physgs.report import tables as T
+from physgs.report import recovery as R
 from physgs.report.summary import prior_lines
 from test_report_tables import BONES, null, paired, record
 from roles import ROLES
@@ -73,7 +73,7 @@ def test_recovery_outputs_read_the_chained_prior_in_every_configuration_and_test
 def _priors(ours, chain, nl, configs):
     """tab_recovery's methods: ours and the chained prior, each beside the null of its K."""
     return {
-        m: T.method_rows(m, configs, paired(per_seed, nl))
+        m: R.method_rows(m, configs, paired(per_seed, nl))
         for m, per_seed in (("ours", ours), ("ours_chain", chain))
     }
 
@@ -83,7 +83,7 @@ def test_tab_null_sets_each_prior_beside_the_null_of_its_k():
     rec = {s: {("sparse", c): record(3, 0.03) for c in configs} for s in (0, 1, 2)}
     chain = {s: {("sparse", c): record(4, 0.010 + 0.001 * s) for c in configs} for s in (0, 1, 2)}
     nl = {s: {("sparse", c): null(0.0456) for c in configs} for s in (0, 1, 2)}
-    tab = T.tab_recovery(_priors(rec, chain, nl, configs), ["sparse"], BONES)
+    tab = R.recovery_table("tab_recovery", _priors(rec, chain, nl, configs), ["sparse"], BONES)
     df = tab.df[tab.df.seed == 1]
     assert list(df.method) == ["ours", "ours", "ours_chain", "ours_chain"]
     mine = df[df.method == "ours_chain"]
@@ -92,7 +92,7 @@ def test_tab_null_sets_each_prior_beside_the_null_of_its_k():
     np.testing.assert_allclose(df[df.method == "ours"].trained_median_rel_err_pct, [3.0, 3.0])
     assert f"{label('ours_chain')}, joint96" in tab.tex
     with pytest.raises(KeyError, match="ours_chain"):
-        T.tab_recovery(_priors(rec, {0: {}}, nl, configs), ["sparse"], BONES)
+        R.recovery_table("tab_recovery", _priors(rec, {0: {}}, nl, configs), ["sparse"], BONES)
 
 
 def test_a_prior_added_to_the_registry_gets_recovery_rows_through_its_entries_alone(
@@ -280,7 +280,7 @@ def test_tab_damping_sets_each_prior_beside_ours_on_both_testbeds():
 
     def methods(chain):
         return {
-            m: T.method_rows(m, configs, d, damping=True)
+            m: R.method_rows(m, configs, d, damping=True)
             for m, d in (("ours", ours), ("ours_chain", chain))
         }
 

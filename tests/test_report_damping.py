@@ -11,7 +11,8 @@ from physgs.recovery.damping_scores import DampingNull, DampingScores, damping_n
 from physgs.recovery.matcher import MatchResult
 from physgs.recovery.record import RecoveryRecord, load_recovery, save_recovery
 from physgs.report.damping import tab_damping
-from physgs.report.tables import method_rows, write_table
+from physgs.report.recovery import method_rows
+from physgs.report.tables import write_table
 
 CONFIGS = {"single": "single", "joint32": "joint"}
 

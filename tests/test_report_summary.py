@@ -10,7 +10,7 @@ import pytest
 from physgs.experiments.cost import read_costs, wall_spans
 from physgs.models.registry import label
 from physgs.report import claims as C
-from physgs.report import tables as T
+from physgs.report import images as IM
 from physgs.report.summary import run_summary
 
 STAMP = {"profile": "quick", "config_hash": "0123456789ab", "physgs_version": "0.1.0"}
@@ -57,7 +57,7 @@ def write_tab_fit(path, seeds=(0, 1)):
                     "iterations": 3000,
                 }
         per_seed[s] = rows
-    tab = T.tab_fit(
+    tab = IM.tab_fit(
         per_seed,
         ["sparse", "medium"],
         {"sparse": 22, "medium": 224},

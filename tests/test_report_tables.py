@@ -10,6 +10,10 @@ from physgs.recovery.damping import damping_summary
 from physgs.recovery.matcher import MatchResult
 from physgs.recovery.null import NullResult
 from physgs.recovery.record import RecoveryRecord
+from physgs.models.registry import MODEL_NAMES, label
+from physgs.report import images as IM
+from physgs.report import seeds as seedstats
+from physgs.report import recovery as R
 from physgs.report import tables as T
 
 TREES = ["sparse", "medium"]
@@ -21,7 +25,7 @@ def summaries():
     rng = np.random.default_rng(0)
     S = {}
     for t in TREES:
-        for m in T.MODELS:
+        for m in MODEL_NAMES:
             d = {"view": 25 + rng.random(), "time": 24 + rng.random()}
             for c in range(3):
                 d[f"train_c{c}"] = 26 + rng.random()
@@ -72,11 +76,11 @@ def per_seed(n_seeds, noise=0.0):
 
 
 def test_one_seed_tab_psnr_agrees_and_bolds_nothing(tmp_path):
-    tab = T.tab_psnr(per_seed(1), TREES, BONES)
+    tab = IM.tab_psnr(per_seed(1), TREES, BONES)
     cols = ["sparse_view", "sparse_time", "medium_view", "medium_time"]
     assert list(tab.df.columns) == ["seed", "model", *cols, "difference"]
-    n = len(T.MODELS)  # the paper's five and its prior, and this project's chained prior
-    assert list(tab.df.model[:n]) == list(T.MODELS) and n == 7  # ids; labels in the .tex
+    n = len(MODEL_NAMES)  # the paper's five and its prior, and this project's chained prior
+    assert list(tab.df.model[:n]) == list(MODEL_NAMES) and n == 7  # ids; labels in the .tex
     T.write_table(tab, tmp_path / "t.tex", tmp_path / "t.csv")
     csv = pd.read_csv(tmp_path / "t.csv")
     rows = tex_rows((tmp_path / "t.tex").read_text())
@@ -91,12 +95,12 @@ def test_one_seed_tab_psnr_agrees_and_bolds_nothing(tmp_path):
         p_static = S[("medium", p)]["time"] - S[("medium", "static")]["time"]
         assert csv.loc[i, "medium_time"] == pytest.approx(p_static)
         assert csv.loc[i + 1, "sparse_view"] == pytest.approx(S[("sparse", p)]["view"] - best_view)
-    assert T.seedstats.UNDECIDED in tab.tex
+    assert seedstats.UNDECIDED in tab.tex
 
 
 def test_seeds_give_mean_sd_and_a_decided_best(tmp_path):
     data = per_seed(4, noise=0.05)
-    tab = T.tab_psnr(data, TREES, BONES)
+    tab = IM.tab_psnr(data, TREES, BONES)
     assert sorted(tab.df.seed.unique()) == [0, 1, 2, 3] and len(tab.df) == 4 * 11
     ours = tab.df[tab.df.model == "ours"]["medium_time"].to_numpy()
     m, sd = ours.mean(), ours.std(ddof=1)  # independent of the module: numpy
@@ -110,8 +114,8 @@ def test_an_undecided_best_is_not_bold():
     for s in data:  # two models tied on average in one column
         data[s][("sparse", "mlp")]["view"] = 40.0 + (1.0 if s % 2 else -1.0)
         data[s][("sparse", "mlp_wind")]["view"] = 40.0
-    tab = T.tab_psnr(data, TREES, BONES)
-    line = [ln for ln in tab.tex.splitlines() if ln.strip().startswith(T.label("mlp") + " &")][0]
+    tab = IM.tab_psnr(data, TREES, BONES)
+    line = [ln for ln in tab.tex.splitlines() if ln.strip().startswith(label("mlp") + " &")][0]
     assert "textbf" not in line.split("&")[1]
 
 
@@ -119,7 +123,7 @@ def test_paired_differences_use_scipy_t_interval():
     from scipy import stats
 
     data = per_seed(5, noise=0.3)
-    tab = T.tab_margin(data, TREES, BONES, COND)
+    tab = IM.tab_margin(data, TREES, BONES, COND)
     d = tab.df[tab.df.tree == "medium"]["margin_0.84v0"].to_numpy()
     exp = [
         data[s][("medium", "ours")]["train_c1"] - data[s][("medium", "mlp_wind")]["train_c1"]
@@ -141,7 +145,7 @@ def test_pairing_decides_what_unpaired_seeds_cannot():
             S[("sparse", "ours")][f"train_c{c}"] = S[("sparse", "mlp_wind")][f"train_c{c}"] + 0.5
     from scipy import stats
 
-    tab = T.tab_margin(base, ["sparse"], BONES, COND)
+    tab = IM.tab_margin(base, ["sparse"], BONES, COND)
     np.testing.assert_allclose(tab.df["margin_v0"], 0.5)
     assert tab.df["seed"].tolist() == [0, 1, 2, 3]
     assert r"\textbf{$+0.50$ [0.50, 0.50]}" in tab.tex
@@ -152,15 +156,15 @@ def test_pairing_decides_what_unpaired_seeds_cannot():
 
 def test_tab_transfer_rows_and_decided_bold():
     data = per_seed(3, noise=0.01)
-    tab = T.tab_transfer(data, TREES, BONES, COND)
+    tab = IM.tab_transfer(data, TREES, BONES, COND)
     assert len(tab.df) == 3 * 2 * len(TREES) * 2
-    assert list(tab.df.columns) == ["seed", "split", "tree", "bones", "condition", *T.MODELS]
+    assert list(tab.df.columns) == ["seed", "split", "tree", "bones", "condition", *MODEL_NAMES]
     first = tab.df[tab.df.seed == 0]
     rows = tex_rows(tab.tex)
     for (nums, bold), (_, r) in zip(rows, first.iterrows()):
         vals = tab.df[
             (tab.df.split == r.split) & (tab.df.tree == r.tree) & (tab.df.condition == r.condition)
-        ][list(T.MODELS)].to_numpy(float)
+        ][list(MODEL_NAMES)].to_numpy(float)
         np.testing.assert_allclose(nums[::2], np.round(vals.mean(0), 2))  # mean, then sd
         top = np.sort(vals.mean(0))
         if top[-1] - top[-2] > 0.1:  # a gap ten times the noise: decided
@@ -171,7 +175,7 @@ def test_tab_transfer_rows_and_decided_bold():
 
 def test_tab_margin_values():
     S = per_seed(1)
-    tab = T.tab_margin(S, TREES, BONES, COND)
+    tab = IM.tab_margin(S, TREES, BONES, COND)
     assert list(tab.df.columns) == [
         "seed",
         "model",
@@ -183,19 +187,19 @@ def test_tab_margin_values():
     ]
     exp = S[0][("medium", "ours")]["train_c1"] - S[0][("medium", "mlp_wind")]["train_c1"]
     assert tab.df.loc[1, "margin_0.84v0"] == pytest.approx(exp)
-    assert f"${exp:+.2f}$" + T.seedstats.UNDECIDED in tab.tex
+    assert f"${exp:+.2f}$" + seedstats.UNDECIDED in tab.tex
     # every prior a block of its own, ours first and unchanged
-    both = T.tab_margin(S, TREES, BONES, COND, priors=("ours", "ours_chain"))
+    both = IM.tab_margin(S, TREES, BONES, COND, priors=("ours", "ours_chain"))
     assert list(both.df.model) == ["ours", "ours", "ours_chain", "ours_chain"]
     pd.testing.assert_frame_equal(both.df.iloc[:2], tab.df)
     chain = S[0][("sparse", "ours_chain")]["train_c2"] - S[0][("sparse", "mlp_wind")]["train_c2"]
     assert both.df.loc[2, "margin_0.71v0"] == pytest.approx(chain)
-    assert rf"{T.label('ours_chain')} $-$ (Deformation MLP" in both.tex
+    assert rf"{label('ours_chain')} $-$ (Deformation MLP" in both.tex
 
 
 def test_results_not_keyed_by_seed_are_refused():
     with pytest.raises(TypeError, match="keyed by training seed"):
-        T.tab_psnr(summaries(), TREES, BONES)
+        IM.tab_psnr(summaries(), TREES, BONES)
 
 
 def record(n_trusted, med):
@@ -235,7 +239,7 @@ def paired(rec, nl):
 
 def ours(rec, nl, configs):
     """tab_null's methods holding ours' rows alone."""
-    return {"ours": T.method_rows("ours", configs, paired(rec, nl))}
+    return {"ours": R.method_rows("ours", configs, paired(rec, nl))}
 
 
 def test_tab_null_per_seed_difference_and_nan_cells(tmp_path):
@@ -251,7 +255,7 @@ def test_tab_null_per_seed_difference_and_nan_cells(tmp_path):
         s: {("sparse", "single"): null(0.0456 + 0.002 * s), ("medium", "single"): null(0.0177)}
         for s in range(3)
     }
-    tab = T.tab_null(ours(rec, nl, cfg), TREES, BONES)
+    tab = R.recovery_table("tab_null", ours(rec, nl, cfg), TREES, BONES)
     sp = tab.df[tab.df.tree == "sparse"]
     np.testing.assert_allclose(sp.trained_median_rel_err_pct, [1.8, 1.9, 2.0])
     np.testing.assert_allclose(sp.null_median_rel_err_pct, [4.56, 4.76, 4.96])
@@ -267,7 +271,7 @@ def test_tab_null_per_seed_difference_and_nan_cells(tmp_path):
     assert np.isnan(csv[csv.tree == "medium"].trained_median_rel_err_pct).all()
     assert "--" in tab.tex  # the medium model has no trusted part
     with pytest.raises(KeyError, match="dense"):
-        T.tab_null(ours(rec, nl, cfg), ["sparse", "dense"], BONES)
+        R.recovery_table("tab_null", ours(rec, nl, cfg), ["sparse", "dense"], BONES)
 
 
 def test_tab_null_refuses_a_null_with_another_k():
@@ -277,14 +281,16 @@ def test_tab_null_refuses_a_null_with_another_k():
         np.array([4]), np.array([0.04]), np.array([0.9]), np.ones((1, 8)), 8, 0.004, 0
     )
     with pytest.raises(ValueError, match="K=8"):
-        T.tab_null(ours(rec, {0: {("sparse", "single"): other}}, cfg), ["sparse"], BONES)
+        R.recovery_table(
+            "tab_null", ours(rec, {0: {("sparse", "single"): other}}, cfg), ["sparse"], BONES
+        )
 
 
 def test_missing_model_names_the_cause():
     S = per_seed(2)
     del S[1][("sparse", "mlp")]
     with pytest.raises(KeyError, match="mlp"):
-        T.tab_psnr(S, TREES, BONES)
+        IM.tab_psnr(S, TREES, BONES)
 
 
 def test_tab_psnr_reference_row_is_separate_and_never_bold():
@@ -292,9 +298,9 @@ def test_tab_psnr_reference_row_is_separate_and_never_bold():
     for s in S:
         for t in TREES:
             S[s][(t, "truth_motion")] = {"view": 40.0 + 0.1 * s, "time": 40.0}  # above every method
-    tab = T.tab_psnr(S, TREES, BONES, references=("truth_motion",))
+    tab = IM.tab_psnr(S, TREES, BONES, references=("truth_motion",))
     first = tab.df[tab.df.seed == 0]
-    n = len(T.MODELS)  # the methods, the reference, two differences per prior
+    n = len(MODEL_NAMES)  # the methods, the reference, two differences per prior
     assert first.reference.tolist() == [False] * n + [True] + [False] * 4
     assert r"\textbf{40.10" not in tab.tex and r"\emph{True motion" in tab.tex
     # one bold per column at most, on a method row (the reference is never a candidate)
@@ -315,7 +321,7 @@ def test_tab_fit_fraction_of_the_ceiling():
                 "train_s": 12.0,
                 "iterations": 1800.0 if m == "static" else 3000.0,
             }
-    tab = T.tab_fit({0: rows}, TREES, BONES, models, "truth_motion")
+    tab = IM.tab_fit({0: rows}, TREES, BONES, models, "truth_motion")
     frac = dict(zip(tab.df.model[tab.df.tree == "sparse"], tab.df.ceiling_frac))
     # (model - static) / (ceiling - static): 0, 2/10, 6/10, 1
     assert frac == pytest.approx({"static": 0.0, "mlp": 0.2, "ours": 0.6, "truth_motion": 1.0})
@@ -349,7 +355,7 @@ def test_tab_fit_held_out_fraction_beside_the_trained_one(tmp_path):
             for t in TREES
             for m, (f, h) in psnr.items()
         }
-    tab = T.tab_fit(per_seed, TREES, BONES, models, "truth_motion")
+    tab = IM.tab_fit(per_seed, TREES, BONES, models, "truth_motion")
     d = tab.df[tab.df.tree == TREES[0]].set_index(["seed", "model"])
     # trained: (28 - 20) / (30 - 20) = 0.8, (26 - 20) / 10 = 0.6
     assert d.loc[(0, "mlp"), "ceiling_frac"] == pytest.approx(0.8)
@@ -362,9 +368,9 @@ def test_tab_fit_held_out_fraction_beside_the_trained_one(tmp_path):
     assert d.loc[(0, "truth_motion"), "heldout_ceiling_frac"] == pytest.approx(1.0)
     # the .tex: the held-out fraction right after the trained one
     assert "& Of ceiling & Held-out of ceiling &" in tab.tex
-    mlp = next(ln for ln in tab.tex.splitlines() if f"& {T.label('mlp')} &" in ln)
+    mlp = next(ln for ln in tab.tex.splitlines() if f"& {label('mlp')} &" in ln)
     cells = [c.strip() for c in mlp.split("&")]
-    i = cells.index(T.label("mlp"))
+    i = cells.index(label("mlp"))
     assert cells[i + 3].startswith("80") and cells[i + 4].startswith("20")
     # the CSV holds it, and reads back through the table's declared columns
     T.write_table(tab, tmp_path / "tab_fit.tex", tmp_path / "tab_fit.csv")

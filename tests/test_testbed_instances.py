@@ -6,9 +6,8 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from physgs.report import tables
-from physgs.report.outputs import testbed as out_testbed
-from physgs.report.outputs.base import Plan
+from physgs.report import testbed
+from physgs.report.output import Plan
 
 
 def _stats(gap: float, span: float, cover: float) -> dict:
@@ -35,7 +34,7 @@ def test_the_mean_and_spread_over_instances_by_hand():
     """Gaps 5%, 6%, 10% over three instances: mean 7%, sample sd sqrt(((2)^2 + 1^2 + 3^2) / 2) =
     sqrt(7) points; the paper's sparse gap (5.40%) and bones (22) beside, through role.paper."""
     inst = [_stats(0.05, 4.0, 0.10), _stats(0.06, 4.2, 0.12), _stats(0.10, 4.4, 0.14)]
-    t = tables.tab_testbed(
+    t = testbed.tab_testbed(
         {"oak": inst[0]}, ["oak"], instances={"oak": inst}, paper_trees={"oak": "sparse"}
     )
     r = t.df.iloc[0]
@@ -49,7 +48,7 @@ def test_the_mean_and_spread_over_instances_by_hand():
 
 
 def test_one_instance_is_the_papers_protocol():
-    t = tables.tab_testbed({"oak": _stats(0.05, 4.0, 0.1)}, ["oak"])
+    t = testbed.tab_testbed({"oak": _stats(0.05, 4.0, 0.1)}, ["oak"])
     r = t.df.iloc[0]
     assert r["instances"] == 1 and np.isnan(r["nearest_bone_gap_pct_sd"])
     assert np.isnan(r["paper_nearest_bone_gap_pct"])  # no role.paper: no paper figure
@@ -59,6 +58,6 @@ def test_one_instance_is_the_papers_protocol():
 @pytest.mark.parametrize("seeded", [False, True])
 def test_tab_testbed_reads_every_instance_with_testbed_seeds(seeded):
     plan = Plan(trees=["sparse"], configs={}, seeds=[0, 1, 2], testbed_seeds=seeded)
-    got = out_testbed.TAB_TESTBED.needs(plan, [])
+    got = testbed.TAB_TESTBED.needs(plan, [])
     inst = [("instance_stats", "sparse", s) for s in (0, 1, 2)]
     assert got == [("stats", "sparse"), *(inst if seeded else [])]

@@ -21,7 +21,7 @@ from physgs.recovery.matcher import MatchResult
 from physgs.recovery.null import NullResult
 from physgs.recovery.record import RecoveryRecord, load_recovery
 from physgs.report import build, claims, thresholds
-from physgs.report import tables as T
+from physgs.report import recovery as R
 from physgs.report.damping import tab_damping
 from physgs.report.tracks import tab_tracks
 from physgs.tracks import settings as tsettings
@@ -243,9 +243,10 @@ def test_tab_recovery_adds_the_tracks_rows_after_ours_and_leaves_ours_rows_as_th
         s: {(t, "joint32"): (_record(0.03 + 0.002 * s, K=2), _null(0.06, K=2)) for t in BONES}
         for s in (0, 1)
     }
-    plain = T.tab_null(ours_rows(rec, nl, cfg), list(BONES), BONES).df
-    both = T.tab_recovery(
-        {**ours_rows(rec, nl, cfg), "tracks": T.method_rows("tracks", {"joint32": "j2"}, tracks)},
+    plain = R.recovery_table("tab_null", ours_rows(rec, nl, cfg), list(BONES), BONES).df
+    both = R.recovery_table(
+        "tab_recovery",
+        {**ours_rows(rec, nl, cfg), "tracks": R.method_rows("tracks", {"joint32": "j2"}, tracks)},
         list(BONES),
         BONES,
     )
@@ -269,10 +270,11 @@ def test_tab_recovery_adds_the_tracks_rows_after_ours_and_leaves_ours_rows_as_th
     assert r"\emph{2D tracks}, j2" in both.tex
     bad = {0: {(t, "joint32"): (_record(0.03, K=2), _null(0.06, K=4)) for t in BONES}}
     with pytest.raises(ValueError, match="K=4 but the model has K=2"):
-        T.tab_recovery(
+        R.recovery_table(
+            "tab_recovery",
             {
                 **ours_rows({0: rec[0]}, {0: nl[0]}, cfg),
-                "tracks": T.method_rows("tracks", {"joint32": "j"}, bad),
+                "tracks": R.method_rows("tracks", {"joint32": "j"}, bad),
             },
             list(BONES),
             BONES,
@@ -302,8 +304,8 @@ def test_tab_damping_adds_the_tracks_rows_with_their_own_scores():
         for s in (0, 1)
     }
     methods = {
-        "ours": T.method_rows("ours", {"a": "A", "b": "B"}, ours, damping=True),
-        "tracks": T.method_rows("tracks", {"a": "A"}, mine, damping=True),
+        "ours": R.method_rows("ours", {"a": "A", "b": "B"}, ours, damping=True),
+        "tracks": R.method_rows("tracks", {"a": "A"}, mine, damping=True),
     }
     tab = tab_damping(methods, ["sparse"], {"sparse": 22})
     df = tab.df
@@ -318,7 +320,7 @@ def test_tab_damping_adds_the_tracks_rows_with_their_own_scores():
     }
     with pytest.raises(ValueError, match="tracks control"):
         tab_damping(
-            {**methods, "tracks": T.method_rows("tracks", {"a": "A"}, none, damping=True)},
+            {**methods, "tracks": R.method_rows("tracks", {"a": "A"}, none, damping=True)},
             ["sparse"],
             {"sparse": 22},
         )

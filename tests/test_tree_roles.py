@@ -15,7 +15,7 @@ import yaml
 import physgs.config
 from physgs.report import claims
 from physgs.report.claim_cells import roles_of
-from physgs.report.outputs.views import teaser_tree
+from physgs.report.images import teaser_tree
 from roles import ROLES
 from workflow_helpers import workflow_copy
 

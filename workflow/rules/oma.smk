@@ -57,5 +57,5 @@ rule oma_recovery:
 rule oma:
     input:
         expand(recovery_record("oma"), tree=TESTBEDS, seed=SEEDS, config=OMA_CONFIGS),
-        # each tree's stabilisation diagram (an output: physgs.report.outputs.oma)
+        # each tree's stabilisation diagram (an output: physgs.report.stabilisation)
         expand(FIGURE, name="fig_stabilisation", ext=("pdf", "png")) if OMA_CONFIGS else [],

@@ -23,7 +23,7 @@ rule speed_accuracy_point:
         "../scripts/speed_accuracy_point.py"
 
 
-# the sweep's points in one CSV; fig_speed_accuracy (physgs.report.outputs.trade) draws it
+# the sweep's points in one CSV; fig_speed_accuracy (physgs.report.trade) draws it
 rule speed_accuracy:
     input:
         points=expand(SWEEP_POINT, seed=STUDY_SEEDS, point=SWEEP_POINTS),
@@ -81,7 +81,7 @@ use rule fit_curve_point as fit_curve_window_point with:
         series=lambda wc: wc.model + _fit_curve.WINDOW_SERIES,
 
 
-# the fit curve's points in one CSV; fig_fit_curve (physgs.report.outputs.trade) draws it
+# the fit curve's points in one CSV; fig_fit_curve (physgs.report.trade) draws it
 rule fit_curve:
     input:
         unpack(fit_curve_inputs),

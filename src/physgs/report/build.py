@@ -23,7 +23,7 @@ from physgs.recovery.record import load_recovery
 from physgs.report import catalogue, claims, tables
 from physgs.report.claim_cells import CONFIG as CLAIMS_CONFIG
 from physgs.report.outputs import NEED_FIELDS, OUTPUTS, Plan, key, reader
-from physgs.report.outputs.views import fit_row
+from physgs.report.images import fit_row
 
 if TYPE_CHECKING:
     from physgs.report.tables import Table

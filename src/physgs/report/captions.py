@@ -28,7 +28,7 @@ class Caption:
         shows: what is drawn, every colour, band, line and unit.
         read: how to read it: what a reader looks for.
         seeds: which training seeds it draws when it is not one of the report's outputs
-            (``physgs.report.outputs.base.SEEDS``; the testbed figures: ``none``).
+            (``physgs.report.output.SEEDS``; the testbed figures: ``none``).
     """
 
     pattern: str
@@ -224,7 +224,7 @@ def find(name: str) -> tuple[int, Caption, str]:
 
 
 def scope(caption: Caption) -> str:
-    """Which training seeds a figure draws (``physgs.report.outputs.base.SEEDS``).
+    """Which training seeds a figure draws (``physgs.report.output.SEEDS``).
 
     Args:
         caption: the figure's caption.

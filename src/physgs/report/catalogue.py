@@ -52,7 +52,7 @@ from physgs.report.claim_cells import (
     rows_of,
     value,
 )
-from physgs.report.tables import OMA
+from physgs.report.recovery import OMA
 from physgs.testbed.variant import DAMPING
 
 #: The origins of a claim: stated by the source paper, or this project's own.

@@ -9,6 +9,8 @@ diagnosis is p near 0: a frequency-independent rate fitted in place of a ratio; 
 ratio gives the truth's p, 1 for a constant zeta), each beside the untrained null (zeta drawn
 log-uniformly from the damping range, scored on the same matching; medians over its draws).
 Built from the recovery records ([`physgs.recovery.record`][], ``damping_scores``/``damping_null``).
+
+Beside it, fig_damping: each prior's recovered damping on the run's own trees (first seed).
 """
 
 from __future__ import annotations
@@ -17,10 +19,23 @@ from typing import Mapping, Sequence
 
 import pandas as pd
 
+from physgs.models.registry import RECOVERY_METHODS, models_of
+from physgs.recovery.record import load_recovery
 from physgs.report import latex
 from physgs.report import seeds as seedstats
-from physgs.report.tables import MethodRows, Table, _method_seeds, _who, interval_cells, tree_label
-from physgs.testbed.variant import DAMPING, FAITHFUL
+from physgs.report.output import Columns, Output
+from physgs.report.recovery import (
+    INTERVAL_COLUMNS,
+    MethodRows,
+    interval_cells,
+    method_seeds,
+    methods_needs,
+    methods_settings,
+    table_methods,
+    who,
+)
+from physgs.report.tables import Table, tree_label
+from physgs.testbed.variant import DAMPING, FAITHFUL, damping_id
 
 VARIANTS = (FAITHFUL, DAMPING)
 COLUMNS = (
@@ -49,7 +64,7 @@ def tab_damping(
     interval.
 
     Args:
-        methods: method id -> its [`MethodRows`][physgs.report.tables.MethodRows], in row order
+        methods: method id -> its [`MethodRows`][physgs.report.recovery.MethodRows], in row order
             (ours first, as tab_null's; a method with no configurations has no rows):
             ``per_seed[seed][(tree, variant, config)]`` = its ``RecoveryRecord`` with damping
             scores and null; variant 'faithful' or 'damping'.
@@ -67,16 +82,16 @@ def tab_damping(
     methods = {m: mr for m, mr in methods.items() if mr.configs}
     block = [(c, m) for m, mr in methods.items() for c in mr.configs]
     keys = [(t, v, c, m) for t in trees for v in VARIANTS for c, m in block]
-    seeds = _method_seeds(methods, "tab_damping", keys)
+    seeds = method_seeds(methods, "tab_damping", keys)
     rows = []
     for s in seeds:
         for t, v, c, method in keys:
             rec = methods[method].per_seed[s][(t, v, c)]
             sc, nl = rec.damping_scores, rec.damping_null
             if sc is None or nl is None:
-                who = "" if method == "ours" else f" ({_who(method)})"
+                name = "" if method == "ours" else f" ({who(method)})"
                 raise ValueError(
-                    f"tab_damping: the recovery of {t}/{v}/{c}{who} (seed {s}) has no "
+                    f"tab_damping: the recovery of {t}/{v}/{c}{name} (seed {s}) has no "
                     "damping scores; re-run its recovery rule with damping params"
                 )
             rows.append(
@@ -139,3 +154,97 @@ def tab_damping(
         + latex.seed_note(len(seeds))
     )
     return Table("tab_damping", df, latex.render(cells, cap, "tab:damping"))
+
+
+# ---- the declarations ----------------------------------------------------------------------
+def _testbeds(tree: str) -> dict:
+    """{variant: testbed id} of a damping-benchmark tree: its faithful and damping testbeds."""
+    return {FAITHFUL: tree, DAMPING: damping_id(tree)}
+
+
+def _damping_needs(plan, seeds):
+    testbeds = [tb for t in plan.damping_trees for tb in _testbeds(t).values()]
+    return [
+        x
+        for s in seeds
+        for x in methods_needs(plan, plan.recovery, plan.damping_configs, testbeds, int(s))
+    ]
+
+
+def _damping_settings(cfg: dict) -> dict:
+    configs = cfg["damping_benchmark"]["configs"]
+    return methods_settings(cfg, RECOVERY_METHODS, configs)
+
+
+def _tab_damping(path, settings, inputs, out):
+    trees, seeds = settings["trees"], settings["seeds"]
+
+    def records(m, configs):
+        """{seed: {(tree, variant, config): record}} of a method on each tree's testbeds."""
+        return {
+            s: {
+                (t, v, c): load_recovery(path("recovery", tb, m, c, s))
+                for t in trees
+                for v, tb in _testbeds(t).items()
+                for c in configs
+            }
+            for s in seeds
+        }
+
+    methods = table_methods(settings, records, damping=True)
+    return tab_damping(methods, trees, settings["bones"], digits=settings["digits"])
+
+
+DAMPING_COLUMNS = Columns(
+    keys=("seed", "tree", "testbed", "config", "method"),
+    values=(*COLUMNS, *INTERVAL_COLUMNS),
+    about=("bones",),
+)
+
+
+TAB_DAMPING = Output(
+    "tab_damping",
+    "table",
+    _damping_needs,
+    _tab_damping,
+    settings=_damping_settings,
+    trees="damping_benchmark",
+    in_report=lambda plan: bool(plan.damping_trees),
+    columns=DAMPING_COLUMNS,
+)
+
+
+def _fig_damping(path, settings, inputs, out):
+    from physgs.report import figures  # matplotlib: not for the workflow's planning imports
+
+    trees, configs, s0 = settings["trees"], settings["configs"], settings["seeds"][0]
+    damping = {
+        m: {
+            (t, c): load_recovery(path("recovery", t, m, c, s0)).damping
+            for t in trees
+            for c in configs
+        }
+        for m in models_of("prior")
+    }
+    zeta, bound = float(settings["zeta"]), float(settings["zeta_bound"])
+    figures.fig_damping(damping, trees, configs, zeta, out, bound)
+
+
+FIG_DAMPING = Output(
+    "fig_damping",
+    "figure",
+    lambda plan, seeds: [
+        ("recovery", t, m, c, s)
+        for s in seeds
+        for t in plan.trees
+        for m in models_of("prior")
+        for c in plan.configs
+    ],
+    _fig_damping,
+    settings=lambda cfg: {
+        "configs": list(cfg["models"]["configs"]),
+        "zeta": float(cfg["testbed"]["zeta"]),
+        "zeta_bound": float(max(cfg["models"]["ours"]["zeta"])),
+    },
+    seeds="first",
+)

@@ -1,8 +1,8 @@
 """tab_kselect: each prior with fixed K (`single`) beside the same prior with K chosen from the
 data (`auto`): ours, and every prior under ``models.kselect.priors`` (the chained prior).
 
-Built by ``physgs.report.build.make_table('tab_kselect', ...)`` from each tree's K selections
-and the evaluation, recovery and loss log of ``<prior>_single`` and ``<prior>_auto``.
+Built from each tree's K selections and the evaluation, recovery and loss log of
+``<prior>_single`` and ``<prior>_auto``; declared last (``TAB_KSELECT``).
 """
 
 from __future__ import annotations
@@ -12,11 +12,16 @@ from typing import Mapping, Sequence
 import numpy as np
 import pandas as pd
 
+from physgs.evaluate.splits import load_eval
+from physgs.experiments.kselect import BASE_MODEL, load_selection, selected_models
 from physgs.models.registry import spec_of
+from physgs.recovery.record import load_recovery
 from physgs.report import latex
-from physgs.report.tables import Table, _seeds, _tree_index
+from physgs.report.output import Columns, Output
+from physgs.report.tables import Table, seeds_of, tree_index
 
-ROWS = (("single", "fixed $K$"), ("auto", "chosen $K$"))
+#: the rows of each prior: configuration -> its label (fixed K, then K chosen from the data)
+ROWS = {"single": "fixed $K$", "auto": "chosen $K$"}
 
 
 def row_label(model: str, config: str) -> str:
@@ -29,7 +34,7 @@ def row_label(model: str, config: str) -> str:
     Returns:
         'Ours, fixed $K$' / 'Chained, chosen $K$'.
     """
-    return f"{spec_of(model).short}, {dict(ROWS)[config]}"
+    return f"{spec_of(model).short}, {ROWS[config]}"
 
 
 def cost_ratio(train_s: float, select_s: float, fixed_train_s: float) -> float:
@@ -72,14 +77,14 @@ def tab_kselect(
             rest mean +- sd over seeds; the CSV also holds each seed's cost against the fixed
             K, ``cost_x`` = (train_s + select_s) / train_s of the fixed-K row.
     """
-    keys = [(t, m, c) for t in trees for m in models for c, _ in ROWS]
-    seeds = _seeds(per_seed, "tab_kselect", keys)
+    keys = [(t, m, c) for t in trees for m in models for c in ROWS]
+    seeds = seeds_of(per_seed, "tab_kselect", keys)
     recs = []
     for s in seeds:
         for t in trees:
             for m in models:
                 fixed_s = float(per_seed[s][(t, m, "single")]["train_s"])
-                for c, _ in ROWS:
+                for c in ROWS:
                     r = per_seed[s][(t, m, c)]
                     select_s = float(r["select_s"]) if c == "auto" else np.nan
                     recs.append(
@@ -123,7 +128,7 @@ def tab_kselect(
             "Select (s)": latex.cells(df, "select_s", ".0f"),
             "Cost": latex.cells(df, "cost_x", ".2g", r"$\times$"),
         },
-        index=_tree_index(first, labels, "Model"),
+        index=tree_index(first, labels, "Model"),
     )
     cap = (
         rf"Each prior with fixed $K$ against $K$ chosen from the data (method: {method}, on "
@@ -136,3 +141,93 @@ def tab_kselect(
         + r" $K$: as each seed chose it."
     )
     return Table("tab_kselect", df, latex.render(cells, cap, "tab:kselect"))
+
+
+# ---- the declaration -----------------------------------------------------------------------
+
+
+def _kselect_models(plan) -> list[str]:
+    """The priors whose K is chosen: ours, then the plan's others (``models.kselect.priors``)."""
+    return [BASE_MODEL, *plan.kselect_priors]
+
+
+def _selection_need(t: str, m: str, s: int) -> tuple:
+    """The need of prior ``m``'s K selection on tree ``t`` (ours' has its own kind)."""
+    return ("kselect", t, s) if m == BASE_MODEL else ("prior_kselect", t, m, s)
+
+
+def _kselect_needs(plan, seeds):
+    """Per seed, tree and prior: its K selection, and the evaluation, recovery and loss log
+    (training seconds) of its fixed-K and chosen-K models."""
+    out = []
+    for s in seeds:
+        for t in plan.trees:
+            for m in _kselect_models(plan):
+                out.append(_selection_need(t, m, s))
+                for c in ROWS:
+                    rec = ("recovery", t, m, c, s)
+                    out += [("eval", t, m, c, s), rec, ("loss", t, m, c, s)]
+    return out
+
+
+def _tab_kselect(path, settings, inputs, out):
+    rows = {}
+    for s in settings["seeds"]:
+        rows[s] = {}
+        for t in settings["trees"]:
+            for m in settings["models"]:
+                sel = load_selection(path(*_selection_need(t, m, s)))
+                for c in ROWS:
+                    ev = load_eval(path("eval", t, m, c, s)).summary()
+                    rec = load_recovery(path("recovery", t, m, c, s))
+                    loss = pd.read_csv(path("loss", t, m, c, s))
+                    rows[s][(t, m, c)] = {
+                        "K": rec.match.n_parts,
+                        "view_psnr": ev["view"],
+                        "time_psnr": ev["time"],
+                        "median_rel_err": rec.match.median_rel_err,
+                        "trusted": rec.match.n_trusted,
+                        "frozen": rec.n_frozen,
+                        "k_heldout": sel.k_heldout,
+                        "k_bic": sel.k_bic,
+                        "train_s": float(loss["seconds"].iloc[-1]),
+                        "select_s": float(sum(sel.wall_s)),
+                    }
+    return tab_kselect(
+        rows,
+        settings["trees"],
+        settings["bones"],
+        settings["method"],
+        models=settings["models"],
+        digits=settings["digits"],
+    )
+
+
+KSELECT_COLUMNS = Columns(
+    keys=("seed", "tree", "model", "config"),
+    values=(
+        "view_psnr_db",
+        "time_psnr_db",
+        "median_rel_err_pct",
+        "parts_trusted",
+        "parts_frozen",
+        "k_heldout",
+        "k_bic",
+    ),
+    timing=("train_s", "select_s", "cost_x"),
+    about=("bones", "K"),
+)
+
+
+TAB_KSELECT = Output(
+    "tab_kselect",
+    "table",
+    _kselect_needs,
+    _tab_kselect,
+    settings=lambda cfg: {
+        "method": cfg["models"]["kselect"]["method"],
+        "models": list(selected_models(cfg["models"]["kselect"])),
+    },
+    in_report=lambda plan: False,  # `all` builds it (Snakefile): K selection costs trainings
+    columns=KSELECT_COLUMNS,
+)

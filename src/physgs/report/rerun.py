@@ -16,7 +16,7 @@ from pathlib import Path
 import pandas as pd
 
 from physgs.report.outputs import OUTPUTS
-from physgs.report.outputs.base import PROVENANCE_COLUMNS
+from physgs.report.outputs import PROVENANCE_COLUMNS
 
 
 @dataclass(frozen=True)

@@ -10,6 +10,9 @@ from typing import Mapping, Sequence
 
 import numpy as np
 
+from physgs.report.output import Output
+from physgs.report.recovery import OMA
+
 #: the panels' frequency axis ends at max(this, 1.2 x the highest bone's), Hz
 MIN_FREQ_AXIS_HZ = 3.0
 
@@ -82,3 +85,37 @@ def fig_stabilisation(
     ]
     _legend_below(fig, handles, ncol=4, top=0.1)
     save_figure(fig, outputs, dpi=150)
+
+
+# ---- the declaration -----------------------------------------------------------------------
+def _analysed(plan) -> bool:
+    return bool(plan.recovery.get(OMA))
+
+
+def _fig_stabilisation_needs(plan, seeds):
+    """Per tree, the first seed's identification in the first configuration and the truth of
+    that seed's instance."""
+    s0, config = int(seeds[0]), next(iter(plan.recovery[OMA]))
+    return [need for t in plan.trees for need in (("oma_modes", t, config, s0), ("truth", t, s0))]
+
+
+def _fig_stabilisation(path, settings, inputs, out):
+    from physgs.oma.run import load_identification  # not for the planning imports
+    from physgs.testbed.dataset import load_truth
+
+    trees, s0, config = settings["trees"], settings["seeds"][0], settings["configs"][0]
+    idents = {t: load_identification(path("oma_modes", t, config, s0)) for t in trees}
+    omega = {t: load_truth(path("truth", t, s0)).omega for t in trees}
+    title = f"Output-only modal analysis of the training window ({config}, seed {s0})"
+    fig_stabilisation(idents, omega, trees, out, title=title)
+
+
+FIG_STABILISATION = Output(
+    "fig_stabilisation",
+    "figure",
+    _fig_stabilisation_needs,
+    _fig_stabilisation,
+    settings=lambda cfg: {"configs": list(cfg["oma"]["configs"])},
+    seeds="first",
+    in_report=_analysed,
+)

@@ -12,7 +12,7 @@ import pandas as pd
 from physgs.experiments.sweep import null_level
 from physgs.models.registry import BASE_CONFIG
 from physgs.recovery.record import load_null
-from physgs.report.outputs.base import Output
+from physgs.report.output import Output
 
 #: the studies' CSVs (need ``("table", <study>)``), written by the rules of the same name
 SPEED_ACCURACY, FIT_CURVE = "speed_accuracy", "fit_curve"
@@ -39,12 +39,6 @@ def _fig_speed_accuracy(path, settings, inputs, out):
     figures.fig_speed_accuracy(df, out, null=null)
 
 
-def _fig_fit_curve(path, settings, inputs, out):
-    from physgs.report import figures  # matplotlib: not for the workflow's planning imports
-
-    figures.fig_fit_curve(pd.read_csv(path("table", FIT_CURVE)), out)
-
-
 FIG_SPEED_ACCURACY = Output(
     "fig_speed_accuracy",
     "figure",
@@ -57,6 +51,12 @@ FIG_SPEED_ACCURACY = Output(
     seeds="studies",
     in_report=_studies_only,
 )
+
+
+def _fig_fit_curve(path, settings, inputs, out):
+    from physgs.report import figures  # matplotlib: not for the workflow's planning imports
+
+    figures.fig_fit_curve(pd.read_csv(path("table", FIT_CURVE)), out)
 
 
 # ---- fig_fit_curve -------------------------------------------------------------------------
@@ -99,7 +99,7 @@ def draw_fit_vs_extrapolation(df: pd.DataFrame, outputs) -> None:
     seeds' own points faint), the profile's budget starred, the fit bar and zero gain marked.
 
     Args:
-        df: [`fit_vs_extrapolation`][physgs.report.outputs.trade.fit_vs_extrapolation]'s rows.
+        df: [`fit_vs_extrapolation`][physgs.report.trade.fit_vs_extrapolation]'s rows.
         outputs: the paths to write.
     """
     import matplotlib.pyplot as plt  # matplotlib: not for the workflow's planning imports

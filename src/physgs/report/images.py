@@ -1,0 +1,745 @@
+"""The outputs that score rendered images: the tables tab_psnr, tab_fit, tab_transfer and
+tab_margin (their builders here) and the figures fig_temporal, fig_teaser and fig_results
+(drawn by ``physgs.report.figures``), each declared here. Each reads the evaluations of the
+models of its roles, trained in the base configuration."""
+
+from __future__ import annotations
+
+from typing import Mapping, Sequence
+
+import numpy as np
+import pandas as pd
+
+from physgs.evaluate.splits import load_eval
+from physgs.evaluate.trajectories import load_trajectories
+from physgs.experiments.recipe import heldout_split
+from physgs.evaluate.metrics import ceiling_fraction
+from physgs.models.registry import BASE_CONFIG, BLIND_CONFIG, MODEL_NAMES, blind_priors
+from physgs.models.registry import label, models_of, spec_of
+from physgs.report import latex, paper
+from physgs.report import seeds as seedstats
+from physgs.report.claim_cells import roles_of
+from physgs.report.output import Columns, Output
+from physgs.report.tables import Table, condition_label, seeds_of, tree_index, tree_label
+
+#: the roles of the methods compared on images, and of the references shown beside them
+METHODS = ("control", "field", "prior")
+REFERENCES = ("reference",)
+#: tab_margin: the wind-conditioned field every prior's margin is taken against
+MARGIN_BASELINE = "mlp_wind"
+
+
+def _evals(kinds: Sequence[str], roles: Sequence[str]):
+    """needs(plan, seeds): ``kinds`` of every model of ``roles`` on every tree, per seed."""
+
+    def needs(plan, seeds):
+        return [
+            (k, t, m, BASE_CONFIG, s)
+            for s in seeds
+            for k in kinds
+            for t in plan.trees
+            for m in models_of(*roles)
+        ]
+
+    return needs
+
+
+def _conditions(cfg: dict) -> dict:
+    return {"conditions": [float(c) for c in cfg["testbed"]["conditions"]]}
+
+
+def _teaser_settings(cfg: dict) -> dict:
+    """The conditions, and the trees' roles: the teaser shows the tree standing for the paper's."""
+    return {**_conditions(cfg), "roles": roles_of(cfg["presets"], cfg["trees"])}
+
+
+def summaries(path, trees, models, seeds) -> dict:
+    """{seed: {(tree, model): summary}} of the models trained in the base configuration.
+
+    Args:
+        path (Callable[..., str]): the need -> file function of
+            [`reader`][physgs.report.output.reader].
+        trees (Sequence[str]): the trees.
+        models (Sequence[str]): the models.
+        seeds (Sequence[int]): the training seeds.
+
+    Returns:
+        ``{seed: {(tree, model): summary}}``, each summary split -> mean (dB; centroid errors px).
+    """
+    return {
+        s: {
+            (t, m): load_eval(path("eval", t, m, BASE_CONFIG, s)).summary()
+            for t in trees
+            for m in models
+        }
+        for s in seeds
+    }
+
+
+def fit_row(eval_path, loss_path, n_train: int, holdout_every: int) -> dict:
+    """One tab_fit row from a model's evaluation and loss log: fit and held-out-frame PSNR (dB,
+    training camera and wind, frames < n_train), view and time PSNR (dB), training seconds and
+    iterations used (NaN without a loss log).
+
+    Args:
+        eval_path (str | Path): the model's evaluation ``.npz``.
+        loss_path (str | Path | None): its loss log CSV (its last ``seconds``), or None.
+        n_train: training-window length, frames.
+        holdout_every: the held-out stride (0: no held-out frames, ``heldout`` NaN).
+
+    Returns:
+        ``fit``, ``heldout``, ``view``, ``time`` (dB), ``train_s`` (s) and ``iterations``.
+    """
+    ev = load_eval(eval_path)
+    cam = np.asarray(ev.camera_psnr[0, :n_train], dtype=np.float64)  # [n_train] dB
+    if holdout_every:
+        trained, held = heldout_split(n_train, holdout_every)
+    else:
+        trained, held = np.arange(n_train), np.arange(0)
+    s = ev.summary()
+    log = (
+        pd.read_csv(loss_path, usecols=["iteration", "seconds"])
+        if loss_path is not None
+        else pd.DataFrame({"iteration": [np.nan], "seconds": [np.nan]})
+    )
+    return {
+        "fit": float(cam[trained].mean()),
+        "heldout": float(cam[held].mean()) if held.size else float("nan"),
+        "view": s["view"],
+        "time": s["time"],
+        "train_s": float(log["seconds"].iloc[-1]),
+        "iterations": float(log["iteration"].iloc[-1]) + 1,
+    }
+
+
+def fit_settings(cfg: dict) -> dict:
+    """What ``fit_row`` reads: the training window's length and its held-out stride.
+
+    Args:
+        cfg: the resolved config.
+
+    Returns:
+        ``n_train`` and ``holdout_every``.
+    """
+    return {
+        "n_train": int(cfg["testbed"]["n_train"]),
+        "holdout_every": int(cfg["train"]["holdout_every"]),
+    }
+
+
+# ---- the tables' builders ------------------------------------------------------------------
+#: a .tex cell that a method does not define (a forcing-free prior beyond the window): never 0
+NOT_DEFINED = "n/d"
+
+
+#: tab_psnr's difference rows: ``<prior>-static`` and ``<prior>-best_field`` (column ``model``)
+PSNR_MINUS = "-"
+
+
+#: the id of "the best learned field, per seed" in tab_psnr's difference rows
+BEST_FIELD = "best_field"
+
+
+def _best_cols(V: np.ndarray, rows: np.ndarray, higher: bool = True) -> np.ndarray:
+    """[R] bool: among ``rows`` [R] bool, the row whose mean is best when decided (V [S, R])."""
+    out = np.zeros(V.shape[1], bool)
+    idx = np.flatnonzero(rows)
+    b = seedstats.decided_best(V[:, idx], higher=higher)
+    if b is not None:
+        out[idx[b]] = True
+    return out
+
+
+def tab_psnr(
+    per_seed: Mapping[int, Mapping[tuple[str, str], Mapping[str, float]]],
+    trees: Sequence[str],
+    bones: Mapping[str, int],
+    models: Sequence[str] = MODEL_NAMES,
+    digits: int = 2,
+    references: Sequence[str] = (),
+) -> Table:
+    """PSNR (dB) on the view and time splits, one row per model, two columns per tree.
+
+    The CSV's ``model`` column holds ids (a difference row: ``<prior>-static``,
+    ``<prior>-best_field``); the labels are the .tex's.
+
+    Below the models: references (the true-motion ceiling; never bold) and two paired
+    differences, ours - static and ours - the best learned field (per seed, the learned field with
+    the highest PSNR in that column), for every prior among ``models`` (role "prior" in the
+    registry: ours, then the chained prior). The best method per column is bold when its paired
+    difference to the runner-up is decided.
+
+    Args:
+        per_seed: ``per_seed[seed][(tree, model)]``: ``EvalResult.summary()`` of the model trained
+            ``single`` with that training seed.
+        trees: the trees, in column order.
+        bones: tree -> its bone count (in the header).
+        models: the methods, in row order.
+        digits: decimals shown in the .tex.
+        references: the reference rows.
+
+    Returns:
+        The [`Table`][physgs.report.tables.Table].
+    """
+    fmt = f".{int(digits)}f"
+    seeds = seeds_of(per_seed, "tab_psnr", [(t, m) for t in trees for m in (*models, *references)])
+    learned = [m for m in models if spec_of(m).role == "field"]
+    priors = [m for m in models if spec_of(m).role == "prior"]
+    cols = [f"{t}_{sp}" for t in trees for sp in ("view", "time")]
+    rows = []
+    for s in seeds:
+        S = per_seed[s]
+        val = {
+            m: {f"{t}_{sp}": S[(t, m)][sp] for t in trees for sp in ("view", "time")}
+            for m in (*models, *references)
+        }
+        for m in (*models, *references):
+            rows.append(
+                {"seed": s, "model": m, **val[m], "reference": m in references, "difference": False}
+            )
+        subtracted = {"static": val["static"]} if "static" in models else {}
+        if learned:  # the best learned field, per seed and column
+            subtracted[BEST_FIELD] = {c: max(val[m][c] for m in learned) for c in cols}
+        for p in priors:
+            for other, v in subtracted.items():
+                rows.append(
+                    {
+                        "seed": s,
+                        "model": f"{p}{PSNR_MINUS}{other}",
+                        **{c: val[p][c] - v[c] for c in cols},
+                        "reference": False,
+                        "difference": True,
+                    }
+                )
+    df = pd.DataFrame(rows)
+    first = latex.rows(df)
+    ref, diff = first["reference"].to_numpy(bool), first["difference"].to_numpy(bool)
+    names = [
+        " $-$ ".join(
+            "best learned field" if x == BEST_FIELD else label(x) for x in m.split(PSNR_MINUS)
+        )
+        if d
+        else (rf"\emph{{{label(m)}}}" if r else label(m))
+        for m, r, d in zip(first["model"], ref, diff)
+    ]
+    cells = pd.DataFrame(
+        {
+            (tree_label(t, bones[t]), sp): np.where(
+                diff,
+                latex.cells(df, f"{t}_{sp}", fmt, cell=seedstats.difference),
+                latex.cells(df, f"{t}_{sp}", fmt),
+            )
+            for t in trees
+            for sp in ("view", "time")
+        },
+        index=names,
+    )
+    bold = np.stack([_best_cols(latex.by_seed(df, c), ~ref & ~diff) for c in cols], axis=1)
+    if not references:
+        df = df.drop(columns="reference")
+    cap = (
+        r"PSNR (dB). \emph{view}: held-out azimuths at the training wind inside the training "
+        r"window. \emph{time}: frames beyond the training window at the training wind and camera. "
+        r"Best method per column in bold."
+        + (
+            r" In italics, a reference (not a method, never bold): the canonical Gaussians moved "
+            r"by the ground-truth motion, appearance trained by the same recipe."
+            if references
+            else ""
+        )
+        + r" Last rows: paired differences (dB); the best learned field is taken per seed."
+        + latex.seed_note(len(seeds))
+    )
+    return Table("tab_psnr", df, latex.render(cells, cap, "tab:psnr", bold))
+
+
+def tab_fit(
+    per_seed: Mapping[int, Mapping[tuple[str, str], Mapping[str, float]]],
+    trees: Sequence[str],
+    bones: Mapping[str, int],
+    models: Sequence[str],
+    reference: str,
+    digits: int = 2,
+    static: str = "static",
+    holdout_every: int = 10,
+) -> Table:
+    """How much of the achievable fit each model reaches, per tree and model.
+
+    ceiling_frac is (model - static) / (reference - static) on ``fit``, per seed against that
+    seed's static pose and ceiling: 1 reaches the true-motion ceiling, 0 is no better than the
+    static pose. heldout_ceiling_frac is the same on ``heldout`` (the held-out window frames,
+    against the static pose's and the ceiling's on those frames): a field that memorises its
+    trained frames shows as a held-out fraction well below its trained one. The reference row
+    is listed for scale. A split a model does not define (NaN at every seed: a forcing-free
+    prior beyond the window) is an empty CSV cell and ``NOT_DEFINED`` in the .tex, never a
+    number.
+
+    Args:
+        per_seed: ``per_seed[seed][(tree, model)]``: fit (dB: mean PSNR over the trained
+            training-window frames at the training camera and wind), heldout (dB: the same over
+            the held-out training-window frames), view, time (dB: the evaluation splits), train_s
+            (seconds of training), iterations (training iterations used: the stopping rule's).
+        trees: the trees.
+        bones: tree -> its bone count.
+        models: the models, in row order.
+        reference: the ceiling's id.
+        digits: decimals shown in the .tex.
+        static: the static model's id.
+        holdout_every: train.holdout_every (the caption says which frames were held out).
+
+    Returns:
+        The [`Table`][physgs.report.tables.Table].
+    """
+    seeds = seeds_of(per_seed, "tab_fit", [(t, m) for t in trees for m in (*models, reference)])
+    recs = []
+    for s in seeds:
+        rows = per_seed[s]
+        for t in trees:
+            ceil, stat = rows[(t, reference)]["fit"], rows[(t, static)]["fit"]
+            hceil, hstat = rows[(t, reference)]["heldout"], rows[(t, static)]["heldout"]
+            for m in (*models, reference):
+                r = rows[(t, m)]
+                recs.append(
+                    {
+                        "seed": s,
+                        "tree": t,
+                        "bones": bones[t],
+                        "model": m,
+                        "reference": m == reference,
+                        "fit_psnr_db": r["fit"],
+                        "heldout_psnr_db": r["heldout"],
+                        "ceiling_frac": float(ceiling_fraction(r["fit"], stat, ceil)),
+                        "heldout_ceiling_frac": float(ceiling_fraction(r["heldout"], hstat, hceil)),
+                        "view_psnr_db": r["view"],
+                        "time_psnr_db": r["time"],
+                        "train_s": r["train_s"],
+                        "iterations": r["iterations"],
+                    }
+                )
+    df = pd.DataFrame(recs)
+    first = latex.rows(df)
+    fmt = f".{int(digits)}f"
+    view, time = (
+        [NOT_DEFINED if c == "--" else c for c in latex.cells(df, col, fmt)]
+        for col in ("view_psnr_db", "time_psnr_db")
+    )
+    cells = pd.DataFrame(
+        {
+            "Fit": latex.cells(df, "fit_psnr_db", fmt),
+            "Held-out frames": latex.cells(df, "heldout_psnr_db", fmt),
+            "Of ceiling": latex.cells(df, "ceiling_frac", ".0f", r"\%", scale=100),
+            "Held-out of ceiling": latex.cells(df, "heldout_ceiling_frac", ".0f", r"\%", scale=100),
+            "View": view,
+            "Time": time,
+            "Train (s)": latex.cells(df, "train_s", ".0f"),
+            "Iter.": latex.cells(df, "iterations", ".0f"),
+        },
+        index=tree_index(
+            first,
+            [rf"\emph{{{label(m)}}}" if m == reference else label(m) for m in first["model"]],
+            "Model",
+        ),
+    )
+    cap = (
+        r"Fit to the training window, PSNR (dB) at the training camera and wind. \emph{Fit}: "
+        r"the training-window frames each model was trained on; \emph{Held-out frames}: every "
+        + f"{holdout_every}th"
+        + r" training-window frame, never trained on; \emph{Of ceiling}: "
+        r"(model $-$ static) / "
+        r"(true motion $-$ static) on the fit; \emph{Held-out of ceiling}: the same on the "
+        r"held-out frames (below the fit's: the model memorises its trained frames). "
+        r"\emph{View}, \emph{Time}: the evaluation splits. "
+        r"\emph{Iter.}: training iterations used (the stopping rule's, capped at train.iterations). "
+        r"In italics the reference: the canonical Gaussians moved by the ground-truth motion."
+        + (
+            f" {NOT_DEFINED}: not defined (a learned forcing has no wind to read beyond the "
+            "window or under another wind)."
+            if NOT_DEFINED in (*view, *time)
+            else ""
+        )
+        + latex.seed_note(len(seeds), decides=False)
+    )
+    return Table("tab_fit", df, latex.render(cells, cap, "tab:fit"))
+
+
+def tab_transfer(
+    per_seed: Mapping[int, Mapping[tuple[str, str], Mapping[str, float]]],
+    trees: Sequence[str],
+    bones: Mapping[str, int],
+    conditions: Sequence[float],
+    models: Sequence[str] = MODEL_NAMES,
+    digits: int = 2,
+) -> Table:
+    """Zero-shot transfer PSNR (dB) on the unseen conditions (index >= 1), all models ``single``.
+
+    Rows: split (training timestamps / beyond the window) x tree x unseen condition; columns:
+    models. The best per row is bold when its paired difference to the runner-up is decided.
+
+    Args:
+        per_seed: ``per_seed[seed][(tree, model)]``: ``EvalResult.summary()``.
+        trees: the trees.
+        bones: tree -> its bone count.
+        conditions: the mean-speed multipliers, the training one first.
+        models: the methods, in column order.
+        digits: decimals shown in the .tex.
+
+    Returns:
+        The [`Table`][physgs.report.tables.Table].
+    """
+    seeds = seeds_of(per_seed, "tab_transfer", [(t, m) for t in trees for m in models])
+    rows = []
+    for s in seeds:
+        S = per_seed[s]
+        for split, key in (("train", "train_c"), ("beyond", "beyond_c")):
+            for t in trees:
+                for c in range(1, len(conditions)):
+                    r = {
+                        "seed": s,
+                        "split": split,
+                        "tree": t,
+                        "bones": bones[t],
+                        "condition": float(conditions[c]),
+                    }
+                    for m in models:
+                        r[m] = S[(t, m)][f"{key}{c}"]
+                    rows.append(r)
+    df = pd.DataFrame(rows)
+    first = latex.rows(df)
+    V = np.stack([latex.by_seed(df, m) for m in models], axis=-1)  # [S, R, M]
+    best = [seedstats.decided_best(V[:, i, :]) for i in range(len(first))]
+    splits = {
+        "train": r"\shortstack[l]{Training\\timestamps}",
+        "beyond": r"\shortstack[l]{Beyond the\\training window}",
+    }
+    index = pd.MultiIndex.from_arrays(
+        [
+            [splits[x] for x in first["split"]],
+            [
+                f"{tree_label(r.tree, r.bones)}, {condition_label(r.condition)}"
+                for r in first.itertuples()
+            ],
+        ],
+        names=["Split", "Tree / unseen wind"],
+    )
+    fmt = f".{int(digits)}f"
+    cells = pd.DataFrame({_family_head(m): latex.cells(df, m, fmt) for m in models}, index=index)
+    cap = (
+        r"Zero-shot transfer to unseen wind, PSNR (dB); every model is fit to $v_0$ only. "
+        r"Top: training timestamps; bottom: frames beyond the training window. Best per row in "
+        r"bold." + latex.seed_note(len(seeds))
+    )
+    bold = np.arange(len(models)) == np.array([-1 if b is None else b for b in best])[:, None]
+    return Table("tab_transfer", df, latex.render(cells, cap, "tab:transfer", bold))
+
+
+#: a family heading over the learned fields' columns of tab_transfer
+FAMILY_HEADS = {"mlp": "Deformation MLP", "d3dgs": "Deformable-3DGS"}
+
+
+def _family_head(model: str) -> tuple[str, str]:
+    """A model's tab_transfer heading: (its field family's, spanning the family's adjacent
+    columns; "" for the rest), its short name."""
+    spec = spec_of(model)
+    return FAMILY_HEADS.get(spec.family, "") if spec.role == "field" else "", spec.short
+
+
+def tab_margin(
+    per_seed: Mapping[int, Mapping[tuple[str, str], Mapping[str, float]]],
+    trees: Sequence[str],
+    bones: Mapping[str, int],
+    conditions: Sequence[float],
+    priors: Sequence[str] = ("ours",),
+    baseline: str = "mlp_wind",
+    digits: int = 2,
+) -> Table:
+    """Each prior minus Deformation MLP + wind, PSNR (dB) at training timestamps, per tree and
+    condition (including the training condition), paired per seed.
+
+    Positive: the prior ahead. A margin is bold when its 95% interval excludes 0, marked undecided
+    when not. One block of rows per prior of ``priors`` (column ``model``: its id), in that order.
+
+    Args:
+        per_seed: ``per_seed[seed][(tree, model)]``: ``EvalResult.summary()``.
+        trees: the trees.
+        bones: tree -> its bone count.
+        conditions: the mean-speed multipliers, the training one first.
+        priors: the priors, in block order.
+        baseline: the model subtracted.
+        digits: decimals shown in the .tex.
+
+    Returns:
+        The [`Table`][physgs.report.tables.Table].
+    """
+    seeds = seeds_of(per_seed, "tab_margin", [(t, m) for t in trees for m in (*priors, baseline)])
+    rows = []
+    for s in seeds:
+        S = per_seed[s]
+        for p in priors:
+            for t in trees:
+                r = {"seed": s, "model": p, "tree": t, "bones": bones[t]}
+                for c, mult in enumerate(conditions):
+                    r[f"margin_{condition_label(mult, tex=False)}"] = (
+                        S[(t, p)][f"train_c{c}"] - S[(t, baseline)][f"train_c{c}"]
+                    )
+                rows.append(r)
+    df = pd.DataFrame(rows)
+    first = latex.rows(df)
+    fmt = f".{int(digits)}f"
+    index = pd.MultiIndex.from_arrays(
+        [
+            [rf"{label(p)} $-$ (Deformation MLP $+$\,wind)" for p in first["model"]],
+            [tree_label(t, b) for t, b in zip(first["tree"], first["bones"])],
+        ]
+    )
+    cells = pd.DataFrame(
+        {
+            condition_label(mult): latex.cells(
+                df, f"margin_{condition_label(mult, tex=False)}", fmt, cell=seedstats.difference
+            )
+            for mult in conditions
+        },
+        index=index,
+    )
+    others = [label(p) for p in priors if p != "ours"]
+    cap = (
+        r"Margin against the wind-conditioned baseline: ours minus Deformation MLP\,$+$\,wind, "
+        r"PSNR (dB) at training timestamps, on the training condition and the two unseen ones. "
+        r"Positive means ours is ahead."
+        + (f" Below, the same for: {', '.join(others)}." if others else "")
+        + latex.seed_note(len(seeds))
+    )
+    return Table("tab_margin", df, latex.render(cells, cap, "tab:margin"))
+
+    # ---- the tables' declarations -------------------------------------------------------------
+
+
+def _tab_psnr(path, settings, inputs, out):
+    seeds = settings["seeds"]
+    return tab_psnr(
+        summaries(path, settings["trees"], models_of(*METHODS, *REFERENCES), seeds),
+        settings["trees"],
+        settings["bones"],
+        models=models_of(*METHODS),
+        digits=settings["digits"],
+        references=models_of(*REFERENCES),
+    )
+
+
+def _fit_needs(plan, seeds):
+    """tab_fit's: every method's and reference's evaluation and loss log, and the forcing-free
+    priors' (``plan.blind``, trained in ``BLIND_CONFIG``)."""
+    blind = [
+        (k, t, m, BLIND_CONFIG, s)
+        for s in seeds
+        for k in ("eval", "loss")
+        for t in plan.trees
+        for m in plan.blind
+    ]
+    return _evals(("eval", "loss"), METHODS + REFERENCES)(plan, seeds) + blind
+
+
+def _fit_table_settings(cfg: dict) -> dict:
+    return {**fit_settings(cfg), "blind": list(blind_priors(cfg["models"]["configs"]))}
+
+
+def _tab_fit(path, settings, inputs, out):
+    n, every = int(settings["n_train"]), int(settings["holdout_every"])
+    config = {m: BASE_CONFIG for m in models_of(*METHODS, *REFERENCES)}
+    config.update({m: BLIND_CONFIG for m in settings.get("blind", [])})
+    rows = {
+        s: {
+            (t, m): fit_row(path("eval", t, m, c, s), path("loss", t, m, c, s), n, every)
+            for t in settings["trees"]
+            for m, c in config.items()
+        }
+        for s in settings["seeds"]
+    }
+    return tab_fit(
+        rows,
+        settings["trees"],
+        settings["bones"],
+        (*models_of(*METHODS), *settings.get("blind", [])),
+        models_of(*REFERENCES)[0],
+        digits=settings["digits"],
+        holdout_every=every,
+    )
+
+
+def _tab_transfer(path, settings, inputs, out):
+    return tab_transfer(
+        summaries(path, settings["trees"], models_of(*METHODS), settings["seeds"]),
+        settings["trees"],
+        settings["bones"],
+        settings["conditions"],
+        models=models_of(*METHODS),
+        digits=settings["digits"],
+    )
+
+
+def _margin_models() -> tuple[str, ...]:
+    return (MARGIN_BASELINE, *models_of("prior"))
+
+
+def _tab_margin(path, settings, inputs, out):
+    return tab_margin(
+        summaries(path, settings["trees"], _margin_models(), settings["seeds"]),
+        settings["trees"],
+        settings["bones"],
+        settings["conditions"],
+        priors=models_of("prior"),
+        baseline=MARGIN_BASELINE,
+        digits=settings["digits"],
+    )
+
+
+#: tab_psnr's CSV: one row per model id (a difference row: ``<prior>-static``,
+#: ``<prior>-best_field``), two columns per tree
+PSNR_COLUMNS = Columns(
+    keys=("seed", "model"), values=("{tree}_view", "{tree}_time"), about=("reference", "difference")
+)
+
+TAB_PSNR = Output(
+    "tab_psnr",
+    "table",
+    _evals(("eval",), METHODS + REFERENCES),
+    _tab_psnr,
+    columns=PSNR_COLUMNS,
+)
+FIT_COLUMNS = Columns(
+    keys=("seed", "tree", "model"),
+    values=(
+        "fit_psnr_db",
+        "heldout_psnr_db",
+        "ceiling_frac",
+        "heldout_ceiling_frac",
+        "view_psnr_db",
+        "time_psnr_db",
+        "iterations",
+    ),
+    timing=("train_s",),
+    about=("bones", "reference"),
+)
+
+TAB_FIT = Output(
+    "tab_fit",
+    "table",
+    _fit_needs,
+    _tab_fit,
+    settings=_fit_table_settings,
+    columns=FIT_COLUMNS,
+)
+#: tab_transfer's CSV: one column per model id; the wind (``condition``) is a numeric key
+TRANSFER_COLUMNS = Columns(
+    keys=("seed", "split", "tree", "condition"), values=("{model}",), about=("bones",)
+)
+
+TAB_TRANSFER = Output(
+    "tab_transfer",
+    "table",
+    _evals(("eval",), METHODS),
+    _tab_transfer,
+    settings=_conditions,
+    columns=TRANSFER_COLUMNS,
+)
+MARGIN_COLUMNS = Columns(
+    keys=("seed", "model", "tree"), values=("margin_{wind}",), about=("bones",)
+)
+
+TAB_MARGIN = Output(
+    "tab_margin",
+    "table",
+    lambda plan, seeds: [
+        ("eval", t, m, BASE_CONFIG, s) for s in seeds for t in plan.trees for m in _margin_models()
+    ],
+    _tab_margin,
+    settings=_conditions,
+    columns=MARGIN_COLUMNS,
+)
+
+
+# ---- figures -------------------------------------------------------------------------------
+def teaser_tree(trees: Sequence[str], roles: dict | None = None) -> str:
+    """The tree the teaser shows: the one whose preset stands for the paper's teaser tree
+    (``paper.TEASER_TREE``, its clearest case) if built, else the last.
+
+    Args:
+        trees: the trees built.
+        roles: tree -> its preset's role (``claim_cells.roles_of``); None: none declared.
+
+    Returns:
+        The tree's name.
+    """
+    stand_in = [t for t in trees if ((roles or {}).get(t) or {}).get("paper") == paper.TEASER_TREE]
+    return stand_in[0] if stand_in else trees[-1]
+
+
+def _fig_temporal(path, settings, inputs, out):
+    from physgs.report import figures  # matplotlib: not for the workflow's planning imports
+
+    curves = {
+        (t, m): np.stack(
+            [load_eval(path("eval", t, m, BASE_CONFIG, s)).temporal_psnr for s in settings["seeds"]]
+        )
+        for t in settings["trees"]
+        for m in models_of(*METHODS, *REFERENCES)
+    }
+    figures.fig_temporal(curves, settings["trees"], int(settings["n_train"]), out)
+
+
+def _fig_teaser(path, settings, inputs, out):
+    from physgs.report import figures
+
+    t, s0 = teaser_tree(settings["trees"], settings.get("roles")), settings["seeds"][0]
+    evals = {m: load_eval(path("eval", t, m, BASE_CONFIG, s0)) for m in models_of(*METHODS)}
+    base = figures.best_baseline(
+        {m: e.summary() for m, e in evals.items()},
+        key="time",
+        exclude=models_of("control", "prior"),
+    )
+    shown = (*models_of("prior"), base)  # every prior beside the best learned field
+    traj = {m: load_trajectories(path("traj", t, m, BASE_CONFIG, s0)) for m in shown}
+    cen = {m: evals[m].centroid_err for m in shown}
+    figures.fig_teaser(
+        traj, cen, settings["conditions"], out, title=f"{t} tree, training seed {s0}"
+    )
+
+
+def _fig_results(path, settings, inputs, out):
+    from physgs.report import figures
+
+    s0, models = settings["seeds"][0], models_of(*METHODS)
+    rows, images = [], {}
+    for t in settings["trees"]:
+        panels = {m: np.load(path("panels", t, m, BASE_CONFIG, s0)) for m in models}
+        for split in ("time", "view", "wind"):
+            row = f"{t}: unseen {split}"
+            rows.append(row)
+            images[(row, "gt")] = (panels["ours"][f"{split}_gt"], None)
+            for m in models:
+                images[(row, m)] = (panels[m][f"{split}_pred"], float(panels[m][f"{split}_psnr"]))
+    figures.fig_results(rows, ["gt", *models], images, out)
+
+
+FIG_TEMPORAL = Output(
+    "fig_temporal",
+    "figure",
+    _evals(("eval",), METHODS + REFERENCES),
+    _fig_temporal,
+    settings=lambda cfg: {"n_train": int(cfg["testbed"]["n_train"])},
+)
+FIG_TEASER = Output(
+    "fig_teaser",
+    "figure",
+    _evals(("eval", "traj"), METHODS),
+    _fig_teaser,
+    settings=_teaser_settings,
+    seeds="first",
+)
+FIG_RESULTS = Output(
+    "fig_results",
+    "figure",
+    _evals(("eval", "panels"), METHODS),
+    _fig_results,
+    settings=_conditions,
+    seeds="first",
+)

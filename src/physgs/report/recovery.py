@@ -1,0 +1,421 @@
+"""The frequency-recovery tables: tab_null (the paper's: ours' frequencies against the untrained
+null) and tab_recovery (every recovery method's, each against the null of its K), their builder
+and their declarations. The rows come from the one list of recovery methods
+(``registry.RECOVERY_METHODS``): one need kind (``recovery``) serves them all, and tab_damping
+(``physgs.report.damping``) shares the method rows (``MethodRows``)."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from typing import Mapping, Sequence
+
+import pandas as pd
+
+from physgs.models.registry import RECOVERY_METHODS, config_label, recovery_label, recovery_plan
+from physgs.recovery.record import load_null, load_recovery
+from physgs.report import latex
+from physgs.report import seeds as seedstats
+from physgs.report.output import Columns, Output
+from physgs.report.tables import Table, check_keys, seeds_of, tree_index
+
+
+#: the method ids of the 2D-track control and the output-only analysis (``RECOVERY_METHODS``)
+TRACKS, OMA = "tracks", "oma"
+
+
+@dataclass(frozen=True)
+class MethodRows:
+    """One recovery method's rows in tab_null, tab_recovery or tab_damping (``method_rows``;
+    ``registry.RECOVERY_METHODS``).
+
+    label: its LaTeX name ("" for ours, the paper's prior: its rows are labelled by their
+    configuration alone); configs: its configurations (name -> LaTeX label, with its own K), in
+    row order; per_seed: ``per_seed[seed][key]``, the table's record of each key (tab_null, tab_recovery:
+    ``(tree, config)`` -> (``RecoveryRecord``, the ``NullResult`` of its K); tab_damping:
+    ``(tree, variant, config)`` -> ``RecoveryRecord``); note: its sentence of the caption."""
+
+    label: str
+    configs: Mapping[str, str]
+    per_seed: Mapping[int, Mapping[tuple, object]]
+    note: str = ""
+
+    def row_label(self, config: str) -> str:
+        """The LaTeX label of its row in a configuration.
+
+        Args:
+            config: the configuration's name (a key of ``configs``).
+
+        Returns:
+            '<label>, <config label>' (ours': the configuration's label alone).
+        """
+        return f"{self.label}, {self.configs[config]}" if self.label else self.configs[config]
+
+
+#: each frequency-recovery table's caption, first sentence
+LEADS = {
+    "tab_null": "Frequency recovery against an untrained null.",
+    "tab_recovery": (
+        r"Frequency recovery of every method against the untrained null of its $K$; rows "
+        r"labelled by their configuration alone are ours (Table~\ref{tab:null})."
+    ),
+}
+
+
+def recovery_table(
+    name: str,
+    methods: Mapping[str, MethodRows],
+    trees: Sequence[str],
+    bones: Mapping[str, int],
+    digits: int = 2,
+) -> Table:
+    """Frequency recovery of each method against the untrained null, per tree and config.
+
+    Each tree's rows: every method's in turn, each in its configurations; column ``method`` the
+    id. Columns: parts trusted, median relative error (%), log-log R^2 for trained and null
+    (null entries are medians over draws), trained - null (percentage points, paired per seed:
+    negative means the trained model beats chance), and the median nearest-bone gap (%).
+
+    Args:
+        name: tab_null (the paper's methods, ``RecoveryMethod.paper``: ours) or tab_recovery
+            (every method, ours' rows first as the reference the others' claims compare with);
+            its LaTeX label is ``tab:<name without tab_>``, its caption's lead ``LEADS[name]``.
+        methods: method id -> its [`MethodRows`][physgs.report.recovery.MethodRows], in row order
+            (``RECOVERY_METHODS``'; a method with no configurations has no rows):
+            ``per_seed[seed][(tree, config)]`` = (its ``RecoveryRecord``, the ``NullResult``
+            drawn with that seed and the method's K).
+        trees: the trees.
+        bones: tree -> its bone count.
+        digits: decimals shown in the .tex.
+
+    Returns:
+        The [`Table`][physgs.report.tables.Table].
+    """
+    methods = {m: mr for m, mr in methods.items() if mr.configs}
+    keys = [(t, c, m) for t in trees for m, mr in methods.items() for c in mr.configs]
+    seeds = method_seeds(methods, name, keys)
+    rows = []
+    for s in seeds:
+        for t, c, method in keys:
+            rec, nl = methods[method].per_seed[s][(t, c)]
+            m = rec.match
+            if nl.n_parts != m.n_parts:
+                raise ValueError(
+                    f"{name}: null for {t}/{c} (seed {s}) has K={nl.n_parts} but the "
+                    f"model has K={m.n_parts}; re-run the null with the model's K"
+                )
+            tr, nu = 100 * m.median_rel_err, 100 * nl.median_median_rel_err
+            rows.append(
+                {
+                    "seed": s,
+                    "tree": t,
+                    "bones": bones[t],
+                    "config": c,
+                    "method": method,
+                    "K": m.n_parts,
+                    "trained_parts_trusted": float(m.n_trusted),
+                    "trained_median_rel_err_pct": tr,
+                    "trained_loglog_r2": m.loglog_r2,
+                    "null_parts_trusted": nl.median_n_trusted,
+                    "null_median_rel_err_pct": nu,
+                    "null_loglog_r2": nl.median_loglog_r2,
+                    "trained_minus_null_pp": tr - nu,
+                    "nearest_bone_gap_pct": 100 * nl.nearest_bone_gap,
+                    "trained_parts_trusted_visible": float(rec.n_trusted_visible),
+                    "trained_median_rel_err_visible_pct": 100 * rec.median_rel_err_visible,
+                    "null_parts_trusted_visible": nl.median_n_trusted_visible,
+                    "null_median_rel_err_visible_pct": 100 * nl.median_median_rel_err_visible,
+                    **interval_cells(rec),
+                }
+            )
+    df = pd.DataFrame(rows)  # each seed's block: each tree's rows together, in ``keys`` order
+    first = latex.rows(df)
+    fmt = f".{int(digits)}f"
+    columns = {}
+    for who, pre in (("Trained", "trained"), ("Untrained null", "null")):
+        trusted = latex.cells(df, f"{pre}_parts_trusted", ".3g", cell=latex.mean)
+        columns[(who, "Parts")] = [f"{n}/{k}" for n, k in zip(trusted, first["K"])]
+        columns[(who, r"Med.\ rel.\ err.")] = latex.cells(
+            df, f"{pre}_median_rel_err_pct", fmt, r"\%"
+        )
+        columns[(who, r"log-log $R^2$")] = latex.cells(df, f"{pre}_loglog_r2", ".3f")
+    columns[("", r"Trained $-$ null")] = latex.cells(
+        df, "trained_minus_null_pp", fmt, cell=seedstats.difference
+    )
+    columns[("", "Gap")] = latex.cells(df, "nearest_bone_gap_pct", fmt, r"\%", cell=latex.mean)
+    for who, pre in (("Trained", "trained"), ("Null", "null")):
+        columns[("Visible bones", who)] = latex.cells(
+            df, f"{pre}_median_rel_err_visible_pct", fmt, r"\%"
+        )
+    labels = [methods[m].row_label(c) for m, c in zip(first["method"], first["config"])]
+    cells = pd.DataFrame(columns, index=tree_index(first, labels, "Config"))
+    cap = (
+        LEADS[name] + r" Parts: parts trusted ($|\mathrm{corr}|\geq0.7$) "
+        r"of $K$ (mean over seeds). Median relative error over trusted parts; $R^2$ of "
+        r"$\log\hat\omega_p$ against $\log\omega_p$. Null entries are medians over 8 draws "
+        r"of each seed, with the trained model's $K$; Trained $-$ null: percentage points, "
+        r"paired per seed (negative: the trained model beats chance); Gap: median nearest-bone "
+        r"gap. Visible bones: the median errors restricted to parts matched to bones whose own "
+        r"motion moves at least a pixel in the training camera (the CSV also gives the part "
+        r"counts)." + "".join(mr.note for mr in methods.values()) + latex.seed_note(len(seeds))
+    )
+    return Table(name, df, latex.render(cells, cap, "tab:" + name.removeprefix("tab_")))
+
+
+def method_seeds(methods: Mapping[str, MethodRows], what: str, keys: Sequence[tuple]) -> list[int]:
+    """The training seeds of a recovery table (its first method's), each method checked to hold
+    its ``keys`` (``(..., method)``) at every seed."""
+    seeds = seeds_of(next(iter(methods.values())).per_seed if methods else {}, what)
+    for s in seeds:
+        for m, mr in methods.items():
+            have = mr.per_seed.get(s, {})
+            check_keys([k[:-1] for k in keys if k[-1] == m], have, f"{what} ({who(m)}, seed {s})")
+    return seeds
+
+
+def who(method: str) -> str:
+    """A method's name in the recovery tables' errors."""
+    return "tracks control" if method == TRACKS else method
+
+
+def method_rows(
+    method: str, configs: Mapping[str, str], per_seed: Mapping[int, Mapping], damping: bool = False
+) -> MethodRows:
+    """A recovery method's rows (``registry.RECOVERY_METHODS``) for tab_null, tab_recovery or
+    tab_damping: its label and caption sentence from its entry.
+
+    Args:
+        method: a recovery method's id.
+        configs: name -> LaTeX label (with its own K), as in
+            [`MethodRows`][physgs.report.recovery.MethodRows].
+        per_seed: its records, as in ``MethodRows``.
+        damping: tab_damping's caption sentence (``RecoveryMethod.damping_note``) in place of
+            the frequency tables'.
+
+    Returns:
+        The rows; the caption sentence '<label>: <note>' (none without a note).
+    """
+    rm, name = RECOVERY_METHODS[method], recovery_label(method)
+    note = rm.damping_note if damping and rm.damping_note is not None else rm.note
+    return MethodRows(name, configs, per_seed, f" {name}: {note}" if note else "")
+
+
+#: tab_null / tab_damping's CSV columns of a method's own intervals (the output-only analysis';
+#: NaN for a method without them): the coverage of its trusted parts' 95% intervals for omega
+#: and zeta, the parts they cover, the median relative standard deviations (sigma / value) over
+#: those parts, and the parts its sigma rule keeps (alone, and with ours'); last, the mean
+#: relative interval scores of its intervals and of the untrained null's draw range on the same
+#: parts (``physgs.oma.intervals.relative_scores``; NaN in a record made before them)
+INTERVAL_COLUMNS = (
+    "omega_rel_sd",
+    "zeta_rel_sd",
+    "omega_interval_cover",
+    "zeta_interval_cover",
+    "interval_parts",
+    "sigma_parts_trusted",
+    "sigma_and_corr_parts_trusted",
+    "omega_interval_score",
+    "omega_null_interval_score",
+    "zeta_interval_score",
+    "zeta_null_interval_score",
+)
+
+
+def interval_cells(rec) -> dict:
+    """A record's ``INTERVAL_COLUMNS`` cells (NaN when
+    the record has no ``intervals``).
+
+    Args:
+        rec (RecoveryRecord): the record.
+
+    Returns:
+        Column -> value.
+    """
+    iv = rec.intervals
+    if not iv:
+        return dict.fromkeys(INTERVAL_COLUMNS, float("nan"))
+    cov = iv["coverage"]
+    score = iv.get("interval_score", {})  # absent in a record made before the scores
+
+    def sc(q: str, key: str) -> float:
+        return float(score.get(q, {}).get(key, float("nan")))
+
+    return {
+        "omega_rel_sd": float(iv["median_rel_std"]["omega"]),
+        "zeta_rel_sd": float(iv["median_rel_std"]["zeta"]),
+        "omega_interval_cover": float(cov["omega"]["fraction"]),
+        "zeta_interval_cover": float(cov["zeta"]["fraction"]),
+        "interval_parts": float(cov["omega"]["n"]),
+        "sigma_parts_trusted": float(iv["n_sigma_trusted"]),
+        "sigma_and_corr_parts_trusted": float(iv["n_both_trusted"]),
+        "omega_interval_score": sc("omega", "score"),
+        "omega_null_interval_score": sc("omega", "null_score"),
+        "zeta_interval_score": sc("zeta", "score"),
+        "zeta_null_interval_score": sc("zeta", "null_score"),
+    }
+
+
+# ---- the declarations ----------------------------------------------------------------------
+def label_with_k(cfg: dict, config: str, K: int) -> str:
+    """The LaTeX label of configuration ``config`` for a method with K parts there (a method
+    with a K of its own: the 2D-track control, the output-only analysis).
+
+    Args:
+        cfg: the resolved config.
+        config: a configuration name.
+        K: the method's number of parts in that configuration.
+
+    Returns:
+        The label ([`config_label`][physgs.models.registry.config_label]).
+    """
+    return config_label(config, {**cfg["models"]["configs"][config], "K": K})
+
+
+def methods_settings(cfg: dict, methods: Sequence[str], configs: Sequence[str]) -> dict:
+    """A recovery table's settings: the recovery methods it shows, each in its configurations.
+
+    Args:
+        cfg: the resolved config.
+        methods: the method ids the table may show (those the run scores are kept:
+            ``registry.recovery_plan``).
+        configs: the table's configurations.
+
+    Returns:
+        ``{"methods": {id: {config: {"K", "label"}}}}``, each configuration with the method's K.
+    """
+    plan = recovery_plan(cfg)
+    return {
+        "methods": {
+            m: {
+                c: {"K": k, "label": label_with_k(cfg, c, k)}
+                for c, k in plan[m].items()
+                if c in configs
+            }
+            for m in methods
+            if m in plan
+        }
+    }
+
+
+def methods_needs(plan, methods, configs, testbeds, s: int) -> list[tuple]:
+    """The records a recovery table reads of one seed.
+
+    Args:
+        plan (Plan): the run's plan (each method's configurations: ``plan.recovery``).
+        methods (Sequence[str]): the method ids.
+        configs (Collection[str]): the table's configurations.
+        testbeds (Sequence[str]): the testbed ids.
+        s: the training seed.
+
+    Returns:
+        ``("recovery", testbed, method, config, s)`` need tuples.
+    """
+    return [
+        ("recovery", tb, m, c, s)
+        for tb in testbeds
+        for m in methods
+        for c in plan.recovery.get(m, {})
+        if c in configs
+    ]
+
+
+def table_methods(settings: dict, records, damping: bool = False) -> dict[str, MethodRows]:
+    """A recovery table's ``MethodRows``, in ``RECOVERY_METHODS``' order (ours first: the
+    settings arrive with their keys sorted).
+
+    Args:
+        settings: the table's settings ([`methods_settings`][physgs.report.recovery.methods_settings]).
+        records (Callable): ``records(method, {config: K})`` -> the table's per-seed records of
+            that method in those configurations (as ``MethodRows.per_seed``).
+        damping: tab_damping's caption sentences (``method_rows``).
+
+    Returns:
+        Method id -> its rows.
+    """
+    methods = settings["methods"]
+    return {
+        m: method_rows(
+            m,
+            {c: v["label"] for c, v in methods[m].items()},
+            records(m, {c: v["K"] for c, v in methods[m].items()}),
+            damping=damping,
+        )
+        for m in RECOVERY_METHODS
+        if m in methods
+    }
+
+
+def _paper(plan_or_methods) -> list[str]:
+    """The paper's recovery methods (``RecoveryMethod.paper``: tab_null's rows) among these."""
+    return [m for m in plan_or_methods if RECOVERY_METHODS[m].paper]
+
+
+# ---- tab_null and tab_recovery: frequencies against the null of each method's K -------------
+#: tab_null's and tab_recovery's CSV: one row per seed, tree, configuration and method id
+NULL_COLUMNS = Columns(
+    keys=("seed", "tree", "config", "method"),
+    values=(
+        "trained_parts_trusted",
+        "trained_median_rel_err_pct",
+        "trained_loglog_r2",
+        "null_parts_trusted",
+        "null_median_rel_err_pct",
+        "null_loglog_r2",
+        "trained_minus_null_pp",
+        "nearest_bone_gap_pct",
+        "trained_parts_trusted_visible",
+        "trained_median_rel_err_visible_pct",
+        "null_parts_trusted_visible",
+        "null_median_rel_err_visible_pct",
+        *INTERVAL_COLUMNS,  # a method's own intervals (the output-only analysis')
+    ),
+    about=("bones", "K"),
+)
+
+
+def _frequency_output(name: str, methods, in_report=lambda plan: True) -> Output:
+    """A frequency-recovery table of the recovery methods ``methods(ids)`` (tab_null: the
+    paper's; tab_recovery: every one), each row beside the untrained null of its K."""
+
+    def needs(plan, seeds):
+        mine = methods(plan.recovery)
+        out = []
+        for s in seeds:
+            out += methods_needs(plan, mine, plan.configs, plan.trees, s)
+            nulls = {int(k) for m in mine for k in plan.recovery[m].values()}
+            out += [("null", t, k, s) for t in plan.trees for k in sorted(nulls)]
+        return out
+
+    def settings(cfg):
+        return methods_settings(cfg, methods(recovery_plan(cfg)), cfg["models"]["configs"])
+
+    def table(path, settings, inputs, out):
+        trees, seeds = settings["trees"], settings["seeds"]
+
+        def paired(m, configs):
+            """{seed: {(tree, config): (its record, the null of its K)}}; configs: {config: K}."""
+            return {
+                s: {
+                    (t, c): (
+                        load_recovery(path("recovery", t, m, c, s)),
+                        load_null(path("null", t, int(k), s)),
+                    )
+                    for t in trees
+                    for c, k in configs.items()
+                }
+                for s in seeds
+            }
+
+        rows = table_methods(settings, paired)
+        return recovery_table(name, rows, trees, settings["bones"], digits=settings["digits"])
+
+    return Output(
+        name, "table", needs, table, settings=settings, in_report=in_report, columns=NULL_COLUMNS
+    )
+
+
+TAB_NULL = _frequency_output("tab_null", _paper)
+TAB_RECOVERY = _frequency_output(
+    "tab_recovery",
+    list,
+    in_report=lambda plan: len(plan.recovery) > len(_paper(plan.recovery)),
+)
