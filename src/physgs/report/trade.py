@@ -6,6 +6,8 @@ gain beyond the window against its in-window fit), each drawn from its study's C
 
 from __future__ import annotations
 
+from typing import Sequence
+
 import numpy as np
 import pandas as pd
 
@@ -93,7 +95,7 @@ def fit_vs_extrapolation(df: pd.DataFrame, static: str = "static") -> pd.DataFra
     return out[out["beyond_gain"].notna() & (out["of_ceiling"] < np.inf)]
 
 
-def draw_fit_vs_extrapolation(df: pd.DataFrame, outputs) -> None:
+def draw_fit_vs_extrapolation(df: pd.DataFrame, outputs: Sequence[str]) -> None:
     """One panel per tree: each model's gain over static beyond the window (dB) against its
     in-window fraction of the ceiling's gain, one line through its budgets (seed means, the
     seeds' own points faint), the profile's budget starred, the fit bar and zero gain marked.
