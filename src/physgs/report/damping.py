@@ -242,7 +242,8 @@ FIG_DAMPING = Output(
     ],
     _fig_damping,
     settings=lambda cfg: {
-        "configs": list(cfg["models"]["configs"]),
+        # sorted, as the settings' mapping of configurations always reached the figure
+        "configs": sorted(cfg["models"]["configs"]),
         "zeta": float(cfg["testbed"]["zeta"]),
         "zeta_bound": float(max(cfg["models"]["ours"]["zeta"])),
     },
