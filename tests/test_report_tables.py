@@ -427,3 +427,13 @@ def test_cells_summarise_each_row_over_the_seed_blocks():
     df = pd.DataFrame({"seed": [0, 0, 1, 1], "x": [1.0, np.nan, 3.0, np.nan]})
     assert latex.cells(df, "x", ".1f", r"\%") == [r"2.0 $\pm$ 1.4\%", "--"]  # sd of (1, 3)
     assert latex.cells(df, "x", ".0f", cell=latex.mean, scale=10) == ["20", "--"]
+
+
+def test_seed_rows_lays_out_one_block_per_seed():
+    df = T.seed_rows([3, 7], [("a", 1), ("b", 2)], lambda s, t, k: {"tree": t, "v": 10 * s + k})
+    assert list(df.columns) == ["seed", "tree", "v"]
+    assert df.to_dict("list") == {
+        "seed": [3, 3, 7, 7],
+        "tree": ["a", "b", "a", "b"],
+        "v": [31, 32, 71, 72],
+    }

@@ -34,7 +34,7 @@ from physgs.report.recovery import (
     table_methods,
     who,
 )
-from physgs.report.tables import Table, tree_label
+from physgs.report.tables import Table, seed_rows, tree_label
 from physgs.testbed.variant import DAMPING, FAITHFUL, damping_id
 
 VARIANTS = (FAITHFUL, DAMPING)
@@ -83,38 +83,35 @@ def tab_damping(
     block = [(c, m) for m, mr in methods.items() for c in mr.configs]
     keys = [(t, v, c, m) for t in trees for v in VARIANTS for c, m in block]
     seeds = method_seeds(methods, "tab_damping", keys)
-    rows = []
-    for s in seeds:
-        for t, v, c, method in keys:
-            rec = methods[method].per_seed[s][(t, v, c)]
-            sc, nl = rec.damping_scores, rec.damping_null
-            if sc is None or nl is None:
-                name = "" if method == "ours" else f" ({who(method)})"
-                raise ValueError(
-                    f"tab_damping: the recovery of {t}/{v}/{c}{name} (seed {s}) has no "
-                    "damping scores; re-run its recovery rule with damping params"
-                )
-            rows.append(
-                {
-                    "seed": s,
-                    "tree": t,
-                    "bones": bones[t],
-                    "testbed": v,
-                    "config": c,
-                    "method": method,
-                    "trusted": sc.n_trusted,
-                    "rel_err_pct": 100 * sc.median_rel_err,
-                    "null_rel_err_pct": 100 * nl.median_median_rel_err,
-                    "trained_minus_null_pp": 100 * (sc.median_rel_err - nl.median_median_rel_err),
-                    "log_corr": sc.log_corr,
-                    "null_log_corr": nl.median_log_corr,
-                    "gamma_exponent": sc.gamma_exponent,
-                    "null_gamma_exponent": nl.median_gamma_exponent,
-                    "gamma_exponent_true": sc.gamma_exponent_true,
-                    **interval_cells(rec),
-                }
+
+    def one(s, t, v, c, method):
+        rec = methods[method].per_seed[s][(t, v, c)]
+        sc, nl = rec.damping_scores, rec.damping_null
+        if sc is None or nl is None:
+            name = "" if method == "ours" else f" ({who(method)})"
+            raise ValueError(
+                f"tab_damping: the recovery of {t}/{v}/{c}{name} (seed {s}) has no "
+                "damping scores; re-run its recovery rule with damping params"
             )
-    df = pd.DataFrame(rows)
+        return {
+            "tree": t,
+            "bones": bones[t],
+            "testbed": v,
+            "config": c,
+            "method": method,
+            "trusted": sc.n_trusted,
+            "rel_err_pct": 100 * sc.median_rel_err,
+            "null_rel_err_pct": 100 * nl.median_median_rel_err,
+            "trained_minus_null_pp": 100 * (sc.median_rel_err - nl.median_median_rel_err),
+            "log_corr": sc.log_corr,
+            "null_log_corr": nl.median_log_corr,
+            "gamma_exponent": sc.gamma_exponent,
+            "null_gamma_exponent": nl.median_gamma_exponent,
+            "gamma_exponent_true": sc.gamma_exponent_true,
+            **interval_cells(rec),
+        }
+
+    df = seed_rows(seeds, keys, one)
     fmt = f".{int(digits)}f"
     p = latex.cells(df, "gamma_exponent", ".2f")
     p_true = latex.cells(df, "gamma_exponent_true", ".2f", cell=latex.mean)

@@ -20,7 +20,14 @@ from physgs.report import latex, paper
 from physgs.report import seeds as seedstats
 from physgs.report.claim_cells import roles_of
 from physgs.report.output import Columns, Output
-from physgs.report.tables import Table, condition_label, seeds_of, tree_index, tree_label
+from physgs.report.tables import (
+    Table,
+    condition_label,
+    seed_rows,
+    seeds_of,
+    tree_index,
+    tree_label,
+)
 
 #: the roles of the methods compared on images, and of the references shown beside them
 METHODS = ("control", "field", "prior")
@@ -290,33 +297,29 @@ def tab_fit(
     Returns:
         The [`Table`][physgs.report.tables.Table].
     """
-    seeds = seeds_of(per_seed, "tab_fit", [(t, m) for t in trees for m in (*models, reference)])
-    recs = []
-    for s in seeds:
-        rows = per_seed[s]
-        for t in trees:
-            ceil, stat = rows[(t, reference)]["fit"], rows[(t, static)]["fit"]
-            hceil, hstat = rows[(t, reference)]["heldout"], rows[(t, static)]["heldout"]
-            for m in (*models, reference):
-                r = rows[(t, m)]
-                recs.append(
-                    {
-                        "seed": s,
-                        "tree": t,
-                        "bones": bones[t],
-                        "model": m,
-                        "reference": m == reference,
-                        "fit_psnr_db": r["fit"],
-                        "heldout_psnr_db": r["heldout"],
-                        "ceiling_frac": float(ceiling_fraction(r["fit"], stat, ceil)),
-                        "heldout_ceiling_frac": float(ceiling_fraction(r["heldout"], hstat, hceil)),
-                        "view_psnr_db": r["view"],
-                        "time_psnr_db": r["time"],
-                        "train_s": r["train_s"],
-                        "iterations": r["iterations"],
-                    }
-                )
-    df = pd.DataFrame(recs)
+    keys = [(t, m) for t in trees for m in (*models, reference)]
+    seeds = seeds_of(per_seed, "tab_fit", keys)
+
+    def one(s, t, m):
+        r, ceil, stat = (per_seed[s][(t, x)] for x in (m, reference, static))
+        return {
+            "tree": t,
+            "bones": bones[t],
+            "model": m,
+            "reference": m == reference,
+            "fit_psnr_db": r["fit"],
+            "heldout_psnr_db": r["heldout"],
+            "ceiling_frac": float(ceiling_fraction(r["fit"], stat["fit"], ceil["fit"])),
+            "heldout_ceiling_frac": float(
+                ceiling_fraction(r["heldout"], stat["heldout"], ceil["heldout"])
+            ),
+            "view_psnr_db": r["view"],
+            "time_psnr_db": r["time"],
+            "train_s": r["train_s"],
+            "iterations": r["iterations"],
+        }
+
+    df = seed_rows(seeds, keys, one)
     first = latex.rows(df)
     fmt = f".{int(digits)}f"
     view, time = (
@@ -387,23 +390,18 @@ def tab_transfer(
         The [`Table`][physgs.report.tables.Table].
     """
     seeds = seeds_of(per_seed, "tab_transfer", [(t, m) for t in trees for m in models])
-    rows = []
-    for s in seeds:
-        S = per_seed[s]
-        for split, key in (("train", "train_c"), ("beyond", "beyond_c")):
-            for t in trees:
-                for c in range(1, len(conditions)):
-                    r = {
-                        "seed": s,
-                        "split": split,
-                        "tree": t,
-                        "bones": bones[t],
-                        "condition": float(conditions[c]),
-                    }
-                    for m in models:
-                        r[m] = S[(t, m)][f"{key}{c}"]
-                    rows.append(r)
-    df = pd.DataFrame(rows)
+    stems = {"train": "train_c", "beyond": "beyond_c"}  # split -> its summary keys' stem
+    df = seed_rows(
+        seeds,
+        [(sp, t, c) for sp in stems for t in trees for c in range(1, len(conditions))],
+        lambda s, sp, t, c: {
+            "split": sp,
+            "tree": t,
+            "bones": bones[t],
+            "condition": float(conditions[c]),
+            **{m: per_seed[s][(t, m)][f"{stems[sp]}{c}"] for m in models},
+        },
+    )
     first = latex.rows(df)
     V = np.stack([latex.by_seed(df, m) for m in models], axis=-1)  # [S, R, M]
     best = [seedstats.decided_best(V[:, i, :]) for i in range(len(first))]
@@ -471,18 +469,20 @@ def tab_margin(
         The [`Table`][physgs.report.tables.Table].
     """
     seeds = seeds_of(per_seed, "tab_margin", [(t, m) for t in trees for m in (*priors, baseline)])
-    rows = []
-    for s in seeds:
-        S = per_seed[s]
-        for p in priors:
-            for t in trees:
-                r = {"seed": s, "model": p, "tree": t, "bones": bones[t]}
-                for c, mult in enumerate(conditions):
-                    r[f"margin_{condition_label(mult, tex=False)}"] = (
-                        S[(t, p)][f"train_c{c}"] - S[(t, baseline)][f"train_c{c}"]
-                    )
-                rows.append(r)
-    df = pd.DataFrame(rows)
+    df = seed_rows(
+        seeds,
+        [(p, t) for p in priors for t in trees],
+        lambda s, p, t: {
+            "model": p,
+            "tree": t,
+            "bones": bones[t],
+            **{
+                f"margin_{condition_label(mult, tex=False)}": per_seed[s][(t, p)][f"train_c{c}"]
+                - per_seed[s][(t, baseline)][f"train_c{c}"]
+                for c, mult in enumerate(conditions)
+            },
+        },
+    )
     first = latex.rows(df)
     fmt = f".{int(digits)}f"
     index = pd.MultiIndex.from_arrays(

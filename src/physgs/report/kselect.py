@@ -18,7 +18,7 @@ from physgs.models.registry import spec_of
 from physgs.recovery.record import load_recovery
 from physgs.report import latex
 from physgs.report.output import Columns, Output
-from physgs.report.tables import Table, seeds_of, tree_index
+from physgs.report.tables import Table, seed_rows, seeds_of, tree_index
 
 #: the rows of each prior: configuration -> its label (fixed K, then K chosen from the data)
 ROWS = {"single": "fixed $K$", "auto": "chosen $K$"}
@@ -79,37 +79,30 @@ def tab_kselect(
     """
     keys = [(t, m, c) for t in trees for m in models for c in ROWS]
     seeds = seeds_of(per_seed, "tab_kselect", keys)
-    recs = []
-    for s in seeds:
-        for t in trees:
-            for m in models:
-                fixed_s = float(per_seed[s][(t, m, "single")]["train_s"])
-                for c in ROWS:
-                    r = per_seed[s][(t, m, c)]
-                    select_s = float(r["select_s"]) if c == "auto" else np.nan
-                    recs.append(
-                        {
-                            "seed": s,
-                            "tree": t,
-                            "bones": bones[t],
-                            "model": m,
-                            "config": c,
-                            "K": int(r["K"]),
-                            "view_psnr_db": r["view_psnr"],
-                            "time_psnr_db": r["time_psnr"],
-                            "median_rel_err_pct": 100 * r["median_rel_err"],
-                            "parts_trusted": int(r["trusted"]),
-                            "parts_frozen": int(r["frozen"]),
-                            "k_heldout": r["k_heldout"],
-                            "k_bic": r["k_bic"],
-                            "train_s": float(r["train_s"]),
-                            "select_s": select_s,
-                            "cost_x": cost_ratio(float(r["train_s"]), select_s, fixed_s)
-                            if c == "auto"
-                            else np.nan,
-                        }
-                    )
-    df = pd.DataFrame(recs)
+
+    def one(s, t, m, c):
+        r = per_seed[s][(t, m, c)]
+        select_s = float(r["select_s"]) if c == "auto" else np.nan
+        fixed_s = float(per_seed[s][(t, m, "single")]["train_s"])
+        return {
+            "tree": t,
+            "bones": bones[t],
+            "model": m,
+            "config": c,
+            "K": int(r["K"]),
+            "view_psnr_db": r["view_psnr"],
+            "time_psnr_db": r["time_psnr"],
+            "median_rel_err_pct": 100 * r["median_rel_err"],
+            "parts_trusted": int(r["trusted"]),
+            "parts_frozen": int(r["frozen"]),
+            "k_heldout": r["k_heldout"],
+            "k_bic": r["k_bic"],
+            "train_s": float(r["train_s"]),
+            "select_s": select_s,
+            "cost_x": cost_ratio(float(r["train_s"]), select_s, fixed_s) if c == "auto" else np.nan,
+        }
+
+    df = seed_rows(seeds, keys, one)
     first = latex.rows(df)
     fmt = f".{digits}f"
     # K as each seed chose it; the rest mean +- sd

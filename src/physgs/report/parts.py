@@ -30,7 +30,7 @@ from physgs.report import latex
 from physgs.report import seeds as seedstats
 from physgs.report.images import fit_row, fit_settings
 from physgs.report.output import Columns, Output
-from physgs.report.tables import Table, seeds_of, tree_label
+from physgs.report.tables import Table, seed_rows, seeds_of, tree_label
 from physgs.testbed.variant import damping_id
 
 COLUMNS = (
@@ -132,20 +132,17 @@ def tab_parts(
     """
     keys = [(t, m, c) for t in trees for c in configs for m in models]
     seeds = seeds_of(per_seed, "tab_parts", keys)
-    recs = []
-    for s in seeds:
-        for t, m, c in keys:
-            recs.append(
-                {
-                    "seed": s,
-                    "tree": t,
-                    "bones": bones[t],
-                    "model": m,
-                    "config": c,
-                    **per_seed[s][(t, m, c)],
-                }
-            )
-    df = pd.DataFrame(recs)
+    df = seed_rows(
+        seeds,
+        keys,
+        lambda s, t, m, c: {
+            "tree": t,
+            "bones": bones[t],
+            "model": m,
+            "config": c,
+            **per_seed[s][(t, m, c)],
+        },
+    )
     fmt = f".{int(digits)}f"
     # each variant's fit fraction less ours' in the same tree and configuration, per seed
     frac = latex.by_seed(df, "ceiling_frac")

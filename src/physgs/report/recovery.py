@@ -16,7 +16,7 @@ from physgs.recovery.record import load_null, load_recovery
 from physgs.report import latex
 from physgs.report import seeds as seedstats
 from physgs.report.output import Columns, Output
-from physgs.report.tables import Table, check_keys, seeds_of, tree_index
+from physgs.report.tables import Table, check_keys, seed_rows, seeds_of, tree_index
 
 
 #: the method ids of the 2D-track control and the output-only analysis (``RECOVERY_METHODS``)
@@ -93,41 +93,40 @@ def recovery_table(
     methods = {m: mr for m, mr in methods.items() if mr.configs}
     keys = [(t, c, m) for t in trees for m, mr in methods.items() for c in mr.configs]
     seeds = method_seeds(methods, name, keys)
-    rows = []
-    for s in seeds:
-        for t, c, method in keys:
-            rec, nl = methods[method].per_seed[s][(t, c)]
-            m = rec.match
-            if nl.n_parts != m.n_parts:
-                raise ValueError(
-                    f"{name}: null for {t}/{c} (seed {s}) has K={nl.n_parts} but the "
-                    f"model has K={m.n_parts}; re-run the null with the model's K"
-                )
-            tr, nu = 100 * m.median_rel_err, 100 * nl.median_median_rel_err
-            rows.append(
-                {
-                    "seed": s,
-                    "tree": t,
-                    "bones": bones[t],
-                    "config": c,
-                    "method": method,
-                    "K": m.n_parts,
-                    "trained_parts_trusted": float(m.n_trusted),
-                    "trained_median_rel_err_pct": tr,
-                    "trained_loglog_r2": m.loglog_r2,
-                    "null_parts_trusted": nl.median_n_trusted,
-                    "null_median_rel_err_pct": nu,
-                    "null_loglog_r2": nl.median_loglog_r2,
-                    "trained_minus_null_pp": tr - nu,
-                    "nearest_bone_gap_pct": 100 * nl.nearest_bone_gap,
-                    "trained_parts_trusted_visible": float(rec.n_trusted_visible),
-                    "trained_median_rel_err_visible_pct": 100 * rec.median_rel_err_visible,
-                    "null_parts_trusted_visible": nl.median_n_trusted_visible,
-                    "null_median_rel_err_visible_pct": 100 * nl.median_median_rel_err_visible,
-                    **interval_cells(rec),
-                }
+
+    def one(s, t, c, method):
+        rec, nl = methods[method].per_seed[s][(t, c)]
+        m = rec.match
+        if nl.n_parts != m.n_parts:
+            raise ValueError(
+                f"{name}: null for {t}/{c} (seed {s}) has K={nl.n_parts} but the "
+                f"model has K={m.n_parts}; re-run the null with the model's K"
             )
-    df = pd.DataFrame(rows)  # each seed's block: each tree's rows together, in ``keys`` order
+        tr, nu = 100 * m.median_rel_err, 100 * nl.median_median_rel_err
+        return {
+            "tree": t,
+            "bones": bones[t],
+            "config": c,
+            "method": method,
+            "K": m.n_parts,
+            "trained_parts_trusted": float(m.n_trusted),
+            "trained_median_rel_err_pct": tr,
+            "trained_loglog_r2": m.loglog_r2,
+            "null_parts_trusted": nl.median_n_trusted,
+            "null_median_rel_err_pct": nu,
+            "null_loglog_r2": nl.median_loglog_r2,
+            "trained_minus_null_pp": tr - nu,
+            "nearest_bone_gap_pct": 100 * nl.nearest_bone_gap,
+            "trained_parts_trusted_visible": float(rec.n_trusted_visible),
+            "trained_median_rel_err_visible_pct": 100 * rec.median_rel_err_visible,
+            "null_parts_trusted_visible": nl.median_n_trusted_visible,
+            "null_median_rel_err_visible_pct": 100 * nl.median_median_rel_err_visible,
+            **interval_cells(rec),
+        }
+
+    df = seed_rows(
+        seeds, keys, one
+    )  # each seed's block: each tree's rows together, in ``keys`` order
     first = latex.rows(df)
     fmt = f".{int(digits)}f"
     columns = {}

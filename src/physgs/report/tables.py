@@ -18,7 +18,7 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 from pathlib import Path
-from typing import Mapping, Sequence
+from typing import Callable, Mapping, Sequence
 
 import numpy as np
 import pandas as pd
@@ -106,6 +106,23 @@ def seeds_of(per_seed: Mapping[int, Mapping], what: str, keys: Sequence = ()) ->
     for s in seeds:
         check_keys(keys, per_seed[s], f"{what} (seed {s})")
     return seeds
+
+
+def seed_rows(
+    seeds: Sequence[int], keys: Sequence[tuple], row: Callable[..., dict]
+) -> pd.DataFrame:
+    """A table's CSV frame: one row per training seed and key, seed by seed (the layout
+    ``latex.by_seed`` reads).
+
+    Args:
+        seeds: the training seeds.
+        keys: the table's row keys (tuples), in row order.
+        row: ``row(seed, *key)`` -> that row's columns after ``seed``, in CSV order.
+
+    Returns:
+        [S * len(keys)] rows: ``seed``, then the row's columns.
+    """
+    return pd.DataFrame([{"seed": s, **row(s, *k)} for s in seeds for k in keys])
 
 
 def tree_index(rows: pd.DataFrame, labels: Sequence[str], name: str) -> pd.MultiIndex:

@@ -25,7 +25,7 @@ from physgs.intermediate import read_json
 from physgs.report import latex
 from physgs.report.output import Columns, Output, key
 from physgs.report.recovery import label_with_k
-from physgs.report.tables import Table, condition_label, seeds_of, tree_label
+from physgs.report.tables import Table, condition_label, seed_rows, seeds_of, tree_label
 from physgs.tracks.settings import parts as tracks_k
 from physgs.tracks.store import load_fit, load_tracks
 
@@ -134,20 +134,17 @@ def tab_tracks(
     """
     keys = [(t, c) for t in trees for c in configs]
     seeds = seeds_of(per_seed, "tab_tracks", keys)
-    recs = []
-    for s in seeds:
-        for t, c in keys:
-            recs.append(
-                {
-                    "seed": s,
-                    "tree": t,
-                    "bones": bones[t],
-                    "config": c,
-                    "conditions": configs[c]["conditions"],
-                    **row(per_seed[s][(t, c)], conditions),
-                }
-            )
-    df = pd.DataFrame(recs)
+    df = seed_rows(
+        seeds,
+        keys,
+        lambda s, t, c: {
+            "tree": t,
+            "bones": bones[t],
+            "config": c,
+            "conditions": configs[c]["conditions"],
+            **row(per_seed[s][(t, c)], conditions),
+        },
+    )
     fmt = f".{int(digits)}f"
 
     def both(a: str, b: str) -> list[str]:  # 'median / 90th percentile'
