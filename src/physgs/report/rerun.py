@@ -15,8 +15,7 @@ from pathlib import Path
 
 import pandas as pd
 
-from physgs.report.outputs import OUTPUTS
-from physgs.report.outputs import PROVENANCE_COLUMNS
+from physgs.report.outputs import OUTPUTS, PROVENANCE_COLUMNS
 
 
 @dataclass(frozen=True)
