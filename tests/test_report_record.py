@@ -14,6 +14,7 @@ import pytest
 from PIL import Image
 
 from physgs.report import catalogue, record
+from physgs.report import claims as ledger
 
 ROOT = Path(__file__).resolve().parents[1]
 RECORD = ROOT / "docs" / "record"
@@ -474,10 +475,10 @@ def test_a_ledger_without_origins_takes_them_from_the_catalogue():
         }
     )
     # the paper's family, but a model the paper did not train; the output-only analysis
-    assert record.origins(claims).tolist() == ["paper", "project", "project"]
+    assert ledger.column(claims, "origin").tolist() == ["paper", "project", "project"]
     assert record.story_line(claims) == ""  # none of the paper's headline claims
     with pytest.raises(ValueError, match="no family"):
-        record.origins(pd.DataFrame({"id": ["nothing/x"], "verdict": ["holds"]}))
+        ledger.column(pd.DataFrame({"id": ["nothing/x"], "verdict": ["holds"]}), "origin")
 
 
 def test_a_headline_family_of_another_prior_is_found_by_its_id_prefix():
