@@ -796,6 +796,50 @@ def _claims_section_again(text: str, claims: pd.DataFrame) -> str:
     return "\n".join([*lines[:a], *section, *lines[b:]])
 
 
+#: The Results page's part the record lays out (``index.md``): its figures, its ledger's counts,
+#: its tables and its run, each included from its own page.
+INDEX_PAGE = """\
+From the run at commit `{commit}` (profile `{profile}`, training seeds {seeds}; its stamp: [the run](#the-run)).
+
+## Figures
+
+--8<-- "docs/record/figures.md"
+
+## The paper against the measured
+
+{ledger}
+
+## Tables
+
+Each table of the run as its summary over seeds (a wide table cut into several, its key columns repeated); the per-seed rows are in the CSV beside it.
+
+--8<-- "docs/record/tables.md"
+
+## The run
+
+--8<-- "docs/record/stamp.md"
+
+Snakemake's report of a run (every table, figure and job, browsable) is made on demand, not kept in the record: after the run, `python tools/record.py --report-html` writes `results/report.html`.
+
+??? note "The run's own summary (`results/summary.md`): every verdict with its interval, each model's fit, what the run cost"
+
+    --8<-- "docs/record/summary.md"
+
+--8<-- "docs/record/rerun.md"
+"""
+#: One table's entry on the Results page (``tables.md``): where its rows come from, its CSV, and
+#: its summary over seeds (``fold``: open, ``???+``, or folded, ``???``).
+TABLE_ENTRY = """\
+### `{name}`
+
+{over}; every seed's row: [{name}.csv](record/tables/{name}.csv) ({rows} rows).
+
+{fold} note "{name}: the summary, {shown} rows"
+
+    --8<-- "docs/record/tables/{name}.md"
+"""
+
+
 def render_pages(record_dir: str | Path) -> list[Path]:
     """Lay out the record's pages from its own files: the Results page's parts.
 
@@ -832,10 +876,7 @@ def render_pages(record_dir: str | Path) -> list[Path]:
         # a long summary folds away (Material's collapsible block), a short one shows open
         fold = "???+" if lines <= OPEN_TABLE_ROWS or t.stem in OPEN_TABLES else "???"
         entries.append(
-            f"### `{t.stem}`\n\n"
-            f"{over}; every seed's row: [{t.name}](record/tables/{t.stem}.csv) ({len(df)} rows).\n\n"
-            f'{fold} note "{t.stem}: the summary, {len(summary)} rows"\n\n'
-            f'    --8<-- "docs/record/tables/{t.stem}.md"\n'
+            TABLE_ENTRY.format(name=t.stem, over=over, rows=len(df), fold=fold, shown=len(summary))
         )
     pages["tables.md"] = "\n".join(entries)
     names = captions.order([f.stem for f in (out / "figures").glob("*.png")], stamp.trees)
@@ -843,42 +884,11 @@ def render_pages(record_dir: str | Path) -> list[Path]:
         f"![{n}](record/figures/{n}.png)\n\n{captions.caption(n, stamp.seeds)}\n" for n in names
     )
     pages["ledger.md"] = ledger_page(out / "claims.csv", stamp.trees)
-    pages["index.md"] = "\n".join(
-        [
-            f"From the run at commit `{stamp.commit}` (profile `{stamp.profile}`, training "
-            f"seeds {', '.join(map(str, stamp.seeds))}; its stamp: [the run](#the-run)).",
-            "",
-            "## Figures",
-            "",
-            '--8<-- "docs/record/figures.md"',
-            "",
-            "## The paper against the measured",
-            "",
-            *ledger_lines(out / "claims.csv"),
-            "",
-            "## Tables",
-            "",
-            "Each table of the run as its summary over seeds (a wide table cut into several, "
-            "its key columns repeated); the per-seed rows are in the CSV beside it.",
-            "",
-            '--8<-- "docs/record/tables.md"',
-            "",
-            "## The run",
-            "",
-            '--8<-- "docs/record/stamp.md"',
-            "",
-            "Snakemake's report of a run (every table, figure and job, browsable) is made on "
-            "demand, not kept in the record: after the run, `python tools/record.py "
-            "--report-html` writes `results/report.html`.",
-            "",
-            "??? note \"The run's own summary (`results/summary.md`): every verdict with its "
-            "interval, each model's fit, what the run cost\"",
-            "",
-            '    --8<-- "docs/record/summary.md"',
-            "",
-            '--8<-- "docs/record/rerun.md"',
-            "",
-        ]
+    pages["index.md"] = INDEX_PAGE.format(
+        commit=stamp.commit,
+        profile=stamp.profile,
+        seeds=", ".join(map(str, stamp.seeds)),
+        ledger="\n".join(ledger_lines(out / "claims.csv")),
     )
     for name, text in pages.items():
         (out / name).write_text(text)
