@@ -245,13 +245,22 @@ def other_configs(files: Iterable[str | Path], config_hash: str) -> list[str]:
     """
     out = []
     for f in files:
-        df = read_run_csv(f)
-        if "config_hash" not in df.columns:
-            continue
-        found = sorted({str(h) for h in df["config_hash"].dropna()})
-        if found != [config_hash]:
+        found = config_hashes(read_run_csv(f))
+        if found is not None and found != [config_hash]:
             out.append(f"{f}: config_hash {', '.join(found) or 'none'}, not {config_hash}")
     return out
+
+
+def config_hashes(df: pd.DataFrame) -> list[str] | None:
+    """The config hashes a table's or the ledger's rows were made under.
+
+    Args:
+        df: the table (its ``config_hash`` column read as text).
+
+    Returns:
+        The hashes, sorted; None for a table without the column (not judged).
+    """
+    return sorted({str(h) for h in df["config_hash"].dropna()}) if "config_hash" in df else None
 
 
 def read_run_csv(path: str | Path) -> pd.DataFrame:
@@ -322,10 +331,7 @@ def demote(markdown: str) -> str:
     Returns:
         The text, headings one ``#`` deeper.
     """
-    return "\n".join(
-        "#" + ln if ln.startswith("#") and ln.lstrip("#").startswith(" ") else ln
-        for ln in markdown.split("\n")
-    )
+    return re.sub(r"^#+ ", r"#\g<0>", markdown, flags=re.MULTILINE)
 
 
 def _png_for_web(src: Path, dst: Path) -> None:
@@ -915,6 +921,18 @@ def _tree_and_claim(text: str, trees: Sequence[str]) -> tuple[str, str]:
     return "", text
 
 
+#: The ledger page's columns (``ledger_page``).
+LEDGER_COLUMNS = (
+    "claim (click for the full claim)",
+    "tree",
+    "the paper",
+    "measured: mean [95% interval]",
+    "verdict",
+    "kind",
+    "origin",
+)
+
+
 def ledger_page(claims_csv: str | Path, trees: Sequence[str]) -> str:
     """The ledger page's table (``docs/ledger.md`` includes it): one compact row per claim, the
     paper's claims first, each with its tree, the paper's value, the measured mean and 95%
@@ -971,29 +989,9 @@ def ledger_page(claims_csv: str | Path, trees: Sequence[str]) -> str:
             f'<td class="verdict-{r["_verdict"]}">{r["_verdict"]}</td>'
             f"<td>{r['_kind']}</td><td>{e(r['_origin'])}</td></tr>"
         )
-    head = "".join(
-        f"<th>{h}</th>"
-        for h in (
-            "claim (click for the full claim)",
-            "tree",
-            "the paper",
-            "measured: mean [95% interval]",
-            "verdict",
-            "kind",
-            "origin",
-        )
-    )
-    return "\n".join(
-        [
-            '<table class="ledger">',
-            f"<thead><tr>{head}</tr></thead>",
-            "<tbody>",
-            *rows,
-            "</tbody>",
-            "</table>",
-            "",
-        ]
-    )
+    head = "".join(f"<th>{h}</th>" for h in LEDGER_COLUMNS)
+    body = "".join(row + "\n" for row in rows)
+    return f'<table class="ledger">\n<thead><tr>{head}</tr></thead>\n<tbody>\n{body}</tbody>\n</table>\n'
 
 
 def ledger_lines(claims_csv: str | Path) -> list[str]:

@@ -22,7 +22,7 @@ from physgs.models.registry import label
 from physgs.report.thresholds import FIT_BAR
 from physgs.report.catalogue import AHEAD
 from physgs.report.claims import column, counted, decide_cell, failed_premises, number
-from physgs.report.record import markdown_table, story_line
+from physgs.report.record import config_hashes, markdown_table, story_line
 from physgs.report.seeds import interval
 
 VERDICTS = ("holds", "fails", "undecided")
@@ -42,10 +42,8 @@ def _stamp_line(stamp: Mapping[str, str]) -> str:
 
 def _stale(stamp: Mapping[str, str], df: pd.DataFrame, name: str) -> list[str]:
     """A warning when a file was made under another config than the run's stamp."""
-    if "config_hash" not in df.columns or "config_hash" not in stamp:
-        return []
-    found = sorted({str(h) for h in df["config_hash"].dropna()})
-    if found and found != [str(stamp["config_hash"])]:
+    found = config_hashes(df)
+    if found and "config_hash" in stamp and found != [str(stamp["config_hash"])]:
         return [
             f"> **Warning**: {name} was made under config_hash {', '.join(found)}, not this "
             f"run's {stamp['config_hash']}: rerun `snakemake` for the target first.",
