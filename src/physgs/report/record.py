@@ -769,17 +769,13 @@ def derive_claims(record_dir: str | Path) -> list[Path]:
         written.append(path)
     df = read_run_csv(path)
     stamp = {c: str(df[c].iloc[0]) for c in STAMP_COLUMNS if c in df and len(df)}
-    printed = demote(ledger.ledger_markdown(df, stamp or None))
-    if not page.is_file() or page.read_text() != printed:
-        page.write_text(printed)
-        written.append(page)
-    summary = out / "summary.md"
-    if summary.is_file():
-        text = summary.read_text()
-        again = _claims_section_again(text, df)
-        if again != text:
-            summary.write_text(again)
-            written.append(summary)
+    pages = {page: demote(ledger.ledger_markdown(df, stamp or None))}
+    if (out / "summary.md").is_file():
+        pages[out / "summary.md"] = _claims_section_again((out / "summary.md").read_text(), df)
+    for p, printed in pages.items():
+        if not p.is_file() or p.read_text() != printed:
+            p.write_text(printed)
+            written.append(p)
     return written
 
 
