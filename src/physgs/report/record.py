@@ -954,7 +954,7 @@ def ledger_page(claims_csv: str | Path, trees: Sequence[str]) -> str:
     claims = claims.assign(
         _origin=ledger.column(claims, "origin"),
         _kind=ledger.column(claims, "kind"),
-        _verdict=claims["verdict"].astype(str).str.split(":").str[0],
+        _verdict=claims["verdict"].map(rerun.verdict_kind),
     )
     order = {o: i for i, o in enumerate(catalogue.ORIGINS)}  # the paper's first
     claims = claims.iloc[claims["_origin"].map(order).argsort(kind="stable")]

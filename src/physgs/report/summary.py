@@ -23,6 +23,7 @@ from physgs.report.thresholds import FIT_BAR
 from physgs.report.catalogue import AHEAD
 from physgs.report.claims import column, counted, decide_cell, failed_premises, number
 from physgs.report.record import config_hashes, markdown_table, story_line
+from physgs.report.rerun import verdict_kind
 from physgs.report.seeds import interval
 
 VERDICTS = ("holds", "fails", "undecided")
@@ -65,7 +66,7 @@ def claims_section(claims: pd.DataFrame) -> list[str]:
     Raises:
         ValueError: for a verdict not in ``VERDICTS``.
     """
-    kind = claims["verdict"].astype(str).str.split(":").str[0]
+    kind = claims["verdict"].map(verdict_kind)
     bad = sorted(set(kind) - set(VERDICTS))
     if bad:
         raise ValueError(f"claims: unknown verdicts {bad} (expected one of {VERDICTS})")
