@@ -42,55 +42,10 @@ WINDOW, TAIL = "0.6", "tab:blue"
 #: (MkDocs Material in Chromium: 688 px at 1280-1440 px windows, where the contents sidebar shows;
 #: 911 px at 1200 px, where it folds away; the narrower is the one a figure must read at).
 PAGE_WIDTH_PX = 688
-#: The smallest text a reader can read on the page, px.
-MIN_TEXT_PX = 9.0
 #: A figure drawn this wide (inches) shows one point as one pixel on the page; fonts of
 #: ``FONT_PT`` points then read at ``FONT_PT`` px.
 PAGE_WIDTH_IN = PAGE_WIDTH_PX / 72
 FONT_PT = 9.0
-
-
-def text_px(fig) -> list[tuple[str, float]]:
-    """Every visible text of ``fig`` with its height on the page, px: its font size scaled by the
-    factor the page shows the figure at (its tight bounding box shrunk to ``PAGE_WIDTH_PX``).
-
-    Args:
-        fig (matplotlib.figure.Figure): a drawn figure (not yet closed).
-
-    Returns:
-        ``(text, px)`` per non-empty visible text (titles, labels, tick labels, legends).
-    """
-    fig.canvas.draw()
-    renderer = fig.canvas.get_renderer()
-    width_in = fig.get_tightbbox(renderer).width  # inches
-    scale = min(1.0, PAGE_WIDTH_PX / (width_in * 72))  # page px per point
-    out = []
-    for t in fig.findobj(matplotlib.text.Text):
-        if t.get_visible() and t.get_text().strip() and t.get_figure() is not None:
-            if t.get_window_extent(renderer).width > 0:
-                out.append((t.get_text(), t.get_fontsize() * scale))
-    return out
-
-
-def legends_over_data(fig) -> list[str]:
-    """The legends of ``fig`` that cover an axes' data area.
-
-    Args:
-        fig (matplotlib.figure.Figure): a drawn figure (not yet closed).
-
-    Returns:
-        One line per legend overlapping an axes (empty when every legend sits outside the data).
-    """
-    fig.canvas.draw()
-    renderer = fig.canvas.get_renderer()
-    legends = [a.get_legend() for a in fig.axes if a.get_legend() is not None] + list(fig.legends)
-    out = []
-    for lg in legends:
-        box = lg.get_window_extent(renderer)
-        for i, ax in enumerate(fig.axes):
-            if box.overlaps(ax.get_window_extent(renderer)):
-                out.append(f"legend {lg.get_texts()[0].get_text()!r}... covers axes {i}")
-    return out
 
 
 def save_figure(fig, outputs: Sequence[str | Path], dpi: int = 200) -> None:
