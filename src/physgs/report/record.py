@@ -499,11 +499,9 @@ class RunFiles:
         parts = [PurePosixPath(p).parts for p in self.left_out]
         files = [p for p, (top, *_) in zip(self.left_out, parts) if top != BENCHMARKS]
         stages = Counter(x[1] for x in parts if x[0] == BENCHMARKS)
-        bench = f"{stages.total()} benchmark files (" + ", ".join(
-            f"{k} {n}" for k, n in sorted(stages.items())
-        )
-        what = "; ".join(x for x in (", ".join(files), bench + ")" if stages else "") if x)
-        what = what or "nothing"
+        by_stage = ", ".join(f"{k} {n}" for k, n in sorted(stages.items()))
+        bench = f"{stages.total()} benchmark files ({by_stage})" if stages else ""
+        what = "; ".join(x for x in (", ".join(files), bench) if x) or "nothing"
         return f"left out (not made by {self.target}): {what}"
 
 
