@@ -152,6 +152,16 @@ def test_write_record_copies_every_table_as_csv_and_summarises_it_over_seeds(tmp
     assert "#not a heading" in summary
 
 
+def test_a_markdown_table_aligns_the_columns_named_right_and_prints_floats_to_four_digits():
+    df = pd.DataFrame({"table": ["a|b", "c"], "rows": [3, 12], "x": [1.23456, np.nan]})
+    assert record.markdown_table(df, right=["rows", "x"]) == (
+        "| table | rows | x |\n"
+        "|---|---:|---:|\n"
+        "| a\\|b | 3 | 1.235 |\n"  # a pipe in a cell escaped, a float to 4 digits
+        "| c | 12 | -- |\n"  # NaN
+    )
+
+
 def test_a_table_summary_is_mean_and_sd_over_seeds_in_readable_widths():
     rng = np.random.default_rng(0)
     rows = []
