@@ -279,3 +279,30 @@ def test_the_fit_curve_covers_every_tree_unless_it_lists_its_own():
     assert fc.trees_of(cfg) == ["dense"]
     job = fc.point_job(cfg, "mlp", 60)
     assert job == fc.point_job(cfg, "mlp", 60, tree="dense")
+
+
+def test_fig_fit_curve_draws_a_row_per_tree(tmp_path):
+    import matplotlib.image as mpimg
+
+    from physgs.report.figures import fig_fit_curve
+
+    pts = [
+        {
+            "model": "mlp",
+            "seed": 0,
+            "iterations": it,
+            "fit": 20.0 + it / 1000,
+            "heldout": 19.0,
+            "time": 17.0,
+            "train_s": it / 10,
+        }
+        for it in (1500, 6000)
+    ]
+    own = {0: {m: _row(f) for m, f in (("static", 18.0), ("mlp", 21.0), ("truth_motion", 28.0))}}
+    one, two = tmp_path / "one.png", tmp_path / "two.png"
+    fig_fit_curve(fc.curve_table({"medium": pts}, {"medium": own}, 3000), [one])
+    fig_fit_curve(
+        fc.curve_table({"medium": pts, "dense": pts}, {"medium": own, "dense": own}, 3000), [two]
+    )
+    h1, h2 = mpimg.imread(one).shape[0], mpimg.imread(two).shape[0]
+    assert 1.8 * h1 < h2 < 2.2 * h1

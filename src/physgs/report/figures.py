@@ -559,8 +559,8 @@ def fig_speed_accuracy(
 
 
 def fig_fit_curve(df: pd.DataFrame, outputs: Sequence[str | Path]) -> None:
-    """The fit curve ([`physgs.experiments.fit_curve`][physgs.experiments.fit_curve]): three panels,
-    one line per model.
+    """The fit curve ([`physgs.experiments.fit_curve`][physgs.experiments.fit_curve]): three panels
+    per tree (a row each), one line per model.
 
     In-window fit PSNR (dB, trained frames) and time-split PSNR (dB, the tail) against training
     iterations, and the fit against training wall time (s). Points are means over seeds, error
@@ -579,45 +579,47 @@ def fig_fit_curve(df: pd.DataFrame, outputs: Sequence[str | Path]) -> None:
         ("train_s", "fit", "training wall time (s, log)", "PSNR, trained frames (dB)"),
     )
     n_seeds = df["seed"].nunique()
-    df = _seed_mean(df, ["model", "iterations"], ("fit", "time", "train_s"))
-    fig, axes = plt.subplots(1, len(panels), figsize=(13, 3.8))
+    trees = list(dict.fromkeys(df["tree"]))
+    fig, grid = plt.subplots(len(trees), len(panels), figsize=(13, 3.8 * len(trees)), squeeze=False)
     refs = {"static": ("0.55", "--"), **{r: ("k", ":") for r in REFERENCE_NAMES}}
-    prof = df[df["is_profile"]].set_index("model")
-    budgets = sorted(df["iterations"].unique())
-    for ax, (x, y, xlabel, ylabel) in zip(axes, panels):
-        for m, g in df.groupby("model", sort=False):
-            if m in refs:
-                continue
-            g = g.sort_values("iterations")
-            base, _, variant = m.partition("@")  # <field>@window: the diagnostic series
-            _seed_errorbar(
-                ax,
-                g,
-                x,
-                y,
-                n_seeds > 1,
-                xbars=x != "iterations",  # the budgets themselves: no spread
-                fmt="-o" if not variant else "D",
-                mfc=None if not variant else "none",
-                ms=3.5 if not variant else 6,
-                color=COLORS.get(base),
-                lw=1.6 if m == "ours" else 1.0,
-                label=label(base) + (f" ({variant} time)" if variant else ""),
-            )
-            p = g[g["is_profile"]]
-            ax.plot(p[x], p[y], "*", ms=10, color=COLORS.get(m))
-        for m, (c, ls) in refs.items():
-            if m in prof.index:
-                ax.axhline(prof.loc[m, y], color=c, ls=ls, lw=1.0, label=label(m))
-        ax.set_xscale("log")
-        if x == "iterations":  # tick the budgets themselves, not powers of ten
-            ax.set_xticks(budgets)
-        else:  # seconds span under a decade: 1-2-5 ticks as plain numbers, minor labels overlap
-            ax.xaxis.set_major_locator(LogLocator(subs=(1.0, 2.0, 5.0)))
-        ax.xaxis.set_major_formatter(ScalarFormatter())
-        ax.xaxis.set_minor_formatter(NullFormatter())
-        ax.set_xlabel(xlabel)
-        ax.set_ylabel(ylabel)
-        ax.grid(alpha=0.3)
-    head = f"Fit curve on the {df['tree'].iloc[0]} tree (star: the profile's budget"
-    _save_sweep(fig, axes, head, n_seeds, outputs)
+    for tree, axes in zip(trees, grid):
+        t = _seed_mean(df[df["tree"] == tree], ["model", "iterations"], ("fit", "time", "train_s"))
+        prof = t[t["is_profile"]].set_index("model")
+        budgets = sorted(t["iterations"].unique())
+        for ax, (x, y, xlabel, ylabel) in zip(axes, panels):
+            for m, g in t.groupby("model", sort=False):
+                if m in refs:
+                    continue
+                g = g.sort_values("iterations")
+                base, _, variant = m.partition("@")  # <field>@window: the diagnostic series
+                _seed_errorbar(
+                    ax,
+                    g,
+                    x,
+                    y,
+                    n_seeds > 1,
+                    xbars=x != "iterations",  # the budgets themselves: no spread
+                    fmt="-o" if not variant else "D",
+                    mfc=None if not variant else "none",
+                    ms=3.5 if not variant else 6,
+                    color=COLORS.get(base),
+                    lw=1.6 if m == "ours" else 1.0,
+                    label=label(base) + (f" ({variant} time)" if variant else ""),
+                )
+                p = g[g["is_profile"]]
+                ax.plot(p[x], p[y], "*", ms=10, color=COLORS.get(m))
+            for m, (c, ls) in refs.items():
+                if m in prof.index:
+                    ax.axhline(prof.loc[m, y], color=c, ls=ls, lw=1.0, label=label(m))
+            ax.set_xscale("log")
+            if x == "iterations":  # tick the budgets themselves, not powers of ten
+                ax.set_xticks(budgets)
+            else:  # seconds span under a decade: 1-2-5 ticks as plain numbers, minor labels overlap
+                ax.xaxis.set_major_locator(LogLocator(subs=(1.0, 2.0, 5.0)))
+            ax.xaxis.set_major_formatter(ScalarFormatter())
+            ax.xaxis.set_minor_formatter(NullFormatter())
+            ax.set_xlabel(xlabel)
+            ax.set_ylabel(ylabel if len(trees) == 1 else f"{tree}: {ylabel}")
+            ax.grid(alpha=0.3)
+    where = f"the {trees[0]} tree" if len(trees) == 1 else "each tree (a row each)"
+    _save_sweep(fig, grid[0], f"Fit curve on {where} (star: the profile's budget", n_seeds, outputs)
