@@ -344,7 +344,11 @@ def _set(path, value, profile=None):
         (_set(("presets", "sparse", "bones"), 23), "default", "presets/sparse"),
         (_set(("train", "holdout_every"), 1), "default", "train/holdout_every"),
         # the fit curve's profile point is the pipeline's own job on its tree; three budgets at least
-        (lambda c: c.update(trees=["sparse", "dense"]), "default", "speed_accuracy/fit_curve/tree"),
+        (
+            _set(("speed_accuracy", "fit_curve", "trees"), ["oak"]),
+            "quick",
+            "speed_accuracy/fit_curve/trees",
+        ),
         (
             _set(("speed_accuracy", "fit_curve", "iterations"), [1500]),
             "default",

@@ -8,6 +8,7 @@ inches, at 72 points per inch, shrunk to the column's px."""
 
 import numpy as np
 import pytest
+from matplotlib.text import Text
 
 from physgs.models.registry import MODEL_NAMES
 from physgs.recovery import damping_summary
@@ -16,6 +17,51 @@ from physgs.report.tracks import fig_tracks
 from physgs.tracks.track import Tracks
 
 TREES = ["sparse", "medium", "dense"]
+#: The smallest text a reader can read on the page, px.
+MIN_TEXT_PX = 9.0
+
+
+def text_px(fig) -> list[tuple[str, float]]:
+    """Every visible text of ``fig`` with its height on the page, px: its font size scaled by the
+    factor the page shows the figure at (its tight bounding box shrunk to ``FG.PAGE_WIDTH_PX``).
+
+    Args:
+        fig (matplotlib.figure.Figure): a drawn figure (not yet closed).
+
+    Returns:
+        ``(text, px)`` per non-empty visible text (titles, labels, tick labels, legends).
+    """
+    fig.canvas.draw()
+    renderer = fig.canvas.get_renderer()
+    width_in = fig.get_tightbbox(renderer).width  # inches
+    scale = min(1.0, FG.PAGE_WIDTH_PX / (width_in * 72))  # page px per point
+    out = []
+    for t in fig.findobj(Text):
+        if t.get_visible() and t.get_text().strip() and t.get_figure() is not None:
+            if t.get_window_extent(renderer).width > 0:
+                out.append((t.get_text(), t.get_fontsize() * scale))
+    return out
+
+
+def legends_over_data(fig) -> list[str]:
+    """The legends of ``fig`` that cover an axes' data area.
+
+    Args:
+        fig (matplotlib.figure.Figure): a drawn figure (not yet closed).
+
+    Returns:
+        One line per legend overlapping an axes (empty when every legend sits outside the data).
+    """
+    fig.canvas.draw()
+    renderer = fig.canvas.get_renderer()
+    legends = [a.get_legend() for a in fig.axes if a.get_legend() is not None] + list(fig.legends)
+    out = []
+    for lg in legends:
+        box = lg.get_window_extent(renderer)
+        for i, ax in enumerate(fig.axes):
+            if box.overlaps(ax.get_window_extent(renderer)):
+                out.append(f"legend {lg.get_texts()[0].get_text()!r}... covers axes {i}")
+    return out
 
 
 @pytest.fixture
@@ -43,9 +89,9 @@ def _smallest_px(fig):
 
 def _legible(fig):
     px, text = _smallest_px(fig)
-    assert px >= FG.MIN_TEXT_PX, f"{text!r} is {px:.1f} px at the page's width"
-    assert not FG.legends_over_data(fig)
-    assert min(px for _, px in FG.text_px(fig)) == pytest.approx(px)
+    assert px >= MIN_TEXT_PX, f"{text!r} is {px:.1f} px at the page's width"
+    assert not legends_over_data(fig)
+    assert min(px for _, px in text_px(fig)) == pytest.approx(px)
 
 
 def test_fig_temporal_reads_at_page_width_and_keys_the_beyond_window_band(caught):
@@ -136,12 +182,12 @@ def test_small_text_is_measured_small(caught):
 
     fig, ax = plt.subplots(figsize=(13, 3))
     ax.set_title("tiny", fontsize=7)
-    px = dict(FG.text_px(fig))["tiny"]
+    px = dict(text_px(fig))["tiny"]
     assert px == pytest.approx(7 * FG.PAGE_WIDTH_PX / (fig.get_tightbbox().width * 72))
-    assert px < FG.MIN_TEXT_PX
+    assert px < MIN_TEXT_PX
     ax.plot([0, 1], [0, 1], label="over the data")
     ax.legend(loc="center")
-    assert FG.legends_over_data(fig)
+    assert legends_over_data(fig)
     plt.close(fig)
 
 

@@ -249,3 +249,60 @@ def test_fig_fit_curve_draws_the_window_series(tmp_path):
     outs = [tmp_path / "f.png"]
     fig_fit_curve(df, outs)
     assert outs[0].stat().st_size > 1000
+
+
+def test_a_curve_over_trees_pairs_each_point_with_its_own_trees_references():
+    """curve_table: seed 0 on two trees, each tree's static pose and ceiling its own."""
+    pt = {
+        "model": "mlp",
+        "seed": 0,
+        "iterations": 500,
+        "fit": 20.0,
+        "heldout": 0.0,
+        "time": 0.0,
+        "train_s": 1.0,
+    }
+    own = {
+        "medium": {0: {"static": _row(18.0), "truth_motion": _row(28.0)}},  # gain 10 dB
+        "dense": {0: {"static": _row(16.0), "truth_motion": _row(24.0)}},  # gain 8 dB
+    }
+    df = fc.curve_table({"medium": [pt], "dense": [pt]}, own, 1500)
+    mlp = df[df["model"] == "mlp"].set_index("tree")["of_ceiling"]
+    assert mlp.to_dict() == pytest.approx({"medium": 0.2, "dense": 0.5})
+    assert list(dict.fromkeys(df["tree"])) == ["medium", "dense"]
+
+
+def test_the_fit_curve_covers_every_tree_unless_it_lists_its_own():
+    cfg = physgs.config.load("config/trees.yaml", "quick")
+    assert fc.trees_of(cfg) == cfg["trees"]
+    cfg["speed_accuracy"]["fit_curve"]["trees"] = ["dense"]
+    assert fc.trees_of(cfg) == ["dense"]
+    job = fc.point_job(cfg, "mlp", 60)
+    assert job == fc.point_job(cfg, "mlp", 60, tree="dense")
+
+
+def test_fig_fit_curve_draws_a_row_per_tree(tmp_path):
+    import matplotlib.image as mpimg
+
+    from physgs.report.figures import fig_fit_curve
+
+    pts = [
+        {
+            "model": "mlp",
+            "seed": 0,
+            "iterations": it,
+            "fit": 20.0 + it / 1000,
+            "heldout": 19.0,
+            "time": 17.0,
+            "train_s": it / 10,
+        }
+        for it in (1500, 6000)
+    ]
+    own = {0: {m: _row(f) for m, f in (("static", 18.0), ("mlp", 21.0), ("truth_motion", 28.0))}}
+    one, two = tmp_path / "one.png", tmp_path / "two.png"
+    fig_fit_curve(fc.curve_table({"medium": pts}, {"medium": own}, 3000), [one])
+    fig_fit_curve(
+        fc.curve_table({"medium": pts, "dense": pts}, {"medium": own, "dense": own}, 3000), [two]
+    )
+    h1, h2 = mpimg.imread(one).shape[0], mpimg.imread(two).shape[0]
+    assert 1.8 * h1 < h2 < 2.2 * h1

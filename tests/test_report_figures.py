@@ -66,10 +66,7 @@ def test_figure_bad_input(tmp_path):
         )
 
 
-def test_representative_frame_and_best_baseline():
-    assert (
-        FG.representative_frame(np.array([1.0, 2.0, 6.0]), np.zeros(3)) == 1
-    )  # gaps 1, 2, 6: mean 3, closest is 2
+def test_best_baseline():
     s = {
         "static": {"time": 30.0},
         "mlp": {"time": 24.0},

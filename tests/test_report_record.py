@@ -14,6 +14,7 @@ import pytest
 from PIL import Image
 
 from physgs.report import catalogue, record
+from physgs.report import claims as ledger
 
 ROOT = Path(__file__).resolve().parents[1]
 RECORD = ROOT / "docs" / "record"
@@ -149,6 +150,16 @@ def test_write_record_copies_every_table_as_csv_and_summarises_it_over_seeds(tmp
     summary = (out / "summary.md").read_text().splitlines()
     assert summary[0] == "## Run summary" and "### Claims ledger" in summary
     assert "#not a heading" in summary
+
+
+def test_a_markdown_table_aligns_the_columns_named_right_and_prints_floats_to_four_digits():
+    df = pd.DataFrame({"table": ["a|b", "c"], "rows": [3, 12], "x": [1.23456, np.nan]})
+    assert record.markdown_table(df, right=["rows", "x"]) == (
+        "| table | rows | x |\n"
+        "|---|---:|---:|\n"
+        "| a\\|b | 3 | 1.235 |\n"  # a pipe in a cell escaped, a float to 4 digits
+        "| c | 12 | -- |\n"  # NaN
+    )
 
 
 def test_a_table_summary_is_mean_and_sd_over_seeds_in_readable_widths():
@@ -474,10 +485,10 @@ def test_a_ledger_without_origins_takes_them_from_the_catalogue():
         }
     )
     # the paper's family, but a model the paper did not train; the output-only analysis
-    assert record.origins(claims).tolist() == ["paper", "project", "project"]
+    assert ledger.column(claims, "origin").tolist() == ["paper", "project", "project"]
     assert record.story_line(claims) == ""  # none of the paper's headline claims
     with pytest.raises(ValueError, match="no family"):
-        record.origins(pd.DataFrame({"id": ["nothing/x"], "verdict": ["holds"]}))
+        ledger.column(pd.DataFrame({"id": ["nothing/x"], "verdict": ["holds"]}), "origin")
 
 
 def test_a_headline_family_of_another_prior_is_found_by_its_id_prefix():

@@ -304,7 +304,7 @@ def test_fit_curve_passes_through_the_tables_numbers(run):
     assert np.isfinite(df[["fit", "heldout", "time", "train_s"]].to_numpy(float)).all()
     fit = _csv(run, "tab_fit")
     for _, r in df[df["is_profile"]].iterrows():
-        cell = fit[(fit["tree"] == fc["tree"]) & (fit["model"] == r["model"])]
+        cell = fit[(fit["tree"] == r["tree"]) & (fit["model"] == r["model"])]
         assert cell["fit_psnr_db"].item() == pytest.approx(r["fit"], abs=1e-4)
     for name in ("fig_fit_curve", "fig_fit_vs_extrapolation"):
         for ext in ("pdf", "png"):

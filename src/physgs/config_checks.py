@@ -948,8 +948,8 @@ def sweep_tree_is_listed(cfg: dict) -> Iterator[Problem]:
 
 
 def fit_curve_is_runnable(cfg: dict) -> Iterator[Problem]:
-    """The fit curve's tree is built by the pipeline (its profile-budget point is the pipeline's
-    own job) and its budgets give at least three points with the profile's.
+    """The fit curve's trees are built by the pipeline (its profile-budget point is the
+    pipeline's own job) and its budgets give at least three points with the profile's.
 
     Args:
         cfg: The resolved config (profile merged, schema-valid).
@@ -958,11 +958,12 @@ def fit_curve_is_runnable(cfg: dict) -> Iterator[Problem]:
         ``(key path, message)`` per problem (the module docstring); none when the config passes.
     """
     fc = cfg["speed_accuracy"]["fit_curve"]
-    if fc["tree"] not in cfg["trees"]:
-        yield (
-            ("speed_accuracy", "fit_curve", "tree"),
-            f"'{fc['tree']}' is not in trees {cfg['trees']}; choose one of them or add it to trees",
-        )
+    for t in fc.get("trees", []):
+        if t not in cfg["trees"]:
+            yield (
+                ("speed_accuracy", "fit_curve", "trees"),
+                f"'{t}' is not in trees {cfg['trees']}; choose among them or add it to trees",
+            )
     own = int(cfg["train"]["iterations"])
     if len({*map(int, fc["iterations"]), own}) < 3:
         yield (

@@ -270,40 +270,49 @@ def sweep_inputs(wildcards):
 
 def fit_point_params(wildcards):
     return _fit_curve.point_job(
-        CFG, wildcards.model, int(wildcards.iterations), seed=int(wildcards.seed)
+        CFG,
+        wildcards.model,
+        int(wildcards.iterations),
+        seed=int(wildcards.seed),
+        tree=wildcards.tree,
     )
 
 
 def fit_window_params(wildcards):
     return _fit_curve.point_job(
-        CFG, wildcards.model, int(wildcards.iterations), seed=int(wildcards.seed), window_time=True
+        CFG,
+        wildcards.model,
+        int(wildcards.iterations),
+        seed=int(wildcards.seed),
+        window_time=True,
+        tree=wildcards.tree,
     )
 
 
 def fit_curve_inputs(wildcards):
-    """The extra-budget points of every seed, and the pipeline's own evaluation and loss log of
-    each model and seed at the profile's budget (keys eval_{model}_{seed}, loss_{model}_{seed})."""
-    tree, cfg = FC["tree"], _models.BASE_CONFIG
-    out = {
-        "points": expand(
+    """Per tree of the fit curve, the extra-budget points of every seed (key points_{tree}) and the
+    pipeline's own evaluation and loss log of each model and seed at the profile's budget (keys
+    eval_{tree}_{model}_{seed}, loss_{tree}_{model}_{seed})."""
+    cfg = _models.BASE_CONFIG
+    out = {}
+    for tree in _fit_curve.trees_of(CFG):
+        out[f"points_{tree}"] = expand(
             FIT_POINT,
             tree=tree,
             seed=STUDY_SEEDS,
             model=FC["models"],
             iterations=_fit_curve.extra_budgets(CFG),
-        )
-        + expand(
+        ) + expand(
             FIT_WINDOW_POINT,
             tree=tree,
             seed=STUDY_SEEDS,
             model=_fit_curve.window_models(CFG),
             iterations=CFG["train"]["iterations"],
         )
-    }
-    for s in STUDY_SEEDS:
-        for m in FC_PROFILE_MODELS:
-            out[f"eval_{m}_{s}"] = EVAL.format(tree=tree, seed=s, model=m, config=cfg)
-            out[f"loss_{m}_{s}"] = LOSS.format(tree=tree, seed=s, model=m, config=cfg)
+        for s in STUDY_SEEDS:
+            for m in FC_PROFILE_MODELS:
+                out[f"eval_{tree}_{m}_{s}"] = EVAL.format(tree=tree, seed=s, model=m, config=cfg)
+                out[f"loss_{tree}_{m}_{s}"] = LOSS.format(tree=tree, seed=s, model=m, config=cfg)
     return out
 
 

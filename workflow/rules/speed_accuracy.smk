@@ -96,7 +96,7 @@ rule fit_curve:
         mem_mb=1000,
         runtime=5,
     params:
-        tree=FC["tree"],
+        trees=_fit_curve.trees_of(CFG),
         models=FC_PROFILE_MODELS,
         seeds=STUDY_SEEDS,
         iterations=CFG["train"]["iterations"],

@@ -1,6 +1,6 @@
 """The fit curve: how each model's fit to its training window grows with the training budget.
 
-For one tree (``speed_accuracy.fit_curve.tree``), each listed model is trained ``single`` at each
+On each tree of ``speed_accuracy.fit_curve.trees`` (absent: every tree of the run), each listed model is trained ``single`` at each
 listed budget (training iterations; the static warm-up keeps its fraction, as in the sweep) by
 the tables' recipe, and scored at the training camera and wind: on the trained frames (fit), on
 the every-``holdout_every``-th frames held out of training (interpolation), and on the tail (the
@@ -30,6 +30,18 @@ from physgs.models.timescale import WINDOW_TIME
 WINDOW_SERIES = "@" + WINDOW_TIME
 
 COLUMNS = ("seed", "model", "iterations", "is_profile", "fit", "heldout", "time", "train_s", "tree")
+
+
+def trees_of(cfg: dict) -> list[str]:
+    """The fit curve's trees: ``speed_accuracy.fit_curve.trees``, or every tree of the run.
+
+    Args:
+        cfg: the resolved config.
+
+    Returns:
+        Tree names.
+    """
+    return list(cfg["speed_accuracy"]["fit_curve"].get("trees") or cfg["trees"])
 
 
 def budgets(cfg: dict) -> list[int]:
@@ -76,17 +88,23 @@ def window_models(cfg: dict) -> list[str]:
 
 
 def point_job(
-    cfg: dict, model: str, iterations: int, seed: int | None = None, window_time: bool = False
+    cfg: dict,
+    model: str,
+    iterations: int,
+    seed: int | None = None,
+    window_time: bool = False,
+    tree: str | None = None,
 ) -> dict:
     """The training job ([`job_spec`][physgs.experiments.recipe.job_spec]) of ``model`` at a budget.
 
     Args:
-        cfg: the resolved config (the fit curve's tree is read from it).
+        cfg: the resolved config.
         model: a model id.
         iterations: the training budget (the warm-up keeps its fraction).
         seed: the training seed (default ``cfg['seed']``).
         window_time: a field with the window-normalised time encoding instead of its chosen one
             (the diagnostic series).
+        tree: the point's tree (its recipe, ``recipes``, applies); None: the fit curve's first.
 
     Returns:
         The job as a sorted dict.
@@ -94,7 +112,7 @@ def point_job(
     Raises:
         ValueError: for ``window_time`` on a model that is not a field.
     """
-    tree = cfg["speed_accuracy"]["fit_curve"]["tree"]
+    tree = tree or trees_of(cfg)[0]
     pcfg = with_knob(cfg, tree, "iterations", iterations)
     if window_time:
         family = MODELS[model].family
@@ -104,7 +122,7 @@ def point_job(
             **pcfg["models"][family]["time_top_hz"],
             model: WINDOW_TIME,
         }
-    return job_spec(pcfg, model, BASE_CONFIG, seed=seed)
+    return job_spec(pcfg, model, BASE_CONFIG, seed=seed, tree=tree)
 
 
 def run_point(job: Mapping, observed, *, progress: bool = False, series: str | None = None) -> dict:
@@ -212,8 +230,8 @@ def collect(
 def ceiling_fraction(
     df: pd.DataFrame, static: str = "static", ceiling: str = "truth_motion"
 ) -> pd.Series:
-    """(fit - static) / (ceiling - static) per row, against the same seed's profile-budget static
-    and ceiling rows (the fraction of the achievable in-window gain); NaN without them.
+    """(fit - static) / (ceiling - static) per row, against the same tree's and seed's
+    profile-budget static and ceiling rows (the fraction of the achievable in-window gain); NaN without them.
 
     Args:
         df: [`collect`][physgs.experiments.fit_curve.collect]'s table.
@@ -223,9 +241,35 @@ def ceiling_fraction(
     Returns:
         The fractions, indexed like ``df``.
     """
-    prof = df[df["is_profile"]].set_index(["seed", "model"])["fit"]
+    prof = df[df["is_profile"]].set_index(["tree", "seed", "model"])["fit"]
     out = pd.Series(np.nan, index=df.index)
-    for seed, g in df.groupby("seed"):
-        if (seed, static) in prof.index and (seed, ceiling) in prof.index:
-            out[g.index] = _fraction(g["fit"], prof[(seed, static)], prof[(seed, ceiling)])
+    for (tree, seed), g in df.groupby(["tree", "seed"]):
+        if (tree, seed, static) in prof.index and (tree, seed, ceiling) in prof.index:
+            out[g.index] = _fraction(
+                g["fit"], prof[(tree, seed, static)], prof[(tree, seed, ceiling)]
+            )
     return out
+
+
+def curve_table(
+    points: Mapping[str, Sequence[dict]],
+    profile_rows: Mapping[str, Mapping[int, Mapping[str, dict]]],
+    profile_iterations: int,
+) -> pd.DataFrame:
+    """The fit curve's CSV over its trees: [`collect`][physgs.experiments.fit_curve.collect] per
+    tree, with each row's fraction of its tree's and seed's ceiling (``of_ceiling``).
+
+    Args:
+        points: tree -> its [`run_point`][physgs.experiments.fit_curve.run_point] records.
+        profile_rows: tree -> seed -> model -> the pipeline's own row at the profile's budget.
+        profile_iterations: the profile's budget.
+
+    Returns:
+        The ``COLUMNS`` table and ``of_ceiling``, tree by tree in ``points``' order.
+    """
+    df = pd.concat(
+        [collect(points[t], profile_rows[t], profile_iterations, t) for t in points],
+        ignore_index=True,
+    )
+    df["of_ceiling"] = ceiling_fraction(df)
+    return df

@@ -42,55 +42,10 @@ WINDOW, TAIL = "0.6", "tab:blue"
 #: (MkDocs Material in Chromium: 688 px at 1280-1440 px windows, where the contents sidebar shows;
 #: 911 px at 1200 px, where it folds away; the narrower is the one a figure must read at).
 PAGE_WIDTH_PX = 688
-#: The smallest text a reader can read on the page, px.
-MIN_TEXT_PX = 9.0
 #: A figure drawn this wide (inches) shows one point as one pixel on the page; fonts of
 #: ``FONT_PT`` points then read at ``FONT_PT`` px.
 PAGE_WIDTH_IN = PAGE_WIDTH_PX / 72
 FONT_PT = 9.0
-
-
-def text_px(fig) -> list[tuple[str, float]]:
-    """Every visible text of ``fig`` with its height on the page, px: its font size scaled by the
-    factor the page shows the figure at (its tight bounding box shrunk to ``PAGE_WIDTH_PX``).
-
-    Args:
-        fig (matplotlib.figure.Figure): a drawn figure (not yet closed).
-
-    Returns:
-        ``(text, px)`` per non-empty visible text (titles, labels, tick labels, legends).
-    """
-    fig.canvas.draw()
-    renderer = fig.canvas.get_renderer()
-    width_in = fig.get_tightbbox(renderer).width  # inches
-    scale = min(1.0, PAGE_WIDTH_PX / (width_in * 72))  # page px per point
-    out = []
-    for t in fig.findobj(matplotlib.text.Text):
-        if t.get_visible() and t.get_text().strip() and t.get_figure() is not None:
-            if t.get_window_extent(renderer).width > 0:
-                out.append((t.get_text(), t.get_fontsize() * scale))
-    return out
-
-
-def legends_over_data(fig) -> list[str]:
-    """The legends of ``fig`` that cover an axes' data area.
-
-    Args:
-        fig (matplotlib.figure.Figure): a drawn figure (not yet closed).
-
-    Returns:
-        One line per legend overlapping an axes (empty when every legend sits outside the data).
-    """
-    fig.canvas.draw()
-    renderer = fig.canvas.get_renderer()
-    legends = [a.get_legend() for a in fig.axes if a.get_legend() is not None] + list(fig.legends)
-    out = []
-    for lg in legends:
-        box = lg.get_window_extent(renderer)
-        for i, ax in enumerate(fig.axes):
-            if box.overlaps(ax.get_window_extent(renderer)):
-                out.append(f"legend {lg.get_texts()[0].get_text()!r}... covers axes {i}")
-    return out
 
 
 def save_figure(fig, outputs: Sequence[str | Path], dpi: int = 200) -> None:
@@ -138,20 +93,6 @@ def best_baseline(
     if not cands:
         raise ValueError("best_baseline: no baseline among the given models")
     return max(cands, key=cands.get)
-
-
-def representative_frame(psnr_ours: np.ndarray, psnr_base: np.ndarray) -> int:
-    """Index of the frame whose ours-minus-baseline PSNR gap is closest to the split's mean gap.
-
-    Args:
-        psnr_ours: [F] ours' per-frame PSNR, dB.
-        psnr_base: [F] the baseline's, dB.
-
-    Returns:
-        The frame's index into the arrays.
-    """
-    gap = np.asarray(psnr_ours, float) - np.asarray(psnr_base, float)
-    return int(np.argmin(np.abs(gap - gap.mean())))
 
 
 # --------------------------------------------------------------------------------------------
@@ -521,6 +462,25 @@ def _seed_mean(df: pd.DataFrame, by: list[str], cols: Sequence[str]) -> pd.DataF
     return pd.concat([out, sd, rest], axis=1).reset_index()
 
 
+def _seed_errorbar(ax, g: pd.DataFrame, x: str, y: str, bars: bool, xbars: bool = True, **style):
+    """One series of ``_seed_mean``'s means, ``y`` against ``x``, the seeds' sd as error bars
+    (``bars``: more than one seed; ``xbars``: on ``x`` too)."""
+    yerr = g[f"{y}_sd"] if bars else None
+    ax.errorbar(
+        g[x], g[y], yerr=yerr, xerr=g[f"{x}_sd"] if bars and xbars else None, capsize=2, **style
+    )
+
+
+def _save_sweep(fig, axes, head: str, n_seeds: int, outputs: Sequence[str | Path]) -> None:
+    """Key a sweep's first panel, title it ``head`` and the seeds its points are the mean of
+    (closing ``head``'s parenthesis), and save it."""
+    axes[0].legend(fontsize=7)
+    seeds = f"; mean +- sd over {n_seeds} training seeds" if n_seeds > 1 else "; one seed"
+    fig.suptitle(f"{head}{seeds})")
+    fig.tight_layout()
+    save_figure(fig, outputs)
+
+
 def fig_speed_accuracy(
     df: pd.DataFrame, outputs: Sequence[str | Path], null: Mapping[str, float] | None = None
 ) -> None:
@@ -548,14 +508,14 @@ def fig_speed_accuracy(
     for knob, g in m.groupby("knob", sort=False):
         g = g.sort_values("value")
         for ax, col in ((axes[0], "psnr_time"), (axes[1], "rel_pct")):
-            ax.errorbar(
-                g["wall_s"],
-                g[col],
-                yerr=g[f"{col}_sd"] if n_seeds > 1 else None,
-                xerr=g["wall_s_sd"] if n_seeds > 1 else None,
+            _seed_errorbar(
+                ax,
+                g,
+                "wall_s",
+                col,
+                n_seeds > 1,
                 fmt="-o",
                 ms=3.5,
-                capsize=2,
                 lw=1.0,
                 color=colors[knob],
                 label=knob,
@@ -594,18 +554,13 @@ def fig_speed_accuracy(
         axes[1].legend(fontsize=7)
     axes[0].set_ylabel("PSNR, time split (dB)")
     axes[1].set_ylabel("median rel. error of omega, trusted parts (%)")
-    axes[0].legend(fontsize=7)
-    seeds = f"; mean +- sd over {n_seeds} training seeds" if n_seeds > 1 else "; one seed"
-    fig.suptitle(
-        f"Speed-accuracy trade, ours on the {df['tree'].iloc[0]} tree (one knob at a time{seeds})"
-    )
-    fig.tight_layout()
-    save_figure(fig, outputs)
+    head = f"Speed-accuracy trade, ours on the {df['tree'].iloc[0]} tree (one knob at a time"
+    _save_sweep(fig, axes, head, n_seeds, outputs)
 
 
 def fig_fit_curve(df: pd.DataFrame, outputs: Sequence[str | Path]) -> None:
-    """The fit curve ([`physgs.experiments.fit_curve`][physgs.experiments.fit_curve]): three panels,
-    one line per model.
+    """The fit curve ([`physgs.experiments.fit_curve`][physgs.experiments.fit_curve]): three panels
+    per tree (a row each), one line per model.
 
     In-window fit PSNR (dB, trained frames) and time-split PSNR (dB, the tail) against training
     iterations, and the fit against training wall time (s). Points are means over seeds, error
@@ -624,48 +579,47 @@ def fig_fit_curve(df: pd.DataFrame, outputs: Sequence[str | Path]) -> None:
         ("train_s", "fit", "training wall time (s, log)", "PSNR, trained frames (dB)"),
     )
     n_seeds = df["seed"].nunique()
-    df = _seed_mean(df, ["model", "iterations"], ("fit", "time", "train_s"))
-    fig, axes = plt.subplots(1, len(panels), figsize=(13, 3.8))
+    trees = list(dict.fromkeys(df["tree"]))
+    fig, grid = plt.subplots(len(trees), len(panels), figsize=(13, 3.8 * len(trees)), squeeze=False)
     refs = {"static": ("0.55", "--"), **{r: ("k", ":") for r in REFERENCE_NAMES}}
-    prof = df[df["is_profile"]].set_index("model")
-    budgets = sorted(df["iterations"].unique())
-    for ax, (x, y, xlabel, ylabel) in zip(axes, panels):
-        for m, g in df.groupby("model", sort=False):
-            if m in refs:
-                continue
-            g = g.sort_values("iterations")
-            bars = n_seeds > 1
-            base, _, variant = m.partition("@")  # <field>@window: the diagnostic series
-            ax.errorbar(
-                g[x],
-                g[y],
-                yerr=g[f"{y}_sd"] if bars else None,
-                xerr=g[f"{x}_sd"] if bars and x != "iterations" else None,
-                fmt="-o" if not variant else "D",
-                mfc=None if not variant else "none",
-                ms=3.5 if not variant else 6,
-                capsize=2,
-                color=COLORS.get(base),
-                lw=1.6 if m == "ours" else 1.0,
-                label=label(base) + (f" ({variant} time)" if variant else ""),
-            )
-            p = g[g["is_profile"]]
-            ax.plot(p[x], p[y], "*", ms=10, color=COLORS.get(m))
-        for m, (c, ls) in refs.items():
-            if m in prof.index:
-                ax.axhline(prof.loc[m, y], color=c, ls=ls, lw=1.0, label=label(m))
-        ax.set_xscale("log")
-        if x == "iterations":  # tick the budgets themselves, not powers of ten
-            ax.set_xticks(budgets)
-        else:  # seconds span under a decade: 1-2-5 ticks as plain numbers, minor labels overlap
-            ax.xaxis.set_major_locator(LogLocator(subs=(1.0, 2.0, 5.0)))
-        ax.xaxis.set_major_formatter(ScalarFormatter())
-        ax.xaxis.set_minor_formatter(NullFormatter())
-        ax.set_xlabel(xlabel)
-        ax.set_ylabel(ylabel)
-        ax.grid(alpha=0.3)
-    axes[0].legend(fontsize=7)
-    seeds = f"; mean +- sd over {n_seeds} training seeds" if n_seeds > 1 else "; one seed"
-    fig.suptitle(f"Fit curve on the {df['tree'].iloc[0]} tree (star: the profile's budget{seeds})")
-    fig.tight_layout()
-    save_figure(fig, outputs)
+    for tree, axes in zip(trees, grid):
+        t = _seed_mean(df[df["tree"] == tree], ["model", "iterations"], ("fit", "time", "train_s"))
+        prof = t[t["is_profile"]].set_index("model")
+        budgets = sorted(t["iterations"].unique())
+        for ax, (x, y, xlabel, ylabel) in zip(axes, panels):
+            for m, g in t.groupby("model", sort=False):
+                if m in refs:
+                    continue
+                g = g.sort_values("iterations")
+                base, _, variant = m.partition("@")  # <field>@window: the diagnostic series
+                _seed_errorbar(
+                    ax,
+                    g,
+                    x,
+                    y,
+                    n_seeds > 1,
+                    xbars=x != "iterations",  # the budgets themselves: no spread
+                    fmt="-o" if not variant else "D",
+                    mfc=None if not variant else "none",
+                    ms=3.5 if not variant else 6,
+                    color=COLORS.get(base),
+                    lw=1.6 if m == "ours" else 1.0,
+                    label=label(base) + (f" ({variant} time)" if variant else ""),
+                )
+                p = g[g["is_profile"]]
+                ax.plot(p[x], p[y], "*", ms=10, color=COLORS.get(m))
+            for m, (c, ls) in refs.items():
+                if m in prof.index:
+                    ax.axhline(prof.loc[m, y], color=c, ls=ls, lw=1.0, label=label(m))
+            ax.set_xscale("log")
+            if x == "iterations":  # tick the budgets themselves, not powers of ten
+                ax.set_xticks(budgets)
+            else:  # seconds span under a decade: 1-2-5 ticks as plain numbers, minor labels overlap
+                ax.xaxis.set_major_locator(LogLocator(subs=(1.0, 2.0, 5.0)))
+            ax.xaxis.set_major_formatter(ScalarFormatter())
+            ax.xaxis.set_minor_formatter(NullFormatter())
+            ax.set_xlabel(xlabel)
+            ax.set_ylabel(ylabel if len(trees) == 1 else f"{tree}: {ylabel}")
+            ax.grid(alpha=0.3)
+    where = f"the {trees[0]} tree" if len(trees) == 1 else "each tree (a row each)"
+    _save_sweep(fig, grid[0], f"Fit curve on {where} (star: the profile's budget", n_seeds, outputs)

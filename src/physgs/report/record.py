@@ -25,6 +25,7 @@ import math
 import re
 import shlex
 import shutil
+from collections import Counter
 from collections.abc import Iterable, Mapping, Sequence
 from dataclasses import asdict, dataclass, field
 from pathlib import Path, PurePosixPath
@@ -59,6 +60,18 @@ OPEN_TABLES = ("tab_fit", "tab_null")
 STAMP_COLUMNS = ("profile", "config_hash", "physgs_version")
 #: Cells moved beyond their row's seed spread that the record lists, largest first.
 RERUN_CELLS_SHOWN = 10
+#: The columns of the record's comparison with the one it replaces: its moved verdicts, its
+#: tables and its cells moved furthest (``rerun_lines``).
+RERUN_VERDICT_COLUMNS = ("claim", "before", "after", "threshold", "intervals overlap")
+RERUN_TABLE_COLUMNS = (
+    "table",
+    "rows in both",
+    "numeric cells",
+    "identical",
+    "within the seed spread",
+    "beyond it",
+)
+RERUN_CELL_COLUMNS = ("table", "row", "column", "before", "after", "seed spread")
 COSTS_COLUMNS = ("name", "command", "wall_s", "date", "commit", "cpu", "from_nothing", "segments")
 BEGIN, END = "<!-- record:begin -->", "<!-- record:end -->"
 
@@ -197,11 +210,11 @@ def instances_of(testbed: pd.DataFrame, seeds: Sequence[int], seed: int) -> dict
         tree -> testbed seeds.
     """
     seeds = sorted(int(x) for x in seeds)
-    out = {}
-    for _, r in testbed.iterrows():
-        n = int(r["instances"]) if "instances" in testbed.columns else 1
-        out[str(r["tree"])] = seeds if n > 1 and n == len(seeds) else [int(seed)]
-    return out
+    n = testbed["instances"] if "instances" in testbed else pd.Series(1, testbed.index)
+    return {
+        str(t): seeds if k > 1 and k == len(seeds) else [int(seed)]
+        for t, k in zip(testbed["tree"], n)
+    }
 
 
 def overrides_words(overrides: Iterable[str]) -> str:
@@ -232,13 +245,34 @@ def other_configs(files: Iterable[str | Path], config_hash: str) -> list[str]:
     """
     out = []
     for f in files:
-        df = pd.read_csv(f, dtype={"config_hash": str})
-        if "config_hash" not in df.columns:
-            continue
-        found = sorted({str(h) for h in df["config_hash"].dropna()})
-        if found != [config_hash]:
+        found = config_hashes(read_run_csv(f))
+        if found is not None and found != [config_hash]:
             out.append(f"{f}: config_hash {', '.join(found) or 'none'}, not {config_hash}")
     return out
+
+
+def config_hashes(df: pd.DataFrame) -> list[str] | None:
+    """The config hashes a table's or the ledger's rows were made under.
+
+    Args:
+        df: the table (its ``config_hash`` column read as text).
+
+    Returns:
+        The hashes, sorted; None for a table without the column (not judged).
+    """
+    return sorted({str(h) for h in df["config_hash"].dropna()}) if "config_hash" in df else None
+
+
+def read_run_csv(path: str | Path) -> pd.DataFrame:
+    """A table's or the ledger's CSV of a run.
+
+    Args:
+        path: the CSV.
+
+    Returns:
+        Its rows, the config hash read as text (a hash of digits stays one).
+    """
+    return pd.read_csv(path, dtype={"config_hash": str})
 
 
 def format_duration(seconds: float) -> str:
@@ -270,18 +304,20 @@ def _cell(x) -> str:
     return str(x).replace("|", "\\|")
 
 
-def markdown_table(df: pd.DataFrame) -> str:
-    """A DataFrame as a Markdown table; floats to 4 significant digits, NaN as ``--``.
+def markdown_table(df: pd.DataFrame, right: Iterable[str] = ()) -> str:
+    """A DataFrame as a Markdown table; floats to 4 significant digits, NaN as ``--``: every
+    table of the record and of the run's summary is written here.
 
     Args:
         df: the table (its index is dropped).
+        right: the columns aligned right (counts read down a column).
 
     Returns:
         The table's lines, ending in a newline.
     """
-    lines = ["| " + " | ".join(map(str, df.columns)) + " |", "|" + "---|" * len(df.columns)]
-    for row in df.itertuples(index=False):
-        lines.append("| " + " | ".join(_cell(x) for x in row) + " |")
+    rule = "".join("---:|" if c in set(right) else "---|" for c in df.columns)
+    lines = ["| " + " | ".join(map(str, df.columns)) + " |", "|" + rule]
+    lines += ["| " + " | ".join(map(_cell, row)) + " |" for row in df.itertuples(index=False)]
     return "\n".join(lines) + "\n"
 
 
@@ -295,10 +331,7 @@ def demote(markdown: str) -> str:
     Returns:
         The text, headings one ``#`` deeper.
     """
-    return "\n".join(
-        "#" + ln if ln.startswith("#") and ln.lstrip("#").startswith(" ") else ln
-        for ln in markdown.split("\n")
-    )
+    return re.sub(r"^#+ ", r"#\g<0>", markdown, flags=re.MULTILINE)
 
 
 def _png_for_web(src: Path, dst: Path) -> None:
@@ -351,6 +384,8 @@ def rerun_lines(
         if old.get("config_hash") == stamp.config_hash
         else f"config hash `{old.get('config_hash')}`: the comparison spans a change of settings"
     )
+    c = rerun.compare_claims(read_run_csv(prev / "claims.csv"), read_run_csv(claims_csv))
+    apart = f" ({len(c.only_new)} claims new in this run, {len(c.only_old)} no longer asked.)"
     lines = [
         *head,
         f"This run (commit `{stamp.commit}`) against the record it replaced: commit "
@@ -358,83 +393,69 @@ def rerun_lines(
         "two commits is in `CHANGELOG.md`; `python tools/compare_runs.py OLD NEW` repeats the "
         "tables' comparison for any two runs.",
         "",
-    ]
-    text = {"config_hash": str}
-    c = rerun.compare_claims(
-        pd.read_csv(prev / "claims.csv", dtype=text), pd.read_csv(claims_csv, dtype=text)
-    )
-    total = c.same + len(c.changed)
-    lines.append(
-        f"**The ledger**: {c.same} of {total} claims in both runs keep their verdict"
+        f"**The ledger**: {c.same} of {c.same + len(c.changed)} claims in both runs keep their "
+        "verdict"
         + (f", {len(c.changed)} changed:" if c.changed else ".")
-    )
-    if c.only_new or c.only_old:
-        lines[-1] += (
-            f" ({len(c.only_new)} claims new in this run, {len(c.only_old)} no longer asked.)"
-        )
-    lines.append("")
+        + (apart if c.only_new or c.only_old else ""),
+        "",
+    ]
     if c.changed:
+        verdicts = pd.DataFrame(
+            [
+                (f"`{v.id}`: {v.claim}", f"{v.old}, {v.old_value}", f"**{v.new}**, {v.new_value}")
+                + (v.threshold, v.overlap)
+                for v in c.changed
+            ],
+            columns=RERUN_VERDICT_COLUMNS,
+        )
+        n = Counter(v.overlap for v in c.changed)
         lines += [
-            "| claim | before | after | threshold | intervals overlap |",
-            "|---|---|---|---|---|",
-        ]
-        lines += [
-            f"| `{v.id}`: {_cell(v.claim)} | {v.old}, {v.old_value} | **{v.new}**, {v.new_value}"
-            f" | {_cell(v.threshold)} | {v.overlap} |"
-            for v in c.changed
-        ]
-        n = {k: sum(v.overlap == k for v in c.changed) for k in ("yes", "no", "--")}
-        lines += [
+            *markdown_table(verdicts).splitlines(),
             "",
             f"Of the {len(c.changed)} moved verdicts, {n['yes']} moved with overlapping intervals "
             f"(within the seeds' noise: an interval that now clears or now touches its "
             f"threshold), {n['no']} with intervals apart (the runs disagree beyond that noise)"
             + (f", {n['--']} without an interval in one of the runs" if n["--"] else "")
             + ".",
+            "",
         ]
-        lines.append("")
-    rows = [
-        "| table | rows in both | numeric cells | identical | within the seed spread | beyond it |",
-        "|---|---:|---:|---:|---:|---:|",
-    ]
-    moved: list[tuple[str, rerun.CellChange]] = []
+    rows, moved = [], []
     for t in sorted(Path(p) for p in tables):
         before = prev / "tables" / t.name
         if not before.is_file():
             continue
-        a, b = pd.read_csv(before, dtype=text), pd.read_csv(t, dtype=text)
+        a, b = read_run_csv(before), read_run_csv(t)
         if "seed" not in a.columns or "seed" not in b.columns:
             same = "identical" if a.equals(b) else "changed"
-            rows.append(f"| `{t.stem}` (not seeded) | {len(b)} | | {same} | | |")
+            rows.append((f"`{t.stem}` (not seeded)", len(b), "", same, "", ""))
             continue
         r = rerun.compare_table_csv(before, t)
-        rows.append(
-            f"| `{t.stem}` | {r.rows} | {r.cells} | {r.identical} | {r.within} | {len(r.beyond)} |"
-        )
+        rows.append((f"`{t.stem}`", r.rows, r.cells, r.identical, r.within, len(r.beyond)))
         moved += [(t.stem, ch) for ch in r.beyond]
+    tabled = pd.DataFrame(rows, columns=RERUN_TABLE_COLUMNS)
     lines += [
         "**The seeded tables**, each numeric cell beside the previous run's spread (max - min) "
         "over seeds of its row; job timings are left out:",
         "",
-        *rows,
+        *markdown_table(tabled, right=RERUN_TABLE_COLUMNS[1:]).splitlines(),
         "",
     ]
     if moved:
         moved.sort(key=lambda m: rerun.spreads_moved(m[1]), reverse=True)
+        cells = pd.DataFrame(
+            [
+                (f"`{name}`", ", ".join(f"{k} {v}" for k, v in ch.key.items()), f"`{ch.column}`")
+                + (ch.old, ch.new, ch.spread)
+                for name, ch in moved[:RERUN_CELLS_SHOWN]
+            ],
+            columns=RERUN_CELL_COLUMNS,
+        )
         lines += [
-            f"The largest moves beyond the spread ({min(len(moved), RERUN_CELLS_SHOWN)} of "
-            f"{len(moved)}):",
+            f"The largest moves beyond the spread ({len(cells)} of {len(moved)}):",
             "",
-            "| table | row | column | before | after | seed spread |",
-            "|---|---|---|---:|---:|---:|",
+            *markdown_table(cells, right=RERUN_CELL_COLUMNS[3:]).splitlines(),
+            "",
         ]
-        for name, ch in moved[:RERUN_CELLS_SHOWN]:
-            key = ", ".join(f"{k} {v}" for k, v in ch.key.items())
-            lines.append(
-                f"| `{name}` | {_cell(key)} | `{ch.column}` | {_cell(ch.old)} | {_cell(ch.new)} | "
-                f"{_cell(ch.spread)} |"
-            )
-        lines.append("")
     return lines
 
 
@@ -475,19 +496,11 @@ class RunFiles:
             ``left out (not made by all): tables/x.csv, ...; N benchmark files (stage n, ...)``,
                 or ``left out (not made by all): nothing``.
         """
-        files = [p for p in self.left_out if PurePosixPath(p).parts[0] != BENCHMARKS]
-        stages: dict[str, int] = {}
-        for p in self.left_out:
-            parts = PurePosixPath(p).parts
-            if parts[0] == BENCHMARKS:
-                stages[parts[1]] = stages.get(parts[1], 0) + 1
-        bench = (
-            f"{sum(stages.values())} benchmark files ("
-            + ", ".join(f"{k} {n}" for k, n in sorted(stages.items()))
-            + ")"
-            if stages
-            else ""
-        )
+        parts = [PurePosixPath(p).parts for p in self.left_out]
+        files = [p for p, (top, *_) in zip(self.left_out, parts) if top != BENCHMARKS]
+        stages = Counter(x[1] for x in parts if x[0] == BENCHMARKS)
+        by_stage = ", ".join(f"{k} {n}" for k, n in sorted(stages.items()))
+        bench = f"{stages.total()} benchmark files ({by_stage})" if stages else ""
         what = "; ".join(x for x in (", ".join(files), bench) if x) or "nothing"
         return f"left out (not made by {self.target}): {what}"
 
@@ -637,34 +650,25 @@ def write_record(
     _remove(out)  # an earlier write that stopped before its swap
     (out / "tables").mkdir(parents=True)
     (out / "figures").mkdir()
-    written: list[Path] = []
-
-    def put(name: str, text: str) -> None:
-        (out / name).write_text(text)
-        written.append(out / name)
-
     for name, data in kept.items():
         (out / name).write_bytes(data)
-        written.append(out / name)
-    put("stamp.json", json.dumps(asdict(stamp), indent=2) + "\n")
-    put("rerun.md", against)
-    put("summary.md", demote(Path(summary_md).read_text()))
-    put("claims.md", demote(Path(claims_md).read_text()))
+    (out / "stamp.json").write_text(json.dumps(asdict(stamp), indent=2) + "\n")
+    (out / "rerun.md").write_text(against)
+    for name, page in (("summary.md", summary_md), ("claims.md", claims_md)):
+        (out / name).write_text(demote(Path(page).read_text()))
     shutil.copyfile(claims_csv, out / "claims.csv")
-    written.append(out / "claims.csv")
-    for t in sorted(Path(p) for p in tables):
+    for t in map(Path, tables):
         shutil.copyfile(t, out / "tables" / t.name)
-        written.append(out / "tables" / t.name)
-    for f in sorted(Path(p) for p in figures):
+    for f in map(Path, figures):
         _png_for_web(f, out / "figures" / f.name)
-        written.append(out / "figures" / f.name)
-    written += render_pages(out)
+    render_pages(out)
+    written = sorted(final / p.relative_to(out) for p in out.rglob("*") if p.is_file())
     old = final.with_name(final.name + ".old")
     if final.exists():
         final.rename(old)
     out.rename(final)
     _remove(old)
-    return sorted({final / p.relative_to(out) for p in written})
+    return written
 
 
 def _mean_sd(values: pd.Series) -> str:
@@ -699,13 +703,13 @@ def table_summary(df: pd.DataFrame) -> tuple[pd.DataFrame, list[str], list[int]]
     if "seed" not in df:
         return df.map(_cell).reset_index(drop=True), keys, []
     seeds = sorted(int(x) for x in df["seed"].unique())
-    values = [c for c in df.columns if c not in keys and c != "seed"]
-    groups = df.groupby(keys, sort=False, dropna=False) if keys else [((), df)]
-    rows = []
-    for k, g in groups:
-        k = k if isinstance(k, tuple) else (k,)
-        rows.append([_cell(x) for x in k] + [_mean_sd(g[c]) for c in values])
-    return pd.DataFrame(rows, columns=[*keys, *values]), keys, seeds
+    values = df.drop(columns=[*keys, "seed"])
+    if not keys:
+        return pd.DataFrame([values.agg(_mean_sd)]), keys, seeds
+    summary = values.groupby([df[k] for k in keys], sort=False, dropna=False).agg(_mean_sd)
+    summary = summary.reset_index()
+    summary[keys] = summary[keys].map(_cell)
+    return summary, keys, seeds
 
 
 def summary_markdown(df: pd.DataFrame) -> str:
@@ -761,19 +765,15 @@ def derive_claims(record_dir: str | Path) -> list[Path]:
     if missing:
         text.to_csv(path, index=False)
         written.append(path)
-    df = pd.read_csv(path, dtype={"config_hash": str})
+    df = read_run_csv(path)
     stamp = {c: str(df[c].iloc[0]) for c in STAMP_COLUMNS if c in df and len(df)}
-    printed = demote(ledger.ledger_markdown(df, stamp or None))
-    if not page.is_file() or page.read_text() != printed:
-        page.write_text(printed)
-        written.append(page)
-    summary = out / "summary.md"
-    if summary.is_file():
-        text = summary.read_text()
-        again = _claims_section_again(text, df)
-        if again != text:
-            summary.write_text(again)
-            written.append(summary)
+    pages = {page: demote(ledger.ledger_markdown(df, stamp or None))}
+    if (out / "summary.md").is_file():
+        pages[out / "summary.md"] = _claims_section_again((out / "summary.md").read_text(), df)
+    for p, printed in pages.items():
+        if not p.is_file() or p.read_text() != printed:
+            p.write_text(printed)
+            written.append(p)
     return written
 
 
@@ -794,6 +794,50 @@ def _claims_section_again(text: str, claims: pd.DataFrame) -> str:
     b = next((i for i in range(a + 1, len(lines)) if lines[i].startswith("### ")), len(lines))
     section = demote("\n".join(claims_section(claims))).split("\n")
     return "\n".join([*lines[:a], *section, *lines[b:]])
+
+
+#: The Results page's part the record lays out (``index.md``): its figures, its ledger's counts,
+#: its tables and its run, each included from its own page.
+INDEX_PAGE = """\
+From the run at commit `{commit}` (profile `{profile}`, training seeds {seeds}; its stamp: [the run](#the-run)).
+
+## Figures
+
+--8<-- "docs/record/figures.md"
+
+## The paper against the measured
+
+{ledger}
+
+## Tables
+
+Each table of the run as its summary over seeds (a wide table cut into several, its key columns repeated); the per-seed rows are in the CSV beside it.
+
+--8<-- "docs/record/tables.md"
+
+## The run
+
+--8<-- "docs/record/stamp.md"
+
+Snakemake's report of a run (every table, figure and job, browsable) is made on demand, not kept in the record: after the run, `python tools/record.py --report-html` writes `results/report.html`.
+
+??? note "The run's own summary (`results/summary.md`): every verdict with its interval, each model's fit, what the run cost"
+
+    --8<-- "docs/record/summary.md"
+
+--8<-- "docs/record/rerun.md"
+"""
+#: One table's entry on the Results page (``tables.md``): where its rows come from, its CSV, and
+#: its summary over seeds (``fold``: open, ``???+``, or folded, ``???``).
+TABLE_ENTRY = """\
+### `{name}`
+
+{over}; every seed's row: [{name}.csv](record/tables/{name}.csv) ({rows} rows).
+
+{fold} note "{name}: the summary, {shown} rows"
+
+    --8<-- "docs/record/tables/{name}.md"
+"""
 
 
 def render_pages(record_dir: str | Path) -> list[Path]:
@@ -817,19 +861,12 @@ def render_pages(record_dir: str | Path) -> list[Path]:
     """
     out = Path(record_dir)
     stamp = Stamp(**json.loads((out / "stamp.json").read_text()))
-    written: list[Path] = []
-
-    def put(name: str, text: str) -> None:
-        (out / name).write_text(text)
-        written.append(out / name)
-
-    put("stamp.md", stamp.markdown())
-    index = []
+    pages = {"stamp.md": stamp.markdown()}
+    entries = []
     for t in sorted((out / "tables").glob("*.csv")):
         df = pd.read_csv(t, dtype={c: str for c in STAMP_COLUMNS})
         summary, _, seeds = table_summary(df)
-        text = summary_markdown(df)
-        put(f"tables/{t.stem}.md", text)
+        pages[f"tables/{t.stem}.md"] = text = summary_markdown(df)
         over = (
             f"mean ± sd over training seeds {', '.join(map(str, seeds))}"
             if len(seeds) > 1
@@ -838,69 +875,24 @@ def render_pages(record_dir: str | Path) -> list[Path]:
         lines = len(summary) * (text.count("\n\n") + 1)  # rows of all its parts
         # a long summary folds away (Material's collapsible block), a short one shows open
         fold = "???+" if lines <= OPEN_TABLE_ROWS or t.stem in OPEN_TABLES else "???"
-        index += [
-            f"### `{t.stem}`",
-            "",
-            f"{over}; every seed's row: [{t.name}](record/tables/{t.stem}.csv) ({len(df)} rows).",
-            "",
-            f'{fold} note "{t.stem}: the summary, {len(summary)} rows"',
-            "",
-            f'    --8<-- "docs/record/tables/{t.stem}.md"',
-            "",
-        ]
-    put("tables.md", "\n".join(index))
-    gallery = []
+        entries.append(
+            TABLE_ENTRY.format(name=t.stem, over=over, rows=len(df), fold=fold, shown=len(summary))
+        )
+    pages["tables.md"] = "\n".join(entries)
     names = captions.order([f.stem for f in (out / "figures").glob("*.png")], stamp.trees)
-    for name in names:
-        gallery += [
-            f"![{name}](record/figures/{name}.png)",
-            "",
-            captions.caption(name, stamp.seeds),
-            "",
-        ]
-    put("figures.md", "\n".join(gallery))
-    put("ledger.md", ledger_page(out / "claims.csv", stamp.trees))
-    put(
-        "index.md",
-        "\n".join(
-            [
-                f"From the run at commit `{stamp.commit}` (profile `{stamp.profile}`, training "
-                f"seeds {', '.join(map(str, stamp.seeds))}; its stamp: [the run](#the-run)).",
-                "",
-                "## Figures",
-                "",
-                '--8<-- "docs/record/figures.md"',
-                "",
-                "## The paper against the measured",
-                "",
-                *ledger_lines(out / "claims.csv"),
-                "",
-                "## Tables",
-                "",
-                "Each table of the run as its summary over seeds (a wide table cut into several, "
-                "its key columns repeated); the per-seed rows are in the CSV beside it.",
-                "",
-                '--8<-- "docs/record/tables.md"',
-                "",
-                "## The run",
-                "",
-                '--8<-- "docs/record/stamp.md"',
-                "",
-                "Snakemake's report of a run (every table, figure and job, browsable) is made on "
-                "demand, not kept in the record: after the run, `python tools/record.py "
-                "--report-html` writes `results/report.html`.",
-                "",
-                "??? note \"The run's own summary (`results/summary.md`): every verdict with its "
-                "interval, each model's fit, what the run cost\"",
-                "",
-                '    --8<-- "docs/record/summary.md"',
-                "",
-                '--8<-- "docs/record/rerun.md"',
-                "",
-            ]
-        ),
+    pages["figures.md"] = "\n".join(
+        f"![{n}](record/figures/{n}.png)\n\n{captions.caption(n, stamp.seeds)}\n" for n in names
     )
-    return written
+    pages["ledger.md"] = ledger_page(out / "claims.csv", stamp.trees)
+    pages["index.md"] = INDEX_PAGE.format(
+        commit=stamp.commit,
+        profile=stamp.profile,
+        seeds=", ".join(map(str, stamp.seeds)),
+        ledger="\n".join(ledger_lines(out / "claims.csv")),
+    )
+    for name, text in pages.items():
+        (out / name).write_text(text)
+    return [out / name for name in pages]
 
 
 def _value_text(r: pd.Series) -> str:
@@ -923,6 +915,18 @@ def _tree_and_claim(text: str, trees: Sequence[str]) -> tuple[str, str]:
     return "", text
 
 
+#: The ledger page's columns (``ledger_page``).
+LEDGER_COLUMNS = (
+    "claim (click for the full claim)",
+    "tree",
+    "the paper",
+    "measured: mean [95% interval]",
+    "verdict",
+    "kind",
+    "origin",
+)
+
+
 def ledger_page(claims_csv: str | Path, trees: Sequence[str]) -> str:
     """The ledger page's table (``docs/ledger.md`` includes it): one compact row per claim, the
     paper's claims first, each with its tree, the paper's value, the measured mean and 95%
@@ -938,7 +942,7 @@ def ledger_page(claims_csv: str | Path, trees: Sequence[str]) -> str:
     Returns:
         The page part: raw HTML, ending in a newline.
     """
-    claims = pd.read_csv(claims_csv, dtype={"config_hash": str})
+    claims = read_run_csv(claims_csv)
     # a ledger of fewer columns (an older or a partial one) shows what it has
     shown = {"paper": "--", "source": "--", "threshold": "", "unit": "", "seeds": 0}
     shown |= {c: np.nan for c in ("measured", "ci_low", "ci_high")}
@@ -948,7 +952,7 @@ def ledger_page(claims_csv: str | Path, trees: Sequence[str]) -> str:
     claims = claims.assign(
         _origin=ledger.column(claims, "origin"),
         _kind=ledger.column(claims, "kind"),
-        _verdict=claims["verdict"].astype(str).str.split(":").str[0],
+        _verdict=claims["verdict"].map(rerun.verdict_kind),
     )
     order = {o: i for i, o in enumerate(catalogue.ORIGINS)}  # the paper's first
     claims = claims.iloc[claims["_origin"].map(order).argsort(kind="stable")]
@@ -979,29 +983,9 @@ def ledger_page(claims_csv: str | Path, trees: Sequence[str]) -> str:
             f'<td class="verdict-{r["_verdict"]}">{r["_verdict"]}</td>'
             f"<td>{r['_kind']}</td><td>{e(r['_origin'])}</td></tr>"
         )
-    head = "".join(
-        f"<th>{h}</th>"
-        for h in (
-            "claim (click for the full claim)",
-            "tree",
-            "the paper",
-            "measured: mean [95% interval]",
-            "verdict",
-            "kind",
-            "origin",
-        )
-    )
-    return "\n".join(
-        [
-            '<table class="ledger">',
-            f"<thead><tr>{head}</tr></thead>",
-            "<tbody>",
-            *rows,
-            "</tbody>",
-            "</table>",
-            "",
-        ]
-    )
+    head = "".join(f"<th>{h}</th>" for h in LEDGER_COLUMNS)
+    body = "".join(row + "\n" for row in rows)
+    return f'<table class="ledger">\n<thead><tr>{head}</tr></thead>\n<tbody>\n{body}</tbody>\n</table>\n'
 
 
 def ledger_lines(claims_csv: str | Path) -> list[str]:
@@ -1014,7 +998,7 @@ def ledger_lines(claims_csv: str | Path) -> list[str]:
     Returns:
         The Markdown lines.
     """
-    claims = pd.read_csv(claims_csv, dtype={"config_hash": str})
+    claims = read_run_csv(claims_csv)
     story, premise = story_line(claims), premise_line(claims)
     return [
         f"The ledger holds the paper's {ledger.counted(claims, 'paper')}; and this project's own "
@@ -1043,20 +1027,6 @@ def write_unrecorded(out_dir: str | Path) -> Path:
         "`python tools/record.py results` writes it here.\n"
     )
     return out / "index.md"
-
-
-def origins(claims: pd.DataFrame) -> pd.Series:
-    """Each claim's origin, ``paper`` or ``project``: the ledger's ``origin`` column, or the
-    catalogue's word for its id in a ledger written before the column
-    ([`physgs.report.catalogue.origin_of`][]).
-
-    Args:
-        claims: the ledger (``claims.csv``).
-
-    Returns:
-        One origin per row.
-    """
-    return ledger.column(claims, "origin")
 
 
 def count_line(claims: pd.DataFrame) -> str:
@@ -1091,10 +1061,17 @@ def premise_line(claims: pd.DataFrame) -> str:
     )
 
 
-def _family_rows(claims: pd.DataFrame, fam: str) -> pd.DataFrame:
-    """The claims of a headline family: their id is it, or starts with it + "/"."""
+def _headline_families(claims: pd.DataFrame, origin: str | None = None):
+    """The headline families (``catalogue.headline``, of ``origin`` if given) the ledger holds,
+    in the catalogue's order: their words, their claims (the id is the family's, or starts with
+    it + "/"), each claim's cell (the id past the family's; ``all`` for the family's own) and
+    verdict kind."""
     ids = claims["id"].astype(str)
-    return claims[(ids == fam) | ids.str.startswith(fam + "/")]
+    for fam, words, of in catalogue.headline():
+        rows = (ids == fam) | ids.str.startswith(fam + "/")
+        if rows.any() and origin in (None, of):
+            cells = ids[rows].str[len(fam) + 1 :].replace("", "all")
+            yield words, claims[rows], cells, claims.loc[rows, "verdict"].map(rerun.verdict_kind)
 
 
 def story_line(claims: pd.DataFrame) -> str:
@@ -1107,28 +1084,26 @@ def story_line(claims: pd.DataFrame) -> str:
     Returns:
         One Markdown bullet; "" when the ledger holds none of the paper's headline claims.
     """
-    fails, open_, n, held = [], [], 0, 0
-    for fam, words, origin in catalogue.headline():
-        rows = _family_rows(claims, fam)
-        if origin != "paper" or rows.empty:
-            continue
-        kind = rows["verdict"].astype(str).str.split(":").str[0]
-        where = {
-            v: ", ".join(str(i)[len(fam) + 1 :] or "all" for i in rows["id"][kind == v])
-            for v in ("fails", "undecided")
-        }
-        n, held = n + len(rows), held + int((kind == "holds").sum())
-        fails += [f"{words} ({where['fails']})"] if where["fails"] else []
-        open_ += [f"{words} ({where['undecided']})"] if where["undecided"] else []
+    fams = list(_headline_families(claims, "paper"))
+    n = sum(len(rows) for _, rows, _, _ in fams)
+    held = sum(int((kind == "holds").sum()) for *_, kind in fams)
+
+    def where(v: str) -> str:  # the families with a claim of verdict v, each with its cells
+        return "; ".join(
+            f"{words} ({', '.join(cells[kind == v])})"
+            for words, _, cells, kind in fams
+            if (kind == v).any()
+        )
+
     if not n:
         return ""
     if held == n:
         return f"- **The paper's story stands**: all {n} of its headline claims hold."
     text = f"- **The paper's story stands in part**: {held} of its {n} headline claims hold"
-    if fails:
-        text += "; it fails on " + "; ".join(fails)
-    if open_:
-        text += "; undecided: " + "; ".join(open_)
+    if where("fails"):
+        text += "; it fails on " + where("fails")
+    if where("undecided"):
+        text += "; undecided: " + where("undecided")
     return text + "."
 
 
@@ -1145,24 +1120,18 @@ def headline_lines(claims: pd.DataFrame) -> list[str]:
     Returns:
         The Markdown lines.
     """
-    kind = claims["verdict"].astype(str).str.split(":").str[0]
-    story = story_line(claims)
-    premise = premise_line(claims)
+    story, premise = story_line(claims), premise_line(claims)
     lines = [count_line(claims), *([premise] if premise else []), *([story] if story else [])]
-    for fam, words, _ in catalogue.headline():
-        rows = _family_rows(claims, fam)
-        if rows.empty:
-            continue
+    for words, rows, where, kind in _headline_families(claims):
         cells = []
-        for (_, r), k in zip(rows.iterrows(), kind[rows.index]):
-            where = str(r["id"])[len(fam) + 1 :] or "all"
+        for (_, r), w, k in zip(rows.iterrows(), where, kind):
             value = _value_text(r).replace(" (one value)", "")
             size = r.get("paper_in_interval")  # a record made before the column has none
             if isinstance(size, str) and size:
                 p_lo, p_hi = r["paper_low"], r["paper_high"]
                 fig = f"{p_lo:+.3g}" if p_lo == p_hi else f"{p_lo:+.3g} to {p_hi:+.3g}"
                 value = f"{value.strip()}; the paper's {fig} {size}"
-            cells.append(f"{where} **{k}** ({value.strip()})")
+            cells.append(f"{w} **{k}** ({value.strip()})")
         lines.append(f"- {words[0].upper() + words[1:]}: " + "; ".join(cells) + ".")
     return lines
 
@@ -1177,12 +1146,12 @@ def cost_lines(costs: pd.DataFrame) -> list[str]:
     Returns:
         The lines of a Markdown table: command, wall time on 2 cores, when and where measured.
     """
-    lines = ["| command | wall time on 2 cores | measured on |", "|---|---|---|"]
-    by_name = {r["name"]: r for _, r in costs.iterrows()} if len(costs) else {}
+    by_name = {r["name"]: r for _, r in costs.iterrows()}
+    rows = []
     for name, command in COMMANDS:
         r = by_name.get(name)
         if r is None:
-            lines.append(f"| `{command}` | not measured | |")
+            rows.append((f"`{command}`", "not measured", ""))
             continue
         start = ""  # where a run starts from says something only of a workflow's targets
         if command.startswith("snakemake"):
@@ -1191,11 +1160,15 @@ def cost_lines(costs: pd.DataFrame) -> list[str]:
         if n > 1:  # a run resumed after an interruption: its wall time is the segments' sum
             start += f", in {n} segments"
         # the command as it was measured (e.g. tab_null at three seeds), not the canonical one
-        lines.append(
-            f"| `{r['command']}` | {format_duration(float(r['wall_s']))}{start} | "
-            f"{r['date']}, commit `{r['commit']}`, {r['cpu']} |"
+        rows.append(
+            (
+                f"`{r['command']}`",
+                format_duration(float(r["wall_s"])) + start,
+                f"{r['date']}, commit `{r['commit']}`, {r['cpu']}",
+            )
         )
-    return lines
+    columns = ("command", "wall time on 2 cores", "measured on")
+    return markdown_table(pd.DataFrame(rows, columns=columns)).splitlines()
 
 
 def read_costs(path: str | Path) -> pd.DataFrame:
@@ -1245,7 +1218,7 @@ def found_lines(record_dir: str | Path) -> list[str]:
     lines = ["**What the last full run found** (its record: `docs/record/`):", ""]
     if (record / "claims.csv").is_file():
         stamp = json.loads((record / "stamp.json").read_text())
-        claims = pd.read_csv(record / "claims.csv", dtype={"config_hash": str})
+        claims = read_run_csv(record / "claims.csv")
         overrides = stamp.get("overrides") or []
         made_with = f", made with `{overrides_words(overrides)}`" if overrides else ""
         lines += [

@@ -13,6 +13,7 @@ from __future__ import annotations
 from dataclasses import dataclass
 from pathlib import Path
 
+import numpy as np
 import pandas as pd
 
 from physgs.report.outputs import OUTPUTS, PROVENANCE_COLUMNS
@@ -187,26 +188,25 @@ def compare_seeded(
         and not pd.api.types.is_bool_dtype(old[c])  # a flag of the row, not a measurement
     ]
     group = [k for k in keys if k != seed]
-    spread = old.groupby(group, dropna=False)[numeric].agg(lambda s: s.max() - s.min())
+    # each old row beside its row's spread over the old run's seeds (max - min)
+    spread = old.groupby(group, dropna=False)[numeric].transform(lambda s: s.max() - s.min())
+    old = old.join(spread.add_suffix("_spread"))
     merged = old.merge(new, on=keys, how="outer", suffixes=("_old", "_new"), indicator=True)
     both = merged[merged["_merge"] == "both"]
     only_old = [tuple(r) for r in merged.loc[merged["_merge"] == "left_only", keys].values]
     only_new = [tuple(r) for r in merged.loc[merged["_merge"] == "right_only", keys].values]
-    cells = identical = within = 0
-    beyond: list[CellChange] = []
-    for _, row in both.iterrows():
-        sp_row = spread.loc[tuple(row[g] for g in group) if len(group) > 1 else row[group[0]]]
-        for c in numeric:
-            a, b = float(row[f"{c}_old"]), float(row[f"{c}_new"])
-            cells += 1
-            if a == b or (pd.isna(a) and pd.isna(b)):
-                identical += 1
-                continue
-            sp = float(sp_row[c])
-            if abs(b - a) <= sp:
-                within += 1
-            else:
-                beyond.append(CellChange({k: row[k] for k in keys}, c, a, b, sp))
+    a, b, sp = (
+        both[[f"{c}_{s}" for c in numeric]].to_numpy(float) for s in ("old", "new", "spread")
+    )
+    same = (a == b) | (np.isnan(a) & np.isnan(b))
+    moved = ~same & ~(np.abs(b - a) <= sp)  # NaN in one run only: beyond
+    rows = both[keys].astype(object).to_numpy()  # plain Python values, as a reader prints them
+    beyond = [
+        CellChange(dict(zip(keys, rows[i])), numeric[j], *map(float, (a[i, j], b[i, j], sp[i, j])))
+        for i, j in zip(*np.nonzero(moved))  # row by row, as the table reads
+    ]
+    cells, identical = a.size, int(same.sum())
+    within = cells - identical - len(beyond)
     beyond.sort(key=spreads_moved, reverse=True)
     return RerunComparison(len(both), only_old, only_new, cells, identical, within, beyond)
 

@@ -21,11 +21,20 @@ from physgs.experiments.cost import read_costs, summarise, wall_spans
 from physgs.models.registry import label
 from physgs.report.thresholds import FIT_BAR
 from physgs.report.catalogue import AHEAD
-from physgs.report.claims import counted, decide_cell, failed_premises, number
-from physgs.report.record import origins, story_line
+from physgs.report.claims import column, counted, decide_cell, failed_premises, number
+from physgs.report.record import config_hashes, markdown_table, story_line
+from physgs.report.rerun import verdict_kind
 from physgs.report.seeds import interval
 
 VERDICTS = ("holds", "fails", "undecided")
+#: The columns of the summary's table of claims.
+CLAIM_COLUMNS = (
+    "claim",
+    "measured [95% interval]",
+    "threshold",
+    "verdict",
+    "seeds to decide (est.)",
+)
 
 
 def _stamp_line(stamp: Mapping[str, str]) -> str:
@@ -34,10 +43,8 @@ def _stamp_line(stamp: Mapping[str, str]) -> str:
 
 def _stale(stamp: Mapping[str, str], df: pd.DataFrame, name: str) -> list[str]:
     """A warning when a file was made under another config than the run's stamp."""
-    if "config_hash" not in df.columns or "config_hash" not in stamp:
-        return []
-    found = sorted({str(h) for h in df["config_hash"].dropna()})
-    if found and found != [str(stamp["config_hash"])]:
+    found = config_hashes(df)
+    if found and "config_hash" in stamp and found != [str(stamp["config_hash"])]:
         return [
             f"> **Warning**: {name} was made under config_hash {', '.join(found)}, not this "
             f"run's {stamp['config_hash']}: rerun `snakemake` for the target first.",
@@ -59,7 +66,7 @@ def claims_section(claims: pd.DataFrame) -> list[str]:
     Raises:
         ValueError: for a verdict not in ``VERDICTS``.
     """
-    kind = claims["verdict"].astype(str).str.split(":").str[0]
+    kind = claims["verdict"].map(verdict_kind)
     bad = sorted(set(kind) - set(VERDICTS))
     if bad:
         raise ValueError(f"claims: unknown verdicts {bad} (expected one of {VERDICTS})")
@@ -76,9 +83,8 @@ def claims_section(claims: pd.DataFrame) -> list[str]:
         *([story_line(claims), ""] if story_line(claims) else []),
         *prior_lines(claims),
         *decide_lines(claims),
-        "| claim | measured [95% interval] | threshold | verdict | seeds to decide (est.) |",
-        "|---|---|---|---|---|",
     ]
+    rows = []
     for _, r in claims.iterrows():
         meas = (
             "--"
@@ -87,10 +93,9 @@ def claims_section(claims: pd.DataFrame) -> list[str]:
         )
         if np.isfinite(r["ci_low"]):
             meas += f" [{number(r['ci_low'], r['unit'])}, {number(r['ci_high'], r['unit'])}]"
-        lines.append(
-            f"| `{r['id']}` | {meas} | {r['threshold']} | {r['verdict']} | {decide_cell(r)} |"
-        )
-    return lines + [""]
+        rows.append((f"`{r['id']}`", meas, str(r["threshold"]), str(r["verdict"]), decide_cell(r)))
+    table = markdown_table(pd.DataFrame(rows, columns=CLAIM_COLUMNS))
+    return [*lines, *table.splitlines(), ""]
 
 
 #: The seed counts ``decide_lines`` tabulates (the default profile runs three).
@@ -114,27 +119,23 @@ def decide_lines(claims: pd.DataFrame) -> list[str]:
     if not set(cols.values()) <= set(claims.columns):
         return []
     undecided = claims["verdict"].astype(str) == "undecided"
-    origin = origins(claims)
+    origin = column(claims, "origin")
     lines = [
         "Seeds that would decide each undecided claim, **an estimate** at its observed effect "
         "and sd (the plug-in t half-width; a t-test at 80% power, `tt_solve_power`): how many "
         "would decide at each seed count.",
         "",
-        "| undecided claims | estimate | "
-        + " | ".join(f"by {n} seeds" for n in DECIDE_AT)
-        + " | more |",
-        "|---|---|" + "---:|" * (len(DECIDE_AT) + 1),
     ]
+    rows = []
     for who, words in (("paper", "the paper's"), ("project", "this project's")):
         mine = claims[undecided & (origin == who)]
         for est, col in cols.items():
             n = mine[col].to_numpy(dtype=float)
             at = [int((n <= k).sum()) for k in DECIDE_AT]
-            more = len(n) - at[-1]
-            lines.append(
-                f"| {words} ({len(mine)}) | {est} | " + " | ".join(map(str, at)) + f" | {more} |"
-            )
-    return [*lines, ""]
+            rows.append([f"{words} ({len(mine)})", est, *at, len(n) - at[-1]])
+    head = ["undecided claims", "estimate", *(f"by {n} seeds" for n in DECIDE_AT), "more"]
+    table = markdown_table(pd.DataFrame(rows, columns=head), right=head[2:])
+    return [*lines, *table.splitlines(), ""]
 
 
 def prior_lines(claims: pd.DataFrame) -> list[str]:
@@ -189,20 +190,17 @@ def fit_section(tab_fit: pd.DataFrame) -> list[str]:
         )
         + " The table with every PSNR: `results/tables/tab_fit.tex`.",
         "",
-        "| model | " + " | ".join(trees) + " |",
-        "|---|" + "---|" * len(trees),
     ]
-    for m in models:
-        cells = []
-        for t in trees:
-            v = tab_fit.loc[(tab_fit["tree"] == t) & (tab_fit["model"] == m), "ceiling_frac"]
-            mean, _, lo, hi = interval(100 * v.to_numpy(float))
-            cell = "--" if not np.isfinite(mean) else f"{mean:.0f}%"
-            if np.isfinite(lo):
-                cell += f" [{lo:.0f}, {hi:.0f}]"
-            cells.append(cell)
-        lines.append(f"| {label(m)} | " + " | ".join(cells) + " |")
-    return lines + [""]
+
+    def cell(v: pd.Series) -> str:  # the mean over seeds, %, and its 95% interval
+        mean, _, lo, hi = interval(100 * v.to_numpy(float))
+        text = "--" if not np.isfinite(mean) else f"{mean:.0f}%"
+        return text + (f" [{lo:.0f}, {hi:.0f}]" if np.isfinite(lo) else "")
+
+    fit = tab_fit.groupby(["model", "tree"], sort=False)["ceiling_frac"].agg(cell).unstack()
+    fit = fit.reindex(index=models, columns=trees, fill_value="--")
+    table = markdown_table(fit.rename(index=label).rename_axis(index="model").reset_index())
+    return [*lines, *table.splitlines(), ""]
 
 
 def cost_section(benchmark_dir) -> list[str]:
@@ -226,7 +224,11 @@ def cost_section(benchmark_dir) -> list[str]:
     s, spans = summarise(jobs), wall_spans(jobs)
     seeds = list(s["per_seed"])
     cols = ["shared", *seeds]
-    head = ["shared" if c == "shared" else f"seed {c}" for c in cols]
+    head = [
+        "stage",
+        "span min",
+        *(f"job-min {c}" if c == "shared" else f"job-min seed {c}" for c in cols),
+    ]
     lines = [
         "## What the run cost",
         "",
@@ -239,17 +241,15 @@ def cost_section(benchmark_dir) -> list[str]:
         "seed or per training seed (`python tools/pipeline_cost.py` prints the same, and one "
         "more seed's cost).",
         "",
-        "| stage | span min | " + " | ".join(f"job-min {h}" for h in head) + " |",
-        "|---|---|" + "---|" * len(cols),
     ]
-    for stage, row in sorted(s["by_stage"].items()):
-        cells = [f"{row[c] / 60:.1f}" if c in row else "" for c in cols]
-        lines.append(
-            f"| {stage} | {spans['by_stage'][stage] / 60:.1f} | " + " | ".join(cells) + " |"
-        )
-    totals = [f"{s['shared_s'] / 60:.1f}", *(f"{s['per_seed'][k] / 60:.1f}" for k in seeds)]
-    lines.append(f"| **all** | {spans['run_s'] / 60:.1f} | " + " | ".join(totals) + " |")
-    return lines + [""]
+    rows = [
+        [stage, spans["by_stage"][stage], *(row.get(c, np.nan) for c in cols)]
+        for stage, row in sorted(s["by_stage"].items())
+    ]
+    rows.append(["**all**", spans["run_s"], s["shared_s"], *s["per_seed"].values()])
+    minutes = pd.DataFrame(rows, columns=head).set_index("stage") / 60
+    table = markdown_table(minutes.map(lambda x: "" if np.isnan(x) else f"{x:.1f}").reset_index())
+    return [*lines, *table.splitlines(), ""]
 
 
 def run_summary(stamp: Mapping[str, str], claims_csv, tab_fit_csv, benchmark_dir) -> str:
