@@ -18,7 +18,7 @@ from __future__ import annotations
 
 import time
 from dataclasses import dataclass
-from typing import Callable
+from typing import TYPE_CHECKING, Callable
 
 import pandas as pd
 
@@ -26,6 +26,9 @@ from physgs.experiments.recipe import Job, fit, heldout_split
 from physgs.mappings import deep_merge
 from physgs.models.registry import condition_indices, spec_of
 from physgs.models.timescale import WINDOW_TIME
+
+if TYPE_CHECKING:  # torch: the planning side imports this module
+    from physgs.train.holdout import HoldoutEval
 
 #: the columns of a search's steps file: every held-out score a trial reported
 STEP_FIELDS = ("trial", "iteration", "holdout_loss", "holdout_psnr")
@@ -176,7 +179,7 @@ def trial_job(base: dict, recipe: dict) -> Job:
     )
 
 
-def window_scorer(observed, job: Job):
+def window_scorer(observed, job: Job) -> "HoldoutEval":
     """The held-out window frames' evaluator of ``job`` (its trained winds only).
 
     Args:

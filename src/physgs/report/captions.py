@@ -165,8 +165,9 @@ FIGURES: tuple[Caption, ...] = (
     Caption(
         "fig_fit_curve",
         "Fit against training budget",
-        "Each model trained on one tree at each budget: the in-window fit PSNR (dB, trained "
-        "frames) and the time-split PSNR (dB, the tail) against training iterations (log), and "
+        "Each model trained at each budget, a row of panels per tree: the in-window fit PSNR (dB, "
+        "trained frames) and the time-split PSNR (dB, the tail) against training iterations "
+        "(log), and "
         "the fit against training wall time (s, log); points the mean over the seeds, error bars "
         "the sd. The static pose (dashed) and the true-motion ceiling (dotted) at the profile's "
         "budget are horizontal lines; the profile's budget is starred; a field trained with "
