@@ -693,3 +693,17 @@ def test_leftovers_of_a_write_that_stopped_are_settled_not_an_oserror(tmp_path):
     _record(r, out)
     assert (out / "costs.csv").read_text() == "name,wall_s\nall,5\n"
     assert not (tmp_path / "record.old").exists()
+
+
+def test_the_findings_say_when_a_trees_name_stands_for_several_instances():
+    from physgs.report.record import instances_phrase
+
+    assert instances_phrase({}) == ""
+    assert instances_phrase({"sparse": [0], "medium": [0]}) == ""  # the paper's one instance
+    five = instances_phrase({"sparse": [0, 1, 2, 3, 4], "medium": [0, 1, 2, 3, 4]})
+    assert five == (
+        "; each of sparse, medium measured on five instances of its preset (testbed seeds "
+        '0, 1, 2, 3, 4), so "sparse" below means sparse-preset trees'
+    )
+    mixed = instances_phrase({"sparse": [0, 1], "dense": [0, 1, 2]})
+    assert "several instances" in mixed and "testbed seeds" not in mixed

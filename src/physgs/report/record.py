@@ -1204,6 +1204,35 @@ def readme_block(found: Sequence[str]) -> str:
     return "\n".join([BEGIN, "", *found, END])
 
 
+NUMBER_WORDS = ("no", "one", "two", "three", "four", "five", "six", "seven", "eight", "nine", "ten")
+
+
+def instances_phrase(instances: Mapping[str, Sequence[int]]) -> str:
+    """What a tree's name stands for in the findings: ``"; each tree measured on five instances
+    of its preset (testbed seeds 0-4), so "sparse" below means sparse-preset trees"``, or ""
+    where each tree is one instance (the paper's protocol) or the stamp names none.
+
+    Args:
+        instances: tree -> the testbed seeds of its instances (the stamp's).
+
+    Returns:
+        The phrase, starting with "; ", or "".
+    """
+    many = {t: list(s) for t, s in instances.items() if len(s) > 1}
+    if not many:
+        return ""
+    counts = {len(s) for s in many.values()}
+    n = counts.pop() if len(counts) == 1 else None
+    number = (NUMBER_WORDS[n] if n < len(NUMBER_WORDS) else str(n)) if n else "several"
+    seeds = {tuple(s) for s in many.values()}
+    which = f" (testbed seeds {', '.join(map(str, seeds.pop()))})" if len(seeds) == 1 else ""
+    first = next(iter(many))
+    return (
+        f"; each of {', '.join(many)} measured on {number} instances of its preset{which}, so "
+        f'"{first}" below means {first}-preset trees'
+    )
+
+
 def found_lines(record_dir: str | Path) -> list[str]:
     """The lines of [`readme_block`][physgs.report.record.readme_block] without its markers: what
     the home page includes.
@@ -1223,7 +1252,7 @@ def found_lines(record_dir: str | Path) -> list[str]:
         made_with = f", made with `{overrides_words(overrides)}`" if overrides else ""
         lines += [
             f"Profile `{stamp['profile']}`{made_with}, seeds {', '.join(map(str, stamp['seeds']))}, "
-            f"commit `{stamp['commit']}`:",
+            f"commit `{stamp['commit']}`{instances_phrase(stamp.get('instances') or {})}:",
             "",
             *headline_lines(claims),
             "",
