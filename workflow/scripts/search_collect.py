@@ -12,7 +12,8 @@ with job(sm) as log:
     trials = pd.concat([pd.read_csv(p) for p in sm.input.trials], ignore_index=True)
     trials.to_csv(sm.output.trials, index=False)
     text = "recipes:\n" + "".join(
-        "".join(f"  {line}\n" for line in Path(p).read_text().splitlines()) for p in sm.input.recipes
+        "".join(f"  {line}\n" for line in Path(p).read_text().splitlines())
+        for p in sm.input.recipes
     )
     Path(sm.output.recipes).write_text(text)
     print(f"{len(trials)} trials, {len(sm.input.recipes)} recipes", file=log)
