@@ -47,7 +47,15 @@ class FieldSpace:
     depths: tuple[int, ...]
 
     def suggest(self, trial, model: str) -> dict:
-        """The trial's recipe (``recipes.<tree>.<model>``'s shape)."""
+        """The trial's recipe.
+
+        Args:
+            trial (optuna.trial.Trial): the trial that draws the parameters.
+            model: the model's id.
+
+        Returns:
+            ``{"train": {...}, "settings": {...}}`` (``recipes.<tree>.<model>``'s shape).
+        """
         top = trial.suggest_categorical("time_top_hz", list(TIME_TOPS))
         return {
             "train": {"lr": {"deform": trial.suggest_float("lr_deform", 2e-4, 4e-3, log=True)}},
@@ -61,7 +69,14 @@ class FieldSpace:
         }
 
     def params(self, job: Job) -> dict:
-        """The parameters of ``job``'s own recipe (the search's first trial)."""
+        """The parameters of ``job``'s own recipe (the search's first trial).
+
+        Args:
+            job: the model's job on the tree.
+
+        Returns:
+            Parameter name -> value, as ``suggest`` draws them.
+        """
         s = job.settings[self.family]
         top = s["time_top_hz"][job.model]
         return {
@@ -78,7 +93,15 @@ class PriorSpace:
     the search over omega, config_checks)."""
 
     def suggest(self, trial, model: str) -> dict:
-        """The trial's recipe (``recipes.<tree>.<model>``'s shape)."""
+        """The trial's recipe.
+
+        Args:
+            trial (optuna.trial.Trial): the trial that draws the parameters.
+            model: the model's id.
+
+        Returns:
+            ``{"train": {...}, "settings": {...}}`` (``recipes.<tree>.<model>``'s shape).
+        """
         return {
             "train": {
                 "lr": {
@@ -89,7 +112,14 @@ class PriorSpace:
         }
 
     def params(self, job: Job) -> dict:
-        """The parameters of ``job``'s own recipe (the search's first trial)."""
+        """The parameters of ``job``'s own recipe (the search's first trial).
+
+        Args:
+            job: the model's job on the tree.
+
+        Returns:
+            Parameter name -> value, as ``suggest`` draws them.
+        """
         return {
             "lr_physics": float(job.train["lr"]["physics"]),
             "lr_pivot": float(job.train["lr"]["pivot"]),

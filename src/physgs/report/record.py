@@ -1208,9 +1208,10 @@ NUMBER_WORDS = ("no", "one", "two", "three", "four", "five", "six", "seven", "ei
 
 
 def instances_phrase(instances: Mapping[str, Sequence[int]]) -> str:
-    """What a tree's name stands for in the findings: ``"; each tree measured on five instances
-    of its preset (testbed seeds 0-4), so "sparse" below means sparse-preset trees"``, or ""
-    where each tree is one instance (the paper's protocol) or the stamp names none.
+    """What a tree's name stands for in the findings: ``"; each of <trees> measured on five
+    instances of its preset (testbed seeds 0, 1, 2, 3, 4), so "<tree>" below means <tree>-preset
+    trees"``, or "" where each tree is one instance (the paper's protocol) or the stamp names
+    none.
 
     Args:
         instances: tree -> the testbed seeds of its instances (the stamp's).

@@ -162,7 +162,19 @@ def recovery_table(
 
 def method_seeds(methods: Mapping[str, MethodRows], what: str, keys: Sequence[tuple]) -> list[int]:
     """The training seeds of a recovery table (its first method's), each method checked to hold
-    its ``keys`` (``(..., method)``) at every seed."""
+    its ``keys`` (``(..., method)``) at every seed.
+
+    Args:
+        methods: method id -> its rows.
+        what: the table's name (in errors).
+        keys: the cells every seed must hold, each ending in its method's id.
+
+    Returns:
+        The seeds, ascending.
+
+    Raises:
+        KeyError: a method missing a cell at a seed, naming the table, the method and the seed.
+    """
     seeds = seeds_of(next(iter(methods.values())).per_seed if methods else {}, what)
     for s in seeds:
         for m, mr in methods.items():
@@ -172,7 +184,14 @@ def method_seeds(methods: Mapping[str, MethodRows], what: str, keys: Sequence[tu
 
 
 def who(method: str) -> str:
-    """A method's name in the recovery tables' errors."""
+    """A method's name in the recovery tables' errors.
+
+    Args:
+        method: a recovery method's id.
+
+    Returns:
+        Its name in words.
+    """
     return "tracks control" if method == TRACKS else method
 
 
