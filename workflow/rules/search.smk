@@ -25,7 +25,9 @@ rule search_recipe:
         * (10 + search_job(wc)["train"]["iterations"] // 60),
     params:
         job=search_job,
-        search=lambda wc: {k: CFG["search"][k] for k in ("trials", "every", "startup", "seed")},
+        search=lambda wc: {
+            k: CFG["search"][k] for k in ("trials", "every", "startup", "seed", "prune_after")
+        },
     script:
         "../scripts/search.py"
 

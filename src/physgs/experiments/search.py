@@ -148,12 +148,15 @@ class SearchSettings:
         every: iterations between a trial's held-out scores (what the pruner reads).
         startup: trials never pruned (the median needs them) and sampled at random before TPE.
         seed: the sampler's seed (the trainings use the job's seed).
+        prune_after: the fraction of a trial's budget before which it is never pruned (early
+            scores rank recipes by how fast they start, not where they end).
     """
 
     trials: int
     every: int
     startup: int
     seed: int
+    prune_after: float = 0.0
 
     @staticmethod
     def from_config(search: dict) -> "SearchSettings":
@@ -165,7 +168,10 @@ class SearchSettings:
         Returns:
             The settings.
         """
-        return SearchSettings(*(int(search[k]) for k in ("trials", "every", "startup", "seed")))
+        return SearchSettings(
+            *(int(search[k]) for k in ("trials", "every", "startup", "seed")),
+            prune_after=float(search.get("prune_after", 0.0)),
+        )
 
 
 def space_of(model: str) -> FieldSpace | PriorSpace:
@@ -300,7 +306,10 @@ def run_search(
     study = optuna.create_study(
         direction="minimize",
         sampler=optuna.samplers.TPESampler(seed=settings.seed, n_startup_trials=settings.startup),
-        pruner=optuna.pruners.MedianPruner(n_startup_trials=settings.startup),
+        pruner=optuna.pruners.MedianPruner(
+            n_startup_trials=settings.startup,
+            n_warmup_steps=int(settings.prune_after * int(base["train"]["iterations"])),
+        ),
     )
     # the first trial is the recipe the config holds: the search is measured against it
     study.enqueue_trial(space.params(trial_job(base, {})))
