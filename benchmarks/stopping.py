@@ -274,7 +274,13 @@ def stops(df: pd.DataFrame, every: int, tol: float, patience: int, anneal: int =
     return pd.DataFrame(out)
 
 
-def plateaus(df: pd.DataFrame, patience: int, tol: float, refs: pd.DataFrame | None = None):
+def plateaus(
+    df: pd.DataFrame,
+    patience: int,
+    tol: float,
+    refs: pd.DataFrame | None = None,
+    within_db: float = 0.5,
+):
     """Per (tree, model) curve: where the rule's criterion finds its plateau and where it heads.
 
     Args:
@@ -283,6 +289,8 @@ def plateaus(df: pd.DataFrame, patience: int, tol: float, refs: pd.DataFrame | N
         tol: the relative improvement that counts.
         refs: the static pose's and the ceiling's curves (their last score is the held-out
             window's reference), or None.
+        within_db: ``enough_at`` is the first scored iteration within this many dB of the
+            curve's best (the budget that buys all but ``within_db`` of what the curve reaches).
 
     Returns:
         One row per curve: its budget, the plateau iteration (empty: none before the end), the
@@ -306,6 +314,7 @@ def plateaus(df: pd.DataFrame, patience: int, tol: float, refs: pd.DataFrame | N
             "psnr_3000": psnr[it == 3000][0] if (it == 3000).any() else np.nan,
             "psnr_end": psnr[-1],
             "best_at": int(it[np.argmax(psnr)]),
+            "enough_at": int(it[np.argmax(psnr >= psnr.max() - within_db)]),
             "slope_db_per_1000": slope,
         }
         if refs is not None:
@@ -322,7 +331,7 @@ def plateau(a: argparse.Namespace) -> None:
     df = pd.concat([pd.read_csv(p) for p in a.curves], ignore_index=True)
     refs = df[df["model"].isin(["static", "truth_motion"])]
     curves_ = df[~df["model"].isin(["static", "truth_motion"])]
-    r = plateaus(curves_, a.patience, a.tol, refs if len(refs) else None)
+    r = plateaus(curves_, a.patience, a.tol, refs if len(refs) else None, a.within)
     print(r.to_string(index=False, float_format=lambda x: f"{x:.3g}"))
     if a.markdown:
         Path(a.markdown).write_text(r.to_markdown(index=False, floatfmt=".3g") + "\n")
@@ -461,6 +470,7 @@ def main() -> None:
     p.add_argument("curves", nargs="+")
     p.add_argument("--patience", type=int, default=2)
     p.add_argument("--tol", type=float, default=0.005)
+    p.add_argument("--within", type=float, default=0.5, help="enough_at: dB below the best")
     p.add_argument("--markdown", default=None, help="write the table here")
     p.add_argument("--figure", default=None, help="draw the curves here (PNG)")
     p.set_defaults(run=plateau, threads=None)

@@ -229,4 +229,5 @@ def test_a_curves_plateau_and_heading_are_read_as_worked_by_hand():
     assert r["plateau_at"] == 3000 and r["psnr_plateau"] == pytest.approx(23.0)
     assert r["psnr_3000"] == pytest.approx(23.0) and r["psnr_end"] == pytest.approx(26.0)
     assert r["slope_db_per_1000"] == pytest.approx(1.0)
+    assert r["enough_at"] == 5700  # 26.0 - 0.5 = 25.5 dB: 25.4 at 5400, 25.7 at 5700
     assert r["heldout_of_ceiling_end"] == pytest.approx((26.0 - 18.0) / 20.0)
