@@ -306,3 +306,22 @@ def test_fig_fit_curve_draws_a_row_per_tree(tmp_path):
     )
     h1, h2 = mpimg.imread(one).shape[0], mpimg.imread(two).shape[0]
     assert 1.8 * h1 < h2 < 2.2 * h1
+
+
+def test_a_trees_recipe_moves_a_models_own_point_and_never_a_budget_point(cfg):
+    """With medium's MLP trained 6000 iterations by its recipe, its own job is the 6000 point
+    (not retrained), the 3000 point is trained, and a point's budget wins over the recipe's."""
+    cfg["recipes"] = {"medium": {"mlp": {"train": {"iterations": 6000, "warmup": 100}}}}
+    cfg["speed_accuracy"]["fit_curve"]["iterations"] = [1500, 6000]
+    assert fc.own_budget(cfg, "medium", "mlp") == 6000
+    assert fc.extra_budgets(cfg, "medium", "mlp") == [1500, 3000]
+    assert fc.extra_budgets(cfg, "dense", "mlp") == [1500, 6000]
+    j = fc.point_job(cfg, "mlp", 1500, tree="medium")
+    assert (j["train"]["iterations"], j["train"]["warmup"]) == (1500, 25)  # 100/6000 of 1500
+    assert fc.point_job(cfg, "mlp", 6000, tree="medium") == job_spec(
+        cfg, "mlp", "single", tree="medium"
+    )
+    own = {0: {"static": _row(18.0), "mlp": dict(_row(21.0), iterations=6000.0)}}
+    df = fc.collect([], own, 3000, "medium")
+    assert df.set_index("model").loc["mlp", "iterations"] == 6000
+    assert df.set_index("model").loc["static", "iterations"] == 3000

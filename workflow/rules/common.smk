@@ -296,19 +296,19 @@ def fit_curve_inputs(wildcards):
     cfg = _models.BASE_CONFIG
     out = {}
     for tree in _fit_curve.trees_of(CFG):
-        out[f"points_{tree}"] = expand(
-            FIT_POINT,
-            tree=tree,
-            seed=STUDY_SEEDS,
-            model=FC["models"],
-            iterations=_fit_curve.extra_budgets(CFG),
-        ) + expand(
-            FIT_WINDOW_POINT,
-            tree=tree,
-            seed=STUDY_SEEDS,
-            model=_fit_curve.window_models(CFG),
-            iterations=CFG["train"]["iterations"],
-        )
+        out[f"points_{tree}"] = [
+            FIT_POINT.format(tree=tree, seed=s, model=m, iterations=b)
+            for m in FC["models"]
+            for b in _fit_curve.extra_budgets(CFG, tree, m)
+            for s in STUDY_SEEDS
+        ] + [
+            # the window-time series at the field's own budget
+            FIT_WINDOW_POINT.format(
+                tree=tree, seed=s, model=m, iterations=_fit_curve.own_budget(CFG, tree, m)
+            )
+            for m in _fit_curve.window_models(CFG)
+            for s in STUDY_SEEDS
+        ]
         for s in STUDY_SEEDS:
             for m in FC_PROFILE_MODELS:
                 out[f"eval_{tree}_{m}_{s}"] = EVAL.format(tree=tree, seed=s, model=m, config=cfg)

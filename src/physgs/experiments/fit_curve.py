@@ -14,6 +14,8 @@ that convention, as the series ``<model>@window``, so a reader sees both.
 
 from __future__ import annotations
 
+import copy
+
 import time
 from typing import Mapping, Sequence
 
@@ -22,7 +24,6 @@ import pandas as pd
 
 from physgs.evaluate.metrics import ceiling_fraction as _fraction
 from physgs.experiments.recipe import fit, heldout_split, job_spec
-from physgs.experiments.sweep import with_knob
 from physgs.models.registry import BASE_CONFIG, FIELD_FAMILIES, MODELS
 from physgs.models.timescale import WINDOW_TIME
 
@@ -44,29 +45,53 @@ def trees_of(cfg: dict) -> list[str]:
     return list(cfg["speed_accuracy"]["fit_curve"].get("trees") or cfg["trees"])
 
 
-def budgets(cfg: dict) -> list[int]:
-    """Every budget on the curve, ascending: the listed ones and the profile's own.
+def own_budget(cfg: dict, tree: str | None = None, model: str | None = None) -> int:
+    """The budget the pipeline's own job trains: ``train.iterations``, or the tree's recipe's for
+    that model (``recipes``).
 
     Args:
         cfg: the resolved config.
+        tree: the tree; None: the shared budget.
+        model: the model; None: the shared budget.
+
+    Returns:
+        Training iterations.
+    """
+    if tree is None or model is None:
+        return int(cfg["train"]["iterations"])
+    return int(job_spec(cfg, model, BASE_CONFIG, tree=tree)["train"]["iterations"])
+
+
+def budgets(cfg: dict, tree: str | None = None, model: str | None = None) -> list[int]:
+    """Every budget on a model's curve, ascending: the listed ones, the shared
+    ``train.iterations`` and its own job's (a tree's recipe may set another).
+
+    Args:
+        cfg: the resolved config.
+        tree: the tree (its recipe may set the model's own budget); None: the shared budget.
+        model: the model; None: the shared budget.
 
     Returns:
         Training iterations, ascending, without repeats.
     """
     fc = cfg["speed_accuracy"]["fit_curve"]
-    return sorted({*map(int, fc["iterations"]), int(cfg["train"]["iterations"])})
+    shared = int(cfg["train"]["iterations"])
+    return sorted({*map(int, fc["iterations"]), shared, own_budget(cfg, tree, model)})
 
 
-def extra_budgets(cfg: dict) -> list[int]:
-    """The budgets that need a training job of their own (all but the profile's).
+def extra_budgets(cfg: dict, tree: str | None = None, model: str | None = None) -> list[int]:
+    """The budgets that need a training job of their own (all but the model's own job's).
 
     Args:
         cfg: the resolved config.
+        tree: the tree; None: the shared budget.
+        model: the model; None: the shared budget.
 
     Returns:
         Training iterations, ascending.
     """
-    return [b for b in budgets(cfg) if b != int(cfg["train"]["iterations"])]
+    own = own_budget(cfg, tree, model)
+    return [b for b in budgets(cfg, tree, model) if b != own]
 
 
 def window_models(cfg: dict) -> list[str]:
@@ -113,7 +138,7 @@ def point_job(
         ValueError: for ``window_time`` on a model that is not a field.
     """
     tree = tree or trees_of(cfg)[0]
-    pcfg = with_knob(cfg, tree, "iterations", iterations)
+    pcfg = copy.deepcopy(cfg)
     if window_time:
         family = MODELS[model].family
         if family not in FIELD_FAMILIES:
@@ -122,7 +147,26 @@ def point_job(
             **pcfg["models"][family]["time_top_hz"],
             model: WINDOW_TIME,
         }
-    return job_spec(pcfg, model, BASE_CONFIG, seed=seed, tree=tree)
+    job = job_spec(pcfg, model, BASE_CONFIG, seed=seed, tree=tree)
+    # the budget alone changes, over the tree's recipe too; the warm-up keeps its fraction
+    return job_spec_with_budget(job, iterations)
+
+
+def job_spec_with_budget(job: dict, iterations: int) -> dict:
+    """``job`` trained for ``iterations`` instead, its static warm-up keeping its fraction (as
+    the sweep's iterations knob, ``sweep.with_knob``).
+
+    Args:
+        job: a job's dict ([`job_spec`][physgs.experiments.recipe.job_spec]).
+        iterations: the new budget.
+
+    Returns:
+        A new job dict.
+    """
+    train = dict(job["train"])
+    frac = train["warmup"] / train["iterations"]
+    train.update(iterations=int(iterations), warmup=max(1, int(round(frac * int(iterations)))))
+    return {**job, "train": train}
 
 
 def run_point(job: Mapping, observed, *, progress: bool = False, series: str | None = None) -> dict:
@@ -188,7 +232,8 @@ def collect(
         profile_rows: seed -> model -> the pipeline's own row at the profile's budget
             ([`fit_row`][physgs.report.build.fit_row]: fit, heldout, time, train_s), references
             included.
-        profile_iterations: the profile's budget.
+        profile_iterations: the profile's budget (a profile row's own ``iterations``, the
+            job's, wins: a tree's recipe may set a model's budget).
         tree: the fit curve's tree (a column).
 
     Returns:
@@ -205,11 +250,12 @@ def collect(
     ]
     for seed, by_model in profile_rows.items():
         for m, r in by_model.items():
+            used = r.get("iterations", np.nan)  # the job's own: a tree's recipe may set it
             rows.append(
                 {
                     "seed": int(seed),
                     "model": m,
-                    "iterations": int(profile_iterations),
+                    "iterations": int(profile_iterations if np.isnan(used) else used),
                     "fit": r["fit"],
                     "heldout": r["heldout"],
                     "time": r["time"],
