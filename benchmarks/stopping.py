@@ -342,10 +342,12 @@ def plateau(a: argparse.Namespace) -> None:
         import matplotlib.pyplot as plt
 
         trees = list(dict.fromkeys(curves_["tree"]))
+        # one colour per model across the panels
+        color = {m: f"C{i}" for i, m in enumerate(sorted(set(curves_["model"])))}
         fig, axes = plt.subplots(1, len(trees), figsize=(4.8 * len(trees), 3.8), squeeze=False)
         for ax, t in zip(axes[0], trees):
             for m, g in curves_[curves_["tree"] == t].groupby("model", sort=False):
-                ax.plot(g["iteration"], g["holdout_psnr"], label=m, lw=1.2)
+                ax.plot(g["iteration"], g["holdout_psnr"], label=m, lw=1.2, color=color[m])
                 row = r[(r["tree"] == t) & (r["model"] == m)].iloc[0]
                 if row["plateau_at"] == row["plateau_at"] and row["plateau_at"] is not None:
                     ax.plot(row["plateau_at"], row["psnr_plateau"], "kx", ms=6)
