@@ -39,6 +39,12 @@ def test_a_trees_recipe_reaches_its_jobs_and_its_damping_variant_only():
     assert job_spec(cfg, "d3dgs_wind", "single", tree="dense") == shared
     assert job_spec(cfg, "d3dgs", "single", tree="medium") == job_spec(cfg, "d3dgs", "single")
     assert tree_recipe(cfg, None, "d3dgs_wind") == {}
+    # a forcing-free variant trains as long as its prior (the claims compare the two)
+    cfg["recipes"] = {"medium": {"ours": {"train": {"iterations": 60}}}}
+    assert job_spec(cfg, "ours_blind", "single", tree="medium")["train"]["iterations"] == 60
+    assert job_spec(cfg, "ours_chain_blind", "single", tree="medium") == job_spec(
+        cfg, "ours_chain_blind", "single"
+    )
 
 
 def test_a_misspelt_or_misplaced_recipe_is_refused_naming_its_key():

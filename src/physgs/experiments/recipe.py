@@ -151,7 +151,8 @@ def tree_recipe(cfg: dict, tree: str | None, model: str) -> dict:
     """The settings chosen for ``model`` on ``tree`` (``recipes``), over the shared ones.
 
     A damping testbed (``<tree>_damping``) takes its tree's recipe: the same tree, another
-    damping.
+    damping. A forcing-free variant (``ours_blind``) takes its prior's recipe where it has none
+    of its own: the claims compare the two, so one budget trains both.
 
     Args:
         cfg: the resolved config.
@@ -164,7 +165,9 @@ def tree_recipe(cfg: dict, tree: str | None, model: str) -> dict:
     if tree is None:
         return {}
     recipes = cfg.get("recipes") or {}
-    return (recipes.get(tree) or recipes.get(parse_id(tree)[0]) or {}).get(model) or {}
+    own = recipes.get(tree) or recipes.get(parse_id(tree)[0]) or {}
+    parent = spec_of(model).blind_of
+    return own.get(model) or (own.get(parent) if parent else None) or {}
 
 
 def heldout_split(n_train: int, every: int) -> tuple[np.ndarray, np.ndarray]:
