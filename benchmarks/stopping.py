@@ -50,11 +50,18 @@ import pandas as pd
 import torch
 
 from physgs.config import load
-from physgs.experiments.recipe import Job, earliest_stop, fit, heldout_split, job_spec
+from physgs.experiments.recipe import (
+    Job,
+    earliest_stop,
+    fit,
+    heldout_split,
+    job_spec,
+    window_scorer,
+    with_budget,
+)
 from physgs.models.registry import (
     BLIND_PRIORS,
     build_model,
-    condition_indices,
     is_prior,
     is_reference,
     training_jobs,
@@ -98,13 +105,6 @@ def appending(path: str, fields: tuple[str, ...]):
         yield w, fh
 
 
-def window_holdout(obs, job: Job) -> HoldoutEval:
-    """The evaluator of the frames ``job``'s training window holds out, of its trained winds."""
-    held = heldout_split(int(obs.n_train), int(job.train["holdout_every"]))[1]
-    conds = condition_indices(job.conditions, len(obs.conditions))
-    return HoldoutEval.build(obs, held, conds, job.train)
-
-
 RULE_FIELDS = (
     "model",
     "tree",
@@ -140,7 +140,7 @@ def run_rule(a, cfg: dict, obs, truth, models: list[str]) -> None:
         for m in models:
             job = Job.from_dict(job_spec(cfg, m, "single", seed=a.seed))
             res = fit(obs, job, truth=truth if is_reference(m) else None, progress=False)
-            loss, p = window_holdout(obs, job).evaluate(res.model)
+            loss, p = window_scorer(obs, job).evaluate(res.model)
             s = res.stats
             w.writerow(
                 dict(
@@ -184,10 +184,9 @@ def curves(a: argparse.Namespace) -> None:
             # the full budget, scored by the hook below: the curve the rule is chosen on
             train = {**job.train, "stopping": {**RULE_OFF}}
             if a.budget:  # a per-model budget: the schedule and the recipe's fractions over it
-                frac = train["warmup"] / train["iterations"]
-                train.update(iterations=a.budget, warmup=int(round(frac * a.budget)))
+                train = with_budget(train, a.budget)
             job = job.replace(train=train)
-            ev = window_holdout(obs, job)
+            ev = window_scorer(obs, job)
             t0 = time.perf_counter()
             rows = []
 
@@ -349,7 +348,7 @@ def plateau(a: argparse.Namespace) -> None:
             for m, g in curves_[curves_["tree"] == t].groupby("model", sort=False):
                 ax.plot(g["iteration"], g["holdout_psnr"], label=m, lw=1.2, color=color[m])
                 row = r[(r["tree"] == t) & (r["model"] == m)].iloc[0]
-                if row["plateau_at"] == row["plateau_at"] and row["plateau_at"] is not None:
+                if pd.notna(row["plateau_at"]):
                     ax.plot(row["plateau_at"], row["psnr_plateau"], "kx", ms=6)
             for m, ls in (("static", "--"), ("truth_motion", ":")):
                 g = refs[(refs["tree"] == t) & (refs["model"] == m)]

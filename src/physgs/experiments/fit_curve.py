@@ -23,7 +23,7 @@ import numpy as np
 import pandas as pd
 
 from physgs.evaluate.metrics import ceiling_fraction as _fraction
-from physgs.experiments.recipe import fit, heldout_split, job_spec
+from physgs.experiments.recipe import fit, heldout_split, job_spec, with_budget
 from physgs.models.registry import BASE_CONFIG, FIELD_FAMILIES, MODELS
 from physgs.models.timescale import WINDOW_TIME
 
@@ -138,8 +138,9 @@ def point_job(
         ValueError: for ``window_time`` on a model that is not a field.
     """
     tree = tree or trees_of(cfg)[0]
-    pcfg = copy.deepcopy(cfg)
+    pcfg = cfg
     if window_time:
+        pcfg = copy.deepcopy(cfg)
         family = MODELS[model].family
         if family not in FIELD_FAMILIES:
             raise ValueError(f"{model!r} has no time encoding; the window series is for fields")
@@ -149,24 +150,7 @@ def point_job(
         }
     job = job_spec(pcfg, model, BASE_CONFIG, seed=seed, tree=tree)
     # the budget alone changes, over the tree's recipe too; the warm-up keeps its fraction
-    return job_spec_with_budget(job, iterations)
-
-
-def job_spec_with_budget(job: dict, iterations: int) -> dict:
-    """``job`` trained for ``iterations`` instead, its static warm-up keeping its fraction (as
-    the sweep's iterations knob, ``sweep.with_knob``).
-
-    Args:
-        job: a job's dict ([`job_spec`][physgs.experiments.recipe.job_spec]).
-        iterations: the new budget.
-
-    Returns:
-        A new job dict.
-    """
-    train = dict(job["train"])
-    frac = train["warmup"] / train["iterations"]
-    train.update(iterations=int(iterations), warmup=max(1, int(round(frac * int(iterations)))))
-    return {**job, "train": train}
+    return {**job, "train": with_budget(job["train"], iterations)}
 
 
 def run_point(job: Mapping, observed, *, progress: bool = False, series: str | None = None) -> dict:

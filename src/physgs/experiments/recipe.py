@@ -281,6 +281,50 @@ def fit(
     return result
 
 
+def with_budget(train: dict, iterations: int) -> dict:
+    """A ``train`` section trained for ``iterations`` instead, its static warm-up keeping its
+    fraction (the sweep's iterations knob, the fit curve's points, the benchmarks' curves).
+
+    Args:
+        train: a ``train`` config section.
+        iterations: the new budget.
+
+    Returns:
+        A new section.
+    """
+    frac = train["warmup"] / train["iterations"]
+    iterations = int(iterations)
+    return {**train, "iterations": iterations, "warmup": max(1, int(round(frac * iterations)))}
+
+
+def window_scorer(observed, job: Job, device=None):
+    """The evaluator of the frames ``job``'s training window holds out, of its trained winds:
+    what a recipe search and a fit curve read (never the views, the tail or another wind).
+
+    Args:
+        observed (Observed): the testbed's observed dataset.
+        job: the training job (``train.holdout_every`` > 0).
+        device (str | torch.device | None): the training's device (None: ``train.device``
+            resolved here, as ``fit`` does).
+
+    Returns:
+        (HoldoutEval): the evaluator.
+
+    Raises:
+        ValueError: ``train.holdout_every`` is 0 (no frame held out).
+    """
+    from physgs.device import resolve_device
+    from physgs.train.holdout import HoldoutEval  # here: torch (module docstring)
+
+    every = int(job.train.get("holdout_every", 0))
+    if not every:
+        raise ValueError("train.holdout_every is 0: no held-out window frame to score")
+    held = heldout_split(int(observed.n_train), every)[1]
+    conds = condition_indices(job.conditions, len(observed.conditions))
+    dev = resolve_device(job.train.get("device", "auto")) if device is None else device
+    return HoldoutEval.build(observed, held, conds, job.train, device=dev)
+
+
 def holdout_eval(observed, job: Job, held, conditions: list[int], device=None):
     """The evaluator of the held-out window frames the stopping rule reads, or None when the
     rule neither evaluates (``train.stopping.every`` 0) nor has frames to read.

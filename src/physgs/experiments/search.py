@@ -18,17 +18,15 @@ from __future__ import annotations
 
 import time
 from dataclasses import dataclass
-from typing import TYPE_CHECKING, Callable
+from typing import Callable
 
 import pandas as pd
 
-from physgs.experiments.recipe import Job, fit, heldout_split
+from physgs.experiments.recipe import Job, fit, window_scorer
 from physgs.mappings import deep_merge
-from physgs.models.registry import condition_indices, spec_of
+from physgs.models.registry import spec_of
 from physgs.models.timescale import WINDOW_TIME
 
-if TYPE_CHECKING:  # torch: the planning side imports this module
-    from physgs.train.holdout import HoldoutEval
 
 #: the columns of a search's steps file: every held-out score a trial reported
 STEP_FIELDS = ("trial", "iteration", "holdout_loss", "holdout_psnr")
@@ -213,29 +211,6 @@ def trial_job(base: dict, recipe: dict) -> Job:
             settings=deep_merge(base["settings"], recipe.get("settings", {})),
         )
     )
-
-
-def window_scorer(observed, job: Job) -> "HoldoutEval":
-    """The held-out window frames' evaluator of ``job`` (its trained winds only).
-
-    Args:
-        observed (Observed): the testbed's observed dataset.
-        job: the training job (``train.holdout_every`` > 0).
-
-    Returns:
-        A [`HoldoutEval`][physgs.train.holdout.HoldoutEval] on the CPU.
-
-    Raises:
-        ValueError: ``train.holdout_every`` is 0 (no frame held out: nothing to search on).
-    """
-    from physgs.train.holdout import HoldoutEval  # torch: the planning side imports this module
-
-    every = int(job.train.get("holdout_every", 0))
-    if not every:
-        raise ValueError("train.holdout_every is 0: no held-out window frame to search on")
-    held = heldout_split(int(observed.n_train), every)[1]
-    conds = condition_indices(job.conditions, len(observed.conditions))
-    return HoldoutEval.build(observed, held, conds, job.train)
 
 
 def run_search(

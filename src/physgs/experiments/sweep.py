@@ -19,7 +19,7 @@ from typing import Sequence
 import numpy as np
 import pandas as pd
 
-from physgs.experiments.recipe import canonical, fit, job_spec
+from physgs.experiments.recipe import canonical, fit, job_spec, with_budget
 from physgs.models.registry import BASE_CONFIG
 from physgs.recovery.run import recover_model
 from physgs.testbed.dataset import build_dataset, load_observed, load_truth, save_dataset
@@ -74,9 +74,7 @@ def with_knob(cfg: dict, tree: str, knob: str, value: int) -> dict:
     elif knob == "vertices":
         out["testbed"]["vertices"][tree] = value
     elif knob == "iterations":
-        frac = cfg["train"]["warmup"] / cfg["train"]["iterations"]
-        out["train"]["iterations"] = value
-        out["train"]["warmup"] = max(1, int(round(frac * value)))
+        out["train"] = with_budget(cfg["train"], value)
     elif knob == "substeps":
         out["models"]["ours"]["substeps"] = value
     else:
