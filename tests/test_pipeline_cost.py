@@ -221,3 +221,39 @@ def test_a_training_estimate_counts_the_plan_and_never_guesses_a_rate():
     assert est["jobs"] == 2 and est["cpu_s"] == pytest.approx(2 * (10 + 270))
     assert est["per_seed"] == {0: 1, 1: 2}  # K selection is not a training
     assert est["unrated"] == {("dense", "d3dgs_wind", "single"): 1}  # counted apart, no guess
+
+
+def test_a_training_estimate_prices_each_job_at_its_own_budget():
+    """A profile's recipes give models their own budgets: each job is priced at its own, and a
+    damping testbed's job is asked for by its full tree id (its recipe is its tree's)."""
+    from physgs.experiments.cost import training_estimate
+
+    dry = "\n".join(
+        [
+            "job count",
+            "---  ---",
+            "train 2",
+            "total 2",
+            "",
+            "rule train:",
+            "    benchmark: results/benchmarks/train/medium/seed0/mlp_single.tsv",
+            "rule train:",
+            "    benchmark: results/benchmarks/train/medium_damping/seed0/ours_single.tsv",
+        ]
+    )
+    rates = {
+        ("medium", "mlp", "single"): 0.2,
+        ("medium", "ours", "single"): 0.5,
+        ("medium", "static", "single"): 0.1,
+    }
+    asked = []
+
+    def budget(tree, model):
+        asked.append((tree, model))
+        return {"mlp": (4000, 200), "ours": (1000, 100)}[model]
+
+    est = training_estimate(plan_jobs(dry), rates, ["single"], 3000, 50, budget=budget)
+    assert asked == [("medium", "mlp"), ("medium_damping", "ours")]
+    mlp, ours = 200 * 0.1 + 3800 * 0.2, 100 * 0.1 + 900 * 0.5
+    assert est["cpu_s"] == pytest.approx(mlp + ours)
+    assert est["longest_s"] == pytest.approx(max(mlp, ours))

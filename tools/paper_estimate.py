@@ -24,6 +24,7 @@ import pandas as pd
 
 import physgs.config
 from physgs.experiments.cost import dry_run, plan_jobs, training_estimate
+from physgs.experiments.recipe import tree_recipe
 from physgs.report.record import format_duration
 
 
@@ -44,15 +45,15 @@ def main() -> None:
     rates = {(r.tree, r.model, r.config): r.cpu_s_per_iter for r in rates_df.itertuples()}
     configs = sorted({c for _, _, c in rates} | set(cfg["models"]["configs"]))
     it, warm = cfg["train"]["iterations"], cfg["train"]["warmup"]
-    est = training_estimate(planned, rates, configs, it, warm)
+    est = training_estimate(planned, rates, configs, it, warm, budget=budget_of(cfg))
     seeds = sorted(est["per_seed"])
     per_seed = sorted(set(est["per_seed"].values()))
-    longest = max(rates_df["cpu_s_per_iter"]) * it
+    own = "" if not cfg.get("recipes") else ", or the budget its tree's recipe gives a model"
     r0 = rates_df.iloc[0]
     unrated = ", ".join(f"{k} {n}" for k, n in _by_model(est["unrated"]).items())
     lines = [
         f"The `{args.profile}` profile ({cfg['testbed']['resolution']} px, {it:,} iterations of "
-        f"which {warm:,} static warm-up, seeds {', '.join(map(str, seeds))}) plans "
+        f"which {warm:,} static warm-up{own}, seeds {', '.join(map(str, seeds))}) plans "
         f"**{sum(est['per_seed'].values())} trainings**, "
         f"{' or '.join(map(str, per_seed))} per seed (`snakemake -n --forceall all --config "
         f"profile={args.profile}`). The {est['jobs']} with a measured rate cost "
@@ -65,14 +66,23 @@ def main() -> None:
         f"Not priced: {sum(est['unrated'].values())} trainings without a measured rate "
         f"({unrated or 'none'}), and the jobs that do not train (K selection, evaluation, "
         "recovery, the control). At one thread per job CPU-hours are job-hours; no run takes "
-        f"less than its longest training, {format_duration(longest)} at the slowest rate "
-        "measured.",
+        f"less than its longest training, {format_duration(est['longest_s'])}.",
         "",
     ]
     if args.gpu_rates is not None:
         lines += gpu_paragraph(args.gpu_rates, planned, cfg, configs, args.profile)
     args.out.write_text("\n".join(lines))
     print(args.out.read_text())
+
+
+def budget_of(cfg: dict):
+    """(iterations, warmup) of a model's trainings on a tree: its recipe's, else the profile's."""
+
+    def budget(tree: str, model: str) -> tuple[int, int]:
+        train = {**cfg["train"], **tree_recipe(cfg, tree, model).get("train", {})}
+        return train["iterations"], train["warmup"]
+
+    return budget
 
 
 def _by_model(unrated: dict) -> dict[str, int]:
@@ -96,7 +106,7 @@ def gpu_paragraph(path: Path, planned, cfg: dict, configs, profile: str) -> list
         )
     rates = {(r.tree, r.model, r.config): r.wall_s_per_iter for r in at.itertuples()}
     it, warm = cfg["train"]["iterations"], cfg["train"]["warmup"]
-    est = training_estimate(planned, rates, configs, it, warm)
+    est = training_estimate(planned, rates, configs, it, warm, budget=budget_of(cfg))
     r0 = at.iloc[0]
     unrated = ", ".join(f"{k} {n}" for k, n in _by_model(est["unrated"]).items())
     where = "one GPU" if r0["device"] == "cuda" else f"one {r0['device']} device"
@@ -107,7 +117,7 @@ def gpu_paragraph(path: Path, planned, cfg: dict, configs, profile: str) -> list
         f"**{est['cpu_s'] / 3600:,.1f} {'GPU-hours' if r0['device'] == 'cuda' else 'hours'}** "
         "one after another "
         f"({est['cpu_s'] / max(est['jobs'], 1) / 60:,.1f} min a training; slowest "
-        f"{format_duration(at['wall_s_per_iter'].max() * it)}). Not priced: "
+        f"{format_duration(est['longest_s'])}). Not priced: "
         f"{sum(est['unrated'].values())} trainings ({unrated or 'none'}).",
         "",
     ]

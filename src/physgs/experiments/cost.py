@@ -20,7 +20,7 @@ import os
 import re
 import subprocess
 import sys
-from collections.abc import Collection, Mapping, Sequence
+from collections.abc import Callable, Collection, Mapping, Sequence
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -504,6 +504,7 @@ def training_estimate(
     configs: list[str],
     iterations: int,
     warmup: int = 0,
+    budget: Callable[[str, str], tuple[int, int]] | None = None,
 ) -> dict:
     """The CPU time a plan's trainings would take, from measured seconds per iteration.
 
@@ -523,12 +524,16 @@ def training_estimate(
             others the plan trains, e.g. ``auto``).
         iterations: training iterations per job (``train.iterations``).
         warmup: the static warm-up's iterations among them (``train.warmup``).
+        budget: ``(iterations, warmup)`` of a job by (tree id, model), where a profile gives
+            models budgets of their own (``recipes``: ``physgs.experiments.recipe.tree_recipe``);
+            None: every job trains ``iterations``.
 
     Returns:
-        {"cpu_s": CPU seconds of the rated trainings, "jobs": their number, "per_seed": {seed:
-        trainings planned}, "unrated": {(tree, model, configuration): jobs without a rate}}.
+        {"cpu_s": CPU seconds of the rated trainings, "longest_s": the longest one's, "jobs":
+        their number, "per_seed": {seed: trainings planned}, "unrated": {(tree, model,
+        configuration): jobs without a rate}}.
     """
-    out: dict = {"cpu_s": 0.0, "jobs": 0, "per_seed": {}, "unrated": {}}
+    out: dict = {"cpu_s": 0.0, "jobs": 0, "per_seed": {}, "unrated": {}, "longest_s": 0.0}
     ends = sorted(configs, key=len, reverse=True)
     for _, bench in planned:
         m = _TRAIN_JOB.search(bench or "")
@@ -544,6 +549,9 @@ def training_estimate(
             key = (tree, model, config)
             out["unrated"][key] = out["unrated"].get(key, 0) + 1
             continue
-        out["cpu_s"] += warmup * (static or 0.0) + (iterations - warmup) * rate
+        it, warm = budget(m["tree"], model) if budget else (iterations, warmup)
+        job_s = warm * (static or 0.0) + (it - warm) * rate
+        out["cpu_s"] += job_s
+        out["longest_s"] = max(out["longest_s"], job_s)
         out["jobs"] += 1
     return out
