@@ -325,13 +325,90 @@ def plateaus(
     return pd.DataFrame(out)
 
 
+def own_budgets(curves_: pd.DataFrame, own: pd.DataFrame) -> pd.DataFrame:
+    """Trainings whose schedule ends at their own budget B against the long curve at B.
+
+    The long curve's checkpoint at B is a training still at a higher learning rate, before any
+    milestone set as a fraction of the budget (ours' part freeze, the omega search's bank), so
+    it can lie below what a training of budget B reaches; this measures by how much.
+
+    Args:
+        curves_: the long curves' rows (``FIELDS``), one per (tree, model).
+        own: the shorter trainings' rows, with a ``budget`` column.
+
+    Returns:
+        One row per (tree, model, budget): ``own_end`` (the B-training's last held-out window
+        PSNR, dB), ``long_at`` (the long curve's score at B), ``long_best`` (its best) and
+        ``own_below_best`` = long_best - own_end.
+    """
+    out = []
+    for (tree, m, b), g in own.groupby(["tree", "model", "budget"]):
+        long_ = curves_[(curves_["tree"] == tree) & (curves_["model"] == m)]
+        at = long_[long_["iteration"] <= b]["holdout_psnr"]
+        end = g.sort_values("iteration")["holdout_psnr"].iloc[-1]
+        best = long_["holdout_psnr"].max() if len(long_) else np.nan
+        out.append(
+            {
+                "tree": tree,
+                "model": m,
+                "budget": int(b),
+                "own_end": end,
+                "long_at": at.iloc[-1] if len(at) else np.nan,
+                "long_best": best,
+                "own_below_best": best - end,
+            }
+        )
+    return pd.DataFrame(out)
+
+
+def shortfalls(df: pd.DataFrame, caps: list[int]) -> pd.DataFrame:
+    """Per curve, how far below its best its held-out window score is when training stops at each
+    cap: the cost in fit of a budget lower than the curve's own.
+
+    Args:
+        df: curve rows (``FIELDS``).
+        caps: budgets, iterations; a cap past the curve's end reads its last score.
+
+    Returns:
+        One row per (tree, model): ``below_best_<cap>`` = best PSNR - PSNR at the last score at
+        or before the cap, dB (NaN where the curve has no score by then).
+    """
+    out = []
+    for (tree, m), g in df.groupby(["tree", "model"], sort=False):
+        g = g.sort_values("iteration")
+        best = g["holdout_psnr"].max()
+        row = {"tree": tree, "model": m}
+        for c in caps:
+            by = g[g["iteration"] <= c]
+            row[f"below_best_{c}"] = best - by["holdout_psnr"].iloc[-1] if len(by) else np.nan
+        out.append(row)
+    return pd.DataFrame(out)
+
+
 def plateau(a: argparse.Namespace) -> None:
     """Print (and with ``--markdown`` write) each curve's plateau; ``--figure`` draws them."""
-    df = pd.concat([pd.read_csv(p) for p in a.curves], ignore_index=True)
+    df = pd.concat(
+        [pd.read_csv(p).assign(budget=lambda d: d["iteration"].max()) for p in a.curves],
+        ignore_index=True,
+    )
     refs = df[df["model"].isin(["static", "truth_motion"])]
-    curves_ = df[~df["model"].isin(["static", "truth_motion"])]
+    learned = df[~df["model"].isin(["static", "truth_motion"])]
+    # the longest training of each (tree, model) is its curve; shorter ones are own-budget runs
+    longest = learned.groupby(["tree", "model"])["budget"].transform("max")
+    curves_, shorter = learned[learned["budget"] == longest], learned[learned["budget"] < longest]
+    if len(shorter):
+        print("trainings at their own budget against the long curve's checkpoint there (dB):")
+        print(own_budgets(curves_, shorter).to_string(index=False, float_format="{:.2f}".format))
+        print()
     r = plateaus(curves_, a.patience, a.tol, refs if len(refs) else None, a.within)
     print(r.to_string(index=False, float_format=lambda x: f"{x:.3g}"))
+    if a.caps:
+        caps = [int(c) for c in a.caps.split(",")]
+        short = shortfalls(curves_, caps)
+        print("\nheld-out window PSNR below the curve's best at each cap (dB):")
+        print(short.to_string(index=False, float_format=lambda x: f"{x:.2f}"))
+        if a.markdown:
+            r = r.merge(short, on=["tree", "model"])
     if a.markdown:
         Path(a.markdown).write_text(r.to_markdown(index=False, floatfmt=".3g") + "\n")
     if a.figure:
@@ -472,6 +549,7 @@ def main() -> None:
     p.add_argument("--patience", type=int, default=2)
     p.add_argument("--tol", type=float, default=0.005)
     p.add_argument("--within", type=float, default=0.5, help="enough_at: dB below the best")
+    p.add_argument("--caps", default="", help="e.g. 4500,6000: the shortfall at each budget")
     p.add_argument("--markdown", default=None, help="write the table here")
     p.add_argument("--figure", default=None, help="draw the curves here (PNG)")
     p.set_defaults(run=plateau, threads=None)

@@ -231,3 +231,14 @@ def test_a_curves_plateau_and_heading_are_read_as_worked_by_hand():
     assert r["slope_db_per_1000"] == pytest.approx(1.0)
     assert r["enough_at"] == 5700  # 26.0 - 0.5 = 25.5 dB: 25.4 at 5400, 25.7 at 5700
     assert r["heldout_of_ceiling_end"] == pytest.approx((26.0 - 18.0) / 20.0)
+
+    # the shortfall at a cap: best 26.0 - the last score at or before 4500 (24.5)
+    short = bench.shortfalls(curve, [4500, 9000]).iloc[0]
+    assert short["below_best_4500"] == pytest.approx(1.5) and short["below_best_9000"] == 0.0
+    # a training at its own budget of 3000 that ends at 24.0, against the long curve at 3000
+    own = curve[curve["iteration"] <= 3000].assign(
+        budget=3000, holdout_psnr=lambda d: d.holdout_psnr + 1
+    )
+    o = bench.own_budgets(curve, own).iloc[0]
+    assert o["own_end"] == pytest.approx(24.0) and o["long_at"] == pytest.approx(23.0)
+    assert o["own_below_best"] == pytest.approx(2.0)
