@@ -1,5 +1,1 @@
-"""Tables and figures from collected evaluation and recovery results.
-
-Modules: ``tables`` (tab_psnr, tab_null, tab_transfer, tab_margin -> .tex + .csv) and
-``figures`` (fig_temporal, fig_teaser, fig_results, fig_damping -> .pdf + .png).
-"""
+"""Tables, figures and the claims ledger from the collected evaluation and recovery results."""

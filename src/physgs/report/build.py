@@ -1,18 +1,15 @@
-"""Collect per-job result files into the tables and figures (what the report rules call).
+"""Per-job result files into the tables, figures and claims ledger (what the report rules call).
 
-The library never knows where the workflow keeps its files. Each output (``physgs.report.outputs``)
-declares what it needs as *need tuples* (``needs``): ``("eval" | "traj" | "panels" | "loss", tree,
-model, config, seed)``, ``("recovery", tree, method, config, seed)``, ``("null", tree, K, seed)``,
-``("kselect", tree, seed)``, ``("stats", tree)``, ``("table", name)`` and the rest of
-``NEED_FIELDS``; seed is a training seed. The workflow maps each tuple to a path
-(``workflow/rules/common.smk``) and hands the builders a mapping ``key(need) -> path`` (the
-claims ledger: ``need -> path``, the tuples as they are); the builders read only those paths. ``settings_for`` gives the narrow settings an output reads, so
-editing one table's format rebuilds that table only.
+Each output (``physgs.report.outputs``) declares what it reads as need tuples (``needs``, fields
+``NEED_FIELDS``); the workflow maps each to a path (``workflow/rules/common.smk``) and hands the
+builders ``key(need) -> path`` (the claims ledger: ``need -> path``). ``settings_for`` gives the
+narrow settings an output reads, so editing one table's format rebuilds that table only.
 """
 
 from __future__ import annotations
 
-from typing import TYPE_CHECKING, Mapping, Sequence
+from itertools import product
+from typing import Mapping, Sequence
 
 import pandas as pd
 
@@ -25,68 +22,57 @@ from physgs.report.claim_cells import CONFIG as CLAIMS_CONFIG
 from physgs.report.outputs import NEED_FIELDS, OUTPUTS, Plan, key, reader
 from physgs.report.images import fit_row
 
-if TYPE_CHECKING:
-    from physgs.report.tables import Table
-
 __all__ = ["NEED_FIELDS", "Plan", "fit_row", "key"]
 
 TABLES = tuple(n for n, o in OUTPUTS.items() if o.kind == "table")
 FIGURES = tuple(n for n, o in OUTPUTS.items() if o.kind == "figure")
 
 
-def _output(name: str):
-    if name not in OUTPUTS:
+def _output(name: str, kind: str | None = None):
+    """The output ``name`` (of ``kind`` when given), or ValueError naming the choices."""
+    o = OUTPUTS.get(name)
+    if o is None:
         raise ValueError(f"unknown output '{name}'; choose one of {TABLES + FIGURES}")
-    return OUTPUTS[name]
+    if kind is not None and o.kind != kind:
+        names = TABLES if kind == "table" else FIGURES
+        raise ValueError(f"unknown {kind} '{name}'; choose one of {names}")
+    return o
 
 
 def in_report(name: str, plan: Plan) -> bool:
-    """Whether the ``report`` target builds output ``name`` in this plan (the rest: ``all``
-    builds tab_kselect, ``studies`` tab_parts_k; a study or control not run builds nothing).
+    """Whether the ``report`` target builds output ``name`` (ValueError for an unknown one).
 
     Args:
         name: an output's name.
         plan: the run's plan.
 
     Returns:
-        True when ``report`` builds it.
-
-    Raises:
-        ValueError: for an unknown output.
+        True when ``report`` builds it (``all`` builds tab_kselect, ``studies`` tab_parts_k).
     """
     return _output(name).in_report(plan)
 
 
 def claims_needs(plan: Plan, every: bool = False) -> list[tuple]:
-    """What the claims ledger reads: the tables of the catalogue
-    ([`physgs.report.catalogue.tables`][]) that the run builds, and every prior's recovery
-    (damping) of every seed in the joint K=32 configuration (the paper's), or the base
-    configuration when the config has none.
+    """What the claims ledger reads: the catalogue's tables that the run builds, and every
+    prior's recovery of every seed in the joint K=32 configuration (else the base one).
 
     Args:
-        plan: the run's plan (trees, configurations, seeds; whether it builds the optional
-            tables: ``in_report``).
-        every: every table of the catalogue, built or not (``tools/ledger.py`` reads what
-            exists).
+        plan: the run's plan.
+        every: every table of the catalogue, built or not (``tools/ledger.py``).
 
     Returns:
-        Need tuples (module docstring).
+        Need tuples.
     """
     c = CLAIMS_CONFIG if CLAIMS_CONFIG in plan.configs else BASE_CONFIG
     required = catalogue.required_tables()
     tabs = [n for n in catalogue.tables() if every or n in required or _output(n).in_report(plan)]
-    recovery = [
-        ("recovery", t, m, c, int(s))
-        for m in models_of("prior")
-        for t in plan.trees
-        for s in plan.seeds
-    ]
-    return [("table", n) for n in tabs] + (recovery if catalogue.reads_recovery() else [])
+    prior = models_of("prior") if catalogue.reads_recovery() else ()
+    rec = [("recovery", t, m, c, int(s)) for m, t, s in product(prior, plan.trees, plan.seeds)]
+    return [("table", n) for n in tabs] + rec
 
 
 def read_table(name: str, path) -> pd.DataFrame:
-    """A report table's CSV, read through its declared columns (``Output.columns``): refused
-    when it breaks the declaration (a CSV of another version, a column renamed).
+    """A report table's CSV; ValueError for a CSV that breaks its declared ``Output.columns``.
 
     Args:
         name: the table's name.
@@ -94,28 +80,18 @@ def read_table(name: str, path) -> pd.DataFrame:
 
     Returns:
         The table.
-
-    Raises:
-        ValueError: for a name that is not a table, or a CSV that breaks its columns.
     """
-    o = _output(name)
-    if o.kind != "table":
-        raise ValueError(f"unknown table '{name}'; choose one of {TABLES}")
+    o = _output(name, "table")
     df = pd.read_csv(path, dtype={"config_hash": str})  # a hash of digits stays text
     o.columns.check(name, list(df.columns))
     return df
 
 
 def claims_frame(
-    inputs: Mapping[tuple, str],
-    trees: Sequence[str],
-    roles: Mapping[str, Mapping[str, str]] | None = None,
+    inputs: Mapping[tuple, str], trees: Sequence[str], roles: Mapping | None = None
 ) -> pd.DataFrame:
     """The claims ledger ([`physgs.report.claims`][physgs.report.claims]) from the files in
-    ``inputs``.
-
-    The rule gives every table; a table left out of ``inputs`` leaves its claims "undecided: not
-    measured" (a partial run's ledger, ``tools/ledger.py``).
+    ``inputs``; a table left out leaves its claims "undecided: not measured" (a partial run).
 
     Args:
         inputs: need tuple -> path ([`claims_needs`][physgs.report.build.claims_needs]).
@@ -130,29 +106,19 @@ def claims_frame(
     }
     damping: dict[str, dict[str, list]] = {}  # model -> tree -> one summary per seed
     for need in sorted(n for n in inputs if n[0] == "recovery"):
-        _, tree, model, _, _ = need  # ("recovery", tree, model, config, seed)
+        _, tree, model, _, _ = need
         d = load_recovery(inputs[need]).damping
         damping.setdefault(model, {}).setdefault(tree, []).append(
-            {
-                "median_zeta": d.median_zeta,
-                "zeta_true": d.zeta_true,
-                "loglog_exponent": d.loglog_exponent,
-            }
+            {k: getattr(d, k) for k in ("median_zeta", "zeta_true", "loglog_exponent")}
         )
     ours = damping.pop("ours", {})  # the paper's claims; the other priors' are asked again
     return claims.ledger(claims.measure(tabs, ours, trees, damping, roles))
 
 
 def make_claims(
-    inputs: Mapping[tuple, str],
-    trees: Sequence[str],
-    md_path,
-    csv_path,
-    stamp=None,
-    roles: Mapping[str, Mapping[str, str]] | None = None,
-):
-    """Build the claims ledger from the files in ``inputs``
-    ([`claims_frame`][physgs.report.build.claims_frame]) and write results/claims.md and .csv.
+    inputs: Mapping[tuple, str], trees: Sequence[str], md_path, csv_path, stamp=None, roles=None
+) -> pd.DataFrame:
+    """Write results/claims.md and .csv ([`claims_frame`][physgs.report.build.claims_frame]).
 
     Args:
         inputs: need tuple -> path.
@@ -163,7 +129,7 @@ def make_claims(
         roles: tree -> its preset's role (``claim_cells.roles_of``); None: no tree has one.
 
     Returns:
-        (pd.DataFrame): The ledger (without the stamp's columns).
+        The ledger (without the stamp's columns).
     """
     df = claims_frame(inputs, trees, roles)
     sd = stamp.to_dict() if stamp is not None else None
@@ -173,31 +139,21 @@ def make_claims(
     return df
 
 
-def _seeds_of(output, seeds: Sequence[int], study_seeds: Sequence[int]) -> list[int]:
-    """The training seeds ``output`` reads (``Output.seeds``) of the run's ``seeds``."""
-    return {
-        "all": [int(s) for s in seeds],
-        "first": [int(s) for s in seeds[:1]],
-        "studies": [int(s) for s in study_seeds],
-        "none": [],
-    }[output.seeds]
+def _seeds_of(output, seeds: Sequence[int], study: Sequence[int]) -> list[int]:
+    """The training seeds ``output`` reads (``Output.seeds``)."""
+    picked = {"all": seeds, "first": seeds[:1], "studies": study, "none": []}[output.seeds]
+    return [int(s) for s in picked]
 
 
 def needs(name: str, plan: Plan) -> list[tuple]:
-    """Every result output ``name`` reads in run ``plan``, as need tuples (module docstring).
-
-    The outputs that show one training seed (a figure of images, trajectories or a scatter)
-    read the first seed only; tab_parts_k reads the studies' seeds; tab_testbed none.
+    """Every result output ``name`` reads in run ``plan`` (ValueError: no seeds to read).
 
     Args:
         name: an output's name.
         plan: the run's plan.
 
     Returns:
-        The need tuples.
-
-    Raises:
-        ValueError: for an unknown output, or a plan without seeds for an output that reads them.
+        The need tuples, for the seeds of ``Output.seeds``.
     """
     o = _output(name)
     if o.seeds in ("all", "first") and not plan.seeds:
@@ -206,25 +162,17 @@ def needs(name: str, plan: Plan) -> list[tuple]:
 
 
 def settings_for(name: str, cfg: dict) -> dict:
-    """The settings output ``name`` reads from the resolved config (and nothing more).
-
-    Its trees with their bones, its training seeds, a table's digits, and its own
-    (``Output.settings``).
+    """The settings output ``name`` reads from the resolved config, and nothing more.
 
     Args:
         name: an output's name.
         cfg: the resolved config.
 
     Returns:
-        The settings (the rule's params).
-
-    Raises:
-        ValueError: for an unknown output.
+        The rule's params: its trees, their bones, its seeds, a table's digits, its own settings.
     """
     o = _output(name)
-    trees = list(
-        cfg["damping_benchmark"]["trees"] if o.trees == "damping_benchmark" else cfg["trees"]
-    )
+    trees = list(cfg[o.trees]["trees"] if o.trees == "damping_benchmark" else cfg["trees"])
     out = {"trees": trees, "bones": {t: int(cfg["presets"][t]["bones"]) for t in trees}}
     if o.seeds != "none":
         study = study_seeds(cfg) if o.seeds == "studies" else ()
@@ -236,7 +184,7 @@ def settings_for(name: str, cfg: dict) -> dict:
 
 def make_table(
     name: str, inputs: Mapping[str, str], settings: dict, tex_path, csv_path, stamp=None
-) -> Table:
+) -> tables.Table:
     """Build table ``name`` from the files in ``inputs`` and write its .tex and .csv.
 
     Args:
@@ -245,20 +193,14 @@ def make_table(
         settings: [`settings_for`][physgs.report.build.settings_for] of the table.
         tex_path (str | Path): the .tex to write.
         csv_path (str | Path): the .csv to write.
-        stamp (Stamp | None): a [`Stamp`][physgs.provenance.Stamp] written into every CSV row
-            (profile, config hash, package version).
+        stamp (Stamp | None): a [`Stamp`][physgs.provenance.Stamp] written into every CSV row.
 
     Returns:
         The [`Table`][physgs.report.tables.Table].
-
-    Raises:
-        ValueError: for a name that is not a table.
     """
-    o = _output(name)
-    if o.kind != "table":
-        raise ValueError(f"unknown table '{name}'; choose one of {TABLES}")
+    o = _output(name, "table")
     settings = {**settings, "seeds": [int(x) for x in settings.get("seeds", ())]}
-    settings["digits"] = settings.get("digits", 2)
+    settings.setdefault("digits", 2)
     table = o.build(reader(inputs), settings, inputs, None)
     o.columns.check(name, list(table.df.columns))  # the CSV keeps its declared contract
     tables.write_table(table, tex_path, csv_path, stamp=stamp)
@@ -275,12 +217,6 @@ def make_figure(
         inputs: need key -> path.
         settings: [`settings_for`][physgs.report.build.settings_for] of the figure.
         outputs: the paths to write.
-
-    Raises:
-        ValueError: for a name that is not a figure.
     """
-    o = _output(name)
-    if o.kind != "figure":
-        raise ValueError(f"unknown figure '{name}'; choose one of {FIGURES}")
     settings = {**settings, "seeds": [int(x) for x in settings.get("seeds", ())]}
-    o.build(reader(inputs), settings, inputs, outputs)
+    _output(name, "figure").build(reader(inputs), settings, inputs, outputs)

@@ -1,9 +1,9 @@
 """The LaTeX of every table: a DataFrame of display cells, rendered by pandas' ``Styler.to_latex``.
 
-A builder lays its rows out as a DataFrame whose index holds the row labels (the outer levels
-grouped: a ``\\multirow`` label and a rule between groups) and whose columns hold the headings (a
-MultiIndex: the outer levels span their columns); each cell is the .tex of one summary over
-training seeds (``cells``). ``render`` turns it into a booktabs table with its caption and label.
+A builder lays out its cells (``cells``: each the .tex of one summary over training seeds) with
+the row labels as index (outer levels grouped: a ``\\multirow`` label, a rule between groups) and
+the headings as columns (a MultiIndex: outer levels span their columns); ``render`` makes the
+booktabs table.
 """
 
 from __future__ import annotations
@@ -23,15 +23,13 @@ def render(cells: pd.DataFrame, caption: str, label: str, bold: np.ndarray | Non
     """A table's LaTeX: booktabs rules, grouped row labels, the caption and the label.
 
     Args:
-        cells: [R, C] each cell's LaTeX; its index the row labels (with several levels, each
-            outer level's runs share one ``\\multirow`` label and are separated by a rule), its
-            columns the headings (a MultiIndex: an outer level's runs share one heading).
+        cells: [R, C] each cell's LaTeX, indexed by the row labels, columned by the headings.
         caption: the caption's LaTeX.
         label: the ``\\label``, e.g. ``tab:psnr``.
         bold: [R, C] bool, the cells set in bold; None: none.
 
     Returns:
-        The ``table`` environment, after a comment line naming the packages it needs.
+        ``PREAMBLE``, then the ``table`` environment.
     """
     styler = cells.style.set_table_styles([{"selector": "small", "props": ":;"}])
     if bold is not None:
@@ -53,8 +51,7 @@ def by_seed(df: pd.DataFrame, col: str) -> np.ndarray:
     """One column of a table's CSV frame, seed by seed.
 
     Args:
-        df: the frame, one block of rows per seed (column ``seed``), every block listing the same
-            rows in the same order.
+        df: the frame, one block of rows per seed (column ``seed``), each the same rows in order.
         col: the column.
 
     Returns:
@@ -76,14 +73,14 @@ def rows(df: pd.DataFrame) -> pd.DataFrame:
 
 
 def mean(values: Sequence[float], fmt: str) -> str:
-    """.tex cell of the mean over seeds alone (a count, a shared setting).
+    """.tex cell of the mean over seeds alone (a count, a shared setting); '--' without one.
 
     Args:
         values: [S] per-seed values.
         fmt: the number format (e.g. ``'.0f'``).
 
     Returns:
-        The mean, ``'--'`` without a finite value.
+        The cell.
     """
     m = seedstats.interval(values)[0]
     return format(m, fmt) if np.isfinite(m) else "--"
@@ -104,9 +101,8 @@ def cells(
         col: the column.
         fmt: the number format (e.g. ``'.2f'``).
         unit: appended to a defined cell (e.g. ``'\\%'``).
-        scale: the values' factor before the summary (100: a fraction shown in percent).
-        cell: values [S], fmt -> the cell: ``seedstats.pm`` (mean $\\pm$ sd),
-            ``seedstats.difference`` (a paired difference with its interval) or ``mean``.
+        scale: the values' factor (100: a fraction shown in percent).
+        cell: values [S], fmt -> the cell: ``seedstats.pm``, ``seedstats.difference`` or ``mean``.
 
     Returns:
         [R] the cells, ``'--'`` where no seed has a value.
@@ -126,11 +122,8 @@ def seed_note(n_seeds: int, decides: bool = True) -> str:
         The sentence, with a leading space.
     """
     if n_seeds < 2:
-        if decides:
-            return (
-                " One training seed: no interval, so no difference is decided and nothing is bold."
-            )
-        return " One training seed."
+        tail = ": no interval, so no difference is decided and nothing is bold." if decides else "."
+        return " One training seed" + tail
     note = rf" Mean $\pm$ sd over {n_seeds} training seeds"
     if decides:
         note += (

@@ -1,11 +1,9 @@
 """What every report output declares, and what the run plans (the shared vocabulary).
 
-An output (a table or a figure) is one ``Output``: the result files it reads as *need tuples*
-(``needs``: the models of the registry roles it shows, ``physgs.models.registry.models_of``), the
-settings it reads from the resolved config (``settings``) and how it builds itself (``build``).
-A need tuple is ``(kind, *fields)`` with the fields of ``NEED_FIELDS[kind]``; the workflow maps
-each to a path (``workflow/rules/common.smk``) and hands the builder a mapping ``key(need) ->
-path``. The builder reads only those paths, through ``reader``.
+An ``Output`` (a table or a figure) declares the result files it reads as *need tuples*
+``(kind, *NEED_FIELDS[kind])`` (``needs``), the settings it reads from the resolved config
+(``settings``) and its builder (``build``). The workflow maps each need to a path
+(``workflow/rules/common.smk``) and hands the builder ``key(need) -> path``, read through ``reader``.
 """
 
 from __future__ import annotations
@@ -28,37 +26,25 @@ from physgs.tracks.settings import fields_scored
 
 #: The fields of each need tuple after its kind (what a workflow path template is formatted with).
 NEED_FIELDS = {
-    "eval": ("tree", "model", "config", "seed"),
-    "traj": ("tree", "model", "config", "seed"),
-    "panels": ("tree", "model", "config", "seed"),
-    "loss": ("tree", "model", "config", "seed"),
-    # any recovery method's record (``registry.RECOVERY_METHODS``: the priors, ours too, the
-    # forcing-free priors, the 2D-track control, the output-only analysis)
-    "recovery": ("tree", "method", "config", "seed"),
-    "parts": ("tree", "seed"),  # the priors' segmentations (physgs.evaluate.parts)
-    "kmatch": ("tree", "K", "seed"),  # the chained prior at a smaller K (experiments.kmatch)
-    "null": ("tree", "K", "seed"),
-    "kselect": ("tree", "seed"),  # ours' K selection
-    "prior_kselect": ("tree", "model", "seed"),  # another prior's (models.kselect.priors)
-    "stats": ("tree",),
-    "instance_stats": ("tree", "seed"),  # a tree instance's (testbed_seeds: testbed seed = seed)
-    "table": ("name",),
-    # the 2D-track control (physgs.tracks): its evaluation record, its fit, one condition's
-    # tracks, and the observed dataset (fig_tracks' frame)
-    "tracks_eval": ("tree", "config", "seed"),
-    "tracks_fields": ("tree", "config", "seed"),  # the learned fields at the tracked points
-    "tracks_fit": ("tree", "config", "seed"),
+    **dict.fromkeys(("eval", "traj", "panels", "loss"), ("tree", "model", "config", "seed")),
+    "recovery": ("tree", "method", "config", "seed"),  # any of ``registry.RECOVERY_METHODS``
+    # the priors' segmentations, ours' K selection, a tree instance's stats (``testbed_seeds``),
+    # the observed dataset (fig_tracks' frame), the truth (beside the output-only analysis)
+    **dict.fromkeys(("parts", "kselect", "instance_stats", "observed", "truth"), ("tree", "seed")),
+    # the 2D-track control's record, learned fields at its points and fit; an OMA identification
+    **dict.fromkeys(
+        ("tracks_eval", "tracks_fields", "tracks_fit", "oma_modes"), ("tree", "config", "seed")
+    ),
+    **dict.fromkeys(("kmatch", "null"), ("tree", "K", "seed")),  # kmatch: the chained prior's
+    "prior_kselect": ("tree", "model", "seed"),  # a prior's besides ours' (models.kselect.priors)
     "tracks": ("tree", "condition", "seed"),
-    "observed": ("tree", "seed"),
-    # the output-only analysis: one identification, and the truth its figure draws beside it
-    "oma_modes": ("tree", "config", "seed"),
-    "truth": ("tree", "seed"),
+    "stats": ("tree",),
+    "table": ("name",),
 }
 
 
 def key(need: tuple) -> str:
-    """The name of a need among a rule's inputs (Snakemake names them by strings): its parts
-    joined by '/'; never split again (a reader keeps the tuple).
+    """A need's name among a rule's inputs: its parts joined by '/' (never split again).
 
     Args:
         need: a need tuple (kind, then its parts).
@@ -70,7 +56,7 @@ def key(need: tuple) -> str:
 
 
 def reader(inputs: Mapping[str, str]) -> Callable[..., str]:
-    """``path(*need)``: the file of a need in ``inputs`` (KeyError naming it when absent).
+    """``path(*need)``: the file of a need in ``inputs``.
 
     Args:
         inputs: need key -> path (the rule's inputs).
@@ -93,39 +79,29 @@ def reader(inputs: Mapping[str, str]) -> Callable[..., str]:
 
 @dataclass(frozen=True)
 class Plan:
-    """What a run builds, as the report outputs' needs read it (``from_config`` of the resolved
-    config; tests construct it directly). configs: ``models.configs`` (name -> {conditions, K});
-    recovery: the recovery methods scored (``registry.recovery_plan``: id -> {configuration:
-    K}, in ``RECOVERY_METHODS`` order; None: the wind-driven priors, ``models_of("prior")``, in
-    every configuration); damping_trees/damping_configs: the damping benchmark's;
-    tracks_fields: the (tree, configuration) pairs whose learned fields are scored at the
-    tracked points; parts_models/parts_configs: the parts study's variants and configurations
-    ({} without a study); study_seeds/k_candidates: the K match's; kselect_priors: the priors
-    besides ours whose K is chosen from the data (``models.kselect.priors``); sweep_tree: the
-    speed-accuracy sweep's tree (``speed_accuracy.tree``); testbed_seeds: whether each training
-    seed has its own tree instance (``testbed_seeds``)."""
+    """What a run builds, as the outputs' needs read it (``from_config``; tests build it)."""
 
     trees: Sequence[str]
-    configs: Mapping[str, dict]
+    configs: Mapping[str, dict]  # ``models.configs``: name -> {conditions, K}
     seeds: Sequence[int]
+    # ``registry.recovery_plan``: method -> {configuration: K}; None: the priors in every one
     recovery: Mapping[str, Mapping[str, int]] | None = None
     damping_trees: Sequence[str] = ()
     damping_configs: Sequence[str] = ()
-    tracks_fields: Sequence[tuple[str, str]] = ()
+    tracks_fields: Sequence[tuple[str, str]] = ()  # (tree, config): fields scored at the tracks
     parts_models: Sequence[str] = ()
-    parts_configs: Mapping[str, dict] = field(default_factory=dict)
+    parts_configs: Mapping[str, dict] = field(default_factory=dict)  # {} without a parts study
     study_seeds: Sequence[int] = ()
     k_candidates: Sequence[int] = ()
-    kselect_priors: Sequence[str] = ()
-    sweep_tree: str = ""
-    testbed_seeds: bool = False
+    kselect_priors: Sequence[str] = ()  # the priors besides ours whose K the data choose
+    sweep_tree: str = ""  # the speed-accuracy sweep's
+    testbed_seeds: bool = False  # whether each training seed has its own tree instance
 
     def __post_init__(self):
         """Default the recovery methods to the wind-driven priors in every configuration."""
         if self.recovery is None:
             K = {c: int(v["K"]) for c, v in self.configs.items()}
-            priors = {m: dict(K) for m in models_of("prior")}
-            object.__setattr__(self, "recovery", priors)
+            object.__setattr__(self, "recovery", {m: dict(K) for m in models_of("prior")})
 
     @property
     def tracks(self) -> Mapping[str, int]:
@@ -159,9 +135,7 @@ class Plan:
             damping_configs=list(cfg["damping_benchmark"]["configs"]),
             tracks_fields=[(t, c) for t in trees for c in tracks if fields_scored(cfg, c, t)],
             parts_models=parts_models,
-            parts_configs={c: configs[c] for c in cfg["parts_study"]["configs"]}
-            if parts_models
-            else {},
+            parts_configs={c: configs[c] for c in cfg["parts_study"]["configs"] if parts_models},
             study_seeds=[int(s) for s in study_seeds(cfg)],
             k_candidates=[int(k) for k in cfg["parts_study"]["k_candidates"]],
             kselect_priors=list(selected_models(cfg["models"]["kselect"])[1:]),
@@ -184,40 +158,13 @@ PLACEHOLDERS = {
 
 @dataclass(frozen=True)
 class Columns:
-    """A table's CSV contract: which columns identify a row, which describe it, which hold its
-    measurements and which time its jobs. A name may hold ``{placeholder}``s
-    (``PLACEHOLDERS``): ``{tree}_view`` is one column per tree. Ids only, never labels: the
-    labels live in the registry and appear in the .tex, Markdown and figures alone.
+    """A table's CSV contract, by column name (ids, never labels); a name may hold
+    ``{placeholder}``s (``PLACEHOLDERS``): ``{tree}_view`` is one column per tree."""
 
-    keys: the columns that identify a row (seed first in a seeded table), present in every CSV;
-    values: its measurements (what a rerun compares against the seed spread); timing: job
-    seconds or ratios of them (what the machine did: never compared); about: columns that
-    describe the row without identifying it (bones, K, a flag)."""
-
-    keys: tuple[str, ...]
-    values: tuple[str, ...]
-    timing: tuple[str, ...] = ()
-    about: tuple[str, ...] = ()
-
-    def _pattern(self, names: Sequence[str]) -> re.Pattern:
-        parts = [
-            re.sub(r"\\\{(\w+)\\\}", lambda m: f"(?:{PLACEHOLDERS[m.group(1)]})", re.escape(n))
-            for n in names
-        ]
-        return re.compile("|".join(f"(?:{p})" for p in parts) or "(?!)")
-
-    def of(self, columns: Sequence[str], part: str) -> list[str]:
-        """The columns of a CSV that are of one part of the contract.
-
-        Args:
-            columns: a CSV's columns.
-            part: "keys", "values", "timing" or "about".
-
-        Returns:
-            Those of ``columns`` that the part's names match, in the CSV's order.
-        """
-        pat = self._pattern(getattr(self, part))
-        return [c for c in columns if pat.fullmatch(c)]
+    keys: tuple[str, ...]  # identify a row (seed first in a seeded table), in every CSV
+    values: tuple[str, ...]  # its measurements (what a rerun compares)
+    timing: tuple[str, ...] = ()  # job seconds or their ratios (never compared)
+    about: tuple[str, ...] = ()  # describe a row without identifying it (bones, K, a flag)
 
     def check(self, name: str, columns: Sequence[str]) -> None:
         """Refuse a CSV that breaks the contract: a key missing, or a column not declared.
@@ -229,8 +176,12 @@ class Columns:
         Raises:
             ValueError: naming the missing keys or the undeclared columns.
         """
+        declared = [
+            re.sub(r"\\\{(\w+)\\\}", lambda m: f"(?:{PLACEHOLDERS[m.group(1)]})", re.escape(n))
+            for n in (*self.keys, *self.values, *self.timing, *self.about)
+        ]
+        every = re.compile("|".join(f"(?:{p})" for p in declared) or "(?!)")
         missing = [k for k in self.keys if k not in columns]
-        every = self._pattern((*self.keys, *self.values, *self.timing, *self.about))
         extra = [c for c in columns if c not in PROVENANCE_COLUMNS and not every.fullmatch(c)]
         if missing or extra:
             raise ValueError(
@@ -246,31 +197,21 @@ SEEDS = ("all", "first", "studies", "none")
 
 @dataclass(frozen=True)
 class Output:
-    """One table or figure of the report.
+    """One table or figure of the report."""
 
-    name: its file name (results/tables/<name>.* or results/figures/<name>.*); kind: "table" or
-    "figure"; seeds: which training seeds it reads (``SEEDS``); trees: the config key of its
-    trees ("trees", or
-    "damping_benchmark" for the damping benchmark's); needs(plan, seeds): its need tuples for
-    those seeds; settings(cfg): the settings it reads beyond the common ones (trees, bones,
-    seeds, digits); build(path, settings, inputs, out): writes a figure to ``out`` (its paths)
-    or returns a ``Table`` (``out`` unused); in_report(plan): whether the ``report`` target
-    builds it (else another target does: ``all``, ``studies``); columns: a table's CSV
-    contract (``Columns``; required of a table)."""
-
-    name: str
-    kind: str
-    needs: Callable[[Plan, Sequence[int]], list[tuple]]
+    name: str  # its file name: results/tables/<name>.* or results/figures/<name>.*
+    kind: str  # "table" or "figure"
+    needs: Callable[[Plan, Sequence[int]], list[tuple]]  # (plan, training seeds) -> need tuples
+    # (path, settings, inputs, out): writes a figure to the paths ``out``, or returns a ``Table``
     build: Callable[..., Any]
-    settings: Callable[[dict], dict] = lambda cfg: {}
-    seeds: str = "all"
-    trees: str = "trees"
-    in_report: Callable[[Plan], bool] = lambda plan: True
-    columns: Columns | None = None
+    settings: Callable[[dict], dict] = lambda cfg: {}  # beyond trees, bones, seeds and digits
+    seeds: str = "all"  # which training seeds it reads (``SEEDS``)
+    trees: str = "trees"  # the config key of its trees: "trees" or "damping_benchmark"
+    in_report: Callable[[Plan], bool] = lambda plan: True  # else ``all`` or ``studies`` builds it
+    columns: Columns | None = None  # a table's CSV contract (required of a table)
 
     def __post_init__(self):
-        """Refuse an unknown kind or seed scope, or a table without its columns, naming the
-        output."""
+        """Refuse an unknown kind or seed scope, or a table without its columns."""
         if self.kind not in ("table", "figure"):
             raise ValueError(f"output {self.name!r}: kind must be table or figure")
         if (self.kind == "table") != (self.columns is not None):

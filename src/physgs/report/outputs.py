@@ -1,11 +1,7 @@
 """The report's tables and figures, in build order: ``OUTPUTS``, the one list the workflow reads.
 
-Each output is one ``Output`` (``physgs.report.output``: its needs, its settings and its
-builder) declared beside its builder, in the module of its kind; a model joins every output
-that reads the models of its role (``physgs.models.registry.models_of``) through its registry
-entry (``physgs.models.registry.MODELS``), and a new output is one ``Output`` declared beside
-its builder and listed here. Importing this plans, never draws: the figures' modules load
-matplotlib when they draw.
+Each is an ``Output`` (``physgs.report.output``) declared beside its builder; a model joins the
+outputs of its role (``physgs.models.registry.models_of``). Importing this plans, never draws.
 """
 
 from physgs.report.damping import FIG_DAMPING, TAB_DAMPING

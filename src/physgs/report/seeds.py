@@ -1,10 +1,8 @@
-"""Statistics over training seeds: every table's mean +- sd, and paired differences with their
-95% interval, decided only when the interval excludes 0.
+"""Statistics over training seeds: mean +- sd, and paired differences with their 95% interval
+(Student's t), decided only when the interval excludes 0; with one seed nothing is decided.
 
-A table's CSV holds one row per seed (a ``seed`` column); its .tex shows the mean +- sd over
-seeds. A difference between two models is taken per seed first (the two share the seed's
-initialisation stream, k-means and frame draws) and then summarised (Student's t on the mean of
-the paired differences). With one seed there is no interval, so nothing is decided.
+A difference between two models is taken per seed first (the two share the seed's
+initialisation stream, k-means and frame draws), then summarised.
 """
 
 from __future__ import annotations
@@ -23,24 +21,24 @@ def finite(values: Sequence[float]) -> np.ndarray:
     """The finite values of ``values``, flattened, as float64.
 
     Args:
-        values (Sequence[float]): per-seed values; NaN and infinity are dropped.
+        values: per-seed values.
 
     Returns:
-        np.ndarray: the finite values, ``[n]``.
+        [n] the finite ones.
     """
-    return np.asarray([x for x in np.asarray(values, dtype=np.float64).ravel() if np.isfinite(x)])
+    v = np.asarray(values, dtype=np.float64).ravel()
+    return v[np.isfinite(v)]
 
 
 def interval(values: Sequence[float], level: float = LEVEL) -> tuple[float, float, float, float]:
-    """(mean, sd, low, high) over seeds, NaNs dropped; the interval is Student's t on the mean
-    (sd and bounds NaN with one value, all NaN with none).
+    """(mean, sd, low, high) of the finite values, Student's t on the mean.
 
     Args:
         values: per-seed values.
         level: the interval's coverage.
 
     Returns:
-        ``(mean, sd, low, high)``.
+        ``(mean, sd, low, high)``: sd and bounds NaN with one value, all NaN with none.
     """
     v = finite(values)
     if v.size == 0:
@@ -58,18 +56,14 @@ def interval(values: Sequence[float], level: float = LEVEL) -> tuple[float, floa
 def log_interval(
     values: Sequence[float], level: float = LEVEL
 ) -> tuple[float, float, float, float]:
-    """A ratio's (geometric mean, sd of the logs, low, high) over seeds: Student's t on the mean
-    of the per-seed log-ratios, exponentiated, so that the interval of a ratio stays positive.
+    """``interval`` of the per-seed log-ratios, exponentiated: a ratio's interval stays positive.
 
     Args:
-        values: per-seed ratios (> 0; NaN dropped).
+        values: per-seed ratios (> 0, else ValueError; NaN dropped).
         level: the interval's coverage.
 
     Returns:
-        ``(exp(mean log), sd of log, exp(low), exp(high))``; NaN as ``interval``'s.
-
-    Raises:
-        ValueError: for a ratio that is not positive (it has no log).
+        ``(exp(mean log), sd of log, exp(low), exp(high))``.
     """
     v = finite(values)
     if (v <= 0).any():
@@ -82,24 +76,20 @@ def seeds_to_decide(
     effect: float, sd: float, level: float = LEVEL, power: float = POWER
 ) -> tuple[float, float]:
     """How many seeds would decide a claim whose mean lies ``effect`` from its threshold with
-    seed-to-seed spread ``sd``, if both stayed as observed: an estimate, two ways.
+    seed-to-seed spread ``sd``, if both stayed as observed, estimated two ways.
 
-    - plug-in: the smallest n whose t half-width, ``t_{(1+level)/2, n-1} sd / sqrt(n)``, is below
-      ``|effect|`` (the interval would then clear the threshold);
-    - power: statsmodels' ``tt_solve_power`` for a one-sample two-sided t-test of effect size
-      ``|effect| / sd`` at ``alpha = 1 - level`` and ``power``, rounded up (the plug-in decides
-      about half the time at its n; this one ``power`` of the time).
+    Plug-in: the smallest n whose t half-width ``t_{(1+level)/2, n-1} sd / sqrt(n)`` is below
+    ``|effect|`` (decides about half the time); power: statsmodels' ``tt_solve_power`` for a
+    one-sample two-sided t-test of effect size ``|effect| / sd`` at ``alpha = 1 - level``.
 
     Args:
-        effect: the mean's distance from the threshold, in the claim's unit (log units for a
-            ratio).
+        effect: the mean's distance from the threshold, in the claim's unit (log for a ratio).
         sd: the per-seed sd, same unit.
         level: the interval's coverage.
         power: the test's power.
 
     Returns:
-        ``(plug-in n, power n)``; NaN where it is not finite (no spread, no effect) or above
-            ``MAX_SEEDS``.
+        ``(plug-in n, power n)``; NaN where not finite (no spread, no effect) or > ``MAX_SEEDS``.
     """
     from scipy import stats  # here: the workflow plans with modules that import this one
     from statsmodels.stats.power import tt_solve_power
@@ -111,20 +101,14 @@ def seeds_to_decide(
     ok = stats.t.ppf(0.5 + level / 2, n - 1) * sd / np.sqrt(n) < e
     plug = float(n[np.argmax(ok)]) if ok.any() else np.nan
     try:
-        need = float(
-            tt_solve_power(
-                effect_size=e / sd, alpha=1 - level, power=power, alternative="two-sided"
-            )
-        )
+        need = float(tt_solve_power(effect_size=e / sd, alpha=1 - level, power=power))
     except (ValueError, RuntimeError):  # no root in statsmodels' bracket: far too many seeds
         need = np.nan
-    pw = float(np.ceil(need)) if np.isfinite(need) and need <= MAX_SEEDS else np.nan
-    return plug, pw
+    return plug, float(np.ceil(need)) if np.isfinite(need) and need <= MAX_SEEDS else np.nan
 
 
 def decided(values: Sequence[float], level: float = LEVEL) -> bool:
-    """Whether the interval of the mean excludes 0 (False with fewer than two seeds, or when the
-    differences are all exactly 0).
+    """Whether the interval of the mean excludes 0 (never with fewer than two seeds).
 
     Args:
         values: per-seed values (e.g. paired differences).
@@ -138,17 +122,14 @@ def decided(values: Sequence[float], level: float = LEVEL) -> bool:
 
 
 def paired(a: Sequence[float], b: Sequence[float]) -> np.ndarray:
-    """Per-seed differences a - b [S] (a, b [S] in the same seed order).
+    """Per-seed differences a - b (ValueError when the shapes differ).
 
     Args:
         a: [S] values.
-        b: [S] values.
+        b: [S] values, in the same seed order.
 
     Returns:
         [S] differences.
-
-    Raises:
-        ValueError: when the shapes differ.
     """
     a, b = np.asarray(a, dtype=np.float64), np.asarray(b, dtype=np.float64)
     if a.shape != b.shape:
@@ -159,8 +140,7 @@ def paired(a: Sequence[float], b: Sequence[float]) -> np.ndarray:
 
 
 def decided_best(values: np.ndarray, higher: bool = True, level: float = LEVEL) -> int | None:
-    """Column of values [S, M] (seeds x candidates) whose mean is best, when its paired
-    difference to the runner-up is decided; None otherwise (ties, one seed, all NaN).
+    """The candidate whose mean is best, when its paired difference to the runner-up is decided.
 
     Args:
         values: [S, M] per-seed values of M candidates.
@@ -168,26 +148,25 @@ def decided_best(values: np.ndarray, higher: bool = True, level: float = LEVEL) 
         level: the interval's coverage.
 
     Returns:
-        The best column's index, or None.
+        The best column's index; None for a tie, one seed or fewer than two finite means.
     """
     v = np.asarray(values, dtype=np.float64)
     means = np.array([np.nanmean(c) if np.isfinite(c).any() else np.nan for c in v.T])
-    if np.isfinite(means).sum() < 2:
-        return None
     order = np.argsort(-means if higher else means, kind="stable")
     order = [i for i in order if np.isfinite(means[i])]
-    best, second = order[0], order[1]
-    d = paired(v[:, best], v[:, second])
-    return int(best) if decided(d if higher else -d, level) else None
+    if len(order) < 2:
+        return None
+    d = paired(v[:, order[0]], v[:, order[1]])
+    return int(order[0]) if decided(d if higher else -d, level) else None
 
 
 def pm(values: Sequence[float], fmt: str, bold: bool = False) -> str:
-    """.tex cell 'mean $\\pm$ sd' (just the mean with one seed, '--' with none).
+    """.tex cell 'mean $\\pm$ sd' (the mean alone with one seed, '--' with none).
 
     Args:
         values: per-seed values.
         fmt: the number format (e.g. ``'.2f'``).
-        bold: wrap the cell in ``\textbf``.
+        bold: wrap the cell in ``\\textbf``.
 
     Returns:
         The cell's LaTeX.
@@ -200,15 +179,15 @@ def pm(values: Sequence[float], fmt: str, bold: bool = False) -> str:
 
 
 def difference(values: Sequence[float], fmt: str) -> str:
-    """.tex cell of a paired difference: '$+1.23$ [0.80, 1.66]', bold when decided, marked
-    with a dagger when not (the interval contains 0, or one seed gives none).
+    """.tex cell of a paired difference, '$+1.23$ [0.80, 1.66]': bold when decided, else
+    marked ``UNDECIDED``; '--' without a finite value.
 
     Args:
         values: per-seed paired differences.
         fmt: the number format (e.g. ``'.2f'``).
 
     Returns:
-        The cell's LaTeX (``'--'`` without a finite value).
+        The cell's LaTeX.
     """
     m, _, lo, hi = interval(values)
     if not np.isfinite(m):

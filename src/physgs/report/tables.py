@@ -1,17 +1,11 @@
 """What every table shares: the ``Table`` a builder returns, its row labels, the check of its
 per-seed results, and ``write_table``.
 
-Each builder (one module per kind of output: ``images``, ``recovery``, ``damping``, ``kselect``,
-``parts``, ``tracks``, ``testbed``) returns a ``Table``: a flat pandas DataFrame (what goes to the
-.csv, full precision) and the booktabs LaTeX shown in the paper (rounded; best per column or row
-in bold where the paper bolds; laid out as a frame of cells and rendered by
-``physgs.report.latex``). ``write_table`` writes both atomically. Undefined entries (NaN, e.g. a
-median over zero trusted parts) are written as an empty CSV cell and ``--`` in LaTeX.
-
-Every builder takes its results per training seed ({seed: {key: value}}): the CSV holds one row
-per seed (a ``seed`` column first), the .tex the mean +- sd over seeds, differences paired per
-seed with their 95% interval (physgs.report.seeds). "Best" is bold only when its paired
-difference to the runner-up is decided.
+A builder (``images``, ``recovery``, ``damping``, ``kselect``, ``parts``, ``tracks``,
+``testbed``) takes its results per training seed (``{seed: {key: value}}``) and returns a flat
+DataFrame, one row per seed and key at full precision (the .csv; NaN an empty cell), and the
+booktabs LaTeX of the mean +- sd over seeds (``physgs.report.latex``; NaN ``--``; "best" bold
+only when its paired difference to the runner-up is decided, ``physgs.report.seeds``).
 """
 
 from __future__ import annotations
@@ -39,17 +33,17 @@ def tree_label(tree: str, bones: int) -> str:
     """A tree's row label, ``Sparse (22 bones)``.
 
     Args:
-        tree (str): the tree's name.
-        bones (int): its animated bones.
+        tree: the tree's name.
+        bones: its animated bones.
 
     Returns:
-        str: the label.
+        The label.
     """
     return f"{tree.capitalize()} ({bones} bones)"
 
 
 def condition_label(mult: float, tex: bool = True) -> str:
-    """Mean-speed multiplier -> '$v_0$' / '$0.84v_0$' (tex) or 'v0' / '0.84v0'.
+    """A wind's label: '$v_0$' / '$0.84v_0$' (tex) or 'v0' / '0.84v0'.
 
     Args:
         mult: the multiplier of the training mean speed v0.
@@ -64,15 +58,12 @@ def condition_label(mult: float, tex: bool = True) -> str:
 
 
 def check_keys(keys: Sequence, have: Mapping, what: str) -> None:
-    """Refuse results that lack a key a table reads.
+    """Refuse results that lack a key a table reads (KeyError naming them).
 
     Args:
         keys: the keys the table reads.
         have: the results, by key.
         what: the table (and seed) for the message.
-
-    Raises:
-        KeyError: naming the missing keys.
     """
     missing = [k for k in keys if k not in have]
     if missing:
@@ -83,16 +74,12 @@ def seeds_of(per_seed: Mapping[int, Mapping], what: str, keys: Sequence = ()) ->
     """The training seeds of a builder's results, each checked to hold every one of ``keys``.
 
     Args:
-        per_seed: ``{seed: {key: result}}``.
+        per_seed: ``{seed: {key: result}}`` (ValueError when empty, TypeError when not by seed).
         what: the table, for the messages.
-        keys: the keys every seed must hold.
+        keys: the keys every seed must hold (``check_keys``).
 
     Returns:
         The seeds, sorted.
-
-    Raises:
-        ValueError: without a seed; TypeError: when the outer keys are not seeds; KeyError:
-            when a seed lacks a key.
     """
     if not per_seed:
         raise ValueError(f"{what}: no seeds given")
@@ -111,8 +98,7 @@ def seeds_of(per_seed: Mapping[int, Mapping], what: str, keys: Sequence = ()) ->
 def seed_rows(
     seeds: Sequence[int], keys: Sequence[tuple], row: Callable[..., dict]
 ) -> pd.DataFrame:
-    """A table's CSV frame: one row per training seed and key, seed by seed (the layout
-    ``latex.by_seed`` reads).
+    """A table's CSV frame, seed by seed (the layout ``latex.by_seed`` reads).
 
     Args:
         seeds: the training seeds.
@@ -141,14 +127,14 @@ def tree_index(rows: pd.DataFrame, labels: Sequence[str], name: str) -> pd.Multi
 
 
 def write_table(table: Table, tex_path: str | Path, csv_path: str | Path, stamp=None) -> None:
-    """Write the table's .tex and .csv, each atomically (temp file then rename).
+    """Write the table's .tex and .csv, each atomically.
 
     Args:
         table: the table.
         tex_path: the .tex to write.
         csv_path: the .csv to write.
         stamp (Stamp | None): a [`Stamp`][physgs.provenance.Stamp]; its fields become the CSV's
-            last columns (one value per row) and a comment line of the .tex.
+            last columns and a comment line of the .tex.
     """
     df, tex = table.df, table.tex
     if stamp is not None:
