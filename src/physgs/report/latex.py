@@ -1,9 +1,5 @@
-"""The LaTeX of every table: a DataFrame of display cells, rendered by pandas' ``Styler.to_latex``.
-
-A builder lays out its cells (``cells``: each the .tex of one summary over training seeds) with
-the row labels as index (outer levels grouped: a ``\\multirow`` label, a rule between groups) and
-the headings as columns (a MultiIndex: outer levels span their columns); ``render`` makes the
-booktabs table.
+"""The LaTeX of every table: a DataFrame of display cells (``cells``: each the .tex of one
+summary over training seeds), rendered by pandas' ``Styler.to_latex`` (``render``).
 """
 
 from __future__ import annotations
@@ -23,7 +19,8 @@ def render(cells: pd.DataFrame, caption: str, label: str, bold: np.ndarray | Non
     """A table's LaTeX: booktabs rules, grouped row labels, the caption and the label.
 
     Args:
-        cells: [R, C] each cell's LaTeX, indexed by the row labels, columned by the headings.
+        cells: [R, C] each cell's LaTeX; index: the row labels (an outer level's runs share one
+            ``\\multirow`` label, a rule between them); columns: the headings (outer levels span).
         caption: the caption's LaTeX.
         label: the ``\\label``, e.g. ``tab:psnr``.
         bold: [R, C] bool, the cells set in bold; None: none.

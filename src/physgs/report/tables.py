@@ -1,11 +1,8 @@
 """What every table shares: the ``Table`` a builder returns, its row labels, the check of its
-per-seed results, and ``write_table``.
+per-seed results (``{seed: {key: value}}``), and ``write_table``.
 
-A builder (``images``, ``recovery``, ``damping``, ``kselect``, ``parts``, ``tracks``,
-``testbed``) takes its results per training seed (``{seed: {key: value}}``) and returns a flat
-DataFrame, one row per seed and key at full precision (the .csv; NaN an empty cell), and the
-booktabs LaTeX of the mean +- sd over seeds (``physgs.report.latex``; NaN ``--``; "best" bold
-only when its paired difference to the runner-up is decided, ``physgs.report.seeds``).
+A table's .csv holds one row per seed and key at full precision (NaN an empty cell); its .tex
+the mean +- sd over seeds (``physgs.report.latex``, ``physgs.report.seeds``; NaN ``--``).
 """
 
 from __future__ import annotations
