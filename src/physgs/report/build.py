@@ -126,7 +126,7 @@ def make_claims(
         md_path (str | Path): the Markdown ledger to write.
         csv_path (str | Path): the CSV ledger to write.
         stamp (Stamp | None): written into every CSV row and the Markdown.
-        roles: tree -> its preset's role (``claim_cells.roles_of``); None: no tree has one.
+        roles (Mapping | None): tree -> its preset's role (``claim_cells.roles_of``); None: none.
 
     Returns:
         The ledger (without the stamp's columns).

@@ -1,9 +1,9 @@
 """What every report output declares, and what the run plans (the shared vocabulary).
 
-An ``Output`` (a table or a figure) declares the result files it reads as *need tuples*
-``(kind, *NEED_FIELDS[kind])`` (``needs``), the settings it reads from the resolved config
-(``settings``) and its builder (``build``). The workflow maps each need to a path
-(``workflow/rules/common.smk``) and hands the builder ``key(need) -> path``, read through ``reader``.
+An ``Output`` (a table or a figure) declares the files it reads as *need tuples*
+``(kind, *NEED_FIELDS[kind])`` (``needs``), the settings it reads from the resolved config and
+its builder. The workflow maps each need to a path (``workflow/rules/common.smk``) and hands the
+builder ``key(need) -> path``, read through ``reader``.
 """
 
 from __future__ import annotations
