@@ -167,14 +167,11 @@ class Columns:
     about: tuple[str, ...] = ()  # describe a row without identifying it (bones, K, a flag)
 
     def check(self, name: str, columns: Sequence[str]) -> None:
-        """Refuse a CSV that breaks the contract: a key missing, or a column not declared.
+        """Refuse a CSV that breaks the contract: ValueError naming missing keys, extra columns.
 
         Args:
             name: the table's name (for the message).
             columns: its CSV's columns.
-
-        Raises:
-            ValueError: naming the missing keys or the undeclared columns.
         """
         declared = [
             re.sub(r"\\\{(\w+)\\\}", lambda m: f"(?:{PLACEHOLDERS[m.group(1)]})", re.escape(n))
