@@ -1,20 +1,13 @@
-"""The committed record of a finished run: what the documentation and the README show.
+"""The committed record of a finished run (``docs/record/``): what the documentation and the
+README show.
 
-A run's outputs (``results/``) are not committed; the record is: the run's stamp (date, commit,
-profile, config hash, seeds, the machine's CPU, wall time and job-minutes by stage), its
-``summary.md``, the claims ledger, every table as CSV and as a Markdown table, and the figures as
-PNG sized for the web. The Results page includes the record's pages, which
-[`render_pages`][physgs.report.record.render_pages] writes from the record's own files (so the
-pages can be laid out again without a new run): the figures first, each with its caption
-([`physgs.report.captions`][physgs.report.captions]), then the ledger's counts, then each table
-as its summary over seeds beside its per-seed CSV, then the run's stamp and summary. The README's "what it found" and "what it costs" lines are printed from the record
-by [`readme_block`][physgs.report.record.readme_block], so neither can disagree with the run they
-describe.
-
-What each command costs is measured by ``tools/timed.py`` (one row per command in
-``costs.csv``, the command's last measured wall time on this machine's CPU).
-
-Pure over paths: every function takes the files it reads and the folder it writes.
+The record holds the run's stamp, its ``summary.md``, the claims ledger, every table as CSV and
+the figures as PNG sized for the web. [`render_pages`][physgs.report.record.render_pages] lays
+the Results page's parts out from those files alone (figures with their captions, the ledger's
+counts, each table's summary over seeds, the stamp), and
+[`readme_block`][physgs.report.record.readme_block] prints the README's "what it found" and "what
+it costs" lines from them, so neither can disagree with the run. What each command costs is
+measured by ``tools/timed.py`` (``costs.csv``). Pure over paths.
 """
 
 from __future__ import annotations
@@ -47,38 +40,19 @@ COMMANDS: tuple[tuple[str, str], ...] = (
 )
 #: Widest figure in the record, px: the documentation's content column.
 FIGURE_WIDTH_PX = 1200
-#: Value columns of one summary table on the page: a wider table is cut into several, its key
-#: columns repeated, so it reads in the content column.
+#: Value columns of one summary table on the page: a wider one is cut, its keys repeated.
 VALUE_COLUMNS_SHOWN = 4
-#: Lines of a summary (its rows times its parts) up to which it shows open on the Results page;
-#: a longer one is folded, its heading and CSV link still shown.
-OPEN_TABLE_ROWS = 30
-#: Tables shown open whatever their length: the fit bar (the premise every comparison rests on)
-#: and the null control's (the table the README points a reviewer to).
-OPEN_TABLES = ("tab_fit", "tab_null")
+#: Lines of a table's summary up to which it shows open (a longer one folds), and the tables
+#: open whatever their length (the fit bar, and the null control the README points to).
+OPEN_TABLE_ROWS, OPEN_TABLES = 30, ("tab_fit", "tab_null")
 #: Columns every table carries that the record's stamp already states.
 STAMP_COLUMNS = ("profile", "config_hash", "physgs_version")
-#: Cells moved beyond their row's seed spread that the record lists, largest first.
+#: Cells moved beyond their row's seed spread that the comparison with the last record lists.
 RERUN_CELLS_SHOWN = 10
-#: The columns of the record's comparison with the one it replaces: its moved verdicts, its
-#: tables and its cells moved furthest (``rerun_lines``).
-RERUN_VERDICT_COLUMNS = ("claim", "before", "after", "threshold", "intervals overlap")
-RERUN_TABLE_COLUMNS = (
-    "table",
-    "rows in both",
-    "numeric cells",
-    "identical",
-    "within the seed spread",
-    "beyond it",
-)
-RERUN_CELL_COLUMNS = ("table", "row", "column", "before", "after", "seed spread")
 COSTS_COLUMNS = ("name", "command", "wall_s", "date", "commit", "cpu", "from_nothing", "segments")
 BEGIN, END = "<!-- record:begin -->", "<!-- record:end -->"
-
-#: Files of the record's folder that no run makes, kept when a new record replaces the old:
-#: each command's measured cost (``tools/timed.py``), the paper profile's measured iteration
-#: rates (``benchmarks/training.py``) and the estimate ``tools/paper_estimate.py`` computes
-#: from them and today's plan.
+#: Files of the record that no run makes, kept when a new record replaces the old: each
+#: command's cost, the paper profile's measured rates and the estimate made from them.
 OUTLIVE = ("costs.csv", "rates_paper.csv", "paper_estimate.md")
 
 #: The words and units of the findings, defined once under them (the glossary says more).
@@ -102,6 +76,15 @@ WORDS = (
 COMMIT = re.compile(r"^[0-9a-f]{7,40}$")
 
 
+def _join(xs: Iterable) -> str:
+    return ", ".join(map(str, xs))
+
+
+def _shell(words: Iterable[str]) -> str:
+    """Command-line words, each quoted as a shell needs."""
+    return " ".join(shlex.quote(w) for w in words)
+
+
 @dataclass(frozen=True)
 class Stamp:
     """Where a record comes from.
@@ -114,17 +97,14 @@ class Stamp:
         seeds: training seeds of the run.
         trees: trees of the run.
         cpu: the machine's CPU model and its bf16/AMX flags.
-        wall_s: wall time of the run, s: the time its command ran, summed over the segments
-            of a run resumed after an interruption, as ``tools/timed.py`` measures it (the one
-            definition the record, the costs and the README use).
+        wall_s: wall time of the run, s: the time its command ran, summed over the segments of
+            a resumed run (``tools/timed.py``; the one definition the record and README use).
         job_min_by_stage: job-minutes per stage, from the run's benchmark files.
         note: what a reader should know about how the run was made (apart from the commit).
         jobs: the run's benchmarked jobs (one benchmark file each; light jobs have none).
-        instances: tree -> the testbed seeds of its tree instances (``testbed_seeds``: one per
-            training seed; without, the one of ``seed``); {} in a record made before it.
-        overrides: the ``--configfile`` and ``--config`` words the run was made with, as
-            Snakemake's command line takes them (none: the config file as committed, at the
-            stamp's profile).
+        instances: tree -> the testbed seeds of its tree instances; {} in an older record.
+        overrides: the run's ``--configfile`` and ``--config`` words (none: the config file as
+            committed, at the stamp's profile).
     """
 
     date: str
@@ -149,42 +129,29 @@ class Stamp:
                 "rest in the stamp's note"
             )
 
-    def instances_words(self) -> str:
-        """The trees' instances in words: ``sparse, medium: testbed seeds 0-4``.
-
-        Returns:
-            One phrase per set of testbed seeds, "; "-joined.
-        """
-        by: dict[tuple[int, ...], list[str]] = {}
-        for t, seeds in self.instances.items():
-            by.setdefault(tuple(seeds), []).append(t)
-        words = [
-            f"{', '.join(trees)}: {'testbed seed' if len(s) == 1 else 'testbed seeds'} "
-            + ", ".join(map(str, s))
-            for s, trees in by.items()
-        ]
-        return "; ".join(words)
-
     def markdown(self) -> str:
         """The stamp as a short Markdown list.
 
         Returns:
-            Bullet lines (run, commit and date, the note if any, machine, wall time with jobs
-                and job-minutes by stage) and a blank line.
+            Bullet lines (run, instances, overrides, commit and date, note, machine, wall time
+                with jobs and job-minutes by stage) and a blank line.
         """
+        by: dict[tuple[int, ...], list[str]] = {}  # the trees of each set of testbed seeds
+        for t, seeds in self.instances.items():
+            by.setdefault(tuple(seeds), []).append(t)
+        instances = "; ".join(
+            f"{', '.join(trees)}: testbed seed{'s' if len(s) > 1 else ''} {_join(s)}"
+            for s, trees in by.items()
+        )
         stages = ", ".join(f"{k} {v:.1f}" for k, v in self.job_min_by_stage.items())
-        total = sum(self.job_min_by_stage.values())
         jobs = f"{self.jobs} benchmarked jobs, " if self.jobs else ""
+        total = sum(self.job_min_by_stage.values())
         return "\n".join(
             [
                 f"- **Run**: profile `{self.profile}`, config hash `{self.config_hash}`, "
-                f"seeds {', '.join(map(str, self.seeds))}, trees {', '.join(self.trees)}",
-                *([f"- **Tree instances**: {self.instances_words()}"] if self.instances else []),
-                *(
-                    [f"- **Overrides**: `{overrides_words(self.overrides)}`"]
-                    if self.overrides
-                    else []
-                ),
+                f"seeds {_join(self.seeds)}, trees {', '.join(self.trees)}",
+                *([f"- **Tree instances**: {instances}"] if self.instances else []),
+                *([f"- **Overrides**: `{_shell(self.overrides)}`"] if self.overrides else []),
                 f"- **Made at** commit `{self.commit}`; record written {self.date}",
                 *([f"- **Note**: {self.note}"] if self.note else []),
                 f"- **Machine**: {self.cpu}, 2 cores",
@@ -197,12 +164,11 @@ class Stamp:
 
 
 def instances_of(testbed: pd.DataFrame, seeds: Sequence[int], seed: int) -> dict[str, list[int]]:
-    """Each tree's instances as a run's ``tab_testbed.csv`` says (its ``instances`` column): the
-    training seeds' testbed seeds where a tree has one per seed, else the one of ``seed``.
+    """Each tree's instances as a run's ``tab_testbed.csv`` says: the training seeds where a
+    tree has one instance per seed, else the one of ``seed``.
 
     Args:
-        testbed: the run's tab_testbed CSV (``tree``, ``instances``; a table made before the
-            column: one instance each).
+        testbed: the run's tab_testbed (``tree``, ``instances``; without it, one instance each).
         seeds: the run's training seeds.
         seed: the config's testbed seed (the one instance of the paper's protocol).
 
@@ -217,24 +183,8 @@ def instances_of(testbed: pd.DataFrame, seeds: Sequence[int], seed: int) -> dict
     }
 
 
-def overrides_words(overrides: Iterable[str]) -> str:
-    """A run's overrides as one command-line fragment, each word quoted as a shell needs.
-
-    Args:
-        overrides: the words (``["--configfile", "config/float32.yaml"]``).
-
-    Returns:
-        The fragment (``--configfile config/float32.yaml``).
-    """
-    return " ".join(shlex.quote(w) for w in overrides)
-
-
 def other_configs(files: Iterable[str | Path], config_hash: str) -> list[str]:
-    """The files of a run, among ``files``, whose rows were made under another config.
-
-    Every table's CSV and the ledger carry the config hash of the run that wrote them: a table
-    rebuilt alone under an edited config carries the new one while the rest keep the old, and
-    such a folder is no one run.
+    """The files, among ``files``, whose rows were made under another config than the run's.
 
     Args:
         files: CSVs (a file without a ``config_hash`` column is not judged).
@@ -245,7 +195,7 @@ def other_configs(files: Iterable[str | Path], config_hash: str) -> list[str]:
     """
     out = []
     for f in files:
-        found = config_hashes(read_run_csv(f))
+        found = config_hashes(_read(f))
         if found is not None and found != [config_hash]:
             out.append(f"{f}: config_hash {', '.join(found) or 'none'}, not {config_hash}")
     return out
@@ -263,31 +213,23 @@ def config_hashes(df: pd.DataFrame) -> list[str] | None:
     return sorted({str(h) for h in df["config_hash"].dropna()}) if "config_hash" in df else None
 
 
-def read_run_csv(path: str | Path) -> pd.DataFrame:
-    """A table's or the ledger's CSV of a run.
-
-    Args:
-        path: the CSV.
-
-    Returns:
-        Its rows, the config hash read as text (a hash of digits stays one).
-    """
+def _read(path: str | Path) -> pd.DataFrame:
+    """A run's CSV, the config hash read as text (a hash of digits stays one)."""
     return pd.read_csv(path, dtype={"config_hash": str})
 
 
 def format_duration(seconds: float) -> str:
-    """``3 h 8 min``, ``29 min 9 s`` or ``42 s``; ``--`` for a missing value.
+    """``3 h 8 min``, ``29 min 9 s`` or ``42 s``, rounded to the second; ``--`` if not finite.
 
     Args:
-        seconds: a duration, s (NaN or inf: missing).
+        seconds: a duration, s.
 
     Returns:
-        The duration in words, rounded to the second.
+        The duration in words.
     """
     if not math.isfinite(seconds):
         return "--"
-    s = round(seconds)
-    h, rest = divmod(s, 3600)
+    h, rest = divmod(round(seconds), 3600)
     m, s = divmod(rest, 60)
     if h:
         return f"{h} h {m} min"
@@ -296,21 +238,17 @@ def format_duration(seconds: float) -> str:
 
 def _cell(x) -> str:
     if isinstance(x, (float, np.floating)):
-        if not math.isfinite(x):
-            return "--"
-        return f"{x:.4g}"
-    if x is None:
-        return "--"
-    return str(x).replace("|", "\\|")
+        return f"{x:.4g}" if math.isfinite(x) else "--"
+    return "--" if x is None else str(x).replace("|", "\\|")
 
 
 def markdown_table(df: pd.DataFrame, right: Iterable[str] = ()) -> str:
-    """A DataFrame as a Markdown table; floats to 4 significant digits, NaN as ``--``: every
-    table of the record and of the run's summary is written here.
+    """A DataFrame as a Markdown table, floats to 4 significant digits, NaN as ``--`` (every
+    table of the record and of the run's summary).
 
     Args:
         df: the table (its index is dropped).
-        right: the columns aligned right (counts read down a column).
+        right: the columns aligned right.
 
     Returns:
         The table's lines, ending in a newline.
@@ -321,70 +259,31 @@ def markdown_table(df: pd.DataFrame, right: Iterable[str] = ()) -> str:
     return "\n".join(lines) + "\n"
 
 
-def demote(markdown: str) -> str:
-    """Every Markdown heading one level down (``# x`` -> ``## x``), so that an included page sits
-    under the including page's title.
+def _table(rows: Iterable, columns: Sequence[str], right: Iterable[str] = ()) -> list[str]:
+    """``rows`` under ``columns`` as Markdown table lines, then a blank line."""
+    return [*markdown_table(pd.DataFrame(rows, columns=columns), right).splitlines(), ""]
 
-    Args:
-        markdown: the page's text.
 
-    Returns:
-        The text, headings one ``#`` deeper.
-    """
+def _demote(markdown: str) -> str:
+    """Every heading one level down, so an included page sits under the including page's title."""
     return re.sub(r"^#+ ", r"#\g<0>", markdown, flags=re.MULTILINE)
 
 
-def _png_for_web(src: Path, dst: Path) -> None:
-    """Copy a PNG, downscaled to ``FIGURE_WIDTH_PX`` wide if wider."""
-    with Image.open(src) as im:
-        if im.width > FIGURE_WIDTH_PX:
-            h = round(im.height * FIGURE_WIDTH_PX / im.width)
-            im = im.resize((FIGURE_WIDTH_PX, h), Image.LANCZOS)
-        im.save(dst, optimize=True)
-
-
-def _same_run(a: Mapping, b: Mapping) -> bool:
-    """Two stamps of one run (its record rewritten, say to add the Snakemake report)."""
-
-    def plain(v):  # a stamp read from JSON holds lists where the dataclass holds tuples
-        return list(v) if isinstance(v, (list, tuple)) else v
-
-    keys = ("commit", "config_hash", "profile", "seeds", "trees")
-    return all(plain(a.get(k)) == plain(b.get(k)) for k in keys)
-
-
-def rerun_lines(
-    previous: str | Path, stamp: Stamp, claims_csv: str | Path, tables: Sequence[str | Path]
+def _rerun_lines(
+    previous: Path, stamp: Stamp, claims_csv: str | Path, tables: Sequence[str | Path]
 ) -> list[str]:
     """The record's "Against the previous record" section: this run's ledger verdict by verdict
-    and its seeded tables cell by cell against the record it replaces
-    ([`physgs.report.rerun`][physgs.report.rerun]).
-
-    A change that only reorders floating-point work moves every training's trajectory; this says
-    which verdicts and how many numbers moved, and whether beyond the seeds' own spread.
-
-    Args:
-        previous: the record folder being replaced (``stamp.json``, ``claims.csv``,
-            ``tables/*.csv``).
-        stamp: this run's stamp.
-        claims_csv: this run's ledger.
-        tables: this run's table CSVs.
-
-    Returns:
-        The section's Markdown lines (heading included); a line saying there is nothing to
-            compare with when ``previous`` holds no record.
-    """
-    prev = Path(previous)
+    and its seeded tables cell by cell against the record in ``previous`` (``rerun``)."""
     head = ["## Against the previous record", ""]
-    if not ((prev / "stamp.json").is_file() and (prev / "claims.csv").is_file()):
+    if not ((previous / "stamp.json").is_file() and (previous / "claims.csv").is_file()):
         return [*head, "No earlier record to compare with.", ""]
-    old = json.loads((prev / "stamp.json").read_text())
+    old = json.loads((previous / "stamp.json").read_text())
     settings = (
         "the same config hash"
         if old.get("config_hash") == stamp.config_hash
         else f"config hash `{old.get('config_hash')}`: the comparison spans a change of settings"
     )
-    c = rerun.compare_claims(read_run_csv(prev / "claims.csv"), read_run_csv(claims_csv))
+    c = rerun.compare_claims(_read(previous / "claims.csv"), _read(claims_csv))
     apart = f" ({len(c.only_new)} claims new in this run, {len(c.only_old)} no longer asked.)"
     lines = [
         *head,
@@ -400,18 +299,14 @@ def rerun_lines(
         "",
     ]
     if c.changed:
-        verdicts = pd.DataFrame(
-            [
-                (f"`{v.id}`: {v.claim}", f"{v.old}, {v.old_value}", f"**{v.new}**, {v.new_value}")
-                + (v.threshold, v.overlap)
-                for v in c.changed
-            ],
-            columns=RERUN_VERDICT_COLUMNS,
-        )
+        verdicts = [
+            (f"`{v.id}`: {v.claim}", f"{v.old}, {v.old_value}", f"**{v.new}**, {v.new_value}")
+            + (v.threshold, v.overlap)
+            for v in c.changed
+        ]
         n = Counter(v.overlap for v in c.changed)
         lines += [
-            *markdown_table(verdicts).splitlines(),
-            "",
+            *_table(verdicts, ("claim", "before", "after", "threshold", "intervals overlap")),
             f"Of the {len(c.changed)} moved verdicts, {n['yes']} moved with overlapping intervals "
             f"(within the seeds' noise: an interval that now clears or now touches its "
             f"threshold), {n['no']} with intervals apart (the runs disagree beyond that noise)"
@@ -421,10 +316,10 @@ def rerun_lines(
         ]
     rows, moved = [], []
     for t in sorted(Path(p) for p in tables):
-        before = prev / "tables" / t.name
+        before = previous / "tables" / t.name
         if not before.is_file():
             continue
-        a, b = read_run_csv(before), read_run_csv(t)
+        a, b = _read(before), _read(t)
         if "seed" not in a.columns or "seed" not in b.columns:
             same = "identical" if a.equals(b) else "changed"
             rows.append((f"`{t.stem}` (not seeded)", len(b), "", same, "", ""))
@@ -432,36 +327,31 @@ def rerun_lines(
         r = rerun.compare_table_csv(before, t)
         rows.append((f"`{t.stem}`", r.rows, r.cells, r.identical, r.within, len(r.beyond)))
         moved += [(t.stem, ch) for ch in r.beyond]
-    tabled = pd.DataFrame(rows, columns=RERUN_TABLE_COLUMNS)
+    counts = ("rows in both", "numeric cells", "identical", "within the seed spread", "beyond it")
     lines += [
         "**The seeded tables**, each numeric cell beside the previous run's spread (max - min) "
         "over seeds of its row; job timings are left out:",
         "",
-        *markdown_table(tabled, right=RERUN_TABLE_COLUMNS[1:]).splitlines(),
-        "",
+        *_table(rows, ("table", *counts), right=counts),
     ]
     if moved:
         moved.sort(key=lambda m: rerun.spreads_moved(m[1]), reverse=True)
-        cells = pd.DataFrame(
-            [
-                (f"`{name}`", ", ".join(f"{k} {v}" for k, v in ch.key.items()), f"`{ch.column}`")
-                + (ch.old, ch.new, ch.spread)
-                for name, ch in moved[:RERUN_CELLS_SHOWN]
-            ],
-            columns=RERUN_CELL_COLUMNS,
-        )
+        cells = [
+            (f"`{name}`", ", ".join(f"{k} {v}" for k, v in ch.key.items()), f"`{ch.column}`")
+            + (ch.old, ch.new, ch.spread)
+            for name, ch in moved[:RERUN_CELLS_SHOWN]
+        ]
+        shown = ("before", "after", "seed spread")
         lines += [
             f"The largest moves beyond the spread ({len(cells)} of {len(moved)}):",
             "",
-            *markdown_table(cells, right=RERUN_CELL_COLUMNS[3:]).splitlines(),
-            "",
+            *_table(cells, ("table", "row", "column", *shown), right=shown),
         ]
     return lines
 
 
-#: What the record takes of a run's folder (``results/``), as the workflow lays it out: each
-#: table's CSV and each figure's PNG (folder, suffix), and the jobs' benchmark files (below
-#: ``benchmarks/``, ``physgs.experiments.cost``).
+#: What the record takes of a run's folder: each table's CSV and each figure's PNG (folder,
+#: suffix), and the jobs' benchmark files (below ``benchmarks/``).
 RUN_FILES = {"tables": ("tables", ".csv"), "figures": ("figures", ".png")}
 BENCHMARKS = "benchmarks"
 
@@ -475,11 +365,9 @@ class RunFiles:
         target: the target whose plan it is (``all``).
         tables: the plan's table CSVs, sorted.
         figures: the plan's figure PNGs, sorted.
-        jobs: the plan's benchmarked jobs, one per benchmark file
-            ([`JobCost`][physgs.experiments.cost.JobCost]).
+        jobs: the plan's benchmarked jobs ([`JobCost`][physgs.experiments.cost.JobCost]).
         left_out: the tables, figures and benchmark files the folder holds that the plan does
-            not make (another target's, such as ``studies``, or an earlier run's), relative to
-            the folder, sorted.
+            not make (another target's, or an earlier run's), relative to the folder, sorted.
     """
 
     target: str
@@ -489,8 +377,7 @@ class RunFiles:
     left_out: tuple[str, ...] = ()
 
     def left_out_line(self) -> str:
-        """What was left out, in a line: the tables and figures by name, the benchmark files
-        counted by stage.
+        """What was left out: the tables and figures by name, the benchmark files by stage.
 
         Returns:
             ``left out (not made by all): tables/x.csv, ...; N benchmark files (stage n, ...)``,
@@ -506,45 +393,34 @@ class RunFiles:
 
 
 def run_files(
-    results: str | Path,
-    outputs: Iterable[str],
-    benchmarks: Iterable[str],
-    target: str = "all",
+    results: str | Path, outputs: Iterable[str], benchmarks: Iterable[str], target: str = "all"
 ) -> RunFiles:
     """The tables, figures and benchmarked jobs of a run's folder that its target's plan makes.
 
-    A folder may hold more than one target's files (``snakemake studies`` run in it after
-    ``all``, or an earlier run's): the record of ``all`` takes ``all``'s alone, so its stamp's
-    jobs and job-minutes are those of the run whose wall time it states. The plan is
-    Snakemake's own (``snakemake -n --forceall all``: the jobs' outputs and benchmark files,
-    [`plan_outputs`][physgs.experiments.cost.plan_outputs] and
-    [`plan_jobs`][physgs.experiments.cost.plan_jobs]), so no second list of what ``all`` makes
-    is kept here.
+    A folder may hold more than one target's files (``studies`` run after ``all``, or an
+    earlier run's): the record takes the plan's alone, the plan being Snakemake's own
+    ([`plan_outputs`][physgs.experiments.cost.plan_outputs],
+    [`plan_jobs`][physgs.experiments.cost.plan_jobs]), so no second list of it is kept here.
 
     Args:
         results: the run's folder (``results/``).
-        outputs: every output file of the plan, relative to ``results``
-            (``tables/tab_fit.csv``); those outside ``RUN_FILES`` are not the record's.
-        benchmarks: every benchmark file of the plan, relative to ``results``
-            (``benchmarks/train/sparse/seed0/ours_single.tsv``).
+        outputs: every output file of the plan, relative to ``results`` (``tables/tab_fit.csv``).
+        benchmarks: every benchmark file of the plan, relative to ``results``.
         target: the plan's target, named in messages.
 
     Returns:
         The [`RunFiles`][physgs.report.record.RunFiles].
 
     Raises:
-        FileNotFoundError: naming every table or figure of the plan that the folder lacks, or
-            the benchmark files of the plan it lacks (an unfinished run, or another config's).
+        FileNotFoundError: naming every table or figure of the plan that the folder lacks.
     """
     root = Path(results)
     made = {PurePosixPath(p) for p in outputs}
-    picked: dict[str, list[Path]] = {}
-    missing: list[str] = []
-    left_out: list[str] = []
+    picked, missing, left_out = {}, [], []
     for kind, (folder, suffix) in RUN_FILES.items():
         planned = {p for p in made if p.parent == PurePosixPath(folder) and p.suffix == suffix}
         missing += sorted(str(p) for p in planned if not (root / p).is_file())
-        picked[kind] = sorted(root / p for p in planned)
+        picked[kind] = tuple(sorted(root / p for p in planned))
         present = {PurePosixPath(folder, f.name) for f in (root / folder).glob(f"*{suffix}")}
         left_out += [str(p) for p in present - planned]
     if missing:
@@ -559,11 +435,7 @@ def run_files(
     }
     left_out += [f"{BENCHMARKS}/{p}" for p in present - bench]
     return RunFiles(
-        target,
-        tuple(picked["tables"]),
-        tuple(picked["figures"]),
-        tuple(jobs),
-        tuple(sorted(left_out)),
+        target, picked["tables"], picked["figures"], tuple(jobs), tuple(sorted(left_out))
     )
 
 
@@ -579,10 +451,8 @@ def _settle_swap(final: Path) -> None:
     """Finish what a write of the record at ``final`` left undone when it stopped.
 
     A write swaps the records by two renames (``final`` to ``final.old``, ``final.partial`` to
-    ``final``) and then removes ``final.old``. Stopped between the renames, it leaves the last
-    record as ``final.old`` and no ``final``: that record is put back. Stopped after them, or
-    unable to remove it, it leaves a ``final.old`` beside a ``final`` that is the newer record:
-    it is removed (a rename onto a folder that is not empty fails, ``OSError`` 39).
+    ``final``), then removes ``final.old``. A ``final.old`` without a ``final`` (stopped between
+    the renames) is the last record: put back; beside a ``final`` it is removed.
     """
     old = final.with_name(final.name + ".old")
     if not (old.exists() or old.is_symlink()):
@@ -605,23 +475,20 @@ def write_record(
     tables: Sequence[str | Path],
     figures: Sequence[str | Path],
 ) -> list[Path]:
-    """Write a run's record into ``out_dir`` (replacing the record there).
+    """Write a run's record into ``out_dir``, replacing the record there.
 
-    Snakemake's report of a run is not part of the record (it is ~10 MB: every clone would
-    carry each record's); ``tools/record.py --report-html`` makes it into ``results/``. What an
-    earlier write left when it stopped is settled first, and said: a ``<out_dir>.partial`` is
-    removed, a ``<out_dir>.old`` beside the record is removed, and one without a record beside
-    it (the last record, stopped between the swap's renames) is put back.
+    Snakemake's report (~10 MB) is not part of it: ``tools/record.py --report-html`` makes it.
+    The new record is written beside the old (``<out_dir>.partial``) and swapped in whole;
+    what an earlier write left when it stopped is settled first, and said.
 
     Args:
-        out_dir: the record's folder (the project keeps it at ``docs/record``).
+        out_dir: the record's folder (``docs/record``).
         stamp: where the run comes from.
         summary_md: the run's ``summary.md``.
         claims_csv: the claims ledger as CSV.
         claims_md: the claims ledger as Markdown.
-        tables: the run's table CSVs; each becomes ``tables/<name>.csv`` and its summary
-            ``tables/<name>.md``.
-        figures: the run's figure PNGs; each becomes ``figures/<name>.png``, web-sized.
+        tables: the run's table CSVs, each copied to ``tables/`` and summarised beside.
+        figures: the run's figure PNGs, each copied web-sized to ``figures/``.
 
     Returns:
         The files written.
@@ -629,23 +496,20 @@ def write_record(
     Raises:
         FileNotFoundError: naming the first input that is missing.
     """
-    inputs = [Path(p) for p in (summary_md, claims_csv, claims_md, *tables, *figures)]
-    for p in inputs:
+    for p in map(Path, (summary_md, claims_csv, claims_md, *tables, *figures)):
         if not p.is_file():
             raise FileNotFoundError(f"{p}: missing; finish the run first (snakemake --cores 2 all)")
     final = Path(out_dir)
     _settle_swap(final)
     kept = {n: (final / n).read_bytes() for n in OUTLIVE if (final / n).is_file()}
-    # against the record this one replaces; the same run recorded again keeps its comparison
-    old_stamp = final / "stamp.json"
-    if (
-        old_stamp.is_file()
-        and (final / "rerun.md").is_file()
-        and _same_run(json.loads(old_stamp.read_text()), asdict(stamp))
-    ):
-        against = (final / "rerun.md").read_text()
+    old_stamp, old_rerun = final / "stamp.json", final / "rerun.md"
+    prior = json.loads(old_stamp.read_text()) if old_stamp.is_file() else {}
+    now = json.loads(json.dumps(asdict(stamp)))  # its tuples as the JSON's lists
+    keys = ("commit", "config_hash", "profile", "seeds", "trees")
+    if old_rerun.is_file() and all(prior.get(k) == now[k] for k in keys):
+        against = old_rerun.read_text()  # the same run recorded again keeps its comparison
     else:
-        against = "\n".join(rerun_lines(final, stamp, claims_csv, tables))
+        against = "\n".join(_rerun_lines(final, stamp, claims_csv, tables))
     out = final.with_name(final.name + ".partial")  # the old record stands until this is whole
     _remove(out)  # an earlier write that stopped before its swap
     (out / "tables").mkdir(parents=True)
@@ -655,12 +519,16 @@ def write_record(
     (out / "stamp.json").write_text(json.dumps(asdict(stamp), indent=2) + "\n")
     (out / "rerun.md").write_text(against)
     for name, page in (("summary.md", summary_md), ("claims.md", claims_md)):
-        (out / name).write_text(demote(Path(page).read_text()))
+        (out / name).write_text(_demote(Path(page).read_text()))
     shutil.copyfile(claims_csv, out / "claims.csv")
     for t in map(Path, tables):
         shutil.copyfile(t, out / "tables" / t.name)
     for f in map(Path, figures):
-        _png_for_web(f, out / "figures" / f.name)
+        with Image.open(f) as im:
+            if im.width > FIGURE_WIDTH_PX:
+                h = round(im.height * FIGURE_WIDTH_PX / im.width)
+                im = im.resize((FIGURE_WIDTH_PX, h), Image.LANCZOS)
+            im.save(out / "figures" / f.name, optimize=True)
     render_pages(out)
     written = sorted(final / p.relative_to(out) for p in out.rglob("*") if p.is_file())
     old = final.with_name(final.name + ".old")
@@ -672,8 +540,8 @@ def write_record(
 
 
 def _mean_sd(values: pd.Series) -> str:
-    """``mean ± sd`` of a column's per-seed values (NaN dropped): the value alone where the seeds
-    agree (to rounding) or one seed has it, ``--`` where none has."""
+    """``mean ± sd`` over seeds (NaN dropped): the value alone where the seeds agree (to
+    rounding) or one seed has it, ``--`` where none has."""
     v = pd.to_numeric(values, errors="coerce").dropna()
     if v.empty:
         return "--"
@@ -684,15 +552,12 @@ def _mean_sd(values: pd.Series) -> str:
 
 
 def table_summary(df: pd.DataFrame) -> tuple[pd.DataFrame, list[str], list[int]]:
-    """A per-seed table as its summary over seeds: one row per key, each value column as
-    ``mean ± sd`` over the seeds (NaN seeds left out; the value alone where the seeds agree).
-
-    The keys are the text and true/false columns (tree, model, configuration...); the stamp's columns are
-    dropped, and so are columns with no value. A table without a ``seed`` column is returned as
-    it is, its keys its text columns.
+    """A per-seed table as its summary over seeds: one row per key (its text and true/false
+    columns), each value column as ``mean ± sd`` over the seeds; the stamp's columns and empty
+    ones dropped. A table without a ``seed`` column is returned as it is.
 
     Args:
-        df: the table, one row per seed (its CSV as read with the stamp's columns as text).
+        df: the table, one row per seed (the stamp's columns read as text).
 
     Returns:
         ``(summary, key columns, seeds)``: the summary's cells as text, the key columns in
@@ -724,38 +589,34 @@ def summary_markdown(df: pd.DataFrame) -> str:
     """
     summary, keys, _ = table_summary(df)
     values = [c for c in summary.columns if c not in keys]
-    parts = [
-        values[i : i + VALUE_COLUMNS_SHOWN] for i in range(0, len(values), VALUE_COLUMNS_SHOWN)
-    ]
+    n = VALUE_COLUMNS_SHOWN
+    parts = [values[i : i + n] for i in range(0, len(values), n)] or [[]]
     # a long column name may break after an underscore (<wbr>: no character when copied)
     heads = {c: str(c).replace("_", "_<wbr>") for c in summary.columns}
-    return "\n".join(
-        markdown_table(summary[keys + cols].rename(columns=heads)) for cols in parts or [[]]
-    )
+    return "\n".join(markdown_table(summary[keys + cols].rename(columns=heads)) for cols in parts)
 
 
-#: The ledger's columns the catalogue derives from a claim's id: a record written before one of
-#: them gains it from its own ids (``derive_claims``), placed after the column named.
+#: The ledger's columns the catalogue derives from a claim's id, each placed after the one named.
 DERIVED_COLUMNS = {"kind": "origin"}
+#: The heading of the run summary's claims section as the record holds it (demoted).
+SUMMARY_CLAIMS = "### Claims ledger"
 
 
 def derive_claims(record_dir: str | Path) -> list[Path]:
-    """Give a record's ledger the columns the catalogue derives from its ids that it lacks
-    (``DERIVED_COLUMNS``: ``kind``), and print its ``claims.md`` and the claims section of its
-    ``summary.md`` again from that ``claims.csv`` with the rules' own printers
-    (``claims.ledger_markdown`` with the CSV's stamp columns, ``summary.claims_section``): on a
-    ledger of today's columns and today's printers they print what the run printed. No number is
-    touched: the CSV is read and written back as text.
+    """Give a record's ledger the ``DERIVED_COLUMNS`` it lacks, and print its ``claims.md`` and
+    the claims section of its ``summary.md`` again from it with the rules' own printers. No
+    number is touched: the CSV is read and written back as text.
 
     Args:
         record_dir: the record folder (``claims.csv``).
 
     Returns:
-        The files that changed; none when the ledger and its page are up to date.
+        The files that changed; none when the ledger and its pages are up to date.
     """
+    from physgs.report.summary import claims_section  # summary imports this module
+
     out = Path(record_dir)
-    path, page = out / "claims.csv", out / "claims.md"
-    written = []
+    path, written = out / "claims.csv", []
     text = pd.read_csv(path, dtype=str, keep_default_na=False)
     missing = [c for c in DERIVED_COLUMNS if c not in text.columns]
     for name in missing:
@@ -765,35 +626,22 @@ def derive_claims(record_dir: str | Path) -> list[Path]:
     if missing:
         text.to_csv(path, index=False)
         written.append(path)
-    df = read_run_csv(path)
+    df = _read(path)
     stamp = {c: str(df[c].iloc[0]) for c in STAMP_COLUMNS if c in df and len(df)}
-    pages = {page: demote(ledger.ledger_markdown(df, stamp or None))}
-    if (out / "summary.md").is_file():
-        pages[out / "summary.md"] = _claims_section_again((out / "summary.md").read_text(), df)
+    pages = {out / "claims.md": _demote(ledger.ledger_markdown(df, stamp or None))}
+    if (out / "summary.md").is_file():  # its other sections come from files the record lacks
+        lines = (out / "summary.md").read_text().split("\n")
+        if SUMMARY_CLAIMS in lines:
+            a = lines.index(SUMMARY_CLAIMS)
+            b = next((i for i in range(a + 1, len(lines)) if lines[i].startswith("### ")), None)
+            section = _demote("\n".join(claims_section(df))).split("\n")
+            lines[a:b] = section
+        pages[out / "summary.md"] = "\n".join(lines)
     for p, printed in pages.items():
         if not p.is_file() or p.read_text() != printed:
             p.write_text(printed)
             written.append(p)
     return written
-
-
-#: The heading of the run summary's claims section as the record holds it (demoted).
-SUMMARY_CLAIMS = "### Claims ledger"
-
-
-def _claims_section_again(text: str, claims: pd.DataFrame) -> str:
-    """The record's ``summary.md`` with its claims section printed again from ``claims``
-    (``summary.claims_section``, the summary rule's own printer); the rest, made from files the
-    record does not keep (the benchmarks), as it was. Unchanged without the section."""
-    from physgs.report.summary import claims_section  # summary imports this module
-
-    lines = text.split("\n")
-    if SUMMARY_CLAIMS not in lines:
-        return text
-    a = lines.index(SUMMARY_CLAIMS)
-    b = next((i for i in range(a + 1, len(lines)) if lines[i].startswith("### ")), len(lines))
-    section = demote("\n".join(claims_section(claims))).split("\n")
-    return "\n".join([*lines[:a], *section, *lines[b:]])
 
 
 #: The Results page's part the record lays out (``index.md``): its figures, its ledger's counts,
@@ -841,14 +689,12 @@ TABLE_ENTRY = """\
 
 
 def render_pages(record_dir: str | Path) -> list[Path]:
-    """Lay out the record's pages from its own files: the Results page's parts.
+    """Lay out the Results page's parts from the record's own files (no run needed).
 
-    From ``stamp.json``, ``claims.csv``, ``tables/*.csv`` and ``figures/*.png`` of the record,
-    writes ``stamp.md``, ``figures.md`` (each figure with its caption, in reading order),
-    ``tables/<name>.md`` (each table's summary over seeds), ``tables.md`` (the summaries, each
-    beside a link to its per-seed CSV) and ``index.md`` (figures, then the ledger's counts, then
-    the tables, then the run). No run is needed: ``tools/record.py --pages-only`` calls it on the
-    committed record.
+    From ``stamp.json``, ``claims.csv``, ``tables/*.csv`` and ``figures/*.png``, writes
+    ``stamp.md``, ``figures.md`` (each figure with its caption, in reading order),
+    ``tables/<name>.md`` (each table's summary over seeds), ``tables.md`` (each summary beside a
+    link to its per-seed CSV), ``ledger.md`` and ``index.md``.
 
     Args:
         record_dir: the record folder.
@@ -868,7 +714,7 @@ def render_pages(record_dir: str | Path) -> list[Path]:
         summary, _, seeds = table_summary(df)
         pages[f"tables/{t.stem}.md"] = text = summary_markdown(df)
         over = (
-            f"mean ± sd over training seeds {', '.join(map(str, seeds))}"
+            f"mean ± sd over training seeds {_join(seeds)}"
             if len(seeds) > 1
             else ("training seed " + str(seeds[0]) if seeds else "not seeded: as the run wrote it")
         )
@@ -883,12 +729,23 @@ def render_pages(record_dir: str | Path) -> list[Path]:
     pages["figures.md"] = "\n".join(
         f"![{n}](record/figures/{n}.png)\n\n{captions.caption(n, stamp.seeds)}\n" for n in names
     )
+    claims = _read(out / "claims.csv")
     pages["ledger.md"] = ledger_page(out / "claims.csv", stamp.trees)
+    story, premise = story_line(claims), _premise_line(claims)
+    counts = [
+        f"The ledger holds the paper's {ledger.counted(claims, 'paper')}; and this project's own "
+        f"{ledger.counted(claims, 'project')} (95% intervals over seeds; a premise is what the "
+        "comparison rests on, a finding what it says). Each claim with the paper's value beside "
+        "the measured one, its verdict and the table cells it comes from: "
+        "[the paper against the measured](ledger.md).",
+        *(["", premise[2:]] if premise else []),
+        *(["", story[2:]] if story else []),
+    ]
     pages["index.md"] = INDEX_PAGE.format(
         commit=stamp.commit,
         profile=stamp.profile,
-        seeds=", ".join(map(str, stamp.seeds)),
-        ledger="\n".join(ledger_lines(out / "claims.csv")),
+        seeds=_join(stamp.seeds),
+        ledger="\n".join(counts),
     )
     for name, text in pages.items():
         (out / name).write_text(text)
@@ -907,8 +764,7 @@ def _value_text(r: pd.Series) -> str:
 
 
 def _tree_and_claim(text: str, trees: Sequence[str]) -> tuple[str, str]:
-    """A claim's sentence as its tree and the rest (``sparse: ours is ...`` -> ``sparse``,
-    ``ours is ...``); no tree where the sentence does not start with one."""
+    """A claim's sentence as its leading tree (or "") and the rest."""
     for t in trees:
         if text.startswith(t) and text[len(t) : len(t) + 1] in (":", ",", " "):
             return t, text[len(t) :].lstrip(":, ")
@@ -929,11 +785,10 @@ LEDGER_COLUMNS = (
 
 def ledger_page(claims_csv: str | Path, trees: Sequence[str]) -> str:
     """The ledger page's table (``docs/ledger.md`` includes it): one compact row per claim, the
-    paper's claims first, each with its tree, the paper's value, the measured mean and 95%
-    interval, the verdict (coloured by ``docs/stylesheets/ledger.css``) and its kind; the full
-    sentence, the threshold, the table cells it comes from and, for a premise, what its failure
-    undermines, one click away (the row's ``<details>``). Each row carries its origin, verdict,
-    tree and kind as data attributes, which ``docs/javascripts/ledger.js`` filters by.
+    paper's first: its tree, the paper's value, the measured mean and 95% interval, the verdict
+    and its kind; the full sentence, the threshold, the cells it comes from and, for a premise,
+    what its failure undermines one click away (``<details>``). Each row carries its origin,
+    verdict, tree and kind as data attributes (``docs/javascripts/ledger.js`` filters by them).
 
     Args:
         claims_csv: the record's ``claims.csv``.
@@ -942,7 +797,7 @@ def ledger_page(claims_csv: str | Path, trees: Sequence[str]) -> str:
     Returns:
         The page part: raw HTML, ending in a newline.
     """
-    claims = read_run_csv(claims_csv)
+    claims = _read(claims_csv)
     # a ledger of fewer columns (an older or a partial one) shows what it has
     shown = {"paper": "--", "source": "--", "threshold": "", "unit": "", "seeds": 0}
     shown |= {c: np.nan for c in ("measured", "ci_low", "ci_high")}
@@ -988,29 +843,6 @@ def ledger_page(claims_csv: str | Path, trees: Sequence[str]) -> str:
     return f'<table class="ledger">\n<thead><tr>{head}</tr></thead>\n<tbody>\n{body}</tbody>\n</table>\n'
 
 
-def ledger_lines(claims_csv: str | Path) -> list[str]:
-    """The Results page's pointer to the ledger: its verdicts counted, and where the paper's value
-    stands beside the measured one.
-
-    Args:
-        claims_csv: the record's ``claims.csv``.
-
-    Returns:
-        The Markdown lines.
-    """
-    claims = read_run_csv(claims_csv)
-    story, premise = story_line(claims), premise_line(claims)
-    return [
-        f"The ledger holds the paper's {ledger.counted(claims, 'paper')}; and this project's own "
-        f"{ledger.counted(claims, 'project')} (95% intervals over seeds; a premise is what the "
-        "comparison rests on, a finding what it says). Each claim with the paper's value beside "
-        "the measured one, its verdict and the table cells it comes from: "
-        "[the paper against the measured](ledger.md).",
-        *(["", premise[2:]] if premise else []),
-        *(["", story[2:]] if story else []),
-    ]
-
-
 def write_unrecorded(out_dir: str | Path) -> Path:
     """``index.md`` of a record folder that holds no run yet, saying how to make one.
 
@@ -1030,8 +862,8 @@ def write_unrecorded(out_dir: str | Path) -> Path:
 
 
 def count_line(claims: pd.DataFrame) -> str:
-    """The ledger's counts, the paper's claims first and this project's apart, each with its
-    findings apart from the premises of the comparison (``claims.counted``).
+    """The ledger's counts, the paper's claims apart from this project's, each with its findings
+    apart from its premises (``claims.counted``).
 
     Args:
         claims: the ledger (``id``, ``verdict``; ``origin``, ``kind`` where written).
@@ -1046,15 +878,8 @@ def count_line(claims: pd.DataFrame) -> str:
     )
 
 
-def premise_line(claims: pd.DataFrame) -> str:
-    """The premises that fail and what each undermines (``claims.failed_premises``).
-
-    Args:
-        claims: the ledger.
-
-    Returns:
-        One Markdown bullet; "" when every premise holds.
-    """
+def _premise_line(claims: pd.DataFrame) -> str:
+    """A bullet naming the premises that fail and what each undermines; "" when all hold."""
     failed = ledger.failed_premises(claims)
     return (
         f"- **Premises that fail**: {'; '.join(f.rstrip('.') for f in failed)}." if failed else ""
@@ -1075,8 +900,7 @@ def _headline_families(claims: pd.DataFrame, origin: str | None = None):
 
 
 def story_line(claims: pd.DataFrame) -> str:
-    """Whether the paper's story stands, and where it does not: its headline families'
-    verdicts (``catalogue.headline`` of origin "paper"), cell by cell.
+    """Whether the paper's story stands: its headline families' verdicts, cell by cell.
 
     Args:
         claims: the ledger.
@@ -1087,32 +911,25 @@ def story_line(claims: pd.DataFrame) -> str:
     fams = list(_headline_families(claims, "paper"))
     n = sum(len(rows) for _, rows, _, _ in fams)
     held = sum(int((kind == "holds").sum()) for *_, kind in fams)
-
-    def where(v: str) -> str:  # the families with a claim of verdict v, each with its cells
-        return "; ".join(
-            f"{words} ({', '.join(cells[kind == v])})"
-            for words, _, cells, kind in fams
-            if (kind == v).any()
-        )
-
     if not n:
         return ""
     if held == n:
         return f"- **The paper's story stands**: all {n} of its headline claims hold."
     text = f"- **The paper's story stands in part**: {held} of its {n} headline claims hold"
-    if where("fails"):
-        text += "; it fails on " + where("fails")
-    if where("undecided"):
-        text += "; undecided: " + where("undecided")
+    for v, words in (("fails", "; it fails on "), ("undecided", "; undecided: ")):
+        where = [
+            f"{w} ({', '.join(cells[kind == v])})"
+            for w, _, cells, kind in fams
+            if (kind == v).any()
+        ]
+        text += words + "; ".join(where) if where else ""
     return text + "."
 
 
 def headline_lines(claims: pd.DataFrame) -> list[str]:
-    """What the run found, in a few lines: the ledger's counts (the paper's claims apart from
-    this project's), whether the paper's story stands, then each headline family's
-    (``catalogue.headline``) verdict per cell with its measured value and 95% interval, and,
-    where the paper gives a number, whether it lies inside that interval (the direction and the
-    size both: ``paper_in_interval``).
+    """What the run found, in a few lines: the ledger's counts, whether the paper's story
+    stands, then each headline family's verdict per cell with its measured value and 95%
+    interval, and, where the paper gives a number, whether it lies inside that interval.
 
     Args:
         claims: the ledger (``claims.csv``: id, measured, ci_low, ci_high, unit, verdict).
@@ -1120,7 +937,7 @@ def headline_lines(claims: pd.DataFrame) -> list[str]:
     Returns:
         The Markdown lines.
     """
-    story, premise = story_line(claims), premise_line(claims)
+    story, premise = story_line(claims), _premise_line(claims)
     lines = [count_line(claims), *([premise] if premise else []), *([story] if story else [])]
     for words, rows, where, kind in _headline_families(claims):
         cells = []
@@ -1137,8 +954,8 @@ def headline_lines(claims: pd.DataFrame) -> list[str]:
 
 
 def cost_lines(costs: pd.DataFrame) -> list[str]:
-    """What each of ``COMMANDS`` costs on 2 cores, from ``costs.csv``, each shown as the command
-    it was measured with; ``not measured`` where the record has no row for it.
+    """What each of ``COMMANDS`` costs on 2 cores, each shown as the command it was measured
+    with (``not measured`` where ``costs.csv`` has no row for it).
 
     Args:
         costs: ``costs.csv`` as [`read_costs`][physgs.report.record.read_costs] reads it.
@@ -1156,19 +973,12 @@ def cost_lines(costs: pd.DataFrame) -> list[str]:
         start = ""  # where a run starts from says something only of a workflow's targets
         if command.startswith("snakemake"):
             start = " (from nothing)" if bool(r["from_nothing"]) else " (on a finished run)"
-        n = int(r["segments"])
-        if n > 1:  # a run resumed after an interruption: its wall time is the segments' sum
-            start += f", in {n} segments"
+        if int(r["segments"]) > 1:  # a resumed run: its wall time is the segments' sum
+            start += f", in {int(r['segments'])} segments"
         # the command as it was measured (e.g. tab_null at three seeds), not the canonical one
-        rows.append(
-            (
-                f"`{r['command']}`",
-                format_duration(float(r["wall_s"])) + start,
-                f"{r['date']}, commit `{r['commit']}`, {r['cpu']}",
-            )
-        )
-    columns = ("command", "wall time on 2 cores", "measured on")
-    return markdown_table(pd.DataFrame(rows, columns=columns)).splitlines()
+        wall = format_duration(float(r["wall_s"])) + start
+        rows.append((f"`{r['command']}`", wall, f"{r['date']}, commit `{r['commit']}`, {r['cpu']}"))
+    return _table(rows, ("command", "wall time on 2 cores", "measured on"))[:-1]
 
 
 def read_costs(path: str | Path) -> pd.DataFrame:
@@ -1180,23 +990,20 @@ def read_costs(path: str | Path) -> pd.DataFrame:
     Returns:
         Its rows (``COSTS_COLUMNS``), text columns read as text.
     """
-    p = Path(path)
-    if not p.is_file():
+    if not Path(path).is_file():
         return pd.DataFrame(columns=list(COSTS_COLUMNS))
     text = {c: str for c in COSTS_COLUMNS if c not in ("wall_s", "from_nothing", "segments")}
-    df = pd.read_csv(p, dtype=text)  # a commit of digits or a command `true` stays text
+    df = pd.read_csv(path, dtype=text)  # a commit of digits or a command `true` stays text
     if "segments" not in df:  # rows recorded before runs could be resumed: one command each
         df["segments"] = 1
     return df
 
 
 def readme_block(found: Sequence[str]) -> str:
-    """The README's "what it found" and "what it costs" block around
-    [`found_lines`][physgs.report.record.found_lines].
+    """The README's "what it found" and "what it costs" block.
 
     Args:
-        found (Sequence[str]): the lines of [`found_lines`][physgs.report.record.found_lines]
-            of the record.
+        found (Sequence[str]): the record's [`found_lines`][physgs.report.record.found_lines].
 
     Returns:
         The block between the ``BEGIN`` and ``END`` markers.
@@ -1208,16 +1015,14 @@ NUMBER_WORDS = ("no", "one", "two", "three", "four", "five", "six", "seven", "ei
 
 
 def instances_phrase(instances: Mapping[str, Sequence[int]]) -> str:
-    """What a tree's name stands for in the findings: ``"; each of <trees> measured on five
-    instances of its preset (testbed seeds 0, 1, 2, 3, 4), so "<tree>" below means <tree>-preset
-    trees"``, or "" where each tree is one instance (the paper's protocol) or the stamp names
-    none.
+    """What a tree's name stands for in the findings where a tree is several instances.
 
     Args:
         instances: tree -> the testbed seeds of its instances (the stamp's).
 
     Returns:
-        The phrase, starting with "; ", or "".
+        ``; each of <trees> measured on five instances of its preset (testbed seeds 0, ...), so
+            "<tree>" below means <tree>-preset trees``, or "" where each tree is one instance.
     """
     many = {t: list(s) for t, s in instances.items() if len(s) > 1}
     if not many:
@@ -1226,7 +1031,7 @@ def instances_phrase(instances: Mapping[str, Sequence[int]]) -> str:
     n = counts.pop() if len(counts) == 1 else None
     number = (NUMBER_WORDS[n] if n < len(NUMBER_WORDS) else str(n)) if n else "several"
     seeds = {tuple(s) for s in many.values()}
-    which = f" (testbed seeds {', '.join(map(str, seeds.pop()))})" if len(seeds) == 1 else ""
+    which = f" (testbed seeds {_join(seeds.pop())})" if len(seeds) == 1 else ""
     first = next(iter(many))
     return (
         f"; each of {', '.join(many)} measured on {number} instances of its preset{which}, so "
@@ -1235,8 +1040,8 @@ def instances_phrase(instances: Mapping[str, Sequence[int]]) -> str:
 
 
 def found_lines(record_dir: str | Path) -> list[str]:
-    """The lines of [`readme_block`][physgs.report.record.readme_block] without its markers: what
-    the home page includes.
+    """The lines of [`readme_block`][physgs.report.record.readme_block] without its markers
+    (what the home page includes).
 
     Args:
         record_dir: the record folder (``claims.csv``, ``stamp.json``, ``costs.csv``).
@@ -1248,14 +1053,13 @@ def found_lines(record_dir: str | Path) -> list[str]:
     lines = ["**What the last full run found** (its record: `docs/record/`):", ""]
     if (record / "claims.csv").is_file():
         stamp = json.loads((record / "stamp.json").read_text())
-        claims = read_run_csv(record / "claims.csv")
         overrides = stamp.get("overrides") or []
-        made_with = f", made with `{overrides_words(overrides)}`" if overrides else ""
+        made_with = f", made with `{_shell(overrides)}`" if overrides else ""
         lines += [
-            f"Profile `{stamp['profile']}`{made_with}, seeds {', '.join(map(str, stamp['seeds']))}, "
+            f"Profile `{stamp['profile']}`{made_with}, seeds {_join(stamp['seeds'])}, "
             f"commit `{stamp['commit']}`{instances_phrase(stamp.get('instances') or {})}:",
             "",
-            *headline_lines(claims),
+            *headline_lines(_read(record / "claims.csv")),
             "",
             *WORDS,
         ]

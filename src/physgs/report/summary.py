@@ -1,12 +1,8 @@
 """results/summary.md: what one finished run says, printed from the run's own files.
 
-The profile and config stamp the run was made with, the claims ledger's verdict counts and each
-verdict (``results/claims.csv``), ``tab_fit``'s fraction of the true-motion ceiling's gain per
-tree and model (``results/tables/tab_fit.csv``), and what the run cost: wall time and
-job-minutes by stage from Snakemake's benchmark files ([`physgs.experiments.cost`][]). Nothing here
-is typed by hand, so the summary cannot go stale against the run it describes.
-
-Pure: takes paths (and the stamp), returns Markdown; the workflow writes it.
+The run's stamp, the claims ledger's verdicts (``results/claims.csv``), ``tab_fit``'s fraction of
+the true-motion ceiling's gain per tree and model, and what the run cost, from Snakemake's
+benchmark files ([`physgs.experiments.cost`][]): nothing typed by hand, so nothing goes stale.
 """
 
 from __future__ import annotations
@@ -27,7 +23,6 @@ from physgs.report.rerun import verdict_kind
 from physgs.report.seeds import interval
 
 VERDICTS = ("holds", "fails", "undecided")
-#: The columns of the summary's table of claims.
 CLAIM_COLUMNS = (
     "claim",
     "measured [95% interval]",
@@ -35,10 +30,13 @@ CLAIM_COLUMNS = (
     "verdict",
     "seeds to decide (est.)",
 )
+#: The seed counts the undecided claims' estimate is tabulated at (the default profile runs 3).
+DECIDE_AT = (4, 5, 6)
 
 
-def _stamp_line(stamp: Mapping[str, str]) -> str:
-    return ", ".join(f"{k}={v}" for k, v in stamp.items())
+def _table(df: pd.DataFrame, right=()) -> list[str]:
+    """A Markdown table's lines and a blank one."""
+    return [*markdown_table(df, right=right).splitlines(), ""]
 
 
 def _stale(stamp: Mapping[str, str], df: pd.DataFrame, name: str) -> list[str]:
@@ -66,11 +64,18 @@ def claims_section(claims: pd.DataFrame) -> list[str]:
     Raises:
         ValueError: for a verdict not in ``VERDICTS``.
     """
-    kind = claims["verdict"].map(verdict_kind)
-    bad = sorted(set(kind) - set(VERDICTS))
+    bad = sorted(set(claims["verdict"].map(verdict_kind)) - set(VERDICTS))
     if bad:
         raise ValueError(f"claims: unknown verdicts {bad} (expected one of {VERDICTS})")
-    lines = [
+    story = story_line(claims)
+    rows = []
+    for _, r in claims.iterrows():
+        unit = r["unit"]
+        meas = "--" if not np.isfinite(r["measured"]) else f"{number(r['measured'], unit)} {unit}"
+        if np.isfinite(r["ci_low"]):
+            meas += f" [{number(r['ci_low'], unit)}, {number(r['ci_high'], unit)}]"
+        rows.append((f"`{r['id']}`", meas, str(r["threshold"]), str(r["verdict"]), decide_cell(r)))
+    return [
         "## Claims ledger",
         "",
         f"The paper's {counted(claims, 'paper')}. This project's own "
@@ -80,52 +85,22 @@ def claims_section(claims: pd.DataFrame) -> list[str]:
         "",
         *[f"- {s[0].upper() + s[1:]}" for s in failed_premises(claims)],
         "",
-        *([story_line(claims), ""] if story_line(claims) else []),
+        *([story, ""] if story else []),
         *prior_lines(claims),
-        *decide_lines(claims),
+        *_decide_lines(claims),
+        *_table(pd.DataFrame(rows, columns=CLAIM_COLUMNS)),
     ]
-    rows = []
-    for _, r in claims.iterrows():
-        meas = (
-            "--"
-            if not np.isfinite(r["measured"])
-            else f"{number(r['measured'], r['unit'])} {r['unit']}"
-        )
-        if np.isfinite(r["ci_low"]):
-            meas += f" [{number(r['ci_low'], r['unit'])}, {number(r['ci_high'], r['unit'])}]"
-        rows.append((f"`{r['id']}`", meas, str(r["threshold"]), str(r["verdict"]), decide_cell(r)))
-    table = markdown_table(pd.DataFrame(rows, columns=CLAIM_COLUMNS))
-    return [*lines, *table.splitlines(), ""]
 
 
-#: The seed counts ``decide_lines`` tabulates (the default profile runs three).
-DECIDE_AT = (4, 5, 6)
-
-
-def decide_lines(claims: pd.DataFrame) -> list[str]:
-    """How many undecided claims would decide at 4, 5 and 6 seeds if their effect and sd
-    stayed as observed (an estimate: the ledger's ``seeds_to_decide_t_est``, the plug-in t
-    half-width, and ``seeds_to_decide_power80_est``, a t-test at 80% power), the paper's claims
-    apart from this project's.
-
-    Args:
-        claims: the ledger.
-
-    Returns:
-        The lines of a short Markdown table and a blank one; none for a ledger without the
-            estimates.
-    """
+def _decide_lines(claims: pd.DataFrame) -> list[str]:
+    """How many undecided claims would decide at ``DECIDE_AT`` seeds at their observed effect
+    and sd (the ledger's plug-in t and 80%-power estimates), the paper's apart from this
+    project's; none for a ledger without the estimates."""
     cols = {"plug-in t": "seeds_to_decide_t_est", "80% power": "seeds_to_decide_power80_est"}
     if not set(cols.values()) <= set(claims.columns):
         return []
     undecided = claims["verdict"].astype(str) == "undecided"
     origin = column(claims, "origin")
-    lines = [
-        "Seeds that would decide each undecided claim, **an estimate** at its observed effect "
-        "and sd (the plug-in t half-width; a t-test at 80% power, `tt_solve_power`): how many "
-        "would decide at each seed count.",
-        "",
-    ]
     rows = []
     for who, words in (("paper", "the paper's"), ("project", "this project's")):
         mine = claims[undecided & (origin == who)]
@@ -134,14 +109,18 @@ def decide_lines(claims: pd.DataFrame) -> list[str]:
             at = [int((n <= k).sum()) for k in DECIDE_AT]
             rows.append([f"{words} ({len(mine)})", est, *at, len(n) - at[-1]])
     head = ["undecided claims", "estimate", *(f"by {n} seeds" for n in DECIDE_AT), "more"]
-    table = markdown_table(pd.DataFrame(rows, columns=head), right=head[2:])
-    return [*lines, *table.splitlines(), ""]
+    return [
+        "Seeds that would decide each undecided claim, **an estimate** at its observed effect "
+        "and sd (the plug-in t half-width; a t-test at 80% power, `tt_solve_power`): how many "
+        "would decide at each seed count.",
+        "",
+        *_table(pd.DataFrame(rows, columns=head), right=head[2:]),
+    ]
 
 
 def prior_lines(claims: pd.DataFrame) -> list[str]:
     """One line per prior other than ours with ``<model>/ahead_of_fields/...`` claims: on how
-    many splits and trees it beats every learned field (the claim holds: its paired 95% interval
-    above 0), and which.
+    many splits and trees it beats every learned field (its claim holds), and which.
 
     Args:
         claims: the ledger.
@@ -165,32 +144,12 @@ def prior_lines(claims: pd.DataFrame) -> list[str]:
     return lines
 
 
-def fit_section(tab_fit: pd.DataFrame) -> list[str]:
-    """Fraction of the ceiling's in-window gain per model (rows) and tree (columns), in percent:
-    the mean over seeds, with its 95% interval when there are two seeds or more.
-
-    Args:
-        tab_fit: ``tab_fit.csv`` (ceiling_frac per seed, model and tree).
-
-    Returns:
-        The section's Markdown lines, ending in a blank one.
-    """
+def _fit_section(tab_fit: pd.DataFrame) -> list[str]:
+    """Each model's (rows) fraction of the ceiling's in-window gain per tree (columns), %: the
+    mean over seeds, with its 95% interval from two seeds on."""
     trees = list(dict.fromkeys(tab_fit["tree"]))
     models = list(dict.fromkeys(tab_fit.loc[~tab_fit["reference"].astype(bool), "model"]))
-    seeds = sorted(tab_fit["seed"].unique())
-    lines = [
-        "## Fit to the training window (`tab_fit`)",
-        "",
-        "Each model's share of the gain from the static pose to the true-motion ceiling on its "
-        f"trained frames, % (the bar an opponent must clear: {FIT_BAR:.0%}); "
-        + (
-            f"mean over {len(seeds)} seeds [95% interval]."
-            if len(seeds) > 1
-            else "one seed, no interval."
-        )
-        + " The table with every PSNR: `results/tables/tab_fit.tex`.",
-        "",
-    ]
+    n = tab_fit["seed"].nunique()
 
     def cell(v: pd.Series) -> str:  # the mean over seeds, %, and its 95% interval
         mean, _, lo, hi = interval(100 * v.to_numpy(float))
@@ -199,37 +158,37 @@ def fit_section(tab_fit: pd.DataFrame) -> list[str]:
 
     fit = tab_fit.groupby(["model", "tree"], sort=False)["ceiling_frac"].agg(cell).unstack()
     fit = fit.reindex(index=models, columns=trees, fill_value="--")
-    table = markdown_table(fit.rename(index=label).rename_axis(index="model").reset_index())
-    return [*lines, *table.splitlines(), ""]
+    return [
+        "## Fit to the training window (`tab_fit`)",
+        "",
+        "Each model's share of the gain from the static pose to the true-motion ceiling on its "
+        f"trained frames, % (the bar an opponent must clear: {FIT_BAR:.0%}); "
+        + (f"mean over {n} seeds [95% interval]." if n > 1 else "one seed, no interval.")
+        + " The table with every PSNR: `results/tables/tab_fit.tex`.",
+        "",
+        *_table(fit.rename(index=label).rename_axis(index="model").reset_index()),
+    ]
 
 
-def cost_section(benchmark_dir) -> list[str]:
-    """The span of the run's benchmarked jobs and of each stage's (first job start to last job
-    end) and job-minutes by stage, shared and per seed, from the benchmark files.
-
-    A span is not the run's wall time: a run resumed after an interruption spans its pauses.
-    The wall time (the time the run's command ran, summed over its segments) is measured by
-    ``tools/timed.py`` and stated by the record's stamp.
-
-    Args:
-        benchmark_dir (str | Path): the run's benchmark folder.
-
-    Returns:
-        The section's Markdown lines, ending in a blank one.
-
-    Raises:
-        FileNotFoundError: when the folder is missing or holds no benchmark file.
-    """
+def _cost_section(benchmark_dir) -> list[str]:
+    """The span (first job start to last job end) of the run's benchmarked jobs and of each
+    stage's, and job-minutes by stage, shared and per seed; not the run's wall time (a resumed
+    run's span holds its pauses: ``tools/timed.py`` measures that)."""
     jobs = read_costs(benchmark_dir)
     s, spans = summarise(jobs), wall_spans(jobs)
-    seeds = list(s["per_seed"])
-    cols = ["shared", *seeds]
+    cols = ["shared", *s["per_seed"]]
     head = [
         "stage",
         "span min",
         *(f"job-min {c}" if c == "shared" else f"job-min seed {c}" for c in cols),
     ]
-    lines = [
+    rows = [
+        [stage, spans["by_stage"][stage], *(row.get(c, np.nan) for c in cols)]
+        for stage, row in sorted(s["by_stage"].items())
+    ]
+    rows.append(["**all**", spans["run_s"], s["shared_s"], *s["per_seed"].values()])
+    minutes = pd.DataFrame(rows, columns=head).set_index("stage") / 60
+    return [
         "## What the run cost",
         "",
         f"The benchmarked jobs span **{spans['run_s'] / 60:.1f} min** from the first one's start "
@@ -241,20 +200,12 @@ def cost_section(benchmark_dir) -> list[str]:
         "seed or per training seed (`python tools/pipeline_cost.py` prints the same, and one "
         "more seed's cost).",
         "",
+        *_table(minutes.map(lambda x: "" if np.isnan(x) else f"{x:.1f}").reset_index()),
     ]
-    rows = [
-        [stage, spans["by_stage"][stage], *(row.get(c, np.nan) for c in cols)]
-        for stage, row in sorted(s["by_stage"].items())
-    ]
-    rows.append(["**all**", spans["run_s"], s["shared_s"], *s["per_seed"].values()])
-    minutes = pd.DataFrame(rows, columns=head).set_index("stage") / 60
-    table = markdown_table(minutes.map(lambda x: "" if np.isnan(x) else f"{x:.1f}").reset_index())
-    return [*lines, *table.splitlines(), ""]
 
 
 def run_summary(stamp: Mapping[str, str], claims_csv, tab_fit_csv, benchmark_dir) -> str:
-    """results/summary.md of a finished run, from its claims ledger, its ``tab_fit`` and its
-    benchmark folder.
+    """results/summary.md of a finished run, from its ledger, ``tab_fit`` and benchmarks.
 
     Args:
         stamp: the run's stamp fields.
@@ -274,18 +225,19 @@ def run_summary(stamp: Mapping[str, str], claims_csv, tab_fit_csv, benchmark_dir
     claims = pd.read_csv(claims_csv, dtype={"config_hash": str})
     tab_fit = pd.read_csv(tab_fit_csv, dtype={"config_hash": str})
     seeds = sorted(int(x) for x in tab_fit["seed"].unique())
-    trees = list(dict.fromkeys(tab_fit["tree"]))
+    made_by = ", ".join(f"{k}={v}" for k, v in stamp.items())
     lines = [
         "# Run summary",
         "",
-        f"Made by: {_stamp_line(stamp)}; training seeds {', '.join(map(str, seeds))}; "
-        f"trees {', '.join(trees)}. Printed from this run's files (`results/claims.csv`, "
-        "`results/tables/tab_fit.csv`, `results/benchmarks/`) by `physgs.report.summary`.",
+        f"Made by: {made_by}; training seeds {', '.join(map(str, seeds))}; "
+        f"trees {', '.join(dict.fromkeys(tab_fit['tree']))}. Printed from this run's files "
+        "(`results/claims.csv`, `results/tables/tab_fit.csv`, `results/benchmarks/`) by "
+        "`physgs.report.summary`.",
         "",
         *_stale(stamp, claims, "results/claims.csv"),
         *_stale(stamp, tab_fit, "results/tables/tab_fit.csv"),
         *claims_section(claims),
-        *fit_section(tab_fit),
-        *cost_section(benchmark_dir),
+        *_fit_section(tab_fit),
+        *_cost_section(benchmark_dir),
     ]
     return "\n".join(lines)
