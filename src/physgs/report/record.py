@@ -1,13 +1,8 @@
-"""The committed record of a finished run (``docs/record/``): what the documentation and the
-README show.
-
-The record holds the run's stamp, its ``summary.md``, the claims ledger, every table as CSV and
-the figures as PNG sized for the web. [`render_pages`][physgs.report.record.render_pages] lays
-the Results page's parts out from those files alone (figures with their captions, the ledger's
-counts, each table's summary over seeds, the stamp), and
-[`readme_block`][physgs.report.record.readme_block] prints the README's "what it found" and "what
-it costs" lines from them, so neither can disagree with the run. What each command costs is
-measured by ``tools/timed.py`` (``costs.csv``). Pure over paths.
+"""The committed record of a finished run (``docs/record/``): its stamp, summary, ledger, tables
+and web-sized figures. [`render_pages`][physgs.report.record.render_pages] lays the Results
+page's parts out from those files alone and [`readme_block`][physgs.report.record.readme_block]
+prints the README's findings and costs (``costs.csv``, ``tools/timed.py``) from them, so neither
+can disagree with the run. Pure over paths.
 """
 
 from __future__ import annotations
@@ -164,8 +159,7 @@ class Stamp:
 
 
 def instances_of(testbed: pd.DataFrame, seeds: Sequence[int], seed: int) -> dict[str, list[int]]:
-    """Each tree's instances as a run's ``tab_testbed.csv`` says: the training seeds where a
-    tree has one instance per seed, else the one of ``seed``.
+    """Each tree's testbed seeds: the training seeds if one instance per seed, else ``seed``.
 
     Args:
         testbed: the run's tab_testbed (``tree``, ``instances``; without it, one instance each).
@@ -243,8 +237,7 @@ def _cell(x) -> str:
 
 
 def markdown_table(df: pd.DataFrame, right: Iterable[str] = ()) -> str:
-    """A DataFrame as a Markdown table, floats to 4 significant digits, NaN as ``--`` (every
-    table of the record and of the run's summary).
+    """A DataFrame as a Markdown table: floats to 4 significant digits, NaN as ``--``.
 
     Args:
         df: the table (its index is dropped).
@@ -350,16 +343,13 @@ def _rerun_lines(
     return lines
 
 
-#: What the record takes of a run's folder: each table's CSV and each figure's PNG (folder,
-#: suffix), and the jobs' benchmark files (below ``benchmarks/``).
-RUN_FILES = {"tables": ("tables", ".csv"), "figures": ("figures", ".png")}
+#: The run's folder of the jobs' benchmark files (``physgs.experiments.cost``).
 BENCHMARKS = "benchmarks"
 
 
 @dataclass(frozen=True)
 class RunFiles:
-    """The files of a finished run that its record takes: exactly what its target's plan makes
-    ([`run_files`][physgs.report.record.run_files]).
+    """The files of a run that its record takes ([`run_files`][physgs.report.record.run_files]).
 
     Attributes:
         target: the target whose plan it is (``all``).
@@ -397,15 +387,12 @@ def run_files(
 ) -> RunFiles:
     """The tables, figures and benchmarked jobs of a run's folder that its target's plan makes.
 
-    A folder may hold more than one target's files (``studies`` run after ``all``, or an
-    earlier run's): the record takes the plan's alone, the plan being Snakemake's own
-    ([`plan_outputs`][physgs.experiments.cost.plan_outputs],
-    [`plan_jobs`][physgs.experiments.cost.plan_jobs]), so no second list of it is kept here.
-
     Args:
         results: the run's folder (``results/``).
-        outputs: every output file of the plan, relative to ``results`` (``tables/tab_fit.csv``).
-        benchmarks: every benchmark file of the plan, relative to ``results``.
+        outputs: every output of Snakemake's plan, relative to ``results``
+            ([`plan_outputs`][physgs.experiments.cost.plan_outputs]).
+        benchmarks: every benchmark file of the plan, relative to ``results``
+            ([`plan_jobs`][physgs.experiments.cost.plan_jobs]).
         target: the plan's target, named in messages.
 
     Returns:
@@ -416,11 +403,11 @@ def run_files(
     """
     root = Path(results)
     made = {PurePosixPath(p) for p in outputs}
-    picked, missing, left_out = {}, [], []
-    for kind, (folder, suffix) in RUN_FILES.items():
+    picked, missing, left_out = [], [], []
+    for folder, suffix in (("tables", ".csv"), ("figures", ".png")):
         planned = {p for p in made if p.parent == PurePosixPath(folder) and p.suffix == suffix}
         missing += sorted(str(p) for p in planned if not (root / p).is_file())
-        picked[kind] = tuple(sorted(root / p for p in planned))
+        picked.append(tuple(sorted(root / p for p in planned)))
         present = {PurePosixPath(folder, f.name) for f in (root / folder).glob(f"*{suffix}")}
         left_out += [str(p) for p in present - planned]
     if missing:
@@ -434,9 +421,7 @@ def run_files(
         f.relative_to(root / BENCHMARKS).as_posix() for f in (root / BENCHMARKS).rglob("*.tsv")
     }
     left_out += [f"{BENCHMARKS}/{p}" for p in present - bench]
-    return RunFiles(
-        target, picked["tables"], picked["figures"], tuple(jobs), tuple(sorted(left_out))
-    )
+    return RunFiles(target, *picked, tuple(jobs), tuple(sorted(left_out)))
 
 
 def _remove(path: Path) -> None:
@@ -445,24 +430,6 @@ def _remove(path: Path) -> None:
         shutil.rmtree(path)
     elif path.exists() or path.is_symlink():
         path.unlink()
-
-
-def _settle_swap(final: Path) -> None:
-    """Finish what a write of the record at ``final`` left undone when it stopped.
-
-    A write swaps the records by two renames (``final`` to ``final.old``, ``final.partial`` to
-    ``final``), then removes ``final.old``. A ``final.old`` without a ``final`` (stopped between
-    the renames) is the last record: put back; beside a ``final`` it is removed.
-    """
-    old = final.with_name(final.name + ".old")
-    if not (old.exists() or old.is_symlink()):
-        return
-    if final.exists():
-        print(f"{old}: left by an earlier write of the record after its swap; removed")
-        _remove(old)
-    else:
-        print(f"{old}: the last record, left there by a write that stopped; put back at {final}")
-        old.rename(final)
 
 
 def write_record(
@@ -475,11 +442,7 @@ def write_record(
     tables: Sequence[str | Path],
     figures: Sequence[str | Path],
 ) -> list[Path]:
-    """Write a run's record into ``out_dir``, replacing the record there.
-
-    Snakemake's report (~10 MB) is not part of it: ``tools/record.py --report-html`` makes it.
-    The new record is written beside the old (``<out_dir>.partial``) and swapped in whole;
-    what an earlier write left when it stopped is settled first, and said.
+    """Write a run's record into ``out_dir``, swapped in whole for the record there.
 
     Args:
         out_dir: the record's folder (``docs/record``).
@@ -500,7 +463,15 @@ def write_record(
         if not p.is_file():
             raise FileNotFoundError(f"{p}: missing; finish the run first (snakemake --cores 2 all)")
     final = Path(out_dir)
-    _settle_swap(final)
+    # a write swaps the records by two renames (final -> final.old, final.partial -> final), then
+    # removes final.old: one that stopped between the renames left the last record there
+    old = final.with_name(final.name + ".old")
+    if (old.exists() or old.is_symlink()) and final.exists():
+        print(f"{old}: left by an earlier write of the record after its swap; removed")
+        _remove(old)
+    elif old.exists() or old.is_symlink():
+        print(f"{old}: the last record, left there by a write that stopped; put back at {final}")
+        old.rename(final)
     kept = {n: (final / n).read_bytes() for n in OUTLIVE if (final / n).is_file()}
     old_stamp, old_rerun = final / "stamp.json", final / "rerun.md"
     prior = json.loads(old_stamp.read_text()) if old_stamp.is_file() else {}
@@ -531,7 +502,6 @@ def write_record(
             im.save(out / "figures" / f.name, optimize=True)
     render_pages(out)
     written = sorted(final / p.relative_to(out) for p in out.rglob("*") if p.is_file())
-    old = final.with_name(final.name + ".old")
     if final.exists():
         final.rename(old)
     out.rename(final)
@@ -552,9 +522,8 @@ def _mean_sd(values: pd.Series) -> str:
 
 
 def table_summary(df: pd.DataFrame) -> tuple[pd.DataFrame, list[str], list[int]]:
-    """A per-seed table as its summary over seeds: one row per key (its text and true/false
-    columns), each value column as ``mean ± sd`` over the seeds; the stamp's columns and empty
-    ones dropped. A table without a ``seed`` column is returned as it is.
+    """A per-seed table as ``mean ± sd`` over seeds per key (its text and true/false columns),
+    the stamp's and empty columns dropped; a table without a ``seed`` column as it is.
 
     Args:
         df: the table, one row per seed (the stamp's columns read as text).
@@ -578,14 +547,13 @@ def table_summary(df: pd.DataFrame) -> tuple[pd.DataFrame, list[str], list[int]]
 
 
 def summary_markdown(df: pd.DataFrame) -> str:
-    """[`table_summary`][physgs.report.record.table_summary] as Markdown tables of at most
-    ``VALUE_COLUMNS_SHOWN`` value columns each, the key columns repeated.
+    """[`table_summary`][physgs.report.record.table_summary] as Markdown tables, the keys repeated.
 
     Args:
         df: the table, one row per seed.
 
     Returns:
-        The tables' lines, blank-line separated, ending in a newline.
+        Tables of ``VALUE_COLUMNS_SHOWN`` value columns at most, blank-line separated.
     """
     summary, keys, _ = table_summary(df)
     values = [c for c in summary.columns if c not in keys]
@@ -596,16 +564,13 @@ def summary_markdown(df: pd.DataFrame) -> str:
     return "\n".join(markdown_table(summary[keys + cols].rename(columns=heads)) for cols in parts)
 
 
-#: The ledger's columns the catalogue derives from a claim's id, each placed after the one named.
-DERIVED_COLUMNS = {"kind": "origin"}
 #: The heading of the run summary's claims section as the record holds it (demoted).
 SUMMARY_CLAIMS = "### Claims ledger"
 
 
 def derive_claims(record_dir: str | Path) -> list[Path]:
-    """Give a record's ledger the ``DERIVED_COLUMNS`` it lacks, and print its ``claims.md`` and
-    the claims section of its ``summary.md`` again from it with the rules' own printers. No
-    number is touched: the CSV is read and written back as text.
+    """Give a record's ledger the ``kind`` column it may lack (derived from its ids), and print its
+    ``claims.md`` and the claims section of its ``summary.md`` again with the rules' printers.
 
     Args:
         record_dir: the record folder (``claims.csv``).
@@ -617,13 +582,10 @@ def derive_claims(record_dir: str | Path) -> list[Path]:
 
     out = Path(record_dir)
     path, written = out / "claims.csv", []
-    text = pd.read_csv(path, dtype=str, keep_default_na=False)
-    missing = [c for c in DERIVED_COLUMNS if c not in text.columns]
-    for name in missing:
-        after = DERIVED_COLUMNS[name]
-        at = text.columns.get_loc(after) + 1 if after in text else len(text.columns)
-        text.insert(at, name, ledger.column(text, name))
-    if missing:
+    text = pd.read_csv(path, dtype=str, keep_default_na=False)  # no number is touched
+    if "kind" not in text:
+        at = text.columns.get_loc("origin") + 1 if "origin" in text else len(text.columns)
+        text.insert(at, "kind", ledger.column(text, "kind"))
         text.to_csv(path, index=False)
         written.append(path)
     df = _read(path)
@@ -689,12 +651,8 @@ TABLE_ENTRY = """\
 
 
 def render_pages(record_dir: str | Path) -> list[Path]:
-    """Lay out the Results page's parts from the record's own files (no run needed).
-
-    From ``stamp.json``, ``claims.csv``, ``tables/*.csv`` and ``figures/*.png``, writes
-    ``stamp.md``, ``figures.md`` (each figure with its caption, in reading order),
-    ``tables/<name>.md`` (each table's summary over seeds), ``tables.md`` (each summary beside a
-    link to its per-seed CSV), ``ledger.md`` and ``index.md``.
+    """Lay out the Results page's parts (``stamp.md``, ``figures.md``, ``tables.md`` and
+    ``tables/<name>.md``, ``ledger.md``, ``index.md``) from the record's own files.
 
     Args:
         record_dir: the record folder.
@@ -763,32 +721,9 @@ def _value_text(r: pd.Series) -> str:
     return f"{ledger.number(r['measured'], r['unit'])} {r['unit']} (one value)"
 
 
-def _tree_and_claim(text: str, trees: Sequence[str]) -> tuple[str, str]:
-    """A claim's sentence as its leading tree (or "") and the rest."""
-    for t in trees:
-        if text.startswith(t) and text[len(t) : len(t) + 1] in (":", ",", " "):
-            return t, text[len(t) :].lstrip(":, ")
-    return "", text
-
-
-#: The ledger page's columns (``ledger_page``).
-LEDGER_COLUMNS = (
-    "claim (click for the full claim)",
-    "tree",
-    "the paper",
-    "measured: mean [95% interval]",
-    "verdict",
-    "kind",
-    "origin",
-)
-
-
 def ledger_page(claims_csv: str | Path, trees: Sequence[str]) -> str:
-    """The ledger page's table (``docs/ledger.md`` includes it): one compact row per claim, the
-    paper's first: its tree, the paper's value, the measured mean and 95% interval, the verdict
-    and its kind; the full sentence, the threshold, the cells it comes from and, for a premise,
-    what its failure undermines one click away (``<details>``). Each row carries its origin,
-    verdict, tree and kind as data attributes (``docs/javascripts/ledger.js`` filters by them).
+    """The ledger page's table (``docs/ledger.md``): one row per claim, the paper's first, its
+    details one click away, its origin, verdict, tree and kind as data attributes (``ledger.js``).
 
     Args:
         claims_csv: the record's ``claims.csv``.
@@ -814,7 +749,11 @@ def ledger_page(claims_csv: str | Path, trees: Sequence[str]) -> str:
     e = html.escape
     rows = []
     for _, r in claims.iterrows():
-        tree, short = _tree_and_claim(str(r["claim"]), trees)
+        text = str(r["claim"])  # a sentence's leading tree, and the rest
+        lead = [
+            t for t in trees if text.startswith(t) and text[len(t) : len(t) + 1] in (":", ",", " ")
+        ]
+        tree, short = (lead[0], text[len(lead[0]) :].lstrip(":, ")) if lead else ("", text)
         more = [
             f"<b>{e(str(r['claim']))}</b>",
             f"id <code>{e(str(r['id']))}</code>; {e(r['_origin'])}'s {r['_kind']}",
@@ -838,7 +777,10 @@ def ledger_page(claims_csv: str | Path, trees: Sequence[str]) -> str:
             f'<td class="verdict-{r["_verdict"]}">{r["_verdict"]}</td>'
             f"<td>{r['_kind']}</td><td>{e(r['_origin'])}</td></tr>"
         )
-    head = "".join(f"<th>{h}</th>" for h in LEDGER_COLUMNS)
+    head = (
+        "<th>claim (click for the full claim)</th><th>tree</th><th>the paper</th>"
+        "<th>measured: mean [95% interval]</th><th>verdict</th><th>kind</th><th>origin</th>"
+    )
     body = "".join(row + "\n" for row in rows)
     return f'<table class="ledger">\n<thead><tr>{head}</tr></thead>\n<tbody>\n{body}</tbody>\n</table>\n'
 
@@ -927,9 +869,8 @@ def story_line(claims: pd.DataFrame) -> str:
 
 
 def headline_lines(claims: pd.DataFrame) -> list[str]:
-    """What the run found, in a few lines: the ledger's counts, whether the paper's story
-    stands, then each headline family's verdict per cell with its measured value and 95%
-    interval, and, where the paper gives a number, whether it lies inside that interval.
+    """What the run found: the ledger's counts, whether the paper's story stands, each headline
+    family's verdicts with their intervals and whether the paper's number lies inside.
 
     Args:
         claims: the ledger (``claims.csv``: id, measured, ci_low, ci_high, unit, verdict).
@@ -954,8 +895,7 @@ def headline_lines(claims: pd.DataFrame) -> list[str]:
 
 
 def cost_lines(costs: pd.DataFrame) -> list[str]:
-    """What each of ``COMMANDS`` costs on 2 cores, each shown as the command it was measured
-    with (``not measured`` where ``costs.csv`` has no row for it).
+    """What each of ``COMMANDS`` costs on 2 cores, as measured (or ``not measured``).
 
     Args:
         costs: ``costs.csv`` as [`read_costs`][physgs.report.record.read_costs] reads it.
@@ -1040,8 +980,7 @@ def instances_phrase(instances: Mapping[str, Sequence[int]]) -> str:
 
 
 def found_lines(record_dir: str | Path) -> list[str]:
-    """The lines of [`readme_block`][physgs.report.record.readme_block] without its markers
-    (what the home page includes).
+    """The lines of [`readme_block`][physgs.report.record.readme_block] (the home page's).
 
     Args:
         record_dir: the record folder (``claims.csv``, ``stamp.json``, ``costs.csv``).

@@ -19,7 +19,7 @@ from physgs.report.outputs import OUTPUTS, PROVENANCE_COLUMNS
 @dataclass(frozen=True)
 class CellChange:
     """One numeric cell (``key``: its row's key values, seed included; ``column``) that moved
-    from ``old`` to ``new`` by more than ``spread``, the old run's max - min over its row's seeds."""
+    from ``old`` to ``new`` by more than ``spread`` (the old run's max - min over its seeds)."""
 
     key: dict
     column: str
