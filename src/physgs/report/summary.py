@@ -23,13 +23,8 @@ from physgs.report.rerun import verdict_kind
 from physgs.report.seeds import interval
 
 VERDICTS = ("holds", "fails", "undecided")
-CLAIM_COLUMNS = (
-    "claim",
-    "measured [95% interval]",
-    "threshold",
-    "verdict",
-    "seeds to decide (est.)",
-)
+#: The columns of the summary's table of claims (and the seeds that would decide each).
+CLAIM_COLUMNS = ("claim", "measured [95% interval]", "threshold", "verdict")
 #: The seed counts the undecided claims' estimate is tabulated at (the default profile runs 3).
 DECIDE_AT = (4, 5, 6)
 
@@ -88,7 +83,7 @@ def claims_section(claims: pd.DataFrame) -> list[str]:
         *([story, ""] if story else []),
         *prior_lines(claims),
         *_decide_lines(claims),
-        *_table(pd.DataFrame(rows, columns=CLAIM_COLUMNS)),
+        *_table(pd.DataFrame(rows, columns=[*CLAIM_COLUMNS, "seeds to decide (est.)"])),
     ]
 
 
