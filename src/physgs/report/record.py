@@ -69,6 +69,11 @@ WORDS = (
 
 #: A commit as the record names it: a plain (abbreviated) hash.
 COMMIT = re.compile(r"^[0-9a-f]{7,40}$")
+#: The run's folder of the jobs' benchmark files (``physgs.experiments.cost``).
+BENCHMARKS = "benchmarks"
+#: The heading of the run summary's claims section as the record holds it (demoted).
+SUMMARY_CLAIMS = "### Claims ledger"
+NUMBER_WORDS = ("no", "one", "two", "three", "four", "five", "six", "seven", "eight", "nine", "ten")
 
 
 def _join(xs: Iterable) -> str:
@@ -187,12 +192,12 @@ def other_configs(files: Iterable[str | Path], config_hash: str) -> list[str]:
     Returns:
         One phrase per file that disagrees: its path and the hashes it holds.
     """
-    out = []
-    for f in files:
-        found = config_hashes(_read(f))
-        if found is not None and found != [config_hash]:
-            out.append(f"{f}: config_hash {', '.join(found) or 'none'}, not {config_hash}")
-    return out
+    found = [(f, config_hashes(_read(f))) for f in files]
+    return [
+        f"{f}: config_hash {', '.join(h) or 'none'}, not {config_hash}"
+        for f, h in found
+        if h is not None and h != [config_hash]
+    ]
 
 
 def config_hashes(df: pd.DataFrame) -> list[str] | None:
@@ -341,10 +346,6 @@ def _rerun_lines(
             *_table(cells, ("table", "row", "column", *shown), right=shown),
         ]
     return lines
-
-
-#: The run's folder of the jobs' benchmark files (``physgs.experiments.cost``).
-BENCHMARKS = "benchmarks"
 
 
 @dataclass(frozen=True)
@@ -562,10 +563,6 @@ def summary_markdown(df: pd.DataFrame) -> str:
     # a long column name may break after an underscore (<wbr>: no character when copied)
     heads = {c: str(c).replace("_", "_<wbr>") for c in summary.columns}
     return "\n".join(markdown_table(summary[keys + cols].rename(columns=heads)) for cols in parts)
-
-
-#: The heading of the run summary's claims section as the record holds it (demoted).
-SUMMARY_CLAIMS = "### Claims ledger"
 
 
 def derive_claims(record_dir: str | Path) -> list[Path]:
@@ -949,9 +946,6 @@ def readme_block(found: Sequence[str]) -> str:
         The block between the ``BEGIN`` and ``END`` markers.
     """
     return "\n".join([BEGIN, "", *found, END])
-
-
-NUMBER_WORDS = ("no", "one", "two", "three", "four", "five", "six", "seven", "eight", "nine", "ten")
 
 
 def instances_phrase(instances: Mapping[str, Sequence[int]]) -> str:
