@@ -97,14 +97,12 @@ class Stamp:
         seeds: training seeds of the run.
         trees: trees of the run.
         cpu: the machine's CPU model and its bf16/AMX flags.
-        wall_s: wall time of the run, s: the time its command ran, summed over the segments of
-            a resumed run (``tools/timed.py``; the one definition the record and README use).
+        wall_s: the time the run's command ran, s, summed over its segments (``tools/timed.py``).
         job_min_by_stage: job-minutes per stage, from the run's benchmark files.
         note: what a reader should know about how the run was made (apart from the commit).
         jobs: the run's benchmarked jobs (one benchmark file each; light jobs have none).
         instances: tree -> the testbed seeds of its tree instances; {} in an older record.
-        overrides: the run's ``--configfile`` and ``--config`` words (none: the config file as
-            committed, at the stamp's profile).
+        overrides: the run's ``--configfile`` and ``--config`` words (none: the committed config).
     """
 
     date: str
@@ -357,8 +355,7 @@ class RunFiles:
         tables: the plan's table CSVs, sorted.
         figures: the plan's figure PNGs, sorted.
         jobs: the plan's benchmarked jobs ([`JobCost`][physgs.experiments.cost.JobCost]).
-        left_out: the tables, figures and benchmark files the folder holds that the plan does
-            not make (another target's, or an earlier run's), relative to the folder, sorted.
+        left_out: the files of these kinds in the folder that the plan does not make, sorted.
     """
 
     target: str
@@ -371,8 +368,7 @@ class RunFiles:
         """What was left out: the tables and figures by name, the benchmark files by stage.
 
         Returns:
-            ``left out (not made by all): tables/x.csv, ...; N benchmark files (stage n, ...)``,
-                or ``left out (not made by all): nothing``.
+            ``left out (not made by all): tables/x.csv, ...; N benchmark files (stage n, ...)``.
         """
         parts = [PurePosixPath(p).parts for p in self.left_out]
         files = [p for p, (top, *_) in zip(self.left_out, parts) if top != BENCHMARKS]
@@ -511,8 +507,7 @@ def write_record(
 
 
 def _mean_sd(values: pd.Series) -> str:
-    """``mean ± sd`` over seeds (NaN dropped): the value alone where the seeds agree (to
-    rounding) or one seed has it, ``--`` where none has."""
+    """``mean ± sd`` over seeds, NaN dropped (the value alone where the seeds agree; ``--``)."""
     v = pd.to_numeric(values, errors="coerce").dropna()
     if v.empty:
         return "--"
@@ -530,8 +525,7 @@ def table_summary(df: pd.DataFrame) -> tuple[pd.DataFrame, list[str], list[int]]
         df: the table, one row per seed (the stamp's columns read as text).
 
     Returns:
-        ``(summary, key columns, seeds)``: the summary's cells as text, the key columns in
-            the table's order, the seeds summarised over (empty without a seed column).
+        ``(summary as text, key columns in the table's order, seeds summarised over)``.
     """
     df = df.drop(columns=[c for c in STAMP_COLUMNS if c in df]).dropna(axis=1, how="all")
     keys = [c for c in df.columns if c != "seed" and not pd.api.types.is_numeric_dtype(df[c])]
@@ -566,8 +560,7 @@ def summary_markdown(df: pd.DataFrame) -> str:
 
 
 def derive_claims(record_dir: str | Path) -> list[Path]:
-    """Give a record's ledger the ``kind`` column it may lack (derived from its ids), and print its
-    ``claims.md`` and the claims section of its ``summary.md`` again with the rules' printers.
+    """Derive a record ledger's ``kind`` if it lacks it; print its ``claims.md`` and claims again.
 
     Args:
         record_dir: the record folder (``claims.csv``).
@@ -648,8 +641,7 @@ TABLE_ENTRY = """\
 
 
 def render_pages(record_dir: str | Path) -> list[Path]:
-    """Lay out the Results page's parts (``stamp.md``, ``figures.md``, ``tables.md`` and
-    ``tables/<name>.md``, ``ledger.md``, ``index.md``) from the record's own files.
+    """Lay out the Results page's parts (``index.md`` and what it includes) from the record.
 
     Args:
         record_dir: the record folder.
@@ -708,8 +700,7 @@ def render_pages(record_dir: str | Path) -> list[Path]:
 
 
 def _value_text(r: pd.Series) -> str:
-    """A ledger row's measured mean and 95% interval, ``+2.26 [+1.94, +2.57] dB`` (``--``
-    unmeasured, the value alone where one value gives no interval)."""
+    """A ledger row's measured mean and 95% interval, ``+2.26 [+1.94, +2.57] dB``, or ``--``."""
     if not math.isfinite(r["measured"]):
         return "--"
     if math.isfinite(r["ci_low"]):
@@ -719,8 +710,7 @@ def _value_text(r: pd.Series) -> str:
 
 
 def ledger_page(claims_csv: str | Path, trees: Sequence[str]) -> str:
-    """The ledger page's table (``docs/ledger.md``): one row per claim, the paper's first, its
-    details one click away, its origin, verdict, tree and kind as data attributes (``ledger.js``).
+    """The ledger page's HTML table: a row per claim, its details one click away (``ledger.js``).
 
     Args:
         claims_csv: the record's ``claims.csv``.
@@ -801,8 +791,7 @@ def write_unrecorded(out_dir: str | Path) -> Path:
 
 
 def count_line(claims: pd.DataFrame) -> str:
-    """The ledger's counts, the paper's claims apart from this project's, each with its findings
-    apart from its premises (``claims.counted``).
+    """The ledger's counts, the paper's claims apart from this project's (``claims.counted``).
 
     Args:
         claims: the ledger (``id``, ``verdict``; ``origin``, ``kind`` where written).
@@ -826,10 +815,8 @@ def _premise_line(claims: pd.DataFrame) -> str:
 
 
 def _headline_families(claims: pd.DataFrame, origin: str | None = None):
-    """The headline families (``catalogue.headline``, of ``origin`` if given) the ledger holds,
-    in the catalogue's order: their words, their claims (the id is the family's, or starts with
-    it + "/"), each claim's cell (the id past the family's; ``all`` for the family's own) and
-    verdict kind."""
+    """The ledger's headline families (``catalogue.headline``, of ``origin`` if given): their
+    words, claims, each claim's cell (its id past the family's, or ``all``) and verdict kind."""
     ids = claims["id"].astype(str)
     for fam, words, of in catalogue.headline():
         rows = (ids == fam) | ids.str.startswith(fam + "/")
@@ -866,8 +853,7 @@ def story_line(claims: pd.DataFrame) -> str:
 
 
 def headline_lines(claims: pd.DataFrame) -> list[str]:
-    """What the run found: the ledger's counts, whether the paper's story stands, each headline
-    family's verdicts with their intervals and whether the paper's number lies inside.
+    """What the run found: the ledger's counts, the paper's story, each headline family's verdicts.
 
     Args:
         claims: the ledger (``claims.csv``: id, measured, ci_low, ci_high, unit, verdict).
@@ -955,8 +941,7 @@ def instances_phrase(instances: Mapping[str, Sequence[int]]) -> str:
         instances: tree -> the testbed seeds of its instances (the stamp's).
 
     Returns:
-        ``; each of <trees> measured on five instances of its preset (testbed seeds 0, ...), so
-            "<tree>" below means <tree>-preset trees``, or "" where each tree is one instance.
+        ``; each of <trees> measured on five instances of its preset ...``, or "" if none is.
     """
     many = {t: list(s) for t, s in instances.items() if len(s) > 1}
     if not many:

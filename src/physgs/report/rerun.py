@@ -1,8 +1,6 @@
-"""Two runs compared: each seeded table cell by cell, the claims ledger verdict by verdict.
-
-A change that only reorders floating-point work still moves every training's trajectory; each
-numeric cell's change is set beside the old run's spread over seeds of the same row (the same
-key but the seed): within it, the rerun says nothing the seeds did not.
+"""Two runs compared: each seeded table cell by cell, each numeric cell's change beside the old
+run's spread over seeds of its row (within it, the rerun says nothing the seeds did not), and the
+claims ledger verdict by verdict.
 """
 
 from __future__ import annotations
@@ -80,8 +78,7 @@ def seeded_keys(table: pd.DataFrame, seed: str = "seed") -> list[str]:
 
 
 def table_keys(name: str, table: pd.DataFrame) -> list[str]:
-    """The key columns of seeded table ``name``: its declared ``Columns.keys``, else
-    [`seeded_keys`][physgs.report.rerun.seeded_keys].
+    """Table ``name``'s ``Columns.keys``, else [`seeded_keys`][physgs.report.rerun.seeded_keys].
 
     Args:
         name: the table's name (the CSV's stem).
@@ -95,8 +92,7 @@ def table_keys(name: str, table: pd.DataFrame) -> list[str]:
 
 
 def timing_columns(name: str) -> tuple[str, ...]:
-    """The columns of table ``name`` that time its jobs: its declared ones, else
-    ``TIMING_COLUMNS``.
+    """The columns of table ``name`` that time its jobs: its declared ones, else ``TIMING_COLUMNS``.
 
     Args:
         name: the table's name (the CSV's stem).
@@ -109,8 +105,7 @@ def timing_columns(name: str) -> tuple[str, ...]:
 
 
 def compare_table_csv(old_csv, new_csv, keys: list[str] | None = None) -> RerunComparison:
-    """Compare two runs' CSVs of one seeded table, keyed by ``keys`` or its
-    [`table_keys`][physgs.report.rerun.table_keys].
+    """Compare two runs' CSVs of one seeded table ([`table_keys`][physgs.report.rerun.table_keys]).
 
     Args:
         old_csv (str | Path): the earlier run's table.
@@ -266,16 +261,14 @@ def compare_claims(old: pd.DataFrame, new: pd.DataFrame) -> ClaimsComparison:
     """Compare two runs' ledgers (``claims.csv``) verdict by verdict, by kind (not reason).
 
     Args:
-        old: the earlier run's ledger (id, verdict, measured, ci_low, ci_high, unit,
-            threshold; claim optional).
+        old: the earlier run's ledger (id, verdict, measured, ci_low, ci_high, unit, threshold).
         new: the new run's ledger, same columns.
 
     Returns:
         The [`ClaimsComparison`][physgs.report.rerun.ClaimsComparison].
 
     Raises:
-        ValueError: a ledger without an ``id``, ``verdict`` or ``measured`` column, or with an
-            id repeated.
+        ValueError: a ledger without ``id``, ``verdict`` or ``measured``, or repeating an id.
     """
     for name, df in (("old", old), ("new", new)):
         missing = [c for c in ("id", "verdict", "measured") if c not in df.columns]

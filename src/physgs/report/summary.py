@@ -47,8 +47,7 @@ def _stale(stamp: Mapping[str, str], df: pd.DataFrame, name: str) -> list[str]:
 
 
 def claims_section(claims: pd.DataFrame) -> list[str]:
-    """Verdict counts, the paper's claims apart from this project's, whether the paper's story
-    stands, and one line per claim (verdict, measured value with its interval).
+    """The ledger's counts, the paper's story, and one line per claim with its interval.
 
     Args:
         claims: the ledger (``claims.csv``).
@@ -114,8 +113,7 @@ def _decide_lines(claims: pd.DataFrame) -> list[str]:
 
 
 def prior_lines(claims: pd.DataFrame) -> list[str]:
-    """One line per prior other than ours with ``<model>/ahead_of_fields/...`` claims: on how
-    many splits and trees it beats every learned field (its claim holds), and which.
+    """Per prior with ``<model>/ahead_of_fields/...`` claims: where it beats every learned field.
 
     Args:
         claims: the ledger.
