@@ -599,7 +599,7 @@ def derive_claims(record_dir: str | Path) -> list[Path]:
 #: The Results page's part the record lays out (``index.md``): its figures, its ledger's counts,
 #: its tables and its run, each included from its own page.
 INDEX_PAGE = """\
-From the run at commit `{commit}` (profile `{profile}`, training seeds {seeds}; its stamp: [the run](#the-run)).
+From the run at commit `{s.commit}` (profile `{s.profile}`, training seeds {seeds}; its stamp: [the run](#the-run)).
 
 ## Figures
 
@@ -679,7 +679,7 @@ def render_pages(record_dir: str | Path) -> list[Path]:
     claims = _read(out / "claims.csv")
     pages["ledger.md"] = ledger_page(out / "claims.csv", stamp.trees)
     story, premise = story_line(claims), _premise_line(claims)
-    counts = [
+    led = [
         f"The ledger holds the paper's {ledger.counted(claims, 'paper')}; and this project's own "
         f"{ledger.counted(claims, 'project')} (95% intervals over seeds; a premise is what the "
         "comparison rests on, a finding what it says). Each claim with the paper's value beside "
@@ -688,12 +688,7 @@ def render_pages(record_dir: str | Path) -> list[Path]:
         *(["", premise[2:]] if premise else []),
         *(["", story[2:]] if story else []),
     ]
-    pages["index.md"] = INDEX_PAGE.format(
-        commit=stamp.commit,
-        profile=stamp.profile,
-        seeds=_join(stamp.seeds),
-        ledger="\n".join(counts),
-    )
+    pages["index.md"] = INDEX_PAGE.format(s=stamp, seeds=_join(stamp.seeds), ledger="\n".join(led))
     for name, text in pages.items():
         (out / name).write_text(text)
     return [out / name for name in pages]

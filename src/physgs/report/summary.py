@@ -170,11 +170,7 @@ def _cost_section(benchmark_dir) -> list[str]:
     jobs = read_costs(benchmark_dir)
     s, spans = summarise(jobs), wall_spans(jobs)
     cols = ["shared", *s["per_seed"]]
-    head = [
-        "stage",
-        "span min",
-        *(f"job-min {c}" if c == "shared" else f"job-min seed {c}" for c in cols),
-    ]
+    head = ["stage", "span min", "job-min shared", *(f"job-min seed {c}" for c in s["per_seed"])]
     rows = [
         [stage, spans["by_stage"][stage], *(row.get(c, np.nan) for c in cols)]
         for stage, row in sorted(s["by_stage"].items())
