@@ -398,8 +398,11 @@ def plateau(a: argparse.Namespace) -> None:
     curves_, shorter = learned[learned["budget"] == longest], learned[learned["budget"] < longest]
     if len(shorter):
         print("trainings at their own budget against the long curve's checkpoint there (dB):")
-        print(own_budgets(curves_, shorter).to_string(index=False, float_format="{:.2f}".format))
+        own = own_budgets(curves_, shorter)
+        print(own.to_string(index=False, float_format="{:.2f}".format))
         print()
+        if a.own_markdown:
+            Path(a.own_markdown).write_text(own.to_markdown(index=False, floatfmt=".2f") + "\n")
     r = plateaus(curves_, a.patience, a.tol, refs if len(refs) else None, a.within)
     print(r.to_string(index=False, float_format=lambda x: f"{x:.3g}"))
     if a.caps:
@@ -549,6 +552,7 @@ def main() -> None:
     p.add_argument("--patience", type=int, default=2)
     p.add_argument("--tol", type=float, default=0.005)
     p.add_argument("--within", type=float, default=0.5, help="enough_at: dB below the best")
+    p.add_argument("--own-markdown", default=None, help="write the own-budget table here")
     p.add_argument("--caps", default="", help="e.g. 4500,6000: the shortfall at each budget")
     p.add_argument("--markdown", default=None, help="write the table here")
     p.add_argument("--figure", default=None, help="draw the curves here (PNG)")
