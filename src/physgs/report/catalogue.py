@@ -1,57 +1,30 @@
 """The catalogue of claims: every claim family of the ledger as one entry of data.
 
-An entry ([`ClaimSpec`][physgs.report.catalogue.ClaimSpec]) says what the family ranges over
-(its scope: trees, cells of a table, and, for ``of="priors"``, every prior of the registry other
-than ours that the run's tables hold), the table and how one seed's value is read from it (its
-reader), its threshold (a name of [`physgs.report.thresholds`][physgs.report.thresholds]) and
-side, its unit, its sentence, the paper's figure, whether it carries the story (a headline, with
-the words the README uses), and its origin: the paper's claim, or this project's own.
-[`physgs.report.claims.measure`][] loops over it; the tables the ledger reads, the README's
-headline families and the list of claims on the claims page
-([`markdown`][physgs.report.catalogue.markdown]) are derived from it.
-
-Adding a claim family is one entry here, with its scope and reader beside it (the shared ones
-come first; a scope's docstring is what the claims page says the family ranges over).
-
-Entries are Python, not YAML: a family's scope and reader are functions over the tables, and a
-frozen dataclass keeps them typed and importable where a YAML file would need a small language
-of its own for the cell arithmetic.
+An entry ([`ClaimSpec`][physgs.report.catalogue.ClaimSpec]) holds its scope (the run -> its
+cells, and for ``of="priors"`` every prior of the registry other than ours that the run's tables
+hold), its table and reader (one seed's value), its threshold (a name of
+[`physgs.report.thresholds`][physgs.report.thresholds]) and side, its unit and sentence, the
+paper's figure, the README's words for a headline, and its origin (the paper's or this
+project's). [`physgs.report.claims.measure`][] loops over it; the tables the ledger reads, the
+headline families and the claims page ([`markdown`][physgs.report.catalogue.markdown]) derive
+from it. Entries are Python, not YAML: a scope and a reader are functions over the tables (a
+scope's docstring is what the claims page says the family ranges over).
 """
 
 from __future__ import annotations
 
 import string
 from dataclasses import dataclass
-from typing import Callable, Sequence
+from typing import Any, Callable, Sequence
 
 import numpy as np
 import pandas as pd
 
-from physgs.models.registry import (
-    BLIND_CONFIG,
-    BLIND_PRIORS,
-    MODELS,
-    PRIOR_VARIANTS,
-    label,
-    models_of,
-    spec_of,
-)
+from physgs.models.registry import BLIND_CONFIG, BLIND_PRIORS, MODELS, PRIOR_VARIANTS
+from physgs.models.registry import label, models_of, spec_of
 from physgs.report import paper, thresholds
-from physgs.report.claim_cells import (
-    CONFIG,
-    FIELD_KINDS,
-    RECOVERY,
-    SEPARATED,
-    TILED,
-    Cell,
-    Reader,
-    Run,
-    Scope,
-    fields,
-    fields_of_kind,
-    rows_of,
-    value,
-)
+from physgs.report.claim_cells import CONFIG, FIELD_KINDS, RECOVERY, SEPARATED, TILED, Cell
+from physgs.report.claim_cells import Reader, Run, Scope, fields_of_kind, rows_of, value
 from physgs.report.recovery import OMA
 from physgs.testbed.variant import DAMPING
 
@@ -59,17 +32,12 @@ from physgs.testbed.variant import DAMPING
 ORIGINS = ("paper", "project")
 #: The models the paper itself compared: a claim about any other model is this project's.
 PAPER_MODELS = (*models_of("control", "field"), "ours")
-
-#: The kinds of a claim: a premise of the comparison (the testbed is the paper's, the models fit
-#: their window) or a finding the comparison makes. Every family is a finding but ``PREMISES``'.
+#: The kinds of a claim: a premise of the comparison (``PREMISES``) or a finding.
 KINDS = ("premise", "finding")
-#: The side of an equivalence claim (flat, equal, matching): the value lies inside the band
-#: (-threshold, +threshold). Two one-sided tests on the 95% interval, each at 2.5% (stricter
-#: than the customary 90% interval of TOST at 5%: one interval serves every verdict).
+#: The side of an equivalence claim (flat, equal, matching): inside (-threshold, +threshold),
+#: two one-sided tests on the 95% interval (stricter than TOST's customary 90%).
 WITHIN = "within"
-#: The sides a claim may take.
 SIDES = (">", "<", WITHIN)
-
 #: The family the summary's line on the other priors counts (``physgs.report.summary``).
 AHEAD = "ahead_of_fields"
 #: Names a sentence may use: every threshold, and the ledger's recovery configuration.
@@ -84,16 +52,14 @@ class Figure:
 
     Attributes:
         what: what the figure is and where the paper gives it (the claims page prints it).
-        value: the cell -> ``(low, high)`` in the claim's unit (equal ends for one figure);
-            ``NO_VALUE`` where the paper gives none.
-        words: the figure as the ledger prints it: a ``str.format`` template of the cell's
-            fields and ``v`` (``value``'s low end; "--" where it is NaN), or a function of the
-            cell.
+        value: the cell -> ``(low, high)`` in the claim's unit; ``NO_VALUE`` where none.
+        words: as the ledger prints it: a ``str.format`` template of the cell's fields and
+            ``v`` (``value``'s low end), or a function of the cell.
     """
 
     what: str
     value: Callable[[Cell], tuple[float, float]]
-    words: str | Callable[[Cell], str]
+    words: str | Callable[[Cell], str] = "{v:+.2f} dB"
 
     def text(self, cell: Cell) -> str:
         """The figure of ``cell`` as the ledger prints it.
@@ -116,31 +82,25 @@ class ClaimSpec:
 
     Attributes:
         family: the claim id's family (ids are ``[<prior>/]<family>[/<cell>]``).
-        of: ``"ours"`` (asked once) or ``"priors"`` (asked of every prior of the registry other
-            than ours that the run's tables hold, ids prefixed by the prior's).
-        over: its scope (the run -> the family's cells; ``claim_cells.Scope``).
+        of: ``"ours"`` (asked once) or ``"priors"`` (asked of every other prior the run's
+            tables hold, ids prefixed by the prior's).
+        over: its scope (``claim_cells.Scope``).
         table: the table it reads (``claim_cells.RECOVERY``: the priors' damping summaries).
-        read: its reader (one seed's rows and a cell -> the value; ``claim_cells.Reader``).
+        read: its reader (``claim_cells.Reader``).
         threshold: a name of ``physgs.report.thresholds``, ``-`` in front to negate it.
-        side: ``">"`` or ``"<"``: the side of the threshold the claim holds on; ``WITHIN``: an
-            equivalence claim (flat, equal, matching), inside (-threshold, +threshold).
+        side: ``">"`` or ``"<"``: the side the claim holds on; ``WITHIN``: an equivalence band.
         unit: the value's unit (``"ratio"``: its interval is taken on the log scale).
-        text: the claim's sentence (``str.format`` fields: the cell's, ``name`` of the prior,
-            ``WORDS``).
+        text: the claim's sentence (``str.format`` fields: the cell's, ``name``, ``WORDS``).
         source: where it is measured (same fields, and ``table``).
-        paper: the paper's figure: words (same fields), or a
-            [`Figure`][physgs.report.catalogue.Figure] (its value in the claim's unit too).
+        paper: the paper's figure: words (same fields), or a ``Figure``.
         origin: ``"paper"`` or ``"project"`` (``ORIGINS``).
         headline: the words the README tells the family with; "" when it is not a headline.
         needs_variance: False for a claim about the fixed testbed (a verdict from one value).
-        optional: listed only when its table is given (a study or control the run may not
-            make); otherwise a missing table lists its claims "undecided: not measured".
-        one_sided: why a one-sided test (``">"``, ``"<"``) is the claim's own test; required
-            for every side but ``WITHIN``: a claim of flatness, equality or match is tested
-            inside a band, never one-sided without a stated reason.
-        requires: a family whose claim on the same cell must hold for this one to hold (a
-            coverage holds only where its intervals also beat the null's interval score); ""
-            for none.
+        optional: listed only when its table is given; otherwise a missing table lists its
+            claims "undecided: not measured".
+        one_sided: why a one-sided test is the claim's own; required for every side but
+            ``WITHIN``.
+        requires: a family whose claim on the same cell must hold for this one to hold.
     """
 
     family: str
@@ -162,9 +122,7 @@ class ClaimSpec:
     requires: str = ""
 
     def __post_init__(self):
-        """Refuse an unknown side, origin or threshold name, a scope or reader that is not a
-        function, a one-sided claim without its reason, and an equivalence band on a ratio,
-        naming the family."""
+        """Refuse what the ledger cannot decide, naming the family."""
         if self.side not in SIDES or self.origin not in ORIGINS:
             raise ValueError(f"claim {self.family!r}: side in {SIDES}, origin in {ORIGINS}")
         if (self.side == WITHIN) == bool(self.one_sided):
@@ -187,34 +145,8 @@ class ClaimSpec:
         v = float(WORDS[self.threshold.lstrip("-")])
         return -v if self.threshold.startswith("-") else v
 
-    def claim_id(self, cell: Cell, family: str = "") -> str:
-        """The id of the claim of ``cell``.
-
-        Args:
-            cell: the claim's cell (``model``: the prior asked; ``prefix``, ``suffix``).
-            family: another family's id on the same cell (``requires``); "": this one's.
-
-        Returns:
-            ``[<prior>/]<family>[/<suffix>]``.
-        """
-        prefix = cell.get("prefix", "" if cell["model"] == "ours" else f"{cell['model']}/")
-        fam = family or self.family
-        return prefix + fam + (f"/{cell['suffix']}" if cell.get("suffix") else "")
-
-    def words(self, template: str, cell: Cell) -> str:
-        """A sentence of the claim of ``cell``.
-
-        Args:
-            template: ``text`` or ``source``.
-            cell: the claim's cell (its fields and ``name``, the prior's label).
-
-        Returns:
-            ``template`` with the cell's fields and ``WORDS`` filled in.
-        """
-        return template.format(**WORDS, **cell)
-
     def value_of_paper(self, cell: Cell) -> tuple[float, float]:
-        """The paper's figure for the claim of ``cell``, as a number in the claim's unit.
+        """The paper's figure for the claim of ``cell``, in the claim's unit.
 
         Args:
             cell: the claim's cell.
@@ -224,49 +156,54 @@ class ClaimSpec:
         """
         return self.paper.value(cell) if isinstance(self.paper, Figure) else NO_VALUE
 
-    def figure(self, cell: Cell) -> str:
-        """The paper's figure for the claim of ``cell``.
+    def claim_of(self, cell: Cell) -> dict[str, Any]:
+        """The fields of the ledger's claim of ``cell`` (``physgs.report.claims.Claim``).
 
         Args:
-            cell: the claim's cell.
+            cell: the claim's cell (its fields; ``model``, the prior asked, and ``name``, its
+                label; ``prefix`` and ``suffix`` of the id).
 
         Returns:
-            ``paper``, filled in or computed.
+            The claim's fields by name: the id (``[<prior>/]<family>[/<suffix>]``), the
+                sentences and the paper's figure filled in, the threshold's value, the origin
+                (``origin_of``) and the companion's id on the same cell (``requires``).
         """
-        if isinstance(self.paper, Figure):
-            return self.paper.text(cell)
-        return self.words(self.paper, cell)
+
+        def fill(template: str) -> str:
+            return template.format(**WORDS, **cell)
+
+        prefix = cell.get("prefix", "" if cell["model"] == "ours" else f"{cell['model']}/")
+        suffix = f"/{cell['suffix']}" if cell.get("suffix") else ""
+        cid = prefix + self.family + suffix
+        paper = self.paper.text(cell) if isinstance(self.paper, Figure) else fill(self.paper)
+        return dict(
+            id=cid, text=fill(self.text), paper=paper, source=fill(self.source),
+            threshold=self.value, side=self.side, unit=self.unit,
+            needs_variance=self.needs_variance, origin=origin_of(cid),
+            paper_value=self.value_of_paper(cell),
+            requires=prefix + self.requires + suffix if self.requires else "",
+        )  # fmt: skip
 
 
 # ---- why a family is one-sided (``ClaimSpec.one_sided``) -----------------------------------------
-#: a sign: the claim says which is ahead, not by how much (its size: ``paper_in_interval``)
 DIRECTION = "a direction: which is ahead, not by how much"
-#: the reader takes |value - truth|: a band around the truth on both sides by construction
 ABSOLUTE = (
     "two-sided by construction: the reader takes |offset|, so one bound on it is a band on both "
     "sides (the mean of |x| is at least |mean x|: stricter than a band on the signed offset)"
 )
-#: a coverage floor: more coverage is never against it; its width is judged apart (the
-#: interval score against the null's, ``*_interval_score``)
 COVER = "a floor: coverage of at least the bar; width is judged by its interval-score companion"
-#: the paper's headline split by kind of field: one-sided as its parent, a direction (the
-#: question is which kind of field contradicts the paper's sign, not by how much)
 KIND_DIRECTION = (
     "a direction, as the paper's claim it splits: which kind of field is below static (and so "
     "which contradicts the paper's sign), not by how much"
 )
-#: not worse by more than a margin: the better side supports the claim too
 NON_INFERIOR = (
     "non-inferiority: the claim is that the other does not lose, and its winning supports it too"
 )
-#: a margin's growth: its sign
 GROWS = "a direction: the margin grows, not by how much"
-#: an interval's width bar
 INFORMATIVE = (
     "a bar: an interval at most this wide says something; narrower never hurts "
     "(its misses are the interval score's)"
 )
-
 #: The paper's figure of a family the paper does not state.
 PROJECT_ONLY = "not in the paper (this project's)"
 TRACKS_PROPOSAL = "not run (the paper's closing proposal)"
@@ -279,28 +216,29 @@ def _trees(run: Run) -> list[Cell]:
 
 
 def _with_role(run: Run, role: str) -> list[Cell]:
-    """The trees whose preset declares their frequencies ``role``."""
     return [c for c in _trees(run) if run.role(c["tree"], "frequencies") == role]
 
 
 def _recovered_trees(run: Run) -> list[Cell]:
     """each tree with the asked prior's recovery records (joint K = 32)"""
     rec = run.own
-    if rec is None:
-        return []
-    have = set(rec.loc[rec["model"] == run.model, "tree"])
+    have = set() if rec is None else set(rec.loc[rec["model"] == run.model, "tree"])
     return [{**c, "config": CONFIG} for c in _trees(run) if c["tree"] in have]
 
 
 def _psnr(d: pd.DataFrame, c: Cell, models: Sequence[str], split: str = "time") -> float:
-    """tab_psnr: the best of ``models``' ``<tree>_<split>`` cells (by model id)."""
+    """tab_psnr: the best of ``models``' ``<tree>_<split>`` cells."""
     return max(value(d, d["model"].astype(str) == m, f"{c['tree']}_{split}") for m in models)
 
 
+def _over_static(d: pd.DataFrame, c: Cell, models: Sequence[str]) -> float:
+    """tab_psnr, beyond the window: the best of ``models`` - static."""
+    return _psnr(d, c, models) - _psnr(d, c, ["static"])
+
+
 def _ahead_of_fields(d: pd.DataFrame, c: Cell) -> float:
-    """tab_psnr, the cell's split: the prior - max over learned fields"""
     sp = c.get("split", "view")
-    return _psnr(d, c, [c["model"]], sp) - _psnr(d, c, fields(), sp)
+    return _psnr(d, c, [c["model"]], sp) - _psnr(d, c, models_of("field"), sp)
 
 
 def _winds_beyond(run: Run) -> list[Cell]:
@@ -317,17 +255,12 @@ def _winds_beyond(run: Run) -> list[Cell]:
 
 def _transfer(d: pd.DataFrame, c: Cell, models: Sequence[str]) -> float:
     """tab_transfer: the best of ``models`` in the cell's split, tree and wind."""
-    row = (
-        (d["split"] == c["split"])
-        & (d["tree"] == c["tree"])
-        & np.isclose(d["condition"], c["condition"])
-    )
-    return max(value(d, row, m) for m in models)
+    row = (d["split"] == c["split"]) & (d["tree"] == c["tree"])
+    return max(value(d, row & np.isclose(d["condition"], c["condition"]), m) for m in models)
 
 
 def _wind_ahead(d: pd.DataFrame, c: Cell) -> float:
-    """tab_transfer: the prior - max over learned fields"""
-    return _transfer(d, c, [c["model"]]) - _transfer(d, c, fields())
+    return _transfer(d, c, [c["model"]]) - _transfer(d, c, models_of("field"))
 
 
 def _margin_trees(run: Run) -> list[Cell]:
@@ -339,7 +272,6 @@ def _margin_trees(run: Run) -> list[Cell]:
 
 
 def _margin_growth(d: pd.DataFrame, c: Cell) -> float:
-    """tab_margin: the prior's last wind's margin - its first's"""
     mine = (d["tree"] == c["tree"]) & rows_of(d, c["model"], "model")
     return value(d, mine, c["last"]) - value(d, mine, c["first"])
 
@@ -351,51 +283,45 @@ def _null_trees_separated(run: Run) -> list[Cell]:
 
 
 def _null_row(d: pd.DataFrame, c: Cell, who: str = "") -> pd.Series:
-    """tab_null / tab_recovery: the row of method ``who`` (default: the cell's) in the cell's
-    tree and configuration."""
+    """tab_null / tab_recovery: method ``who``'s row (default: the cell's) in its tree, config."""
     who = who or c.get("method", c["model"])
     return rows_of(d, who) & (d["tree"] == c["tree"]) & (d["config"] == c["config"])
 
 
+def _null_err(d: pd.DataFrame, c: Cell, of: str) -> float:
+    """tab_null / tab_recovery: the ``of`` (trained, null) median omega error (%)."""
+    return value(d, _null_row(d, c), f"{of}_median_rel_err_pct")
+
+
 def _null_over_trained(d: pd.DataFrame, c: Cell) -> float:
-    """tab_null / tab_recovery: null / trained median omega error of the cell's method"""
-    row = _null_row(d, c)
-    return value(d, row, "null_median_rel_err_pct") / value(d, row, "trained_median_rel_err_pct")
+    return _null_err(d, c, "null") / _null_err(d, c, "trained")
 
 
 def _trained_minus_null(d: pd.DataFrame, c: Cell) -> float:
-    """tab_null / tab_recovery: trained - null median omega error of the cell's method (points)"""
-    row = _null_row(d, c)
-    return value(d, row, "trained_median_rel_err_pct") - value(d, row, "null_median_rel_err_pct")
+    return _null_err(d, c, "trained") - _null_err(d, c, "null")
+
+
+def _recovery(d: pd.DataFrame, c: Cell, col: str) -> float:
+    """The prior's recovery summary ``col`` in the cell's tree."""
+    return value(d, (d["model"] == c["model"]) & (d["tree"] == c["tree"]), col)
 
 
 def _damping_off(d: pd.DataFrame, c: Cell) -> float:
-    """the prior's recovery: |median zeta_hat - zeta| / zeta"""
-    row = (d["model"] == c["model"]) & (d["tree"] == c["tree"])
-    z = value(d, row, "zeta_true")
-    return abs(value(d, row, "median_zeta") - z) / z
-
-
-def _decay_exponent(d: pd.DataFrame, c: Cell) -> float:
-    """the prior's recovery: the exponent p of gamma ~ omega^p"""
-    return value(d, (d["model"] == c["model"]) & (d["tree"] == c["tree"]), "loglog_exponent")
+    """|median zeta_hat - zeta| / zeta"""
+    z = _recovery(d, c, "zeta_true")
+    return abs(_recovery(d, c, "median_zeta") - z) / z
 
 
 # ---- the paper's figures (``ClaimSpec.paper``) ---------------------------------------------------
-def _point(x: float) -> tuple[float, float]:
-    """A single figure as ``(low, high)``."""
-    return (float(x), float(x))
-
-
 def _tab_psnr(c: Cell, f: Callable[[dict], float]) -> tuple[float, float]:
     """``f`` of the cell's paper tree's tab:psnr ((view, time) dB per model); none without."""
     pp = paper.PSNR.get(c.get("paper"))
-    return _point(f(pp)) if pp else NO_VALUE
+    return (float(f(pp)),) * 2 if pp else NO_VALUE
 
 
 def _tab_null(c: Cell, f: Callable[[float, float], float]) -> tuple[float, float]:
     """``f`` of the cell's paper tree's tab:null (trained, null median omega error, %)."""
-    return _point(f(*paper.NULL.get(c.get("paper"), (np.nan, np.nan))))
+    return (float(f(*paper.NULL.get(c.get("paper"), (np.nan, np.nan)))),) * 2
 
 
 def _zeta_off(c: Cell) -> tuple[float, float]:
@@ -410,7 +336,7 @@ def _zeta_off(c: Cell) -> tuple[float, float]:
 def _margin(c: Cell) -> tuple[float, float]:
     """tab:margin's last wind - its first (dB)."""
     p = paper.MARGIN.get(c.get("paper"))
-    return _point(p[-1] - p[0]) if p else NO_VALUE
+    return (float(p[-1] - p[0]),) * 2 if p else NO_VALUE
 
 
 NULL_RATIO = Figure(
@@ -424,88 +350,73 @@ NULL_RATIO = Figure(
 _MOTION = (
     ClaimSpec(
         family="ours_above_static_beyond", over=_trees, table="tab_psnr",
-        read=lambda d, c: _psnr(d, c, [c["model"]]) - _psnr(d, c, ["static"]),
-        threshold="EVEN", side=">", unit="dB",
+        read=lambda d, c: _over_static(d, c, [c["model"]]),
+        threshold="EVEN", side=">", unit="dB", one_sided=DIRECTION,
         text="{tree}: ours is above the static pose beyond the window",
         source="tab_psnr, time column: ours - static",
         paper=Figure(
             "ours - static beyond the window, tab:psnr",
             lambda c: _tab_psnr(c, lambda pp: pp["ours"][1] - pp["static"][1]),
-            "{v:+.2f} dB",
         ),
         headline="ours above the static pose beyond the training window",
-        one_sided=DIRECTION,
     ),
     ClaimSpec(
         family="baselines_below_static_beyond", over=_trees, table="tab_psnr",
-        read=lambda d, c: _psnr(d, c, fields()) - _psnr(d, c, ["static"]),
-        threshold="EVEN", side="<", unit="dB",
+        read=lambda d, c: _over_static(d, c, models_of("field")),
+        threshold="EVEN", side="<", unit="dB", one_sided=DIRECTION,
         text="{tree}: every learned baseline is below the static pose beyond the window",
         source="tab_psnr, time column: max over learned fields of (model - static)",
         paper=Figure(
             "best learned field - static beyond the window, tab:psnr",
-            lambda c: _tab_psnr(c, lambda pp: max(pp[m][1] - pp["static"][1] for m in fields())),
+            lambda c: _tab_psnr(
+                c, lambda pp: max(pp[m][1] - pp["static"][1] for m in models_of("field"))
+            ),
             "best baseline - static = {v:+.2f} dB",
         ),
         headline="every learned field below static beyond the window",
-        one_sided=DIRECTION,
     ),
     ClaimSpec(
         family="ours_behind_on_views", over=_trees, table="tab_psnr", read=_ahead_of_fields,
-        threshold="EVEN", side="<", unit="dB",
+        threshold="EVEN", side="<", unit="dB", one_sided=DIRECTION,
         text="{tree}: ours is behind the best learned field on held-out views",
         source="tab_psnr, view column: ours - max over learned fields",
         paper=Figure(
             "ours - best learned field on held-out views, tab:psnr",
-            lambda c: _tab_psnr(c, lambda pp: pp["ours"][0] - max(pp[m][0] for m in fields())),
-            "{v:+.2f} dB",
+            lambda c: _tab_psnr(
+                c, lambda pp: pp["ours"][0] - max(pp[m][0] for m in models_of("field"))
+            ),
         ),
-        one_sided=DIRECTION,
     ),
     ClaimSpec(
         family="transfer_ours_ahead", over=_winds_beyond, table="tab_transfer", read=_wind_ahead,
-        threshold="EVEN", side=">", unit="dB",
+        threshold="EVEN", side=">", unit="dB", one_sided=DIRECTION,
         text="{tree}, {cond} v0, beyond the window: ours ahead of the best baseline",
         source="tab_transfer (beyond): ours - max learned",
         paper="ahead in every cell, by 0.38-4.68 dB",
         headline="ours ahead of the best learned field under unseen wind",
-        one_sided=DIRECTION,
     ),
     ClaimSpec(
         family="transfer_baselines_below_static", over=_winds_beyond, table="tab_transfer",
-        read=lambda d, c: _transfer(d, c, fields()) - _transfer(d, c, ["static"]),
-        threshold="EVEN", side="<", unit="dB",
+        read=lambda d, c: _transfer(d, c, models_of("field")) - _transfer(d, c, ["static"]),
+        threshold="EVEN", side="<", unit="dB", one_sided=DIRECTION,
         text="{tree}, {cond} v0, beyond the window: every learned baseline below static",
         source="tab_transfer (beyond): max learned - static",
         paper="below static in all 24 cells, by 0.10-2.79 dB",
-        one_sided=DIRECTION,
     ),
 )  # fmt: skip
 
 
-# ---- this project's: the two headlines above split by kind of field (wind-blind,
-# wind-conditioned: the registry's ``ModelSpec.wind``), so the ledger says which kind contradicts
-# the paper --------------------------------------------------------------------------------------
+# ---- this project's: the two headlines above split by kind of field (``ModelSpec.wind``), so
+# the ledger says which kind contradicts the paper; the paper's margin under unseen wind --------
 def _kind_cells(cells: list[Cell]) -> list[Cell]:
-    """``cells`` x each kind of learned field the registry holds, the kind in the suffix after
-    the tree."""
-    out = []
-    for c in cells:
-        for k, words in FIELD_KINDS.items():
-            ms = fields_of_kind(k)
-            if not ms:  # a registry without fields of this kind asks nothing of it
-                continue
-            rest = c["suffix"].split("/", 1)[1:]  # what follows the tree (a wind), if anything
-            out.append(
-                {
-                    **c,
-                    "suffix": "/".join([c["tree"], k, *rest]),
-                    "kind": k,
-                    "kind_words": words,
-                    "kind_fields": ", ".join(label(m) for m in ms),
-                }
-            )
-    return out
+    """``cells`` x each kind of learned field the registry holds, the kind after the tree."""
+    return [
+        {**c, "suffix": "/".join([c["tree"], k, *c["suffix"].split("/", 1)[1:]]), "kind": k,
+         "kind_words": words, "kind_fields": ", ".join(label(m) for m in fields_of_kind(k))}
+        for c in cells
+        for k, words in FIELD_KINDS.items()
+        if fields_of_kind(k)  # a registry without fields of this kind asks nothing of it
+    ]  # fmt: skip
 
 
 def _kind_trees(run: Run) -> list[Cell]:
@@ -523,8 +434,8 @@ def _kind_winds_beyond(run: Run) -> list[Cell]:
 _KINDS = (
     ClaimSpec(
         family="kind_below_static_beyond", over=_kind_trees, table="tab_psnr",
-        read=lambda d, c: _psnr(d, c, fields_of_kind(c["kind"])) - _psnr(d, c, ["static"]),
-        threshold="EVEN", side="<", unit="dB",
+        read=lambda d, c: _over_static(d, c, fields_of_kind(c["kind"])),
+        threshold="EVEN", side="<", unit="dB", origin="project", one_sided=KIND_DIRECTION,
         text="{tree}: every {kind_words} learned field ({kind_fields}) is below the static pose "
         "beyond the window",
         source="tab_psnr, time column: max over the {kind_words} fields of (model - static)",
@@ -535,32 +446,24 @@ _KINDS = (
             ),
             "best {kind_words} baseline - static = {v:+.2f} dB",
         ),
-        origin="project",
-        one_sided=KIND_DIRECTION,
     ),
     ClaimSpec(
         family="transfer_kind_below_static", over=_kind_winds_beyond, table="tab_transfer",
         read=lambda d, c: _transfer(d, c, fields_of_kind(c["kind"])) - _transfer(d, c, ["static"]),
-        threshold="EVEN", side="<", unit="dB",
+        threshold="EVEN", side="<", unit="dB", origin="project", one_sided=KIND_DIRECTION,
         text="{tree}, {cond} v0, beyond the window: every {kind_words} learned field "
         "({kind_fields}) below static",
         source="tab_transfer (beyond): max {kind_words} learned - static",
         paper="every baseline below static in all 24 cells",
-        origin="project",
-        one_sided=KIND_DIRECTION,
     ),
-    # the paper's: the margin under unseen wind (tab:margin)
     ClaimSpec(
         family="margin_grows", over=_margin_trees, table="tab_margin", read=_margin_growth,
-        threshold="EVEN", side=">", unit="dB",
+        threshold="EVEN", side=">", unit="dB", one_sided=GROWS,
         text="{tree}: the margin against MLP + wind grows as the wind departs from training",
         source="tab_margin: {last} - {first}",
         paper=Figure(
-            "the margin's growth from the training wind to the farthest, tab:margin",
-            _margin,
-            "{v:+.2f} dB",
+            "the margin's growth from the training wind to the farthest, tab:margin", _margin
         ),
-        one_sided=GROWS,
     ),
 )  # fmt: skip
 
@@ -583,7 +486,6 @@ def _gap_off(d: pd.DataFrame, c: Cell) -> float:
 
 
 def _zeta_words(c: Cell) -> str:
-    """The paper's median zeta_hat range beside the truth; "--" where it gives none."""
     z = paper.ZETA.get(c.get("paper"))
     return f"median zeta_hat {z} vs {paper.ZETA_TRUE:g}" if z else "--"
 
@@ -593,7 +495,7 @@ def _fit_models(run: Run) -> list[Cell]:
     return [
         {"suffix": f"{t}/{m}", "tree": t, "fit_model": m, "fit_label": label(m)}
         for t in run.trees
-        for m in (*fields(), "ours", *run.others)
+        for m in (*models_of("field"), "ours", *run.others)
     ]
 
 
@@ -602,8 +504,7 @@ _RECOVERY = (
         family="null_factor", over=_null_trees_separated, table="tab_null",
         read=_null_over_trained, threshold="NULL_FACTOR", side=">", unit="ratio",
         text="{tree}: ... by the paper's factor of {NULL_FACTOR:g}",
-        source="{table}, {config}: null / trained",
-        paper=NULL_RATIO,
+        source="{table}, {config}: null / trained", paper=NULL_RATIO,
         headline="ours beats the untrained null by the paper's factor on frequency",
         one_sided="a lower bound: the paper's factor or more (a larger one supports it)",
     ),
@@ -611,8 +512,7 @@ _RECOVERY = (
         family="null_loses", over=_null_trees_separated, table="tab_null",
         read=_null_over_trained, threshold="RATIO_EVEN", side=">", unit="ratio",
         text="{tree}: joint training beats the untrained null",
-        source="{table}, {config}: null / trained median rel. error",
-        paper=NULL_RATIO,
+        source="{table}, {config}: null / trained median rel. error", paper=NULL_RATIO,
         one_sided=DIRECTION,
     ),
     ClaimSpec(
@@ -632,7 +532,7 @@ _RECOVERY = (
     ),
     ClaimSpec(
         family="nearest_bone_gap", over=_gap_trees, table="tab_testbed", read=_gap_off,
-        threshold="GAP_RTOL", side="<", unit="fraction",
+        threshold="GAP_RTOL", side="<", unit="fraction", one_sided=ABSOLUTE,
         text="{tree}: the median nearest-bone gap is the paper's (within {GAP_RTOL:.0%} of it)",
         source="tab_testbed: |gap - paper| / paper",
         paper=Figure(
@@ -641,7 +541,6 @@ _RECOVERY = (
             lambda c: f"{paper.NEAREST_BONE_GAP_PCT[c['paper']]:.2f}%",
         ),
         needs_variance=False,
-        one_sided=ABSOLUTE,
     ),
     ClaimSpec(
         family="damping_not_recovered", over=_recovered_trees, table=RECOVERY,
@@ -649,24 +548,19 @@ _RECOVERY = (
         text="{tree}: damping is not recovered (median zeta_hat off the truth by more than "
         "{DAMPING_OFF:.0%})",
         source="recovery ({config}): |median zeta_hat - zeta| / zeta",
-        paper=Figure(
-            "the median fitted zeta, section 4",
-            _zeta_off,
-            _zeta_words,
-        ),
+        paper=Figure("the median fitted zeta, section 4", _zeta_off, _zeta_words),
         headline="damping is not recovered",
         one_sided="|offset| above the bar on either side: off the truth, whichever way",
     ),
     ClaimSpec(
         family="decay_rate_flat", over=_recovered_trees, table=RECOVERY,
-        read=_decay_exponent, threshold="RATE_EXPONENT", side=WITHIN, unit="exponent",
+        read=lambda d, c: _recovery(d, c, "loglog_exponent"),
+        threshold="RATE_EXPONENT", side=WITHIN, unit="exponent",
         text="{tree}: the fitted decay rate gamma = zeta*omega is nearly frequency-independent "
         "(gamma ~ omega^p, |p| < {RATE_EXPONENT})",
-        source="recovery ({config}): exponent p",
-        paper="nearly frequency-independent",
+        source="recovery ({config}): exponent p", paper="nearly frequency-independent",
     ),
-    # the premise of every comparison: the fields fit their window (a model the paper did not
-    # train makes its row this project's: ``origin_of``)
+    # the premise of every comparison (a model the paper did not train: the project's row)
     ClaimSpec(
         family="fits_window", over=_fit_models, table="tab_fit",
         read=lambda d, c: value(
@@ -698,18 +592,11 @@ def _winds(run: Run) -> list[Cell]:
     tr = run.own
     if tr is None:
         return []
-    where = {"beyond": "beyond the window"}
     return [
-        {
-            "suffix": f"{t}/wind_{sp}/{c:.2f}",
-            "tree": t,
-            "condition": c,
-            "cond": f"{c:.2f}",
-            "split": sp,
-            "where": where.get(sp, "at training timestamps"),
-        }
+        {"suffix": f"{t}/wind_{sp}/{c:.2f}", "tree": t, "condition": c, "cond": f"{c:.2f}",
+         "split": sp, "where": "beyond the window" if sp == "beyond" else "at training timestamps"}
         for (sp, t, c), _ in tr.groupby(["split", "tree", "condition"], sort=False)
-    ]
+    ]  # fmt: skip
 
 
 def _recovery_trees(run: Run) -> list[Cell]:
@@ -720,37 +607,29 @@ def _recovery_trees(run: Run) -> list[Cell]:
 _PRIORS = (
     ClaimSpec(
         family="above_static_beyond", of="priors", over=_trees, table="tab_psnr",
-        read=lambda d, c: _psnr(d, c, [c["model"]]) - _psnr(d, c, ["static"]),
-        threshold="EVEN", side=">", unit="dB",
+        read=lambda d, c: _over_static(d, c, [c["model"]]),
+        threshold="EVEN", side=">", unit="dB", origin="project", one_sided=DIRECTION,
         text="{tree}: the {name} is above the static pose beyond the window",
         source="tab_psnr, time column: prior - static",
-        origin="project",
         headline="the {name} above the static pose beyond the window",
-        one_sided=DIRECTION,
     ),
     ClaimSpec(
         family=AHEAD, of="priors", over=_splits, table="tab_psnr", read=_ahead_of_fields,
-        threshold="EVEN", side=">", unit="dB",
+        threshold="EVEN", side=">", unit="dB", origin="project", one_sided=DIRECTION,
         text="{tree}: the {name} is ahead of the best learned field on {where}",
         source="tab_psnr, {split} column: prior - max over learned fields",
-        origin="project",
-        one_sided=DIRECTION,
     ),
     ClaimSpec(
         family=AHEAD, of="priors", over=_winds, table="tab_transfer", read=_wind_ahead,
-        threshold="EVEN", side=">", unit="dB",
+        threshold="EVEN", side=">", unit="dB", origin="project", one_sided=DIRECTION,
         text="{tree}, {cond} v0, {where}: the {name} is ahead of the best learned field",
         source="tab_transfer ({split}): prior - max learned",
-        origin="project",
-        one_sided=DIRECTION,
     ),
     ClaimSpec(
         family="margin_grows", of="priors", over=_margin_trees, table="tab_margin",
-        read=_margin_growth, threshold="EVEN", side=">", unit="dB",
+        read=_margin_growth, threshold="EVEN", side=">", unit="dB", origin="project",
         text="{tree}: the {name}'s margin against MLP + wind grows as the wind departs",
-        source="tab_margin ({model}): {last} - {first}",
-        origin="project",
-        one_sided=GROWS,
+        source="tab_margin ({model}): {last} - {first}", one_sided=GROWS,
     ),
     ClaimSpec(
         family="beats_null", of="priors", over=_recovery_trees, table="tab_recovery",
@@ -767,50 +646,48 @@ _PRIORS = (
         text="{tree}: the {name} recovers damping (median zeta_hat within {DAMPING_OFF:.0%} of "
         "the truth)",
         source="recovery ({config}): |median zeta_hat - zeta| / zeta",
-        origin="project",
-        one_sided=ABSOLUTE,
+        origin="project", one_sided=ABSOLUTE,
     ),
     ClaimSpec(
         family="decay_rate_flat", of="priors", over=_recovered_trees, table=RECOVERY,
-        read=_decay_exponent, threshold="RATE_EXPONENT", side=WITHIN, unit="exponent",
+        read=lambda d, c: _recovery(d, c, "loglog_exponent"),
+        threshold="RATE_EXPONENT", side=WITHIN, unit="exponent",
         text="{tree}: the {name}'s fitted decay rate gamma = zeta*omega is nearly "
         "frequency-independent (gamma ~ omega^p, |p| < {RATE_EXPONENT})",
-        source="recovery ({config}): exponent p",
-        origin="project",
+        source="recovery ({config}): exponent p", origin="project",
     ),
 )  # fmt: skip
 
 
 # ---- this project's: without the anemometer, and the output-only analysis (docs/blind.md) ------
+def _has(df: pd.DataFrame | None, method: str | None = None) -> bool:
+    """Whether ``df`` has a ``method`` column (holding ``method``, when given)."""
+    ok = df is not None and "method" in df.columns
+    return ok and (method is None or method in set(df["method"]))
+
+
 def _blind_trees(run: Run) -> list[Cell]:
     """each forcing-free prior in tab_recovery x each tree, against the prior whose measured wind it
     replaces (ids ``<prior>/...`` for a prior other than ours)"""
     null = run.own
-    if null is None or "method" not in null.columns:
+    if not _has(null):
         return []
     have, out = set(null["method"]), []
     for blind in (m for m in BLIND_PRIORS if m in have):
         wind = spec_of(blind).blind_of
         who, prefix = ("ours", "") if wind == "ours" else (f"the {label(wind)}", f"{wind}/")
         out += [
-            {
-                **c,
-                "prefix": prefix,
-                "blind": blind,
-                "wind": wind,
-                "who": who,
-                "config": BLIND_CONFIG,
-            }
+            {**c, "prefix": prefix, "blind": blind, "wind": wind, "who": who,
+             "config": BLIND_CONFIG}
             for c in _trees(run)
             if (null["tree"] == c["tree"]).any()
-        ]
+        ]  # fmt: skip
     return out
 
 
 def _oma_separated(run: Run) -> list[Cell]:
     """each tree of separated frequencies, when tab_recovery holds the output-only analysis"""
-    null = run.own
-    if null is None or "method" not in null.columns or OMA not in set(null["method"]):
+    if not _has(run.own, OMA):
         return []
     return [{**c, "config": BLIND_CONFIG, "method": OMA} for c in _with_role(run, SEPARATED)]
 
@@ -818,7 +695,7 @@ def _oma_separated(run: Run) -> list[Cell]:
 def _oma_damping_trees(run: Run) -> list[Cell]:
     """each tree of tab_damping, when it holds the output-only analysis"""
     dmp = run.own
-    if dmp is None or "method" not in dmp.columns or OMA not in set(dmp["method"]):
+    if not _has(dmp, OMA):
         return []
     return [{**c, "config": BLIND_CONFIG} for c in _trees(run) if (dmp["tree"] == c["tree"]).any()]
 
@@ -834,27 +711,20 @@ def _oma_interval_trees(run: Run) -> list[Cell]:
 def _oma(d: pd.DataFrame, c: Cell, col: str) -> float:
     """tab_damping (damping testbed): the output-only analysis' ``col`` in the cell's tree and
     configuration."""
-    row = (
-        (d["testbed"] == DAMPING)
-        & (d["tree"] == c["tree"])
-        & (d["config"] == c["config"])
-        & (d["method"] == OMA)
-    )
-    return value(d, row, col)
+    row = (d["testbed"] == DAMPING) & (d["tree"] == c["tree"]) & (d["config"] == c["config"])
+    return value(d, row & (d["method"] == OMA), col)
 
 
 def _halfwidth(d: pd.DataFrame, c: Cell, q: str) -> float:
-    """tab_damping: the output-only analysis' median relative half-width of its ``q``
-    intervals, 1.96 sigma / value."""
+    """The median relative half-width of the ``q`` intervals, 1.96 sigma / value."""
     from physgs.oma.intervals import Z95  # here: scipy, which planning never loads
 
     return Z95 * _oma(d, c, f"{q}_rel_sd")
 
 
 def _oma_intervals(q: str, name: str) -> dict[str, ClaimSpec]:
-    """The three families of the output-only analysis' 95% intervals for ``q`` (``omega``,
-    ``zeta``; ``name`` in the family ids: ``frequency``, ``damping``): they cover, they score
-    better than the null's, they are informative."""
+    """The output-only analysis' 95% intervals for ``q`` (``omega``, ``zeta``; ``name`` in the
+    ids): they cover, they score better than the null's, they are informative."""
     intervals = f"{{tree}} (damping testbed): the output-only analysis' 95% intervals for {q}"
     common = dict(over=_oma_interval_trees, table="tab_damping", paper=PROJECT_ONLY,
                   origin="project", optional=True)  # fmt: skip
@@ -901,14 +771,12 @@ _BLIND = (
             value(d, _null_row(d, c, c["blind"]), "trained_median_rel_err_pct")
             - value(d, _null_row(d, c, c["wind"]), "trained_median_rel_err_pct")
         ),
-        threshold="EVEN", side=">", unit="pp",
+        threshold="EVEN", side=">", unit="pp", origin="project", optional=True,
         text="{tree}: without the measured wind (a learned forcing) {who} recovers omega worse",
         source="{table}, {config}: {blind} - {wind} median rel. error (points)",
         paper="the paper's closing limit: 'real footage needs an anemometer'",
-        origin="project",
         headline="without the anemometer (a learned forcing), ours' frequency error grows "
         "(points)",
-        optional=True,
         one_sided=DIRECTION,
     ),
     ClaimSpec(
@@ -917,29 +785,19 @@ _BLIND = (
         text="{tree}: output-only modal analysis of the video recovers omega better than the "
         "untrained null",
         source="{table}, {config}: null / output-only median rel. error",
-        paper="not run",
-        origin="project",
+        paper="not run", origin="project", optional=True, one_sided=DIRECTION,
         headline="output-only modal analysis of the video beats the untrained null",
-        optional=True,
-        one_sided=DIRECTION,
     ),
     ClaimSpec(
         family="oma_recovers_zeta", over=_oma_damping_trees, table="tab_damping",
         read=lambda d, c: _oma(d, c, "trained_minus_null_pp"),
-        threshold="EVEN", side="<", unit="pp",
+        threshold="EVEN", side="<", unit="pp", origin="project", optional=True,
         text="{tree} (damping testbed): output-only modal analysis recovers zeta better than "
         "the untrained null",
         source="tab_damping, {config}: output-only - null median zeta error (points)",
-        paper="no method here recovers zeta (the paper)",
-        origin="project",
-        optional=True,
-        one_sided=DIRECTION,
+        paper="no method here recovers zeta (the paper)", one_sided=DIRECTION,
     ),
-    _OMEGA["covers"],
-    _ZETA["covers"],
-    _OMEGA["score"],
-    _OMEGA["informative"],
-    _ZETA["score"],
+    _OMEGA["covers"], _ZETA["covers"], _OMEGA["score"], _OMEGA["informative"], _ZETA["score"],
     _ZETA["informative"],
 )  # fmt: skip
 
@@ -957,7 +815,7 @@ def _parts_damping_trees(run: Run) -> list[Cell]:
     """each tree with a damping testbed in tab_parts (its first configuration), when it holds
     the topology parts"""
     df, models, c0 = _parts(run)
-    if df is None or "ours_topo" not in models:
+    if "ours_topo" not in models:
         return []
     return [
         {**c, "config": c0}
@@ -969,17 +827,15 @@ def _parts_damping_trees(run: Run) -> list[Cell]:
 def _parts_coupling(run: Run) -> list[Cell]:
     """each tree of separated frequencies in tab_parts (its first configuration), when it holds
     both topology priors (no id suffix for a single such tree: the family's id as before)"""
-    df, models, c0 = _parts(run)
-    if df is None or not {"ours_topo", "ours_chain"} <= models:
+    _, models, c0 = _parts(run)
+    if not {"ours_topo", "ours_chain"} <= models:
         return []
     cells = _with_role(run, SEPARATED)
-    one = len(cells) == 1
-    return [{**c, "suffix": "" if one else c["tree"], "config": c0} for c in cells]
+    return [{**c, "suffix": "" if len(cells) == 1 else c["tree"], "config": c0} for c in cells]
 
 
 def _parts_gain(d: pd.DataFrame, c: Cell, better: str, base: str, col: str) -> float:
-    """tab_parts: ``col`` of parts ``better`` - of parts ``base`` in the cell's tree and
-    configuration."""
+    """tab_parts: ``col`` of parts ``better`` - of parts ``base`` in the cell's tree, config."""
     row = (d["tree"] == c["tree"]) & (d["config"] == c["config"])
     return value(d, row & (d["model"] == better), col) - value(d, row & (d["model"] == base), col)
 
@@ -989,40 +845,39 @@ _PARTS = (
         family="topology_parts_reduce_damping_error", over=_parts_damping_trees,
         table="tab_parts",
         read=lambda d, c: _parts_gain(d, c, "ours_topo", "ours", "zeta_rel_err_pct"),
-        threshold="EVEN", side="<", unit="pp",
+        threshold="EVEN", side="<", unit="pp", origin="project", optional=True,
         text="{tree}: topology-aware parts reduce the damping error (damping testbed)",
         source="tab_parts ({config}): median rel. err. of zeta, topology - k-means parts",
         paper="hypothesis (k-means parts 'plausibly feed the damping bias')",
-        origin="project",
-        optional=True,
         one_sided=DIRECTION,
     ),
     ClaimSpec(
         family="coupling_lifts_sparse_fit", over=_parts_coupling, table="tab_parts",
         read=lambda d, c: _parts_gain(d, c, "ours_chain", "ours_topo", "ceiling_frac"),
-        threshold="EVEN", side=">", unit="fraction",
+        threshold="EVEN", side=">", unit="fraction", origin="project", optional=True,
         text="{tree}: parent-child coupling lifts the in-window fit",
         source="tab_parts ({config}): fraction of the ceiling's gain, chained - independent "
         "topology parts",
         paper="hypothesis (independent parts 'represent no coupling')",
-        origin="project",
-        optional=True,
         one_sided=DIRECTION,
     ),
 )  # fmt: skip
 
 
 # ---- this project's: the 2D-track control (docs/tracks.md) ---------------------------------------
+def _config_of(configs: pd.Series, preferred: str) -> str | None:
+    """``preferred`` where ``configs`` hold it, else the first; None for none."""
+    cs = list(dict.fromkeys(configs))
+    return preferred if preferred in cs else next(iter(cs), None)
+
+
 def _tracks_separated(run: Run) -> list[Cell]:
     """each tree of separated frequencies, the 2D-track control's recovery in joint K = 32
     (else its first configuration)"""
     null = run.own
-    if null is None or "method" not in null.columns:
+    c = _config_of(null.loc[null["method"] == "tracks", "config"], CONFIG) if _has(null) else None
+    if c is None:
         return []
-    cfgs = list(dict.fromkeys(null.loc[null["method"] == "tracks", "config"]))
-    if not cfgs:
-        return []
-    c = CONFIG if CONFIG in cfgs else cfgs[0]
     return [{**x, "config": c, "method": "tracks"} for x in _with_role(run, SEPARATED)]
 
 
@@ -1038,12 +893,9 @@ def _tracks_minus_ours(d: pd.DataFrame, c: Cell) -> float:
 def _tracks_trees(run: Run) -> list[Cell]:
     """each tree in tab_tracks, its base configuration (else its first)"""
     tr = run.own
-    if tr is None:
+    c = None if tr is None else _config_of(tr["config"], "single")
+    if c is None:
         return []
-    tc = list(dict.fromkeys(tr["config"]))
-    if not tc:
-        return []
-    c = "single" if "single" in tc else tc[0]
     return [{**x, "config": c} for x in _trees(run) if (tr["tree"] == x["tree"]).any()]
 
 
@@ -1060,10 +912,7 @@ _TRACKS = (
         text="{tree}: oscillators fitted to 2D tracks recover omega better than the untrained "
         "null",
         source="{table}, 2D tracks {config}: null / tracks median rel. error",
-        paper=TRACKS_PROPOSAL,
-        origin="project",
-        optional=True,
-        one_sided=DIRECTION,
+        paper=TRACKS_PROPOSAL, origin="project", optional=True, one_sided=DIRECTION,
     ),
     ClaimSpec(
         family="tracks_match_ours", over=_tracks_separated, table="tab_recovery",
@@ -1071,35 +920,23 @@ _TRACKS = (
         text="{tree}: oscillators fitted to 2D tracks match ours' omega recovery (ours does not "
         "beat them by {NULL_MATCH_PP} points or more)",
         source="{table}, {config}: 2D tracks - ours median rel. error (points)",
-        paper=TRACKS_PROPOSAL,
-        origin="project",
-        optional=True,
-        one_sided=NON_INFERIOR,
+        paper=TRACKS_PROPOSAL, origin="project", optional=True, one_sided=NON_INFERIOR,
     ),
     ClaimSpec(
         family="tracks_extrapolate_as_ours", over=_tracks_trees, table="tab_tracks",
-        read=_tracks_tail, threshold="EVEN", side="<", unit="px",
+        read=_tracks_tail,
+        threshold="EVEN", side="<", unit="px",
         text="{tree}: beyond the window, oscillators fitted to 2D tracks predict the tracked "
         "points at least as well as ours' Gaussians",
         source="tab_tracks, {config}: tail displacement error, 2D tracks - ours (px)",
-        paper=TRACKS_PROPOSAL,
-        origin="project",
-        optional=True,
-        one_sided=NON_INFERIOR,
+        paper=TRACKS_PROPOSAL, origin="project", optional=True, one_sided=NON_INFERIOR,
     ),
 )  # fmt: skip
 
 #: Every claim family, in the ledger's order.
 CATALOGUE: tuple[ClaimSpec, ...] = (
-    *_MOTION,
-    *_KINDS,
-    *_RECOVERY,
-    *_PRIORS,
-    *_BLIND,
-    *_PARTS,
-    *_TRACKS,
-)
-
+    *_MOTION, *_KINDS, *_RECOVERY, *_PRIORS, *_BLIND, *_PARTS, *_TRACKS
+)  # fmt: skip
 
 #: The families that are premises of the comparison, each with what its failure undermines (the
 #: claims' ``kind``: ``kind_of``); every other family is a finding.
@@ -1111,17 +948,19 @@ PREMISES: dict[str, str] = {
     "held-out views, under unseen wind): a model that does not fit its own training window says "
     "little about what lies beyond it",
 }
+if not set(PREMISES) <= {s.family for s in CATALOGUE}:  # a renamed family stays a premise
+    raise ValueError(f"PREMISES: no family {sorted(set(PREMISES) - {s.family for s in CATALOGUE})}")
 
 
 # ---- derived from the catalogue ----------------------------------------------------------------
 def tables(optional: bool = True) -> tuple[str, ...]:
-    """The tables the ledger reads, in catalogue order.
+    """The tables the ledger reads, in catalogue order (the recovery summaries are not one).
 
     Args:
         optional: include the tables only some runs make (``ClaimSpec.optional``).
 
     Returns:
-        Table names (the recovery summaries are not a table: ``reads_recovery``).
+        Table names.
     """
     required = {s.table for s in CATALOGUE if not s.optional}
     every = dict.fromkeys(s.table for s in CATALOGUE if s.table != RECOVERY)
@@ -1129,10 +968,10 @@ def tables(optional: bool = True) -> tuple[str, ...]:
 
 
 def required_tables() -> tuple[str, ...]:
-    """The tables every run's ledger reads.
+    """The tables every run's ledger reads (a missing one: "undecided: not measured").
 
     Returns:
-        Table names (a missing one leaves its claims "undecided: not measured").
+        Table names.
     """
     return tables(optional=False)
 
@@ -1157,15 +996,9 @@ def reads_recovery() -> bool:
     return any(s.table == RECOVERY for s in CATALOGUE)
 
 
-def _name(model: str) -> str:
-    """A prior's label as words inside a sentence (its first letter lower case)."""
-    name = label(model)
-    return name[0].lower() + name[1:]
-
-
 def headline(priors: Sequence[str] | None = None) -> list[tuple[str, str, str]]:
-    """The families that carry the story, in catalogue order: ``(id prefix, words, origin)``;
-    a family asked of the priors gives one per prior other than ours.
+    """The families that carry the story, in catalogue order: ``(id prefix, words, origin)``,
+    one per prior other than ours for a family asked of the priors.
 
     Args:
         priors: the priors other than ours (default: the registry's).
@@ -1175,20 +1008,21 @@ def headline(priors: Sequence[str] | None = None) -> list[tuple[str, str, str]]:
     """
     others = [m for m in models_of("prior") if m != "ours"] if priors is None else priors
     out = []
-    for s in CATALOGUE:
-        if not s.headline:
-            continue
+    for s in (s for s in CATALOGUE if s.headline):
         if s.of == "ours":
             out.append((s.family, s.headline, s.origin))
-        else:
-            out += [(f"{m}/{s.family}", s.headline.format(name=_name(m)), s.origin) for m in others]
+        else:  # the prior's label inside a sentence: its first letter lower case
+            names = {m: label(m)[0].lower() + label(m)[1:] for m in others}
+            out += [(f"{m}/{s.family}", s.headline.format(name=names[m]), s.origin) for m in others]
     return out
 
 
 _MODEL_IDS = set(MODELS) | set(PRIOR_VARIANTS)
-# a premise names a family of the catalogue (a renamed family must not turn it into a finding)
-if not set(PREMISES) <= {s.family for s in CATALOGUE}:
-    raise ValueError(f"PREMISES: no family {sorted(set(PREMISES) - {s.family for s in CATALOGUE})}")
+
+
+def _family(claim_id: str) -> str:
+    parts = claim_id.split("/")
+    return parts[1] if parts[0] in _MODEL_IDS and len(parts) > 1 else parts[0]
 
 
 def origin_of(claim_id: str) -> str:
@@ -1214,15 +1048,8 @@ def origin_of(claim_id: str) -> str:
     raise ValueError(f"claim {claim_id!r}: no family {fam!r} in the catalogue")
 
 
-def _family(claim_id: str) -> str:
-    """The family of a claim id (``[<prior>/]<family>[/<cell>]``)."""
-    parts = claim_id.split("/")
-    return parts[1] if parts[0] in _MODEL_IDS and len(parts) > 1 else parts[0]
-
-
 def kind_of(claim_id: str) -> str:
-    """Whether a claim is a premise of the comparison or a finding (``KINDS``): its family's
-    entry in ``PREMISES``.
+    """Whether a claim is a premise of the comparison or a finding (its family in ``PREMISES``).
 
     Args:
         claim_id: a ledger id (``[<prior>/]<family>[/<cell>]``).
@@ -1246,27 +1073,16 @@ def undermines(claim_id: str) -> str:
 
 
 def _template(text: str, table: str = "") -> str:
-    """A sentence template as the claims page shows it: thresholds filled in, the cell's fields
-    as ``<field>``."""
+    """A sentence template as the claims page shows it: thresholds filled in, fields ``<f>``."""
     out = []
-    for lit, field, spec, _ in string.Formatter().parse(text):
-        out.append(lit)
-        if field is None:
-            continue
-        if field in WORDS:
-            out.append(format(WORDS[field], spec or ""))
-        elif field == "name":
-            out.append("<prior>")
-        elif field == "table":
-            out.append(table)
+    for lit, f, spec, _ in string.Formatter().parse(text):
+        if f is None:
+            out.append(lit)
+        elif f in WORDS:
+            out.append(lit + format(WORDS[f], spec or ""))
         else:
-            out.append(f"<{field}>")
+            out.append(lit + {"name": "<prior>", "table": table}.get(f, f"<{f}>"))
     return "".join(out)
-
-
-def _doc(fn) -> str:
-    """A function's docstring's first paragraph, on one line."""
-    return " ".join((fn.__doc__ or fn.__name__).strip().split("\n\n")[0].split())
 
 
 BEGIN, END = "<!-- catalogue:begin -->", "<!-- catalogue:end -->"
@@ -1279,36 +1095,24 @@ def markdown() -> str:
     Returns:
         The block, markers included.
     """
-    head = [
-        BEGIN,
-        "",
-        "<!-- no verdict -->",  # thresholds and the paper's figures: the record states verdicts
-        "| family | asked of, over | claim | threshold | test | reads | the paper | origin |",
-        "|---|---|---|---|---|---|---|---|",
-    ]
     rows = []
     for s in CATALOGUE:
         fam = f"`{s.family}`" if s.of == "ours" else f"`<prior>/{s.family}`"
-        if s.headline:
-            fam += " (headline)"
-        if s.family in PREMISES:
-            fam += " (premise)"
-        over = ("ours" if s.of == "ours" else "every other prior") + ", " + _doc(s.over)
-        thr = s.threshold.lstrip("-")
-        sign = "-" if s.threshold.startswith("-") else ""
+        fam += " (headline)" * bool(s.headline) + " (premise)" * (s.family in PREMISES)
+        doc = " ".join((s.over.__doc__ or s.over.__name__).strip().split("\n\n")[0].split())
+        sign = "±" if s.side == WITHIN else "-" * s.threshold.startswith("-")
         figure = s.paper.what if isinstance(s.paper, Figure) else _template(s.paper)
-        figure = "this project" if figure == "--" else figure
         cells = [
             fam,
-            over,
+            ("ours" if s.of == "ours" else "every other prior") + ", " + doc,
             _template(s.text),
-            f"{s.side} {sign}`{thr}` = {s.value:g} {s.unit}"
-            if s.side != WITHIN
-            else f"within ±`{thr}` = {s.value:g} {s.unit}",
+            f"{s.side} {sign}`{s.threshold.lstrip('-')}` = {s.value:g} {s.unit}",
             "equivalence (inside the band)" if s.side == WITHIN else f"one-sided: {s.one_sided}",
-            f"{_template(s.source, s.table)}{' (optional)' if s.optional else ''}",
-            figure,
+            _template(s.source, s.table) + " (optional)" * s.optional,
+            "this project" if figure == "--" else figure,
             s.origin,
         ]
         rows.append("| " + " | ".join(c.replace("|", "\\|") for c in cells) + " |")
-    return "\n".join([*head, *rows, "", END])
+    head = "| family | asked of, over | claim | threshold | test | reads | the paper | origin |"
+    # thresholds and the paper's figures: the record states verdicts
+    return "\n".join([BEGIN, "", "<!-- no verdict -->", head, "|---" * 8 + "|", *rows, "", END])

@@ -1,23 +1,16 @@
 """What the claims of the catalogue ([`physgs.report.catalogue`][physgs.report.catalogue]) are
-measured on: the [`Run`][physgs.report.claim_cells.Run] a family is asked of, the trees' roles,
-the registry's learned fields, and the reading of one cell of one seed's rows.
+measured on: the [`Run`][physgs.report.claim_cells.Run] a family is asked of, the trees' roles
+and the reading of one cell of one seed's rows.
 
-A family's *scope* (``ClaimSpec.over``) takes the run (and reads only the family's own table,
-``Run.own``: moving a family to another table is its entry's ``table``) and returns its cells:
-one dict per claim, with ``suffix`` (the claim id after the family, "" for none), the fields
-its sentence and its reader use (``tree``, ``config``, ``method``, ...) and, where the id is
-not the asked prior's, ``prefix``. Its *reader* (``ClaimSpec.read``) takes one seed's rows and
-a cell and returns a float, NaN where the rows are not there (a model the run's table does not
-hold: "undecided: not measured").
+A family's *scope* (``ClaimSpec.over``) takes the run, reads only its own table (``Run.own``)
+and returns one cell per claim: a dict with ``suffix`` (the id after the family, "" for none),
+the fields its sentence and reader use and, where the id is not the asked prior's, ``prefix``.
+Its *reader* (``ClaimSpec.read``) takes one seed's rows and a cell and returns a float, NaN
+where the rows are not there ("undecided: not measured").
 
-Which trees a role-scoped family asks (the tree whose bones' frequencies the untrained null
-cannot fake, the trees where it is expected to match) is declared in each tree's preset
-(``presets.<tree>.role`` in config/trees.yaml: ``frequencies`` separated or tiled, and
-``paper``, the paper's tree it stands for and whose figures it is read against), never by a
-tree's name: a tree without a role gets the claims of every tree and none of a role's.
-
-A table without a ``method`` (``model``) column is ours' alone (a table made before another
-prior joined it).
+A role-scoped family asks the trees whose preset declares the role (``presets.<tree>.role`` in
+config/trees.yaml: ``frequencies`` separated or tiled, and ``paper``, the paper's tree it stands
+for), never a tree by name. A table without a ``method`` (``model``) column is ours' alone.
 """
 
 from __future__ import annotations
@@ -29,12 +22,16 @@ import pandas as pd
 
 from physgs.models.registry import models_of, spec_of
 
-#: The configuration the recovery claims read (the paper's joint K = 32; the base configuration
-#: where a config has none: ``physgs.report.build.claims_needs``).
+#: The configuration the recovery claims read (the paper's joint K = 32).
 CONFIG = "joint32"
-#: The pseudo-table of the priors' damping summaries (one row per seed, model and tree:
-#: median_zeta, zeta_true, loglog_exponent), read from their recovery records.
+#: The pseudo-table of the priors' damping summaries (one row per seed, model and tree).
 RECOVERY = "recovery"
+#: The role of a tree whose bones' frequencies the untrained null cannot fake (the null loses).
+SEPARATED = "separated"
+#: The role of a tree whose bones' frequencies tile the axis (the null is expected to match).
+TILED = "tiled"
+#: The kinds of learned field, by whether its registry entry reads the wind: id -> its words.
+FIELD_KINDS = {"blind": "wind-blind", "wind": "wind-conditioned"}
 
 Cell = dict[str, Any]
 
@@ -49,8 +46,7 @@ class Run:
         model: the prior the claim is asked of (``ours``, or another prior of the registry).
         others: the priors other than ours that the run's tables hold.
         table: the family's table (``ClaimSpec.table``): the one its scope reads.
-        roles: tree -> its preset's ``role`` (``frequencies``, ``paper``); a tree not in it has
-            none.
+        roles: tree -> its preset's ``role`` (``frequencies``, ``paper``).
     """
 
     tables: Mapping[str, pd.DataFrame]
@@ -78,16 +74,11 @@ class Run:
         return (self.roles.get(tree) or {}).get(key)
 
 
-#: A scope: the run -> the family's cells (its docstring's first paragraph: what the claims page
-#: says it ranges over).
+#: A scope: the run -> the family's cells (its docstring: what the claims page says it ranges
+#: over).
 Scope = Callable[[Run], list[Cell]]
 #: A reader: one seed's rows of the family's table and a cell -> the claim's value.
 Reader = Callable[[pd.DataFrame, Cell], float]
-
-#: The role of a tree whose bones' frequencies the untrained null cannot fake (the null loses).
-SEPARATED = "separated"
-#: The role of a tree whose bones' frequencies tile the axis (the null is expected to match).
-TILED = "tiled"
 
 
 def roles_of(presets: Mapping[str, Mapping], trees: Sequence[str]) -> dict[str, dict[str, str]]:
@@ -103,21 +94,6 @@ def roles_of(presets: Mapping[str, Mapping], trees: Sequence[str]) -> dict[str, 
     return {t: dict((presets.get(t) or {}).get("role") or {}) for t in trees}
 
 
-def fields() -> tuple[str, ...]:
-    """The learned deformation fields.
-
-    Returns:
-        The model ids of registry role "field".
-    """
-    return models_of("field")
-
-
-#: The kinds of learned field, by whether the field's registry entry reads the wind
-#: (``ModelSpec.wind``): kind id -> its words. The paper's headline lumps both kinds; the
-#: project's split families (``physgs.report.catalogue``) ask it of each.
-FIELD_KINDS = {"blind": "wind-blind", "wind": "wind-conditioned"}
-
-
 def fields_of_kind(kind: str) -> tuple[str, ...]:
     """The learned fields of one kind, from the registry (never from their names).
 
@@ -125,10 +101,9 @@ def fields_of_kind(kind: str) -> tuple[str, ...]:
         kind: a key of ``FIELD_KINDS``.
 
     Returns:
-        The model ids of role "field" whose spec reads the wind (``"wind"``) or does not
-            (``"blind"``), in registry order.
+        The model ids of role "field" that read the wind (``"wind"``) or not (``"blind"``).
     """
-    return tuple(m for m in fields() if spec_of(m).wind == (kind == "wind"))
+    return tuple(m for m in models_of("field") if spec_of(m).wind == (kind == "wind"))
 
 
 def value(df: pd.DataFrame, mask: pd.Series, col: str) -> float:
@@ -142,9 +117,7 @@ def value(df: pd.DataFrame, mask: pd.Series, col: str) -> float:
     Returns:
         The cell; NaN where no row holds or ``col`` is not a column.
     """
-    if col not in df.columns:
-        return float("nan")
-    v = df.loc[mask, col]
+    v = df.loc[mask, col] if col in df.columns else ()
     return float(v.iloc[0]) if len(v) else float("nan")
 
 

@@ -1,19 +1,14 @@
 """The claims ledger: each quantitative claim of the source paper, measured, with a verdict
 computed by code (never written by hand).
 
-A claim is a measured quantity (one value per training seed), a threshold and a side: the
-claim **holds** when the 95% interval of the mean over seeds lies entirely on the claimed side
-of the threshold, **fails** when it lies entirely on the other side, and is **undecided** when it
-straddles it. A claim of flatness, equality or match (side ``WITHIN``) is an equivalence test,
-two one-sided tests: it **holds** when the interval lies inside the band (-threshold,
-+threshold), **fails** when it lies entirely outside it (beyond either edge), and is
-**undecided** when it straddles either edge. A claim about a comparison between trained models
-needs seed variance: with a single seed it is "undecided: one seed" (the point estimate is still
-shown, with the side it falls on). A claim about the fixed testbed (the nearest-bone gap) needs
-none.
-
-The tables give one value per seed: a table whose CSV has a ``seed`` column contributes one
-value per seed, one without it (today's single-seed pipeline) contributes one value.
+A claim is a measured quantity (one value per training seed: a table without a ``seed`` column
+gives one), a threshold and a side. It **holds** when the 95% interval of the mean over seeds
+lies entirely on the claimed side of the threshold, **fails** when it lies entirely on the other
+side, and is **undecided** when it straddles it. A claim of flatness, equality or match (side
+``WITHIN``) is an equivalence test, two one-sided tests: it **holds** inside the band
+(-threshold, +threshold), **fails** wholly outside it, and is **undecided** across either edge.
+A comparison between trained models needs seed variance: with one seed it is "undecided: one
+seed" (with the side its point estimate falls on); a claim about the fixed testbed needs none.
 
 Which claims there are, what each reads and its threshold: the catalogue
 ([`physgs.report.catalogue`][physgs.report.catalogue]); this module measures them and decides.
@@ -28,15 +23,8 @@ import numpy as np
 import pandas as pd
 
 from physgs.models.registry import label, models_of
-from physgs.report.catalogue import (
-    CATALOGUE,
-    KINDS,
-    WITHIN,
-    kind_of,
-    origin_of,
-    prior_tables,
-    undermines,
-)
+from physgs.report.catalogue import CATALOGUE, KINDS, WITHIN, kind_of, origin_of, prior_tables
+from physgs.report.catalogue import undermines
 from physgs.report.claim_cells import RECOVERY, Run
 from physgs.report.seeds import MAX_SEEDS, finite, interval, log_interval, seeds_to_decide
 
@@ -48,7 +36,8 @@ RATIO = "ratio"
 class Claim:
     """One claim: id, the claim in one line, the paper's figure, where it is measured, the
     threshold and side ('>', '<', or ``WITHIN``: inside (-threshold, +threshold)), the unit,
-    whether a verdict needs seed variance, and its origin (the paper's or this project's)."""
+    whether a verdict needs seed variance, its origin (the paper's or this project's), the
+    paper's figure in the claim's unit and the companion that must hold too."""
 
     id: str
     text: str
@@ -75,28 +64,10 @@ class Claim:
         return f"{self.side} {self.threshold:g}"
 
 
-def on_claim(claim: Claim, x: float) -> bool:
-    """Whether a value lies on the claimed side of the threshold (inside the band for
-    ``WITHIN``).
-
-    Args:
-        claim: the claim (threshold, side).
-        x: a value in the claim's unit.
-
-    Returns:
-        True on the claimed side.
-    """
-    t = claim.threshold
-    if claim.side == WITHIN:
-        return -t < x < t
-    return x > t if claim.side == ">" else x < t
-
-
 def estimate(claim: Claim, values: Sequence[float]) -> tuple[float, float, float, float]:
     """(estimate, sd, low, high) of a claim over seeds: Student's t on the mean
     ([`interval`][physgs.report.seeds.interval]); for a ratio, on the mean of the per-seed
-    log-ratios, exponentiated ([`log_interval`][physgs.report.seeds.log_interval]: the
-    geometric mean, the sd of the logs, and an interval that stays positive).
+    log-ratios, exponentiated ([`log_interval`][physgs.report.seeds.log_interval]).
 
     Args:
         claim: the claim (its unit).
@@ -116,18 +87,15 @@ def verdict(claim: Claim, values: Sequence[float]) -> str:
         values: its per-seed values (NaN: not measured for that seed).
 
     Returns:
-        The verdict; ``'undecided: not measured'`` without a finite value, and the one-seed
-            verdict says on which side the point estimate lies.
+        The verdict, as [`decide`][physgs.report.claims.decide]'s.
     """
     m, _, lo, hi = estimate(claim, values)
-    n = int(np.isfinite(np.asarray(values, dtype=np.float64)).sum())
-    return decide(claim, m, lo, hi, n)
+    return decide(claim, m, lo, hi, int(np.isfinite(np.asarray(values, dtype=np.float64)).sum()))
 
 
 def decide(claim: Claim, m: float, lo: float, hi: float, n: int) -> str:
-    """The verdict of an estimate and its 95% interval ([`verdict`][physgs.report.claims.verdict]
-    from the per-seed values; this from a ledger's own columns, e.g. a committed record's
-    ``measured``, ``ci_low``, ``ci_high`` and ``seeds``).
+    """The verdict of an estimate and its 95% interval (e.g. a committed record's ``measured``,
+    ``ci_low``, ``ci_high`` and ``seeds``).
 
     Args:
         claim: the claim (threshold, side, whether it needs seed variance).
@@ -137,14 +105,18 @@ def decide(claim: Claim, m: float, lo: float, hi: float, n: int) -> str:
         n: the seeds measured.
 
     Returns:
-        The verdict, as ``verdict``'s.
+        The verdict; ``'undecided: not measured'`` without a finite estimate, and the one-seed
+            verdict says on which side the point estimate lies.
     """
+    t = claim.threshold
+
+    def on(x: float) -> bool:  # on the claimed side (inside the band for WITHIN)
+        if claim.side == WITHIN:
+            return -t < x < t
+        return x > t if claim.side == ">" else x < t
+
     if not np.isfinite(m):
         return "undecided: not measured"
-
-    def on(x: float) -> bool:
-        return on_claim(claim, x)
-
     if not claim.needs_variance:
         return "holds" if on(m) else "fails"
     if n < 2:
@@ -152,38 +124,22 @@ def decide(claim: Claim, m: float, lo: float, hi: float, n: int) -> str:
     if on(lo) and on(hi):
         return "holds"
     if claim.side == WITHIN:  # outside the band: wholly beyond one edge
-        return "fails" if hi <= -claim.threshold or lo >= claim.threshold else "undecided"
-    if not on(lo) and not on(hi):
-        return "fails"
-    return "undecided"
+        return "fails" if hi <= -t or lo >= t else "undecided"
+    return "fails" if not on(lo) and not on(hi) else "undecided"
 
 
 def _per_seed(df: pd.DataFrame) -> list[pd.DataFrame]:
     return [g for _, g in df.groupby("seed")] if "seed" in df.columns else [df]
 
 
-def _recovery_table(
-    damping: Mapping[str, Mapping[str, Sequence[Mapping[str, float]]]],
-) -> pd.DataFrame | None:
-    """The priors' damping summaries as one frame (seed: the summary's place in its list)."""
-    rows = [
-        {"seed": i, "model": m, "tree": t, **summary}
-        for m, by_tree in damping.items()
-        for t, per_seed in by_tree.items()
-        for i, summary in enumerate(per_seed)
-    ]
-    return pd.DataFrame(rows) if rows else None
-
-
 def _holds(tables: Mapping[str, pd.DataFrame], model: str) -> bool:
-    """Whether a table read of the other priors (``catalogue.prior_tables``) has a row or column
-    of ``model`` (its id)."""
+    """Whether a table of the other priors (``catalogue.prior_tables``) has a row or column of
+    ``model``."""
     for df in (tables[k] for k in prior_tables() if k in tables):
-        if model in df.columns:
+        if model in df.columns or any(
+            c in df.columns and (df[c].astype(str) == model).any() for c in ("model", "method")
+        ):
             return True
-        for col, v in (("model", model), ("method", model)):
-            if col in df.columns and (df[col].astype(str) == v).any():
-                return True
     return False
 
 
@@ -197,12 +153,10 @@ def measure(
     """Every claim of the catalogue with its per-seed values, from the tables' CSVs and the
     priors' damping summaries.
 
-    A partial run gives a partial ledger: a claim whose table is not in ``tables`` is listed with
-    no values (verdict "undecided: not measured"), except where the family's cells come from the
-    table itself (the per-wind rows of tab_transfer) and the optional families'
-    (``ClaimSpec.optional``: listed when their tables are given). A damping claim is listed for
-    each tree with the prior's summaries. The families asked of the priors are asked of every
-    prior of the registry other than ours that the run's tables hold.
+    A claim whose table is missing is listed with no values ("undecided: not measured"), except
+    where its cells come from the table itself and in the optional families
+    (``ClaimSpec.optional``). The families asked of the priors are asked of every prior of the
+    registry other than ours that the run's tables hold.
 
     Args:
         tables: table name -> its CSV (``catalogue.tables()``).
@@ -210,17 +164,22 @@ def measure(
             zeta_true), for the joint K=32 configuration.
         trees: the trees.
         prior_damping: model -> tree -> per-seed summaries, as ``damping``, of the other priors.
-        roles: tree -> its preset's role (``claim_cells.roles_of``: ``frequencies``, ``paper``);
-            None or a tree left out: no role, so none of the role-scoped claims and no paper
-            figure for it.
+        roles: tree -> its preset's role (``claim_cells.roles_of``); None or a tree left out: no
+            role, so none of the role-scoped claims and no paper figure for it.
 
     Returns:
         ``(claim, per-seed values)`` pairs, in the ledger's order (the catalogue's).
     """
     tabs = dict(tables)
-    rec = _recovery_table({"ours": damping, **(prior_damping or {})})
-    if rec is not None:
-        tabs[RECOVERY] = rec
+    summaries = {"ours": damping, **(prior_damping or {})}
+    rec = [
+        {"seed": i, "model": m, "tree": t, **summary}  # seed: the summary's place in its list
+        for m, by_tree in summaries.items()
+        for t, per_seed in by_tree.items()
+        for i, summary in enumerate(per_seed)
+    ]
+    if rec:
+        tabs[RECOVERY] = pd.DataFrame(rec)
     others = tuple(m for m in models_of("prior") if m != "ours" and _holds(tables, m))
     out: list[tuple[Claim, list[float]]] = []
     for spec in CATALOGUE:
@@ -231,28 +190,15 @@ def measure(
             run = Run(tabs, trees, model, others, spec.table, dict(roles or {}))
             for cell in spec.over(run):
                 cell = {"model": model, "name": label(model), "table": spec.table, **cell}
-                cid = spec.claim_id(cell)
-                claim = Claim(
-                    cid,
-                    spec.words(spec.text, cell),
-                    spec.figure(cell),
-                    spec.words(spec.source, cell),
-                    spec.value,
-                    spec.side,
-                    spec.unit,
-                    spec.needs_variance,
-                    origin_of(cid),
-                    spec.value_of_paper(cell),
-                    spec.claim_id(cell, spec.requires) if spec.requires else "",
-                )
+                claim = Claim(**spec.claim_of(cell))
                 out.append((claim, [float(spec.read(d, cell)) for d in seeds]))
     return out
 
 
 def to_decide(claim: Claim, values: Sequence[float]) -> tuple[float, float]:
-    """The seeds that would decide an undecided claim at its observed effect and sd, an
-    estimate two ways ([`seeds_to_decide`][physgs.report.seeds.seeds_to_decide]: the plug-in
-    t half-width, and ``tt_solve_power`` at 80% power); on the log scale for a ratio.
+    """The seeds that would decide an undecided claim at its observed effect and sd, two
+    estimates ([`seeds_to_decide`][physgs.report.seeds.seeds_to_decide]); on the log scale for a
+    ratio.
 
     Args:
         claim: the claim.
@@ -272,9 +218,8 @@ def to_decide(claim: Claim, values: Sequence[float]) -> tuple[float, float]:
 
 
 def paper_in_interval(claim: Claim, low: float, high: float) -> str:
-    """Whether the paper's figure lies inside the measured 95% interval: the claim reproduced
-    in size, beside its verdict (a direction, or a bar). A paper's range (``low < high``)
-    counts as inside when it meets the interval.
+    """Whether the paper's figure (a range: whether it meets it) lies inside the measured 95%
+    interval: the claim reproduced in size, beside its verdict.
 
     Args:
         claim: the claim (``paper_value``, in its unit).
@@ -283,7 +228,7 @@ def paper_in_interval(claim: Claim, low: float, high: float) -> str:
 
     Returns:
         ``"inside"`` or ``"outside"``; ``""`` where the paper gives no number or there is no
-            interval (one seed, nothing measured).
+            interval.
     """
     p_lo, p_hi = claim.paper_value
     if not (np.isfinite(p_lo) and np.isfinite(low) and np.isfinite(high)):
@@ -291,39 +236,24 @@ def paper_in_interval(claim: Claim, low: float, high: float) -> str:
     return "inside" if p_lo <= high and p_hi >= low else "outside"
 
 
-def gated(claim: Claim, own: str, verdicts: Mapping[str, str]) -> str:
-    """A claim's verdict where it holds only if its companion (``Claim.requires``) holds too: a
-    coverage whose intervals do not beat the null's interval score does not hold.
-
-    Args:
-        claim: the claim.
-        own: its verdict on its own values.
-        verdicts: claim id -> verdict, the companion's among them.
-
-    Returns:
-        ``own`` where it does not hold or there is no companion; otherwise ``own`` when the
-            companion holds, "fails: ..." when it fails and "undecided: ..." when it is
-            undecided or absent, naming the companion's verdict.
-    """
+def _gated(claim: Claim, own: str, verdicts: Mapping[str, str]) -> str:
+    """``own``, unless it holds and its companion (``Claim.requires``) does not: then "fails:
+    ..." or "undecided: ...", naming the companion's verdict."""
     if not claim.requires or own != "holds":
         return own
     comp = verdicts.get(claim.requires, "undecided: not measured")
     kind = comp.split(":")[0]
     if kind == "holds":
         return own
-    word = "fails" if kind == "fails" else "undecided"
-    return f"{word}: covers, but {claim.requires} {comp}"
+    return f"{'fails' if kind == 'fails' else 'undecided'}: covers, but {claim.requires} {comp}"
 
 
 def ledger(measured: Sequence[tuple[Claim, list[float]]]) -> pd.DataFrame:
     """One row per claim: the claim, the paper's figure, the measured mean (a ratio's geometric
-    mean), sd (a ratio's: of its logs, ``scale`` "log"), 95% interval and number of seeds, the
-    threshold and side, the verdict, where it comes from, its origin, its kind (a premise of the
-    comparison or a finding: ``catalogue.kind_of``), and for an undecided claim the seeds that
-    would decide it (an estimate: ``to_decide``); last (added columns, so older readers keep
-    theirs), the paper's figure as a number (``paper_low``, ``paper_high``) and whether it lies
-    inside the interval (``paper_in_interval``), and the companion a claim needs to hold
-    (``requires``: [`gated`][physgs.report.claims.gated]).
+    mean), sd (a ratio's: of its logs), 95% interval and seeds, the threshold, the verdict (one
+    that holds only if its companion ``requires`` holds too), its source, origin and kind
+    (``catalogue.kind_of``), for an undecided claim the seeds that would decide it
+    (``to_decide``), the paper's figure as a number and whether it lies inside the interval.
 
     Args:
         measured: [`measure`][physgs.report.claims.measure]'s pairs.
@@ -331,9 +261,9 @@ def ledger(measured: Sequence[tuple[Claim, list[float]]]) -> pd.DataFrame:
     Returns:
         The ledger, one row per claim.
     """
-    rows = []
     own = [verdict(c, values) for c, values in measured]
     alone = {c.id: v for (c, _), v in zip(measured, own)}  # the companions' (``requires``)
+    rows = []
     for (c, values), v in zip(measured, own):
         m, sd, lo, hi = estimate(c, values)
         n_t, n_power = to_decide(c, values)
@@ -349,7 +279,7 @@ def ledger(measured: Sequence[tuple[Claim, list[float]]]) -> pd.DataFrame:
                 "seeds": int(np.isfinite(values).sum()),
                 "unit": c.unit,
                 "threshold": c.threshold_text,
-                "verdict": gated(c, v, alone),
+                "verdict": _gated(c, v, alone),
                 "source": c.source,
                 "origin": c.origin,
                 "kind": kind_of(c.id),
@@ -367,7 +297,7 @@ def ledger(measured: Sequence[tuple[Claim, list[float]]]) -> pd.DataFrame:
 
 def column(claims: pd.DataFrame, name: str) -> pd.Series:
     """A catalogue-derived column of the ledger (``origin``, ``kind``): as written, or the
-    catalogue's word for each id in a ledger written before the column.
+    catalogue's word for each id of a ledger written before the column.
 
     Args:
         claims: the ledger (``claims.csv``: ``id`` at least).
@@ -382,8 +312,7 @@ def column(claims: pd.DataFrame, name: str) -> pd.Series:
 
 
 def number(x: float, unit: str) -> str:
-    """A measured value as the ledger prints it: signed (a difference's side of 0 is its news),
-    except a ratio's, which is always positive.
+    """A measured value as the ledger prints it: signed, but a ratio's (always positive).
 
     Args:
         x: the value.
@@ -396,9 +325,8 @@ def number(x: float, unit: str) -> str:
 
 
 def counted(claims: pd.DataFrame, origin: str) -> str:
-    """The claims of one origin counted, the findings apart from the premises of the comparison
-    (``catalogue.PREMISES``), each by verdict: ``52 claims: 34 findings (20 hold, 10 fail, 4
-    undecided), 18 premises (4 hold, 14 fail)``; a verdict none has is left out.
+    """The claims of one origin counted, findings apart from premises, each by verdict:
+    ``52 claims: 34 findings (20 hold, 10 fail, 4 undecided), 18 premises (4 hold, 14 fail)``.
 
     Args:
         claims: the ledger (``id``, ``verdict``; ``origin``, ``kind`` where written).
@@ -426,8 +354,7 @@ def counted(claims: pd.DataFrame, origin: str) -> str:
 
 
 def failed_premises(claims: pd.DataFrame) -> list[str]:
-    """Each premise family with a failed claim: where it fails and what that undermines
-    (``catalogue.undermines``).
+    """Each premise family with a failed claim: where it fails and what that undermines.
 
     Args:
         claims: the ledger.
@@ -475,10 +402,7 @@ def ledger_markdown(df: pd.DataFrame, stamp: Mapping[str, str] | None = None) ->
         "undecided claim, the seeds that would decide it if its effect and sd stayed as observed, "
         "an estimate: the plug-in t half-width / a t-test at 80% power (`tt_solve_power`).",
         "",
-    ]
-    if stamp:
-        lines += ["Made by: " + ", ".join(f"{k}={v}" for k, v in stamp.items()), ""]
-    lines += [
+        *(["Made by: " + ", ".join(f"{k}={v}" for k, v in stamp.items()), ""] if stamp else []),
         f"The paper's {counted(df, 'paper')}. This project's own {counted(df, 'project')}. "
         "A premise is what the comparison rests on (the testbed is the paper's, the models fit "
         "their window); a finding is what it says.",
@@ -489,8 +413,7 @@ def ledger_markdown(df: pd.DataFrame, stamp: Mapping[str, str] | None = None) ->
         "| seeds to decide (est.) | from |",
         "|---|---|---|---|---|---|---|---|---|",
     ]
-    kinds = column(df, "kind")
-    for (_, r), k in zip(df.iterrows(), kinds):
+    for (_, r), k in zip(df.iterrows(), column(df, "kind")):
         meas = "--" if not np.isfinite(r.measured) else f"{number(r.measured, r.unit)} {r.unit}"
         if np.isfinite(r.ci_low):
             lo, hi = number(r.ci_low, r.unit), number(r.ci_high, r.unit)
