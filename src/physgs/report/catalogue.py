@@ -185,13 +185,12 @@ class ClaimSpec:
         )  # fmt: skip
 
 
-# ---- why a family is one-sided (``ClaimSpec.one_sided``) -----------------------------------------
+# ---- why a family is one-sided (``ClaimSpec.one_sided``), and what most families share ----------
 DIRECTION = "a direction: which is ahead, not by how much"
 ABSOLUTE = (
     "two-sided by construction: the reader takes |offset|, so one bound on it is a band on both "
     "sides (the mean of |x| is at least |mean x|: stricter than a band on the signed offset)"
 )
-COVER = "a floor: coverage of at least the bar; width is judged by its interval-score companion"
 KIND_DIRECTION = (
     "a direction, as the paper's claim it splits: which kind of field is below static (and so "
     "which contradicts the paper's sign), not by how much"
@@ -200,13 +199,11 @@ NON_INFERIOR = (
     "non-inferiority: the claim is that the other does not lose, and its winning supports it too"
 )
 GROWS = "a direction: the margin grows, not by how much"
-INFORMATIVE = (
-    "a bar: an interval at most this wide says something; narrower never hurts "
-    "(its misses are the interval score's)"
-)
-#: The paper's figure of a family the paper does not state.
-PROJECT_ONLY = "not in the paper (this project's)"
 TRACKS_PROPOSAL = "not run (the paper's closing proposal)"
+#: A difference whose sign is the claim (dB).
+_AHEAD_DB = dict(threshold="EVEN", unit="dB", one_sided=DIRECTION)
+#: A study or control of this project's that only some runs make.
+_STUDY = dict(origin="project", optional=True)
 
 
 # ---- scopes and readers several families share ---------------------------------------------------
@@ -232,7 +229,6 @@ def _psnr(d: pd.DataFrame, c: Cell, models: Sequence[str], split: str = "time") 
 
 
 def _over_static(d: pd.DataFrame, c: Cell, models: Sequence[str]) -> float:
-    """tab_psnr, beyond the window: the best of ``models`` - static."""
     return _psnr(d, c, models) - _psnr(d, c, ["static"])
 
 
@@ -259,6 +255,10 @@ def _transfer(d: pd.DataFrame, c: Cell, models: Sequence[str]) -> float:
     return max(value(d, row & np.isclose(d["condition"], c["condition"]), m) for m in models)
 
 
+def _transfer_over_static(d: pd.DataFrame, c: Cell, models: Sequence[str]) -> float:
+    return _transfer(d, c, models) - _transfer(d, c, ["static"])
+
+
 def _wind_ahead(d: pd.DataFrame, c: Cell) -> float:
     return _transfer(d, c, [c["model"]]) - _transfer(d, c, models_of("field"))
 
@@ -282,23 +282,28 @@ def _null_trees_separated(run: Run) -> list[Cell]:
     return [{**c, "config": CONFIG, "method": run.model} for c in _with_role(run, SEPARATED)]
 
 
+def _at(d: pd.DataFrame, c: Cell) -> pd.Series:
+    """The rows of the cell's tree and configuration."""
+    return (d["tree"] == c["tree"]) & (d["config"] == c["config"])
+
+
 def _null_row(d: pd.DataFrame, c: Cell, who: str = "") -> pd.Series:
     """tab_null / tab_recovery: method ``who``'s row (default: the cell's) in its tree, config."""
     who = who or c.get("method", c["model"])
-    return rows_of(d, who) & (d["tree"] == c["tree"]) & (d["config"] == c["config"])
+    return rows_of(d, who) & _at(d, c)
 
 
-def _null_err(d: pd.DataFrame, c: Cell, of: str) -> float:
-    """tab_null / tab_recovery: the ``of`` (trained, null) median omega error (%)."""
-    return value(d, _null_row(d, c), f"{of}_median_rel_err_pct")
+def _err(d: pd.DataFrame, c: Cell, of: str = "trained", who: str = "") -> float:
+    """tab_null / tab_recovery: the ``of`` (trained, null) median omega error (%) of ``who``."""
+    return value(d, _null_row(d, c, who), f"{of}_median_rel_err_pct")
 
 
 def _null_over_trained(d: pd.DataFrame, c: Cell) -> float:
-    return _null_err(d, c, "null") / _null_err(d, c, "trained")
+    return _err(d, c, "null") / _err(d, c)
 
 
 def _trained_minus_null(d: pd.DataFrame, c: Cell) -> float:
-    return _null_err(d, c, "trained") - _null_err(d, c, "null")
+    return _err(d, c) - _err(d, c, "null")
 
 
 def _recovery(d: pd.DataFrame, c: Cell, col: str) -> float:
@@ -313,15 +318,15 @@ def _damping_off(d: pd.DataFrame, c: Cell) -> float:
 
 
 # ---- the paper's figures (``ClaimSpec.paper``) ---------------------------------------------------
-def _tab_psnr(c: Cell, f: Callable[[dict], float]) -> tuple[float, float]:
-    """``f`` of the cell's paper tree's tab:psnr ((view, time) dB per model); none without."""
-    pp = paper.PSNR.get(c.get("paper"))
-    return (float(f(pp)),) * 2 if pp else NO_VALUE
+def _from_paper(table: dict, c: Cell, f: Callable) -> tuple[float, float]:
+    """``f`` of the cell's paper tree's entry of ``table`` as one figure; none without one."""
+    v = table.get(c.get("paper"))
+    return (float(f(v)),) * 2 if v else NO_VALUE
 
 
-def _tab_null(c: Cell, f: Callable[[float, float], float]) -> tuple[float, float]:
-    """``f`` of the cell's paper tree's tab:null (trained, null median omega error, %)."""
-    return (float(f(*paper.NULL.get(c.get("paper"), (np.nan, np.nan)))),) * 2
+def _paper_over_static(c: Cell, models: Sequence[str]) -> tuple[float, float]:
+    """tab:psnr: the best of ``models`` - static beyond the window (dB)."""
+    return _from_paper(paper.PSNR, c, lambda pp: max(pp[m][1] - pp["static"][1] for m in models))
 
 
 def _zeta_off(c: Cell) -> tuple[float, float]:
@@ -333,15 +338,9 @@ def _zeta_off(c: Cell) -> tuple[float, float]:
     return (ends[0], ends[-1])
 
 
-def _margin(c: Cell) -> tuple[float, float]:
-    """tab:margin's last wind - its first (dB)."""
-    p = paper.MARGIN.get(c.get("paper"))
-    return (float(p[-1] - p[0]),) * 2 if p else NO_VALUE
-
-
 NULL_RATIO = Figure(
     "null / trained median omega error, tab:null",
-    lambda c: _tab_null(c, lambda tr, nl: nl / tr),
+    lambda c: _from_paper(paper.NULL, c, lambda v: v[1] / v[0]),  # (trained, null) %
     "null / trained = {v:.2f}",
 )
 
@@ -349,47 +348,36 @@ NULL_RATIO = Figure(
 # ---- the paper's: beyond the window and on held-out views (tab:psnr), unseen wind (tab:transfer)
 _MOTION = (
     ClaimSpec(
-        family="ours_above_static_beyond", over=_trees, table="tab_psnr",
+        family="ours_above_static_beyond", over=_trees, table="tab_psnr", **_AHEAD_DB, side=">",
         read=lambda d, c: _over_static(d, c, [c["model"]]),
-        threshold="EVEN", side=">", unit="dB", one_sided=DIRECTION,
         text="{tree}: ours is above the static pose beyond the window",
         source="tab_psnr, time column: ours - static",
-        paper=Figure(
-            "ours - static beyond the window, tab:psnr",
-            lambda c: _tab_psnr(c, lambda pp: pp["ours"][1] - pp["static"][1]),
-        ),
+        paper=Figure("ours - static beyond the window, tab:psnr",
+                     lambda c: _paper_over_static(c, ["ours"])),
         headline="ours above the static pose beyond the training window",
     ),
     ClaimSpec(
-        family="baselines_below_static_beyond", over=_trees, table="tab_psnr",
-        read=lambda d, c: _over_static(d, c, models_of("field")),
-        threshold="EVEN", side="<", unit="dB", one_sided=DIRECTION,
+        family="baselines_below_static_beyond", over=_trees, table="tab_psnr", **_AHEAD_DB,
+        side="<", read=lambda d, c: _over_static(d, c, models_of("field")),
         text="{tree}: every learned baseline is below the static pose beyond the window",
         source="tab_psnr, time column: max over learned fields of (model - static)",
-        paper=Figure(
-            "best learned field - static beyond the window, tab:psnr",
-            lambda c: _tab_psnr(
-                c, lambda pp: max(pp[m][1] - pp["static"][1] for m in models_of("field"))
-            ),
-            "best baseline - static = {v:+.2f} dB",
-        ),
+        paper=Figure("best learned field - static beyond the window, tab:psnr",
+                     lambda c: _paper_over_static(c, models_of("field")),
+                     "best baseline - static = {v:+.2f} dB"),
         headline="every learned field below static beyond the window",
     ),
     ClaimSpec(
         family="ours_behind_on_views", over=_trees, table="tab_psnr", read=_ahead_of_fields,
-        threshold="EVEN", side="<", unit="dB", one_sided=DIRECTION,
+        **_AHEAD_DB, side="<",
         text="{tree}: ours is behind the best learned field on held-out views",
         source="tab_psnr, view column: ours - max over learned fields",
-        paper=Figure(
-            "ours - best learned field on held-out views, tab:psnr",
-            lambda c: _tab_psnr(
-                c, lambda pp: pp["ours"][0] - max(pp[m][0] for m in models_of("field"))
-            ),
-        ),
+        paper=Figure("ours - best learned field on held-out views, tab:psnr", lambda c: _from_paper(
+            paper.PSNR, c, lambda pp: pp["ours"][0] - max(pp[m][0] for m in models_of("field"))
+        )),
     ),
     ClaimSpec(
         family="transfer_ours_ahead", over=_winds_beyond, table="tab_transfer", read=_wind_ahead,
-        threshold="EVEN", side=">", unit="dB", one_sided=DIRECTION,
+        **_AHEAD_DB, side=">",
         text="{tree}, {cond} v0, beyond the window: ours ahead of the best baseline",
         source="tab_transfer (beyond): ours - max learned",
         paper="ahead in every cell, by 0.38-4.68 dB",
@@ -397,8 +385,7 @@ _MOTION = (
     ),
     ClaimSpec(
         family="transfer_baselines_below_static", over=_winds_beyond, table="tab_transfer",
-        read=lambda d, c: _transfer(d, c, models_of("field")) - _transfer(d, c, ["static"]),
-        threshold="EVEN", side="<", unit="dB", one_sided=DIRECTION,
+        read=lambda d, c: _transfer_over_static(d, c, models_of("field")), **_AHEAD_DB, side="<",
         text="{tree}, {cond} v0, beyond the window: every learned baseline below static",
         source="tab_transfer (beyond): max learned - static",
         paper="below static in all 24 cells, by 0.10-2.79 dB",
@@ -439,17 +426,13 @@ _KINDS = (
         text="{tree}: every {kind_words} learned field ({kind_fields}) is below the static pose "
         "beyond the window",
         source="tab_psnr, time column: max over the {kind_words} fields of (model - static)",
-        paper=Figure(
-            "the kind's best learned field - static beyond the window, tab:psnr",
-            lambda c: _tab_psnr(
-                c, lambda pp: max(pp[m][1] - pp["static"][1] for m in fields_of_kind(c["kind"]))
-            ),
-            "best {kind_words} baseline - static = {v:+.2f} dB",
-        ),
+        paper=Figure("the kind's best learned field - static beyond the window, tab:psnr",
+                     lambda c: _paper_over_static(c, fields_of_kind(c["kind"])),
+                     "best {kind_words} baseline - static = {v:+.2f} dB"),
     ),
     ClaimSpec(
         family="transfer_kind_below_static", over=_kind_winds_beyond, table="tab_transfer",
-        read=lambda d, c: _transfer(d, c, fields_of_kind(c["kind"])) - _transfer(d, c, ["static"]),
+        read=lambda d, c: _transfer_over_static(d, c, fields_of_kind(c["kind"])),
         threshold="EVEN", side="<", unit="dB", origin="project", one_sided=KIND_DIRECTION,
         text="{tree}, {cond} v0, beyond the window: every {kind_words} learned field "
         "({kind_fields}) below static",
@@ -461,9 +444,8 @@ _KINDS = (
         threshold="EVEN", side=">", unit="dB", one_sided=GROWS,
         text="{tree}: the margin against MLP + wind grows as the wind departs from training",
         source="tab_margin: {last} - {first}",
-        paper=Figure(
-            "the margin's growth from the training wind to the farthest, tab:margin", _margin
-        ),
+        paper=Figure("the margin's growth from the training wind to the farthest, tab:margin",
+                     lambda c: _from_paper(paper.MARGIN, c, lambda p: p[-1] - p[0])),
     ),
 )  # fmt: skip
 
@@ -521,11 +503,9 @@ _RECOVERY = (
         text="{tree}: the untrained null matches the trained model (it is not beaten by "
         "{NULL_MATCH_PP} points or more)",
         source="{table}, {config}: trained - null median rel. error (points)",
-        paper=Figure(
-            "trained - null median omega error, tab:null",
-            lambda c: _tab_null(c, lambda tr, nl: tr - nl),
-            "trained - null = {v:+.2f} points",
-        ),
+        paper=Figure("trained - null median omega error, tab:null",
+                     lambda c: _from_paper(paper.NULL, c, lambda v: v[0] - v[1]),
+                     "trained - null = {v:+.2f} points"),
         headline="the untrained null matches ours on frequency",
         one_sided="non-inferiority of the null: the paper's point is that training adds nothing "
         "over it on these trees, which a null ahead of the trained model supports too",
@@ -535,11 +515,9 @@ _RECOVERY = (
         threshold="GAP_RTOL", side="<", unit="fraction", one_sided=ABSOLUTE,
         text="{tree}: the median nearest-bone gap is the paper's (within {GAP_RTOL:.0%} of it)",
         source="tab_testbed: |gap - paper| / paper",
-        paper=Figure(
-            "the median nearest-bone gap, section 4",
-            lambda c: NO_VALUE,  # a figure of the testbed, not in the claim's unit
-            lambda c: f"{paper.NEAREST_BONE_GAP_PCT[c['paper']]:.2f}%",
-        ),
+        paper=Figure("the median nearest-bone gap, section 4",
+                     lambda c: NO_VALUE,  # a figure of the testbed, not in the claim's unit
+                     lambda c: f"{paper.NEAREST_BONE_GAP_PCT[c['paper']]:.2f}%"),
         needs_variance=False,
     ),
     ClaimSpec(
@@ -606,22 +584,21 @@ def _recovery_trees(run: Run) -> list[Cell]:
 
 _PRIORS = (
     ClaimSpec(
-        family="above_static_beyond", of="priors", over=_trees, table="tab_psnr",
-        read=lambda d, c: _over_static(d, c, [c["model"]]),
-        threshold="EVEN", side=">", unit="dB", origin="project", one_sided=DIRECTION,
+        family="above_static_beyond", of="priors", over=_trees, table="tab_psnr", **_AHEAD_DB,
+        side=">", read=lambda d, c: _over_static(d, c, [c["model"]]), origin="project",
         text="{tree}: the {name} is above the static pose beyond the window",
         source="tab_psnr, time column: prior - static",
         headline="the {name} above the static pose beyond the window",
     ),
     ClaimSpec(
         family=AHEAD, of="priors", over=_splits, table="tab_psnr", read=_ahead_of_fields,
-        threshold="EVEN", side=">", unit="dB", origin="project", one_sided=DIRECTION,
+        **_AHEAD_DB, side=">", origin="project",
         text="{tree}: the {name} is ahead of the best learned field on {where}",
         source="tab_psnr, {split} column: prior - max over learned fields",
     ),
     ClaimSpec(
         family=AHEAD, of="priors", over=_winds, table="tab_transfer", read=_wind_ahead,
-        threshold="EVEN", side=">", unit="dB", origin="project", one_sided=DIRECTION,
+        **_AHEAD_DB, side=">", origin="project",
         text="{tree}, {cond} v0, {where}: the {name} is ahead of the best learned field",
         source="tab_transfer ({split}): prior - max learned",
     ),
@@ -636,8 +613,7 @@ _PRIORS = (
         read=_trained_minus_null, threshold="-NULL_MATCH_PP", side="<", unit="points",
         text="{tree}: the {name} beats the untrained null on frequency recovery (by "
         "{NULL_MATCH_PP} points or more)",
-        source="{table}, {config}: trained - null median rel. error (points)",
-        origin="project",
+        source="{table}, {config}: trained - null median rel. error (points)", origin="project",
         one_sided="superiority by a margin: ahead of the null by the margin or more",
     ),
     ClaimSpec(
@@ -711,8 +687,7 @@ def _oma_interval_trees(run: Run) -> list[Cell]:
 def _oma(d: pd.DataFrame, c: Cell, col: str) -> float:
     """tab_damping (damping testbed): the output-only analysis' ``col`` in the cell's tree and
     configuration."""
-    row = (d["testbed"] == DAMPING) & (d["tree"] == c["tree"]) & (d["config"] == c["config"])
-    return value(d, row & (d["method"] == OMA), col)
+    return value(d, _at(d, c) & (d["testbed"] == DAMPING) & (d["method"] == OMA), col)
 
 
 def _halfwidth(d: pd.DataFrame, c: Cell, q: str) -> float:
@@ -726,8 +701,12 @@ def _oma_intervals(q: str, name: str) -> dict[str, ClaimSpec]:
     """The output-only analysis' 95% intervals for ``q`` (``omega``, ``zeta``; ``name`` in the
     ids): they cover, they score better than the null's, they are informative."""
     intervals = f"{{tree}} (damping testbed): the output-only analysis' 95% intervals for {q}"
-    common = dict(over=_oma_interval_trees, table="tab_damping", paper=PROJECT_ONLY,
-                  origin="project", optional=True)  # fmt: skip
+    common = dict(
+        over=_oma_interval_trees,
+        table="tab_damping",
+        paper="not in the paper (this project's)",
+        **_STUDY,
+    )
     return {
         "covers": ClaimSpec(
             family=f"oma_{name}_interval_covers", **common,
@@ -736,7 +715,9 @@ def _oma_intervals(q: str, name: str) -> dict[str, ClaimSpec]:
             text=f"{intervals} hold the matched bone's true {q} on at least "
             "{INTERVAL_COVER:.0%} of its trusted parts",
             source=f"{{table}}, {{config}}: output-only {q}_interval_cover",
-            one_sided=COVER, requires=f"oma_{name}_interval_score",
+            one_sided="a floor: coverage of at least the bar; width is judged by its "
+            "interval-score companion",
+            requires=f"oma_{name}_interval_score",
         ),
         "score": ClaimSpec(
             family=f"oma_{name}_interval_score", **common,
@@ -757,7 +738,8 @@ def _oma_intervals(q: str, name: str) -> dict[str, ClaimSpec]:
             text=f"{intervals} are informative (median half-width below "
             "{INFORMATIVE_HALFWIDTH:.0%} of the value: the interval excludes zero)",
             source=f"{{table}}, {{config}}: 1.96 x output-only {q}_rel_sd",
-            one_sided=INFORMATIVE,
+            one_sided="a bar: an interval at most this wide says something; narrower never "
+            "hurts (its misses are the interval score's)",
         ),
     }  # fmt: skip
 
@@ -767,17 +749,13 @@ _OMEGA, _ZETA = _oma_intervals("omega", "frequency"), _oma_intervals("zeta", "da
 _BLIND = (
     ClaimSpec(
         family="anemometer_needed", over=_blind_trees, table="tab_recovery",
-        read=lambda d, c: (
-            value(d, _null_row(d, c, c["blind"]), "trained_median_rel_err_pct")
-            - value(d, _null_row(d, c, c["wind"]), "trained_median_rel_err_pct")
-        ),
-        threshold="EVEN", side=">", unit="pp", origin="project", optional=True,
+        read=lambda d, c: _err(d, c, who=c["blind"]) - _err(d, c, who=c["wind"]),
+        threshold="EVEN", side=">", unit="pp", **_STUDY, one_sided=DIRECTION,
         text="{tree}: without the measured wind (a learned forcing) {who} recovers omega worse",
         source="{table}, {config}: {blind} - {wind} median rel. error (points)",
         paper="the paper's closing limit: 'real footage needs an anemometer'",
         headline="without the anemometer (a learned forcing), ours' frequency error grows "
         "(points)",
-        one_sided=DIRECTION,
     ),
     ClaimSpec(
         family="oma_beats_null", over=_oma_separated, table="tab_recovery",
@@ -785,17 +763,17 @@ _BLIND = (
         text="{tree}: output-only modal analysis of the video recovers omega better than the "
         "untrained null",
         source="{table}, {config}: null / output-only median rel. error",
-        paper="not run", origin="project", optional=True, one_sided=DIRECTION,
+        paper="not run", **_STUDY, one_sided=DIRECTION,
         headline="output-only modal analysis of the video beats the untrained null",
     ),
     ClaimSpec(
         family="oma_recovers_zeta", over=_oma_damping_trees, table="tab_damping",
         read=lambda d, c: _oma(d, c, "trained_minus_null_pp"),
-        threshold="EVEN", side="<", unit="pp", origin="project", optional=True,
+        threshold="EVEN", side="<", unit="pp", **_STUDY, one_sided=DIRECTION,
         text="{tree} (damping testbed): output-only modal analysis recovers zeta better than "
         "the untrained null",
         source="tab_damping, {config}: output-only - null median zeta error (points)",
-        paper="no method here recovers zeta (the paper)", one_sided=DIRECTION,
+        paper="no method here recovers zeta (the paper)",
     ),
     _OMEGA["covers"], _ZETA["covers"], _OMEGA["score"], _OMEGA["informative"], _ZETA["score"],
     _ZETA["informative"],
@@ -836,30 +814,28 @@ def _parts_coupling(run: Run) -> list[Cell]:
 
 def _parts_gain(d: pd.DataFrame, c: Cell, better: str, base: str, col: str) -> float:
     """tab_parts: ``col`` of parts ``better`` - of parts ``base`` in the cell's tree, config."""
-    row = (d["tree"] == c["tree"]) & (d["config"] == c["config"])
-    return value(d, row & (d["model"] == better), col) - value(d, row & (d["model"] == base), col)
+    at = _at(d, c)
+    return value(d, at & (d["model"] == better), col) - value(d, at & (d["model"] == base), col)
 
 
 _PARTS = (
     ClaimSpec(
         family="topology_parts_reduce_damping_error", over=_parts_damping_trees,
-        table="tab_parts",
+        table="tab_parts", **_STUDY, one_sided=DIRECTION,
         read=lambda d, c: _parts_gain(d, c, "ours_topo", "ours", "zeta_rel_err_pct"),
-        threshold="EVEN", side="<", unit="pp", origin="project", optional=True,
+        threshold="EVEN", side="<", unit="pp",
         text="{tree}: topology-aware parts reduce the damping error (damping testbed)",
         source="tab_parts ({config}): median rel. err. of zeta, topology - k-means parts",
         paper="hypothesis (k-means parts 'plausibly feed the damping bias')",
-        one_sided=DIRECTION,
     ),
     ClaimSpec(
         family="coupling_lifts_sparse_fit", over=_parts_coupling, table="tab_parts",
         read=lambda d, c: _parts_gain(d, c, "ours_chain", "ours_topo", "ceiling_frac"),
-        threshold="EVEN", side=">", unit="fraction", origin="project", optional=True,
+        threshold="EVEN", side=">", unit="fraction", **_STUDY, one_sided=DIRECTION,
         text="{tree}: parent-child coupling lifts the in-window fit",
         source="tab_parts ({config}): fraction of the ceiling's gain, chained - independent "
         "topology parts",
         paper="hypothesis (independent parts 'represent no coupling')",
-        one_sided=DIRECTION,
     ),
 )  # fmt: skip
 
@@ -883,11 +859,9 @@ def _tracks_separated(run: Run) -> list[Cell]:
 
 def _tracks_minus_ours(d: pd.DataFrame, c: Cell) -> float:
     """tab_recovery: 2D tracks - ours median omega error (points); NaN at another K than ours'"""
-    tracks, ours = _null_row(d, c), _null_row(d, c, "ours")
-    if value(d, tracks, "K") != value(d, ours, "K"):
+    if value(d, _null_row(d, c), "K") != value(d, _null_row(d, c, "ours"), "K"):
         return float("nan")  # another K: not the same question
-    col = "trained_median_rel_err_pct"
-    return value(d, tracks, col) - value(d, ours, col)
+    return _err(d, c) - _err(d, c, who="ours")
 
 
 def _tracks_trees(run: Run) -> list[Cell]:
@@ -899,12 +873,6 @@ def _tracks_trees(run: Run) -> list[Cell]:
     return [{**x, "config": c} for x in _trees(run) if (tr["tree"] == x["tree"]).any()]
 
 
-def _tracks_tail(d: pd.DataFrame, c: Cell) -> float:
-    """tab_tracks: tail displacement error, 2D tracks - ours (px)"""
-    row = (d["tree"] == c["tree"]) & (d["config"] == c["config"])
-    return value(d, row, "tail_px") - value(d, row, "tail_ours_px")
-
-
 _TRACKS = (
     ClaimSpec(
         family="tracks_beats_null", over=_tracks_separated, table="tab_recovery",
@@ -912,7 +880,7 @@ _TRACKS = (
         text="{tree}: oscillators fitted to 2D tracks recover omega better than the untrained "
         "null",
         source="{table}, 2D tracks {config}: null / tracks median rel. error",
-        paper=TRACKS_PROPOSAL, origin="project", optional=True, one_sided=DIRECTION,
+        paper=TRACKS_PROPOSAL, **_STUDY, one_sided=DIRECTION,
     ),
     ClaimSpec(
         family="tracks_match_ours", over=_tracks_separated, table="tab_recovery",
@@ -920,16 +888,16 @@ _TRACKS = (
         text="{tree}: oscillators fitted to 2D tracks match ours' omega recovery (ours does not "
         "beat them by {NULL_MATCH_PP} points or more)",
         source="{table}, {config}: 2D tracks - ours median rel. error (points)",
-        paper=TRACKS_PROPOSAL, origin="project", optional=True, one_sided=NON_INFERIOR,
+        paper=TRACKS_PROPOSAL, **_STUDY, one_sided=NON_INFERIOR,
     ),
     ClaimSpec(
         family="tracks_extrapolate_as_ours", over=_tracks_trees, table="tab_tracks",
-        read=_tracks_tail,
+        read=lambda d, c: value(d, _at(d, c), "tail_px") - value(d, _at(d, c), "tail_ours_px"),
         threshold="EVEN", side="<", unit="px",
         text="{tree}: beyond the window, oscillators fitted to 2D tracks predict the tracked "
         "points at least as well as ours' Gaussians",
         source="tab_tracks, {config}: tail displacement error, 2D tracks - ours (px)",
-        paper=TRACKS_PROPOSAL, origin="project", optional=True, one_sided=NON_INFERIOR,
+        paper=TRACKS_PROPOSAL, **_STUDY, one_sided=NON_INFERIOR,
     ),
 )  # fmt: skip
 
