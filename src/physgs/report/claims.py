@@ -267,31 +267,15 @@ def ledger(measured: Sequence[tuple[Claim, list[float]]]) -> pd.DataFrame:
     for (c, values), v in zip(measured, own):
         m, sd, lo, hi = estimate(c, values)
         n_t, n_power = to_decide(c, values)
-        rows.append(
-            {
-                "id": c.id,
-                "claim": c.text,
-                "paper": c.paper,
-                "measured": m,
-                "sd": sd,
-                "ci_low": lo,
-                "ci_high": hi,
-                "seeds": int(np.isfinite(values).sum()),
-                "unit": c.unit,
-                "threshold": c.threshold_text,
-                "verdict": _gated(c, v, alone),
-                "source": c.source,
-                "origin": c.origin,
-                "kind": kind_of(c.id),
-                "scale": "log" if c.log_scale else "linear",
-                "seeds_to_decide_t_est": n_t,
-                "seeds_to_decide_power80_est": n_power,
-                "paper_low": c.paper_value[0],
-                "paper_high": c.paper_value[1],
-                "paper_in_interval": paper_in_interval(c, lo, hi),
-                "requires": c.requires,
-            }
-        )
+        rows.append(dict(
+            id=c.id, claim=c.text, paper=c.paper, measured=m, sd=sd, ci_low=lo, ci_high=hi,
+            seeds=int(np.isfinite(values).sum()), unit=c.unit, threshold=c.threshold_text,
+            verdict=_gated(c, v, alone), source=c.source, origin=c.origin, kind=kind_of(c.id),
+            scale="log" if c.log_scale else "linear", seeds_to_decide_t_est=n_t,
+            seeds_to_decide_power80_est=n_power, paper_low=c.paper_value[0],
+            paper_high=c.paper_value[1], paper_in_interval=paper_in_interval(c, lo, hi),
+            requires=c.requires,
+        ))  # fmt: skip
     return pd.DataFrame(rows)
 
 
