@@ -253,7 +253,8 @@ def ledger(measured: Sequence[tuple[Claim, list[float]]]) -> pd.DataFrame:
     mean), sd (a ratio's: of its logs), 95% interval and seeds, the threshold, the verdict (one
     that holds only if its companion ``requires`` holds too), its source, origin and kind
     (``catalogue.kind_of``), for an undecided claim the seeds that would decide it
-    (``to_decide``), the paper's figure as a number and whether it lies inside the interval.
+    (``to_decide``); last (added later: older readers keep their columns), the paper's figure as
+    a number, whether it lies inside the interval, and the companion.
 
     Args:
         measured: [`measure`][physgs.report.claims.measure]'s pairs.
