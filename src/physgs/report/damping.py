@@ -1,16 +1,12 @@
 """tab_damping: can the oscillator prior recover damping on a testbed built to show it?
 
-For each tree of the damping benchmark, ours trained on the faithful testbed (one zeta on every
-bone, no deliberate transient) and on its damping variant (zeta per bone, log-uniform, and a gust
-dropping to calm inside the window), per configuration and training seed: the median relative
-error of zeta_hat over trusted parts, the correlation of log zeta_hat with log zeta, and the
-exponent p of the fitted decay rate gamma_hat = zeta_hat omega_hat ~ omega_hat^p (the paper's
-diagnosis is p near 0: a frequency-independent rate fitted in place of a ratio; a recovered
-ratio gives the truth's p, 1 for a constant zeta), each beside the untrained null (zeta drawn
-log-uniformly from the damping range, scored on the same matching; medians over its draws).
-Built from the recovery records ([`physgs.recovery.record`][], ``damping_scores``/``damping_null``).
-
-Beside it, fig_damping: each prior's recovered damping on the run's own trees (first seed).
+Per tree of the damping benchmark, each method on the faithful testbed (one zeta on every bone)
+and on its damping variant (zeta per bone, log-uniform, and a gust dropping to calm inside the
+window), from the recovery records' ``damping_scores``/``damping_null``: the median relative
+error of zeta_hat over trusted parts, corr(log zeta_hat, log zeta) and the exponent p of the
+fitted decay rate gamma_hat = zeta_hat omega_hat ~ omega_hat^p (p near 0: a frequency-independent
+rate fitted in place of a ratio), each beside the untrained null. fig_damping: each prior's
+recovered damping on the run's own trees (first seed).
 """
 
 from __future__ import annotations
@@ -59,21 +55,17 @@ def tab_damping(
 ) -> Table:
     """Damping recovery per seed, tree, variant, method and configuration, beside the null.
 
-    One CSV row per seed, tree, variant, method and configuration (column ``method`` the id);
-    the .tex gives mean +- sd over seeds and the paired trained - null difference with its 95%
-    interval.
-
     Args:
-        methods: method id -> its [`MethodRows`][physgs.report.recovery.MethodRows], in row order
-            (ours first, as tab_null's; a method with no configurations has no rows):
-            ``per_seed[seed][(tree, variant, config)]`` = its ``RecoveryRecord`` with damping
-            scores and null; variant 'faithful' or 'damping'.
+        methods: method id -> its ``MethodRows``, in row order (ours first; one without
+            configurations has no rows): ``per_seed[seed][(tree, variant, config)]`` = its
+            ``RecoveryRecord`` with damping scores and null; variant 'faithful' or 'damping'.
         trees: the trees.
         bones: tree -> its bone count.
         digits: decimals shown in the .tex.
 
     Returns:
-        The [`Table`][physgs.report.tables.Table].
+        The table: one CSV row per seed and row; the .tex mean +- sd over seeds and the paired
+            trained - null difference with its 95% interval.
 
     Raises:
         ValueError: when a record has no damping scores.
@@ -155,29 +147,20 @@ def tab_damping(
 
 # ---- the declarations ----------------------------------------------------------------------
 def _testbeds(tree: str) -> dict:
-    """{variant: testbed id} of a damping-benchmark tree: its faithful and damping testbeds."""
+    """{variant: testbed id} of a damping-benchmark tree."""
     return {FAITHFUL: tree, DAMPING: damping_id(tree)}
 
 
 def _damping_needs(plan, seeds):
     testbeds = [tb for t in plan.damping_trees for tb in _testbeds(t).values()]
-    return [
-        x
-        for s in seeds
-        for x in methods_needs(plan, plan.recovery, plan.damping_configs, testbeds, int(s))
-    ]
-
-
-def _damping_settings(cfg: dict) -> dict:
-    configs = cfg["damping_benchmark"]["configs"]
-    return methods_settings(cfg, RECOVERY_METHODS, configs)
+    configs = plan.damping_configs
+    return [x for s in seeds for x in methods_needs(plan, plan.recovery, configs, testbeds, int(s))]
 
 
 def _tab_damping(path, settings, inputs, out):
     trees, seeds = settings["trees"], settings["seeds"]
 
-    def records(m, configs):
-        """{seed: {(tree, variant, config): record}} of a method on each tree's testbeds."""
+    def records(m, configs):  # {seed: {(tree, variant, config): record}}
         return {
             s: {
                 (t, v, c): load_recovery(path("recovery", tb, m, c, s))
@@ -192,22 +175,21 @@ def _tab_damping(path, settings, inputs, out):
     return tab_damping(methods, trees, settings["bones"], digits=settings["digits"])
 
 
-DAMPING_COLUMNS = Columns(
-    keys=("seed", "tree", "testbed", "config", "method"),
-    values=(*COLUMNS, *INTERVAL_COLUMNS),
-    about=("bones",),
-)
-
-
 TAB_DAMPING = Output(
     "tab_damping",
     "table",
     _damping_needs,
     _tab_damping,
-    settings=_damping_settings,
+    settings=lambda cfg: methods_settings(
+        cfg, RECOVERY_METHODS, cfg["damping_benchmark"]["configs"]
+    ),
     trees="damping_benchmark",
     in_report=lambda plan: bool(plan.damping_trees),
-    columns=DAMPING_COLUMNS,
+    columns=Columns(
+        keys=("seed", "tree", "testbed", "config", "method"),
+        values=(*COLUMNS, *INTERVAL_COLUMNS),
+        about=("bones",),
+    ),
 )
 
 

@@ -1,9 +1,5 @@
 """tab_kselect: each prior with fixed K (`single`) beside the same prior with K chosen from the
-data (`auto`): ours, and every prior under ``models.kselect.priors`` (the chained prior).
-
-Built from each tree's K selections and the evaluation, recovery and loss log of
-``<prior>_single`` and ``<prior>_auto``; declared last (``TAB_KSELECT``).
-"""
+data (`auto`): ours, and every prior under ``models.kselect.priors`` (the chained prior)."""
 
 from __future__ import annotations
 
@@ -22,33 +18,6 @@ from physgs.report.tables import Table, seed_rows, seeds_of, tree_index
 
 #: the rows of each prior: configuration -> its label (fixed K, then K chosen from the data)
 ROWS = {"single": "fixed $K$", "auto": "chosen $K$"}
-
-
-def row_label(model: str, config: str) -> str:
-    """A row's LaTeX label: the registry's short name and the row kind.
-
-    Args:
-        model: the prior's registry id.
-        config: the row kind (``single``: fixed K, ``auto``: chosen K).
-
-    Returns:
-        'Ours, fixed $K$' / 'Chained, chosen $K$'.
-    """
-    return f"{spec_of(model).short}, {ROWS[config]}"
-
-
-def cost_ratio(train_s: float, select_s: float, fixed_train_s: float) -> float:
-    """What K from the data costs against the fixed K.
-
-    Args:
-        train_s: training of the chosen-K model, s.
-        select_s: the selection's runs, s.
-        fixed_train_s: training of the fixed-K model, s.
-
-    Returns:
-        (train_s + select_s) / fixed_train_s.
-    """
-    return (train_s + select_s) / fixed_train_s
 
 
 def tab_kselect(
@@ -99,7 +68,7 @@ def tab_kselect(
             "k_bic": r["k_bic"],
             "train_s": float(r["train_s"]),
             "select_s": select_s,
-            "cost_x": cost_ratio(float(r["train_s"]), select_s, fixed_s) if c == "auto" else np.nan,
+            "cost_x": (float(r["train_s"]) + select_s) / fixed_s if c == "auto" else np.nan,
         }
 
     df = seed_rows(seeds, keys, one)
@@ -108,7 +77,7 @@ def tab_kselect(
     # K as each seed chose it; the rest mean +- sd
     ks = ["/".join(str(k) for k in dict.fromkeys(v.astype(int))) for v in latex.by_seed(df, "K").T]
     trusted = latex.cells(df, "parts_trusted", ".3g")
-    labels = [row_label(m, c) for m, c in zip(first["model"], first["config"])]
+    labels = [f"{spec_of(m).short}, {ROWS[c]}" for m, c in zip(first["model"], first["config"])]
     cells = pd.DataFrame(
         {
             "$K$": ks,
@@ -137,13 +106,6 @@ def tab_kselect(
 
 
 # ---- the declaration -----------------------------------------------------------------------
-
-
-def _kselect_models(plan) -> list[str]:
-    """The priors whose K is chosen: ours, then the plan's others (``models.kselect.priors``)."""
-    return [BASE_MODEL, *plan.kselect_priors]
-
-
 def _selection_need(t: str, m: str, s: int) -> tuple:
     """The need of prior ``m``'s K selection on tree ``t`` (ours' has its own kind)."""
     return ("kselect", t, s) if m == BASE_MODEL else ("prior_kselect", t, m, s)
@@ -151,22 +113,20 @@ def _selection_need(t: str, m: str, s: int) -> tuple:
 
 def _kselect_needs(plan, seeds):
     """Per seed, tree and prior: its K selection, and the evaluation, recovery and loss log
-    (training seconds) of its fixed-K and chosen-K models."""
+    of its fixed-K and chosen-K models."""
     out = []
     for s in seeds:
         for t in plan.trees:
-            for m in _kselect_models(plan):
+            for m in [BASE_MODEL, *plan.kselect_priors]:
                 out.append(_selection_need(t, m, s))
                 for c in ROWS:
-                    rec = ("recovery", t, m, c, s)
-                    out += [("eval", t, m, c, s), rec, ("loss", t, m, c, s)]
+                    out += [(k, t, m, c, s) for k in ("eval", "recovery", "loss")]
     return out
 
 
 def _tab_kselect(path, settings, inputs, out):
-    rows = {}
-    for s in settings["seeds"]:
-        rows[s] = {}
+    rows = {s: {} for s in settings["seeds"]}
+    for s in rows:
         for t in settings["trees"]:
             for m in settings["models"]:
                 sel = load_selection(path(*_selection_need(t, m, s)))
@@ -186,30 +146,9 @@ def _tab_kselect(path, settings, inputs, out):
                         "train_s": float(loss["seconds"].iloc[-1]),
                         "select_s": float(sum(sel.wall_s)),
                     }
-    return tab_kselect(
-        rows,
-        settings["trees"],
-        settings["bones"],
-        settings["method"],
-        models=settings["models"],
-        digits=settings["digits"],
-    )
-
-
-KSELECT_COLUMNS = Columns(
-    keys=("seed", "tree", "model", "config"),
-    values=(
-        "view_psnr_db",
-        "time_psnr_db",
-        "median_rel_err_pct",
-        "parts_trusted",
-        "parts_frozen",
-        "k_heldout",
-        "k_bic",
-    ),
-    timing=("train_s", "select_s", "cost_x"),
-    about=("bones", "K"),
-)
+    trees, bones, method = settings["trees"], settings["bones"], settings["method"]
+    models, digits = settings["models"], settings["digits"]
+    return tab_kselect(rows, trees, bones, method, models=models, digits=digits)
 
 
 TAB_KSELECT = Output(
@@ -222,5 +161,18 @@ TAB_KSELECT = Output(
         "models": list(selected_models(cfg["models"]["kselect"])),
     },
     in_report=lambda plan: False,  # `all` builds it (Snakefile): K selection costs trainings
-    columns=KSELECT_COLUMNS,
+    columns=Columns(
+        keys=("seed", "tree", "model", "config"),
+        values=(
+            "view_psnr_db",
+            "time_psnr_db",
+            "median_rel_err_pct",
+            "parts_trusted",
+            "parts_frozen",
+            "k_heldout",
+            "k_bic",
+        ),
+        timing=("train_s", "select_s", "cost_x"),
+        about=("bones", "K"),
+    ),
 )

@@ -1,16 +1,10 @@
 """tab_parts and fig_parts: ours' k-means parts beside parts cut along the tree.
 
-For every tree, training seed and configuration of the parts study (``parts_study`` of the
-config): the paper's prior (``ours``: spatial k-means, independent parts about fixed pivots)
-beside its topology-aware variants (``ours_topo``: parts cut along the tree, independent;
-``ours_chain``: the same parts, each riding on its parent), on one recipe. Per row: the purity
-of the model's segmentation (share of Gaussians in their part's majority bone; the ``single``
-configuration's parts), the in-window fit as a fraction of the true-motion ceiling's gain, the
-view and time PSNR, frequency recovery against the untrained null of the same K, damping
-recovery on the damping testbed against its null (tab_damping's measure), and training seconds.
-
-tab_parts_k: the smallest K at which the chained prior matches ours (a study: the `studies`
-target). Each output's declaration follows its builders.
+Per tree, training seed and configuration of ``parts_study``: the paper's prior (``ours``:
+spatial k-means, independent parts about fixed pivots) beside its topology-aware variants
+(``ours_topo``: parts cut along the tree; ``ours_chain``: the same, each riding on its parent).
+tab_parts_k (a study: the `studies` target): the smallest K at which the chained prior matches
+ours.
 """
 
 from __future__ import annotations
@@ -62,19 +56,16 @@ def row(
     """One tab_parts row.
 
     Args:
-        fit: [`fit_row`][physgs.report.build.fit_row] of the model (dB, seconds).
+        fit: the model's ``images.fit_row`` (dB, seconds).
         static_fit: the same seed's static pose's fit, dB.
         ceiling_fit: the same seed's true-motion fit, dB.
         recovery (RecoveryRecord): the model's record on the faithful testbed.
         null (NullResult): the null of its K.
-        damping_recovery (RecoveryRecord | None): its record on the damping testbed (with damping
-            scores), or None.
+        damping_recovery (RecoveryRecord | None): its record on the damping testbed, or None.
         purity: the segmentation's overall purity (fraction).
 
     Returns:
-        The row: purity, fit, ceiling fraction, view and time PSNR (dB), trusted parts, omega and
-            zeta errors against their nulls (%; zeta NaN without ``damping_recovery``), training
-            seconds.
+        ``COLUMNS`` -> value (%, dB, seconds; the zeta errors NaN without ``damping_recovery``).
 
     Raises:
         ValueError: when ``damping_recovery`` has no damping scores.
@@ -114,13 +105,8 @@ def tab_parts(
 ) -> Table:
     """The parts study per tree, model and configuration.
 
-    One CSV row per seed, tree, model and configuration; the .tex gives mean +- sd over seeds and,
-    per variant, the paired difference of its fit fraction from ours' (percentage points, 95%
-    interval).
-
     Args:
-        per_seed: ``per_seed[seed][(tree, model, config)]``: a
-            [`row`][physgs.report.parts.row].
+        per_seed: ``per_seed[seed][(tree, model, config)]``: a ``row``.
         trees: the trees.
         bones: tree -> its bone count.
         models: ids in row order (``ours`` first).
@@ -128,7 +114,8 @@ def tab_parts(
         digits: decimals shown in the .tex.
 
     Returns:
-        The [`Table`][physgs.report.tables.Table].
+        The table: one CSV row per seed and row; the .tex mean +- sd over seeds and each
+            variant's paired fit-fraction difference from ours' (pp, 95% interval).
     """
     keys = [(t, m, c) for t in trees for c in configs for m in models]
     seeds = seeds_of(per_seed, "tab_parts", keys)
@@ -144,8 +131,7 @@ def tab_parts(
         },
     )
     fmt = f".{int(digits)}f"
-    # each variant's fit fraction less ours' in the same tree and configuration, per seed
-    frac = latex.by_seed(df, "ceiling_frac")
+    frac = latex.by_seed(df, "ceiling_frac")  # less ours' in the same tree and configuration
     vs_ours = [
         seedstats.difference(100 * (frac[:, i] - frac[:, keys.index((t, BASELINE, c))]), ".0f")
         if m != BASELINE and BASELINE in models
@@ -153,13 +139,8 @@ def tab_parts(
         for i, (t, m, c) in enumerate(keys)
     ]
     omega, omega_null, zeta, zeta_null = (
-        latex.cells(df, col, f, r"\%")
-        for col, f in (
-            ("omega_rel_err_pct", ".1f"),
-            ("omega_null_rel_err_pct", ".1f"),
-            ("zeta_rel_err_pct", ".0f"),
-            ("zeta_null_rel_err_pct", ".0f"),
-        )
+        latex.cells(df, f"{q}_rel_err_pct", f, r"\%")
+        for q, f in (("omega", ".1f"), ("omega_null", ".1f"), ("zeta", ".0f"), ("zeta_null", ".0f"))
     )
     ceiling = r"Of ceiling"
     cells = pd.DataFrame(
@@ -201,15 +182,11 @@ def fig_parts(
     outputs: Sequence[str],
     title: str = "",
 ) -> None:
-    """One row per tree, one panel per model of its parts record.
-
-    The canonical Gaussians seen from the side (x right, z up, world units), coloured by part, each
-    part's pivot as a black dot and, for parts with a parent, a line from its pivot to the
-    parent's; the panel title gives the segmentation's purity.
+    """One row per tree, one panel per model: its canonical Gaussians from the side (x, z; m),
+    coloured by part, each pivot a black dot joined to its parent's; the title gives the purity.
 
     Args:
-        records: tree -> its parts record
-            ([`segmentation_record`][physgs.evaluate.parts.segmentation_record]).
+        records: tree -> its parts record (``physgs.evaluate.parts.segmentation_record``).
         trees: the trees, one row each.
         outputs: the paths to write (pdf, png).
         title: the figure's title.
@@ -263,12 +240,7 @@ def tab_parts_k(
     tie_db: float,
     digits: int = 2,
 ) -> Table:
-    """The smallest K at which the chained prior matches ours
-    ([`physgs.experiments.kmatch`][physgs.experiments.kmatch]).
-
-    One CSV row per seed, tree and (model, K), with that seed's matched K (NaN where none
-    matches) on every row of the tree; the .tex gives mean +- sd over seeds and the matched K of
-    each seed.
+    """The smallest K at which the chained prior matches ours (``experiments.kmatch``).
 
     Args:
         per_seed: ``per_seed[seed][tree]``: {"ours": held-out dB of ours at ``base_k``, "chain":
@@ -280,7 +252,8 @@ def tab_parts_k(
         digits: decimals shown in the .tex.
 
     Returns:
-        The [`Table`][physgs.report.tables.Table].
+        The table: one CSV row per seed, tree and (model, K), with that seed's matched K (NaN
+            where none matches); the .tex mean +- sd over seeds and each seed's matched K.
     """
     seeds = seeds_of(per_seed, "tab_parts_k", trees)
     recs = []
@@ -289,30 +262,13 @@ def tab_parts_k(
             r = per_seed[s][t]
             chain = {int(k): float(v) for k, v in r["chain"].items()}
             m = matched_k(chain, float(r["ours"]), tie_db)
-            mk = float("nan") if m is None else float(m)
-            recs.append(
-                {
-                    "seed": s,
-                    "tree": t,
-                    "bones": bones[t],
-                    "model": "ours",
-                    "K": int(base_k),
-                    "heldout_psnr_db": float(r["ours"]),
-                    "matched_k": mk,
-                }
-            )
-            for k in sorted(chain):
-                recs.append(
-                    {
-                        "seed": s,
-                        "tree": t,
-                        "bones": bones[t],
-                        "model": "ours_chain",
-                        "K": k,
-                        "heldout_psnr_db": chain[k],
-                        "matched_k": mk,
-                    }
-                )
+            points = [("ours", int(base_k), float(r["ours"]))]
+            points += [("ours_chain", k, chain[k]) for k in sorted(chain)]
+            recs += [
+                {"seed": s, "tree": t, "bones": bones[t], "model": model, "K": k}
+                | {"heldout_psnr_db": v, "matched_k": float("nan") if m is None else float(m)}
+                for model, k, v in points
+            ]
     df = pd.DataFrame(recs)
     first = latex.rows(df)
     ks = sorted(int(k) for k in first.loc[first["model"] == "ours_chain", "K"].unique())
@@ -349,12 +305,10 @@ def _studied(plan) -> bool:
     return bool(plan.parts_models)
 
 
-# ---- tab_parts -----------------------------------------------------------------------------
 def _parts_needs(plan, seeds):
-    """Every prior's evaluation, loss log and recovery on each tree (and damping testbed), the
+    """Each prior's evaluation, loss log and recovery on each tree (and damping testbed), the
     null of each K, the static pose's and the ceiling's fit, and the segmentation record."""
-    priors = [BASELINE, *plan.parts_models]
-    configs = plan.parts_configs
+    priors, configs = [BASELINE, *plan.parts_models], plan.parts_configs
     damping_trees = [t for t in plan.damping_trees if t in plan.trees]
     out = []
     for s in (int(x) for x in seeds):
@@ -371,11 +325,11 @@ def _parts_needs(plan, seeds):
 
 
 def _parts_settings(cfg: dict) -> dict:
-    study = cfg["parts_study"]
+    study, configs = cfg["parts_study"], cfg["models"]["configs"]
     return {
         "models": [BASELINE, *study["models"]],
-        "configs": {c: config_label(c, cfg["models"]["configs"][c]) for c in study["configs"]},
-        "K": {c: int(cfg["models"]["configs"][c]["K"]) for c in study["configs"]},
+        "configs": {c: config_label(c, configs[c]) for c in study["configs"]},
+        "K": {c: int(configs[c]["K"]) for c in study["configs"]},
         "damping_trees": [t for t in cfg["damping_benchmark"]["trees"] if t in cfg["trees"]],
         **fit_settings(cfg),
     }
@@ -384,16 +338,15 @@ def _parts_settings(cfg: dict) -> dict:
 def _tab_parts(path, settings, inputs, out):
     trees, models, configs = settings["trees"], settings["models"], settings["configs"]
     n, every = int(settings["n_train"]), int(settings["holdout_every"])
+
+    def fit(t, m, c, s):
+        return fit_row(path("eval", t, m, c, s), path("loss", t, m, c, s), n, every)
+
     rows: dict[int, dict] = {}
     for s in settings["seeds"]:
         rows[s] = {}
         for t in trees:
-            frame = {
-                m: fit_row(
-                    path("eval", t, m, BASE_CONFIG, s), path("loss", t, m, BASE_CONFIG, s), n, every
-                )
-                for m in FIT_FRAME
-            }
+            static, ceiling = (fit(t, m, BASE_CONFIG, s)["fit"] for m in FIT_FRAME)
             seg = load_segmentations(path("parts", t, s))
             for c in configs:
                 null = load_null(path("null", t, int(settings["K"][c]), s))
@@ -404,9 +357,9 @@ def _tab_parts(path, settings, inputs, out):
                         else None
                     )
                     rows[s][(t, m, c)] = row(
-                        fit_row(path("eval", t, m, c, s), path("loss", t, m, c, s), n, every),
-                        frame["static"]["fit"],
-                        frame[FIT_FRAME[1]]["fit"],
+                        fit(t, m, c, s),
+                        static,
+                        ceiling,
                         load_recovery(path("recovery", t, m, c, s)),
                         null,
                         damp,
@@ -415,13 +368,6 @@ def _tab_parts(path, settings, inputs, out):
     return tab_parts(rows, trees, settings["bones"], models, configs, digits=settings["digits"])
 
 
-PARTS_COLUMNS = Columns(
-    keys=("seed", "tree", "model", "config"),
-    values=tuple(c for c in COLUMNS if c != "train_s"),  # the table's own column list
-    timing=("train_s",),
-    about=("bones",),
-)
-
 TAB_PARTS = Output(
     "tab_parts",
     "table",
@@ -429,11 +375,15 @@ TAB_PARTS = Output(
     _tab_parts,
     settings=_parts_settings,
     in_report=_studied,
-    columns=PARTS_COLUMNS,
+    columns=Columns(
+        keys=("seed", "tree", "model", "config"),
+        values=COLUMNS[:-1],  # all but train_s
+        timing=("train_s",),
+        about=("bones",),
+    ),
 )
 
 
-# ---- fig_parts -----------------------------------------------------------------------------
 def _fig_parts(path, settings, inputs, out):
     trees, s0 = settings["trees"], settings["seeds"][0]
     recs = {t: load_segmentations(path("parts", t, s0)) for t in trees}
@@ -451,10 +401,9 @@ FIG_PARTS = Output(
 )
 
 
-# ---- tab_parts_k ---------------------------------------------------------------------------
 def _kmatch_needs(plan, seeds):
     """Ours' and the chained prior's evaluation in the base configuration (their held-out
-    training-window frames) and the chained prior's kmatch points at each smaller K."""
+    frames) and the chained prior's kmatch points at each smaller K."""
     out = []
     for s in (int(x) for x in seeds):
         for t in plan.trees:
@@ -479,31 +428,20 @@ def _tab_parts_k(path, settings, inputs, out):
     def held(m, t, s):
         return fit_row(path("eval", t, m, BASE_CONFIG, s), None, n, every)["heldout"]
 
-    rows: dict[int, dict] = {}
-    for s in settings["seeds"]:
-        rows[s] = {}
-        for t in settings["trees"]:
-            chain = {K: held("ours_chain", t, s)}
-            for k in settings["k_candidates"]:
-                point = read_json(
-                    path("kmatch", t, int(k), s), ("heldout_psnr",), rule="kmatch_point"
-                )
-                chain[int(k)] = float(point["heldout_psnr"])
-            rows[s][t] = {"ours": held(BASELINE, t, s), "chain": chain}
-    return tab_parts_k(
-        rows,
-        settings["trees"],
-        settings["bones"],
-        K,
-        float(settings["tie_db"]),
-        digits=settings["digits"],
-    )
+    def chain(t, s):  # the chained prior's held-out dB at each K
+        out = {K: held("ours_chain", t, s)}
+        for k in settings["k_candidates"]:
+            point = read_json(path("kmatch", t, int(k), s), ("heldout_psnr",), rule="kmatch_point")
+            out[int(k)] = float(point["heldout_psnr"])
+        return out
 
+    trees, tie = settings["trees"], float(settings["tie_db"])
+    rows = {
+        s: {t: {"ours": held(BASELINE, t, s), "chain": chain(t, s)} for t in trees}
+        for s in settings["seeds"]
+    }
+    return tab_parts_k(rows, trees, settings["bones"], K, tie, digits=settings["digits"])
 
-#: tab_parts_k's CSV: the chained prior at several K (a numeric key)
-PARTS_K_COLUMNS = Columns(
-    keys=("seed", "tree", "model", "K"), values=("heldout_psnr_db", "matched_k"), about=("bones",)
-)
 
 TAB_PARTS_K = Output(
     "tab_parts_k",
@@ -513,5 +451,9 @@ TAB_PARTS_K = Output(
     settings=_kmatch_settings,
     seeds="studies",
     in_report=lambda plan: False,  # a study: the `studies` target (Snakefile)
-    columns=PARTS_K_COLUMNS,
+    columns=Columns(  # the chained prior at several K (a numeric key)
+        keys=("seed", "tree", "model", "K"),
+        values=("heldout_psnr_db", "matched_k"),
+        about=("bones",),
+    ),
 )

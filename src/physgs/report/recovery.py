@@ -1,8 +1,6 @@
-"""The frequency-recovery tables: tab_null (the paper's: ours' frequencies against the untrained
-null) and tab_recovery (every recovery method's, each against the null of its K), their builder
-and their declarations. The rows come from the one list of recovery methods
-(``registry.RECOVERY_METHODS``): one need kind (``recovery``) serves them all, and tab_damping
-(``physgs.report.damping``) shares the method rows (``MethodRows``)."""
+"""tab_null (ours' frequencies against the untrained null) and tab_recovery (every recovery
+method's, each against the null of its K), rows from ``registry.RECOVERY_METHODS``; tab_damping
+(``physgs.report.damping``) shares their method rows (``MethodRows``)."""
 
 from __future__ import annotations
 
@@ -18,21 +16,19 @@ from physgs.report import seeds as seedstats
 from physgs.report.output import Columns, Output
 from physgs.report.tables import Table, check_keys, seed_rows, seeds_of, tree_index
 
-
 #: the method ids of the 2D-track control and the output-only analysis (``RECOVERY_METHODS``)
 TRACKS, OMA = "tracks", "oma"
 
 
 @dataclass(frozen=True)
 class MethodRows:
-    """One recovery method's rows in tab_null, tab_recovery or tab_damping (``method_rows``;
-    ``registry.RECOVERY_METHODS``).
+    """One recovery method's rows in tab_null, tab_recovery or tab_damping (``method_rows``).
 
-    label: its LaTeX name ("" for ours, the paper's prior: its rows are labelled by their
-    configuration alone); configs: its configurations (name -> LaTeX label, with its own K), in
-    row order; per_seed: ``per_seed[seed][key]``, the table's record of each key (tab_null, tab_recovery:
-    ``(tree, config)`` -> (``RecoveryRecord``, the ``NullResult`` of its K); tab_damping:
-    ``(tree, variant, config)`` -> ``RecoveryRecord``); note: its sentence of the caption."""
+    label: its LaTeX name ("" for ours: its rows are labelled by their configuration alone);
+    configs: its configurations (name -> LaTeX label, with its own K), in row order; per_seed:
+    ``per_seed[seed][key]`` (tab_null, tab_recovery: ``(tree, config)`` -> (``RecoveryRecord``,
+    the ``NullResult`` of its K); tab_damping: ``(tree, variant, config)`` ->
+    ``RecoveryRecord``); note: its sentence of the caption."""
 
     label: str
     configs: Mapping[str, str]
@@ -40,14 +36,7 @@ class MethodRows:
     note: str = ""
 
     def row_label(self, config: str) -> str:
-        """The LaTeX label of its row in a configuration.
-
-        Args:
-            config: the configuration's name (a key of ``configs``).
-
-        Returns:
-            '<label>, <config label>' (ours': the configuration's label alone).
-        """
+        """'<label>, <config label>' (ours': the configuration's label alone)."""
         return f"{self.label}, {self.configs[config]}" if self.label else self.configs[config]
 
 
@@ -70,25 +59,21 @@ def recovery_table(
 ) -> Table:
     """Frequency recovery of each method against the untrained null, per tree and config.
 
-    Each tree's rows: every method's in turn, each in its configurations; column ``method`` the
-    id. Columns: parts trusted, median relative error (%), log-log R^2 for trained and null
-    (null entries are medians over draws), trained - null (percentage points, paired per seed:
-    negative means the trained model beats chance), and the median nearest-bone gap (%).
+    Columns, trained and null (null: medians over draws): parts trusted, median relative error
+    (%), log-log R^2; trained - null (pp, paired per seed); the median nearest-bone gap (%).
 
     Args:
-        name: tab_null (the paper's methods, ``RecoveryMethod.paper``: ours) or tab_recovery
-            (every method, ours' rows first as the reference the others' claims compare with);
-            its LaTeX label is ``tab:<name without tab_>``, its caption's lead ``LEADS[name]``.
-        methods: method id -> its [`MethodRows`][physgs.report.recovery.MethodRows], in row order
-            (``RECOVERY_METHODS``'; a method with no configurations has no rows):
-            ``per_seed[seed][(tree, config)]`` = (its ``RecoveryRecord``, the ``NullResult``
-            drawn with that seed and the method's K).
+        name: tab_null (the paper's methods) or tab_recovery (every method, ours first); its
+            label ``tab:<name without tab_>``, its caption's lead ``LEADS[name]``.
+        methods: method id -> its ``MethodRows``, in row order (one without configurations has
+            no rows): ``per_seed[seed][(tree, config)]`` = (``RecoveryRecord``, ``NullResult``
+            of that seed and the method's K).
         trees: the trees.
         bones: tree -> its bone count.
         digits: decimals shown in the .tex.
 
     Returns:
-        The [`Table`][physgs.report.tables.Table].
+        The table: one CSV row per seed, tree, method and configuration.
     """
     methods = {m: mr for m, mr in methods.items() if mr.configs}
     keys = [(t, c, m) for t in trees for m, mr in methods.items() for c in mr.configs]
@@ -124,9 +109,7 @@ def recovery_table(
             **interval_cells(rec),
         }
 
-    df = seed_rows(
-        seeds, keys, one
-    )  # each seed's block: each tree's rows together, in ``keys`` order
+    df = seed_rows(seeds, keys, one)
     first = latex.rows(df)
     fmt = f".{int(digits)}f"
     columns = {}
@@ -161,8 +144,7 @@ def recovery_table(
 
 
 def method_seeds(methods: Mapping[str, MethodRows], what: str, keys: Sequence[tuple]) -> list[int]:
-    """The training seeds of a recovery table (its first method's), each method checked to hold
-    its ``keys`` (``(..., method)``) at every seed.
+    """A recovery table's seeds (its first method's), each method checked to hold its keys.
 
     Args:
         methods: method id -> its rows.
@@ -184,33 +166,23 @@ def method_seeds(methods: Mapping[str, MethodRows], what: str, keys: Sequence[tu
 
 
 def who(method: str) -> str:
-    """A method's name in the recovery tables' errors.
-
-    Args:
-        method: a recovery method's id.
-
-    Returns:
-        Its name in words.
-    """
+    """A recovery method's name in the recovery tables' errors."""
     return "tracks control" if method == TRACKS else method
 
 
 def method_rows(
     method: str, configs: Mapping[str, str], per_seed: Mapping[int, Mapping], damping: bool = False
 ) -> MethodRows:
-    """A recovery method's rows (``registry.RECOVERY_METHODS``) for tab_null, tab_recovery or
-    tab_damping: its label and caption sentence from its entry.
+    """A recovery method's rows, its label and caption sentence from ``RECOVERY_METHODS``.
 
     Args:
         method: a recovery method's id.
-        configs: name -> LaTeX label (with its own K), as in
-            [`MethodRows`][physgs.report.recovery.MethodRows].
-        per_seed: its records, as in ``MethodRows``.
-        damping: tab_damping's caption sentence (``RecoveryMethod.damping_note``) in place of
-            the frequency tables'.
+        configs: name -> LaTeX label (with its own K), as ``MethodRows.configs``.
+        per_seed: its records, as ``MethodRows.per_seed``.
+        damping: tab_damping's caption sentence (``damping_note``) in place of ``note``.
 
     Returns:
-        The rows; the caption sentence '<label>: <note>' (none without a note).
+        The rows; the caption sentence ' <label>: <note>' ('' without a note).
     """
     rm, name = RECOVERY_METHODS[method], recovery_label(method)
     note = rm.damping_note if damping and rm.damping_note is not None else rm.note
@@ -218,11 +190,10 @@ def method_rows(
 
 
 #: tab_null / tab_damping's CSV columns of a method's own intervals (the output-only analysis';
-#: NaN for a method without them): the coverage of its trusted parts' 95% intervals for omega
-#: and zeta, the parts they cover, the median relative standard deviations (sigma / value) over
-#: those parts, and the parts its sigma rule keeps (alone, and with ours'); last, the mean
-#: relative interval scores of its intervals and of the untrained null's draw range on the same
-#: parts (``physgs.oma.intervals.relative_scores``; NaN in a record made before them)
+#: NaN for a method without): the median relative sd (sigma / value) over its trusted parts, the
+#: coverage of their 95% intervals, the parts covered, the parts its sigma rule keeps (alone, and
+#: with ours'), the mean relative interval scores of its intervals and of the null's draw range
+#: (``physgs.oma.intervals.relative_scores``; NaN in a record made before them)
 INTERVAL_COLUMNS = (
     "omega_rel_sd",
     "zeta_rel_sd",
@@ -239,66 +210,37 @@ INTERVAL_COLUMNS = (
 
 
 def interval_cells(rec) -> dict:
-    """A record's ``INTERVAL_COLUMNS`` cells (NaN when
-    the record has no ``intervals``).
-
-    Args:
-        rec (RecoveryRecord): the record.
-
-    Returns:
-        Column -> value.
-    """
-    iv = rec.intervals
+    """A ``RecoveryRecord``'s ``INTERVAL_COLUMNS`` -> value (NaN without ``intervals``)."""
+    iv, q2 = rec.intervals, ("omega", "zeta")
     if not iv:
         return dict.fromkeys(INTERVAL_COLUMNS, float("nan"))
-    cov = iv["coverage"]
-    score = iv.get("interval_score", {})  # absent in a record made before the scores
-
-    def sc(q: str, key: str) -> float:
-        return float(score.get(q, {}).get(key, float("nan")))
-
-    return {
-        "omega_rel_sd": float(iv["median_rel_std"]["omega"]),
-        "zeta_rel_sd": float(iv["median_rel_std"]["zeta"]),
-        "omega_interval_cover": float(cov["omega"]["fraction"]),
-        "zeta_interval_cover": float(cov["zeta"]["fraction"]),
-        "interval_parts": float(cov["omega"]["n"]),
-        "sigma_parts_trusted": float(iv["n_sigma_trusted"]),
-        "sigma_and_corr_parts_trusted": float(iv["n_both_trusted"]),
-        "omega_interval_score": sc("omega", "score"),
-        "omega_null_interval_score": sc("omega", "null_score"),
-        "zeta_interval_score": sc("zeta", "score"),
-        "zeta_null_interval_score": sc("zeta", "null_score"),
-    }
+    cov, score = iv["coverage"], iv.get("interval_score", {})
+    out = {f"{q}_rel_sd": float(iv["median_rel_std"][q]) for q in q2}
+    out |= {f"{q}_interval_cover": float(cov[q]["fraction"]) for q in q2}
+    out["interval_parts"] = float(cov["omega"]["n"])
+    out["sigma_parts_trusted"] = float(iv["n_sigma_trusted"])
+    out["sigma_and_corr_parts_trusted"] = float(iv["n_both_trusted"])
+    for q in q2:
+        for k, col in (
+            ("score", f"{q}_interval_score"),
+            ("null_score", f"{q}_null_interval_score"),
+        ):
+            out[col] = float(score.get(q, {}).get(k, float("nan")))
+    return out
 
 
 # ---- the declarations ----------------------------------------------------------------------
 def label_with_k(cfg: dict, config: str, K: int) -> str:
-    """The LaTeX label of configuration ``config`` for a method with K parts there (a method
-    with a K of its own: the 2D-track control, the output-only analysis).
-
-    Args:
-        cfg: the resolved config.
-        config: a configuration name.
-        K: the method's number of parts in that configuration.
-
-    Returns:
-        The label ([`config_label`][physgs.models.registry.config_label]).
-    """
+    """The LaTeX label of ``config`` for a method with its own K there (``config_label``)."""
     return config_label(config, {**cfg["models"]["configs"][config], "K": K})
 
 
 def methods_settings(cfg: dict, methods: Sequence[str], configs: Sequence[str]) -> dict:
-    """A recovery table's settings: the recovery methods it shows, each in its configurations.
-
-    Args:
-        cfg: the resolved config.
-        methods: the method ids the table may show (those the run scores are kept:
-            ``registry.recovery_plan``).
-        configs: the table's configurations.
+    """A recovery table's settings: the methods it shows (of those the run scores), each in
+    its configurations among ``configs``.
 
     Returns:
-        ``{"methods": {id: {config: {"K", "label"}}}}``, each configuration with the method's K.
+        ``{"methods": {id: {config: {"K", "label"}}}}``, each with the method's K.
     """
     plan = recovery_plan(cfg)
     return {
@@ -315,18 +257,8 @@ def methods_settings(cfg: dict, methods: Sequence[str], configs: Sequence[str]) 
 
 
 def methods_needs(plan, methods, configs, testbeds, s: int) -> list[tuple]:
-    """The records a recovery table reads of one seed.
-
-    Args:
-        plan (Plan): the run's plan (each method's configurations: ``plan.recovery``).
-        methods (Sequence[str]): the method ids.
-        configs (Collection[str]): the table's configurations.
-        testbeds (Sequence[str]): the testbed ids.
-        s: the training seed.
-
-    Returns:
-        ``("recovery", testbed, method, config, s)`` need tuples.
-    """
+    """``("recovery", testbed, method, config, s)`` of one seed: each method in its
+    configurations (``plan.recovery``) among ``configs``, on each testbed."""
     return [
         ("recovery", tb, m, c, s)
         for tb in testbeds
@@ -337,18 +269,8 @@ def methods_needs(plan, methods, configs, testbeds, s: int) -> list[tuple]:
 
 
 def table_methods(settings: dict, records, damping: bool = False) -> dict[str, MethodRows]:
-    """A recovery table's ``MethodRows``, in ``RECOVERY_METHODS``' order (ours first: the
-    settings arrive with their keys sorted).
-
-    Args:
-        settings: the table's settings ([`methods_settings`][physgs.report.recovery.methods_settings]).
-        records (Callable): ``records(method, {config: K})`` -> the table's per-seed records of
-            that method in those configurations (as ``MethodRows.per_seed``).
-        damping: tab_damping's caption sentences (``method_rows``).
-
-    Returns:
-        Method id -> its rows.
-    """
+    """A recovery table's ``MethodRows`` in ``RECOVERY_METHODS``' order, from its
+    ``methods_settings`` and ``records(method, {config: K})`` -> the per-seed records."""
     methods = settings["methods"]
     return {
         m: method_rows(
@@ -363,36 +285,33 @@ def table_methods(settings: dict, records, damping: bool = False) -> dict[str, M
 
 
 def _paper(plan_or_methods) -> list[str]:
-    """The paper's recovery methods (``RecoveryMethod.paper``: tab_null's rows) among these."""
+    """The paper's recovery methods among these (tab_null's rows)."""
     return [m for m in plan_or_methods if RECOVERY_METHODS[m].paper]
 
 
-# ---- tab_null and tab_recovery: frequencies against the null of each method's K -------------
 #: tab_null's and tab_recovery's CSV: one row per seed, tree, configuration and method id
 NULL_COLUMNS = Columns(
     keys=("seed", "tree", "config", "method"),
     values=(
-        "trained_parts_trusted",
-        "trained_median_rel_err_pct",
-        "trained_loglog_r2",
-        "null_parts_trusted",
-        "null_median_rel_err_pct",
-        "null_loglog_r2",
+        *(
+            f"{who}_{c}"
+            for who in ("trained", "null")
+            for c in ("parts_trusted", "median_rel_err_pct", "loglog_r2")
+        ),
         "trained_minus_null_pp",
         "nearest_bone_gap_pct",
         "trained_parts_trusted_visible",
         "trained_median_rel_err_visible_pct",
         "null_parts_trusted_visible",
         "null_median_rel_err_visible_pct",
-        *INTERVAL_COLUMNS,  # a method's own intervals (the output-only analysis')
+        *INTERVAL_COLUMNS,
     ),
     about=("bones", "K"),
 )
 
 
 def _frequency_output(name: str, methods, in_report=lambda plan: True) -> Output:
-    """A frequency-recovery table of the recovery methods ``methods(ids)`` (tab_null: the
-    paper's; tab_recovery: every one), each row beside the untrained null of its K."""
+    """A frequency-recovery table of the methods ``methods(ids)``, each beside its K's null."""
 
     def needs(plan, seeds):
         mine = methods(plan.recovery)
@@ -409,8 +328,7 @@ def _frequency_output(name: str, methods, in_report=lambda plan: True) -> Output
     def table(path, settings, inputs, out):
         trees, seeds = settings["trees"], settings["seeds"]
 
-        def paired(m, configs):
-            """{seed: {(tree, config): (its record, the null of its K)}}; configs: {config: K}."""
+        def paired(m, configs):  # configs: {config: K}
             return {
                 s: {
                     (t, c): (
@@ -433,7 +351,5 @@ def _frequency_output(name: str, methods, in_report=lambda plan: True) -> Output
 
 TAB_NULL = _frequency_output("tab_null", _paper)
 TAB_RECOVERY = _frequency_output(
-    "tab_recovery",
-    list,
-    in_report=lambda plan: len(plan.recovery) > len(_paper(plan.recovery)),
+    "tab_recovery", list, in_report=lambda plan: len(plan.recovery) > len(_paper(plan.recovery))
 )

@@ -1,8 +1,6 @@
 """fig_stabilisation: the output-only analysis' stabilisation diagrams ([`physgs.oma`][],
-docs/blind.md), one panel per tree, the bones' true frequencies in a strip below each.
-
-The truth is drawn, never used to select anything: the modes are the identification's own.
-"""
+docs/blind.md), one panel per tree, the bones' true frequencies (drawn, never used to select
+anything) in a strip below each."""
 
 from __future__ import annotations
 
@@ -24,9 +22,8 @@ def fig_stabilisation(
     outputs: Sequence[str],
     title: str = "",
 ) -> None:
-    """One column per tree: the poles (frequency in Hz against model order; filled where stable)
-    with the identified modes as vertical lines, each with its 95% frequency interval
-    (+-1.96 sigma) as an error bar above the highest order; below, the bones' true frequencies.
+    """One column per tree: the poles (Hz against model order; filled where stable), the
+    identified modes as lines with their 95% interval (+-1.96 sigma) above; below, the truth.
 
     Args:
         idents: ``idents[tree]``: its [`Identification`][physgs.oma.run.Identification], the
@@ -42,13 +39,9 @@ def fig_stabilisation(
     from physgs.report.figures import FONT_PT, PAGE_WIDTH_IN, _legend_below, save_figure
 
     fig, axes = plt.subplots(
-        2,
-        len(trees),
-        figsize=(PAGE_WIDTH_IN, 4.6),
-        sharex="col",
-        squeeze=False,
+        2, len(trees), figsize=(PAGE_WIDTH_IN, 4.6), sharex="col", squeeze=False,
         gridspec_kw={"height_ratios": [4, 1]},
-    )
+    )  # fmt: skip
     for j, t in enumerate(trees):
         ax, strip = axes[0, j], axes[1, j]
         st, m = idents[t].modes.stab, idents[t].modes
@@ -88,10 +81,6 @@ def fig_stabilisation(
 
 
 # ---- the declaration -----------------------------------------------------------------------
-def _analysed(plan) -> bool:
-    return bool(plan.recovery.get(OMA))
-
-
 def _fig_stabilisation_needs(plan, seeds):
     """Per tree, the first seed's identification in the first configuration and the truth of
     that seed's instance."""
@@ -117,5 +106,5 @@ FIG_STABILISATION = Output(
     _fig_stabilisation,
     settings=lambda cfg: {"configs": list(cfg["oma"]["configs"])},
     seeds="first",
-    in_report=_analysed,
+    in_report=lambda plan: bool(plan.recovery.get(OMA)),
 )

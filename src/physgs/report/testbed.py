@@ -1,5 +1,4 @@
-"""tab_testbed: the testbed's statistics per tree (no model: it reads no training seed), its
-builder and its declaration."""
+"""tab_testbed: the testbed's statistics per tree (no model: it reads no training seed)."""
 
 from __future__ import annotations
 
@@ -14,9 +13,8 @@ from physgs.report.output import Columns, Output
 from physgs.report.tables import Table, check_keys
 from physgs.testbed.stats import load_stats
 
-
-#: tab_testbed's statistics that vary from one tree instance to the next: each gets a
-#: ``<col>_sd`` column, its spread over the instances (``testbed_seeds``)
+#: the statistics that vary from one tree instance to the next: each gets a ``<col>_sd`` column,
+#: its spread over the instances (``testbed_seeds``)
 INSTANCE_SPREAD = (
     "distinct_frequencies",
     "f_min_hz",
@@ -31,25 +29,21 @@ INSTANCE_SPREAD = (
     "height_fill_pct",
     "coverage_pct",
 )
+#: the percentage columns -> the fraction they show
+PERCENT = {
+    "nearest_bone_gap_pct": "nearest_bone_gap",
+    "visible_below_px_pct": "visible_below_px_fraction",
+    "height_fill_pct": "height_fill",
+    "coverage_pct": "coverage",
+}
+COUNTS = ("distinct_frequencies", "clamped")
 
 
 def _testbed_row(s: Mapping) -> dict:
     """One instance's statistics in tab_testbed's columns (percentages as percent)."""
+    cols = (*INSTANCE_SPREAD, "order_share", "order_share_random")
     return {
-        "distinct_frequencies": int(s["distinct_frequencies"]),
-        "f_min_hz": s["f_min_hz"],
-        "f_median_hz": s["f_median_hz"],
-        "f_max_hz": s["f_max_hz"],
-        "f_span": s["f_span"],
-        "clamped": int(s["clamped"]),
-        "nearest_bone_gap_pct": 100 * s["nearest_bone_gap"],
-        "swing_deg_median": s["swing_deg_median"],
-        "visible_px_median": s["visible_px_median"],
-        "visible_below_px_pct": 100 * s["visible_below_px_fraction"],
-        "height_fill_pct": 100 * s["height_fill"],
-        "coverage_pct": 100 * s["coverage"],
-        "order_share": s["order_share"],
-        "order_share_random": s["order_share_random"],
+        c: 100 * s[PERCENT[c]] if c in PERCENT else int(s[c]) if c in COUNTS else s[c] for c in cols
     }
 
 
@@ -60,52 +54,42 @@ def tab_testbed(
     instances: Mapping[str, Sequence[Mapping]] | None = None,
     paper_trees: Mapping[str, str | None] | None = None,
 ) -> Table:
-    """The testbed's statistics per tree
-    ([`testbed_stats`][physgs.testbed.stats.testbed_stats]), beside the paper's figures where it
-    gives them ([`physgs.report.paper`][physgs.report.paper]).
+    """The testbed's statistics per tree (``testbed.stats.testbed_stats``), beside the paper's
+    figures where it gives them (``report.paper``).
 
-    Columns: bones; distinct natural frequencies; f min / median / max (Hz) and span; bones
-    clamped into the band; median nearest-bone gap (%); median per-bone swing (degrees); how
-    visible each bone's own motion is in the training camera (median pixels, % under 1 px);
-    the training frame's height filled by the swept tree and pixels covered (%). With tree
-    instances (``testbed_seeds``: one per training seed), each is the mean over a tree's
-    instances, ``<col>_sd`` its spread (sample sd; ``INSTANCE_SPREAD``) and ``instances`` their
-    number; without, the one instance's (sd NaN, ``instances`` 1).
+    With tree instances (``testbed_seeds``: one per training seed), each statistic is the mean
+    over a tree's instances, ``<col>_sd`` its sample sd (``INSTANCE_SPREAD``) and ``instances``
+    their number; without, the one instance's (sd NaN, ``instances`` 1).
 
     Args:
-        stats: tree -> its statistics (as [`load_stats`][physgs.testbed.stats.load_stats] reads
-            them): the one instance's.
+        stats: tree -> the one instance's statistics (as ``load_stats`` reads them).
         trees: the trees, in row order.
         digits: decimals shown in the .tex.
-        instances: tree -> each instance's statistics (``testbed_seeds``); None or a tree left
-            out: the one instance of ``stats``.
-        paper_trees: tree -> the paper's tree it stands for (its preset's ``role.paper``), whose
-            figures go beside it; None or a tree left out: none.
+        instances: tree -> each instance's statistics; None or a tree left out: ``stats``'.
+        paper_trees: tree -> the paper's tree it stands for (its preset's ``role.paper``);
+            None or a tree left out: none.
 
     Returns:
-        The [`Table`][physgs.report.tables.Table].
+        The table: one row per tree.
     """
     check_keys(list(trees), stats, "tab_testbed")
     rows = []
     for t in trees:
-        per = [_testbed_row(x) for x in ((instances or {}).get(t) or [stats[t]])]
-        inst = pd.DataFrame(per)
-        mean = {c: float(inst[c].mean()) for c in inst.columns}
-        sd = {
-            f"{c}_sd": float(inst[c].std(ddof=1)) if len(inst) > 1 else np.nan
-            for c in INSTANCE_SPREAD
-        }
+        inst = pd.DataFrame([_testbed_row(x) for x in (instances or {}).get(t) or [stats[t]]])
         pt = (paper_trees or {}).get(t)
         rows.append(
             {
                 "tree": t,
                 "bones": int(stats[t]["bones"]),
                 "paper_bones": paper.BONES.get(pt),
-                **mean,
+                **{c: float(inst[c].mean()) for c in inst.columns},
                 "paper_f_span": paper.FREQUENCY_SPAN,
                 "paper_nearest_bone_gap_pct": paper.NEAREST_BONE_GAP_PCT.get(pt, np.nan),
-                "instances": len(per),
-                **sd,
+                "instances": len(inst),
+                **{
+                    f"{c}_sd": float(inst[c].std(ddof=1)) if len(inst) > 1 else np.nan
+                    for c in INSTANCE_SPREAD
+                },
             }
         )
     df = pd.DataFrame(rows)
@@ -157,8 +141,6 @@ def tab_testbed(
 
 
 # ---- the declaration -----------------------------------------------------------------------
-
-
 def _tab_testbed(path, settings, inputs, out):
     trees, seeds = settings["trees"], settings["instances"]
     return tab_testbed(
@@ -186,33 +168,6 @@ def _needs(plan, seeds):
     return one + [("instance_stats", t, int(s)) for t in plan.trees for s in plan.seeds]
 
 
-#: tab_testbed's CSV: one row per tree (no seed: the testbed's, or the mean over its instances),
-#: the paper's values beside
-TESTBED_COLUMNS = Columns(
-    keys=("tree",),
-    values=(
-        "distinct_frequencies",
-        "f_min_hz",
-        "f_median_hz",
-        "f_max_hz",
-        "f_span",
-        "paper_f_span",
-        "clamped",
-        "nearest_bone_gap_pct",
-        "paper_nearest_bone_gap_pct",
-        "swing_deg_median",
-        "visible_px_median",
-        "visible_below_px_pct",
-        "height_fill_pct",
-        "coverage_pct",
-        "order_share",
-        "order_share_random",
-        # spreads over the tree's instances (NaN with one)
-        *(f"{c}_sd" for c in INSTANCE_SPREAD),
-    ),
-    about=("bones", "paper_bones", "instances"),
-)
-
 TAB_TESTBED = Output(
     "tab_testbed",
     "table",
@@ -220,5 +175,21 @@ TAB_TESTBED = Output(
     _tab_testbed,
     settings=_settings,
     seeds="none",
-    columns=TESTBED_COLUMNS,
+    # one row per tree (no seed: the testbed's, or the mean over its instances), the paper's
+    # values beside, and the spreads over the tree's instances (NaN with one)
+    columns=Columns(
+        keys=("tree",),
+        values=(
+            *INSTANCE_SPREAD[:5],
+            "paper_f_span",
+            "clamped",
+            "nearest_bone_gap_pct",
+            "paper_nearest_bone_gap_pct",
+            *INSTANCE_SPREAD[7:],
+            "order_share",
+            "order_share_random",
+            *(f"{c}_sd" for c in INSTANCE_SPREAD),
+        ),
+        about=("bones", "paper_bones", "instances"),
+    ),
 )

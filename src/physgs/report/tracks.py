@@ -1,17 +1,11 @@
 """tab_tracks and fig_tracks: the 2D-track control ([`physgs.tracks`][], docs/tracks.md).
 
 tab_tracks, per tree, configuration and training seed, from the control's evaluation record
-([`physgs.tracks.run.evaluate_job`][]): the tracker against the truth-projected vertices (tracks
-started, share of the frame-0 tracks kept to the window's end, median and 90th-percentile
-position error and displacement error, px), the fit (K, parts with an estimate, fit seconds),
-and the motion errors (px, median over tracks and frames of the displacement error since each
-track's seed frame) of the control's predicted tracks beyond the window (the tail frames at the
-training wind) and under each unseen wind (window frames), beside ours' Gaussians at the same
-tracked points, the best learned field's (the lowest error of the fields scored there, per seed)
-and a motionless prediction (each track's mean tracked position).
-
-fig_tracks: per tree, the training camera's frame 0 with the tracks' paths over the window,
-coloured by the part of the fit they were grouped into (grey: not fitted).
+([`physgs.tracks.run.evaluate_job`][]): the tracker against the truth-projected vertices, the
+fit, and the motion errors (px) of the control's predicted tracks beyond the window and under
+each unseen wind, beside ours' Gaussians, the best learned field and a motionless prediction at
+the same tracked points. fig_tracks: per tree, the training camera's frame 0 under the tracks'
+paths, coloured by their part in the fit (grey: not fitted).
 """
 
 from __future__ import annotations
@@ -29,39 +23,33 @@ from physgs.report.tables import Table, condition_label, seed_rows, seeds_of, tr
 from physgs.tracks.settings import parts as tracks_k
 from physgs.tracks.store import load_fit, load_tracks
 
-TRACKER_COLUMNS = (
-    "n_tracks",
-    "n_seed0",
-    "share_kept",
-    "track_median_px",
-    "track_p90_px",
-    "disp_median_px",
-    "disp_p90_px",
-)
+#: tab_tracks' tracker columns -> their entry in the evaluation record's ``tracker``
+TRACKER = {
+    "n_tracks": "n_tracks",
+    "n_seed0": "n_seed0",
+    "share_kept": "share_kept",
+    "track_median_px": "median_px",
+    "track_p90_px": "p90_px",
+    "disp_median_px": "disp_median_px",
+    "disp_p90_px": "disp_p90_px",
+}
+#: its fit columns -> their entry in the record's ``fit``
+FIT = {"K": "K", "parts_estimated": "n_estimated", "n_fitted": "n_fitted", "fit_s": "seconds"}
+#: each motion prediction's column suffix and .tex heading
+WHO = {"": "Tracks", "_ours": "Ours", "_best_field": "Field", "_static": "Still"}
 
 
-def case_label(case: str, conditions: Sequence[float]) -> str:
-    """CSV column stem of a motion case: 'tail', or 'wind_<mult>v0' for case 'wind<c>'.
-
-    Args:
-        case: ``'tail'`` or ``'wind<c>'``.
-        conditions: the testbed's mean-speed multipliers.
-
-    Returns:
-        The column stem.
-    """
-    if case == "tail":
-        return "tail"
-    return "wind_" + condition_label(float(conditions[int(case[4:])]), tex=False)
+def _stems(conditions: Sequence[float]) -> list[str]:
+    """The motion cases' column stems: 'tail', then 'wind_<mult>v0' per unseen wind."""
+    return ["tail", *("wind_" + condition_label(float(c), tex=False) for c in conditions[1:])]
 
 
 def row(scores: Mapping, conditions: Sequence[float]) -> dict[str, float]:
     """One tab_tracks row from an evaluation record.
 
     Motion columns ``<case>_px`` (the control), ``<case>_ours_px`` (ours' Gaussians at the same
-    points; NaN when not scored), ``<case>_field_<id>_px`` (each learned field scored, at the
-    same points), ``<case>_best_field_px`` (the lowest of them; NaN when none was scored),
-    ``<case>_static_px`` (motionless).
+    points; NaN when not scored), ``<case>_field_<id>_px`` (each learned field scored),
+    ``<case>_best_field_px`` (the lowest of them; NaN without one), ``<case>_static_px``.
 
     Args:
         scores: [`evaluate_job`][physgs.tracks.run.evaluate_job]'s scores, plus ``ours_train_s``:
@@ -75,32 +63,19 @@ def row(scores: Mapping, conditions: Sequence[float]) -> dict[str, float]:
         KeyError: when the record lacks a motion case.
     """
     tr, fit = scores["tracker"], scores["fit"]
-    out = {
-        "n_tracks": float(tr["n_tracks"]),
-        "n_seed0": float(tr["n_seed0"]),
-        "share_kept": float(tr["share_kept"]),
-        "track_median_px": float(tr["median_px"]),
-        "track_p90_px": float(tr["p90_px"]),
-        "disp_median_px": float(tr["disp_median_px"]),
-        "disp_p90_px": float(tr["disp_p90_px"]),
-        "K": float(fit["K"]),
-        "parts_estimated": float(fit["n_estimated"]),
-        "n_fitted": float(fit["n_fitted"]),
-        "fit_s": float(fit["seconds"]),
-        "ours_train_s": float(scores.get("ours_train_s", float("nan"))),
-        "fit_rms_px": float(fit["rms_px"]),
-    }
+    out = {c: float(tr[k]) for c, k in TRACKER.items()} | {c: float(fit[k]) for c, k in FIT.items()}
+    out["ours_train_s"] = float(scores.get("ours_train_s", float("nan")))
+    out["fit_rms_px"] = float(fit["rms_px"])
     cases = ["tail", *(f"wind{c}" for c in range(1, len(conditions)))]
-    for case in cases:
+    for case, stem in zip(cases, _stems(conditions)):
         if case not in scores:
             raise KeyError(f"tab_tracks: the evaluation record has no {case!r} motion scores")
-        stem, sc = case_label(case, conditions), scores[case]
+        sc = scores[case]
         ours = sc.get("ours")
         out[f"{stem}_px"] = float(sc["tracks"]["motion_median_px"])
         out[f"{stem}_ours_px"] = float(ours["motion_median_px"]) if ours else float("nan")
         fields = {m: float(e["motion_median_px"]) for m, e in sc.get("fields", {}).items()}
-        for m, v in fields.items():
-            out[f"{stem}_field_{m}_px"] = v
+        out |= {f"{stem}_field_{m}_px": v for m, v in fields.items()}
         finite = [v for v in fields.values() if np.isfinite(v)]
         out[f"{stem}_best_field_px"] = min(finite) if finite else float("nan")
         out[f"{stem}_static_px"] = float(sc["tracks"]["static_median_px"])
@@ -117,9 +92,6 @@ def tab_tracks(
 ) -> Table:
     """The 2D-track control per tree and configuration.
 
-    One CSV row per seed, tree and configuration; the .tex gives the mean +- sd over seeds (one
-    seed: the value).
-
     Args:
         per_seed: ``per_seed[seed][(tree, config)]``: an evaluation record
             ([`evaluate_job`][physgs.tracks.run.evaluate_job]'s scores).
@@ -130,7 +102,7 @@ def tab_tracks(
         digits: decimals shown in the .tex.
 
     Returns:
-        The [`Table`][physgs.report.tables.Table].
+        The table: one CSV row per seed, tree and configuration; the .tex mean +- sd over seeds.
     """
     keys = [(t, c) for t in trees for c in configs]
     seeds = seeds_of(per_seed, "tab_tracks", keys)
@@ -163,14 +135,8 @@ def tab_tracks(
         ("Fit", "ours (s)"): latex.cells(df, "ours_train_s", ".0f"),
     }
     winds = [f"wind {condition_label(float(c))}" for c in conditions[1:]]
-    stems = ["tail", *(case_label(f"wind{c}", conditions) for c in range(1, len(conditions)))]
-    for head, stem in zip(["beyond the window", *winds], stems):
-        for who, suffix in (
-            ("Tracks", ""),
-            ("Ours", "_ours"),
-            ("Field", "_best_field"),
-            ("Still", "_static"),
-        ):
+    for head, stem in zip(["beyond the window", *winds], _stems(conditions)):
+        for suffix, who in WHO.items():
             columns[(f"{head} (px)", who)] = latex.cells(df, f"{stem}{suffix}_px", fmt)
     cells = pd.DataFrame(
         columns,
@@ -179,7 +145,7 @@ def tab_tracks(
             names=["Tree", "Config"],
         ),
     )
-    joint = [c for c in configs if configs[c]["conditions"] != "train"]
+    joint = [c.replace("_", r"\_") for c in configs if configs[c]["conditions"] != "train"]
     cap = (
         r"The 2D-track control: ours' oscillators fitted to Lucas--Kanade point tracks of the "
         r"training video. \emph{Tracker}, against the truth-projected mesh vertices over the "
@@ -194,9 +160,8 @@ def tab_tracks(
         r"seed; -- where none is) and a motionless prediction (each track's mean tracked "
         r"position)."
         + (
-            " The joint configurations ("
-            + ", ".join(j.replace("_", r"\_") for j in joint)
-            + r") are fitted to every wind: their other-wind columns are not transfer."
+            f" The joint configurations ({', '.join(joint)}) are fitted to every wind: their "
+            "other-wind columns are not transfer."
             if joint
             else ""
         )
@@ -213,10 +178,8 @@ def fig_tracks(
     outputs: Sequence[str],
     title: str = "",
 ) -> None:
-    """One panel per tree: the training camera's frame 0 under the tracks' paths.
-
-    Pixel centres are at integer + 0.5, so a path is drawn at xy - 0.5 in imshow's coordinates;
-    each path's seed position is a dot.
+    """One panel per tree: the training camera's frame 0 under the tracks' paths (each seed
+    position a dot; pixel centres at integer + 0.5, so drawn at xy - 0.5 in imshow's frame).
 
     Args:
         frames: ``frames[tree]``: [H, W, 3] uint8, the training camera's frame 0.
@@ -251,8 +214,7 @@ def fig_tracks(
             f"{t}: {tr.n_tracks} tracks\n{100 * kept:.0f}% of frame 0's kept, {fitted} in parts",
             fontsize=FONT_PT,
         )
-        # the image's own pixels are the scale: a path's length reads in px of the frame
-        ax.set_xlabel("x (px)", fontsize=FONT_PT)
+        ax.set_xlabel("x (px)", fontsize=FONT_PT)  # the frame's own pixels are the scale
         ax.tick_params(labelsize=FONT_PT)
     axes[0, 0].set_ylabel("y (px)", fontsize=FONT_PT)
     if title:
@@ -262,20 +224,15 @@ def fig_tracks(
 
 
 # ---- the declarations ----------------------------------------------------------------------
-def _controlled(plan) -> bool:
-    return bool(plan.tracks)
-
-
-# ---- tab_tracks ----------------------------------------------------------------------------
 def _tab_tracks_needs(plan, seeds):
-    """Its evaluation record, ours' loss log (training seconds) and, for ``plan.tracks_fields``,
-    the fields' scores, per tree, configuration and seed."""
+    """Per tree, configuration and seed: the evaluation record, ours' loss log (training
+    seconds) and, for ``plan.tracks_fields``, the fields' scores."""
     return [
         (kind, t, *m, c, int(s))
         for s in seeds
         for t in plan.trees
         for c in plan.tracks
-        for kind, m in (("tracks_eval", ()), ("loss", ("ours",)))  # ours' training seconds
+        for kind, m in (("tracks_eval", ()), ("loss", ("ours",)))
     ] + [("tracks_fields", t, c, int(s)) for s in seeds for t, c in plan.tracks_fields]
 
 
@@ -293,18 +250,19 @@ def _tab_tracks_settings(cfg: dict) -> dict:
 
 
 def _tab_tracks(path, settings, inputs, out):
-    scores = {}
-    for s in settings["seeds"]:
-        scores[s] = {}
+    scores = {s: {} for s in settings["seeds"]}
+    for s in scores:
         for t in settings["trees"]:
             for c in settings["configs"]:
-                scores[s][(t, c)] = read_json(path("tracks_eval", t, c, s), rule="tracks_evaluate")
+                sc = scores[s][(t, c)] = read_json(
+                    path("tracks_eval", t, c, s), rule="tracks_evaluate"
+                )
                 if key(("tracks_fields", t, c, s)) in inputs:  # {case: {field: errors}}
                     fields = read_json(path("tracks_fields", t, c, s), rule="tracks_fields")
                     for case, f in fields.items():
-                        scores[s][(t, c)][case]["fields"] = f
+                        sc[case]["fields"] = f
                 loss = pd.read_csv(path("loss", t, "ours", c, s))
-                scores[s][(t, c)]["ours_train_s"] = float(loss["seconds"].iloc[-1])
+                sc["ours_train_s"] = float(loss["seconds"].iloc[-1])
     return tab_tracks(
         scores,
         settings["trees"],
@@ -315,40 +273,37 @@ def _tab_tracks(path, settings, inputs, out):
     )
 
 
-#: tab_tracks' CSV: the tracker, the fit and the displacement errors per case (``tail``, each
-#: unseen wind) of the control, ours, the best field, the static pose and each field scored
-TRACKS_COLUMNS = Columns(
-    keys=("seed", "tree", "config"),
-    values=(
-        *TRACKER_COLUMNS,
-        "parts_estimated",
-        "n_fitted",
-        "fit_rms_px",
-        *(
-            f"{case}{who}_px"
-            for case in ("tail", "wind_{wind}")
-            for who in ("", "_ours", "_best_field", "_static", "_field_{model}")
-        ),
-    ),
-    timing=("fit_s", "ours_train_s"),
-    about=("bones", "conditions", "K"),
-)
-
 TAB_TRACKS = Output(
     "tab_tracks",
     "table",
     _tab_tracks_needs,
     _tab_tracks,
     settings=_tab_tracks_settings,
-    in_report=_controlled,
-    columns=TRACKS_COLUMNS,
+    in_report=lambda plan: bool(plan.tracks),
+    # the tracker, the fit and the displacement errors per case (``tail``, each unseen wind) of
+    # the control, ours, the best field, the static pose and each field scored
+    columns=Columns(
+        keys=("seed", "tree", "config"),
+        values=(
+            *TRACKER,
+            "parts_estimated",
+            "n_fitted",
+            "fit_rms_px",
+            *(
+                f"{case}{who}_px"
+                for case in ("tail", "wind_{wind}")
+                for who in ("", "_ours", "_best_field", "_static", "_field_{model}")
+            ),
+        ),
+        timing=("fit_s", "ours_train_s"),
+        about=("bones", "conditions", "K"),
+    ),
 )
 
 
-# ---- fig_tracks ----------------------------------------------------------------------------
 def _fig_tracks_needs(plan, seeds):
-    """Per tree, the observed frames, the training video's tracks and (with a configuration)
-    the first configuration's fit, of the first seed."""
+    """Per tree, the first seed's observed frames, training video's tracks and (with a
+    configuration) the first configuration's fit."""
     s0, configs = int(seeds[0]), list(plan.tracks)
     out = []
     for t in plan.trees:
