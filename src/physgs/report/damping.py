@@ -11,6 +11,7 @@ recovered damping on the run's own trees (first seed).
 
 from __future__ import annotations
 
+from functools import partial
 from typing import Mapping, Sequence
 
 import pandas as pd
@@ -24,13 +25,13 @@ from physgs.report.recovery import (
     INTERVAL_COLUMNS,
     MethodRows,
     interval_cells,
-    method_seeds,
+    method_frame,
     methods_needs,
     methods_settings,
     table_methods,
     who,
 )
-from physgs.report.tables import Table, seed_rows, tree_label
+from physgs.report.tables import Table, tree_label
 from physgs.testbed.variant import DAMPING, FAITHFUL, damping_id
 
 VARIANTS = (FAITHFUL, DAMPING)
@@ -74,7 +75,6 @@ def tab_damping(
     methods = {m: mr for m, mr in methods.items() if mr.configs}
     block = [(c, m) for m, mr in methods.items() for c in mr.configs]
     keys = [(t, v, c, m) for t in trees for v in VARIANTS for c, m in block]
-    seeds = method_seeds(methods, "tab_damping", keys)
 
     def one(s, t, v, c, method):
         rec = methods[method].per_seed[s][(t, v, c)]
@@ -103,30 +103,26 @@ def tab_damping(
             **interval_cells(rec),
         }
 
-    df = seed_rows(seeds, keys, one)
-    fmt = f".{int(digits)}f"
-    p = latex.cells(df, "gamma_exponent", ".2f")
-    p_true = latex.cells(df, "gamma_exponent_true", ".2f", cell=latex.mean)
-    err = r"Med.\ rel.\ err.\ of $\hat\zeta$"
-    corr = r"corr($\log\hat\zeta$, $\log\zeta$)"
+    df, seeds = method_frame("tab_damping", methods, keys, one)
+    col, fmt = partial(latex.cells, df), f".{int(digits)}f"
+    p, p_true = col("gamma_exponent", ".2f"), col("gamma_exponent_true", ".2f", cell=latex.mean)
+    err, corr = r"Med.\ rel.\ err.\ of $\hat\zeta$", r"corr($\log\hat\zeta$, $\log\zeta$)"
+    rows = [(tree_label(t, bones[t]), v, methods[m].row_label(c)) for t, v, c, m in keys]
     cells = pd.DataFrame(
         {
-            ("", "Trusted"): latex.cells(df, "trusted", ".1f"),  # a mean count: one decimal
-            (err, "Trained"): latex.cells(df, "rel_err_pct", ".0f", r"\%"),
-            (err, "Null"): latex.cells(df, "null_rel_err_pct", ".0f", r"\%"),
-            (err, r"Trained $-$ null"): latex.cells(
-                df, "trained_minus_null_pp", ".0f", cell=seedstats.difference
+            ("", "Trusted"): col("trusted", ".1f"),  # a mean count: one decimal
+            (err, "Trained"): col("rel_err_pct", ".0f", r"\%"),
+            (err, "Null"): col("null_rel_err_pct", ".0f", r"\%"),
+            (err, r"Trained $-$ null"): col(
+                "trained_minus_null_pp", ".0f", cell=seedstats.difference
             ),
-            (corr, "Trained"): latex.cells(df, "log_corr", fmt),
-            (corr, "Null"): latex.cells(df, "null_log_corr", fmt),
+            (corr, "Trained"): col("log_corr", fmt),
+            (corr, "Null"): col("null_log_corr", fmt),
             (r"$\hat\gamma\propto\hat\omega^p$", "$p$ (truth)"): [
                 a if b == "--" else f"{a} ({b})" for a, b in zip(p, p_true)
             ],
         },
-        index=pd.MultiIndex.from_tuples(
-            [(tree_label(t, bones[t]), v, methods[m].row_label(c)) for t, v, c, m in keys],
-            names=["Tree", "Testbed", "Config"],
-        ),
+        index=pd.MultiIndex.from_tuples(rows, names=["Tree", "Testbed", "Config"]),
     )
     cap = (
         r"Damping recovery on the faithful testbed ($\zeta$ fixed on every bone, no deliberate "

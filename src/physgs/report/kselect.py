@@ -3,6 +3,7 @@ data (`auto`): ours, and every prior under ``models.kselect.priors`` (the chaine
 
 from __future__ import annotations
 
+from functools import partial
 from typing import Mapping, Sequence
 
 import numpy as np
@@ -73,22 +74,22 @@ def tab_kselect(
 
     df = seed_rows(seeds, keys, one)
     first = latex.rows(df)
-    fmt = f".{digits}f"
+    col, fmt = partial(latex.cells, df), f".{digits}f"
     # K as each seed chose it; the rest mean +- sd
     ks = ["/".join(str(k) for k in dict.fromkeys(v.astype(int))) for v in latex.by_seed(df, "K").T]
-    trusted = latex.cells(df, "parts_trusted", ".3g")
+    trusted = col("parts_trusted", ".3g")
     labels = [f"{spec_of(m).short}, {ROWS[c]}" for m, c in zip(first["model"], first["config"])]
     cells = pd.DataFrame(
         {
             "$K$": ks,
-            "PSNR views": latex.cells(df, "view_psnr_db", fmt),
-            "PSNR time": latex.cells(df, "time_psnr_db", fmt),
-            r"Med.\ rel.\ err.": latex.cells(df, "median_rel_err_pct", fmt, r"\%"),
+            "PSNR views": col("view_psnr_db", fmt),
+            "PSNR time": col("time_psnr_db", fmt),
+            r"Med.\ rel.\ err.": col("median_rel_err_pct", fmt, r"\%"),
             "Trusted": [f"{n}/{k}" for n, k in zip(trusted, ks)],
-            "Frozen": latex.cells(df, "parts_frozen", ".3g"),
-            "Train (s)": latex.cells(df, "train_s", ".0f"),
-            "Select (s)": latex.cells(df, "select_s", ".0f"),
-            "Cost": latex.cells(df, "cost_x", ".2g", r"$\times$"),
+            "Frozen": col("parts_frozen", ".3g"),
+            "Train (s)": col("train_s", ".0f"),
+            "Select (s)": col("select_s", ".0f"),
+            "Cost": col("cost_x", ".2g", r"$\times$"),
         },
         index=tree_index(first, labels, "Model"),
     )

@@ -9,6 +9,8 @@ ours.
 
 from __future__ import annotations
 
+from functools import partial
+from itertools import product
 from typing import Mapping, Sequence
 
 import numpy as np
@@ -70,7 +72,16 @@ def row(
     Raises:
         ValueError: when ``damping_recovery`` has no damping scores.
     """
-    out = {
+    zeta = zeta_null = np.nan
+    if damping_recovery is not None:
+        sc, nl = damping_recovery.damping_scores, damping_recovery.damping_null
+        if sc is None or nl is None:
+            raise ValueError(
+                "tab_parts: a damping-testbed recovery has no damping scores; re-run its "
+                "recovery rule with damping params"
+            )
+        zeta, zeta_null = 100 * sc.median_rel_err, 100 * nl.median_median_rel_err
+    return {
         "purity": float(purity),
         "fit_psnr_db": fit["fit"],
         "ceiling_frac": float(ceiling_fraction(fit["fit"], static_fit, ceiling_fit)),
@@ -79,20 +90,10 @@ def row(
         "trusted": float(recovery.match.n_trusted),
         "omega_rel_err_pct": 100 * recovery.match.median_rel_err,
         "omega_null_rel_err_pct": 100 * null.median_median_rel_err,
-        "zeta_rel_err_pct": np.nan,
-        "zeta_null_rel_err_pct": np.nan,
+        "zeta_rel_err_pct": zeta,
+        "zeta_null_rel_err_pct": zeta_null,
         "train_s": fit["train_s"],
     }
-    if damping_recovery is not None:
-        sc, nl = damping_recovery.damping_scores, damping_recovery.damping_null
-        if sc is None or nl is None:
-            raise ValueError(
-                "tab_parts: a damping-testbed recovery has no damping scores; re-run its "
-                "recovery rule with damping params"
-            )
-        out["zeta_rel_err_pct"] = 100 * sc.median_rel_err
-        out["zeta_null_rel_err_pct"] = 100 * nl.median_median_rel_err
-    return out
 
 
 def tab_parts(
@@ -119,18 +120,12 @@ def tab_parts(
     """
     keys = [(t, m, c) for t in trees for c in configs for m in models]
     seeds = seeds_of(per_seed, "tab_parts", keys)
-    df = seed_rows(
-        seeds,
-        keys,
-        lambda s, t, m, c: {
-            "tree": t,
-            "bones": bones[t],
-            "model": m,
-            "config": c,
-            **per_seed[s][(t, m, c)],
-        },
-    )
-    fmt = f".{int(digits)}f"
+
+    def one(s, t, m, c):
+        return {"tree": t, "bones": bones[t], "model": m, "config": c, **per_seed[s][(t, m, c)]}
+
+    df = seed_rows(seeds, keys, one)
+    col, fmt = partial(latex.cells, df), f".{int(digits)}f"
     frac = latex.by_seed(df, "ceiling_frac")  # less ours' in the same tree and configuration
     vs_ours = [
         seedstats.difference(100 * (frac[:, i] - frac[:, keys.index((t, BASELINE, c))]), ".0f")
@@ -139,29 +134,25 @@ def tab_parts(
         for i, (t, m, c) in enumerate(keys)
     ]
     omega, omega_null, zeta, zeta_null = (
-        latex.cells(df, f"{q}_rel_err_pct", f, r"\%")
+        col(f"{q}_rel_err_pct", f, r"\%")
         for q, f in (("omega", ".1f"), ("omega_null", ".1f"), ("zeta", ".0f"), ("zeta_null", ".0f"))
     )
-    ceiling = r"Of ceiling"
+    ceiling, omega_head = r"Of ceiling", r"Med.\ rel.\ err.\ $\hat\omega$"
+    rows = [(tree_label(t, bones[t]), configs[c], label(m)) for t, m, c in keys]
     cells = pd.DataFrame(
         {
-            ("", "Purity"): latex.cells(df, "purity", ".2f"),
-            (ceiling, "Fit"): latex.cells(df, "ceiling_frac", ".0f", r"\%", scale=100),
+            ("", "Purity"): col("purity", ".2f"),
+            (ceiling, "Fit"): col("ceiling_frac", ".0f", r"\%", scale=100),
             (ceiling, r"$-$ ours (pp)"): vs_ours,
-            ("", "View"): latex.cells(df, "view_psnr_db", fmt),
-            ("", "Time"): latex.cells(df, "time_psnr_db", fmt),
-            (r"Med.\ rel.\ err.\ $\hat\omega$", "trained / null"): [
-                f"{a} / {b}" for a, b in zip(omega, omega_null)
-            ],
+            ("", "View"): col("view_psnr_db", fmt),
+            ("", "Time"): col("time_psnr_db", fmt),
+            (omega_head, "trained / null"): [f"{a} / {b}" for a, b in zip(omega, omega_null)],
             (r"Med.\ rel.\ err.\ $\hat\zeta$", "damping testbed: trained / null"): [
                 "--" if a == "--" else f"{a} / {b}" for a, b in zip(zeta, zeta_null)
             ],
-            ("", "Train (s)"): latex.cells(df, "train_s", ".0f"),
+            ("", "Train (s)"): col("train_s", ".0f"),
         },
-        index=pd.MultiIndex.from_tuples(
-            [(tree_label(t, bones[t]), configs[c], label(m)) for t, m, c in keys],
-            names=["Tree", "Config", "Parts"],
-        ),
+        index=pd.MultiIndex.from_tuples(rows, names=["Tree", "Config", "Parts"]),
     )
     cap = (
         r"The oscillator prior with the paper's spatial k-means parts beside parts cut along the "
@@ -301,10 +292,6 @@ def tab_parts_k(
 FIT_FRAME = ("static", REFERENCE_NAMES[0])
 
 
-def _studied(plan) -> bool:
-    return bool(plan.parts_models)
-
-
 def _parts_needs(plan, seeds):
     """Each prior's evaluation, loss log and recovery on each tree (and damping testbed), the
     null of each K, the static pose's and the ceiling's fit, and the segmentation record."""
@@ -342,29 +329,18 @@ def _tab_parts(path, settings, inputs, out):
     def fit(t, m, c, s):
         return fit_row(path("eval", t, m, c, s), path("loss", t, m, c, s), n, every)
 
-    rows: dict[int, dict] = {}
-    for s in settings["seeds"]:
-        rows[s] = {}
-        for t in trees:
-            static, ceiling = (fit(t, m, BASE_CONFIG, s)["fit"] for m in FIT_FRAME)
-            seg = load_segmentations(path("parts", t, s))
-            for c in configs:
-                null = load_null(path("null", t, int(settings["K"][c]), s))
-                for m in models:
-                    damp = (
-                        load_recovery(path("recovery", damping_id(t), m, c, s))
-                        if t in settings["damping_trees"]
-                        else None
-                    )
-                    rows[s][(t, m, c)] = row(
-                        fit(t, m, c, s),
-                        static,
-                        ceiling,
-                        load_recovery(path("recovery", t, m, c, s)),
-                        null,
-                        damp,
-                        purity=float(seg[f"{m}/overall"]) if c == BASE_CONFIG else float("nan"),
-                    )
+    rows = {s: {} for s in settings["seeds"]}
+    for s, t in product(rows, trees):
+        static, ceiling = (fit(t, m, BASE_CONFIG, s)["fit"] for m in FIT_FRAME)
+        seg = load_segmentations(path("parts", t, s))
+        damp = damping_id(t) if t in settings["damping_trees"] else None
+        for c in configs:
+            null = load_null(path("null", t, int(settings["K"][c]), s))
+            for m in models:
+                rec = load_recovery(path("recovery", t, m, c, s))
+                drec = load_recovery(path("recovery", damp, m, c, s)) if damp else None
+                purity = float(seg[f"{m}/overall"]) if c == BASE_CONFIG else float("nan")
+                rows[s][(t, m, c)] = row(fit(t, m, c, s), static, ceiling, rec, null, drec, purity)
     return tab_parts(rows, trees, settings["bones"], models, configs, digits=settings["digits"])
 
 
@@ -374,7 +350,7 @@ TAB_PARTS = Output(
     _parts_needs,
     _tab_parts,
     settings=_parts_settings,
-    in_report=_studied,
+    in_report=lambda plan: bool(plan.parts_models),
     columns=Columns(
         keys=("seed", "tree", "model", "config"),
         values=COLUMNS[:-1],  # all but train_s
@@ -397,7 +373,7 @@ FIG_PARTS = Output(
     _fig_parts,
     settings=lambda cfg: {"models": [BASELINE, *cfg["parts_study"]["models"]]},
     seeds="first",
-    in_report=_studied,
+    in_report=lambda plan: bool(plan.parts_models),
 )
 
 

@@ -5,6 +5,7 @@ method's, each against the null of its K), rows from ``registry.RECOVERY_METHODS
 from __future__ import annotations
 
 from dataclasses import dataclass
+from functools import partial
 from typing import Mapping, Sequence
 
 import pandas as pd
@@ -77,7 +78,6 @@ def recovery_table(
     """
     methods = {m: mr for m, mr in methods.items() if mr.configs}
     keys = [(t, c, m) for t in trees for m, mr in methods.items() for c in mr.configs]
-    seeds = method_seeds(methods, name, keys)
 
     def one(s, t, c, method):
         rec, nl = methods[method].per_seed[s][(t, c)]
@@ -109,25 +109,22 @@ def recovery_table(
             **interval_cells(rec),
         }
 
-    df = seed_rows(seeds, keys, one)
+    df, seeds = method_frame(name, methods, keys, one)
     first = latex.rows(df)
     fmt = f".{int(digits)}f"
+    col = partial(latex.cells, df)
     columns = {}
     for who, pre in (("Trained", "trained"), ("Untrained null", "null")):
-        trusted = latex.cells(df, f"{pre}_parts_trusted", ".3g", cell=latex.mean)
+        trusted = col(f"{pre}_parts_trusted", ".3g", cell=latex.mean)
         columns[(who, "Parts")] = [f"{n}/{k}" for n, k in zip(trusted, first["K"])]
-        columns[(who, r"Med.\ rel.\ err.")] = latex.cells(
-            df, f"{pre}_median_rel_err_pct", fmt, r"\%"
-        )
-        columns[(who, r"log-log $R^2$")] = latex.cells(df, f"{pre}_loglog_r2", ".3f")
-    columns[("", r"Trained $-$ null")] = latex.cells(
-        df, "trained_minus_null_pp", fmt, cell=seedstats.difference
+        columns[(who, r"Med.\ rel.\ err.")] = col(f"{pre}_median_rel_err_pct", fmt, r"\%")
+        columns[(who, r"log-log $R^2$")] = col(f"{pre}_loglog_r2", ".3f")
+    columns[("", r"Trained $-$ null")] = col(
+        "trained_minus_null_pp", fmt, cell=seedstats.difference
     )
-    columns[("", "Gap")] = latex.cells(df, "nearest_bone_gap_pct", fmt, r"\%", cell=latex.mean)
+    columns[("", "Gap")] = col("nearest_bone_gap_pct", fmt, r"\%", cell=latex.mean)
     for who, pre in (("Trained", "trained"), ("Null", "null")):
-        columns[("Visible bones", who)] = latex.cells(
-            df, f"{pre}_median_rel_err_visible_pct", fmt, r"\%"
-        )
+        columns[("Visible bones", who)] = col(f"{pre}_median_rel_err_visible_pct", fmt, r"\%")
     labels = [methods[m].row_label(c) for m, c in zip(first["method"], first["config"])]
     cells = pd.DataFrame(columns, index=tree_index(first, labels, "Config"))
     cap = (
@@ -143,16 +140,18 @@ def recovery_table(
     return Table(name, df, latex.render(cells, cap, "tab:" + name.removeprefix("tab_")))
 
 
-def method_seeds(methods: Mapping[str, MethodRows], what: str, keys: Sequence[tuple]) -> list[int]:
-    """A recovery table's seeds (its first method's), each method checked to hold its keys.
+def method_frame(what: str, methods: Mapping[str, MethodRows], keys: Sequence[tuple], one):
+    """A recovery table's CSV frame and seeds (its first method's), each method checked to hold
+    its keys at every seed.
 
     Args:
-        methods: method id -> its rows.
         what: the table's name (in errors).
-        keys: the cells every seed must hold, each ending in its method's id.
+        methods: method id -> its rows.
+        keys: the table's row keys, each ending in its method's id.
+        one (Callable): ``one(seed, *key)`` -> that row's columns (``tables.seed_rows``).
 
     Returns:
-        The seeds, ascending.
+        tuple[pd.DataFrame, list[int]]: the frame and the seeds, ascending.
 
     Raises:
         KeyError: a method missing a cell at a seed, naming the table, the method and the seed.
@@ -162,7 +161,7 @@ def method_seeds(methods: Mapping[str, MethodRows], what: str, keys: Sequence[tu
         for m, mr in methods.items():
             have = mr.per_seed.get(s, {})
             check_keys([k[:-1] for k in keys if k[-1] == m], have, f"{what} ({who(m)}, seed {s})")
-    return seeds
+    return seed_rows(seeds, keys, one), seeds
 
 
 def who(method: str) -> str:
@@ -211,22 +210,25 @@ INTERVAL_COLUMNS = (
 
 def interval_cells(rec) -> dict:
     """A ``RecoveryRecord``'s ``INTERVAL_COLUMNS`` -> value (NaN without ``intervals``)."""
-    iv, q2 = rec.intervals, ("omega", "zeta")
+    iv, nan = rec.intervals, float("nan")
     if not iv:
-        return dict.fromkeys(INTERVAL_COLUMNS, float("nan"))
+        return dict.fromkeys(INTERVAL_COLUMNS, nan)
     cov, score = iv["coverage"], iv.get("interval_score", {})
-    out = {f"{q}_rel_sd": float(iv["median_rel_std"][q]) for q in q2}
-    out |= {f"{q}_interval_cover": float(cov[q]["fraction"]) for q in q2}
-    out["interval_parts"] = float(cov["omega"]["n"])
-    out["sigma_parts_trusted"] = float(iv["n_sigma_trusted"])
-    out["sigma_and_corr_parts_trusted"] = float(iv["n_both_trusted"])
-    for q in q2:
-        for k, col in (
-            ("score", f"{q}_interval_score"),
-            ("null_score", f"{q}_null_interval_score"),
-        ):
-            out[col] = float(score.get(q, {}).get(k, float("nan")))
-    return out
+    sc = {q: score.get(q, {}) for q in ("omega", "zeta")}  # none in a record made before them
+    values = (
+        iv["median_rel_std"]["omega"],
+        iv["median_rel_std"]["zeta"],
+        cov["omega"]["fraction"],
+        cov["zeta"]["fraction"],
+        cov["omega"]["n"],
+        iv["n_sigma_trusted"],
+        iv["n_both_trusted"],
+        sc["omega"].get("score", nan),
+        sc["omega"].get("null_score", nan),
+        sc["zeta"].get("score", nan),
+        sc["zeta"].get("null_score", nan),
+    )
+    return dict(zip(INTERVAL_COLUMNS, map(float, values)))
 
 
 # ---- the declarations ----------------------------------------------------------------------
@@ -293,11 +295,12 @@ def _paper(plan_or_methods) -> list[str]:
 NULL_COLUMNS = Columns(
     keys=("seed", "tree", "config", "method"),
     values=(
-        *(
-            f"{who}_{c}"
-            for who in ("trained", "null")
-            for c in ("parts_trusted", "median_rel_err_pct", "loglog_r2")
-        ),
+        "trained_parts_trusted",
+        "trained_median_rel_err_pct",
+        "trained_loglog_r2",
+        "null_parts_trusted",
+        "null_median_rel_err_pct",
+        "null_loglog_r2",
         "trained_minus_null_pp",
         "nearest_bone_gap_pct",
         "trained_parts_trusted_visible",

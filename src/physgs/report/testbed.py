@@ -86,10 +86,7 @@ def tab_testbed(
                 "paper_f_span": paper.FREQUENCY_SPAN,
                 "paper_nearest_bone_gap_pct": paper.NEAREST_BONE_GAP_PCT.get(pt, np.nan),
                 "instances": len(inst),
-                **{
-                    f"{c}_sd": float(inst[c].std(ddof=1)) if len(inst) > 1 else np.nan
-                    for c in INSTANCE_SPREAD
-                },
+                **{f"{c}_sd": float(inst[c].std(ddof=1)) for c in INSTANCE_SPREAD},  # one: NaN
             }
         )
     df = pd.DataFrame(rows)
@@ -143,15 +140,10 @@ def tab_testbed(
 # ---- the declaration -----------------------------------------------------------------------
 def _tab_testbed(path, settings, inputs, out):
     trees, seeds = settings["trees"], settings["instances"]
-    return tab_testbed(
-        {t: load_stats(path("stats", t)) for t in trees},
-        trees,
-        digits=settings["digits"],
-        instances={t: [load_stats(path("instance_stats", t, s)) for s in seeds] for t in trees}
-        if seeds
-        else None,
-        paper_trees={t: r.get("paper") for t, r in settings["roles"].items()},
-    )
+    stats = {t: load_stats(path("stats", t)) for t in trees}
+    each = {t: [load_stats(path("instance_stats", t, s)) for s in seeds] for t in trees}
+    paper_trees = {t: r.get("paper") for t, r in settings["roles"].items()}
+    return tab_testbed(stats, trees, settings["digits"], each if seeds else None, paper_trees)
 
 
 def _settings(cfg: dict) -> dict:
@@ -162,10 +154,8 @@ def _settings(cfg: dict) -> dict:
 
 
 def _needs(plan, seeds):
-    one = [("stats", t) for t in plan.trees]
-    if not plan.testbed_seeds:
-        return one
-    return one + [("instance_stats", t, int(s)) for t in plan.trees for s in plan.seeds]
+    each = [("instance_stats", t, int(s)) for t in plan.trees for s in plan.seeds]
+    return [("stats", t) for t in plan.trees] + (each if plan.testbed_seeds else [])
 
 
 TAB_TESTBED = Output(

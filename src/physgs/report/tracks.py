@@ -10,6 +10,7 @@ paths, coloured by their part in the fit (grey: not fitted).
 
 from __future__ import annotations
 
+from functools import partial
 from typing import Mapping, Sequence
 
 import numpy as np
@@ -106,24 +107,19 @@ def tab_tracks(
     """
     keys = [(t, c) for t in trees for c in configs]
     seeds = seeds_of(per_seed, "tab_tracks", keys)
-    df = seed_rows(
-        seeds,
-        keys,
-        lambda s, t, c: {
-            "tree": t,
-            "bones": bones[t],
-            "config": c,
-            "conditions": configs[c]["conditions"],
-            **row(per_seed[s][(t, c)], conditions),
-        },
-    )
-    fmt = f".{int(digits)}f"
+
+    def one(s, t, c):
+        about = {"tree": t, "bones": bones[t], "config": c, "conditions": configs[c]["conditions"]}
+        return about | row(per_seed[s][(t, c)], conditions)
+
+    df = seed_rows(seeds, keys, one)
+    col, fmt = partial(latex.cells, df), f".{int(digits)}f"
 
     def both(a: str, b: str) -> list[str]:  # 'median / 90th percentile'
-        return [f"{x} / {y}" for x, y in zip(latex.cells(df, a, fmt), latex.cells(df, b, fmt))]
+        return [f"{x} / {y}" for x, y in zip(col(a, fmt), col(b, fmt))]
 
     n, kept, est, k = (
-        latex.cells(df, c, ".0f", cell=latex.mean, scale=f)
+        col(c, ".0f", cell=latex.mean, scale=f)
         for c, f in (("n_tracks", 1), ("share_kept", 100), ("parts_estimated", 1), ("K", 1))
     )
     columns = {
@@ -131,20 +127,15 @@ def tab_tracks(
         ("Tracker", "Error (px)"): both("track_median_px", "track_p90_px"),
         ("Tracker", r"Displ.\ (px)"): both("disp_median_px", "disp_p90_px"),
         ("Fit", "Parts"): [f"{a}/{b}" for a, b in zip(est, k)],
-        ("Fit", "s"): latex.cells(df, "fit_s", ".0f"),
-        ("Fit", "ours (s)"): latex.cells(df, "ours_train_s", ".0f"),
+        ("Fit", "s"): col("fit_s", ".0f"),
+        ("Fit", "ours (s)"): col("ours_train_s", ".0f"),
     }
     winds = [f"wind {condition_label(float(c))}" for c in conditions[1:]]
     for head, stem in zip(["beyond the window", *winds], _stems(conditions)):
         for suffix, who in WHO.items():
-            columns[(f"{head} (px)", who)] = latex.cells(df, f"{stem}{suffix}_px", fmt)
-    cells = pd.DataFrame(
-        columns,
-        index=pd.MultiIndex.from_tuples(
-            [(tree_label(t, bones[t]), configs[c]["label"]) for t, c in keys],
-            names=["Tree", "Config"],
-        ),
-    )
+            columns[(f"{head} (px)", who)] = col(f"{stem}{suffix}_px", fmt)
+    rows = [(tree_label(t, bones[t]), configs[c]["label"]) for t, c in keys]
+    cells = pd.DataFrame(columns, index=pd.MultiIndex.from_tuples(rows, names=["Tree", "Config"]))
     joint = [c.replace("_", r"\_") for c in configs if configs[c]["conditions"] != "train"]
     cap = (
         r"The 2D-track control: ours' oscillators fitted to Lucas--Kanade point tracks of the "
@@ -250,27 +241,18 @@ def _tab_tracks_settings(cfg: dict) -> dict:
 
 
 def _tab_tracks(path, settings, inputs, out):
-    scores = {s: {} for s in settings["seeds"]}
-    for s in scores:
-        for t in settings["trees"]:
-            for c in settings["configs"]:
-                sc = scores[s][(t, c)] = read_json(
-                    path("tracks_eval", t, c, s), rule="tracks_evaluate"
-                )
-                if key(("tracks_fields", t, c, s)) in inputs:  # {case: {field: errors}}
-                    fields = read_json(path("tracks_fields", t, c, s), rule="tracks_fields")
-                    for case, f in fields.items():
-                        sc[case]["fields"] = f
-                loss = pd.read_csv(path("loss", t, "ours", c, s))
-                sc["ours_train_s"] = float(loss["seconds"].iloc[-1])
-    return tab_tracks(
-        scores,
-        settings["trees"],
-        settings["bones"],
-        settings["configs"],
-        settings["conditions"],
-        digits=settings["digits"],
-    )
+    def scores(s, t, c):
+        sc = read_json(path("tracks_eval", t, c, s), rule="tracks_evaluate")
+        if key(("tracks_fields", t, c, s)) in inputs:  # {case: {field: errors}}
+            for case, f in read_json(path("tracks_fields", t, c, s), rule="tracks_fields").items():
+                sc[case]["fields"] = f
+        sc["ours_train_s"] = float(pd.read_csv(path("loss", t, "ours", c, s))["seconds"].iloc[-1])
+        return sc
+
+    trees, configs, seeds = settings["trees"], settings["configs"], settings["seeds"]
+    per_seed = {s: {(t, c): scores(s, t, c) for t in trees for c in configs} for s in seeds}
+    conditions, digits = settings["conditions"], settings["digits"]
+    return tab_tracks(per_seed, trees, settings["bones"], configs, conditions, digits=digits)
 
 
 TAB_TRACKS = Output(
