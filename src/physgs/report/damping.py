@@ -23,13 +23,13 @@ from physgs.report import seeds as seedstats
 from physgs.report.output import Columns, Output
 from physgs.report.recovery import (
     INTERVAL_COLUMNS,
+    WHO,
     MethodRows,
     interval_cells,
     method_frame,
     methods_needs,
     methods_settings,
     table_methods,
-    who,
 )
 from physgs.report.tables import Table, tree_label
 from physgs.testbed.variant import DAMPING, FAITHFUL, damping_id
@@ -80,7 +80,7 @@ def tab_damping(
         rec = methods[method].per_seed[s][(t, v, c)]
         sc, nl = rec.damping_scores, rec.damping_null
         if sc is None or nl is None:
-            name = "" if method == "ours" else f" ({who(method)})"
+            name = "" if method == "ours" else f" ({WHO.get(method, method)})"
             raise ValueError(
                 f"tab_damping: the recovery of {t}/{v}/{c}{name} (seed {s}) has no "
                 "damping scores; re-run its recovery rule with damping params"

@@ -351,12 +351,8 @@ TAB_PARTS = Output(
     _tab_parts,
     settings=_parts_settings,
     in_report=lambda plan: bool(plan.parts_models),
-    columns=Columns(
-        keys=("seed", "tree", "model", "config"),
-        values=COLUMNS[:-1],  # all but train_s
-        timing=("train_s",),
-        about=("bones",),
-    ),
+    # keys, values (all but train_s), timing, about
+    columns=Columns(("seed", "tree", "model", "config"), COLUMNS[:-1], ("train_s",), ("bones",)),
 )
 
 
@@ -427,9 +423,8 @@ TAB_PARTS_K = Output(
     settings=_kmatch_settings,
     seeds="studies",
     in_report=lambda plan: False,  # a study: the `studies` target (Snakefile)
-    columns=Columns(  # the chained prior at several K (a numeric key)
-        keys=("seed", "tree", "model", "K"),
-        values=("heldout_psnr_db", "matched_k"),
-        about=("bones",),
+    # the chained prior at several K (a numeric key)
+    columns=Columns(
+        ("seed", "tree", "model", "K"), ("heldout_psnr_db", "matched_k"), about=("bones",)
     ),
 )

@@ -19,6 +19,8 @@ from physgs.report.tables import Table, check_keys, seed_rows, seeds_of, tree_in
 
 #: the method ids of the 2D-track control and the output-only analysis (``RECOVERY_METHODS``)
 TRACKS, OMA = "tracks", "oma"
+#: a method's name in the recovery tables' errors, where it is not its id
+WHO = {TRACKS: "tracks control"}
 
 
 @dataclass(frozen=True)
@@ -37,7 +39,14 @@ class MethodRows:
     note: str = ""
 
     def row_label(self, config: str) -> str:
-        """'<label>, <config label>' (ours': the configuration's label alone)."""
+        """The LaTeX label of its row in a configuration.
+
+        Args:
+            config: a key of ``configs``.
+
+        Returns:
+            '<label>, <config label>' (ours': the configuration's label alone).
+        """
         return f"{self.label}, {self.configs[config]}" if self.label else self.configs[config]
 
 
@@ -140,7 +149,9 @@ def recovery_table(
     return Table(name, df, latex.render(cells, cap, "tab:" + name.removeprefix("tab_")))
 
 
-def method_frame(what: str, methods: Mapping[str, MethodRows], keys: Sequence[tuple], one):
+def method_frame(
+    what: str, methods: Mapping[str, MethodRows], keys: Sequence[tuple], one
+) -> tuple[pd.DataFrame, list[int]]:
     """A recovery table's CSV frame and seeds (its first method's), each method checked to hold
     its keys at every seed.
 
@@ -151,7 +162,7 @@ def method_frame(what: str, methods: Mapping[str, MethodRows], keys: Sequence[tu
         one (Callable): ``one(seed, *key)`` -> that row's columns (``tables.seed_rows``).
 
     Returns:
-        tuple[pd.DataFrame, list[int]]: the frame and the seeds, ascending.
+        The frame and the seeds, ascending.
 
     Raises:
         KeyError: a method missing a cell at a seed, naming the table, the method and the seed.
@@ -160,13 +171,10 @@ def method_frame(what: str, methods: Mapping[str, MethodRows], keys: Sequence[tu
     for s in seeds:
         for m, mr in methods.items():
             have = mr.per_seed.get(s, {})
-            check_keys([k[:-1] for k in keys if k[-1] == m], have, f"{what} ({who(m)}, seed {s})")
+            check_keys(
+                [k[:-1] for k in keys if k[-1] == m], have, f"{what} ({WHO.get(m, m)}, seed {s})"
+            )
     return seed_rows(seeds, keys, one), seeds
-
-
-def who(method: str) -> str:
-    """A recovery method's name in the recovery tables' errors."""
-    return "tracks control" if method == TRACKS else method
 
 
 def method_rows(
@@ -209,7 +217,14 @@ INTERVAL_COLUMNS = (
 
 
 def interval_cells(rec) -> dict:
-    """A ``RecoveryRecord``'s ``INTERVAL_COLUMNS`` -> value (NaN without ``intervals``)."""
+    """A record's ``INTERVAL_COLUMNS`` cells.
+
+    Args:
+        rec (RecoveryRecord): the record.
+
+    Returns:
+        Column -> value (NaN when the record has no ``intervals``).
+    """
     iv, nan = rec.intervals, float("nan")
     if not iv:
         return dict.fromkeys(INTERVAL_COLUMNS, nan)
@@ -233,13 +248,26 @@ def interval_cells(rec) -> dict:
 
 # ---- the declarations ----------------------------------------------------------------------
 def label_with_k(cfg: dict, config: str, K: int) -> str:
-    """The LaTeX label of ``config`` for a method with its own K there (``config_label``)."""
+    """The LaTeX label of a configuration for a method with its own K there.
+
+    Args:
+        cfg: the resolved config.
+        config: a configuration name.
+        K: the method's number of parts in that configuration.
+
+    Returns:
+        The label ([`config_label`][physgs.models.registry.config_label]).
+    """
     return config_label(config, {**cfg["models"]["configs"][config], "K": K})
 
 
 def methods_settings(cfg: dict, methods: Sequence[str], configs: Sequence[str]) -> dict:
-    """A recovery table's settings: the methods it shows (of those the run scores), each in
-    its configurations among ``configs``.
+    """A recovery table's settings: the methods it shows, each in its configurations.
+
+    Args:
+        cfg: the resolved config.
+        methods: the method ids it may show (those the run scores: ``registry.recovery_plan``).
+        configs: the table's configurations.
 
     Returns:
         ``{"methods": {id: {config: {"K", "label"}}}}``, each with the method's K.
@@ -259,8 +287,18 @@ def methods_settings(cfg: dict, methods: Sequence[str], configs: Sequence[str]) 
 
 
 def methods_needs(plan, methods, configs, testbeds, s: int) -> list[tuple]:
-    """``("recovery", testbed, method, config, s)`` of one seed: each method in its
-    configurations (``plan.recovery``) among ``configs``, on each testbed."""
+    """The records a recovery table reads of one seed.
+
+    Args:
+        plan (Plan): the run's plan (each method's configurations: ``plan.recovery``).
+        methods (Sequence[str]): the method ids.
+        configs (Collection[str]): the table's configurations.
+        testbeds (Sequence[str]): the testbed ids.
+        s: the training seed.
+
+    Returns:
+        ``("recovery", testbed, method, config, s)`` need tuples.
+    """
     return [
         ("recovery", tb, m, c, s)
         for tb in testbeds
@@ -271,8 +309,16 @@ def methods_needs(plan, methods, configs, testbeds, s: int) -> list[tuple]:
 
 
 def table_methods(settings: dict, records, damping: bool = False) -> dict[str, MethodRows]:
-    """A recovery table's ``MethodRows`` in ``RECOVERY_METHODS``' order, from its
-    ``methods_settings`` and ``records(method, {config: K})`` -> the per-seed records."""
+    """A recovery table's ``MethodRows``, in ``RECOVERY_METHODS``' order (ours first).
+
+    Args:
+        settings: the table's settings (``methods_settings``).
+        records (Callable): ``records(method, {config: K})`` -> its ``MethodRows.per_seed``.
+        damping: tab_damping's caption sentences (``method_rows``).
+
+    Returns:
+        Method id -> its rows.
+    """
     methods = settings["methods"]
     return {
         m: method_rows(
