@@ -26,10 +26,10 @@ from physgs.report.recovery import (
     WHO,
     MethodRows,
     interval_cells,
-    method_frame,
-    methods_needs,
-    methods_settings,
-    table_methods,
+    _method_frame,
+    _methods_needs,
+    _methods_settings,
+    _table_methods,
 )
 from physgs.report.tables import Table, tree_label
 from physgs.testbed.variant import DAMPING, FAITHFUL, damping_id
@@ -103,7 +103,7 @@ def tab_damping(
             **interval_cells(rec),
         }
 
-    df, seeds = method_frame("tab_damping", methods, keys, one)
+    df, seeds = _method_frame("tab_damping", methods, keys, one)
     col, fmt = partial(latex.cells, df), f".{int(digits)}f"
     p, p_true = col("gamma_exponent", ".2f"), col("gamma_exponent_true", ".2f", cell=latex.mean)
     err, corr = r"Med.\ rel.\ err.\ of $\hat\zeta$", r"corr($\log\hat\zeta$, $\log\zeta$)"
@@ -150,7 +150,9 @@ def _testbeds(tree: str) -> dict:
 def _damping_needs(plan, seeds):
     testbeds = [tb for t in plan.damping_trees for tb in _testbeds(t).values()]
     configs = plan.damping_configs
-    return [x for s in seeds for x in methods_needs(plan, plan.recovery, configs, testbeds, int(s))]
+    return [
+        x for s in seeds for x in _methods_needs(plan, plan.recovery, configs, testbeds, int(s))
+    ]
 
 
 def _tab_damping(path, settings, inputs, out):
@@ -167,7 +169,7 @@ def _tab_damping(path, settings, inputs, out):
             for s in seeds
         }
 
-    methods = table_methods(settings, records, damping=True)
+    methods = _table_methods(settings, records, damping=True)
     return tab_damping(methods, trees, settings["bones"], digits=settings["digits"])
 
 
@@ -176,7 +178,7 @@ TAB_DAMPING = Output(
     "table",
     _damping_needs,
     _tab_damping,
-    settings=lambda cfg: methods_settings(
+    settings=lambda cfg: _methods_settings(
         cfg, RECOVERY_METHODS, cfg["damping_benchmark"]["configs"]
     ),
     trees="damping_benchmark",

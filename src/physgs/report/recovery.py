@@ -118,7 +118,7 @@ def recovery_table(
             **interval_cells(rec),
         }
 
-    df, seeds = method_frame(name, methods, keys, one)
+    df, seeds = _method_frame(name, methods, keys, one)
     first = latex.rows(df)
     fmt = f".{int(digits)}f"
     col = partial(latex.cells, df)
@@ -149,31 +149,16 @@ def recovery_table(
     return Table(name, df, latex.render(cells, cap, "tab:" + name.removeprefix("tab_")))
 
 
-def method_frame(
+def _method_frame(
     what: str, methods: Mapping[str, MethodRows], keys: Sequence[tuple], one
 ) -> tuple[pd.DataFrame, list[int]]:
-    """A recovery table's CSV frame and seeds (its first method's), each method checked to hold
-    its keys at every seed.
-
-    Args:
-        what: the table's name (in errors).
-        methods: method id -> its rows.
-        keys: the table's row keys, each ending in its method's id.
-        one (Callable): ``one(seed, *key)`` -> that row's columns (``tables.seed_rows``).
-
-    Returns:
-        The frame and the seeds, ascending.
-
-    Raises:
-        KeyError: a method missing a cell at a seed, naming the table, the method and the seed.
-    """
+    """A recovery table's CSV frame and seeds, each method checked (KeyError) to hold its keys
+    (each ending in its id) at every seed of its first method."""
     seeds = seeds_of(next(iter(methods.values())).per_seed if methods else {}, what)
     for s in seeds:
         for m, mr in methods.items():
-            have = mr.per_seed.get(s, {})
-            check_keys(
-                [k[:-1] for k in keys if k[-1] == m], have, f"{what} ({WHO.get(m, m)}, seed {s})"
-            )
+            mine = [k[:-1] for k in keys if k[-1] == m]
+            check_keys(mine, mr.per_seed.get(s, {}), f"{what} ({WHO.get(m, m)}, seed {s})")
     return seed_rows(seeds, keys, one), seeds
 
 
@@ -247,36 +232,19 @@ def interval_cells(rec) -> dict:
 
 
 # ---- the declarations ----------------------------------------------------------------------
-def label_with_k(cfg: dict, config: str, K: int) -> str:
-    """The LaTeX label of a configuration for a method with its own K there.
-
-    Args:
-        cfg: the resolved config.
-        config: a configuration name.
-        K: the method's number of parts in that configuration.
-
-    Returns:
-        The label ([`config_label`][physgs.models.registry.config_label]).
-    """
+def _label_with_k(cfg: dict, config: str, K: int) -> str:
+    """The LaTeX label of ``config`` for a method with K parts of its own there."""
     return config_label(config, {**cfg["models"]["configs"][config], "K": K})
 
 
-def methods_settings(cfg: dict, methods: Sequence[str], configs: Sequence[str]) -> dict:
-    """A recovery table's settings: the methods it shows, each in its configurations.
-
-    Args:
-        cfg: the resolved config.
-        methods: the method ids it may show (those the run scores: ``registry.recovery_plan``).
-        configs: the table's configurations.
-
-    Returns:
-        ``{"methods": {id: {config: {"K", "label"}}}}``, each with the method's K.
-    """
+def _methods_settings(cfg: dict, methods: Sequence[str], configs: Sequence[str]) -> dict:
+    """``{"methods": {id: {config: {"K", "label"}}}}``: each of ``methods`` the run scores, in
+    its configurations among ``configs``, with its own K."""
     plan = recovery_plan(cfg)
     return {
         "methods": {
             m: {
-                c: {"K": k, "label": label_with_k(cfg, c, k)}
+                c: {"K": k, "label": _label_with_k(cfg, c, k)}
                 for c, k in plan[m].items()
                 if c in configs
             }
@@ -286,19 +254,9 @@ def methods_settings(cfg: dict, methods: Sequence[str], configs: Sequence[str]) 
     }
 
 
-def methods_needs(plan, methods, configs, testbeds, s: int) -> list[tuple]:
-    """The records a recovery table reads of one seed.
-
-    Args:
-        plan (Plan): the run's plan (each method's configurations: ``plan.recovery``).
-        methods (Sequence[str]): the method ids.
-        configs (Collection[str]): the table's configurations.
-        testbeds (Sequence[str]): the testbed ids.
-        s: the training seed.
-
-    Returns:
-        ``("recovery", testbed, method, config, s)`` need tuples.
-    """
+def _methods_needs(plan, methods, configs, testbeds, s: int) -> list[tuple]:
+    """``("recovery", testbed, method, config, s)`` of each method in its configurations
+    (``plan.recovery``) among ``configs``."""
     return [
         ("recovery", tb, m, c, s)
         for tb in testbeds
@@ -308,28 +266,14 @@ def methods_needs(plan, methods, configs, testbeds, s: int) -> list[tuple]:
     ]
 
 
-def table_methods(settings: dict, records, damping: bool = False) -> dict[str, MethodRows]:
-    """A recovery table's ``MethodRows``, in ``RECOVERY_METHODS``' order (ours first).
-
-    Args:
-        settings: the table's settings (``methods_settings``).
-        records (Callable): ``records(method, {config: K})`` -> its ``MethodRows.per_seed``.
-        damping: tab_damping's caption sentences (``method_rows``).
-
-    Returns:
-        Method id -> its rows.
-    """
-    methods = settings["methods"]
-    return {
-        m: method_rows(
-            m,
-            {c: v["label"] for c, v in methods[m].items()},
-            records(m, {c: v["K"] for c, v in methods[m].items()}),
-            damping=damping,
-        )
-        for m in RECOVERY_METHODS
-        if m in methods
-    }
+def _table_methods(settings: dict, records, damping: bool = False) -> dict[str, MethodRows]:
+    """Method id -> its ``MethodRows`` in ``RECOVERY_METHODS``' order (ours first), from the
+    ``_methods_settings`` and ``records(method, {config: K})`` -> its per-seed records."""
+    out, methods = {}, settings["methods"]
+    for m in (m for m in RECOVERY_METHODS if m in methods):
+        labels, ks = ({c: v[f] for c, v in methods[m].items()} for f in ("label", "K"))
+        out[m] = method_rows(m, labels, records(m, ks), damping=damping)
+    return out
 
 
 def _paper(plan_or_methods) -> list[str]:
@@ -366,13 +310,13 @@ def _frequency_output(name: str, methods, in_report=lambda plan: True) -> Output
         mine = methods(plan.recovery)
         out = []
         for s in seeds:
-            out += methods_needs(plan, mine, plan.configs, plan.trees, s)
+            out += _methods_needs(plan, mine, plan.configs, plan.trees, s)
             nulls = {int(k) for m in mine for k in plan.recovery[m].values()}
             out += [("null", t, k, s) for t in plan.trees for k in sorted(nulls)]
         return out
 
     def settings(cfg):
-        return methods_settings(cfg, methods(recovery_plan(cfg)), cfg["models"]["configs"])
+        return _methods_settings(cfg, methods(recovery_plan(cfg)), cfg["models"]["configs"])
 
     def table(path, settings, inputs, out):
         trees, seeds = settings["trees"], settings["seeds"]
@@ -390,7 +334,7 @@ def _frequency_output(name: str, methods, in_report=lambda plan: True) -> Output
                 for s in seeds
             }
 
-        rows = table_methods(settings, paired)
+        rows = _table_methods(settings, paired)
         return recovery_table(name, rows, trees, settings["bones"], digits=settings["digits"])
 
     return Output(

@@ -19,7 +19,7 @@ import pandas as pd
 from physgs.intermediate import read_json
 from physgs.report import latex
 from physgs.report.output import Columns, Output, key
-from physgs.report.recovery import label_with_k
+from physgs.report.recovery import _label_with_k
 from physgs.report.tables import Table, condition_label, seed_rows, seeds_of, tree_label
 from physgs.tracks.settings import parts as tracks_k
 from physgs.tracks.store import load_fit, load_tracks
@@ -45,23 +45,10 @@ def _stems(conditions: Sequence[float]) -> list[str]:
     return ["tail", *("wind_" + condition_label(float(c), tex=False) for c in conditions[1:])]
 
 
-def row(scores: Mapping, conditions: Sequence[float]) -> dict[str, float]:
-    """One tab_tracks row from an evaluation record.
-
-    Motion columns ``<case>_px`` (the control), ``<case>_ours_px`` (ours' Gaussians at the same
-    points; NaN when not scored), ``<case>_field_<id>_px`` (each learned field scored),
-    ``<case>_best_field_px`` (the lowest of them; NaN without one), ``<case>_static_px``.
-
-    Args:
-        scores: [`evaluate_job`][physgs.tracks.run.evaluate_job]'s scores, plus ``ours_train_s``:
-            ours' training seconds in the same configuration, NaN when absent.
-        conditions: the testbed's mean-speed multipliers (the first is the training wind).
-
-    Returns:
-        The row, px and seconds.
-
-    Raises:
-        KeyError: when the record lacks a motion case.
+def _row(scores: Mapping, conditions: Sequence[float]) -> dict[str, float]:
+    """One tab_tracks row (px, s) from ``evaluate_job``'s scores (+ ``ours_train_s``). Per
+    motion case (KeyError if missing): ``<case>_px`` (the control), ``<case>_ours_px``,
+    ``<case>_field_<id>_px``, ``<case>_best_field_px`` (NaN when unscored), ``<case>_static_px``.
     """
     tr, fit = scores["tracker"], scores["fit"]
     out = {c: float(tr[k]) for c, k in TRACKER.items()} | {c: float(fit[k]) for c, k in FIT.items()}
@@ -110,7 +97,7 @@ def tab_tracks(
 
     def one(s, t, c):
         about = {"tree": t, "bones": bones[t], "config": c, "conditions": configs[c]["conditions"]}
-        return about | row(per_seed[s][(t, c)], conditions)
+        return about | _row(per_seed[s][(t, c)], conditions)
 
     df = seed_rows(seeds, keys, one)
     col, fmt = partial(latex.cells, df), f".{int(digits)}f"
@@ -231,7 +218,7 @@ def _tab_tracks_settings(cfg: dict) -> dict:
     return {
         "configs": {
             c: {
-                "label": label_with_k(cfg, c, tracks_k(cfg, c)[0]),
+                "label": _label_with_k(cfg, c, tracks_k(cfg, c)[0]),
                 "conditions": cfg["models"]["configs"][c]["conditions"],
             }
             for c in cfg["tracks"]["configs"]
