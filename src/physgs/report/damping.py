@@ -149,10 +149,8 @@ def _testbeds(tree: str) -> dict:
 
 def _damping_needs(plan, seeds):
     testbeds = [tb for t in plan.damping_trees for tb in _testbeds(t).values()]
-    configs = plan.damping_configs
-    return [
-        x for s in seeds for x in _methods_needs(plan, plan.recovery, configs, testbeds, int(s))
-    ]
+    need = partial(_methods_needs, plan, plan.recovery, plan.damping_configs, testbeds)
+    return [x for s in seeds for x in need(int(s))]
 
 
 def _tab_damping(path, settings, inputs, out):

@@ -1,10 +1,7 @@
-"""tab_parts and fig_parts: ours' k-means parts beside parts cut along the tree.
-
-Per tree, training seed and configuration of ``parts_study``: the paper's prior (``ours``:
-spatial k-means, independent parts about fixed pivots) beside its topology-aware variants
-(``ours_topo``: parts cut along the tree; ``ours_chain``: the same, each riding on its parent).
-tab_parts_k (a study: the `studies` target): the smallest K at which the chained prior matches
-ours.
+"""tab_parts and fig_parts: the paper's prior (``ours``: spatial k-means, independent parts
+about fixed pivots) beside its topology-aware variants (``ours_topo``: parts cut along the tree;
+``ours_chain``: the same, each riding on its parent), per tree, seed and configuration of
+``parts_study``. tab_parts_k (a study): the smallest K at which the chained prior matches ours.
 """
 
 from __future__ import annotations
@@ -196,8 +193,7 @@ def fig_parts(
     )
     cmap = plt.get_cmap("tab20")
     for r, t in enumerate(trees):
-        rec = records[t]
-        xyz = rec["xyz"]
+        rec, xyz = records[t], records[t]["xyz"]
         for j, m in enumerate(str(x) for x in rec["models"]):
             ax = axes[r, j]
             lab, piv, par = rec[f"{m}/labels"], rec[f"{m}/pivots"], rec[f"{m}/parent"]
