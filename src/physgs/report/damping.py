@@ -1,13 +1,6 @@
-"""tab_damping: can the oscillator prior recover damping on a testbed built to show it?
-
-Per tree of the damping benchmark, each method on the faithful testbed (one zeta on every bone)
-and on its damping variant (zeta per bone, log-uniform, and a gust dropping to calm inside the
-window), from the recovery records' ``damping_scores``/``damping_null``: the median relative
-error of zeta_hat over trusted parts, corr(log zeta_hat, log zeta) and the exponent p of the
-fitted decay rate gamma_hat = zeta_hat omega_hat ~ omega_hat^p (p near 0: a frequency-independent
-rate fitted in place of a ratio), each beside the untrained null. fig_damping: each prior's
-recovered damping on the run's own trees (first seed).
-"""
+"""tab_damping: each method's damping recovery (``damping_scores``/``damping_null`` of its
+recovery records) on the faithful testbed and its damping variant, beside the untrained null;
+fig_damping: each prior's recovered damping on the run's own trees (first seed)."""
 
 from __future__ import annotations
 

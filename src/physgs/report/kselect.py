@@ -4,6 +4,7 @@ data (`auto`): ours, and every prior under ``models.kselect.priors`` (the chaine
 from __future__ import annotations
 
 from functools import partial
+from itertools import product
 from typing import Mapping, Sequence
 
 import numpy as np
@@ -116,37 +117,32 @@ def _kselect_needs(plan, seeds):
     """Per seed, tree and prior: its K selection, and the evaluation, recovery and loss log
     of its fixed-K and chosen-K models."""
     out = []
-    for s in seeds:
-        for t in plan.trees:
-            for m in [BASE_MODEL, *plan.kselect_priors]:
-                out.append(_selection_need(t, m, s))
-                for c in ROWS:
-                    out += [(k, t, m, c, s) for k in ("eval", "recovery", "loss")]
+    for s, t, m in product(seeds, plan.trees, [BASE_MODEL, *plan.kselect_priors]):
+        out.append(_selection_need(t, m, s))
+        out += [(k, t, m, c, s) for c in ROWS for k in ("eval", "recovery", "loss")]
     return out
 
 
 def _tab_kselect(path, settings, inputs, out):
     rows = {s: {} for s in settings["seeds"]}
-    for s in rows:
-        for t in settings["trees"]:
-            for m in settings["models"]:
-                sel = load_selection(path(*_selection_need(t, m, s)))
-                for c in ROWS:
-                    ev = load_eval(path("eval", t, m, c, s)).summary()
-                    rec = load_recovery(path("recovery", t, m, c, s))
-                    loss = pd.read_csv(path("loss", t, m, c, s))
-                    rows[s][(t, m, c)] = {
-                        "K": rec.match.n_parts,
-                        "view_psnr": ev["view"],
-                        "time_psnr": ev["time"],
-                        "median_rel_err": rec.match.median_rel_err,
-                        "trusted": rec.match.n_trusted,
-                        "frozen": rec.n_frozen,
-                        "k_heldout": sel.k_heldout,
-                        "k_bic": sel.k_bic,
-                        "train_s": float(loss["seconds"].iloc[-1]),
-                        "select_s": float(sum(sel.wall_s)),
-                    }
+    for s, t, m in product(rows, settings["trees"], settings["models"]):
+        sel = load_selection(path(*_selection_need(t, m, s)))
+        for c in ROWS:
+            ev = load_eval(path("eval", t, m, c, s)).summary()
+            rec = load_recovery(path("recovery", t, m, c, s))
+            loss = pd.read_csv(path("loss", t, m, c, s))
+            rows[s][(t, m, c)] = {
+                "K": rec.match.n_parts,
+                "view_psnr": ev["view"],
+                "time_psnr": ev["time"],
+                "median_rel_err": rec.match.median_rel_err,
+                "trusted": rec.match.n_trusted,
+                "frozen": rec.n_frozen,
+                "k_heldout": sel.k_heldout,
+                "k_bic": sel.k_bic,
+                "train_s": float(loss["seconds"].iloc[-1]),
+                "select_s": float(sum(sel.wall_s)),
+            }
     trees, bones, method = settings["trees"], settings["bones"], settings["method"]
     models, digits = settings["models"], settings["digits"]
     return tab_kselect(rows, trees, bones, method, models=models, digits=digits)

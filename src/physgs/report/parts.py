@@ -179,9 +179,6 @@ def fig_parts(
         outputs: the paths to write (pdf, png).
         title: the figure's title.
     """
-    import matplotlib
-
-    matplotlib.use("Agg")
     import matplotlib.pyplot as plt
 
     from physgs.report.figures import FONT_PT, PAGE_WIDTH_IN, save_figure
@@ -294,16 +291,13 @@ def _parts_needs(plan, seeds):
     priors, configs = [BASELINE, *plan.parts_models], plan.parts_configs
     damping_trees = [t for t in plan.damping_trees if t in plan.trees]
     out = []
-    for s in (int(x) for x in seeds):
-        for t in plan.trees:
-            out += [(k, t, m, BASE_CONFIG, s) for m in FIT_FRAME for k in ("eval", "loss")]
-            for c in configs:
-                for m in priors:
-                    out += [(k, t, m, c, s) for k in ("eval", "loss", "recovery")]
-                    if t in damping_trees:
-                        out.append(("recovery", damping_id(t), m, c, s))
-            out += list(dict.fromkeys(("null", t, int(configs[c]["K"]), s) for c in configs))
-            out.append(("parts", t, s))
+    for s, t in product([int(x) for x in seeds], plan.trees):
+        out += [(k, t, m, BASE_CONFIG, s) for m in FIT_FRAME for k in ("eval", "loss")]
+        for c, m in product(configs, priors):
+            out += [(k, t, m, c, s) for k in ("eval", "loss", "recovery")]
+            out += [("recovery", damping_id(t), m, c, s)] if t in damping_trees else []
+        out += list(dict.fromkeys(("null", t, int(configs[c]["K"]), s) for c in configs))
+        out.append(("parts", t, s))
     return out
 
 
@@ -373,10 +367,9 @@ def _kmatch_needs(plan, seeds):
     """Ours' and the chained prior's evaluation in the base configuration (their held-out
     frames) and the chained prior's kmatch points at each smaller K."""
     out = []
-    for s in (int(x) for x in seeds):
-        for t in plan.trees:
-            out += [("eval", t, m, BASE_CONFIG, s) for m in (BASELINE, "ours_chain")]
-            out += [("kmatch", t, int(k), s) for k in plan.k_candidates]
+    for s, t in product([int(x) for x in seeds], plan.trees):
+        out += [("eval", t, m, BASE_CONFIG, s) for m in (BASELINE, "ours_chain")]
+        out += [("kmatch", t, int(k), s) for k in plan.k_candidates]
     return out
 
 

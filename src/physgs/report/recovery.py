@@ -240,16 +240,11 @@ def _label_with_k(cfg: dict, config: str, K: int) -> str:
 def _methods_settings(cfg: dict, methods: Sequence[str], configs: Sequence[str]) -> dict:
     """``{"methods": {id: {config: {"K", "label"}}}}``: each of ``methods`` the run scores, in
     its configurations among ``configs``, with its own K."""
-    plan = recovery_plan(cfg)
+    plan, label = recovery_plan(cfg), partial(_label_with_k, cfg)
+    mine = {m: {c: k for c, k in plan[m].items() if c in configs} for m in methods if m in plan}
     return {
         "methods": {
-            m: {
-                c: {"K": k, "label": _label_with_k(cfg, c, k)}
-                for c, k in plan[m].items()
-                if c in configs
-            }
-            for m in methods
-            if m in plan
+            m: {c: {"K": k, "label": label(c, k)} for c, k in ck.items()} for m, ck in mine.items()
         }
     }
 
@@ -322,17 +317,11 @@ def _frequency_output(name: str, methods, in_report=lambda plan: True) -> Output
         trees, seeds = settings["trees"], settings["seeds"]
 
         def paired(m, configs):  # configs: {config: K}
-            return {
-                s: {
-                    (t, c): (
-                        load_recovery(path("recovery", t, m, c, s)),
-                        load_null(path("null", t, int(k), s)),
-                    )
-                    for t in trees
-                    for c, k in configs.items()
-                }
-                for s in seeds
-            }
+            def one(t, c, s):  # its record and the null of its K
+                rec = load_recovery(path("recovery", t, m, c, s))
+                return rec, load_null(path("null", t, int(configs[c]), s))
+
+            return {s: {(t, c): one(t, c, s) for t in trees for c in configs} for s in seeds}
 
         rows = _table_methods(settings, paired)
         return recovery_table(name, rows, trees, settings["bones"], digits=settings["digits"])

@@ -1,12 +1,6 @@
-"""tab_tracks and fig_tracks: the 2D-track control ([`physgs.tracks`][], docs/tracks.md).
-
-tab_tracks, per tree, configuration and training seed, from the control's evaluation record
-([`physgs.tracks.run.evaluate_job`][]): the tracker against the truth-projected vertices, the
-fit, and the motion errors (px) of the control's predicted tracks beyond the window and under
-each unseen wind, beside ours' Gaussians, the best learned field and a motionless prediction at
-the same tracked points. fig_tracks: per tree, the training camera's frame 0 under the tracks'
-paths, coloured by their part in the fit (grey: not fitted).
-"""
+"""tab_tracks and fig_tracks: the 2D-track control ([`physgs.tracks`][], docs/tracks.md): its
+tracker, its fit and its predicted tracks' motion errors beside ours', the best learned field's
+and a motionless prediction's at the same points; the tracks drawn over frame 0."""
 
 from __future__ import annotations
 
