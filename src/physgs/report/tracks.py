@@ -209,16 +209,10 @@ def _tab_tracks_needs(plan, seeds):
 
 
 def _tab_tracks_settings(cfg: dict) -> dict:
-    return {
-        "configs": {
-            c: {
-                "label": _label_with_k(cfg, c, tracks_k(cfg, c)[0]),
-                "conditions": cfg["models"]["configs"][c]["conditions"],
-            }
-            for c in cfg["tracks"]["configs"]
-        },
-        "conditions": [float(c) for c in cfg["testbed"]["conditions"]],
-    }
+    conditions = {c: v["conditions"] for c, v in cfg["models"]["configs"].items()}
+    label = {c: _label_with_k(cfg, c, tracks_k(cfg, c)[0]) for c in cfg["tracks"]["configs"]}
+    configs = {c: {"label": lab, "conditions": conditions[c]} for c, lab in label.items()}
+    return {"configs": configs, "conditions": [float(c) for c in cfg["testbed"]["conditions"]]}
 
 
 def _tab_tracks(path, settings, inputs, out):
