@@ -36,15 +36,12 @@ PERCENT = {
     "height_fill_pct": "height_fill",
     "coverage_pct": "coverage",
 }
-COUNTS = ("distinct_frequencies", "clamped")
 
 
 def _testbed_row(s: Mapping) -> dict:
     """One instance's statistics in tab_testbed's columns (percentages as percent)."""
     cols = (*INSTANCE_SPREAD, "order_share", "order_share_random")
-    return {
-        c: 100 * s[PERCENT[c]] if c in PERCENT else int(s[c]) if c in COUNTS else s[c] for c in cols
-    }
+    return {c: 100 * s[PERCENT[c]] if c in PERCENT else s[c] for c in cols}
 
 
 def tab_testbed(
