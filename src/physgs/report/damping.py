@@ -78,12 +78,8 @@ def tab_damping(
                 f"tab_damping: the recovery of {t}/{v}/{c}{name} (seed {s}) has no "
                 "damping scores; re-run its recovery rule with damping params"
             )
-        return {
-            "tree": t,
-            "bones": bones[t],
-            "testbed": v,
-            "config": c,
-            "method": method,
+        about = {"tree": t, "bones": bones[t], "testbed": v, "config": c, "method": method}
+        return about | {
             "trusted": sc.n_trusted,
             "rel_err_pct": 100 * sc.median_rel_err,
             "null_rel_err_pct": 100 * nl.median_median_rel_err,

@@ -55,12 +55,8 @@ def tab_kselect(
         r = per_seed[s][(t, m, c)]
         select_s = float(r["select_s"]) if c == "auto" else np.nan
         fixed_s = float(per_seed[s][(t, m, "single")]["train_s"])
-        return {
-            "tree": t,
-            "bones": bones[t],
-            "model": m,
-            "config": c,
-            "K": int(r["K"]),
+        about = {"tree": t, "bones": bones[t], "model": m, "config": c, "K": int(r["K"])}
+        return about | {
             "view_psnr_db": r["view_psnr"],
             "time_psnr_db": r["time_psnr"],
             "median_rel_err_pct": 100 * r["median_rel_err"],

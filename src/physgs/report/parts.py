@@ -164,17 +164,13 @@ def tab_parts(
     return Table("tab_parts", df, latex.render(cells, cap, "tab:parts"))
 
 
-def fig_parts(
-    records: Mapping[str, Mapping[str, np.ndarray]],
-    trees: Sequence[str],
-    outputs: Sequence[str],
-    title: str = "",
-) -> None:
+def fig_parts(records: Mapping, trees: Sequence[str], outputs: Sequence[str], title: str = ""):
     """One row per tree, one panel per model: its canonical Gaussians from the side (x, z; m),
     coloured by part, each pivot a black dot joined to its parent's; the title gives the purity.
 
     Args:
-        records: tree -> its parts record (``physgs.evaluate.parts.segmentation_record``).
+        records: tree -> its parts record ({key: np.ndarray}:
+            ``physgs.evaluate.parts.segmentation_record``).
         trees: the trees, one row each.
         outputs: the paths to write (pdf, png).
         title: the figure's title.

@@ -97,12 +97,8 @@ def recovery_table(
                 f"model has K={m.n_parts}; re-run the null with the model's K"
             )
         tr, nu = 100 * m.median_rel_err, 100 * nl.median_median_rel_err
-        return {
-            "tree": t,
-            "bones": bones[t],
-            "config": c,
-            "method": method,
-            "K": m.n_parts,
+        about = {"tree": t, "bones": bones[t], "config": c, "method": method, "K": m.n_parts}
+        return about | {
             "trained_parts_trusted": float(m.n_trusted),
             "trained_median_rel_err_pct": tr,
             "trained_loglog_r2": m.loglog_r2,
