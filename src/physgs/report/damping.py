@@ -42,10 +42,7 @@ COLUMNS = (
 
 
 def tab_damping(
-    methods: Mapping[str, MethodRows],
-    trees: Sequence[str],
-    bones: Mapping[str, int],
-    digits: int = 2,
+    methods: Mapping[str, MethodRows], trees: Sequence, bones: Mapping, digits: int = 2
 ) -> Table:
     """Damping recovery per seed, tree, variant, method and configuration, beside the null.
 

@@ -213,12 +213,7 @@ def fig_parts(records: Mapping, trees: Sequence[str], outputs: Sequence[str], ti
 
 
 def tab_parts_k(
-    per_seed: Mapping[int, Mapping[str, Mapping]],
-    trees: Sequence[str],
-    bones: Mapping[str, int],
-    base_k: int,
-    tie_db: float,
-    digits: int = 2,
+    per_seed: Mapping, trees: Sequence, bones: Mapping, base_k: int, tie_db: float, digits: int = 2
 ) -> Table:
     """The smallest K at which the chained prior matches ours (``experiments.kmatch``).
 

@@ -61,11 +61,7 @@ LEADS = {
 
 
 def recovery_table(
-    name: str,
-    methods: Mapping[str, MethodRows],
-    trees: Sequence[str],
-    bones: Mapping[str, int],
-    digits: int = 2,
+    name: str, methods: Mapping[str, MethodRows], trees: Sequence, bones: Mapping, digits: int = 2
 ) -> Table:
     """Frequency recovery of each method against the untrained null, per tree and config.
 

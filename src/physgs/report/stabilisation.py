@@ -16,11 +16,7 @@ MIN_FREQ_AXIS_HZ = 3.0
 
 
 def fig_stabilisation(
-    idents: Mapping[str, object],
-    omega_bones: Mapping[str, np.ndarray],
-    trees: Sequence[str],
-    outputs: Sequence[str],
-    title: str = "",
+    idents: Mapping, omega_bones: Mapping, trees: Sequence, outputs: Sequence, title: str = ""
 ) -> None:
     """One column per tree: the poles (Hz against model order; filled where stable), the
     identified modes as lines with their 95% interval (+-1.96 sigma) above; below, the truth.
