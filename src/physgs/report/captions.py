@@ -1,12 +1,10 @@
-"""The caption of every figure the record shows: what it shows, how to read it, and the run's
-seeds it draws.
+"""The caption of every figure the record shows: what it shows, how to read it, and its seeds.
 
-What a figure shows and how to read it is written here once per figure (it describes the drawing
-code, not a result); which seeds it draws comes from the output's declaration
-(``physgs.report.outputs.OUTPUTS[name].seeds``; the caption's own ``seeds`` for the figures the
-workflow draws outside the report's outputs) and the record's stamp, so a caption never retypes a number of the
-run. ``FIGURES`` orders the figures as a results section reads them: the headline comparison
-first, the testbed last.
+What a figure shows and how to read it is written once per figure here (it describes the drawing
+code, not a result); its seeds come from its output's declaration
+(``physgs.report.outputs.OUTPUTS[name].seeds``, else the caption's own ``seeds``) and the record's
+stamp, so a caption never retypes a number of the run. ``FIGURES`` orders the figures as a
+results section reads them: the headline comparison first, the testbed last.
 """
 
 from __future__ import annotations
@@ -20,16 +18,9 @@ from physgs.report.outputs import OUTPUTS
 
 @dataclass(frozen=True)
 class Caption:
-    """One figure's caption text.
-
-    Attributes:
-        pattern: the figure's name, ``{tree}`` standing for a tree (one figure per tree).
-        title: a few words naming the figure.
-        shows: what is drawn, every colour, band, line and unit.
-        read: how to read it: what a reader looks for.
-        seeds: which training seeds it draws when it is not one of the report's outputs
-            (``physgs.report.output.SEEDS``; the testbed figures: ``none``).
-    """
+    """One figure's caption: ``pattern`` its name (``{tree}`` standing for a tree), ``title`` a
+    few words, ``shows`` what is drawn (every colour, band, line and unit), ``read`` how to read
+    it, ``seeds`` its seed scope when it is not a report output (``physgs.report.output.SEEDS``)."""
 
     pattern: str
     title: str
@@ -38,19 +29,10 @@ class Caption:
     seeds: str = "first"
 
     def match(self, name: str) -> str | None:
-        """The tree of ``name`` when it is this figure ('' for a figure of all trees).
-
-        Args:
-            name: a figure's file stem.
-
-        Returns:
-            The tree, '' when the pattern has none, None when ``name`` is another figure.
-        """
+        """The tree of figure ``name`` ('' for a figure of all trees), None for another figure."""
         rx = "^" + re.escape(self.pattern).replace(r"\{tree\}", "(?P<tree>[a-z0-9_]+?)") + "$"
         m = re.match(rx, name)
-        if m is None:
-            return None
-        return m.groupdict().get("tree") or ""
+        return None if m is None else m.groupdict().get("tree") or ""
 
 
 #: The figures in reading order.
@@ -59,10 +41,11 @@ FIGURES: tuple[Caption, ...] = (
         "fig_temporal",
         "PSNR over time at the training camera",
         "Per-frame PSNR (dB) of each model's render at the training camera and the training wind, "
-        "one panel per tree: each model's mean over the seeds as a line, a band of its colour from "
-        "its lowest to its highest seed; the dashed grey line is the static pose, the black dotted "
-        "line the true-motion ceiling (the renderer driven by the true motion). The grey shaded "
-        "region right of the dotted vertical line is beyond the training window (the time split).",
+        "one panel per tree: each model's mean over the seeds as a line, a band of its colour "
+        "from its lowest to its highest seed; the dashed grey line is the static pose, the black "
+        "dotted line the true-motion ceiling (the renderer driven by the true motion). The grey "
+        "shaded region right of the dotted vertical line is beyond the training window (the time "
+        "split).",
         "In the shaded region a model above the dashed static pose extrapolates the motion; one "
         "below it does worse than standing still.",
     ),
@@ -81,9 +64,9 @@ FIGURES: tuple[Caption, ...] = (
         "A branch tip and the canopy centroid",
         "Top: the path in the image (x, y in px; y down) of the branch tip the ground truth moves "
         "most, for the ground truth and each model drawn: grey through the training window, blue "
-        "beyond it, the ground truth dotted beside each model. Bottom: the canopy centroid's error "
-        "(px) per frame at the training wind and at an unseen wind, each model's mean in its key; "
-        "the dotted vertical line ends the training window.",
+        "beyond it, the ground truth dotted beside each model. Bottom: the canopy centroid's "
+        "error (px) per frame at the training wind and at an unseen wind, each model's mean in "
+        "its key; the dotted vertical line ends the training window.",
         "A model that tracks the motion keeps its blue path on the dotted ground truth and its "
         "error flat after the window.",
     ),
@@ -93,12 +76,12 @@ FIGURES: tuple[Caption, ...] = (
         "The damping benchmark. Left: each part's recovered damping ratio (no unit) per tree "
         "(colour), configuration (marker) and prior (filled: ours; hollow: the chained prior), "
         "jittered sideways for display; the black bar is the median of its group, the dashed line "
-        "the true damping ratio, a row of points at the top sits on the fitting bound (the largest "
-        "damping ratio the fit may take, `models.ours.zeta` in config/trees.yaml; dotted, its "
-        "value in the key): those parts ran into the bound, so their damping is not estimated. "
-        "Right: each part's decay rate (damping ratio times natural "
-        "frequency, 1/s) against its natural frequency (rad/s), both axes logarithmic; the dashed "
-        "line is the truth (decay rate = true damping ratio x frequency).",
+        "the true damping ratio, a row of points at the top sits on the fitting bound (the "
+        "largest damping ratio the fit may take, `models.ours.zeta` in config/trees.yaml; dotted, "
+        "its value in the key): those parts ran into the bound, so their damping is not "
+        "estimated. Right: each part's decay rate (damping ratio times natural frequency, 1/s) "
+        "against its natural frequency (rad/s), both axes logarithmic; the dashed line is the "
+        "truth (decay rate = true damping ratio x frequency).",
         "Points on the dashed lines recover damping; a cloud above them over-damps. A cloud "
         "steeper or flatter than the dashed line on the right has the wrong dependence on "
         "frequency.",
@@ -106,11 +89,11 @@ FIGURES: tuple[Caption, ...] = (
     Caption(
         "fig_parts",
         "The priors' parts",
-        "Each tree's canonical Gaussians seen from the side (x right, height z up, metres), coloured "
-        "by their part in each prior's segmentation (one panel per prior); each part's pivot is a "
-        "black dot, joined to its parent's pivot where the prior chains its parts. Each panel's "
-        "title gives the segmentation's purity (share of Gaussians in their part's majority "
-        "bone).",
+        "Each tree's canonical Gaussians seen from the side (x right, height z up, metres), "
+        "coloured by their part in each prior's segmentation (one panel per prior); each part's "
+        "pivot is a black dot, joined to its parent's pivot where the prior chains its parts. "
+        "Each panel's title gives the segmentation's purity (share of Gaussians in their part's "
+        "majority bone).",
         "Parts that follow the branches (high purity) can move as the bones do; parts that cut "
         "across branches mix bones of different frequencies.",
     ),
@@ -128,10 +111,10 @@ FIGURES: tuple[Caption, ...] = (
     Caption(
         "fig_stabilisation",
         "Output-only modal analysis",
-        "Each tree's stabilisation diagram of its training window (one column a tree): every "
-        "pole found (frequency in Hz, horizontal) at every model order tried (vertical), blue "
-        "where stable across orders, grey where not; the identified modes as red vertical lines, "
-        "each with its 95% frequency interval (Hz) as an error bar along the top. The strip below "
+        "Each tree's stabilisation diagram of its training window (one column a tree): every pole "
+        "found (frequency in Hz, horizontal) at every model order tried (vertical), blue where "
+        "stable across orders, grey where not; the identified modes as red vertical lines, each "
+        "with its 95% frequency interval (Hz) as an error bar along the top. The strip below "
         "marks the bones' true frequencies (Hz); they are drawn, never used to select a mode.",
         "Columns of stable poles are modes the video shows; where they sit over the strip's "
         "ticks, the analysis finds the bones' frequencies without a model of the tree.",
@@ -156,9 +139,9 @@ FIGURES: tuple[Caption, ...] = (
         "side, iterations, RK4 substeps, K, Gaussians). Left: PSNR on the time split (dB) against "
         "the wall time per point (s, log); right: the median relative omega error over trusted "
         "parts (%) against the same time. One line per knob through its values, points the mean "
-        "over the seeds with the sd as error bars on both axes; the profile's setting starred. "
-        "On the right, the untrained null of the profile's K: its median (line) and the central "
-        "95% of its draws (band).",
+        "over the seeds with the sd as error bars on both axes; the profile's setting starred. On "
+        "the right, the untrained null of the profile's K: its median (line) and the central 95% "
+        "of its draws (band).",
         "A knob whose line climbs to the left buys accuracy cheaply; a recovery point inside the "
         "null's band is chance.",
     ),
@@ -167,11 +150,10 @@ FIGURES: tuple[Caption, ...] = (
         "Fit against training budget",
         "Each model trained at each budget, a row of panels per tree: the in-window fit PSNR (dB, "
         "trained frames) and the time-split PSNR (dB, the tail) against training iterations "
-        "(log), and "
-        "the fit against training wall time (s, log); points the mean over the seeds, error bars "
-        "the sd. The static pose (dashed) and the true-motion ceiling (dotted) at the profile's "
-        "budget are horizontal lines; the profile's budget is starred; a field trained with "
-        "Deformable-3DGS's window-normalised time is drawn as open diamonds in its colour.",
+        "(log), and the fit against training wall time (s, log); points the mean over the seeds, "
+        "error bars the sd. The static pose (dashed) and the true-motion ceiling (dotted) at the "
+        "profile's budget are horizontal lines; the profile's budget is starred; a field trained "
+        "with Deformable-3DGS's window-normalised time is drawn as open diamonds in its colour.",
         "A curve still climbing at the profile's budget means that model is under-trained there; "
         "one flat across budgets has converged.",
     ),
@@ -202,8 +184,8 @@ FIGURES: tuple[Caption, ...] = (
 def find(name: str) -> tuple[int, Caption, str]:
     """The caption of figure ``name``, its place in ``FIGURES`` and its tree.
 
-    A per-tree pattern is tried after the plain names, the longer first, so that
-    ``testbed_medium_damping`` is the damping testbed's, not a tree ``medium_damping``.
+    Per-tree patterns are tried after the plain names, the longer first, so that
+    ``testbed_medium_damping`` is the damping testbed's, not a tree ``medium_damping``'s.
 
     Args:
         name: the figure's file stem.
@@ -214,48 +196,24 @@ def find(name: str) -> tuple[int, Caption, str]:
     Raises:
         KeyError: naming a figure without a caption.
     """
-    order = sorted(
+    for i in sorted(
         range(len(FIGURES)), key=lambda i: ("{" in FIGURES[i].pattern, -len(FIGURES[i].pattern))
-    )
-    for i in order:
+    ):
         tree = FIGURES[i].match(name)
         if tree is not None:
             return i, FIGURES[i], tree
     raise KeyError(f"figure {name!r} has no caption: add it to physgs.report.captions.FIGURES")
 
 
-def scope(caption: Caption) -> str:
-    """Which training seeds a figure draws (``physgs.report.output.SEEDS``).
-
-    Args:
-        caption: the figure's caption.
-
-    Returns:
-        The output's declared scope, or the caption's for a figure drawn outside the outputs.
-    """
-    return OUTPUTS[caption.pattern].seeds if caption.pattern in OUTPUTS else caption.seeds
-
-
-def seeds_phrase(what: str, seeds: Sequence[int]) -> str:
-    """The seeds a figure draws, in words.
-
-    Args:
-        what: the figure's seed scope (``all``, ``first``, ``studies``, ``none``).
-        seeds: the run's training seeds.
-
-    Returns:
-        E.g. ``mean over training seeds 0, 1, 2`` or ``training seed 0``.
-    """
-    seeds = list(seeds)
+def _seeds(what: str, seeds: list[int]) -> str:
+    """The seeds a figure of seed scope ``what`` draws, in words."""
+    if what == "all" and len(seeds) == 1:
+        return f"training seed {seeds[0]} (the run's one seed)"
     if what == "all":
-        if len(seeds) == 1:
-            return f"training seed {seeds[0]} (the run's one seed)"
         return f"mean over training seeds {', '.join(map(str, seeds))}"
     if what == "first":
         return f"training seed {seeds[0]} (the first of the run's {len(seeds)})"
-    if what == "none":
-        return "the testbed itself: no training seed"
-    return "the studies' seeds"
+    return "the testbed itself: no training seed" if what == "none" else "the studies' seeds"
 
 
 def caption(name: str, seeds: Sequence[int]) -> str:
@@ -269,10 +227,11 @@ def caption(name: str, seeds: Sequence[int]) -> str:
         One paragraph: title, what it shows, how to read it, its seeds.
     """
     _, c, tree = find(name)
-    fill = {"tree": tree}
+    what = OUTPUTS[c.pattern].seeds if c.pattern in OUTPUTS else c.seeds
+    title, shows, read = (s.format(tree=tree) for s in (c.title, c.shows, c.read))
     return (
-        f"**Figure: {c.title.format(**fill)}** (`{name}`). {c.shows.format(**fill)} "
-        f"*How to read it:* {c.read.format(**fill)} *Seeds:* {seeds_phrase(scope(c), seeds)}."
+        f"**Figure: {title}** (`{name}`). {shows} "
+        f"*How to read it:* {read} *Seeds:* {_seeds(what, list(seeds))}."
     )
 
 

@@ -1,8 +1,8 @@
-"""The studies of the trade's figures (the `studies` target): fig_speed_accuracy (the
-speed-accuracy sweep beside the untrained null's chance level), fig_fit_curve (each model's
-fit against its training budget) and fig_fit_vs_extrapolation (along each field's fit curve, its
-gain beyond the window against its in-window fit), each drawn from its study's CSV (rules
-``speed_accuracy`` and ``fit_curve`` collect the points into ``results/tables/<study>.csv``)."""
+"""The studies' trade figures (the `studies` target, never `report`): fig_speed_accuracy (the
+speed-accuracy sweep beside the untrained null's chance level), fig_fit_curve (each model's fit
+against its training budget) and fig_fit_vs_extrapolation (along each field's fit curve, its gain
+beyond the window against its in-window fit), each drawn from its study's CSV (the rules
+``speed_accuracy`` and ``fit_curve`` write ``results/tables/<study>.csv``)."""
 
 from __future__ import annotations
 
@@ -19,14 +19,14 @@ from physgs.report.output import Output
 SPEED_ACCURACY, FIT_CURVE = "speed_accuracy", "fit_curve"
 
 
-def _studies_only(plan) -> bool:
-    return False  # the `studies` target builds them (Snakefile), never `report`
+def _studies(name: str, needs, build, **kw) -> Output:
+    """A figure of the studies' seeds that the `studies` target builds (Snakefile)."""
+    return Output(name, "figure", needs, build, seeds="studies", in_report=lambda plan: False, **kw)
 
 
-# ---- fig_speed_accuracy --------------------------------------------------------------------
 def _speed_accuracy_needs(plan, seeds):
-    """The sweep's CSV and the untrained null of the sweep tree at the base configuration's K,
-    per study seed (the chance level the recovery panel draws)."""
+    """The sweep's CSV and, per study seed, the untrained null of the sweep tree at the base
+    configuration's K (the recovery panel's chance level)."""
     K = int(plan.configs[BASE_CONFIG]["K"])
     return [("table", SPEED_ACCURACY)] + [("null", plan.sweep_tree, K, int(s)) for s in seeds]
 
@@ -40,38 +40,12 @@ def _fig_speed_accuracy(path, settings, inputs, out):
     figures.fig_speed_accuracy(df, out, null=null)
 
 
-FIG_SPEED_ACCURACY = Output(
-    "fig_speed_accuracy",
-    "figure",
-    _speed_accuracy_needs,
-    _fig_speed_accuracy,
-    settings=lambda cfg: {
-        "tree": cfg["speed_accuracy"]["tree"],
-        "K": int(cfg["models"]["configs"][BASE_CONFIG]["K"]),
-    },
-    seeds="studies",
-    in_report=_studies_only,
-)
-
-
 def _fig_fit_curve(path, settings, inputs, out):
     from physgs.report import figures  # matplotlib: not for the workflow's planning imports
 
     figures.fig_fit_curve(pd.read_csv(path("table", FIT_CURVE)), out)
 
 
-# ---- fig_fit_curve -------------------------------------------------------------------------
-FIG_FIT_CURVE = Output(
-    "fig_fit_curve",
-    "figure",
-    lambda plan, seeds: [("table", FIT_CURVE)],
-    _fig_fit_curve,
-    seeds="studies",  # its CSV holds the studies' seeds' points
-    in_report=_studies_only,
-)
-
-
-# ---- fig_fit_vs_extrapolation --------------------------------------------------------------
 def fit_vs_extrapolation(df: pd.DataFrame, static: str = "static") -> pd.DataFrame:
     """Each fit-curve point's in-window fraction of the ceiling and its gain over the static pose
     beyond the window.
@@ -107,23 +81,18 @@ def draw_fit_vs_extrapolation(df: pd.DataFrame, outputs: Sequence[str]) -> None:
     from physgs.report.figures import COLORS, save_figure
     from physgs.report.thresholds import FIT_BAR
 
+    xy = ["of_ceiling", "beyond_gain"]
     trees = list(dict.fromkeys(df["tree"]))
     fig, axes = plt.subplots(1, len(trees), figsize=(4.6 * len(trees), 3.9), squeeze=False)
     for ax, tree in zip(axes[0], trees):
         t = df[(df["tree"] == tree) & ~df["model"].isin(REFERENCE_NAMES)]
         for m, g in t.groupby("model", sort=False):
-            color = COLORS.get(m.partition("@")[0])
+            field = m.partition("@")[0]
+            lab, color = label(field) + (" (window time)" if "@" in m else ""), COLORS.get(field)
             ax.plot(g["of_ceiling"], g["beyond_gain"], ".", color=color, alpha=0.3, ms=4)
-            mean = g.groupby("iterations")[["of_ceiling", "beyond_gain"]].mean()
-            ax.plot(
-                mean["of_ceiling"],
-                mean["beyond_gain"],
-                "-o",
-                color=color,
-                ms=3.5,
-                label=label(m.partition("@")[0]) + (" (window time)" if "@" in m else ""),
-            )
-            prof = g[g["is_profile"]][["of_ceiling", "beyond_gain"]].mean()
+            mean = g.groupby("iterations")[xy].mean()
+            ax.plot(mean["of_ceiling"], mean["beyond_gain"], "-o", color=color, ms=3.5, label=lab)
+            prof = g[g["is_profile"]][xy].mean()
             ax.plot(prof["of_ceiling"], prof["beyond_gain"], "*", color=color, ms=10)
         ax.axhline(0.0, color="0.55", ls="--", lw=1.0)
         ax.axvline(FIT_BAR, color="k", ls=":", lw=1.0)
@@ -145,11 +114,21 @@ def _fig_fit_vs_extrapolation(path, settings, inputs, out):
     draw_fit_vs_extrapolation(fit_vs_extrapolation(pd.read_csv(path("table", FIT_CURVE))), out)
 
 
-FIG_FIT_VS_EXTRAPOLATION = Output(
+FIG_SPEED_ACCURACY = _studies(
+    "fig_speed_accuracy",
+    _speed_accuracy_needs,
+    _fig_speed_accuracy,
+    settings=lambda cfg: {
+        "tree": cfg["speed_accuracy"]["tree"],
+        "K": int(cfg["models"]["configs"][BASE_CONFIG]["K"]),
+    },
+)
+# its CSV holds the studies' seeds' points
+FIG_FIT_CURVE = _studies(
+    "fig_fit_curve", lambda plan, seeds: [("table", FIT_CURVE)], _fig_fit_curve
+)
+FIG_FIT_VS_EXTRAPOLATION = _studies(
     "fig_fit_vs_extrapolation",
-    "figure",
     lambda plan, seeds: [("table", FIT_CURVE)],
     _fig_fit_vs_extrapolation,
-    seeds="studies",
-    in_report=_studies_only,
 )
