@@ -1,9 +1,8 @@
-"""Figures (the protocol, section 4-5): fig_temporal, fig_teaser, fig_results, fig_damping and the
-speed-accuracy sweep's fig_speed_accuracy.
+"""Figures (the protocol, section 4-5): fig_temporal, fig_teaser, fig_results, fig_damping, and
+the studies' fig_speed_accuracy and fig_fit_curve.
 
-Each ``fig_*`` takes collected results as arrays and a list of output paths; the suffix of a
-path picks its format (.pdf, .png), each written atomically. Matplotlib's Agg backend is used
-so nothing needs a display.
+Each ``fig_*`` takes collected results and a list of output paths; a path's suffix picks its
+format (.pdf, .png), each written atomically. Matplotlib's Agg backend: no display needed.
 """
 
 from __future__ import annotations
@@ -38,12 +37,10 @@ COLORS = {
 }
 GOOD, BAD = "#1a9850", "#f46d43"  # green where ours is best, orange where a baseline beats it
 WINDOW, TAIL = "0.6", "tab:blue"
-#: The documentation's content column, px: a figure wider than it is shown at this width
-#: (MkDocs Material in Chromium: 688 px at 1280-1440 px windows, where the contents sidebar shows;
-#: 911 px at 1200 px, where it folds away; the narrower is the one a figure must read at).
+#: The documentation's content column, px: MkDocs Material in Chromium shows 688 px at 1280-1440
+#: px windows (the contents sidebar shown), 911 px at 1200 px; a figure must read at the narrower.
 PAGE_WIDTH_PX = 688
-#: A figure drawn this wide (inches) shows one point as one pixel on the page; fonts of
-#: ``FONT_PT`` points then read at ``FONT_PT`` px.
+#: A figure this wide (inches) shows one point as one pixel on the page: ``FONT_PT`` reads as px.
 PAGE_WIDTH_IN = PAGE_WIDTH_PX / 72
 FONT_PT = 9.0
 
@@ -95,18 +92,9 @@ def best_baseline(
     return max(cands, key=cands.get)
 
 
-# --------------------------------------------------------------------------------------------
-
-
 def _legend_below(fig, handles: list, *, ncol: int, top: float) -> None:
-    """The figure's key below its panels, never over the data: the panels keep the top 80%.
-
-    Args:
-        fig: the figure, its panels drawn.
-        handles: the key's entries.
-        ncol: entries per row.
-        top: where the key's top sits, in figure fractions (below 0.2).
-    """
+    """The figure's key below its panels (its top at ``top`` < 0.2, in figure fractions), never
+    over the data: the panels keep the top 80%."""
     fig.tight_layout(rect=(0, 0.2, 1, 1))
     fig.legend(
         handles=handles,
@@ -118,6 +106,15 @@ def _legend_below(fig, handles: list, *, ncol: int, top: float) -> None:
     )
 
 
+def _plain_log(axis, locator=None) -> None:
+    """Plain-number labels on a log axis (10^x labels collide on a short one), none on minor
+    ticks; ``locator`` sets the major ticks first."""
+    if locator is not None:
+        axis.set_major_locator(locator)
+    axis.set_major_formatter(ScalarFormatter())
+    axis.set_minor_formatter(NullFormatter())
+
+
 def fig_temporal(
     curves: Mapping[tuple[str, str], np.ndarray],
     trees: Sequence[str],
@@ -125,11 +122,9 @@ def fig_temporal(
     outputs: Sequence[str | Path],
     models: Sequence[str] = MODELS,
 ) -> None:
-    """Per-frame PSNR (dB) at the training camera and wind, one panel per tree.
-
-    The mean over seeds is drawn, with a band from the lowest to the highest seed when there are
-    several. The window boundary (after frame n_train) is marked and the tail shaded. A reference
-    present in ``curves`` (the true-motion ceiling) is drawn as a thin black dotted line.
+    """Per-frame PSNR (dB) at the training camera and wind, one panel per tree: each model's mean
+    over seeds (a band from the lowest to the highest seed when there are several), a reference
+    in ``curves`` (the true-motion ceiling) black dotted, the tail after frame n_train shaded.
 
     Args:
         curves: ``curves[(tree, model)]``: [S, F] PSNR (dB) over recorded frames 1..F, one row per
@@ -155,14 +150,8 @@ def fig_temporal(
             Y = np.atleast_2d(np.asarray(curves[(t, m)], dtype=np.float64))  # [S, F]
             n_seeds, y = len(Y), Y.mean(0)
             x = np.arange(1, len(y) + 1)
-            ax.plot(
-                x,
-                y,
-                color=COLORS.get(m),
-                lw=1.4 if spec_of(m).role == "prior" else 0.8,
-                ls="--" if m == "static" else "-",
-                label=label(m),
-            )
+            lw, ls = 1.4 if spec_of(m).role == "prior" else 0.8, "--" if m == "static" else "-"
+            ax.plot(x, y, color=COLORS.get(m), lw=lw, ls=ls, label=label(m))
             if len(Y) > 1:  # the seeds' spread
                 ax.fill_between(x, Y.min(0), Y.max(0), color=COLORS.get(m), alpha=0.2, lw=0)
         for m in REFERENCE_NAMES:
@@ -176,7 +165,7 @@ def fig_temporal(
         ax.set_xlim(1, len(y))
         ax.tick_params(labelsize=FONT_PT)
     axes[0, 0].set_ylabel("PSNR (dB)", fontsize=FONT_PT)
-    handles, labels_ = axes[0, 0].get_legend_handles_labels()
+    handles, _ = axes[0, 0].get_legend_handles_labels()
     handles.append(Patch(color="0.9", label=f"beyond the training window (after frame {n_train})"))
     if n_seeds > 1:
         handles.append(Patch(color="0.5", alpha=0.3, label=f"lowest to highest of {n_seeds} seeds"))
@@ -184,7 +173,6 @@ def fig_temporal(
     save_figure(fig, outputs)
 
 
-# --------------------------------------------------------------------------------------------
 def fig_teaser(
     trajectories: Mapping[str, object],
     centroid_err: Mapping[str, np.ndarray],
@@ -226,10 +214,9 @@ def fig_teaser(
         ax = fig.add_subplot(gs[0, 2 * i : 2 * i + 2])
         if i:
             ax.plot(gt[:, 0], gt[:, 1], color="k", lw=0.5, ls=":", label="ground truth")
+        tail = p[n_train - 1 :]
         ax.plot(p[:n_train, 0], p[:n_train, 1], color=WINDOW, lw=0.9, label="training window")
-        ax.plot(
-            p[n_train - 1 :, 0], p[n_train - 1 :, 1], color=TAIL, lw=1.4, label="beyond the window"
-        )
+        ax.plot(tail[:, 0], tail[:, 1], color=TAIL, lw=1.4, label="beyond the window")
         ax.set_xlim(lims[0], lims[1])
         ax.set_ylim(lims[2], lims[3])  # image y points down
         ax.set_aspect("equal", adjustable="box")
@@ -242,22 +229,13 @@ def fig_teaser(
             ax.legend(fontsize=FONT_PT, loc="upper left", bbox_to_anchor=(1.02, 1.0), frameon=False)
     unseen = unseen % len(conditions)
     half = len(panels)
-    for j, (c, lab) in enumerate(
-        [
-            (0, "training wind"),
-            (unseen, f"unseen wind {condition_label(conditions[unseen], tex=False)}"),
-        ]
-    ):
+    unseen_wind = f"unseen wind {condition_label(conditions[unseen], tex=False)}"
+    for j, (c, lab) in enumerate([(0, "training wind"), (unseen, unseen_wind)]):
         ax = fig.add_subplot(gs[1, j * half : (j + 1) * half])
         for m in models:
             e = np.asarray(centroid_err[m])[c]
-            ax.plot(
-                np.arange(1, len(e) + 1),
-                e,
-                color=COLORS.get(m),
-                lw=1.0,
-                label=f"{label(m)} (mean {e.mean():.1f} px)",
-            )
+            key = f"{label(m)} (mean {e.mean():.1f} px)"
+            ax.plot(np.arange(1, len(e) + 1), e, color=COLORS.get(m), lw=1.0, label=key)
         ax.axvline(n_train + 0.5, color="k", lw=0.8, ls=":")
         ax.set_title(f"canopy-centroid error, {lab}", fontsize=FONT_PT)
         ax.set_xlabel("frame", fontsize=FONT_PT)
@@ -271,7 +249,6 @@ def fig_teaser(
     save_figure(fig, outputs)
 
 
-# --------------------------------------------------------------------------------------------
 def fig_results(
     rows: Sequence[str],
     columns: Sequence[str],
@@ -279,10 +256,8 @@ def fig_results(
     outputs: Sequence[str | Path],
     ours: str = "ours",
 ) -> None:
-    """Qualitative grid: one row per (tree, split) label, one column per model (or 'gt').
-
-    PSNR is printed on each panel, green on ours where it is best in its row and orange on a
-    baseline that beats ours.
+    """Qualitative grid: one row per (tree, split) label, one column per model (or 'gt'); each
+    panel's PSNR printed, green on ours where best in its row, orange on a baseline beating ours.
 
     Args:
         rows: the row labels.
@@ -297,11 +272,9 @@ def fig_results(
     """
     side = PAGE_WIDTH_IN / (len(columns) + 0.3)  # one panel, inches; the row labels beside
     fig, axes = plt.subplots(
-        len(rows),
-        len(columns),
-        figsize=(PAGE_WIDTH_IN, side * len(rows) + 0.5),
-        squeeze=False,
+        len(rows), len(columns), figsize=(PAGE_WIDTH_IN, side * len(rows) + 0.5), squeeze=False
     )
+    box = dict(facecolor="white", alpha=0.8, lw=0, pad=1)
     for i, r in enumerate(rows):
         scores = {c: images[(r, c)][1] for c in columns if images[(r, c)][1] is not None}
         ours_score = scores.get(ours)
@@ -320,16 +293,9 @@ def fig_results(
                         color = GOOD
                     elif c != ours and score > ours_score:
                         color = BAD
-                ax.text(
-                    0.03,
-                    0.03,
-                    f"{score:.1f} dB",
-                    transform=ax.transAxes,
-                    fontsize=FONT_PT,
-                    color=color,
-                    fontweight="bold" if color != "k" else "normal",
-                    bbox=dict(facecolor="white", alpha=0.8, lw=0, pad=1),
-                )
+                weight = "bold" if color != "k" else "normal"
+                kw = dict(fontsize=FONT_PT, color=color, fontweight=weight, bbox=box)
+                ax.text(0.03, 0.03, f"{score:.1f} dB", transform=ax.transAxes, **kw)
             if i == 0:
                 name = "Ground truth" if c == "gt" else label(c)
                 ax.set_title(textwrap.fill(name, 12), fontsize=FONT_PT)
@@ -339,7 +305,6 @@ def fig_results(
     save_figure(fig, outputs)
 
 
-# --------------------------------------------------------------------------------------------
 def fig_damping(
     damping: Mapping[str, Mapping[tuple[str, str], object]],
     trees: Sequence[str],
@@ -348,15 +313,14 @@ def fig_damping(
     outputs: Sequence[str | Path],
     zeta_bound: float | None = None,
 ) -> None:
-    """Left: zeta_hat per part for each tree and config against the true ratio (line) and the
+    """Left: zeta_hat per part for each tree and config against the true ratio (dashed) and the
     fit's upper bound on zeta (dotted: a part there is pinned to the bound, not estimated).
     Right: decay rate gamma_hat = zeta_hat * omega_hat (1/s) against omega_hat (rad/s), log-log,
     with the ground-truth line gamma = zeta_true * omega.
 
     Args:
         damping (Mapping): each prior's ``DampingResult`` per ``(tree, config)``, by model id in
-            drawing order: ours' (filled markers), then the others' beside it (hollow markers
-            on the right).
+            drawing order: ours' (filled markers), then the others' (hollow markers).
         trees (Sequence[str]): the trees, in column order.
         configs (Sequence[str]): the configurations, in column order.
         zeta_true (float): the testbed's damping ratio.
@@ -392,11 +356,10 @@ def fig_damping(
                 d = damping[model][(t, c)]
                 pos = i * (per_tree + 1) + j * len(models) + k  # a gap between trees
                 jitter = np.random.default_rng(pos).uniform(-0.2, 0.2, len(d.zeta))  # display
-                a0.scatter(
-                    pos + jitter, d.zeta, s=7, marker=markers[c], alpha=0.5, **style(model, t)
-                )
+                look = style(model, t)
+                a0.scatter(pos + jitter, d.zeta, s=7, marker=markers[c], alpha=0.5, **look)
                 a0.plot([pos - 0.35, pos + 0.35], [d.median_zeta] * 2, color="k", lw=1.5)
-                a1.scatter(d.omega, d.gamma, s=9, marker=markers[c], alpha=0.6, **style(model, t))
+                a1.scatter(d.omega, d.gamma, s=9, marker=markers[c], alpha=0.6, **look)
                 allw.append(d.omega)
     a0.axhline(zeta_true, color="k", ls="--", lw=0.8)
     if zeta_bound is not None:
@@ -410,10 +373,8 @@ def fig_damping(
     a1.plot(grid, zeta_true * grid, "k--", lw=1)
     a1.set_xscale("log")
     a1.set_yscale("log")
-    for axis in (a1.xaxis, a1.yaxis):  # plain numbers: 10^x labels collide on a short log axis
-        axis.set_major_locator(LogLocator(base=10, subs=(1.0, 2.0, 5.0)))
-        axis.set_major_formatter(ScalarFormatter())
-        axis.set_minor_formatter(NullFormatter())
+    for axis in (a1.xaxis, a1.yaxis):
+        _plain_log(axis, LogLocator(base=10, subs=(1.0, 2.0, 5.0)))
     a1.set_xlabel(r"$\hat\omega_p$ (rad/s)", fontsize=FONT_PT)
     a1.set_ylabel(r"$\hat\gamma_p = \hat\zeta_p\hat\omega_p$ (1/s)", fontsize=FONT_PT)
     a1.set_title("decay rate against natural frequency", fontsize=FONT_PT)
@@ -426,23 +387,12 @@ def fig_damping(
         Line2D([], [], ls="", marker=markers[c], color=grey, label=c, markersize=5) for c in configs
     ]
     # the prior's key is a swatch, not a marker: a filled circle would also read as a config's
-    handles += [
-        Patch(
-            facecolor=grey if m == models[0] else "none",
-            edgecolor=grey,
-            label=label(m) + (": filled markers" if m == models[0] else ": hollow markers"),
-        )
-        for m in models
-    ]
-    handles.append(
-        Line2D(
-            [],
-            [],
-            color="k",
-            ls="--",
-            label=rf"truth $\zeta$ = {zeta_true} ($\gamma = \zeta\omega$)",
-        )
-    )
+    for m in models:
+        filled = m == models[0]
+        key = label(m) + (": filled markers" if filled else ": hollow markers")
+        handles.append(Patch(facecolor=grey if filled else "none", edgecolor=grey, label=key))
+    truth = rf"truth $\zeta$ = {zeta_true} ($\gamma = \zeta\omega$)"
+    handles.append(Line2D([], [], color="k", ls="--", label=truth))
     if zeta_bound is not None:
         handles.append(
             Line2D([], [], color="0.4", ls=":", label=rf"fitting bound $\zeta$ = {zeta_bound:g}")
@@ -451,7 +401,6 @@ def fig_damping(
     save_figure(fig, outputs)
 
 
-# --------------------------------------------------------------------------------------------
 def _seed_mean(df: pd.DataFrame, by: list[str], cols: Sequence[str]) -> pd.DataFrame:
     """Mean and sd (ddof 1; 0 with one seed) of ``cols`` over seeds per ``by`` group, as columns
     <col> and <col>_sd, groups in first-seen order."""
@@ -463,8 +412,8 @@ def _seed_mean(df: pd.DataFrame, by: list[str], cols: Sequence[str]) -> pd.DataF
 
 
 def _seed_errorbar(ax, g: pd.DataFrame, x: str, y: str, bars: bool, xbars: bool = True, **style):
-    """One series of ``_seed_mean``'s means, ``y`` against ``x``, the seeds' sd as error bars
-    (``bars``: more than one seed; ``xbars``: on ``x`` too)."""
+    """``y`` against ``x`` of ``_seed_mean``'s rows, the seeds' sd as error bars (``bars``: more
+    than one seed; ``xbars``: on ``x`` too)."""
     yerr = g[f"{y}_sd"] if bars else None
     ax.errorbar(
         g[x], g[y], yerr=yerr, xerr=g[f"{x}_sd"] if bars and xbars else None, capsize=2, **style
@@ -484,18 +433,16 @@ def _save_sweep(fig, axes, head: str, n_seeds: int, outputs: Sequence[str | Path
 def fig_speed_accuracy(
     df: pd.DataFrame, outputs: Sequence[str | Path], null: Mapping[str, float] | None = None
 ) -> None:
-    """Two panels against wall time (s): PSNR on the time split (dB) and recovery error (%).
-
-    One line per knob through its values (labelled, mean over seeds; error bars: sd over seeds on
-    both axes), the base point starred.
+    """Two panels against wall time (s): PSNR on the time split (dB) and recovery error (%); one
+    line per knob through its values (mean over seeds, sd error bars on both axes), the base
+    point starred.
 
     Args:
         df: [`sweep.collect`][physgs.experiments.sweep.collect] (one row per seed, knob and
             value).
         outputs: the paths to write.
-        null: [`null_level`][physgs.experiments.sweep.null_level]; the untrained null's median and
-            the central 95% of its draws are drawn on the recovery panel, so a point inside the
-            band reads as chance.
+        null: [`null_level`][physgs.experiments.sweep.null_level]: the untrained null's median and
+            the central 95% of its draws, drawn on the recovery panel (a point inside: chance).
     """
     n_seeds = df["seed"].nunique()
     m = _seed_mean(
@@ -505,51 +452,28 @@ def fig_speed_accuracy(
     )
     fig, axes = plt.subplots(1, 2, figsize=(10, 4))
     colors = {k: f"C{i}" for i, k in enumerate(sorted(m["knob"].unique()))}
+    panels = ((axes[0], "psnr_time"), (axes[1], "rel_pct"))
     for knob, g in m.groupby("knob", sort=False):
         g = g.sort_values("value")
-        for ax, col in ((axes[0], "psnr_time"), (axes[1], "rel_pct")):
-            _seed_errorbar(
-                ax,
-                g,
-                "wall_s",
-                col,
-                n_seeds > 1,
-                fmt="-o",
-                ms=3.5,
-                lw=1.0,
-                color=colors[knob],
-                label=knob,
-            )
+        for ax, col in panels:
+            style = dict(fmt="-o", ms=3.5, lw=1.0, color=colors[knob], label=knob)
+            _seed_errorbar(ax, g, "wall_s", col, n_seeds > 1, **style)
             for _, r in g.iterrows():
-                ax.annotate(
-                    str(int(r["value"])),
-                    (r["wall_s"], r[col]),
-                    fontsize=6,
-                    xytext=(3, 3),
-                    textcoords="offset points",
-                    color=colors[knob],
-                )
+                kw = dict(fontsize=6, xytext=(3, 3), textcoords="offset points", color=colors[knob])
+                ax.annotate(str(int(r["value"])), (r["wall_s"], r[col]), **kw)
     base = m[m["is_base"]].iloc[0]
-    for ax, col in ((axes[0], "psnr_time"), (axes[1], "rel_pct")):
+    for ax, col in panels:
         ax.plot([base["wall_s"]], [base[col]], "k*", ms=11, label="profile setting")
         ax.set_xscale("log")
         ax.set_xlabel("wall time per point (s, log)")
         ax.grid(alpha=0.3)
     if null is not None and np.isfinite(null.get("median", np.nan)):
-        axes[1].axhline(
-            100 * null["median"],
-            color="0.3",
-            ls="--",
-            lw=1.0,
-            label=f"untrained null, K={null.get('K', '?')} (median)",
-        )
+        K, draws = null.get("K", "?"), null["draws"]
+        median = f"untrained null, K={K} (median)"
+        axes[1].axhline(100 * null["median"], color="0.3", ls="--", lw=1.0, label=median)
+        band = f"null: central 95% of {draws} draws"
         axes[1].axhspan(
-            100 * null["low"],
-            100 * null["high"],
-            color="0.6",
-            alpha=0.25,
-            lw=0,
-            label=f"null: central 95% of {null['draws']} draws",
+            100 * null["low"], 100 * null["high"], color="0.6", alpha=0.25, lw=0, label=band
         )
         axes[1].legend(fontsize=7)
     axes[0].set_ylabel("PSNR, time split (dB)")
@@ -559,14 +483,14 @@ def fig_speed_accuracy(
 
 
 def fig_fit_curve(df: pd.DataFrame, outputs: Sequence[str | Path]) -> None:
-    """The fit curve ([`physgs.experiments.fit_curve`][physgs.experiments.fit_curve]): three panels
-    per tree (a row each), one line per model.
+    """The fit curve ([`physgs.experiments.fit_curve`][physgs.experiments.fit_curve]): a row of
+    three panels per tree, one line per model.
 
     In-window fit PSNR (dB, trained frames) and time-split PSNR (dB, the tail) against training
-    iterations, and the fit against training wall time (s). Points are means over seeds, error
+    iterations, and the fit against training wall time (s); points the mean over seeds, error
     bars the sd. The static pose and the true-motion ceiling at the profile's budget are
-    horizontal lines; the profile's budget is starred. A ``<field>@window`` series (the field with
-    Deformable-3DGS's window-normalised time) is drawn as open diamonds in its field's colour.
+    horizontal lines, the profile's budget starred; a ``<field>@window`` series (the field with
+    Deformable-3DGS's window-normalised time) is open diamonds in its field's colour.
 
     Args:
         df: [`fit_curve.collect`][physgs.experiments.fit_curve.collect] (one row per seed, model
@@ -592,19 +516,23 @@ def fig_fit_curve(df: pd.DataFrame, outputs: Sequence[str | Path]) -> None:
                     continue
                 g = g.sort_values("iterations")
                 base, _, variant = m.partition("@")  # <field>@window: the diagnostic series
+                fmt, mfc, ms = ("D", "none", 6) if variant else ("-o", None, 3.5)
+                color, lw = COLORS.get(base), 1.6 if m == "ours" else 1.0
+                lab = label(base) + (f" ({variant} time)" if variant else "")
+                # xbars: none on the budgets themselves (no spread)
                 _seed_errorbar(
                     ax,
                     g,
                     x,
                     y,
                     n_seeds > 1,
-                    xbars=x != "iterations",  # the budgets themselves: no spread
-                    fmt="-o" if not variant else "D",
-                    mfc=None if not variant else "none",
-                    ms=3.5 if not variant else 6,
-                    color=COLORS.get(base),
-                    lw=1.6 if m == "ours" else 1.0,
-                    label=label(base) + (f" ({variant} time)" if variant else ""),
+                    x != "iterations",
+                    fmt=fmt,
+                    mfc=mfc,
+                    ms=ms,
+                    color=color,
+                    lw=lw,
+                    label=lab,
                 )
                 p = g[g["is_profile"]]
                 ax.plot(p[x], p[y], "*", ms=10, color=COLORS.get(m))
@@ -614,10 +542,8 @@ def fig_fit_curve(df: pd.DataFrame, outputs: Sequence[str | Path]) -> None:
             ax.set_xscale("log")
             if x == "iterations":  # tick the budgets themselves, not powers of ten
                 ax.set_xticks(budgets)
-            else:  # seconds span under a decade: 1-2-5 ticks as plain numbers, minor labels overlap
-                ax.xaxis.set_major_locator(LogLocator(subs=(1.0, 2.0, 5.0)))
-            ax.xaxis.set_major_formatter(ScalarFormatter())
-            ax.xaxis.set_minor_formatter(NullFormatter())
+            # seconds span under a decade: 1-2-5 ticks as plain numbers, minor labels overlap
+            _plain_log(ax.xaxis, None if x == "iterations" else LogLocator(subs=(1.0, 2.0, 5.0)))
             ax.set_xlabel(xlabel)
             ax.set_ylabel(ylabel if len(trees) == 1 else f"{tree}: {ylabel}")
             ax.grid(alpha=0.3)

@@ -1,7 +1,7 @@
 """The outputs that score rendered images: the tables tab_psnr, tab_fit, tab_transfer and
-tab_margin (their builders here) and the figures fig_temporal, fig_teaser and fig_results
-(drawn by ``physgs.report.figures``), each declared here. Each reads the evaluations of the
-models of its roles, trained in the base configuration."""
+tab_margin (built here) and the figures fig_temporal, fig_teaser and fig_results (drawn by
+``physgs.report.figures``), each declared here. Each reads the evaluations of the models of its
+roles, trained in the base configuration."""
 
 from __future__ import annotations
 
@@ -10,54 +10,45 @@ from typing import Mapping, Sequence
 import numpy as np
 import pandas as pd
 
+from physgs.evaluate.metrics import ceiling_fraction
 from physgs.evaluate.splits import load_eval
 from physgs.evaluate.trajectories import load_trajectories
 from physgs.experiments.recipe import heldout_split
-from physgs.evaluate.metrics import ceiling_fraction
 from physgs.models.registry import BASE_CONFIG, BLIND_CONFIG, MODEL_NAMES, blind_priors
 from physgs.models.registry import label, models_of, spec_of
 from physgs.report import latex, paper
 from physgs.report import seeds as seedstats
 from physgs.report.claim_cells import roles_of
 from physgs.report.output import Columns, Output
-from physgs.report.tables import (
-    Table,
-    condition_label,
-    seed_rows,
-    seeds_of,
-    tree_index,
-    tree_label,
-)
+from physgs.report.tables import Table, condition_label, seed_rows, seeds_of, tree_index
+from physgs.report.tables import tree_label
 
 #: the roles of the methods compared on images, and of the references shown beside them
-METHODS = ("control", "field", "prior")
-REFERENCES = ("reference",)
+METHODS, REFERENCES = ("control", "field", "prior"), ("reference",)
 #: tab_margin: the wind-conditioned field every prior's margin is taken against
 MARGIN_BASELINE = "mlp_wind"
+#: a .tex cell that a method does not define (a forcing-free prior beyond the window): never 0
+NOT_DEFINED = "n/d"
+#: tab_psnr's difference rows: ``<prior>-static`` and ``<prior>-best_field`` (the best learned
+#: field, per seed and column)
+PSNR_MINUS, BEST_FIELD = "-", "best_field"
+#: a family heading over the learned fields' columns of tab_transfer
+FAMILY_HEADS = {"mlp": "Deformation MLP", "d3dgs": "Deformable-3DGS"}
+SPLITS = ("view", "time")
 
 
-def _evals(kinds: Sequence[str], roles: Sequence[str]):
-    """needs(plan, seeds): ``kinds`` of every model of ``roles`` on every tree, per seed."""
+def _grid(kinds, models, config, plan, seeds) -> list[tuple]:
+    return [(k, t, m, config, s) for s in seeds for k in kinds for t in plan.trees for m in models]
 
-    def needs(plan, seeds):
-        return [
-            (k, t, m, BASE_CONFIG, s)
-            for s in seeds
-            for k in kinds
-            for t in plan.trees
-            for m in models_of(*roles)
-        ]
 
-    return needs
+def _evals(kinds: Sequence[str], *roles: str, extra: Sequence[str] = ()):
+    """needs(plan, seeds): ``kinds`` of the ``extra`` models and every model of ``roles`` (read
+    when planned: the registry may grow) on every tree, per seed."""
+    return lambda plan, seeds: _grid(kinds, (*extra, *models_of(*roles)), BASE_CONFIG, plan, seeds)
 
 
 def _conditions(cfg: dict) -> dict:
     return {"conditions": [float(c) for c in cfg["testbed"]["conditions"]]}
-
-
-def _teaser_settings(cfg: dict) -> dict:
-    """The conditions, and the trees' roles: the teaser shows the tree standing for the paper's."""
-    return {**_conditions(cfg), "roles": roles_of(cfg["presets"], cfg["trees"])}
 
 
 def summaries(path, trees, models, seeds) -> dict:
@@ -84,9 +75,7 @@ def summaries(path, trees, models, seeds) -> dict:
 
 
 def fit_row(eval_path, loss_path, n_train: int, holdout_every: int) -> dict:
-    """One tab_fit row from a model's evaluation and loss log: fit and held-out-frame PSNR (dB,
-    training camera and wind, frames < n_train), view and time PSNR (dB), training seconds and
-    iterations used (NaN without a loss log).
+    """One tab_fit row from a model's evaluation and loss log.
 
     Args:
         eval_path (str | Path): the model's evaluation ``.npz``.
@@ -95,7 +84,9 @@ def fit_row(eval_path, loss_path, n_train: int, holdout_every: int) -> dict:
         holdout_every: the held-out stride (0: no held-out frames, ``heldout`` NaN).
 
     Returns:
-        ``fit``, ``heldout``, ``view``, ``time`` (dB), ``train_s`` (s) and ``iterations``.
+        ``fit`` and ``heldout`` (dB: PSNR at the training camera and wind over the trained and
+        the held-out frames < n_train), ``view``, ``time`` (dB), ``train_s`` (s) and
+        ``iterations`` (NaN without a loss log).
     """
     ev = load_eval(eval_path)
     cam = np.asarray(ev.camera_psnr[0, :n_train], dtype=np.float64)  # [n_train] dB
@@ -120,33 +111,13 @@ def fit_row(eval_path, loss_path, n_train: int, holdout_every: int) -> dict:
 
 
 def fit_settings(cfg: dict) -> dict:
-    """What ``fit_row`` reads: the training window's length and its held-out stride.
-
-    Args:
-        cfg: the resolved config.
-
-    Returns:
-        ``n_train`` and ``holdout_every``.
-    """
-    return {
-        "n_train": int(cfg["testbed"]["n_train"]),
-        "holdout_every": int(cfg["train"]["holdout_every"]),
-    }
+    """What ``fit_row`` reads of the resolved config ``cfg``: ``n_train`` (the training window's
+    length) and ``holdout_every`` (its held-out stride)."""
+    n_train, every = cfg["testbed"]["n_train"], cfg["train"]["holdout_every"]
+    return {"n_train": int(n_train), "holdout_every": int(every)}
 
 
 # ---- the tables' builders ------------------------------------------------------------------
-#: a .tex cell that a method does not define (a forcing-free prior beyond the window): never 0
-NOT_DEFINED = "n/d"
-
-
-#: tab_psnr's difference rows: ``<prior>-static`` and ``<prior>-best_field`` (column ``model``)
-PSNR_MINUS = "-"
-
-
-#: the id of "the best learned field, per seed" in tab_psnr's difference rows
-BEST_FIELD = "best_field"
-
-
 def _best_cols(V: np.ndarray, rows: np.ndarray, higher: bool = True) -> np.ndarray:
     """[R] bool: among ``rows`` [R] bool, the row whose mean is best when decided (V [S, R])."""
     out = np.zeros(V.shape[1], bool)
@@ -167,14 +138,11 @@ def tab_psnr(
 ) -> Table:
     """PSNR (dB) on the view and time splits, one row per model, two columns per tree.
 
-    The CSV's ``model`` column holds ids (a difference row: ``<prior>-static``,
-    ``<prior>-best_field``); the labels are the .tex's.
-
-    Below the models: references (the true-motion ceiling; never bold) and two paired
-    differences, ours - static and ours - the best learned field (per seed, the learned field with
-    the highest PSNR in that column), for every prior among ``models`` (role "prior" in the
-    registry: ours, then the chained prior). The best method per column is bold when its paired
-    difference to the runner-up is decided.
+    Below the models: the references (the true-motion ceiling; never bold), then for every prior
+    among ``models`` (registry role "prior") two paired differences: the prior - static and the
+    prior - the best learned field (per seed, the field with the highest PSNR in that column).
+    The best method per column is bold when its paired difference to the runner-up is decided.
+    The CSV's ``model`` holds ids (a difference: ``<prior>-static``, ``<prior>-best_field``).
 
     Args:
         per_seed: ``per_seed[seed][(tree, model)]``: ``EvalResult.summary()`` of the model trained
@@ -192,33 +160,22 @@ def tab_psnr(
     seeds = seeds_of(per_seed, "tab_psnr", [(t, m) for t in trees for m in (*models, *references)])
     learned = [m for m in models if spec_of(m).role == "field"]
     priors = [m for m in models if spec_of(m).role == "prior"]
-    cols = [f"{t}_{sp}" for t in trees for sp in ("view", "time")]
-    rows = []
-    for s in seeds:
-        S = per_seed[s]
-        val = {
-            m: {f"{t}_{sp}": S[(t, m)][sp] for t in trees for sp in ("view", "time")}
-            for m in (*models, *references)
-        }
-        for m in (*models, *references):
-            rows.append(
-                {"seed": s, "model": m, **val[m], "reference": m in references, "difference": False}
-            )
-        subtracted = {"static": val["static"]} if "static" in models else {}
-        if learned:  # the best learned field, per seed and column
-            subtracted[BEST_FIELD] = {c: max(val[m][c] for m in learned) for c in cols}
-        for p in priors:
-            for other, v in subtracted.items():
-                rows.append(
-                    {
-                        "seed": s,
-                        "model": f"{p}{PSNR_MINUS}{other}",
-                        **{c: val[p][c] - v[c] for c in cols},
-                        "reference": False,
-                        "difference": True,
-                    }
-                )
-    df = pd.DataFrame(rows)
+    others = ["static"] * ("static" in models) + [BEST_FIELD] * bool(learned)
+    cols = {f"{t}_{sp}": (t, sp) for t in trees for sp in SPLITS}
+
+    def psnr(s, m):  # column -> dB of model m (the best learned field's: the max, per column)
+        of = learned if m == BEST_FIELD else [m]
+        return {c: max(per_seed[s][(t, x)][sp] for x in of) for c, (t, sp) in cols.items()}
+
+    def row(s, m, other=None):
+        if other is None:
+            return {"model": m, **psnr(s, m), "reference": m in references, "difference": False}
+        a, b = psnr(s, m), psnr(s, other)
+        diff = {c: a[c] - b[c] for c in cols}
+        return {"model": f"{m}{PSNR_MINUS}{other}", **diff, "reference": False, "difference": True}
+
+    keys = [(m,) for m in (*models, *references)] + [(p, o) for p in priors for o in others]
+    df = seed_rows(seeds, keys, row)
     first = latex.rows(df)
     ref, diff = first["reference"].to_numpy(bool), first["difference"].to_numpy(bool)
     names = [
@@ -233,11 +190,10 @@ def tab_psnr(
         {
             (tree_label(t, bones[t]), sp): np.where(
                 diff,
-                latex.cells(df, f"{t}_{sp}", fmt, cell=seedstats.difference),
-                latex.cells(df, f"{t}_{sp}", fmt),
+                latex.cells(df, c, fmt, cell=seedstats.difference),
+                latex.cells(df, c, fmt),
             )
-            for t in trees
-            for sp in ("view", "time")
+            for c, (t, sp) in cols.items()
         },
         index=names,
     )
@@ -274,12 +230,10 @@ def tab_fit(
 
     ceiling_frac is (model - static) / (reference - static) on ``fit``, per seed against that
     seed's static pose and ceiling: 1 reaches the true-motion ceiling, 0 is no better than the
-    static pose. heldout_ceiling_frac is the same on ``heldout`` (the held-out window frames,
-    against the static pose's and the ceiling's on those frames): a field that memorises its
-    trained frames shows as a held-out fraction well below its trained one. The reference row
-    is listed for scale. A split a model does not define (NaN at every seed: a forcing-free
-    prior beyond the window) is an empty CSV cell and ``NOT_DEFINED`` in the .tex, never a
-    number.
+    static pose; heldout_ceiling_frac the same on ``heldout`` (a field that memorises its trained
+    frames shows a held-out fraction well below its trained one). The reference row is listed
+    for scale. A split a model does not define (NaN at every seed: a forcing-free prior beyond
+    the window) is an empty CSV cell and ``NOT_DEFINED`` in the .tex, never a number.
 
     Args:
         per_seed: ``per_seed[seed][(tree, model)]``: fit (dB: mean PSNR over the trained
@@ -302,6 +256,7 @@ def tab_fit(
 
     def one(s, t, m):
         r, ceil, stat = (per_seed[s][(t, x)] for x in (m, reference, static))
+        frac = {k: float(ceiling_fraction(r[k], stat[k], ceil[k])) for k in ("fit", "heldout")}
         return {
             "tree": t,
             "bones": bones[t],
@@ -309,10 +264,8 @@ def tab_fit(
             "reference": m == reference,
             "fit_psnr_db": r["fit"],
             "heldout_psnr_db": r["heldout"],
-            "ceiling_frac": float(ceiling_fraction(r["fit"], stat["fit"], ceil["fit"])),
-            "heldout_ceiling_frac": float(
-                ceiling_fraction(r["heldout"], stat["heldout"], ceil["heldout"])
-            ),
+            "ceiling_frac": frac["fit"],
+            "heldout_ceiling_frac": frac["heldout"],
             "view_psnr_db": r["view"],
             "time_psnr_db": r["time"],
             "train_s": r["train_s"],
@@ -347,8 +300,7 @@ def tab_fit(
         r"Fit to the training window, PSNR (dB) at the training camera and wind. \emph{Fit}: "
         r"the training-window frames each model was trained on; \emph{Held-out frames}: every "
         + f"{holdout_every}th"
-        + r" training-window frame, never trained on; \emph{Of ceiling}: "
-        r"(model $-$ static) / "
+        + r" training-window frame, never trained on; \emph{Of ceiling}: (model $-$ static) / "
         r"(true motion $-$ static) on the fit; \emph{Held-out of ceiling}: the same on the "
         r"held-out frames (below the fit's: the model memorises its trained frames). "
         r"\emph{View}, \emph{Time}: the evaluation splits. "
@@ -391,17 +343,19 @@ def tab_transfer(
     """
     seeds = seeds_of(per_seed, "tab_transfer", [(t, m) for t in trees for m in models])
     stems = {"train": "train_c", "beyond": "beyond_c"}  # split -> its summary keys' stem
-    df = seed_rows(
-        seeds,
-        [(sp, t, c) for sp in stems for t in trees for c in range(1, len(conditions))],
-        lambda s, sp, t, c: {
+
+    def row(s, sp, t, c):
+        psnr = {m: per_seed[s][(t, m)][f"{stems[sp]}{c}"] for m in models}
+        return {
             "split": sp,
             "tree": t,
             "bones": bones[t],
             "condition": float(conditions[c]),
-            **{m: per_seed[s][(t, m)][f"{stems[sp]}{c}"] for m in models},
-        },
-    )
+            **psnr,
+        }
+
+    keys = [(sp, t, c) for sp in stems for t in trees for c in range(1, len(conditions))]
+    df = seed_rows(seeds, keys, row)
     first = latex.rows(df)
     V = np.stack([latex.by_seed(df, m) for m in models], axis=-1)  # [S, R, M]
     best = [seedstats.decided_best(V[:, i, :]) for i in range(len(first))]
@@ -409,18 +363,19 @@ def tab_transfer(
         "train": r"\shortstack[l]{Training\\timestamps}",
         "beyond": r"\shortstack[l]{Beyond the\\training window}",
     }
+    wind = [
+        f"{tree_label(r.tree, r.bones)}, {condition_label(r.condition)}" for r in first.itertuples()
+    ]
     index = pd.MultiIndex.from_arrays(
-        [
-            [splits[x] for x in first["split"]],
-            [
-                f"{tree_label(r.tree, r.bones)}, {condition_label(r.condition)}"
-                for r in first.itertuples()
-            ],
-        ],
-        names=["Split", "Tree / unseen wind"],
+        [[splits[x] for x in first["split"]], wind], names=["Split", "Tree / unseen wind"]
     )
+
+    def head(m):  # (its field family's heading over the family's columns, or "", its short name)
+        spec = spec_of(m)
+        return FAMILY_HEADS.get(spec.family, "") if spec.role == "field" else "", spec.short
+
     fmt = f".{int(digits)}f"
-    cells = pd.DataFrame({_family_head(m): latex.cells(df, m, fmt) for m in models}, index=index)
+    cells = pd.DataFrame({head(m): latex.cells(df, m, fmt) for m in models}, index=index)
     cap = (
         r"Zero-shot transfer to unseen wind, PSNR (dB); every model is fit to $v_0$ only. "
         r"Top: training timestamps; bottom: frames beyond the training window. Best per row in "
@@ -428,17 +383,6 @@ def tab_transfer(
     )
     bold = np.arange(len(models)) == np.array([-1 if b is None else b for b in best])[:, None]
     return Table("tab_transfer", df, latex.render(cells, cap, "tab:transfer", bold))
-
-
-#: a family heading over the learned fields' columns of tab_transfer
-FAMILY_HEADS = {"mlp": "Deformation MLP", "d3dgs": "Deformable-3DGS"}
-
-
-def _family_head(model: str) -> tuple[str, str]:
-    """A model's tab_transfer heading: (its field family's, spanning the family's adjacent
-    columns; "" for the rest), its short name."""
-    spec = spec_of(model)
-    return FAMILY_HEADS.get(spec.family, "") if spec.role == "field" else "", spec.short
 
 
 def tab_margin(
@@ -451,7 +395,7 @@ def tab_margin(
     digits: int = 2,
 ) -> Table:
     """Each prior minus Deformation MLP + wind, PSNR (dB) at training timestamps, per tree and
-    condition (including the training condition), paired per seed.
+    condition (the training one included), paired per seed.
 
     Positive: the prior ahead. A margin is bold when its 95% interval excludes 0, marked undecided
     when not. One block of rows per prior of ``priors`` (column ``model``: its id), in that order.
@@ -469,20 +413,14 @@ def tab_margin(
         The [`Table`][physgs.report.tables.Table].
     """
     seeds = seeds_of(per_seed, "tab_margin", [(t, m) for t in trees for m in (*priors, baseline)])
-    df = seed_rows(
-        seeds,
-        [(p, t) for p in priors for t in trees],
-        lambda s, p, t: {
-            "model": p,
-            "tree": t,
-            "bones": bones[t],
-            **{
-                f"margin_{condition_label(mult, tex=False)}": per_seed[s][(t, p)][f"train_c{c}"]
-                - per_seed[s][(t, baseline)][f"train_c{c}"]
-                for c, mult in enumerate(conditions)
-            },
-        },
-    )
+    col = {mult: f"margin_{condition_label(mult, tex=False)}" for mult in conditions}
+
+    def row(s, p, t):  # the prior's PSNR minus the baseline's, per condition
+        a, b = per_seed[s][(t, p)], per_seed[s][(t, baseline)]
+        margins = {col[x]: a[f"train_c{c}"] - b[f"train_c{c}"] for c, x in enumerate(conditions)}
+        return {"model": p, "tree": t, "bones": bones[t], **margins}
+
+    df = seed_rows(seeds, [(p, t) for p in priors for t in trees], row)
     first = latex.rows(df)
     fmt = f".{int(digits)}f"
     index = pd.MultiIndex.from_arrays(
@@ -493,9 +431,7 @@ def tab_margin(
     )
     cells = pd.DataFrame(
         {
-            condition_label(mult): latex.cells(
-                df, f"margin_{condition_label(mult, tex=False)}", fmt, cell=seedstats.difference
-            )
+            condition_label(mult): latex.cells(df, col[mult], fmt, cell=seedstats.difference)
             for mult in conditions
         },
         index=index,
@@ -510,36 +446,21 @@ def tab_margin(
     )
     return Table("tab_margin", df, latex.render(cells, cap, "tab:margin"))
 
-    # ---- the tables' declarations -------------------------------------------------------------
 
-
+# ---- the tables' declarations --------------------------------------------------------------
 def _tab_psnr(path, settings, inputs, out):
-    seeds = settings["seeds"]
-    return tab_psnr(
-        summaries(path, settings["trees"], models_of(*METHODS, *REFERENCES), seeds),
-        settings["trees"],
-        settings["bones"],
-        models=models_of(*METHODS),
-        digits=settings["digits"],
-        references=models_of(*REFERENCES),
-    )
+    trees, shown = settings["trees"], models_of(*METHODS, *REFERENCES)
+    per_seed = summaries(path, trees, shown, settings["seeds"])
+    methods, references = models_of(*METHODS), models_of(*REFERENCES)
+    return tab_psnr(per_seed, trees, settings["bones"], methods, settings["digits"], references)
 
 
 def _fit_needs(plan, seeds):
     """tab_fit's: every method's and reference's evaluation and loss log, and the forcing-free
     priors' (``plan.blind``, trained in ``BLIND_CONFIG``)."""
-    blind = [
-        (k, t, m, BLIND_CONFIG, s)
-        for s in seeds
-        for k in ("eval", "loss")
-        for t in plan.trees
-        for m in plan.blind
-    ]
-    return _evals(("eval", "loss"), METHODS + REFERENCES)(plan, seeds) + blind
-
-
-def _fit_table_settings(cfg: dict) -> dict:
-    return {**fit_settings(cfg), "blind": list(blind_priors(cfg["models"]["configs"]))}
+    kinds = ("eval", "loss")
+    blind = _grid(kinds, plan.blind, BLIND_CONFIG, plan, seeds)
+    return _evals(kinds, *METHODS, *REFERENCES)(plan, seeds) + blind
 
 
 def _tab_fit(path, settings, inputs, out):
@@ -554,60 +475,39 @@ def _tab_fit(path, settings, inputs, out):
         }
         for s in settings["seeds"]
     }
-    return tab_fit(
-        rows,
-        settings["trees"],
-        settings["bones"],
-        (*models_of(*METHODS), *settings.get("blind", [])),
-        models_of(*REFERENCES)[0],
-        digits=settings["digits"],
-        holdout_every=every,
-    )
-
-
-def _tab_transfer(path, settings, inputs, out):
-    return tab_transfer(
-        summaries(path, settings["trees"], models_of(*METHODS), settings["seeds"]),
-        settings["trees"],
-        settings["bones"],
-        settings["conditions"],
-        models=models_of(*METHODS),
-        digits=settings["digits"],
-    )
+    models = (*models_of(*METHODS), *settings.get("blind", []))
+    trees, bones, reference = settings["trees"], settings["bones"], models_of(*REFERENCES)[0]
+    return tab_fit(rows, trees, bones, models, reference, settings["digits"], holdout_every=every)
 
 
 def _margin_models() -> tuple[str, ...]:
     return (MARGIN_BASELINE, *models_of("prior"))
 
 
+def _tab_transfer(path, settings, inputs, out):
+    trees, methods = settings["trees"], models_of(*METHODS)
+    per_seed = summaries(path, trees, methods, settings["seeds"])
+    bones, conditions = settings["bones"], settings["conditions"]
+    return tab_transfer(per_seed, trees, bones, conditions, methods, settings["digits"])
+
+
 def _tab_margin(path, settings, inputs, out):
-    return tab_margin(
-        summaries(path, settings["trees"], _margin_models(), settings["seeds"]),
-        settings["trees"],
-        settings["bones"],
-        settings["conditions"],
-        priors=models_of("prior"),
-        baseline=MARGIN_BASELINE,
-        digits=settings["digits"],
-    )
+    trees, bones, conditions = settings["trees"], settings["bones"], settings["conditions"]
+    per_seed = summaries(path, trees, _margin_models(), settings["seeds"])
+    priors, digits = models_of("prior"), settings["digits"]
+    return tab_margin(per_seed, trees, bones, conditions, priors, MARGIN_BASELINE, digits)
 
 
-#: tab_psnr's CSV: one row per model id (a difference row: ``<prior>-static``,
-#: ``<prior>-best_field``), two columns per tree
+# one row per model id (a difference row: ``<prior>-static``, ``<prior>-best_field``)
 PSNR_COLUMNS = Columns(
-    keys=("seed", "model"), values=("{tree}_view", "{tree}_time"), about=("reference", "difference")
+    ("seed", "model"), ("{tree}_view", "{tree}_time"), about=("reference", "difference")
 )
-
 TAB_PSNR = Output(
-    "tab_psnr",
-    "table",
-    _evals(("eval",), METHODS + REFERENCES),
-    _tab_psnr,
-    columns=PSNR_COLUMNS,
+    "tab_psnr", "table", _evals(("eval",), *METHODS, *REFERENCES), _tab_psnr, columns=PSNR_COLUMNS
 )
 FIT_COLUMNS = Columns(
-    keys=("seed", "tree", "model"),
-    values=(
+    ("seed", "tree", "model"),
+    (
         "fit_psnr_db",
         "heldout_psnr_db",
         "ceiling_frac",
@@ -619,40 +519,34 @@ FIT_COLUMNS = Columns(
     timing=("train_s",),
     about=("bones", "reference"),
 )
-
 TAB_FIT = Output(
     "tab_fit",
     "table",
     _fit_needs,
     _tab_fit,
-    settings=_fit_table_settings,
+    settings=lambda cfg: {
+        **fit_settings(cfg),
+        "blind": list(blind_priors(cfg["models"]["configs"])),
+    },
     columns=FIT_COLUMNS,
 )
-#: tab_transfer's CSV: one column per model id; the wind (``condition``) is a numeric key
-TRANSFER_COLUMNS = Columns(
-    keys=("seed", "split", "tree", "condition"), values=("{model}",), about=("bones",)
-)
-
+# one column per model id; the wind (``condition``) is a numeric key
+TRANSFER_COLUMNS = Columns(("seed", "split", "tree", "condition"), ("{model}",), about=("bones",))
 TAB_TRANSFER = Output(
     "tab_transfer",
     "table",
-    _evals(("eval",), METHODS),
+    _evals(("eval",), *METHODS),
     _tab_transfer,
-    settings=_conditions,
+    _conditions,
     columns=TRANSFER_COLUMNS,
 )
-MARGIN_COLUMNS = Columns(
-    keys=("seed", "model", "tree"), values=("margin_{wind}",), about=("bones",)
-)
-
+MARGIN_COLUMNS = Columns(("seed", "model", "tree"), ("margin_{wind}",), about=("bones",))
 TAB_MARGIN = Output(
     "tab_margin",
     "table",
-    lambda plan, seeds: [
-        ("eval", t, m, BASE_CONFIG, s) for s in seeds for t in plan.trees for m in _margin_models()
-    ],
+    _evals(("eval",), "prior", extra=(MARGIN_BASELINE,)),
     _tab_margin,
-    settings=_conditions,
+    _conditions,
     columns=MARGIN_COLUMNS,
 )
 
@@ -676,9 +570,10 @@ def teaser_tree(trees: Sequence[str], roles: dict | None = None) -> str:
 def _fig_temporal(path, settings, inputs, out):
     from physgs.report import figures  # matplotlib: not for the workflow's planning imports
 
+    seeds = settings["seeds"]
     curves = {
         (t, m): np.stack(
-            [load_eval(path("eval", t, m, BASE_CONFIG, s)).temporal_psnr for s in settings["seeds"]]
+            [load_eval(path("eval", t, m, BASE_CONFIG, s)).temporal_psnr for s in seeds]
         )
         for t in settings["trees"]
         for m in models_of(*METHODS, *REFERENCES)
@@ -691,17 +586,13 @@ def _fig_teaser(path, settings, inputs, out):
 
     t, s0 = teaser_tree(settings["trees"], settings.get("roles")), settings["seeds"][0]
     evals = {m: load_eval(path("eval", t, m, BASE_CONFIG, s0)) for m in models_of(*METHODS)}
-    base = figures.best_baseline(
-        {m: e.summary() for m, e in evals.items()},
-        key="time",
-        exclude=models_of("control", "prior"),
-    )
+    summary = {m: e.summary() for m, e in evals.items()}
+    base = figures.best_baseline(summary, key="time", exclude=models_of("control", "prior"))
     shown = (*models_of("prior"), base)  # every prior beside the best learned field
     traj = {m: load_trajectories(path("traj", t, m, BASE_CONFIG, s0)) for m in shown}
     cen = {m: evals[m].centroid_err for m in shown}
-    figures.fig_teaser(
-        traj, cen, settings["conditions"], out, title=f"{t} tree, training seed {s0}"
-    )
+    title = f"{t} tree, training seed {s0}"
+    figures.fig_teaser(traj, cen, settings["conditions"], out, title=title)
 
 
 def _fig_results(path, settings, inputs, out):
@@ -723,23 +614,24 @@ def _fig_results(path, settings, inputs, out):
 FIG_TEMPORAL = Output(
     "fig_temporal",
     "figure",
-    _evals(("eval",), METHODS + REFERENCES),
+    _evals(("eval",), *METHODS, *REFERENCES),
     _fig_temporal,
-    settings=lambda cfg: {"n_train": int(cfg["testbed"]["n_train"])},
+    lambda cfg: {"n_train": int(cfg["testbed"]["n_train"])},
 )
+# the conditions, and the trees' roles: the teaser shows the tree standing for the paper's
 FIG_TEASER = Output(
     "fig_teaser",
     "figure",
-    _evals(("eval", "traj"), METHODS),
+    _evals(("eval", "traj"), *METHODS),
     _fig_teaser,
-    settings=_teaser_settings,
-    seeds="first",
+    lambda cfg: {**_conditions(cfg), "roles": roles_of(cfg["presets"], cfg["trees"])},
+    "first",
 )
 FIG_RESULTS = Output(
     "fig_results",
     "figure",
-    _evals(("eval", "panels"), METHODS),
+    _evals(("eval", "panels"), *METHODS),
     _fig_results,
-    settings=_conditions,
-    seeds="first",
+    _conditions,
+    "first",
 )
