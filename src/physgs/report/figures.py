@@ -72,16 +72,13 @@ def best_baseline(
     key: str = "time",
     exclude: Sequence[str] = ("static", "ours"),
 ) -> str:
-    """The learned baseline with the highest ``summary[key]`` (dB) among summaries[model].
+    """The id of the learned baseline with the highest ``summaries[model][key]`` (dB).
 
     Args:
         summaries: model -> its split means
             ([`EvalResult.summary`][physgs.evaluate.splits.EvalResult.summary]).
         key: the split compared.
         exclude: models that are not candidates.
-
-    Returns:
-        The model id.
 
     Raises:
         ValueError: when no candidate is left.
@@ -113,6 +110,15 @@ def _plain_log(axis, locator=None) -> None:
         axis.set_major_locator(locator)
     axis.set_major_formatter(ScalarFormatter())
     axis.set_minor_formatter(NullFormatter())
+
+
+def _texts(ax, title: str, xlabel: str, ylabel: str | None = None, title_pt=FONT_PT) -> None:
+    """An axes' title, axis labels and tick labels, at the page's font size."""
+    ax.set_title(title, fontsize=title_pt)
+    ax.set_xlabel(xlabel, fontsize=FONT_PT)
+    if ylabel is not None:
+        ax.set_ylabel(ylabel, fontsize=FONT_PT)
+    ax.tick_params(labelsize=FONT_PT)
 
 
 def fig_temporal(
@@ -160,10 +166,8 @@ def fig_temporal(
                 ax.plot(x, Y.mean(0), color="k", lw=0.8, ls=":", label=label(m))
         ax.axvline(n_train + 0.5, color="k", lw=0.8, ls=":")
         ax.axvspan(n_train + 0.5, len(y) + 0.5, color="0.9", zorder=0)
-        ax.set_title(t.capitalize(), fontsize=FONT_PT + 1)
-        ax.set_xlabel("frame", fontsize=FONT_PT)
         ax.set_xlim(1, len(y))
-        ax.tick_params(labelsize=FONT_PT)
+        _texts(ax, t.capitalize(), "frame", title_pt=FONT_PT + 1)
     axes[0, 0].set_ylabel("PSNR (dB)", fontsize=FONT_PT)
     handles, _ = axes[0, 0].get_legend_handles_labels()
     handles.append(Patch(color="0.9", label=f"beyond the training window (after frame {n_train})"))
@@ -186,9 +190,8 @@ def fig_teaser(
     """Branch-tip paths through the window (grey) and tail (blue), and canopy-centroid error.
 
     Args:
-        trajectories: ``trajectories[model]``:
-            [`Trajectories`][physgs.evaluate.trajectories.Trajectories] at the training wind (e.g.
-            ours and the best baseline; the ground truth is taken from the first).
+        trajectories: [`Trajectories`][physgs.evaluate.trajectories.Trajectories] by model at the
+            training wind (e.g. ours and the best baseline; the ground truth: the first's).
         centroid_err: ``centroid_err[model]``: [C, F] canopy-centroid error, px.
         conditions: the mean-speed multipliers of the C conditions.
         outputs: the paths to write.
@@ -220,11 +223,7 @@ def fig_teaser(
         ax.set_xlim(lims[0], lims[1])
         ax.set_ylim(lims[2], lims[3])  # image y points down
         ax.set_aspect("equal", adjustable="box")
-        ax.set_title(textwrap.fill(name, 16), fontsize=FONT_PT)
-        ax.set_xlabel("x (px)", fontsize=FONT_PT)
-        ax.tick_params(labelsize=FONT_PT)
-        if i == 0:
-            ax.set_ylabel("y (px)", fontsize=FONT_PT)
+        _texts(ax, textwrap.fill(name, 16), "x (px)", "y (px)" if i == 0 else None)
         if i == len(panels) - 1:  # one key for the paths, right of the last panel
             ax.legend(fontsize=FONT_PT, loc="upper left", bbox_to_anchor=(1.02, 1.0), frameon=False)
     unseen = unseen % len(conditions)
@@ -237,10 +236,7 @@ def fig_teaser(
             key = f"{label(m)} (mean {e.mean():.1f} px)"
             ax.plot(np.arange(1, len(e) + 1), e, color=COLORS.get(m), lw=1.0, label=key)
         ax.axvline(n_train + 0.5, color="k", lw=0.8, ls=":")
-        ax.set_title(f"canopy-centroid error, {lab}", fontsize=FONT_PT)
-        ax.set_xlabel("frame", fontsize=FONT_PT)
-        ax.set_ylabel("error (px)", fontsize=FONT_PT)
-        ax.tick_params(labelsize=FONT_PT)
+        _texts(ax, f"canopy-centroid error, {lab}", "frame", "error (px)")
         # below its panel, never over the curves
         ax.legend(fontsize=FONT_PT, loc="upper center", bbox_to_anchor=(0.5, -0.22), frameon=False)
     if title:
@@ -287,12 +283,9 @@ def fig_results(
             ax.set_xticks([])
             ax.set_yticks([])
             if score is not None:
-                color = "k"
-                if ours_score is not None:
-                    if c == ours and ours_score >= max(scores.values()):
-                        color = GOOD
-                    elif c != ours and score > ours_score:
-                        color = BAD
+                best = c == ours and ours_score is not None and ours_score >= max(scores.values())
+                beats = c != ours and ours_score is not None and score > ours_score
+                color = GOOD if best else BAD if beats else "k"
                 weight = "bold" if color != "k" else "normal"
                 kw = dict(fontsize=FONT_PT, color=color, fontweight=weight, bbox=box)
                 ax.text(0.03, 0.03, f"{score:.1f} dB", transform=ax.transAxes, **kw)
@@ -319,14 +312,13 @@ def fig_damping(
     with the ground-truth line gamma = zeta_true * omega.
 
     Args:
-        damping (Mapping): each prior's ``DampingResult`` per ``(tree, config)``, by model id in
-            drawing order: ours' (filled markers), then the others' (hollow markers).
-        trees (Sequence[str]): the trees, in column order.
-        configs (Sequence[str]): the configurations, in column order.
-        zeta_true (float): the testbed's damping ratio.
-        outputs (Sequence[str | Path]): the files to write (PDF, PNG).
-        zeta_bound (float | None): the largest zeta the fit may take (``models.ours.zeta``);
-            None draws no bound.
+        damping: each prior's ``DampingResult`` per ``(tree, config)``, by model id in drawing
+            order: ours' (filled markers), then the others' (hollow markers).
+        trees: the trees, in column order.
+        configs: the configurations, in column order.
+        zeta_true: the testbed's damping ratio.
+        outputs: the files to write (PDF, PNG).
+        zeta_bound: the largest zeta the fit may take (``models.ours.zeta``); None: no bound.
 
     Raises:
         KeyError: naming a ``(tree, config)`` (and model) without a result.
@@ -340,9 +332,8 @@ def fig_damping(
     models = list(damping)
 
     def style(model, t):  # the first prior filled, the others hollow in the tree's colour
-        if model == models[0]:
-            return {"color": tree_colors[t]}
-        return {"facecolors": "none", "edgecolors": tree_colors[t]}
+        c = tree_colors[t]
+        return {"color": c} if model == models[0] else {"facecolors": "none", "edgecolors": c}
 
     per_tree = len(configs) * len(models)
     allw, centres = [], []
@@ -375,11 +366,9 @@ def fig_damping(
     a1.set_yscale("log")
     for axis in (a1.xaxis, a1.yaxis):
         _plain_log(axis, LogLocator(base=10, subs=(1.0, 2.0, 5.0)))
-    a1.set_xlabel(r"$\hat\omega_p$ (rad/s)", fontsize=FONT_PT)
-    a1.set_ylabel(r"$\hat\gamma_p = \hat\zeta_p\hat\omega_p$ (1/s)", fontsize=FONT_PT)
-    a1.set_title("decay rate against natural frequency", fontsize=FONT_PT)
-    for ax in (a0, a1):
-        ax.tick_params(labelsize=FONT_PT)
+    gamma = r"$\hat\gamma_p = \hat\zeta_p\hat\omega_p$ (1/s)"
+    _texts(a1, "decay rate against natural frequency", r"$\hat\omega_p$ (rad/s)", gamma)
+    a0.tick_params(labelsize=FONT_PT)
     # one key for both panels, below them: colour = tree, marker = configuration, fill = prior
     grey = "0.35"
     handles = [Patch(color=tree_colors[t], label=t) for t in trees]

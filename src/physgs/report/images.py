@@ -52,11 +52,10 @@ def _conditions(cfg: dict) -> dict:
 
 
 def summaries(path, trees, models, seeds) -> dict:
-    """{seed: {(tree, model): summary}} of the models trained in the base configuration.
+    """The evaluation summaries of the models trained in the base configuration.
 
     Args:
-        path (Callable[..., str]): the need -> file function of
-            [`reader`][physgs.report.output.reader].
+        path (Callable[..., str]): [`reader`][physgs.report.output.reader]'s need -> file.
         trees (Sequence[str]): the trees.
         models (Sequence[str]): the models.
         seeds (Sequence[int]): the training seeds.
@@ -118,11 +117,11 @@ def fit_settings(cfg: dict) -> dict:
 
 
 # ---- the tables' builders ------------------------------------------------------------------
-def _best_cols(V: np.ndarray, rows: np.ndarray, higher: bool = True) -> np.ndarray:
-    """[R] bool: among ``rows`` [R] bool, the row whose mean is best when decided (V [S, R])."""
+def _best_cols(V: np.ndarray, rows: np.ndarray) -> np.ndarray:
+    """[R] bool: among ``rows`` [R] bool, the row whose mean is highest when decided (V [S, R])."""
     out = np.zeros(V.shape[1], bool)
     idx = np.flatnonzero(rows)
-    b = seedstats.decided_best(V[:, idx], higher=higher)
+    b = seedstats.decided_best(V[:, idx], higher=True)
     if b is not None:
         out[idx[b]] = True
     return out
@@ -152,9 +151,6 @@ def tab_psnr(
         models: the methods, in row order.
         digits: decimals shown in the .tex.
         references: the reference rows.
-
-    Returns:
-        The [`Table`][physgs.report.tables.Table].
     """
     fmt = f".{int(digits)}f"
     seeds = seeds_of(per_seed, "tab_psnr", [(t, m) for t in trees for m in (*models, *references)])
@@ -247,9 +243,6 @@ def tab_fit(
         digits: decimals shown in the .tex.
         static: the static model's id.
         holdout_every: train.holdout_every (the caption says which frames were held out).
-
-    Returns:
-        The [`Table`][physgs.report.tables.Table].
     """
     keys = [(t, m) for t in trees for m in (*models, reference)]
     seeds = seeds_of(per_seed, "tab_fit", keys)
@@ -337,9 +330,6 @@ def tab_transfer(
         conditions: the mean-speed multipliers, the training one first.
         models: the methods, in column order.
         digits: decimals shown in the .tex.
-
-    Returns:
-        The [`Table`][physgs.report.tables.Table].
     """
     seeds = seeds_of(per_seed, "tab_transfer", [(t, m) for t in trees for m in models])
     stems = {"train": "train_c", "beyond": "beyond_c"}  # split -> its summary keys' stem
@@ -408,9 +398,6 @@ def tab_margin(
         priors: the priors, in block order.
         baseline: the model subtracted.
         digits: decimals shown in the .tex.
-
-    Returns:
-        The [`Table`][physgs.report.tables.Table].
     """
     seeds = seeds_of(per_seed, "tab_margin", [(t, m) for t in trees for m in (*priors, baseline)])
     col = {mult: f"margin_{condition_label(mult, tex=False)}" for mult in conditions}
@@ -480,10 +467,6 @@ def _tab_fit(path, settings, inputs, out):
     return tab_fit(rows, trees, bones, models, reference, settings["digits"], holdout_every=every)
 
 
-def _margin_models() -> tuple[str, ...]:
-    return (MARGIN_BASELINE, *models_of("prior"))
-
-
 def _tab_transfer(path, settings, inputs, out):
     trees, methods = settings["trees"], models_of(*METHODS)
     per_seed = summaries(path, trees, methods, settings["seeds"])
@@ -493,7 +476,7 @@ def _tab_transfer(path, settings, inputs, out):
 
 def _tab_margin(path, settings, inputs, out):
     trees, bones, conditions = settings["trees"], settings["bones"], settings["conditions"]
-    per_seed = summaries(path, trees, _margin_models(), settings["seeds"])
+    per_seed = summaries(path, trees, (MARGIN_BASELINE, *models_of("prior")), settings["seeds"])
     priors, digits = models_of("prior"), settings["digits"]
     return tab_margin(per_seed, trees, bones, conditions, priors, MARGIN_BASELINE, digits)
 
