@@ -93,14 +93,8 @@ def _legend_below(fig, handles: list, *, ncol: int, top: float) -> None:
     """The figure's key below its panels (its top at ``top`` < 0.2, in figure fractions), never
     over the data: the panels keep the top 80%."""
     fig.tight_layout(rect=(0, 0.2, 1, 1))
-    fig.legend(
-        handles=handles,
-        loc="upper center",
-        bbox_to_anchor=(0.5, top),
-        ncol=ncol,
-        fontsize=FONT_PT,
-        frameon=False,
-    )
+    where = dict(loc="upper center", bbox_to_anchor=(0.5, top), ncol=ncol)
+    fig.legend(handles=handles, **where, fontsize=FONT_PT, frameon=False)
 
 
 def _plain_log(axis, locator=None) -> None:
@@ -145,9 +139,7 @@ def fig_temporal(
     """
     from matplotlib.patches import Patch
 
-    fig, axes = plt.subplots(
-        1, len(trees), figsize=(PAGE_WIDTH_IN, 3.4), squeeze=False, sharey=False
-    )
+    fig, axes = plt.subplots(1, len(trees), figsize=(PAGE_WIDTH_IN, 3.4), squeeze=False)
     n_seeds = 1
     for ax, t in zip(axes[0], trees):
         for m in models:
@@ -434,11 +426,8 @@ def fig_speed_accuracy(
             the central 95% of its draws, drawn on the recovery panel (a point inside: chance).
     """
     n_seeds = df["seed"].nunique()
-    m = _seed_mean(
-        df.assign(rel_pct=100 * df["rel_err"]),
-        ["knob", "value"],
-        ("wall_s", "psnr_time", "rel_pct"),
-    )
+    pct = df.assign(rel_pct=100 * df["rel_err"])
+    m = _seed_mean(pct, ["knob", "value"], ("wall_s", "psnr_time", "rel_pct"))
     fig, axes = plt.subplots(1, 2, figsize=(10, 4))
     colors = {k: f"C{i}" for i, k in enumerate(sorted(m["knob"].unique()))}
     panels = ((axes[0], "psnr_time"), (axes[1], "rel_pct"))
@@ -461,9 +450,8 @@ def fig_speed_accuracy(
         median = f"untrained null, K={K} (median)"
         axes[1].axhline(100 * null["median"], color="0.3", ls="--", lw=1.0, label=median)
         band = f"null: central 95% of {draws} draws"
-        axes[1].axhspan(
-            100 * null["low"], 100 * null["high"], color="0.6", alpha=0.25, lw=0, label=band
-        )
+        low, high = 100 * null["low"], 100 * null["high"]
+        axes[1].axhspan(low, high, color="0.6", alpha=0.25, lw=0, label=band)
         axes[1].legend(fontsize=7)
     axes[0].set_ylabel("PSNR, time split (dB)")
     axes[1].set_ylabel("median rel. error of omega, trusted parts (%)")
@@ -506,23 +494,11 @@ def fig_fit_curve(df: pd.DataFrame, outputs: Sequence[str | Path]) -> None:
                 g = g.sort_values("iterations")
                 base, _, variant = m.partition("@")  # <field>@window: the diagnostic series
                 fmt, mfc, ms = ("D", "none", 6) if variant else ("-o", None, 3.5)
-                color, lw = COLORS.get(base), 1.6 if m == "ours" else 1.0
+                lw = 1.6 if m == "ours" else 1.0
                 lab = label(base) + (f" ({variant} time)" if variant else "")
-                # xbars: none on the budgets themselves (no spread)
-                _seed_errorbar(
-                    ax,
-                    g,
-                    x,
-                    y,
-                    n_seeds > 1,
-                    x != "iterations",
-                    fmt=fmt,
-                    mfc=mfc,
-                    ms=ms,
-                    color=color,
-                    lw=lw,
-                    label=lab,
-                )
+                look = dict(fmt=fmt, mfc=mfc, ms=ms, color=COLORS.get(base), lw=lw, label=lab)
+                # no x error bars on the budgets themselves (no spread)
+                _seed_errorbar(ax, g, x, y, n_seeds > 1, x != "iterations", **look)
                 p = g[g["is_profile"]]
                 ax.plot(p[x], p[y], "*", ms=10, color=COLORS.get(m))
             for m, (c, ls) in refs.items():

@@ -117,6 +117,11 @@ def fit_settings(cfg: dict) -> dict:
 
 
 # ---- the tables' builders ------------------------------------------------------------------
+def _emph(model: str, reference: bool) -> str:
+    """A row's model label, in italics for a reference."""
+    return rf"\emph{{{label(model)}}}" if reference else label(model)
+
+
 def _best_cols(V: np.ndarray, rows: np.ndarray) -> np.ndarray:
     """[R] bool: among ``rows`` [R] bool, the row whose mean is highest when decided (V [S, R])."""
     out = np.zeros(V.shape[1], bool)
@@ -174,14 +179,12 @@ def tab_psnr(
     df = seed_rows(seeds, keys, row)
     first = latex.rows(df)
     ref, diff = first["reference"].to_numpy(bool), first["difference"].to_numpy(bool)
-    names = [
-        " $-$ ".join(
-            "best learned field" if x == BEST_FIELD else label(x) for x in m.split(PSNR_MINUS)
-        )
-        if d
-        else (rf"\emph{{{label(m)}}}" if r else label(m))
-        for m, r, d in zip(first["model"], ref, diff)
-    ]
+
+    def name(m, r, d):  # a reference in italics; a difference "<a> $-$ <b>"
+        terms = [label(x) if x != BEST_FIELD else "best learned field" for x in m.split(PSNR_MINUS)]
+        return " $-$ ".join(terms) if d else _emph(m, r)
+
+    names = [name(*x) for x in zip(first["model"], ref, diff)]
     cells = pd.DataFrame(
         {
             (tree_label(t, bones[t]), sp): np.where(
@@ -283,11 +286,7 @@ def tab_fit(
             "Train (s)": latex.cells(df, "train_s", ".0f"),
             "Iter.": latex.cells(df, "iterations", ".0f"),
         },
-        index=tree_index(
-            first,
-            [rf"\emph{{{label(m)}}}" if m == reference else label(m) for m in first["model"]],
-            "Model",
-        ),
+        index=tree_index(first, [_emph(m, m == reference) for m in first["model"]], "Model"),
     )
     cap = (
         r"Fit to the training window, PSNR (dB) at the training camera and wind. \emph{Fit}: "
