@@ -29,7 +29,14 @@ class Caption:
     seeds: str = "first"
 
     def match(self, name: str) -> str | None:
-        """The tree of figure ``name`` ('' for a figure of all trees), None for another figure."""
+        """The tree of figure ``name`` when it is this figure.
+
+        Args:
+            name: a figure's file stem.
+
+        Returns:
+            The tree, '' when the pattern has none, None when ``name`` is another figure.
+        """
         rx = "^" + re.escape(self.pattern).replace(r"\{tree\}", "(?P<tree>[a-z0-9_]+?)") + "$"
         m = re.match(rx, name)
         return None if m is None else m.groupdict().get("tree") or ""

@@ -80,6 +80,9 @@ def best_baseline(
         key: the split compared.
         exclude: models that are not candidates.
 
+    Returns:
+        The model id.
+
     Raises:
         ValueError: when no candidate is left.
     """

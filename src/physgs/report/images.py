@@ -94,11 +94,8 @@ def fit_row(eval_path, loss_path, n_train: int, holdout_every: int) -> dict:
     else:
         trained, held = np.arange(n_train), np.arange(0)
     s = ev.summary()
-    log = (
-        pd.read_csv(loss_path, usecols=["iteration", "seconds"])
-        if loss_path is not None
-        else pd.DataFrame({"iteration": [np.nan], "seconds": [np.nan]})
-    )
+    none = pd.DataFrame({"iteration": [np.nan], "seconds": [np.nan]})  # no loss log
+    log = none if loss_path is None else pd.read_csv(loss_path, usecols=["iteration", "seconds"])
     return {
         "fit": float(cam[trained].mean()),
         "heldout": float(cam[held].mean()) if held.size else float("nan"),
@@ -110,8 +107,15 @@ def fit_row(eval_path, loss_path, n_train: int, holdout_every: int) -> dict:
 
 
 def fit_settings(cfg: dict) -> dict:
-    """What ``fit_row`` reads of the resolved config ``cfg``: ``n_train`` (the training window's
-    length) and ``holdout_every`` (its held-out stride)."""
+    """What ``fit_row`` reads of the config.
+
+    Args:
+        cfg: the resolved config.
+
+    Returns:
+        ``n_train`` (the training window's length, frames) and ``holdout_every`` (its held-out
+        stride).
+    """
     n_train, every = cfg["testbed"]["n_train"], cfg["train"]["holdout_every"]
     return {"n_train": int(n_train), "holdout_every": int(every)}
 
@@ -156,6 +160,9 @@ def tab_psnr(
         models: the methods, in row order.
         digits: decimals shown in the .tex.
         references: the reference rows.
+
+    Returns:
+        The [`Table`][physgs.report.tables.Table].
     """
     fmt = f".{int(digits)}f"
     seeds = seeds_of(per_seed, "tab_psnr", [(t, m) for t in trees for m in (*models, *references)])
@@ -246,6 +253,9 @@ def tab_fit(
         digits: decimals shown in the .tex.
         static: the static model's id.
         holdout_every: train.holdout_every (the caption says which frames were held out).
+
+    Returns:
+        The [`Table`][physgs.report.tables.Table].
     """
     keys = [(t, m) for t in trees for m in (*models, reference)]
     seeds = seeds_of(per_seed, "tab_fit", keys)
@@ -329,6 +339,9 @@ def tab_transfer(
         conditions: the mean-speed multipliers, the training one first.
         models: the methods, in column order.
         digits: decimals shown in the .tex.
+
+    Returns:
+        The [`Table`][physgs.report.tables.Table].
     """
     seeds = seeds_of(per_seed, "tab_transfer", [(t, m) for t in trees for m in models])
     stems = {"train": "train_c", "beyond": "beyond_c"}  # split -> its summary keys' stem
@@ -397,6 +410,9 @@ def tab_margin(
         priors: the priors, in block order.
         baseline: the model subtracted.
         digits: decimals shown in the .tex.
+
+    Returns:
+        The [`Table`][physgs.report.tables.Table].
     """
     seeds = seeds_of(per_seed, "tab_margin", [(t, m) for t in trees for m in (*priors, baseline)])
     col = {mult: f"margin_{condition_label(mult, tex=False)}" for mult in conditions}
