@@ -107,14 +107,13 @@ def fit_row(eval_path, loss_path, n_train: int, holdout_every: int) -> dict:
 
 
 def fit_settings(cfg: dict) -> dict:
-    """What ``fit_row`` reads of the config.
+    """What ``fit_row`` reads: the training window's length and its held-out stride.
 
     Args:
         cfg: the resolved config.
 
     Returns:
-        ``n_train`` (the training window's length, frames) and ``holdout_every`` (its held-out
-        stride).
+        ``n_train`` and ``holdout_every``.
     """
     n_train, every = cfg["testbed"]["n_train"], cfg["train"]["holdout_every"]
     return {"n_train": int(n_train), "holdout_every": int(every)}
