@@ -199,13 +199,10 @@ def fig_teaser(
     n_train = first.n_train
     if tip is None:
         tip = int(np.argmax(np.ptp(first.gt_px, axis=1).sum(-1)))
-    panels = [("Ground truth", first.gt_px[tip])] + [
-        (label(m), trajectories[m].pred_px[tip]) for m in models
-    ]
-
+    gt = first.gt_px[tip]
+    panels = [("Ground truth", gt)] + [(label(m), trajectories[m].pred_px[tip]) for m in models]
     fig = plt.figure(figsize=(PAGE_WIDTH_IN, PAGE_WIDTH_IN / len(panels) + 4.2))
     gs = fig.add_gridspec(2, 2 * len(panels), height_ratios=[1.0, 1.1])
-    gt = first.gt_px[tip]
     pad = 0.15 * max(np.ptp(gt[:, 0]), np.ptp(gt[:, 1]), 1.0)
     lims = [gt[:, 0].min() - pad, gt[:, 0].max() + pad, gt[:, 1].max() + pad, gt[:, 1].min() - pad]
     for i, (name, p) in enumerate(panels):
