@@ -305,7 +305,8 @@ def tab_fit(
         r"(true motion $-$ static) on the fit; \emph{Held-out of ceiling}: the same on the "
         r"held-out frames (below the fit's: the model memorises its trained frames). "
         r"\emph{View}, \emph{Time}: the evaluation splits. "
-        r"\emph{Iter.}: training iterations used (the stopping rule's, capped at train.iterations). "
+        r"\emph{Iter.}: training iterations used (the stopping rule's, capped at "
+        r"train.iterations). "
         r"In italics the reference: the canonical Gaussians moved by the ground-truth motion."
         + (
             f" {NOT_DEFINED}: not defined (a learned forcing has no wind to read beyond the "
