@@ -51,18 +51,8 @@ def _conditions(cfg: dict) -> dict:
     return {"conditions": [float(c) for c in cfg["testbed"]["conditions"]]}
 
 
-def summaries(path, trees, models, seeds) -> dict:
-    """The evaluation summaries of the models trained in the base configuration.
-
-    Args:
-        path (Callable[..., str]): [`reader`][physgs.report.output.reader]'s need -> file.
-        trees (Sequence[str]): the trees.
-        models (Sequence[str]): the models.
-        seeds (Sequence[int]): the training seeds.
-
-    Returns:
-        ``{seed: {(tree, model): summary}}``, each summary split -> mean (dB; centroid errors px).
-    """
+def _summaries(path, trees, models, seeds) -> dict:
+    """{seed: {(tree, model): summary}} of the models trained in the base configuration."""
     return {
         s: {
             (t, m): load_eval(path("eval", t, m, BASE_CONFIG, s)).summary()
@@ -452,7 +442,7 @@ def tab_margin(
 # ---- the tables' declarations --------------------------------------------------------------
 def _tab_psnr(path, settings, inputs, out):
     trees, shown = settings["trees"], models_of(*METHODS, *REFERENCES)
-    per_seed = summaries(path, trees, shown, settings["seeds"])
+    per_seed = _summaries(path, trees, shown, settings["seeds"])
     methods, references = models_of(*METHODS), models_of(*REFERENCES)
     return tab_psnr(per_seed, trees, settings["bones"], methods, settings["digits"], references)
 
@@ -484,14 +474,14 @@ def _tab_fit(path, settings, inputs, out):
 
 def _tab_transfer(path, settings, inputs, out):
     trees, methods = settings["trees"], models_of(*METHODS)
-    per_seed = summaries(path, trees, methods, settings["seeds"])
+    per_seed = _summaries(path, trees, methods, settings["seeds"])
     bones, conditions = settings["bones"], settings["conditions"]
     return tab_transfer(per_seed, trees, bones, conditions, methods, settings["digits"])
 
 
 def _tab_margin(path, settings, inputs, out):
     trees, bones, conditions = settings["trees"], settings["bones"], settings["conditions"]
-    per_seed = summaries(path, trees, (MARGIN_BASELINE, *models_of("prior")), settings["seeds"])
+    per_seed = _summaries(path, trees, (MARGIN_BASELINE, *models_of("prior")), settings["seeds"])
     priors, digits = models_of("prior"), settings["digits"]
     return tab_margin(per_seed, trees, bones, conditions, priors, MARGIN_BASELINE, digits)
 
