@@ -325,3 +325,25 @@ def test_a_trees_recipe_moves_a_models_own_point_and_never_a_budget_point(cfg):
     df = fc.collect([], own, 3000, "medium")
     assert df.set_index("model").loc["mlp", "iterations"] == 6000
     assert df.set_index("model").loc["static", "iterations"] == 3000
+
+
+def test_a_window_series_profile_star_has_its_lines_colour(monkeypatch):
+    """The starred profile point of ``mlp@window`` is drawn in the MLP's colour, as its line."""
+    from matplotlib.colors import to_rgba
+
+    from physgs.report import figures
+
+    captured = []
+    monkeypatch.setattr(figures, "save_figure", lambda fig, outputs: captured.append(fig))
+    pts = [
+        {"model": m, "seed": 0, "iterations": it, "fit": 20.0 + it / 1000, "heldout": 19.0,
+         "time": 18.0, "train_s": it / 10}
+        for m in ("mlp", "mlp@window")
+        for it in (500, 3000)
+    ]  # fmt: skip
+    own = {0: {m: _row(20.0) for m in ("static", "mlp", "mlp@window", "truth_motion")}}
+    figures.fig_fit_curve(fc.collect(pts, own, 1500, "medium"), ["unused.png"])
+    stars = [ln for ln in captured[0].axes[0].get_lines() if ln.get_marker() == "*"]
+    assert len(stars) == 2
+    want = to_rgba(figures.COLORS["mlp"])
+    assert all(to_rgba(ln.get_color()) == want for ln in stars)

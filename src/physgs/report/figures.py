@@ -499,8 +499,9 @@ def fig_fit_curve(df: pd.DataFrame, outputs: Sequence[str | Path]) -> None:
                 look = dict(fmt=fmt, mfc=mfc, ms=ms, color=COLORS.get(base), lw=lw, label=lab)
                 # no x error bars on the budgets themselves (no spread)
                 _seed_errorbar(ax, g, x, y, n_seeds > 1, x != "iterations", **look)
+                # the profile's star in its line's colour (a @window series: its field's)
                 p = g[g["is_profile"]]
-                ax.plot(p[x], p[y], "*", ms=10, color=COLORS.get(m))
+                ax.plot(p[x], p[y], "*", ms=10, color=COLORS.get(base))
             for m, (c, ls) in refs.items():
                 if m in prof.index:
                     ax.axhline(prof.loc[m, y], color=c, ls=ls, lw=1.0, label=label(m))
