@@ -242,7 +242,7 @@ def _winds_beyond(run: Run) -> list[Cell]:
     tr = run.own
     if tr is None:
         return []
-    beyond = tr[tr["split"] == "beyond"] if "split" in tr.columns else tr
+    beyond = tr[tr["split"] == "beyond"]  # a key of tab_transfer (images.TRANSFER_COLUMNS)
     return [
         {"suffix": f"{t}/{c:.2f}", "tree": t, "condition": c, "cond": f"{c:.2f}", "split": "beyond"}
         for (t, c), _ in beyond.groupby(["tree", "condition"], sort=False)
