@@ -707,3 +707,20 @@ def test_the_findings_say_when_a_trees_name_stands_for_several_instances():
     )
     mixed = instances_phrase({"sparse": [0, 1], "dense": [0, 1, 2]})
     assert "several instances" in mixed and "testbed seeds" not in mixed
+
+
+def test_every_data_file_of_the_package_ships_with_it():
+    """A YAML file the library reads (the schema, the captions) is in the wheel only when
+    pyproject's package-data names it: an install from a wheel would otherwise lose it."""
+    import fnmatch
+    import tomllib
+    from pathlib import Path
+
+    root = Path(__file__).resolve().parents[1]
+    patterns = tomllib.loads((root / "pyproject.toml").read_text())["tool"]["setuptools"][
+        "package-data"
+    ]["physgs"]
+    pkg = root / "src" / "physgs"
+    data = [p.relative_to(pkg).as_posix() for p in pkg.rglob("*.yaml")]
+    assert "report/captions.yaml" in data
+    assert all(any(fnmatch.fnmatch(d, pat) for pat in patterns) for d in data), (data, patterns)
