@@ -710,8 +710,8 @@ def test_the_findings_say_when_a_trees_name_stands_for_several_instances():
 
 
 def test_every_data_file_of_the_package_ships_with_it():
-    """A YAML file the library reads (the schema, the captions) is in the wheel only when
-    pyproject's package-data names it: an install from a wheel would otherwise lose it."""
+    """A data file the library reads (the schema, the captions, the record's page templates) is
+    in the wheel only when pyproject's package-data names it: a wheel would otherwise lose it."""
     import fnmatch
     import tomllib
     from pathlib import Path
@@ -721,6 +721,6 @@ def test_every_data_file_of_the_package_ships_with_it():
         "package-data"
     ]["physgs"]
     pkg = root / "src" / "physgs"
-    data = [p.relative_to(pkg).as_posix() for p in pkg.rglob("*.yaml")]
-    assert "report/captions.yaml" in data
+    data = [p.relative_to(pkg).as_posix() for e in ("yaml", "md") for p in pkg.rglob(f"*.{e}")]
+    assert {"report/captions.yaml", "report/templates/index.md"} <= set(data)
     assert all(any(fnmatch.fnmatch(d, pat) for pat in patterns) for d in data), (data, patterns)

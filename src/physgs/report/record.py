@@ -16,6 +16,7 @@ import shutil
 from collections import Counter
 from collections.abc import Iterable, Mapping, Sequence
 from dataclasses import asdict, dataclass, field
+from importlib import resources
 from pathlib import Path, PurePosixPath
 
 import numpy as np
@@ -596,48 +597,17 @@ def derive_claims(record_dir: str | Path) -> list[Path]:
     return written
 
 
+def _template(name: str) -> str:
+    """A page template of ``report/templates/`` (text, apart from the code that fills it)."""
+    return resources.files("physgs.report").joinpath("templates", name).read_text()
+
+
 #: The Results page's part the record lays out (``index.md``): its figures, its ledger's counts,
 #: its tables and its run, each included from its own page.
-INDEX_PAGE = """\
-From the run at commit `{s.commit}` (profile `{s.profile}`, training seeds {seeds}; its stamp: [the run](#the-run)).
-
-## Figures
-
---8<-- "docs/record/figures.md"
-
-## The paper against the measured
-
-{ledger}
-
-## Tables
-
-Each table of the run as its summary over seeds (a wide table cut into several, its key columns repeated); the per-seed rows are in the CSV beside it.
-
---8<-- "docs/record/tables.md"
-
-## The run
-
---8<-- "docs/record/stamp.md"
-
-Snakemake's report of a run (every table, figure and job, browsable) is made on demand, not kept in the record: after the run, `python tools/record.py --report-html` writes `results/report.html`.
-
-??? note "The run's own summary (`results/summary.md`): every verdict with its interval, each model's fit, what the run cost"
-
-    --8<-- "docs/record/summary.md"
-
---8<-- "docs/record/rerun.md"
-"""
+INDEX_PAGE = _template("index.md")
 #: One table's entry on the Results page (``tables.md``): where its rows come from, its CSV, and
 #: its summary over seeds (``fold``: open, ``???+``, or folded, ``???``).
-TABLE_ENTRY = """\
-### `{name}`
-
-{over}; every seed's row: [{name}.csv](record/tables/{name}.csv) ({rows} rows).
-
-{fold} note "{name}: the summary, {shown} rows"
-
-    --8<-- "docs/record/tables/{name}.md"
-"""
+TABLE_ENTRY = _template("table_entry.md")
 
 
 def render_pages(record_dir: str | Path) -> list[Path]:
