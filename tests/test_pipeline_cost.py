@@ -257,3 +257,7 @@ def test_a_training_estimate_prices_each_job_at_its_own_budget():
     mlp, ours = 200 * 0.1 + 3800 * 0.2, 100 * 0.1 + 900 * 0.5
     assert est["cpu_s"] == pytest.approx(mlp + ours)
     assert est["longest_s"] == pytest.approx(max(mlp, ours))
+    # a job whose own budget has a warm-up needs the static rate, whatever the shared warm-up
+    del rates[("medium", "static", "single")]
+    est = training_estimate(plan_jobs(dry), rates, ["single"], 3000, 0, budget=budget)
+    assert est["jobs"] == 0 and sum(est["unrated"].values()) == 2

@@ -545,11 +545,11 @@ def training_estimate(
         model = job[: -len(config) - 1] if config else job
         out["per_seed"][seed] = out["per_seed"].get(seed, 0) + 1
         rate, static = rates.get((tree, model, config)), rates.get((tree, "static", "single"))
-        if rate is None or (warmup and static is None):
+        it, warm = budget(m["tree"], model) if budget else (iterations, warmup)
+        if rate is None or (warm and static is None):  # this job's own warm-up needs a rate
             key = (tree, model, config)
             out["unrated"][key] = out["unrated"].get(key, 0) + 1
             continue
-        it, warm = budget(m["tree"], model) if budget else (iterations, warmup)
         job_s = warm * (static or 0.0) + (it - warm) * rate
         out["cpu_s"] += job_s
         out["longest_s"] = max(out["longest_s"], job_s)
