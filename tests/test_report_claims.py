@@ -575,3 +575,21 @@ def test_the_ledger_reads_its_files_by_need_tuple(monkeypatch, tmp_path):
     assert chain["measured"] == pytest.approx((0.001 + 0.001) / 0.08 / 2)
     assert led.loc["fits_window/sparse/ours", "measured"] == pytest.approx(0.9)
     assert led.loc["null_factor/sparse", "verdict"] == "undecided: not measured"
+
+
+def test_the_first_seed_alone_is_the_claim_on_that_seed_s_rows_only():
+    """``first_seed``: each claim from the first seed's rows (the instance of testbed seed 0,
+    the paper's one tree, where each seed has its own), not the mean over seeds; the claims
+    over the damping summaries (not in the tables) are left out."""
+    tables = _tables(seeds=(2, 0, 1))
+    psnr = tables["tab_psnr"]
+    psnr.loc[(psnr["seed"] == 0) & (psnr["model"] == "ours"), "sparse_time"] = 17.0  # -3 dB
+    first = C.first_seed(tables, ["sparse", "medium"], roles=ROLES)
+    claim, v = first["ours_above_static_beyond/sparse"]
+    assert claim.id == "ours_above_static_beyond/sparse" and v == pytest.approx(-3.0)
+    assert not C.on_claim(claim, v) and C.on_claim(claim, 2.0)
+    assert first["ours_above_static_beyond/medium"][1] == pytest.approx(2.0)  # seed 0: +0.00
+    assert first["margin_grows/sparse"][1] == pytest.approx(2.0)  # 1.0 + 0.1 * 0 - (-1.0)
+    assert not any(i.startswith("damping_not_recovered") for i in first)
+    mean = C.ledger(C.measure(tables, {}, ["sparse", "medium"], roles=ROLES)).set_index("id")
+    assert mean.loc["ours_above_static_beyond/sparse", "measured"] > 0  # two seeds at +2 dB

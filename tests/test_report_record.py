@@ -724,3 +724,44 @@ def test_every_data_file_of_the_package_ships_with_it():
     data = [p.relative_to(pkg).as_posix() for e in ("yaml", "md") for p in pkg.rglob(f"*.{e}")]
     assert {"report/captions.yaml", "report/templates/index.md"} <= set(data)
     assert all(any(fnmatch.fnmatch(d, pat) for pat in patterns) for d in data), (data, patterns)
+
+
+def test_a_record_on_instances_says_where_the_first_seed_alone_lies(tmp_path):
+    """A run with several instances of a tree against a one-instance record: each moved verdict
+    beside its first seed alone (the record's own tree), recomputed from the run's tables, and a
+    sentence counting which the other instances moved."""
+    r, fit, claims = _run(tmp_path)
+    psnr = pd.DataFrame(
+        [
+            {"seed": s, "model": m, "sparse_view": 22.0, "sparse_time": t}
+            for s, offsets in enumerate([(0.0, 1.5), (0.0, -2.0), (0.0, -2.5)])
+            for m, t in zip(("static", "ours"), (20.0 + offsets[0], 20.0 + offsets[1]))
+        ]
+    )
+    out = tmp_path / "record"
+    _record(r, out, tables=[r / "tables" / "tab_fit.csv"], figures=[])
+    psnr.to_csv(r / "tables" / "tab_psnr.csv", index=False)
+    claims.loc[0, ["measured", "ci_low", "ci_high", "verdict"]] = [-1.0, -4.0, 2.0, "undecided"]
+    claims.to_csv(r / "claims.csv", index=False)
+    stamp = record.Stamp(
+        **{
+            **asdict(_stamp()),
+            "commit": "def5678",
+            "seeds": (0, 1, 2),
+            "instances": {"sparse": [0, 1, 2]},
+        }
+    )
+    _record(r, out, tables=sorted((r / "tables").glob("*.csv")), figures=[], stamp=stamp,
+            roles={"sparse": {}})  # fmt: skip
+    text = (out / "rerun.md").read_text()
+    head, body = _parse_md_table(text.split("keep their verdict")[1].split("\n\n")[1])
+    assert head[-1] == "first seed alone"
+    assert body[0][-1].strip() == "same side, +1.5"  # the record's tree still above static
+    assert "for 1 it lies on the record's side of the threshold" in text
+    assert "for 0 it crossed too" in text
+    claims.loc[0, ["measured", "ci_low", "ci_high", "verdict"]] = [1.99, 1.2, 2.77, "holds"]
+    claims.to_csv(r / "claims.csv", index=False)
+    one = record.Stamp(**{**asdict(stamp), "instances": {"sparse": [0]}, "commit": "0a1b2c3"})
+    _record(r, out, tables=sorted((r / "tables").glob("*.csv")), figures=[], stamp=one)
+    text = (out / "rerun.md").read_text()
+    assert "1 changed" in text and "first seed alone" not in text  # one instance: not asked

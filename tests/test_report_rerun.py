@@ -143,3 +143,23 @@ def test_timings_are_not_compared_and_named_tables_take_their_keys():
     assert set(TIMING_COLUMNS) == {"train_s", "select_s", "cost_x", "fit_s", "ours_train_s"}
     with pytest.raises(ValueError, match="repeat"):
         table_keys("tab_other", t)
+
+
+def test_a_moved_verdict_says_where_the_first_seed_alone_lies():
+    """Against a one-instance record: a verdict the other instances moved keeps its first seed
+    (the record's tree) on the old mean's side; one whose first seed crossed too moved on that
+    tree itself; a claim without a first-seed value says so."""
+    from physgs.report.claims import Claim
+    from physgs.report.rerun import FIRST_CROSSED, FIRST_SAME, compare_claims
+
+    def claim(i):
+        return Claim(id=i, text=i, paper="--", source="--", threshold=0.0, side=">", unit="dB")
+
+    old = _ledger(["holds", "holds", "holds"], [2.0, 2.0, 2.0])
+    new = _ledger(["undecided", "fails", "undecided"], [0.5, -2.0, 0.5])
+    first = {"a/sparse": (claim("a/sparse"), 1.7), "b/sparse": (claim("b/sparse"), -0.4)}
+    c = compare_claims(old, new, first)
+    got = {v.id: v.alone for v in c.changed}
+    assert got == {"a/sparse": f"{FIRST_SAME}, +1.7", "b/sparse": f"{FIRST_CROSSED}, -0.4",
+                   "c/dense": "--"}  # fmt: skip
+    assert all(v.alone == "--" for v in compare_claims(old, new).changed)  # none set beside

@@ -58,6 +58,7 @@ import physgs.config
 from physgs.experiments.cost import dry_run, plan_jobs, plan_outputs, summarise
 from physgs.provenance import EVERY_JOB_ENV, config_hash, git_commit, machine_cpu
 from physgs.report import record
+from physgs.report.claim_cells import roles_of
 from snakemake.cli import parse_config
 
 
@@ -220,6 +221,7 @@ def main() -> None:
         print(run.left_out_line())
         by_stage = summarise(list(run.jobs))["by_stage"]
         commit = args.commit or git_commit()
+        cfg = physgs.config.load("config/trees.yaml", str(fit["profile"].iloc[0]))
         stamp = record.Stamp(
             date=datetime.date.today().isoformat(),
             commit=commit,
@@ -235,7 +237,7 @@ def main() -> None:
             instances=record.instances_of(
                 pd.read_csv(r / "tables" / "tab_testbed.csv"),
                 fit["seed"].unique(),
-                int(physgs.config.load("config/trees.yaml", str(fit["profile"].iloc[0]))["seed"]),
+                int(cfg["seed"]),
             ),
             overrides=tuple(shlex.split(_words(args.config, args.configfile))),
         )
@@ -247,6 +249,7 @@ def main() -> None:
             claims_md=r / "claims.md",
             tables=run.tables,
             figures=run.figures,
+            roles=roles_of(cfg["presets"], stamp.trees),
         )
         print(f"{args.out}: {len(written)} files")
     if not (args.out / "stamp.json").is_file():

@@ -93,6 +93,22 @@ def verdict(claim: Claim, values: Sequence[float]) -> str:
     return decide(claim, m, lo, hi, int(np.isfinite(np.asarray(values, dtype=np.float64)).sum()))
 
 
+def on_claim(claim: Claim, x: float) -> bool:
+    """Whether a value lies on the claimed side of the threshold (inside the band for WITHIN).
+
+    Args:
+        claim: the claim (threshold, side).
+        x: a value in the claim's unit.
+
+    Returns:
+        True on the claim's side; False against it (and for NaN).
+    """
+    t = claim.threshold
+    if claim.side == WITHIN:
+        return bool(-t < x < t)
+    return bool(x > t if claim.side == ">" else x < t)
+
+
 def decide(claim: Claim, m: float, lo: float, hi: float, n: int) -> str:
     """The verdict of an estimate and its 95% interval (e.g. a committed record's ``measured``,
     ``ci_low``, ``ci_high`` and ``seeds``).
@@ -110,10 +126,8 @@ def decide(claim: Claim, m: float, lo: float, hi: float, n: int) -> str:
     """
     t = claim.threshold
 
-    def on(x: float) -> bool:  # on the claimed side (inside the band for WITHIN)
-        if claim.side == WITHIN:
-            return -t < x < t
-        return x > t if claim.side == ">" else x < t
+    def on(x: float) -> bool:
+        return on_claim(claim, x)
 
     if not np.isfinite(m):
         return "undecided: not measured"
@@ -193,6 +207,35 @@ def measure(
                 claim = Claim(**spec.claim_of(cell))
                 out.append((claim, [float(spec.read(d, cell)) for d in seeds]))
     return out
+
+
+def first_seed(
+    tables: Mapping[str, pd.DataFrame],
+    trees: Sequence[str],
+    roles: Mapping[str, Mapping[str, str]] | None = None,
+) -> dict[str, tuple[Claim, float]]:
+    """Each claim on the run's first seed alone: with ``testbed_seeds``, the instance built with
+    the first testbed seed, the one tree of the paper's protocol (a rerun sets it beside a
+    one-instance record: did the other instances move a verdict, or did that tree move too?).
+
+    Claims over the priors' damping summaries (not in the tables) are left out.
+
+    Args:
+        tables: table name -> its CSV, every seed (``measure``'s).
+        trees: the trees.
+        roles: tree -> its preset's role, as ``measure``'s.
+
+    Returns:
+        claim id -> (the claim, its value on the first seed; NaN where not measured).
+    """
+    first = {
+        n: df[df["seed"] == df["seed"].min()] if "seed" in df.columns else df
+        for n, df in tables.items()
+    }
+    return {
+        c.id: (c, float(v[0]) if len(v) else float("nan"))
+        for c, v in measure(first, {}, trees, roles=roles)
+    }
 
 
 def to_decide(claim: Claim, values: Sequence[float]) -> tuple[float, float]:

@@ -267,10 +267,15 @@ def _demote(markdown: str) -> str:
 
 
 def _rerun_lines(
-    previous: Path, stamp: Stamp, claims_csv: str | Path, tables: Sequence[str | Path]
+    previous: Path,
+    stamp: Stamp,
+    claims_csv: str | Path,
+    tables: Sequence[str | Path],
+    first: Mapping[str, tuple] | None = None,
 ) -> list[str]:
     """The record's "Against the previous record" section: this run's ledger verdict by verdict
-    and its seeded tables cell by cell against the record in ``previous`` (``rerun``)."""
+    (beside ``first``, its first seed alone, where the run has several instances of a tree) and
+    its seeded tables cell by cell against the record in ``previous`` (``rerun``)."""
     head = ["## Against the previous record", ""]
     if not ((previous / "stamp.json").is_file() and (previous / "claims.csv").is_file()):
         return [*head, "No earlier record to compare with.", ""]
@@ -280,7 +285,7 @@ def _rerun_lines(
         if old.get("config_hash") == stamp.config_hash
         else f"config hash `{old.get('config_hash')}`: the comparison spans a change of settings"
     )
-    c = rerun.compare_claims(_read(previous / "claims.csv"), _read(claims_csv))
+    c = rerun.compare_claims(_read(previous / "claims.csv"), _read(claims_csv), first)
     apart = f" ({len(c.only_new)} claims new in this run, {len(c.only_old)} no longer asked.)"
     lines = [
         *head,
@@ -296,14 +301,18 @@ def _rerun_lines(
         "",
     ]
     if c.changed:
+        alone = ("first seed alone",) if first else ()
         verdicts = [
             (f"`{v.id}`: {v.claim}", f"{v.old}, {v.old_value}", f"**{v.new}**, {v.new_value}")
             + (v.threshold, v.overlap)
+            + ((v.alone,) if first else ())
             for v in c.changed
         ]
         n = Counter(v.overlap for v in c.changed)
         lines += [
-            *_table(verdicts, ("claim", "before", "after", "threshold", "intervals overlap")),
+            *_table(
+                verdicts, ("claim", "before", "after", "threshold", "intervals overlap", *alone)
+            ),
             f"Of the {len(c.changed)} moved verdicts, {n['yes']} moved with overlapping intervals "
             f"(within the seeds' noise: an interval that now clears or now touches its "
             f"threshold), {n['no']} with intervals apart (the runs disagree beyond that noise)"
@@ -311,6 +320,21 @@ def _rerun_lines(
             + ".",
             "",
         ]
+        if first:
+            k = Counter(v.alone.split(",")[0] for v in c.changed)
+            lines += [
+                f"This run has several instances of a tree (the stamp's), the record one. Its "
+                f"first seed trained on the record's own instance (testbed seed "
+                f"{min(min(s) for s in stamp.instances.values())}), so that seed alone tells why a "
+                f"verdict moved: for {k[rerun.FIRST_SAME]} it lies on the record's side of the "
+                f"threshold (the other instances moved the verdict), for {k[rerun.FIRST_CROSSED]} "
+                f"it crossed too (the record's tree itself moved: the settings, or training "
+                f"noise)"
+                + (f"; {k['--']} have no first-seed value (over the priors' damping summaries, "
+                   "or not measured)" if k["--"] else "")
+                + ".",
+                "",
+            ]  # fmt: skip
     rows, moved = [], []
     for t in sorted(Path(p) for p in tables):
         before = previous / "tables" / t.name
@@ -439,6 +463,7 @@ def write_record(
     claims_md: str | Path,
     tables: Sequence[str | Path],
     figures: Sequence[str | Path],
+    roles: Mapping[str, Mapping[str, str]] | None = None,
 ) -> list[Path]:
     """Write a run's record into ``out_dir``, swapped in whole for the record there.
 
@@ -450,6 +475,9 @@ def write_record(
         claims_md: the claims ledger as Markdown.
         tables: the run's table CSVs, each copied to ``tables/`` and summarised beside.
         figures: the run's figure PNGs, each copied web-sized to ``figures/``.
+        roles: tree -> its preset's role (``claim_cells.roles_of``), for the ledger on the
+            first seed alone ([`first_seed`][physgs.report.claims.first_seed]) that a run with
+            several instances of a tree sets beside each moved verdict.
 
     Returns:
         The files written.
@@ -478,7 +506,16 @@ def write_record(
     if old_rerun.is_file() and all(prior.get(k) == now[k] for k in keys):
         against = old_rerun.read_text()  # the same run recorded again keeps its comparison
     else:
-        against = "\n".join(_rerun_lines(final, stamp, claims_csv, tables))
+        first = None
+        if any(len(s) > 1 for s in stamp.instances.values()):
+            from physgs.report.build import read_table  # build reads every output's module
+
+            names = set(catalogue.tables())
+            tabs = {Path(t).stem: read_table(Path(t).stem, t) for t in tables}
+            first = ledger.first_seed(
+                {n: d for n, d in tabs.items() if n in names}, stamp.trees, roles
+            )
+        against = "\n".join(_rerun_lines(final, stamp, claims_csv, tables, first))
     out = final.with_name(final.name + ".partial")  # the old record stands until this is whole
     _remove(out)  # an earlier write that stopped before its swap
     (out / "tables").mkdir(parents=True)

@@ -7,10 +7,12 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 from pathlib import Path
+from typing import Mapping
 
 import numpy as np
 import pandas as pd
 
+from physgs.report.claims import Claim, on_claim
 from physgs.report.outputs import OUTPUTS, PROVENANCE_COLUMNS
 
 
@@ -204,7 +206,8 @@ def spreads_moved(ch: CellChange) -> float:
 class VerdictChange:
     """A claim whose verdict kind differs between two runs: each run's verdict and measurement
     with its interval in words, the threshold, and whether the runs' 95% intervals overlap
-    (``yes``, ``no``, ``--`` where either run has none)."""
+    (``yes``, ``no``, ``--`` where either run has none), and where the new run's first seed
+    alone lies (``alone``: ``FIRST_SAME`` or ``FIRST_CROSSED`` and its value; ``--``)."""
 
     id: str
     claim: str
@@ -214,6 +217,23 @@ class VerdictChange:
     new_value: str
     threshold: str
     overlap: str
+    alone: str = "--"
+
+
+#: The first seed alone on the old mean's side of the threshold: the other instances moved it.
+FIRST_SAME = "same side"
+#: The first seed alone crossed the threshold too: that tree moved (settings, training noise).
+FIRST_CROSSED = "crossed"
+
+
+def _alone(first: tuple[Claim, float] | None, old: pd.Series) -> str:
+    """Whether the new run's first-seed value lies on the old mean's side of the threshold."""
+    m = pd.to_numeric(old["measured"], errors="coerce")
+    if first is None or not (np.isfinite(first[1]) and np.isfinite(m)):
+        return "--"
+    claim, v = first
+    same = on_claim(claim, v) == on_claim(claim, float(m))
+    return f"{FIRST_SAME if same else FIRST_CROSSED}, {v:+.3g}"
 
 
 @dataclass(frozen=True)
@@ -257,12 +277,16 @@ def _overlap(a: pd.Series, b: pd.Series) -> str:
     return "yes" if max(ends[0], ends[2]) <= min(ends[1], ends[3]) else "no"
 
 
-def compare_claims(old: pd.DataFrame, new: pd.DataFrame) -> ClaimsComparison:
+def compare_claims(
+    old: pd.DataFrame, new: pd.DataFrame, first: Mapping[str, tuple[Claim, float]] | None = None
+) -> ClaimsComparison:
     """Compare two runs' ledgers (``claims.csv``) verdict by verdict, by kind (not reason).
 
     Args:
         old: the earlier run's ledger (id, verdict, measured, ci_low, ci_high, unit, threshold).
         new: the new run's ledger, same columns.
+        first: claim id -> (claim, the new run's value on its first seed alone)
+            ([`first_seed`][physgs.report.claims.first_seed]); None: not set beside.
 
     Returns:
         The [`ClaimsComparison`][physgs.report.rerun.ClaimsComparison].
@@ -288,7 +312,15 @@ def compare_claims(old: pd.DataFrame, new: pd.DataFrame) -> ClaimsComparison:
         claim = str(r.get("claim", r["id"]))
         changed.append(
             VerdictChange(
-                str(r["id"]), claim, a, b, _value(o), _value(r), threshold, _overlap(o, r)
+                str(r["id"]),
+                claim,
+                a,
+                b,
+                _value(o),
+                _value(r),
+                threshold,
+                _overlap(o, r),
+                _alone((first or {}).get(str(r["id"])), o),
             )
         )
     ids_new = set(new["id"].astype(str))
