@@ -5,6 +5,8 @@
     python benchmarks/stopping.py choose curves/sparse.csv curves/medium.csv curves/dense.csv \
         [--every 100 --tol 0.005 --patience 3]   # one setting, per model and tree
     PYTHONPATH=src python benchmarks/stopping.py overhead results/testbed/sparse [--models ...]
+    python benchmarks/stopping.py fits docs/record/claims.csv docs/studies/curves/*.csv \
+        --fit docs/record/tables/tab_fit.csv [--markdown docs/studies/fit_shortfalls.md]
 
 ``curves``: held-out-window fit curves: each model's loss on the frames its training window holds
 out (every ``train.holdout_every``-th, of the trained wind) every ``--every`` iterations of one
@@ -21,6 +23,10 @@ held-out scores took: the real cost of the chosen setting.
 improvement of the held-out loss), its PSNR there, at 3000 iterations and at the end, the slope
 over the last quarter (where it is heading), and with the static pose's and the ceiling's curves
 the end's fraction of the ceiling's held-out gain; ``--markdown``/``--figure`` write them.
+
+``fits``: each ``fits_window`` row of a ledger that does not hold (the fit bar's shortfalls),
+beside the curve of its model on its tree at the budget it trained (``--fit``: the run's
+tab_fit), else the longest measured: its last held-out score, its best and where it was heading.
 
 ``choose``: where the stopping rule would stop each model, from its held-out-window curve
 (``curves``), for a grid of N (every), tol and P (patience), and what it would cost: the
@@ -313,6 +319,7 @@ def plateaus(
             "psnr_3000": psnr[it == 3000][0] if (it == 3000).any() else np.nan,
             "psnr_end": psnr[-1],
             "best_at": int(it[np.argmax(psnr)]),
+            "psnr_best": psnr.max(),
             "enough_at": int(it[np.argmax(psnr >= psnr.max() - within_db)]),
             "slope_db_per_1000": slope,
         }
@@ -385,6 +392,83 @@ def shortfalls(df: pd.DataFrame, caps: list[int]) -> pd.DataFrame:
     return pd.DataFrame(out)
 
 
+#: |slope| over a curve's last quarter below this (dB per 1000 iterations) reads as flat: a
+#: quarter of a 12,000-iteration curve then moves under 0.3 dB, the size of a seed's spread
+FLAT_DB_PER_1000 = 0.1
+
+
+def heading(slope: float) -> str:
+    """Where a curve is heading, in words, from its last quarter's slope.
+
+    Args:
+        slope: dB per 1000 iterations (NaN: too few scores).
+
+    Returns:
+        ``rising``, ``flat`` or ``falling`` with the slope; ``--`` without one.
+    """
+    if not np.isfinite(slope):
+        return "--"
+    word = "flat" if abs(slope) < FLAT_DB_PER_1000 else ("rising" if slope > 0 else "falling")
+    return f"{word} ({slope:+.2f} dB/1000)"
+
+
+def curves_at(df: pd.DataFrame, trained: dict) -> pd.DataFrame:
+    """One curve per (tree, model) of the learned models: the training at the budget the model
+    trained in a run, where one was made; else the longest.
+
+    Args:
+        df: curve rows (``FIELDS``) with each training's ``budget``.
+        trained: (tree, model) -> the iterations it trained in the run.
+
+    Returns:
+        The chosen curves' rows.
+    """
+    learned = df[~df["model"].isin(["static", "truth_motion"])]
+    keep = []
+    for (tree, m), g in learned.groupby(["tree", "model"], sort=False):
+        b = trained.get((tree, m))
+        keep.append(g[g["budget"] == (b if (g["budget"] == b).any() else g["budget"].max())])
+    return pd.concat(keep, ignore_index=True) if keep else learned
+
+
+def fit_shortfalls(claims: pd.DataFrame, p: pd.DataFrame) -> pd.DataFrame:
+    """Each ``fits_window`` row of a ledger that does not hold, beside its curve's plateau.
+
+    Args:
+        claims: a ledger (``claims.csv``: id, verdict, measured, ci_low, ci_high).
+        p: ``plateaus``' rows of the held-out window curves.
+
+    Returns:
+        One row per such (tree, model): the verdict and measured fraction of the ceiling's
+        in-window gain with its interval, the curve's length, its last held-out score and its
+        best (dB, and where), and where it was heading (``heading``); ``--`` without a curve.
+    """
+    fits = claims[claims["id"].astype(str).str.startswith("fits_window/")]
+    out = []
+    for _, c in fits[~fits["verdict"].astype(str).str.startswith("holds")].iterrows():
+        _, tree, model = str(c["id"]).split("/")
+        row = {
+            "tree": tree,
+            "model": model,
+            "verdict": str(c["verdict"]).split(":")[0],
+            "ceiling_frac": f"{c['measured']:.2f} [{c['ci_low']:.2f}, {c['ci_high']:.2f}]",
+        }
+        r = p[(p["tree"] == tree) & (p["model"] == model)]
+        if r.empty:
+            row.update(curve="no curve measured", last_psnr="--", best="--", heading="--")
+        else:
+            r = r.iloc[0]
+            row.update(
+                curve=f"{r['budget']} it",
+                last_psnr=f"{r['psnr_end']:.2f}",
+                best=f"{r['psnr_best']:.2f} at {r['best_at']}",
+                heading=heading(r["slope_db_per_1000"]),
+            )
+        out.append(row)
+    return pd.DataFrame(out, columns=["tree", "model", "verdict", "ceiling_frac", "curve",
+                                      "last_psnr", "best", "heading"])  # fmt: skip
+
+
 def plateau(a: argparse.Namespace) -> None:
     """Print (and with ``--markdown`` write) each curve's plateau; ``--figure`` draws them."""
     df = pd.concat(
@@ -449,6 +533,23 @@ def plateau(a: argparse.Namespace) -> None:
         )
         fig.tight_layout()
         fig.savefig(a.figure, dpi=150)
+
+
+def fits(a: argparse.Namespace) -> None:
+    """Print (and with ``--markdown`` write) the fit bar's shortfalls beside their curves."""
+    df = pd.concat(
+        [pd.read_csv(p).assign(budget=lambda d: d["iteration"].max()) for p in a.curves],
+        ignore_index=True,
+    )
+    trained = {}
+    if a.fit:  # the budget each model trained in the run: its own-schedule curve, where measured
+        tf = pd.read_csv(a.fit)
+        trained = tf.groupby(["tree", "model"])["iterations"].max().astype(int).to_dict()
+    p = plateaus(curves_at(df, trained), a.patience, a.tol)
+    r = fit_shortfalls(pd.read_csv(a.claims), p)
+    print(r.to_string(index=False))
+    if a.markdown:
+        Path(a.markdown).write_text(r.to_markdown(index=False) + "\n")
 
 
 def choose(a: argparse.Namespace) -> None:
@@ -557,6 +658,14 @@ def main() -> None:
     p.add_argument("--markdown", default=None, help="write the table here")
     p.add_argument("--figure", default=None, help="draw the curves here (PNG)")
     p.set_defaults(run=plateau, threads=None)
+    p = sub.add_parser("fits", help="each fits_window row that does not hold, with its curve")
+    p.add_argument("claims", help="a ledger: docs/record/claims.csv")
+    p.add_argument("curves", nargs="+")
+    p.add_argument("--patience", type=int, default=2)
+    p.add_argument("--tol", type=float, default=0.005)
+    p.add_argument("--fit", default=None, help="the run's tab_fit.csv: each model's budget")
+    p.add_argument("--markdown", default=None, help="write the table here")
+    p.set_defaults(run=fits, threads=None)
     p = sub.add_parser("overhead", help="a held-out score's cost against a training iteration")
     p.add_argument("testbed", type=Path)
     p.add_argument("--models", default="static,ours,mlp,mlp_wind,d3dgs,d3dgs_wind")

@@ -242,3 +242,42 @@ def test_a_curves_plateau_and_heading_are_read_as_worked_by_hand():
     o = bench.own_budgets(curve, own).iloc[0]
     assert o["own_end"] == pytest.approx(24.0) and o["long_at"] == pytest.approx(23.0)
     assert o["own_below_best"] == pytest.approx(2.0)
+
+
+def test_the_fit_bars_shortfalls_name_their_curve_and_where_it_heads():
+    """benchmarks/stopping.py fits: each fits_window row that does not hold, beside the curve of
+    its model at the budget it trained (else the longest): last score, best, heading."""
+    import importlib.util
+    from pathlib import Path
+
+    path = Path(__file__).resolve().parents[1] / "benchmarks" / "stopping.py"
+    spec = importlib.util.spec_from_file_location("stopping_bench", path)
+    bench = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(bench)
+    assert bench.heading(0.55) == "rising (+0.55 dB/1000)"
+    assert bench.heading(-0.05).startswith("flat") and bench.heading(-0.2).startswith("falling")
+    assert bench.heading(float("nan")) == "--"
+
+    def curve(model, budget, rise):  # PSNR 20 + rise * it / 1000, scored every 300
+        its = np.arange(300, budget + 1, 300)
+        return pd.DataFrame({"tree": "dense", "model": model, "iteration": its, "budget": budget,
+                             "holdout_loss": 0.1 / its, "holdout_psnr": 20.0 + rise * its / 1000})  # fmt: skip
+
+    df = pd.concat([curve("mlp", 12000, 0.5), curve("ours", 12000, 0.0), curve("ours", 6000, 1.0)])
+    # ours trained 6000 in the run: its own 6000 curve, not the 12000 one's checkpoints
+    picked = bench.curves_at(df, {("dense", "ours"): 6000, ("dense", "mlp"): 3000})
+    assert set(zip(picked["model"], picked["budget"])) == {("mlp", 12000), ("ours", 6000)}
+    p = bench.plateaus(picked, patience=2, tol=0.005)
+    claims = pd.DataFrame({
+        "id": ["fits_window/dense/mlp", "fits_window/dense/ours", "fits_window/dense/d3dgs",
+               "fits_window/sparse/mlp", "null_factor/dense"],
+        "verdict": ["fails", "undecided", "fails", "holds", "fails"],
+        "measured": [0.13, 0.45, 0.4, 0.9, 1.0], "ci_low": [0.08, 0.3, 0.3, 0.8, 0.5],
+        "ci_high": [0.17, 0.6, 0.5, 1.0, 1.5],
+    })  # fmt: skip
+    r = bench.fit_shortfalls(claims, p).set_index("model")
+    assert list(r.index) == ["mlp", "ours", "d3dgs"]  # the rows that do not hold, in order
+    assert r.loc["mlp", "last_psnr"] == "26.00" and r.loc["mlp", "heading"].startswith("rising")
+    assert r.loc["ours", "curve"] == "6000 it" and r.loc["ours", "best"] == "26.00 at 6000"
+    assert r.loc["ours", "ceiling_frac"] == "0.45 [0.30, 0.60]"
+    assert r.loc["d3dgs", "curve"] == "no curve measured"
