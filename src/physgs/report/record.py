@@ -16,16 +16,15 @@ import shutil
 from collections import Counter
 from collections.abc import Iterable, Mapping, Sequence
 from dataclasses import asdict, dataclass, field
-from importlib import resources
 from pathlib import Path, PurePosixPath
 
 import numpy as np
 import pandas as pd
-import yaml
 from PIL import Image
 
 from physgs.experiments import cost
 from physgs.report import captions, catalogue, claims as ledger, rerun
+from physgs.report.prose import PROSE, data, say
 
 #: The commands whose cost the README states, keyed as ``tools/timed.py --name`` records them.
 COMMANDS: tuple[tuple[str, str], ...] = (
@@ -61,20 +60,12 @@ SUMMARY_CLAIMS = "### Claims ledger"
 NUMBER_WORDS = ("no", "one", "two", "three", "four", "five", "six", "seven", "eight", "nine", "ten")
 
 
-def _data(name: str) -> str:
-    """A text file of the package's ``report/`` (text, apart from the code that fills it)."""
-    return resources.files("physgs.report").joinpath(name).read_text(encoding="utf-8")
-
-
-#: The sentences of the record's pages, the README's block and the run summary (``str.format``
-#: templates, each written once): ``report/prose.yaml``.
-PROSE: dict = yaml.safe_load(_data("prose.yaml"))
 #: The Results page's part the record lays out (``index.md``): its figures, its ledger's counts,
 #: its tables and its run, each included from its own page.
-INDEX_PAGE = _data("templates/index.md")
+INDEX_PAGE = data("templates/index.md")
 #: One table's entry on the Results page (``tables.md``): where its rows come from, its CSV, and
 #: its summary over seeds (``fold``: open, ``???+``, or folded, ``???``).
-TABLE_ENTRY = _data("templates/table_entry.md")
+TABLE_ENTRY = data("templates/table_entry.md")
 
 
 def _join(xs: Iterable) -> str:
@@ -256,18 +247,6 @@ def _table(rows: Iterable, columns: Sequence[str], right: Iterable[str] = ()) ->
     return markdown_table(pd.DataFrame(rows, columns=columns), right).split("\n")
 
 
-def _say(name: str, **fields) -> str:
-    """The sentence ``name`` of ``PROSE``, its fields filled in; a field with a clause of its own
-    (``<name>_<field>``: a template, or a pair) becomes that clause, filled in, where the field is
-    set (non-zero, non-empty), else "" (or the pair's second)."""
-    filled = dict(fields)
-    for f, clause in [(f, PROSE.get(f"{name}_{f}")) for f in fields]:
-        if clause is not None:
-            yes, no = clause if isinstance(clause, list) else (clause, "")
-            filled[f] = yes.format(**fields) if fields[f] else no
-    return PROSE[name].format(**filled)
-
-
 def _demote(markdown: str) -> str:
     """Every heading one level down, so an included page sits under the including page's title."""
     return re.sub(r"^#+ ", r"#\g<0>", markdown, flags=re.MULTILINE)
@@ -288,14 +267,14 @@ def _rerun_lines(
         return [*lines, PROSE["rerun_none"], ""]
     old = json.loads((previous / "stamp.json").read_text())
     h = old.get("config_hash")
-    settings = PROSE["rerun_same"] if h == stamp.config_hash else _say("rerun_other", hash=h)
+    settings = PROSE["rerun_same"] if h == stamp.config_hash else say("rerun_other", hash=h)
     c = rerun.compare_claims(_read(previous / "claims.csv"), _read(claims_csv), first)
     n, k = len(c.changed), Counter(v.overlap for v in c.changed)
     old_run = {"commit": stamp.commit, "old": old.get("commit"), "date": old.get("date")}
     new, gone = len(c.only_new), len(c.only_old)
-    lines += [_say("rerun_intro", **old_run, settings=settings), ""]
+    lines += [say("rerun_intro", **old_run, settings=settings), ""]
     both = {"same": c.same, "both": c.same + n, "changed": n, "new": new, "old": gone}
-    lines += [_say("rerun_ledger", **both, apart=new + gone), ""]
+    lines += [say("rerun_ledger", **both, apart=new + gone), ""]
     if c.changed:
         verdicts = [
             (f"`{v.id}`: {v.claim}", f"{v.old}, {v.old_value}", f"**{v.new}**, {v.new_value}")
@@ -305,12 +284,12 @@ def _rerun_lines(
         ]
         heads = ("claim", "before", "after", "threshold", "intervals overlap")
         lines += _table(verdicts, heads + (("first seed alone",) if first else ()))
-        lines += [_say("rerun_overlap", n=n, yes=k["yes"], no=k["no"], none=k["--"]), ""]
+        lines += [say("rerun_overlap", n=n, yes=k["yes"], no=k["no"], none=k["--"]), ""]
     if c.changed and first:
         k = Counter(v.alone.split(",")[0] for v in c.changed)
         seed = min(min(s) for s in stamp.instances.values())
         same, crossed = k[rerun.FIRST_SAME], k[rerun.FIRST_CROSSED]
-        lines += [_say("rerun_first", seed=seed, same=same, crossed=crossed, none=k["--"]), ""]
+        lines += [say("rerun_first", seed=seed, same=same, crossed=crossed, none=k["--"]), ""]
     rows, moved = [], []
     for t in sorted(Path(p) for p in tables):
         before = previous / "tables" / t.name
@@ -335,7 +314,7 @@ def _rerun_lines(
         ]
         shown = ("before", "after", "seed spread")
         lines += [
-            _say("rerun_moves", shown=len(cells), n=len(moved)),
+            say("rerun_moves", shown=len(cells), n=len(moved)),
             "",
             *_table(cells, ("table", "row", "column", *shown), right=shown),
         ]
@@ -491,8 +470,8 @@ def write_record(
     _remove(out)  # an earlier write that stopped before its swap
     (out / "tables").mkdir(parents=True)
     (out / "figures").mkdir()
-    for name, data in kept.items():
-        (out / name).write_bytes(data)
+    for name, kept_bytes in kept.items():
+        (out / name).write_bytes(kept_bytes)
     (out / "stamp.json").write_text(json.dumps(asdict(stamp), indent=2) + "\n")
     (out / "rerun.md").write_text(against)
     for name, page in (("summary.md", summary_md), ("claims.md", claims_md)):
@@ -625,8 +604,8 @@ def render_pages(record_dir: str | Path) -> list[Path]:
         df = pd.read_csv(t, dtype={c: str for c in STAMP_COLUMNS})
         summary, _, seeds = table_summary(df)
         pages[f"tables/{t.stem}.md"] = text = summary_markdown(df)
-        over = PROSE["over_none"] if not seeds else _say("over_seed", seed=seeds[0])
-        over = _say("over_seeds", seeds=_join(seeds)) if len(seeds) > 1 else over
+        over = PROSE["over_none"] if not seeds else say("over_seed", seed=seeds[0])
+        over = say("over_seeds", seeds=_join(seeds)) if len(seeds) > 1 else over
         lines = len(summary) * (text.count("\n\n") + 1)  # rows of all its parts
         # a long summary folds away (Material's collapsible block), a short one shows open
         fold = "???+" if lines <= OPEN_TABLE_ROWS or t.stem in OPEN_TABLES else "???"
@@ -642,7 +621,7 @@ def render_pages(record_dir: str | Path) -> list[Path]:
     pages["ledger.md"] = ledger_page(out / "claims.csv", stamp.trees)
     story, premise = story_line(claims), _premise_line(claims)
     led = [
-        _say("index_ledger", **_counts(claims)),
+        say("index_ledger", **_counts(claims)),
         *(["", premise[2:]] if premise else []),
         *(["", story[2:]] if story else []),
     ]
@@ -686,43 +665,28 @@ def ledger_page(claims_csv: str | Path, trees: Sequence[str]) -> str:
     )
     order = {o: i for i, o in enumerate(catalogue.ORIGINS)}  # the paper's first
     claims = claims.iloc[claims["_origin"].map(order).argsort(kind="stable")]
-    e = html.escape
     rows = []
     for _, r in claims.iterrows():
         text = str(r["claim"])  # a sentence's leading tree, and the rest
         lead = [
             t for t in trees if text.startswith(t) and text[len(t) : len(t) + 1] in (":", ",", " ")
         ]
-        tree, short = (lead[0], text[len(lead[0]) :].lstrip(":, ")) if lead else ("", text)
-        more = [
-            f"<b>{e(str(r['claim']))}</b>",
-            f"id <code>{e(str(r['id']))}</code>; {e(r['_origin'])}'s {r['_kind']}",
-            f"holds when the value is {e(str(r['threshold']))} {e(str(r['unit']))}; "
-            f"{int(r['seeds'])} seed{'s' if int(r['seeds']) != 1 else ''}",
-            f"from {e(str(r['source']))}",
-        ]
-        if str(r["verdict"]) != r["_verdict"]:
-            more.append(e(str(r["verdict"])))
-        if ledger.decide_cell(r):
-            more.append(f"seeds that would decide it (est.): {e(ledger.decide_cell(r))}")
-        if r["_kind"] == "premise":
-            more.append(f"if it fails, it undermines {e(catalogue.undermines(str(r['id'])))}")
-        anchor = "claim-" + re.sub(r"[^a-z0-9]+", "-", str(r["id"]).lower()).strip("-")
-        rows.append(
-            f'<tr id="{anchor}" data-origin="{e(r["_origin"])}" data-verdict="{r["_verdict"]}" '
-            f'data-tree="{e(tree or "--")}" data-kind="{r["_kind"]}">'
-            f"<td><details><summary>{e(short)}</summary>{'<br>'.join(more)}</details></td>"
-            f"<td>{e(tree or '--')}</td><td>{e(str(r['paper']))}</td>"
-            f"<td>{e(_value_text(r))}</td>"
-            f'<td class="verdict-{r["_verdict"]}">{r["_verdict"]}</td>'
-            f"<td>{r['_kind']}</td><td>{e(r['_origin'])}</td></tr>"
+        tree, short = (lead[0], text[len(lead[0]) :].lstrip(":, ")) if lead else ("--", text)
+        f = {c: str(r[c]) for c in ("claim", "id", "threshold", "unit", "source", "paper")}
+        f |= {c: str(r["_" + c]) for c in ("origin", "kind", "verdict")}
+        f |= {"tree": tree, "short": short, "value": _value_text(r)}
+        more = {"verdict": str(r["verdict"]) if str(r["verdict"]) != r["_verdict"] else ""}
+        more["decide"] = ledger.decide_cell(r) and say("ledger_decide", cell=ledger.decide_cell(r))
+        premise = r["_kind"] == "premise"
+        more["undermines"] = premise and say(
+            "ledger_undermines", what=catalogue.undermines(f["id"])
         )
-    head = (
-        "<th>claim (click for the full claim)</th><th>tree</th><th>the paper</th>"
-        "<th>measured: mean [95% interval]</th><th>verdict</th><th>kind</th><th>origin</th>"
-    )
-    body = "".join(row + "\n" for row in rows)
-    return f'<table class="ledger">\n<thead><tr>{head}</tr></thead>\n<tbody>\n{body}</tbody>\n</table>\n'
+        anchor = "claim-" + re.sub(r"[^a-z0-9]+", "-", f["id"].lower()).strip("-")
+        f = {k: html.escape(v) for k, v in f.items()} | {"seeds": int(r["seeds"])}
+        details = [t.format(**f, s="s" if f["seeds"] != 1 else "") for t in PROSE["ledger_more"]]
+        details += [html.escape(m) for m in more.values() if m]
+        rows.append(say("ledger_row", **f, anchor=anchor, more="<br>".join(details)) + "\n")
+    return say("ledger_table", body="".join(rows))
 
 
 def write_unrecorded(out_dir: str | Path) -> Path:
@@ -749,7 +713,7 @@ def count_line(claims: pd.DataFrame) -> str:
     Returns:
         One Markdown bullet.
     """
-    return _say("count", **_counts(claims))
+    return say("count", **_counts(claims))
 
 
 def _counts(claims: pd.DataFrame) -> dict[str, str]:
@@ -760,7 +724,7 @@ def _counts(claims: pd.DataFrame) -> dict[str, str]:
 def _premise_line(claims: pd.DataFrame) -> str:
     """A bullet naming the premises that fail and what each undermines; "" when all hold."""
     failed = "; ".join(f.rstrip(".") for f in ledger.failed_premises(claims))
-    return _say("premises", failed=failed) if failed else ""
+    return say("premises", failed=failed) if failed else ""
 
 
 def _headline_families(claims: pd.DataFrame, origin: str | None = None):
@@ -789,8 +753,8 @@ def story_line(claims: pd.DataFrame) -> str:
     if not n:
         return ""
     if held == n:
-        return _say("story_all", n=n)
-    text = _say("story_part", held=held, n=n)
+        return say("story_all", n=n)
+    text = say("story_part", held=held, n=n)
     for v in ("fails", "undecided"):
         where = [
             f"{w} ({', '.join(cells[kind == v])})"
@@ -900,7 +864,7 @@ def instances_phrase(instances: Mapping[str, Sequence[int]]) -> str:
     number = (NUMBER_WORDS[n] if n < len(NUMBER_WORDS) else str(n)) if n else "several"
     seeds = {tuple(s) for s in many.values()}
     which = _join(seeds.pop()) if len(seeds) == 1 else ""
-    return _say(
+    return say(
         "instances", trees=", ".join(many), number=number, which=which, first=next(iter(many))
     )
 
@@ -921,7 +885,7 @@ def found_lines(record_dir: str | Path) -> list[str]:
         made_with = _shell(s.get("overrides") or [])
         phrase = instances_phrase(s.get("instances") or {})
         fields = {"profile": s["profile"], "seeds": _join(s["seeds"]), "commit": s["commit"]}
-        run = _say("found_run", **fields, made_with=made_with, instances=phrase)
+        run = say("found_run", **fields, made_with=made_with, instances=phrase)
         lines[2:] = [run, "", *headline_lines(_read(record / "claims.csv")), "", PROSE["words"]]
     costs = cost_lines(read_costs(record / "costs.csv"))
     return [*lines, "", PROSE["found_costs"], "", *costs, ""]
