@@ -674,18 +674,18 @@ def ledger_page(claims_csv: str | Path, trees: Sequence[str]) -> str:
         tree, short = (lead[0], text[len(lead[0]) :].lstrip(":, ")) if lead else ("--", text)
         f = {c: str(r[c]) for c in ("claim", "id", "threshold", "unit", "source", "paper")}
         f |= {c: str(r["_" + c]) for c in ("origin", "kind", "verdict")}
-        f |= {"tree": tree, "short": short, "value": _value_text(r)}
-        more = {"verdict": str(r["verdict"]) if str(r["verdict"]) != r["_verdict"] else ""}
-        more["decide"] = ledger.decide_cell(r) and say("ledger_decide", cell=ledger.decide_cell(r))
-        premise = r["_kind"] == "premise"
-        more["undermines"] = premise and say(
-            "ledger_undermines", what=catalogue.undermines(f["id"])
-        )
+        f |= {
+            "tree": tree,
+            "short": short,
+            "value": _value_text(r),
+            "decide": ledger.decide_cell(r),
+        }
+        f["full"] = str(r["verdict"]) if str(r["verdict"]) != r["_verdict"] else ""
+        f["undermines"] = catalogue.undermines(f["id"]) if r["_kind"] == "premise" else ""
         anchor = "claim-" + re.sub(r"[^a-z0-9]+", "-", f["id"].lower()).strip("-")
-        f = {k: html.escape(v) for k, v in f.items()} | {"seeds": int(r["seeds"])}
-        details = [t.format(**f, s="s" if f["seeds"] != 1 else "") for t in PROSE["ledger_more"]]
-        details += [html.escape(m) for m in more.values() if m]
-        rows.append(say("ledger_row", **f, anchor=anchor, more="<br>".join(details)) + "\n")
+        f, n = {k: html.escape(v) for k, v in f.items()}, int(r["seeds"])
+        details = say("ledger_details", **f, seeds=n, s="s" if n != 1 else "")
+        rows.append(say("ledger_row", **f, anchor=anchor, more=details) + "\n")
     return say("ledger_table", body="".join(rows))
 
 
