@@ -120,7 +120,7 @@ class Stamp:
             )
 
     def markdown(self) -> str:
-        """The stamp as a short Markdown list (``PROSE["stamp"]``; a line of an empty field left out).
+        """The stamp as a Markdown list (``PROSE["stamp"]``; an empty field leaves its line out).
 
         Returns:
             Bullet lines (run, instances, overrides, commit and date, note, machine, wall time
