@@ -765,3 +765,16 @@ def test_a_record_on_instances_says_where_the_first_seed_alone_lies(tmp_path):
     _record(r, out, tables=sorted((r / "tables").glob("*.csv")), figures=[], stamp=one)
     text = (out / "rerun.md").read_text()
     assert "1 changed" in text and "first seed alone" not in text  # one instance: not asked
+
+
+def test_a_sentence_of_the_prose_takes_its_clause_only_where_the_field_is_set():
+    """``prose.say``: a field with a clause of its own (``<name>_<field>``) becomes the clause,
+    filled in, where it is set, else "" (or a pair's second); every sentence is a template."""
+    from physgs.report.prose import PROSE, say
+
+    assert say("rerun_overlap", n=3, yes=1, no=2, none=0).endswith("beyond that noise).")
+    assert say("rerun_overlap", n=3, yes=1, no=1, none=1).endswith("in one of the runs.")
+    ledger = dict(same=1, both=2, changed=1, new=0, old=0, apart=0)
+    assert say("rerun_ledger", **ledger).endswith("keep their verdict, 1 changed:")
+    assert say("rerun_ledger", **{**ledger, "changed": 0}).endswith("keep their verdict.")
+    assert all(isinstance(v, (str, list, dict)) for v in PROSE.values())
