@@ -403,7 +403,7 @@ def test_premises_are_counted_apart_and_a_failed_one_says_what_it_undermines():
     )
     assert "nearest_bone_gap" not in lines[1]  # it holds
     written = claims.assign(kind="finding")  # a written column is read, not the catalogue's
-    assert "premise" not in record.count_line(written).split("(95%")[0]
+    assert "premise" not in record.headline_lines(written)[0].split("(95%")[0]
 
 
 def test_headline_counts_the_verdicts_and_gives_each_story_claim_its_interval():

@@ -704,18 +704,6 @@ def write_unrecorded(out_dir: str | Path) -> Path:
     return out / "index.md"
 
 
-def count_line(claims: pd.DataFrame) -> str:
-    """The ledger's counts, the paper's claims apart from this project's (``claims.counted``).
-
-    Args:
-        claims: the ledger (``id``, ``verdict``; ``origin``, ``kind`` where written).
-
-    Returns:
-        One Markdown bullet.
-    """
-    return say("count", **_counts(claims))
-
-
 def _counts(claims: pd.DataFrame) -> dict[str, str]:
     """The ledger's counts (``claims.counted``) of the paper's claims and this project's."""
     return {who: ledger.counted(claims, who) for who in ("paper", "project")}
@@ -766,7 +754,8 @@ def story_line(claims: pd.DataFrame) -> str:
 
 
 def headline_lines(claims: pd.DataFrame) -> list[str]:
-    """What the run found: the ledger's counts, the paper's story, each headline family's verdicts.
+    """What the run found: the ledger's counts (the paper's claims apart from this project's), the
+    premises that fail, the paper's story, each headline family's verdicts.
 
     Args:
         claims: the ledger (``claims.csv``: id, measured, ci_low, ci_high, unit, verdict).
@@ -775,7 +764,8 @@ def headline_lines(claims: pd.DataFrame) -> list[str]:
         The Markdown lines.
     """
     story, premise = story_line(claims), _premise_line(claims)
-    lines = [count_line(claims), *([premise] if premise else []), *([story] if story else [])]
+    lines = [say("count", **_counts(claims)), *([premise] if premise else [])]
+    lines += [story] if story else []
     for words, rows, where, kind in _headline_families(claims):
         cells = []
         for (_, r), w, k in zip(rows.iterrows(), where, kind):
