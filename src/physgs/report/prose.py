@@ -25,7 +25,7 @@ def data(name: str) -> str:
 PROSE: dict = yaml.safe_load(data("prose.yaml"))
 
 
-def say(name: str, /, **fields) -> str:
+def say(name: str, /, **fields: object) -> str:
     """The sentence ``name`` of ``PROSE``, its fields filled in. A field with a clause of its own
     (``<name>_<field>``: a template, or a pair) becomes that clause, filled in, where the field is
     set (non-zero, non-empty), else "" (or the pair's second).
