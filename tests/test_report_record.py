@@ -403,7 +403,7 @@ def test_premises_are_counted_apart_and_a_failed_one_says_what_it_undermines():
     )
     assert "nearest_bone_gap" not in lines[1]  # it holds
     written = claims.assign(kind="finding")  # a written column is read, not the catalogue's
-    assert "premise" not in record.count_line(written).split("(95%")[0]
+    assert "premise" not in record.headline_lines(written)[0].split("(95%")[0]
 
 
 def test_headline_counts_the_verdicts_and_gives_each_story_claim_its_interval():
@@ -722,7 +722,7 @@ def test_every_data_file_of_the_package_ships_with_it():
     ]["physgs"]
     pkg = root / "src" / "physgs"
     data = [p.relative_to(pkg).as_posix() for e in ("yaml", "md") for p in pkg.rglob(f"*.{e}")]
-    assert {"report/captions.yaml", "report/templates/index.md"} <= set(data)
+    assert {"report/captions.yaml", "report/prose.yaml", "report/templates/index.md"} <= set(data)
     assert all(any(fnmatch.fnmatch(d, pat) for pat in patterns) for d in data), (data, patterns)
 
 
@@ -765,3 +765,16 @@ def test_a_record_on_instances_says_where_the_first_seed_alone_lies(tmp_path):
     _record(r, out, tables=sorted((r / "tables").glob("*.csv")), figures=[], stamp=one)
     text = (out / "rerun.md").read_text()
     assert "1 changed" in text and "first seed alone" not in text  # one instance: not asked
+
+
+def test_a_sentence_of_the_prose_takes_its_clause_only_where_the_field_is_set():
+    """``prose.say``: a field with a clause of its own (``<name>_<field>``) becomes the clause,
+    filled in, where it is set, else "" (or a pair's second); every sentence is a template."""
+    from physgs.report.prose import PROSE, say
+
+    assert say("rerun_overlap", n=3, yes=1, no=2, none=0).endswith("beyond that noise).")
+    assert say("rerun_overlap", n=3, yes=1, no=1, none=1).endswith("in one of the runs.")
+    ledger = dict(same=1, both=2, changed=1, new=0, old=0, apart=0)
+    assert say("rerun_ledger", **ledger).endswith("keep their verdict, 1 changed:")
+    assert say("rerun_ledger", **{**ledger, "changed": 0}).endswith("keep their verdict.")
+    assert all(isinstance(v, (str, list, dict)) for v in PROSE.values())

@@ -1,10 +1,12 @@
-"""Seed statistics (physgs.report.seeds) against scipy: intervals, decisions, the best."""
+"""Seed statistics (physgs.statistics) against scipy: intervals, decisions, the best; the .tex
+cells over seeds (physgs.report.seeds)."""
 
 import numpy as np
 import pytest
 from scipy import stats
 
-from physgs.report import seeds as S
+from physgs import statistics as S
+from physgs.report import seeds
 
 
 def test_interval_matches_scipy_t_interval():
@@ -19,8 +21,8 @@ def test_one_seed_gives_no_interval_and_decides_nothing():
     m, sd, lo, hi = S.interval([2.0])
     assert m == 2.0 and np.isnan(sd) and np.isnan(lo) and np.isnan(hi)
     assert not S.decided([2.0])
-    assert S.pm([2.0], ".2f") == "2.00"
-    assert S.difference([2.0], ".2f") == "$+2.00$" + S.UNDECIDED
+    assert seeds.pm([2.0], ".2f") == "2.00"
+    assert seeds.difference([2.0], ".2f") == "$+2.00$" + seeds.UNDECIDED
 
 
 @pytest.mark.parametrize(

@@ -16,7 +16,6 @@ import shutil
 from collections import Counter
 from collections.abc import Iterable, Mapping, Sequence
 from dataclasses import asdict, dataclass, field
-from importlib import resources
 from pathlib import Path, PurePosixPath
 
 import numpy as np
@@ -25,6 +24,7 @@ from PIL import Image
 
 from physgs.experiments import cost
 from physgs.report import captions, catalogue, claims as ledger, rerun
+from physgs.report.prose import PROSE, data, say
 
 #: The commands whose cost the README states, keyed as ``tools/timed.py --name`` records them.
 COMMANDS: tuple[tuple[str, str], ...] = (
@@ -51,23 +51,6 @@ BEGIN, END = "<!-- record:begin -->", "<!-- record:end -->"
 #: command's cost, the paper profile's measured rates and the estimate made from them.
 OUTLIVE = ("costs.csv", "rates_paper.csv", "paper_estimate.md")
 
-#: The words and units of the findings, defined once under them (the glossary says more).
-WORDS = (
-    "<sub>Each finding: the measured mean over seeds and its 95% interval; **holds** / **fails** "
-    "when the interval lies on one side of the paper's threshold, **undecided** when it straddles "
-    "it. dB: a difference of PSNR (peak signal-to-noise ratio, decibels) on held-out frames; "
-    "points (pp): percentage points of relative error; fraction: a share of the true value; "
-    "ratio: a quotient of errors (its interval on the log scale, so it stays positive); "
-    "`sparse/0.84`: a tree under an unseen wind of 0.84 times the training speed. "
-    "*Headline claim*: one of the paper's claims that carry its story (the lines below the "
-    "counts); *premise*: what the comparison rests on (the fit bar, the testbed's nearest-bone "
-    "gap), *finding*: what it says. *Static pose*: the Gaussians frozen at rest; *learned field*: a neural deformation field "
-    "(the baselines); *untrained null*: oscillators with ω drawn over the true range, not "
-    "fitted; *chained prior*: ours with each part riding on its parent; *learned forcing*: "
-    "ours with the wind learned instead of measured; *from nothing*: after `rm -rf results`; "
-    "*segment*: one stretch of a run resumed with the same command (the glossary defines the rest).</sub>",
-)
-
 #: A commit as the record names it: a plain (abbreviated) hash.
 COMMIT = re.compile(r"^[0-9a-f]{7,40}$")
 #: The run's folder of the jobs' benchmark files (``physgs.experiments.cost``).
@@ -75,6 +58,14 @@ BENCHMARKS = "benchmarks"
 #: The heading of the run summary's claims section as the record holds it (demoted).
 SUMMARY_CLAIMS = "### Claims ledger"
 NUMBER_WORDS = ("no", "one", "two", "three", "four", "five", "six", "seven", "eight", "nine", "ten")
+
+
+#: The Results page's part the record lays out (``index.md``): its figures, its ledger's counts,
+#: its tables and its run, each included from its own page.
+INDEX_PAGE = data("templates/index.md")
+#: One table's entry on the Results page (``tables.md``): where its rows come from, its CSV, and
+#: its summary over seeds (``fold``: open, ``???+``, or folded, ``???``).
+TABLE_ENTRY = data("templates/table_entry.md")
 
 
 def _join(xs: Iterable) -> str:
@@ -129,7 +120,7 @@ class Stamp:
             )
 
     def markdown(self) -> str:
-        """The stamp as a short Markdown list.
+        """The stamp as a Markdown list (``PROSE["stamp"]``; an empty field leaves its line out).
 
         Returns:
             Bullet lines (run, instances, overrides, commit and date, note, machine, wall time
@@ -138,28 +129,23 @@ class Stamp:
         by: dict[tuple[int, ...], list[str]] = {}  # the trees of each set of testbed seeds
         for t, seeds in self.instances.items():
             by.setdefault(tuple(seeds), []).append(t)
-        instances = "; ".join(
-            f"{', '.join(trees)}: testbed seed{'s' if len(s) > 1 else ''} {_join(s)}"
-            for s, trees in by.items()
-        )
         stages = ", ".join(f"{k} {v:.1f}" for k, v in self.job_min_by_stage.items())
-        jobs = f"{self.jobs} benchmarked jobs, " if self.jobs else ""
-        total = sum(self.job_min_by_stage.values())
-        return "\n".join(
-            [
-                f"- **Run**: profile `{self.profile}`, config hash `{self.config_hash}`, "
-                f"seeds {_join(self.seeds)}, trees {', '.join(self.trees)}",
-                *([f"- **Tree instances**: {instances}"] if self.instances else []),
-                *([f"- **Overrides**: `{_shell(self.overrides)}`"] if self.overrides else []),
-                f"- **Made at** commit `{self.commit}`; record written {self.date}",
-                *([f"- **Note**: {self.note}"] if self.note else []),
-                f"- **Machine**: {self.cpu}, 2 cores",
-                f"- **Wall time** {format_duration(self.wall_s)} (the time the run's command ran, "
-                f"summed over its segments; `tools/timed.py`); {jobs}{total:.0f} job-minutes"
-                + (f" ({stages})" if stages else ""),
-                "",
-            ]
-        )
+        fields = {
+            "instances": "; ".join(
+                f"{', '.join(trees)}: testbed seed{'s' if len(s) > 1 else ''} {_join(s)}"
+                for s, trees in by.items()
+            ),
+            "overrides": _shell(self.overrides),
+            "note": self.note,
+            "seeds": _join(self.seeds),
+            "trees": ", ".join(self.trees),
+            "wall": format_duration(self.wall_s),
+            "jobs": f"{self.jobs} benchmarked jobs, " if self.jobs else "",
+            "total": sum(self.job_min_by_stage.values()),
+            "stages": f" ({stages})" if stages else "",
+        }
+        lines = PROSE["stamp"].items()
+        return "\n".join([*(t.format(s=self, **fields) for k, t in lines if fields.get(k, 1)), ""])
 
 
 def instances_of(testbed: pd.DataFrame, seeds: Sequence[int], seed: int) -> dict[str, list[int]]:
@@ -258,7 +244,7 @@ def markdown_table(df: pd.DataFrame, right: Iterable[str] = ()) -> str:
 
 def _table(rows: Iterable, columns: Sequence[str], right: Iterable[str] = ()) -> list[str]:
     """``rows`` under ``columns`` as Markdown table lines, then a blank line."""
-    return [*markdown_table(pd.DataFrame(rows, columns=columns), right).splitlines(), ""]
+    return markdown_table(pd.DataFrame(rows, columns=columns), right).split("\n")
 
 
 def _demote(markdown: str) -> str:
@@ -276,65 +262,34 @@ def _rerun_lines(
     """The record's "Against the previous record" section: this run's ledger verdict by verdict
     (beside ``first``, its first seed alone, where the run has several instances of a tree) and
     its seeded tables cell by cell against the record in ``previous`` (``rerun``)."""
-    head = ["## Against the previous record", ""]
+    lines = ["## Against the previous record", ""]
     if not ((previous / "stamp.json").is_file() and (previous / "claims.csv").is_file()):
-        return [*head, "No earlier record to compare with.", ""]
+        return [*lines, PROSE["rerun_none"], ""]
     old = json.loads((previous / "stamp.json").read_text())
-    settings = (
-        "the same config hash"
-        if old.get("config_hash") == stamp.config_hash
-        else f"config hash `{old.get('config_hash')}`: the comparison spans a change of settings"
-    )
+    h = old.get("config_hash")
+    settings = PROSE["rerun_same"] if h == stamp.config_hash else say("rerun_other", hash=h)
     c = rerun.compare_claims(_read(previous / "claims.csv"), _read(claims_csv), first)
-    apart = f" ({len(c.only_new)} claims new in this run, {len(c.only_old)} no longer asked.)"
-    lines = [
-        *head,
-        f"This run (commit `{stamp.commit}`) against the record it replaced: commit "
-        f"`{old.get('commit')}`, written {old.get('date')}, {settings}. What changed between the "
-        "two commits is in `CHANGELOG.md`; `python tools/compare_runs.py OLD NEW` repeats the "
-        "tables' comparison for any two runs.",
-        "",
-        f"**The ledger**: {c.same} of {c.same + len(c.changed)} claims in both runs keep their "
-        "verdict"
-        + (f", {len(c.changed)} changed:" if c.changed else ".")
-        + (apart if c.only_new or c.only_old else ""),
-        "",
-    ]
+    n, k = len(c.changed), Counter(v.overlap for v in c.changed)
+    old_run = {"commit": stamp.commit, "old": old.get("commit"), "date": old.get("date")}
+    new, gone = len(c.only_new), len(c.only_old)
+    lines += [say("rerun_intro", **old_run, settings=settings), ""]
+    both = {"same": c.same, "both": c.same + n, "changed": n, "new": new, "old": gone}
+    lines += [say("rerun_ledger", **both, apart=new + gone), ""]
     if c.changed:
-        alone = ("first seed alone",) if first else ()
         verdicts = [
             (f"`{v.id}`: {v.claim}", f"{v.old}, {v.old_value}", f"**{v.new}**, {v.new_value}")
             + (v.threshold, v.overlap)
             + ((v.alone,) if first else ())
             for v in c.changed
         ]
-        n = Counter(v.overlap for v in c.changed)
-        lines += [
-            *_table(
-                verdicts, ("claim", "before", "after", "threshold", "intervals overlap", *alone)
-            ),
-            f"Of the {len(c.changed)} moved verdicts, {n['yes']} moved with overlapping intervals "
-            f"(within the seeds' noise: an interval that now clears or now touches its "
-            f"threshold), {n['no']} with intervals apart (the runs disagree beyond that noise)"
-            + (f", {n['--']} without an interval in one of the runs" if n["--"] else "")
-            + ".",
-            "",
-        ]
-        if first:
-            k = Counter(v.alone.split(",")[0] for v in c.changed)
-            lines += [
-                f"This run has several instances of a tree (the stamp's), the record one. Its "
-                f"first seed trained on the record's own instance (testbed seed "
-                f"{min(min(s) for s in stamp.instances.values())}), so that seed alone tells why a "
-                f"verdict moved: for {k[rerun.FIRST_SAME]} it lies on the record's side of the "
-                f"threshold (the other instances moved the verdict), for {k[rerun.FIRST_CROSSED]} "
-                f"it crossed too (the record's tree itself moved: the settings, or training "
-                f"noise)"
-                + (f"; {k['--']} have no first-seed value (over the priors' damping summaries, "
-                   "or not measured)" if k["--"] else "")
-                + ".",
-                "",
-            ]  # fmt: skip
+        heads = ("claim", "before", "after", "threshold", "intervals overlap")
+        lines += _table(verdicts, heads + (("first seed alone",) if first else ()))
+        lines += [say("rerun_overlap", n=n, yes=k["yes"], no=k["no"], none=k["--"]), ""]
+    if c.changed and first:
+        k = Counter(v.alone.split(",")[0] for v in c.changed)
+        seed = min(min(s) for s in stamp.instances.values())
+        same, crossed = k[rerun.FIRST_SAME], k[rerun.FIRST_CROSSED]
+        lines += [say("rerun_first", seed=seed, same=same, crossed=crossed, none=k["--"]), ""]
     rows, moved = [], []
     for t in sorted(Path(p) for p in tables):
         before = previous / "tables" / t.name
@@ -349,12 +304,7 @@ def _rerun_lines(
         rows.append((f"`{t.stem}`", r.rows, r.cells, r.identical, r.within, len(r.beyond)))
         moved += [(t.stem, ch) for ch in r.beyond]
     counts = ("rows in both", "numeric cells", "identical", "within the seed spread", "beyond it")
-    lines += [
-        "**The seeded tables**, each numeric cell beside the previous run's spread (max - min) "
-        "over seeds of its row; job timings are left out:",
-        "",
-        *_table(rows, ("table", *counts), right=counts),
-    ]
+    lines += [PROSE["rerun_tables"], "", *_table(rows, ("table", *counts), right=counts)]
     if moved:
         moved.sort(key=lambda m: rerun.spreads_moved(m[1]), reverse=True)
         cells = [
@@ -364,7 +314,7 @@ def _rerun_lines(
         ]
         shown = ("before", "after", "seed spread")
         lines += [
-            f"The largest moves beyond the spread ({len(cells)} of {len(moved)}):",
+            say("rerun_moves", shown=len(cells), n=len(moved)),
             "",
             *_table(cells, ("table", "row", "column", *shown), right=shown),
         ]
@@ -520,8 +470,8 @@ def write_record(
     _remove(out)  # an earlier write that stopped before its swap
     (out / "tables").mkdir(parents=True)
     (out / "figures").mkdir()
-    for name, data in kept.items():
-        (out / name).write_bytes(data)
+    for name, kept_bytes in kept.items():
+        (out / name).write_bytes(kept_bytes)
     (out / "stamp.json").write_text(json.dumps(asdict(stamp), indent=2) + "\n")
     (out / "rerun.md").write_text(against)
     for name, page in (("summary.md", summary_md), ("claims.md", claims_md)):
@@ -634,19 +584,6 @@ def derive_claims(record_dir: str | Path) -> list[Path]:
     return written
 
 
-def _template(name: str) -> str:
-    """A page template of ``report/templates/`` (text, apart from the code that fills it)."""
-    return resources.files("physgs.report").joinpath("templates", name).read_text()
-
-
-#: The Results page's part the record lays out (``index.md``): its figures, its ledger's counts,
-#: its tables and its run, each included from its own page.
-INDEX_PAGE = _template("index.md")
-#: One table's entry on the Results page (``tables.md``): where its rows come from, its CSV, and
-#: its summary over seeds (``fold``: open, ``???+``, or folded, ``???``).
-TABLE_ENTRY = _template("table_entry.md")
-
-
 def render_pages(record_dir: str | Path) -> list[Path]:
     """Lay out the Results page's parts (``index.md`` and what it includes) from the record.
 
@@ -667,11 +604,8 @@ def render_pages(record_dir: str | Path) -> list[Path]:
         df = pd.read_csv(t, dtype={c: str for c in STAMP_COLUMNS})
         summary, _, seeds = table_summary(df)
         pages[f"tables/{t.stem}.md"] = text = summary_markdown(df)
-        over = (
-            f"mean ± sd over training seeds {_join(seeds)}"
-            if len(seeds) > 1
-            else ("training seed " + str(seeds[0]) if seeds else "not seeded: as the run wrote it")
-        )
+        over = PROSE["over_none"] if not seeds else say("over_seed", seed=seeds[0])
+        over = say("over_seeds", seeds=_join(seeds)) if len(seeds) > 1 else over
         lines = len(summary) * (text.count("\n\n") + 1)  # rows of all its parts
         # a long summary folds away (Material's collapsible block), a short one shows open
         fold = "???+" if lines <= OPEN_TABLE_ROWS or t.stem in OPEN_TABLES else "???"
@@ -687,11 +621,7 @@ def render_pages(record_dir: str | Path) -> list[Path]:
     pages["ledger.md"] = ledger_page(out / "claims.csv", stamp.trees)
     story, premise = story_line(claims), _premise_line(claims)
     led = [
-        f"The ledger holds the paper's {ledger.counted(claims, 'paper')}; and this project's own "
-        f"{ledger.counted(claims, 'project')} (95% intervals over seeds; a premise is what the "
-        "comparison rests on, a finding what it says). Each claim with the paper's value beside "
-        "the measured one, its verdict and the table cells it comes from: "
-        "[the paper against the measured](ledger.md).",
+        say("index_ledger", **_counts(claims)),
         *(["", premise[2:]] if premise else []),
         *(["", story[2:]] if story else []),
     ]
@@ -735,43 +665,28 @@ def ledger_page(claims_csv: str | Path, trees: Sequence[str]) -> str:
     )
     order = {o: i for i, o in enumerate(catalogue.ORIGINS)}  # the paper's first
     claims = claims.iloc[claims["_origin"].map(order).argsort(kind="stable")]
-    e = html.escape
     rows = []
     for _, r in claims.iterrows():
         text = str(r["claim"])  # a sentence's leading tree, and the rest
         lead = [
             t for t in trees if text.startswith(t) and text[len(t) : len(t) + 1] in (":", ",", " ")
         ]
-        tree, short = (lead[0], text[len(lead[0]) :].lstrip(":, ")) if lead else ("", text)
-        more = [
-            f"<b>{e(str(r['claim']))}</b>",
-            f"id <code>{e(str(r['id']))}</code>; {e(r['_origin'])}'s {r['_kind']}",
-            f"holds when the value is {e(str(r['threshold']))} {e(str(r['unit']))}; "
-            f"{int(r['seeds'])} seed{'s' if int(r['seeds']) != 1 else ''}",
-            f"from {e(str(r['source']))}",
-        ]
-        if str(r["verdict"]) != r["_verdict"]:
-            more.append(e(str(r["verdict"])))
-        if ledger.decide_cell(r):
-            more.append(f"seeds that would decide it (est.): {e(ledger.decide_cell(r))}")
-        if r["_kind"] == "premise":
-            more.append(f"if it fails, it undermines {e(catalogue.undermines(str(r['id'])))}")
-        anchor = "claim-" + re.sub(r"[^a-z0-9]+", "-", str(r["id"]).lower()).strip("-")
-        rows.append(
-            f'<tr id="{anchor}" data-origin="{e(r["_origin"])}" data-verdict="{r["_verdict"]}" '
-            f'data-tree="{e(tree or "--")}" data-kind="{r["_kind"]}">'
-            f"<td><details><summary>{e(short)}</summary>{'<br>'.join(more)}</details></td>"
-            f"<td>{e(tree or '--')}</td><td>{e(str(r['paper']))}</td>"
-            f"<td>{e(_value_text(r))}</td>"
-            f'<td class="verdict-{r["_verdict"]}">{r["_verdict"]}</td>'
-            f"<td>{r['_kind']}</td><td>{e(r['_origin'])}</td></tr>"
-        )
-    head = (
-        "<th>claim (click for the full claim)</th><th>tree</th><th>the paper</th>"
-        "<th>measured: mean [95% interval]</th><th>verdict</th><th>kind</th><th>origin</th>"
-    )
-    body = "".join(row + "\n" for row in rows)
-    return f'<table class="ledger">\n<thead><tr>{head}</tr></thead>\n<tbody>\n{body}</tbody>\n</table>\n'
+        tree, short = (lead[0], text[len(lead[0]) :].lstrip(":, ")) if lead else ("--", text)
+        f = {c: str(r[c]) for c in ("claim", "id", "threshold", "unit", "source", "paper")}
+        f |= {c: str(r["_" + c]) for c in ("origin", "kind", "verdict")}
+        f |= {
+            "tree": tree,
+            "short": short,
+            "value": _value_text(r),
+            "decide": ledger.decide_cell(r),
+        }
+        f["full"] = str(r["verdict"]) if str(r["verdict"]) != r["_verdict"] else ""
+        f["undermines"] = catalogue.undermines(f["id"]) if r["_kind"] == "premise" else ""
+        anchor = "claim-" + re.sub(r"[^a-z0-9]+", "-", f["id"].lower()).strip("-")
+        f, n = {k: html.escape(v) for k, v in f.items()}, int(r["seeds"])
+        details = say("ledger_details", **f, seeds=n, s="s" if n != 1 else "")
+        rows.append(say("ledger_row", **f, anchor=anchor, more=details) + "\n")
+    return say("ledger_table", body="".join(rows))
 
 
 def write_unrecorded(out_dir: str | Path) -> Path:
@@ -785,35 +700,19 @@ def write_unrecorded(out_dir: str | Path) -> Path:
     """
     out = Path(out_dir)
     out.mkdir(parents=True, exist_ok=True)
-    (out / "index.md").write_text(
-        "No full run is recorded yet. After `snakemake --cores 2 all` at the default profile, "
-        "`python tools/record.py results` writes it here.\n"
-    )
+    (out / "index.md").write_text(PROSE["unrecorded"])
     return out / "index.md"
 
 
-def count_line(claims: pd.DataFrame) -> str:
-    """The ledger's counts, the paper's claims apart from this project's (``claims.counted``).
-
-    Args:
-        claims: the ledger (``id``, ``verdict``; ``origin``, ``kind`` where written).
-
-    Returns:
-        One Markdown bullet.
-    """
-    return (
-        f"- **The paper's {ledger.counted(claims, 'paper')}**; this project's own "
-        f"{ledger.counted(claims, 'project')} (95% intervals over seeds; a *premise* is what the "
-        "comparison rests on, a *finding* what it says)."
-    )
+def _counts(claims: pd.DataFrame) -> dict[str, str]:
+    """The ledger's counts (``claims.counted``) of the paper's claims and this project's."""
+    return {who: ledger.counted(claims, who) for who in ("paper", "project")}
 
 
 def _premise_line(claims: pd.DataFrame) -> str:
     """A bullet naming the premises that fail and what each undermines; "" when all hold."""
-    failed = ledger.failed_premises(claims)
-    return (
-        f"- **Premises that fail**: {'; '.join(f.rstrip('.') for f in failed)}." if failed else ""
-    )
+    failed = "; ".join(f.rstrip(".") for f in ledger.failed_premises(claims))
+    return say("premises", failed=failed) if failed else ""
 
 
 def _headline_families(claims: pd.DataFrame, origin: str | None = None):
@@ -842,20 +741,21 @@ def story_line(claims: pd.DataFrame) -> str:
     if not n:
         return ""
     if held == n:
-        return f"- **The paper's story stands**: all {n} of its headline claims hold."
-    text = f"- **The paper's story stands in part**: {held} of its {n} headline claims hold"
-    for v, words in (("fails", "; it fails on "), ("undecided", "; undecided: ")):
+        return say("story_all", n=n)
+    text = say("story_part", held=held, n=n)
+    for v in ("fails", "undecided"):
         where = [
             f"{w} ({', '.join(cells[kind == v])})"
             for w, _, cells, kind in fams
             if (kind == v).any()
         ]
-        text += words + "; ".join(where) if where else ""
+        text += PROSE[f"story_{v}"] + "; ".join(where) if where else ""
     return text + "."
 
 
 def headline_lines(claims: pd.DataFrame) -> list[str]:
-    """What the run found: the ledger's counts, the paper's story, each headline family's verdicts.
+    """What the run found: the ledger's counts (the paper's claims apart from this project's), the
+    premises that fail, the paper's story, each headline family's verdicts.
 
     Args:
         claims: the ledger (``claims.csv``: id, measured, ci_low, ci_high, unit, verdict).
@@ -864,7 +764,8 @@ def headline_lines(claims: pd.DataFrame) -> list[str]:
         The Markdown lines.
     """
     story, premise = story_line(claims), _premise_line(claims)
-    lines = [count_line(claims), *([premise] if premise else []), *([story] if story else [])]
+    lines = [say("count", **_counts(claims)), *([premise] if premise else [])]
+    lines += [story] if story else []
     for words, rows, where, kind in _headline_families(claims):
         cells = []
         for (_, r), w, k in zip(rows.iterrows(), where, kind):
@@ -952,11 +853,9 @@ def instances_phrase(instances: Mapping[str, Sequence[int]]) -> str:
     n = counts.pop() if len(counts) == 1 else None
     number = (NUMBER_WORDS[n] if n < len(NUMBER_WORDS) else str(n)) if n else "several"
     seeds = {tuple(s) for s in many.values()}
-    which = f" (testbed seeds {_join(seeds.pop())})" if len(seeds) == 1 else ""
-    first = next(iter(many))
-    return (
-        f"; each of {', '.join(many)} measured on {number} instances of its preset{which}, so "
-        f'"{first}" below means {first}-preset trees'
+    which = _join(seeds.pop()) if len(seeds) == 1 else ""
+    return say(
+        "instances", trees=", ".join(many), number=number, which=which, first=next(iter(many))
     )
 
 
@@ -970,26 +869,16 @@ def found_lines(record_dir: str | Path) -> list[str]:
         The Markdown lines, ending in a blank one.
     """
     record = Path(record_dir)
-    lines = ["**What the last full run found** (its record: `docs/record/`):", ""]
+    lines = [PROSE["found_head"], "", PROSE["found_none"]]
     if (record / "claims.csv").is_file():
-        stamp = json.loads((record / "stamp.json").read_text())
-        overrides = stamp.get("overrides") or []
-        made_with = f", made with `{_shell(overrides)}`" if overrides else ""
-        lines += [
-            f"Profile `{stamp['profile']}`{made_with}, seeds {_join(stamp['seeds'])}, "
-            f"commit `{stamp['commit']}`{instances_phrase(stamp.get('instances') or {})}:",
-            "",
-            *headline_lines(_read(record / "claims.csv")),
-            "",
-            *WORDS,
-        ]
-    else:
-        lines.append(
-            "no full run is recorded yet: `python tools/record.py results` writes the record "
-            "after `snakemake --cores 2 all`."
-        )
-    lines += ["", "**What each command costs:**", "", *cost_lines(read_costs(record / "costs.csv"))]
-    return [*lines, ""]
+        s = json.loads((record / "stamp.json").read_text())
+        made_with = _shell(s.get("overrides") or [])
+        phrase = instances_phrase(s.get("instances") or {})
+        fields = {"profile": s["profile"], "seeds": _join(s["seeds"]), "commit": s["commit"]}
+        run = say("found_run", **fields, made_with=made_with, instances=phrase)
+        lines[2:] = [run, "", *headline_lines(_read(record / "claims.csv")), "", PROSE["words"]]
+    costs = cost_lines(read_costs(record / "costs.csv"))
+    return [*lines, "", PROSE["found_costs"], "", *costs, ""]
 
 
 def replace_block(text: str, block: str) -> str:

@@ -310,19 +310,9 @@ def compare_claims(
         unit = "" if pd.isna(r.get("unit")) else f" {r.get('unit')}"
         threshold = "--" if pd.isna(r.get("threshold")) else f"{r.get('threshold')}{unit}"
         claim = str(r.get("claim", r["id"]))
-        changed.append(
-            VerdictChange(
-                str(r["id"]),
-                claim,
-                a,
-                b,
-                _value(o),
-                _value(r),
-                threshold,
-                _overlap(o, r),
-                _alone((first or {}).get(str(r["id"])), o),
-            )
-        )
+        alone = _alone((first or {}).get(str(r["id"])), o)
+        values = (_value(o), _value(r), threshold, _overlap(o, r), alone)
+        changed.append(VerdictChange(str(r["id"]), claim, a, b, *values))
     ids_new = set(new["id"].astype(str))
     only_old = [i for i in old["id"].astype(str) if i not in ids_new]
     only_new = [i for i in new["id"].astype(str) if i not in before]

@@ -12,19 +12,17 @@ from typing import Sequence
 import numpy as np
 
 from physgs.statistics import MAX_SEEDS, decided, decided_best, finite, interval, log_interval
-from physgs.statistics import paired, seeds_to_decide
+from physgs.statistics import seeds_to_decide
 
 #: the statistics (``physgs.statistics``) stay importable from here, beside the cells
 __all__ = [
     "MAX_SEEDS",
     "UNDECIDED",
-    "decided",
     "decided_best",
     "difference",
     "finite",
     "interval",
     "log_interval",
-    "paired",
     "pm",
     "seeds_to_decide",
 ]

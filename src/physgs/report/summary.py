@@ -18,9 +18,10 @@ from physgs.models.registry import label
 from physgs.report.thresholds import FIT_BAR
 from physgs.report.catalogue import AHEAD
 from physgs.report.claims import column, counted, decide_cell, failed_premises, number
+from physgs.report.prose import PROSE, say
 from physgs.report.record import config_hashes, markdown_table, story_line
 from physgs.report.rerun import verdict_kind
-from physgs.report.seeds import interval
+from physgs.statistics import interval
 
 VERDICTS = ("holds", "fails", "undecided")
 #: The columns of the summary's table of claims (and the seeds that would decide each).
@@ -29,9 +30,9 @@ CLAIM_COLUMNS = ("claim", "measured [95% interval]", "threshold", "verdict")
 DECIDE_AT = (4, 5, 6)
 
 
-def _table(df: pd.DataFrame, right=()) -> list[str]:
+def _md(df: pd.DataFrame, right=()) -> list[str]:
     """A Markdown table's lines and a blank one."""
-    return [*markdown_table(df, right=right).splitlines(), ""]
+    return markdown_table(df, right=right).split("\n")
 
 
 def _stale(stamp: Mapping[str, str], df: pd.DataFrame, name: str) -> list[str]:
@@ -39,8 +40,7 @@ def _stale(stamp: Mapping[str, str], df: pd.DataFrame, name: str) -> list[str]:
     found = config_hashes(df)
     if found and "config_hash" in stamp and found != [str(stamp["config_hash"])]:
         return [
-            f"> **Warning**: {name} was made under config_hash {', '.join(found)}, not this "
-            f"run's {stamp['config_hash']}: rerun `snakemake` for the target first.",
+            say("summary_stale", name=name, found=", ".join(found), hash=stamp["config_hash"]),
             "",
         ]
     return []
@@ -72,17 +72,14 @@ def claims_section(claims: pd.DataFrame) -> list[str]:
     return [
         "## Claims ledger",
         "",
-        f"The paper's {counted(claims, 'paper')}. This project's own "
-        f"{counted(claims, 'project')}. A premise is what the comparison rests on, a finding what "
-        "it says. The claims, the paper's figures and the cells each verdict comes from: "
-        "`claims.md` beside this summary (on the documentation site: [the ledger](ledger.md)).",
+        say("summary_claims", paper=counted(claims, "paper"), project=counted(claims, "project")),
         "",
         *[f"- {s[0].upper() + s[1:]}" for s in failed_premises(claims)],
         "",
         *([story, ""] if story else []),
         *prior_lines(claims),
         *_decide_lines(claims),
-        *_table(pd.DataFrame(rows, columns=[*CLAIM_COLUMNS, "seeds to decide (est.)"])),
+        *_md(pd.DataFrame(rows, columns=[*CLAIM_COLUMNS, "seeds to decide (est.)"])),
     ]
 
 
@@ -103,13 +100,7 @@ def _decide_lines(claims: pd.DataFrame) -> list[str]:
             at = [int((n <= k).sum()) for k in DECIDE_AT]
             rows.append([f"{words} ({len(mine)})", est, *at, len(n) - at[-1]])
     head = ["undecided claims", "estimate", *(f"by {n} seeds" for n in DECIDE_AT), "more"]
-    return [
-        "Seeds that would decide each undecided claim, **an estimate** at its observed effect "
-        "and sd (the plug-in t half-width; a t-test at 80% power, `tt_solve_power`): how many "
-        "would decide at each seed count.",
-        "",
-        *_table(pd.DataFrame(rows, columns=head), right=head[2:]),
-    ]
+    return [PROSE["summary_decide"], "", *_md(pd.DataFrame(rows, columns=head), head[2:])]
 
 
 def prior_lines(claims: pd.DataFrame) -> list[str]:
@@ -129,9 +120,7 @@ def prior_lines(claims: pd.DataFrame) -> list[str]:
         held = mine[mine["verdict"].astype(str) == "holds"]
         where = ", ".join(i.split(f"/{AHEAD}/", 1)[1] for i in held["id"].astype(str))
         lines += [
-            f"{label(m)}: beats every learned field on **{len(held)} of {len(mine)}** "
-            "splits and trees (paired 95% interval above 0; views, beyond the window, each "
-            f"unseen wind at training timestamps and beyond){': ' + where if where else ''}.",
+            say("summary_prior", model=label(m), held=len(held), n=len(mine), where=where),
             "",
         ]
     return lines
@@ -151,16 +140,9 @@ def _fit_section(tab_fit: pd.DataFrame) -> list[str]:
 
     fit = tab_fit.groupby(["model", "tree"], sort=False)["ceiling_frac"].agg(cell).unstack()
     fit = fit.reindex(index=models, columns=trees, fill_value="--")
-    return [
-        "## Fit to the training window (`tab_fit`)",
-        "",
-        "Each model's share of the gain from the static pose to the true-motion ceiling on its "
-        f"trained frames, % (the bar an opponent must clear: {FIT_BAR:.0%}); "
-        + (f"mean over {n} seeds [95% interval]." if n > 1 else "one seed, no interval.")
-        + " The table with every PSNR: `results/tables/tab_fit.tex`.",
-        "",
-        *_table(fit.rename(index=label).rename_axis(index="model").reset_index()),
-    ]
+    fit = fit.rename(index=label).rename_axis(index="model").reset_index()
+    text = say("summary_fit", bar=FIT_BAR, seeds=n if n > 1 else 0)
+    return ["## Fit to the training window (`tab_fit`)", "", text, "", *_md(fit)]
 
 
 def _cost_section(benchmark_dir) -> list[str]:
@@ -177,20 +159,9 @@ def _cost_section(benchmark_dir) -> list[str]:
     ]
     rows.append(["**all**", spans["run_s"], s["shared_s"], *s["per_seed"].values()])
     minutes = pd.DataFrame(rows, columns=head).set_index("stage") / 60
-    return [
-        "## What the run cost",
-        "",
-        f"The benchmarked jobs span **{spans['run_s'] / 60:.1f} min** from the first one's start "
-        f"to the last one's end ({len(jobs)} benchmarked jobs, {s['total_s'] / 60:.1f} "
-        "job-minutes; a pause between the segments of a resumed run falls inside the span, so "
-        "the run's wall time is not this but the time its command ran, `tools/timed.py`'s, in "
-        "the record's stamp). Tables, figures and recovery are light jobs without a benchmark "
-        "file. Per stage: minutes of its span (stages overlap) and job-minutes, shared by every "
-        "seed or per training seed (`python tools/pipeline_cost.py` prints the same, and one "
-        "more seed's cost).",
-        "",
-        *_table(minutes.map(lambda x: "" if np.isnan(x) else f"{x:.1f}").reset_index()),
-    ]
+    minutes = minutes.map(lambda x: "" if np.isnan(x) else f"{x:.1f}").reset_index()
+    text = say("summary_cost", span=spans["run_s"] / 60, jobs=len(jobs), job_min=s["total_s"] / 60)
+    return ["## What the run cost", "", text, "", *_md(minutes)]
 
 
 def run_summary(stamp: Mapping[str, str], claims_csv, tab_fit_csv, benchmark_dir) -> str:
@@ -215,13 +186,11 @@ def run_summary(stamp: Mapping[str, str], claims_csv, tab_fit_csv, benchmark_dir
     tab_fit = pd.read_csv(tab_fit_csv, dtype={"config_hash": str})
     seeds = sorted(int(x) for x in tab_fit["seed"].unique())
     made_by = ", ".join(f"{k}={v}" for k, v in stamp.items())
+    trees = ", ".join(dict.fromkeys(tab_fit["tree"]))
     lines = [
         "# Run summary",
         "",
-        f"Made by: {made_by}; training seeds {', '.join(map(str, seeds))}; "
-        f"trees {', '.join(dict.fromkeys(tab_fit['tree']))}. Printed from this run's files "
-        "(`results/claims.csv`, `results/tables/tab_fit.csv`, `results/benchmarks/`) by "
-        "`physgs.report.summary`.",
+        say("summary_head", made_by=made_by, seeds=", ".join(map(str, seeds)), trees=trees),
         "",
         *_stale(stamp, claims, "results/claims.csv"),
         *_stale(stamp, tab_fit, "results/tables/tab_fit.csv"),
