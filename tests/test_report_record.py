@@ -722,7 +722,9 @@ def test_every_data_file_of_the_package_ships_with_it():
     ]["physgs"]
     pkg = root / "src" / "physgs"
     data = [p.relative_to(pkg).as_posix() for e in ("yaml", "md") for p in pkg.rglob(f"*.{e}")]
-    assert {"report/captions.yaml", "report/templates/index.md"} <= set(data)
+    assert {"report/captions.yaml", "report/image_tables.yaml", "report/templates/index.md"} <= set(
+        data
+    )
     assert all(any(fnmatch.fnmatch(d, pat) for pat in patterns) for d in data), (data, patterns)
 
 
