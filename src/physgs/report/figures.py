@@ -109,10 +109,12 @@ def _plain_log(axis, locator=None) -> None:
     axis.set_minor_formatter(NullFormatter())
 
 
-def _texts(ax, title: str, xlabel: str, ylabel: str | None = None, title_pt=FONT_PT) -> None:
-    """An axes' title, axis labels and tick labels, at the page's font size."""
-    ax.set_title(title, fontsize=title_pt)
-    ax.set_xlabel(xlabel, fontsize=FONT_PT)
+def _texts(ax, title=None, xlabel=None, ylabel=None, title_pt=FONT_PT) -> None:
+    """An axes' title and axis labels (those given) and its tick labels, at the page's font size."""
+    if title is not None:
+        ax.set_title(title, fontsize=title_pt)
+    if xlabel is not None:
+        ax.set_xlabel(xlabel, fontsize=FONT_PT)
     if ylabel is not None:
         ax.set_ylabel(ylabel, fontsize=FONT_PT)
     ax.tick_params(labelsize=FONT_PT)
@@ -349,8 +351,9 @@ def fig_damping(
         a0.axhline(zeta_bound, color="0.4", ls=":", lw=1.0)
     a0.set_xticks(centres)
     a0.set_xticklabels(trees, fontsize=FONT_PT)
-    a0.set_ylabel(r"$\hat\zeta_p$ (damping ratio, no unit)", fontsize=FONT_PT)
-    a0.set_title("damping ratio per part (bar: median)", fontsize=FONT_PT)
+    _texts(
+        a0, "damping ratio per part (bar: median)", ylabel=r"$\hat\zeta_p$ (damping ratio, no unit)"
+    )
     w = np.concatenate(allw)
     grid = np.geomspace(w.min() * 0.9, w.max() * 1.1, 50)
     a1.plot(grid, zeta_true * grid, "k--", lw=1)
@@ -360,7 +363,6 @@ def fig_damping(
         _plain_log(axis, LogLocator(base=10, subs=(1.0, 2.0, 5.0)))
     gamma = r"$\hat\gamma_p = \hat\zeta_p\hat\omega_p$ (1/s)"
     _texts(a1, "decay rate against natural frequency", r"$\hat\omega_p$ (rad/s)", gamma)
-    a0.tick_params(labelsize=FONT_PT)
     # one key for both panels, below them: colour = tree, marker = configuration, fill = prior
     grey = "0.35"
     handles = [Patch(color=tree_colors[t], label=t) for t in trees]

@@ -327,10 +327,7 @@ def tab_transfer(
     first = latex.rows(df)
     V = np.stack([latex.by_seed(df, m) for m in models], axis=-1)  # [S, R, M]
     best = [seedstats.decided_best(V[:, i, :]) for i in range(len(first))]
-    splits = {
-        "train": r"\shortstack[l]{Training\\timestamps}",
-        "beyond": r"\shortstack[l]{Beyond the\\training window}",
-    }
+    splits = TEXT["tab_transfer_splits"]
     wind = [
         f"{tree_label(r.tree, r.bones)}, {condition_label(r.condition)}" for r in first.itertuples()
     ]

@@ -11,9 +11,10 @@ from typing import Sequence
 import pandas as pd
 
 from physgs.experiments.sweep import null_level
-from physgs.models.registry import BASE_CONFIG
+from physgs.models.registry import BASE_CONFIG, REFERENCE_NAMES, label
 from physgs.recovery.record import load_null
 from physgs.report.output import Output
+from physgs.report.thresholds import FIT_BAR
 
 #: the studies' CSVs (need ``("table", <study>)``), written by the rules of the same name
 SPEED_ACCURACY, FIT_CURVE = "speed_accuracy", "fit_curve"
@@ -77,9 +78,7 @@ def draw_fit_vs_extrapolation(df: pd.DataFrame, outputs: Sequence[str]) -> None:
     """
     import matplotlib.pyplot as plt  # matplotlib: not for the workflow's planning imports
 
-    from physgs.models.registry import REFERENCE_NAMES, label
     from physgs.report.figures import COLORS, save_figure
-    from physgs.report.thresholds import FIT_BAR
 
     xy = ["of_ceiling", "beyond_gain"]
     trees = list(dict.fromkeys(df["tree"]))
