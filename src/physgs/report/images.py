@@ -545,27 +545,17 @@ def _fig_results(path, settings, inputs, out):
     figures.fig_results(rows, ["gt", *models], images, out)
 
 
-FIG_TEMPORAL = Output(
-    "fig_temporal",
-    "figure",
-    EVAL_SHOWN,
-    _fig_temporal,
-    lambda cfg: {"n_train": int(cfg["testbed"]["n_train"])},
-)
-# the conditions, and the trees' roles: the teaser shows the tree standing for the paper's
-FIG_TEASER = Output(
-    "fig_teaser",
-    "figure",
-    _evals(("eval", "traj"), *METHODS),
-    _fig_teaser,
-    lambda cfg: {**_conditions(cfg), "roles": roles_of(cfg["presets"], cfg["trees"])},
-    "first",
-)
-FIG_RESULTS = Output(
-    "fig_results",
-    "figure",
-    _evals(("eval", "panels"), *METHODS),
-    _fig_results,
-    _conditions,
-    "first",
-)
+def _teaser_settings(cfg: dict) -> dict:
+    """The conditions, and the trees' roles: the teaser shows the tree standing for the paper's."""
+    return {**_conditions(cfg), "roles": roles_of(cfg["presets"], cfg["trees"])}
+
+
+def _n_train(cfg: dict) -> dict:
+    """The training window's length."""
+    return {"n_train": int(cfg["testbed"]["n_train"])}
+
+
+FIG_TEMPORAL = Output("fig_temporal", "figure", EVAL_SHOWN, _fig_temporal, _n_train)
+TEASER_NEEDS, RESULTS_NEEDS = (_evals(("eval", k), *METHODS) for k in ("traj", "panels"))
+FIG_TEASER = Output("fig_teaser", "figure", TEASER_NEEDS, _fig_teaser, _teaser_settings, "first")
+FIG_RESULTS = Output("fig_results", "figure", RESULTS_NEEDS, _fig_results, _conditions, "first")

@@ -18,8 +18,7 @@ MIN_FREQ_AXIS_HZ = 3.0
 def fig_stabilisation(
     idents: Mapping, omega_bones: Mapping, trees: Sequence, outputs: Sequence, title: str = ""
 ) -> None:
-    """One column per tree: the poles (Hz against model order; filled where stable), the
-    identified modes as lines with their 95% interval (+-1.96 sigma) above; below, the truth.
+    """fig_stabilisation: one column per tree, the true frequencies in a strip below.
 
     Args:
         idents: ``idents[tree]``: its [`Identification`][physgs.oma.run.Identification], the

@@ -68,9 +68,7 @@ def fit_vs_extrapolation(df: pd.DataFrame, static: str = "static") -> pd.DataFra
 
 
 def draw_fit_vs_extrapolation(df: pd.DataFrame, outputs: Sequence[str]) -> None:
-    """One panel per tree: each model's gain over static beyond the window (dB) against its
-    in-window fraction of the ceiling's gain, one line through its budgets (seed means, the
-    seeds' own points faint), the profile's budget starred, the fit bar and zero gain marked.
+    """fig_fit_vs_extrapolation: one panel per tree, one line per model through its budgets.
 
     Args:
         df: [`fit_vs_extrapolation`][physgs.report.trade.fit_vs_extrapolation]'s rows.
