@@ -722,7 +722,8 @@ def test_every_data_file_of_the_package_ships_with_it():
     ]["physgs"]
     pkg = root / "src" / "physgs"
     data = [p.relative_to(pkg).as_posix() for e in ("yaml", "md") for p in pkg.rglob(f"*.{e}")]
-    assert {"report/captions.yaml", "report/prose.yaml", "report/templates/index.md"} <= set(data)
+    shipped = ("captions", "prose", "image_tables", "table_captions")
+    assert {f"report/{n}.yaml" for n in shipped} | {"report/templates/index.md"} <= set(data)
     assert all(any(fnmatch.fnmatch(d, pat) for pat in patterns) for d in data), (data, patterns)
 
 

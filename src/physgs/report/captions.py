@@ -11,7 +11,6 @@ from __future__ import annotations
 
 import re
 from collections.abc import Sequence
-from dataclasses import dataclass
 from importlib import resources
 
 import yaml
@@ -19,40 +18,25 @@ import yaml
 from physgs.report.outputs import OUTPUTS
 
 
-@dataclass(frozen=True)
-class Caption:
-    """One figure's caption: ``pattern`` its name (``{tree}`` standing for a tree), ``title`` a
-    few words, ``shows`` what is drawn (every colour, band, line and unit), ``read`` how to read
-    it, ``seeds`` its seed scope when it is not a report output (``physgs.report.output.SEEDS``)."""
-
-    pattern: str
-    title: str
-    shows: str
-    read: str
-    seeds: str = "first"
-
-    def match(self, name: str) -> str | None:
-        """The tree of figure ``name`` when it is this figure.
-
-        Args:
-            name: a figure's file stem.
-
-        Returns:
-            The tree, '' when the pattern has none, None when ``name`` is another figure.
-        """
-        rx = "^" + re.escape(self.pattern).replace(r"\{tree\}", "(?P<tree>[a-z0-9_]+?)") + "$"
-        m = re.match(rx, name)
-        return None if m is None else m.groupdict().get("tree") or ""
-
-
-#: The figures in reading order (`captions.yaml`: text, kept apart from the code that reads it).
-FIGURES: tuple[Caption, ...] = tuple(
-    Caption(**c)
+#: The figures in reading order (``captions.yaml``: text, kept apart from the code that reads it),
+#: each ``pattern`` (its name, ``{tree}`` standing for a tree), ``title`` (a few words), ``shows``
+#: (what is drawn: every colour, band, line and unit), ``read`` (how to read it) and ``seeds`` (its
+#: seed scope when it is not a report output: ``physgs.report.output.SEEDS``).
+FIGURES: tuple[dict, ...] = tuple(
+    {"seeds": "first", **c}
     for c in yaml.safe_load(resources.files("physgs.report").joinpath("captions.yaml").read_text())
 )
+#: each figure's index and name as a regular expression (a tree: the group ``tree``), in the order
+#: ``find`` tries them: the plain names, then the per-tree ones, the longer first
+_NAMES = [
+    (i, re.compile(re.escape(p).replace(r"\{tree\}", "(?P<tree>[a-z0-9_]+?)") + "$"))
+    for i, p in sorted(
+        enumerate(c["pattern"] for c in FIGURES), key=lambda ip: ("{" in ip[1], -len(ip[1]))
+    )
+]
 
 
-def find(name: str) -> tuple[int, Caption, str]:
+def find(name: str) -> tuple[int, dict, str]:
     """The caption of figure ``name``, its place in ``FIGURES`` and its tree.
 
     Per-tree patterns are tried after the plain names, the longer first, so that
@@ -62,17 +46,14 @@ def find(name: str) -> tuple[int, Caption, str]:
         name: the figure's file stem.
 
     Returns:
-        ``(index, caption, tree)``.
+        ``(index, caption, tree)``: the tree '' when the caption's pattern has none.
 
     Raises:
         KeyError: naming a figure without a caption.
     """
-    for i in sorted(
-        range(len(FIGURES)), key=lambda i: ("{" in FIGURES[i].pattern, -len(FIGURES[i].pattern))
-    ):
-        tree = FIGURES[i].match(name)
-        if tree is not None:
-            return i, FIGURES[i], tree
+    for i, rx in _NAMES:
+        if m := rx.match(name):
+            return i, FIGURES[i], m.groupdict().get("tree") or ""
     raise KeyError(f"figure {name!r} has no caption: add it to physgs.report.captions.FIGURES")
 
 
@@ -98,8 +79,8 @@ def caption(name: str, seeds: Sequence[int]) -> str:
         One paragraph: title, what it shows, how to read it, its seeds.
     """
     _, c, tree = find(name)
-    what = OUTPUTS[c.pattern].seeds if c.pattern in OUTPUTS else c.seeds
-    title, shows, read = (s.format(tree=tree) for s in (c.title, c.shows, c.read))
+    what = OUTPUTS[c["pattern"]].seeds if c["pattern"] in OUTPUTS else c["seeds"]
+    title, shows, read = (c[k].format(tree=tree) for k in ("title", "shows", "read"))
     return (
         f"**Figure: {title}** (`{name}`). {shows} "
         f"*How to read it:* {read} *Seeds:* {_seeds(what, list(seeds))}."

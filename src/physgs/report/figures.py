@@ -1,5 +1,6 @@
 """Figures (the protocol, section 4-5): fig_temporal, fig_teaser, fig_results, fig_damping, and
-the studies' fig_speed_accuracy and fig_fit_curve.
+the studies' fig_speed_accuracy and fig_fit_curve; what each shows is its caption
+(``captions.yaml``), written once.
 
 Each ``fig_*`` takes collected results and a list of output paths; a path's suffix picks its
 format (.pdf, .png), each written atomically. Matplotlib's Agg backend: no display needed.
@@ -109,10 +110,12 @@ def _plain_log(axis, locator=None) -> None:
     axis.set_minor_formatter(NullFormatter())
 
 
-def _texts(ax, title: str, xlabel: str, ylabel: str | None = None, title_pt=FONT_PT) -> None:
-    """An axes' title, axis labels and tick labels, at the page's font size."""
-    ax.set_title(title, fontsize=title_pt)
-    ax.set_xlabel(xlabel, fontsize=FONT_PT)
+def _texts(ax, title=None, xlabel=None, ylabel=None, title_pt=FONT_PT) -> None:
+    """An axes' title and axis labels (those given) and its tick labels, at the page's font size."""
+    if title is not None:
+        ax.set_title(title, fontsize=title_pt)
+    if xlabel is not None:
+        ax.set_xlabel(xlabel, fontsize=FONT_PT)
     if ylabel is not None:
         ax.set_ylabel(ylabel, fontsize=FONT_PT)
     ax.tick_params(labelsize=FONT_PT)
@@ -125,9 +128,7 @@ def fig_temporal(
     outputs: Sequence[str | Path],
     models: Sequence[str] = MODELS,
 ) -> None:
-    """Per-frame PSNR (dB) at the training camera and wind, one panel per tree: each model's mean
-    over seeds (a band from the lowest to the highest seed when there are several), a reference
-    in ``curves`` (the true-motion ceiling) black dotted, the tail after frame n_train shaded.
+    """fig_temporal: per-frame PSNR (dB) at the training camera and wind, one panel per tree.
 
     Args:
         curves: ``curves[(tree, model)]``: [S, F] PSNR (dB) over recorded frames 1..F, one row per
@@ -244,8 +245,7 @@ def fig_results(
     outputs: Sequence[str | Path],
     ours: str = "ours",
 ) -> None:
-    """Qualitative grid: one row per (tree, split) label, one column per model (or 'gt'); each
-    panel's PSNR printed, green on ours where best in its row, orange on a baseline beating ours.
+    """fig_results: one row per (tree, split) label, one column per model (or 'gt').
 
     Args:
         rows: the row labels.
@@ -298,10 +298,7 @@ def fig_damping(
     outputs: Sequence[str | Path],
     zeta_bound: float | None = None,
 ) -> None:
-    """Left: zeta_hat per part for each tree and config against the true ratio (dashed) and the
-    fit's upper bound on zeta (dotted: a part there is pinned to the bound, not estimated).
-    Right: decay rate gamma_hat = zeta_hat * omega_hat (1/s) against omega_hat (rad/s), log-log,
-    with the ground-truth line gamma = zeta_true * omega.
+    """fig_damping: the recovered damping ratios (left) and decay rates (right) per part.
 
     Args:
         damping: each prior's ``DampingResult`` per ``(tree, config)``, by model id in drawing
@@ -349,8 +346,9 @@ def fig_damping(
         a0.axhline(zeta_bound, color="0.4", ls=":", lw=1.0)
     a0.set_xticks(centres)
     a0.set_xticklabels(trees, fontsize=FONT_PT)
-    a0.set_ylabel(r"$\hat\zeta_p$ (damping ratio, no unit)", fontsize=FONT_PT)
-    a0.set_title("damping ratio per part (bar: median)", fontsize=FONT_PT)
+    _texts(
+        a0, "damping ratio per part (bar: median)", ylabel=r"$\hat\zeta_p$ (damping ratio, no unit)"
+    )
     w = np.concatenate(allw)
     grid = np.geomspace(w.min() * 0.9, w.max() * 1.1, 50)
     a1.plot(grid, zeta_true * grid, "k--", lw=1)
@@ -360,7 +358,6 @@ def fig_damping(
         _plain_log(axis, LogLocator(base=10, subs=(1.0, 2.0, 5.0)))
     gamma = r"$\hat\gamma_p = \hat\zeta_p\hat\omega_p$ (1/s)"
     _texts(a1, "decay rate against natural frequency", r"$\hat\omega_p$ (rad/s)", gamma)
-    a0.tick_params(labelsize=FONT_PT)
     # one key for both panels, below them: colour = tree, marker = configuration, fill = prior
     grey = "0.35"
     handles = [Patch(color=tree_colors[t], label=t) for t in trees]
@@ -414,9 +411,7 @@ def _save_sweep(fig, axes, head: str, n_seeds: int, outputs: Sequence[str | Path
 def fig_speed_accuracy(
     df: pd.DataFrame, outputs: Sequence[str | Path], null: Mapping[str, float] | None = None
 ) -> None:
-    """Two panels against wall time (s): PSNR on the time split (dB) and recovery error (%); one
-    line per knob through its values (mean over seeds, sd error bars on both axes), the base
-    point starred.
+    """fig_speed_accuracy: PSNR and recovery error against wall time, a line per knob.
 
     Args:
         df: [`sweep.collect`][physgs.experiments.sweep.collect] (one row per seed, knob and
@@ -460,14 +455,8 @@ def fig_speed_accuracy(
 
 
 def fig_fit_curve(df: pd.DataFrame, outputs: Sequence[str | Path]) -> None:
-    """The fit curve ([`physgs.experiments.fit_curve`][physgs.experiments.fit_curve]): a row of
-    three panels per tree, one line per model.
-
-    In-window fit PSNR (dB, trained frames) and time-split PSNR (dB, the tail) against training
-    iterations, and the fit against training wall time (s); points the mean over seeds, error
-    bars the sd. The static pose and the true-motion ceiling at the profile's budget are
-    horizontal lines, the profile's budget starred; a ``<field>@window`` series (the field with
-    Deformable-3DGS's window-normalised time) is open diamonds in its field's colour.
+    """fig_fit_curve ([`physgs.experiments.fit_curve`][physgs.experiments.fit_curve]): a row of
+    three panels per tree, one line per model (a ``<field>@window`` series: open diamonds).
 
     Args:
         df: [`fit_curve.collect`][physgs.experiments.fit_curve.collect] (one row per seed, model

@@ -5,10 +5,12 @@ roles, trained in the base configuration."""
 
 from __future__ import annotations
 
+from importlib import resources
 from typing import Mapping, Sequence
 
 import numpy as np
 import pandas as pd
+import yaml
 
 from physgs.evaluate.metrics import ceiling_fraction
 from physgs.evaluate.splits import load_eval
@@ -35,6 +37,8 @@ PSNR_MINUS, BEST_FIELD = "-", "best_field"
 #: a family heading over the learned fields' columns of tab_transfer
 FAMILY_HEADS = {"mlp": "Deformation MLP", "d3dgs": "Deformable-3DGS"}
 SPLITS = ("view", "time")
+#: the tables' captions, in parts (text, kept apart from the code: ``image_tables.yaml``)
+TEXT = yaml.safe_load(resources.files("physgs.report").joinpath("image_tables.yaml").read_text())
 
 
 def _grid(kinds, models, config, plan, seeds) -> list[tuple]:
@@ -51,15 +55,15 @@ def _conditions(cfg: dict) -> dict:
     return {"conditions": [float(c) for c in cfg["testbed"]["conditions"]]}
 
 
-def _summaries(path, trees, models, seeds) -> dict:
+def _summaries(path, settings, models) -> dict:
     """{seed: {(tree, model): summary}} of the models trained in the base configuration."""
     return {
         s: {
             (t, m): load_eval(path("eval", t, m, BASE_CONFIG, s)).summary()
-            for t in trees
+            for t in settings["trees"]
             for m in models
         }
-        for s in seeds
+        for s in settings["seeds"]
     }
 
 
@@ -110,6 +114,15 @@ def fit_settings(cfg: dict) -> dict:
 
 
 # ---- the tables' builders ------------------------------------------------------------------
+def _caption(*parts: str, n_seeds: int, decides: bool = True, **fills: str) -> str:
+    """The caption joined from ``TEXT``'s ``parts`` (an empty one left out), each ``<key>`` of
+    ``fills`` filled in, and the seeds' sentence."""
+    text = "".join(TEXT[p] for p in parts if p)
+    for key, value in fills.items():
+        text = text.replace(f"<{key}>", value)
+    return text + latex.seed_note(n_seeds, decides=decides)
+
+
 def _emph(model: str, reference: bool) -> str:
     """A row's model label, in italics for a reference."""
     return rf"\emph{{{label(model)}}}" if reference else label(model)
@@ -195,19 +208,8 @@ def tab_psnr(
     bold = np.stack([_best_cols(latex.by_seed(df, c), ~ref & ~diff) for c in cols], axis=1)
     if not references:
         df = df.drop(columns="reference")
-    cap = (
-        r"PSNR (dB). \emph{view}: held-out azimuths at the training wind inside the training "
-        r"window. \emph{time}: frames beyond the training window at the training wind and camera. "
-        r"Best method per column in bold."
-        + (
-            r" In italics, a reference (not a method, never bold): the canonical Gaussians moved "
-            r"by the ground-truth motion, appearance trained by the same recipe."
-            if references
-            else ""
-        )
-        + r" Last rows: paired differences (dB); the best learned field is taken per seed."
-        + latex.seed_note(len(seeds))
-    )
+    refs = "tab_psnr_references" if references else ""
+    cap = _caption("tab_psnr", refs, "tab_psnr_differences", n_seeds=len(seeds))
     return Table("tab_psnr", df, latex.render(cells, cap, "tab:psnr", bold))
 
 
@@ -252,20 +254,10 @@ def tab_fit(
     def one(s, t, m):
         r, ceil, stat = (per_seed[s][(t, x)] for x in (m, reference, static))
         frac = {k: float(ceiling_fraction(r[k], stat[k], ceil[k])) for k in ("fit", "heldout")}
-        return {
-            "tree": t,
-            "bones": bones[t],
-            "model": m,
-            "reference": m == reference,
-            "fit_psnr_db": r["fit"],
-            "heldout_psnr_db": r["heldout"],
-            "ceiling_frac": frac["fit"],
-            "heldout_ceiling_frac": frac["heldout"],
-            "view_psnr_db": r["view"],
-            "time_psnr_db": r["time"],
-            "train_s": r["train_s"],
-            "iterations": r["iterations"],
-        }
+        fit = {f"{k}_psnr_db": r[k] for k in ("fit", "heldout")}
+        fit |= {"ceiling_frac": frac["fit"], "heldout_ceiling_frac": frac["heldout"]}
+        rest = {f"{k}_psnr_db": r[k] for k in SPLITS} | {k: r[k] for k in ("train_s", "iterations")}
+        return {"tree": t, "bones": bones[t], "model": m, "reference": m == reference} | fit | rest
 
     df = seed_rows(seeds, keys, one)
     first = latex.rows(df)
@@ -287,25 +279,9 @@ def tab_fit(
         },
         index=tree_index(first, [_emph(m, m == reference) for m in first["model"]], "Model"),
     )
-    cap = (
-        r"Fit to the training window, PSNR (dB) at the training camera and wind. \emph{Fit}: "
-        r"the training-window frames each model was trained on; \emph{Held-out frames}: every "
-        + f"{holdout_every}th"
-        + r" training-window frame, never trained on; \emph{Of ceiling}: (model $-$ static) / "
-        r"(true motion $-$ static) on the fit; \emph{Held-out of ceiling}: the same on the "
-        r"held-out frames (below the fit's: the model memorises its trained frames). "
-        r"\emph{View}, \emph{Time}: the evaluation splits. "
-        r"\emph{Iter.}: training iterations used (the stopping rule's, capped at "
-        r"train.iterations). "
-        r"In italics the reference: the canonical Gaussians moved by the ground-truth motion."
-        + (
-            f" {NOT_DEFINED}: not defined (a learned forcing has no wind to read beyond the "
-            "window or under another wind)."
-            if NOT_DEFINED in (*view, *time)
-            else ""
-        )
-        + latex.seed_note(len(seeds), decides=False)
-    )
+    nd = "tab_fit_not_defined" if NOT_DEFINED in (*view, *time) else ""
+    fills = {"every": f"{holdout_every}", "nd": NOT_DEFINED}
+    cap = _caption("tab_fit", nd, n_seeds=len(seeds), decides=False, **fills)
     return Table("tab_fit", df, latex.render(cells, cap, "tab:fit"))
 
 
@@ -351,10 +327,7 @@ def tab_transfer(
     first = latex.rows(df)
     V = np.stack([latex.by_seed(df, m) for m in models], axis=-1)  # [S, R, M]
     best = [seedstats.decided_best(V[:, i, :]) for i in range(len(first))]
-    splits = {
-        "train": r"\shortstack[l]{Training\\timestamps}",
-        "beyond": r"\shortstack[l]{Beyond the\\training window}",
-    }
+    splits = TEXT["tab_transfer_splits"]
     wind = [
         f"{tree_label(r.tree, r.bones)}, {condition_label(r.condition)}" for r in first.itertuples()
     ]
@@ -368,11 +341,7 @@ def tab_transfer(
 
     fmt = f".{int(digits)}f"
     cells = pd.DataFrame({head(m): latex.cells(df, m, fmt) for m in models}, index=index)
-    cap = (
-        r"Zero-shot transfer to unseen wind, PSNR (dB); every model is fit to $v_0$ only. "
-        r"Top: training timestamps; bottom: frames beyond the training window. Best per row in "
-        r"bold." + latex.seed_note(len(seeds))
-    )
+    cap = _caption("tab_transfer", n_seeds=len(seeds))
     bold = np.arange(len(models)) == np.array([-1 if b is None else b for b in best])[:, None]
     return Table("tab_transfer", df, latex.render(cells, cap, "tab:transfer", bold))
 
@@ -428,23 +397,21 @@ def tab_margin(
         },
         index=index,
     )
-    others = [label(p) for p in priors if p != "ours"]
-    cap = (
-        r"Margin against the wind-conditioned baseline: ours minus Deformation MLP\,$+$\,wind, "
-        r"PSNR (dB) at training timestamps, on the training condition and the two unseen ones. "
-        r"Positive means ours is ahead."
-        + (f" Below, the same for: {', '.join(others)}." if others else "")
-        + latex.seed_note(len(seeds))
-    )
+    others = ", ".join(label(p) for p in priors if p != "ours")
+    more = "tab_margin_others" if others else ""
+    cap = _caption("tab_margin", more, n_seeds=len(seeds), others=others)
     return Table("tab_margin", df, latex.render(cells, cap, "tab:margin"))
 
 
 # ---- the tables' declarations --------------------------------------------------------------
+#: the needs of the methods' evaluations, and of the methods' and references'
+EVAL_METHODS, EVAL_SHOWN = _evals(("eval",), *METHODS), _evals(("eval",), *METHODS, *REFERENCES)
+
+
 def _tab_psnr(path, settings, inputs, out):
-    trees, shown = settings["trees"], models_of(*METHODS, *REFERENCES)
-    per_seed = _summaries(path, trees, shown, settings["seeds"])
-    methods, references = models_of(*METHODS), models_of(*REFERENCES)
-    return tab_psnr(per_seed, trees, settings["bones"], methods, settings["digits"], references)
+    per_seed = _summaries(path, settings, models_of(*METHODS, *REFERENCES))
+    at = settings["trees"], settings["bones"], models_of(*METHODS), settings["digits"]
+    return tab_psnr(per_seed, *at, models_of(*REFERENCES))
 
 
 def _fit_needs(plan, seeds):
@@ -455,10 +422,19 @@ def _fit_needs(plan, seeds):
     return _evals(kinds, *METHODS, *REFERENCES)(plan, seeds) + blind
 
 
+def _fit_settings(cfg):
+    """``fit_settings``' and the forcing-free priors trained (``blind``)."""
+    return {**fit_settings(cfg), "blind": list(blind_priors(cfg["models"]["configs"]))}
+
+
 def _tab_fit(path, settings, inputs, out):
-    n, every = int(settings["n_train"]), int(settings["holdout_every"])
+    n, every, blind = (
+        int(settings["n_train"]),
+        int(settings["holdout_every"]),
+        settings.get("blind", []),
+    )
     config = {m: BASE_CONFIG for m in models_of(*METHODS, *REFERENCES)}
-    config.update({m: BLIND_CONFIG for m in settings.get("blind", [])})
+    config |= {m: BLIND_CONFIG for m in blind}
     rows = {
         s: {
             (t, m): fit_row(path("eval", t, m, c, s), path("loss", t, m, c, s), n, every)
@@ -467,75 +443,45 @@ def _tab_fit(path, settings, inputs, out):
         }
         for s in settings["seeds"]
     }
-    models = (*models_of(*METHODS), *settings.get("blind", []))
-    trees, bones, reference = settings["trees"], settings["bones"], models_of(*REFERENCES)[0]
-    return tab_fit(rows, trees, bones, models, reference, settings["digits"], holdout_every=every)
+    models, reference = (*models_of(*METHODS), *blind), models_of(*REFERENCES)[0]
+    at = settings["trees"], settings["bones"], models, reference, settings["digits"]
+    return tab_fit(rows, *at, holdout_every=every)
 
 
 def _tab_transfer(path, settings, inputs, out):
-    trees, methods = settings["trees"], models_of(*METHODS)
-    per_seed = _summaries(path, trees, methods, settings["seeds"])
-    bones, conditions = settings["bones"], settings["conditions"]
-    return tab_transfer(per_seed, trees, bones, conditions, methods, settings["digits"])
+    per_seed = _summaries(path, settings, models_of(*METHODS))
+    at = settings["trees"], settings["bones"], settings["conditions"], models_of(*METHODS)
+    return tab_transfer(per_seed, *at, settings["digits"])
 
 
 def _tab_margin(path, settings, inputs, out):
-    trees, bones, conditions = settings["trees"], settings["bones"], settings["conditions"]
-    per_seed = _summaries(path, trees, (MARGIN_BASELINE, *models_of("prior")), settings["seeds"])
-    priors, digits = models_of("prior"), settings["digits"]
-    return tab_margin(per_seed, trees, bones, conditions, priors, MARGIN_BASELINE, digits)
+    per_seed = _summaries(path, settings, (MARGIN_BASELINE, *models_of("prior")))
+    at = settings["trees"], settings["bones"], settings["conditions"], models_of("prior")
+    return tab_margin(per_seed, *at, MARGIN_BASELINE, settings["digits"])
 
 
 # one row per model id (a difference row: ``<prior>-static``, ``<prior>-best_field``)
 PSNR_COLUMNS = Columns(
     ("seed", "model"), ("{tree}_view", "{tree}_time"), about=("reference", "difference")
 )
-TAB_PSNR = Output(
-    "tab_psnr", "table", _evals(("eval",), *METHODS, *REFERENCES), _tab_psnr, columns=PSNR_COLUMNS
-)
+TAB_PSNR = Output("tab_psnr", "table", EVAL_SHOWN, _tab_psnr, columns=PSNR_COLUMNS)
+FIT_VALUES = ("fit_psnr_db", "heldout_psnr_db", "ceiling_frac", "heldout_ceiling_frac")
 FIT_COLUMNS = Columns(
     ("seed", "tree", "model"),
-    (
-        "fit_psnr_db",
-        "heldout_psnr_db",
-        "ceiling_frac",
-        "heldout_ceiling_frac",
-        "view_psnr_db",
-        "time_psnr_db",
-        "iterations",
-    ),
+    (*FIT_VALUES, "view_psnr_db", "time_psnr_db", "iterations"),
     timing=("train_s",),
     about=("bones", "reference"),
 )
-TAB_FIT = Output(
-    "tab_fit",
-    "table",
-    _fit_needs,
-    _tab_fit,
-    settings=lambda cfg: {
-        **fit_settings(cfg),
-        "blind": list(blind_priors(cfg["models"]["configs"])),
-    },
-    columns=FIT_COLUMNS,
-)
+TAB_FIT = Output("tab_fit", "table", _fit_needs, _tab_fit, _fit_settings, columns=FIT_COLUMNS)
 # one column per model id; the wind (``condition``) is a numeric key
 TRANSFER_COLUMNS = Columns(("seed", "split", "tree", "condition"), ("{model}",), about=("bones",))
 TAB_TRANSFER = Output(
-    "tab_transfer",
-    "table",
-    _evals(("eval",), *METHODS),
-    _tab_transfer,
-    _conditions,
-    columns=TRANSFER_COLUMNS,
+    "tab_transfer", "table", EVAL_METHODS, _tab_transfer, _conditions, columns=TRANSFER_COLUMNS
 )
 MARGIN_COLUMNS = Columns(("seed", "model", "tree"), ("margin_{wind}",), about=("bones",))
+MARGIN_NEEDS = _evals(("eval",), "prior", extra=(MARGIN_BASELINE,))
 TAB_MARGIN = Output(
-    "tab_margin",
-    "table",
-    _evals(("eval",), "prior", extra=(MARGIN_BASELINE,)),
-    _tab_margin,
-    _conditions,
-    columns=MARGIN_COLUMNS,
+    "tab_margin", "table", MARGIN_NEEDS, _tab_margin, _conditions, columns=MARGIN_COLUMNS
 )
 
 
@@ -599,27 +545,17 @@ def _fig_results(path, settings, inputs, out):
     figures.fig_results(rows, ["gt", *models], images, out)
 
 
-FIG_TEMPORAL = Output(
-    "fig_temporal",
-    "figure",
-    _evals(("eval",), *METHODS, *REFERENCES),
-    _fig_temporal,
-    lambda cfg: {"n_train": int(cfg["testbed"]["n_train"])},
-)
-# the conditions, and the trees' roles: the teaser shows the tree standing for the paper's
-FIG_TEASER = Output(
-    "fig_teaser",
-    "figure",
-    _evals(("eval", "traj"), *METHODS),
-    _fig_teaser,
-    lambda cfg: {**_conditions(cfg), "roles": roles_of(cfg["presets"], cfg["trees"])},
-    "first",
-)
-FIG_RESULTS = Output(
-    "fig_results",
-    "figure",
-    _evals(("eval", "panels"), *METHODS),
-    _fig_results,
-    _conditions,
-    "first",
-)
+def _teaser_settings(cfg: dict) -> dict:
+    """The conditions, and the trees' roles: the teaser shows the tree standing for the paper's."""
+    return {**_conditions(cfg), "roles": roles_of(cfg["presets"], cfg["trees"])}
+
+
+def _n_train(cfg: dict) -> dict:
+    """The training window's length."""
+    return {"n_train": int(cfg["testbed"]["n_train"])}
+
+
+FIG_TEMPORAL = Output("fig_temporal", "figure", EVAL_SHOWN, _fig_temporal, _n_train)
+TEASER_NEEDS, RESULTS_NEEDS = (_evals(("eval", k), *METHODS) for k in ("traj", "panels"))
+FIG_TEASER = Output("fig_teaser", "figure", TEASER_NEEDS, _fig_teaser, _teaser_settings, "first")
+FIG_RESULTS = Output("fig_results", "figure", RESULTS_NEEDS, _fig_results, _conditions, "first")

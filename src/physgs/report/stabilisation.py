@@ -18,8 +18,7 @@ MIN_FREQ_AXIS_HZ = 3.0
 def fig_stabilisation(
     idents: Mapping, omega_bones: Mapping, trees: Sequence, outputs: Sequence, title: str = ""
 ) -> None:
-    """One column per tree: the poles (Hz against model order; filled where stable), the
-    identified modes as lines with their 95% interval (+-1.96 sigma) above; below, the truth.
+    """fig_stabilisation: one column per tree, the true frequencies in a strip below.
 
     Args:
         idents: ``idents[tree]``: its [`Identification`][physgs.oma.run.Identification], the
@@ -32,7 +31,7 @@ def fig_stabilisation(
     import matplotlib.pyplot as plt
     from matplotlib.lines import Line2D
 
-    from physgs.report.figures import FONT_PT, PAGE_WIDTH_IN, _legend_below, save_figure
+    from physgs.report.figures import FONT_PT, PAGE_WIDTH_IN, _legend_below, _texts, save_figure
 
     fig, axes = plt.subplots(
         2, len(trees), figsize=(PAGE_WIDTH_IN, 4.6), sharex="col", squeeze=False,
@@ -54,16 +53,13 @@ def fig_stabilisation(
                 m.freq_hz, top, xerr=1.96 * np.nan_to_num(m.freq_std), fmt="v", c="C3", ms=4,
                 capsize=3, lw=1.0,
             )  # fmt: skip
-        ax.set_title(f"{t}: {m.n_modes} modes", fontsize=FONT_PT)
-        ax.tick_params(labelsize=FONT_PT)
+        _texts(ax, f"{t}: {m.n_modes} modes")
         fb = np.asarray(omega_bones[t], float) / (2 * np.pi)
         strip.vlines(fb, 0, 1, colors="k", lw=0.8)
         strip.set_yticks([])
         strip.set_xlim(0, max(MIN_FREQ_AXIS_HZ, 1.2 * float(fb.max(initial=0.0))))
-        strip.set_xlabel("frequency (Hz)", fontsize=FONT_PT)
-        strip.tick_params(labelsize=FONT_PT)
+        _texts(strip, xlabel="frequency (Hz)", ylabel="bones" if j == 0 else None)
     axes[0, 0].set_ylabel("model order", fontsize=FONT_PT)
-    axes[1, 0].set_ylabel("bones", fontsize=FONT_PT)
     if title:
         fig.suptitle(title, fontsize=FONT_PT)
     handles = [

@@ -11,9 +11,10 @@ from typing import Sequence
 import pandas as pd
 
 from physgs.experiments.sweep import null_level
-from physgs.models.registry import BASE_CONFIG
+from physgs.models.registry import BASE_CONFIG, REFERENCE_NAMES, label
 from physgs.recovery.record import load_null
 from physgs.report.output import Output
+from physgs.report.thresholds import FIT_BAR
 
 #: the studies' CSVs (need ``("table", <study>)``), written by the rules of the same name
 SPEED_ACCURACY, FIT_CURVE = "speed_accuracy", "fit_curve"
@@ -67,9 +68,7 @@ def fit_vs_extrapolation(df: pd.DataFrame, static: str = "static") -> pd.DataFra
 
 
 def draw_fit_vs_extrapolation(df: pd.DataFrame, outputs: Sequence[str]) -> None:
-    """One panel per tree: each model's gain over static beyond the window (dB) against its
-    in-window fraction of the ceiling's gain, one line through its budgets (seed means, the
-    seeds' own points faint), the profile's budget starred, the fit bar and zero gain marked.
+    """fig_fit_vs_extrapolation: one panel per tree, one line per model through its budgets.
 
     Args:
         df: [`fit_vs_extrapolation`][physgs.report.trade.fit_vs_extrapolation]'s rows.
@@ -77,9 +76,7 @@ def draw_fit_vs_extrapolation(df: pd.DataFrame, outputs: Sequence[str]) -> None:
     """
     import matplotlib.pyplot as plt  # matplotlib: not for the workflow's planning imports
 
-    from physgs.models.registry import REFERENCE_NAMES, label
     from physgs.report.figures import COLORS, save_figure
-    from physgs.report.thresholds import FIT_BAR
 
     xy = ["of_ceiling", "beyond_gain"]
     trees = list(dict.fromkeys(df["tree"]))
