@@ -24,6 +24,7 @@ from physgs.report.recovery import (
     _methods_settings,
     _table_methods,
 )
+from physgs.report.table_captions import caption
 from physgs.report.tables import Table, tree_label
 from physgs.testbed.variant import DAMPING, FAITHFUL, damping_id
 
@@ -110,20 +111,8 @@ def tab_damping(
         },
         index=pd.MultiIndex.from_tuples(rows, names=["Tree", "Testbed", "Config"]),
     )
-    cap = (
-        r"Damping recovery on the faithful testbed ($\zeta$ fixed on every bone, no deliberate "
-        r"transient) and on its damping variant ($\zeta$ per bone, log-uniform, and a gust "
-        r"dropping to calm inside the window). Over trusted parts: median relative error of "
-        r"$\hat\zeta$ against the matched bone's $\zeta$ (\%), beside the untrained null "
-        r"($\zeta$ drawn log-uniformly from the same range, scored on the same matching; "
-        r"medians over its draws) and the paired difference (percentage points; negative: "
-        r"the model beats chance); the correlation of $\log\hat\zeta$ with $\log\zeta$; the "
-        r"exponent $p$ of the fitted decay rate $\hat\gamma=\hat\zeta\hat\omega\propto"
-        r"\hat\omega^p$ ($p\approx0$: a frequency-independent rate fitted in place of a "
-        r"ratio), the truth's own $p$ on the matched bones in brackets."
-        + "".join(mr.note for mr in methods.values())
-        + latex.seed_note(len(seeds))
-    )
+    cap = caption("tab_damping") + "".join(mr.note for mr in methods.values())
+    cap += latex.seed_note(len(seeds))
     return Table("tab_damping", df, latex.render(cells, cap, "tab:damping"))
 
 

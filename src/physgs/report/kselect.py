@@ -16,6 +16,7 @@ from physgs.models.registry import spec_of
 from physgs.recovery.record import load_recovery
 from physgs.report import latex
 from physgs.report.output import Columns, Output
+from physgs.report.table_captions import caption
 from physgs.report.tables import Table, seed_rows, seeds_of, tree_index
 
 #: the rows of each prior: configuration -> its label (fixed K, then K chosen from the data)
@@ -90,16 +91,8 @@ def tab_kselect(
         },
         index=tree_index(first, labels, "Model"),
     )
-    cap = (
-        rf"Each prior with fixed $K$ against $K$ chosen from the data (method: {method}, on "
-        r"held-out training-window frames; the CSV also lists the choice by held-out frames and "
-        r"by BIC). PSNR (dB) on the held-out views and on the time split (beyond the window); "
-        r"median relative frequency error over trusted parts; Frozen: parts whose swing stayed "
-        r"under a pixel. Train: seconds of the model's training; Select: seconds of the "
-        r"selection's short runs; Cost: (train + select) over the fixed-$K$ training."
-        + latex.seed_note(len(seeds), decides=False)
-        + r" $K$: as each seed chose it."
-    )
+    cap = caption("tab_kselect", method=method) + latex.seed_note(len(seeds), decides=False)
+    cap += r" $K$: as each seed chose it."
     return Table("tab_kselect", df, latex.render(cells, cap, "tab:kselect"))
 
 

@@ -15,6 +15,7 @@ from physgs.recovery.record import load_null, load_recovery
 from physgs.report import latex
 from physgs.report import seeds as seedstats
 from physgs.report.output import Columns, Output
+from physgs.report.table_captions import caption
 from physgs.report.tables import Table, check_keys, seed_rows, seeds_of, tree_index
 
 #: the method ids of the 2D-track control and the output-only analysis (``RECOVERY_METHODS``)
@@ -50,16 +51,6 @@ class MethodRows:
         return f"{self.label}, {self.configs[config]}" if self.label else self.configs[config]
 
 
-#: each frequency-recovery table's caption, first sentence
-LEADS = {
-    "tab_null": "Frequency recovery against an untrained null.",
-    "tab_recovery": (
-        r"Frequency recovery of every method against the untrained null of its $K$; rows "
-        r"labelled by their configuration alone are ours (Table~\ref{tab:null})."
-    ),
-}
-
-
 def recovery_table(
     name: str, methods: Mapping[str, MethodRows], trees: Sequence, bones: Mapping, digits: int = 2
 ) -> Table:
@@ -70,7 +61,7 @@ def recovery_table(
 
     Args:
         name: tab_null (the paper's methods) or tab_recovery (every method, ours first); its
-            label ``tab:<name without tab_>``, its caption's lead ``LEADS[name]``.
+            label ``tab:<name without tab_>``, its caption's lead ``table_captions.TEXT[name]``.
         methods: method id -> its ``MethodRows``, in row order (one without configurations has
             no rows): ``per_seed[seed][(tree, config)]`` = (``RecoveryRecord``, ``NullResult``
             of that seed and the method's K).
@@ -128,16 +119,8 @@ def recovery_table(
         columns[("Visible bones", who)] = col(f"{pre}_median_rel_err_visible_pct", fmt, r"\%")
     labels = [methods[m].row_label(c) for m, c in zip(first["method"], first["config"])]
     cells = pd.DataFrame(columns, index=tree_index(first, labels, "Config"))
-    cap = (
-        LEADS[name] + r" Parts: parts trusted ($|\mathrm{corr}|\geq0.7$) "
-        r"of $K$ (mean over seeds). Median relative error over trusted parts; $R^2$ of "
-        r"$\log\hat\omega_p$ against $\log\omega_p$. Null entries are medians over 8 draws "
-        r"of each seed, with the trained model's $K$; Trained $-$ null: percentage points, "
-        r"paired per seed (negative: the trained model beats chance); Gap: median nearest-bone "
-        r"gap. Visible bones: the median errors restricted to parts matched to bones whose own "
-        r"motion moves at least a pixel in the training camera (the CSV also gives the part "
-        r"counts)." + "".join(mr.note for mr in methods.values()) + latex.seed_note(len(seeds))
-    )
+    cap = caption(name, "frequency_recovery") + "".join(mr.note for mr in methods.values())
+    cap += latex.seed_note(len(seeds))
     return Table(name, df, latex.render(cells, cap, "tab:" + name.removeprefix("tab_")))
 
 

@@ -10,6 +10,7 @@ import pandas as pd
 from physgs.report import latex, paper
 from physgs.report.claim_cells import roles_of
 from physgs.report.output import Columns, Output
+from physgs.report.table_captions import caption
 from physgs.report.tables import Table, check_keys
 from physgs.testbed.stats import load_stats
 
@@ -115,22 +116,9 @@ def tab_testbed(
             "Height": [f"{x:.0f}\\%" for x in df["height_fill_pct"]],
         }
     ).set_axis(pd.Index(df["tree"].str.capitalize(), name="Tree"))
-    cap = (
-        r"The testbed. Distinct $f$: distinct natural frequencies; Span: max/min frequency "
-        + f"(paper: $\\sim${paper.FREQUENCY_SPAN}$\\times$)"
-        + r"; Gap: median nearest-bone gap, the "
-        r"paper's in brackets; Swing: median RMS of each bone's own angle over the window; "
-        r"Visible: median image displacement caused by a bone's own angle alone, acting on its "
-        r"subtree, in training-camera pixels, and the share of bones under 1\,px (no method "
-        r"can recover those); Height: training-image height spanned by the swept tree."
-        + (
-            f" Each value is the mean over a tree's {int(df['instances'].max())} instances "
-            r"(one per training seed), the gap $\pm$ its sd over them (the CSV: every "
-            r"statistic's)."
-            if (df["instances"] > 1).any()
-            else " One instance per tree (the paper's protocol)."
-        )
-    )
+    n = int(df["instances"].max())
+    each = "tab_testbed_instances" if (df["instances"] > 1).any() else "tab_testbed_one"
+    cap = caption("tab_testbed", each, span=paper.FREQUENCY_SPAN, n=n)
     return Table("tab_testbed", df, latex.render(cells, cap, "tab:testbed"))
 
 

@@ -14,6 +14,7 @@ from physgs.intermediate import read_json
 from physgs.report import latex
 from physgs.report.output import Columns, Output, key
 from physgs.report.recovery import _label_with_k
+from physgs.report.table_captions import caption
 from physgs.report.tables import Table, condition_label, seed_rows, seeds_of, tree_label
 from physgs.tracks.settings import parts as tracks_k
 from physgs.tracks.store import load_fit, load_tracks
@@ -117,28 +118,9 @@ def tab_tracks(
             columns[(f"{head} (px)", who)] = col(f"{stem}{suffix}_px", fmt)
     rows = [(tree_label(t, bones[t]), configs[c]["label"]) for t, c in keys]
     cells = pd.DataFrame(columns, index=pd.MultiIndex.from_tuples(rows, names=["Tree", "Config"]))
-    joint = [c.replace("_", r"\_") for c in configs if configs[c]["conditions"] != "train"]
-    cap = (
-        r"The 2D-track control: ours' oscillators fitted to Lucas--Kanade point tracks of the "
-        r"training video. \emph{Tracker}, against the truth-projected mesh vertices over the "
-        r"training window: tracks started (share of the frame-0 tracks kept to the window's "
-        r"end), median / 90th-percentile position error and displacement error since each "
-        r"track's seed frame (px). \emph{Fit}: parts with an estimate of $K$ (a part needs "
-        r"enough tracks), wall seconds of the fit, beside ours' training seconds in the same "
-        r"configuration. Motion: median displacement error (px) of "
-        r"the predicted tracks beyond the training window (training wind) and under each other "
-        r"wind (window frames), beside ours' Gaussians at the same tracked points, the best "
-        r"learned field's (the lowest error of the fields trained in that configuration, per "
-        r"seed; -- where none is) and a motionless prediction (each track's mean tracked "
-        r"position)."
-        + (
-            f" The joint configurations ({', '.join(joint)}) are fitted to every wind: their "
-            "other-wind columns are not transfer."
-            if joint
-            else ""
-        )
-        + latex.seed_note(len(seeds), decides=False)
-    )
+    joint = ", ".join(c.replace("_", r"\_") for c in configs if configs[c]["conditions"] != "train")
+    cap = caption("tab_tracks", *(["tab_tracks_joint"] if joint else []), joint=joint)
+    cap += latex.seed_note(len(seeds), decides=False)
     return Table("tab_tracks", df, latex.render(cells, cap, "tab:tracks"))
 
 
