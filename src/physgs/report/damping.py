@@ -7,7 +7,6 @@ from __future__ import annotations
 from functools import partial
 from typing import Mapping, Sequence
 
-import pandas as pd
 
 from physgs.models.registry import RECOVERY_METHODS, models_of
 from physgs.recovery.record import load_recovery
@@ -19,13 +18,13 @@ from physgs.report.recovery import (
     WHO,
     MethodRows,
     interval_cells,
-    _method_frame,
+    _method_table,
     _methods_needs,
     _methods_settings,
     _table_methods,
 )
 from physgs.report.table_captions import caption
-from physgs.report.tables import Table, tree_label
+from physgs.report.tables import Table
 from physgs.testbed.variant import DAMPING, FAITHFUL, damping_id
 
 VARIANTS = (FAITHFUL, DAMPING)
@@ -63,12 +62,8 @@ def tab_damping(
         ValueError: when a record has no damping scores.
         KeyError: when a seed lacks a record.
     """
-    methods = {m: mr for m, mr in methods.items() if mr.configs}
-    block = [(c, m) for m, mr in methods.items() for c in mr.configs]
-    keys = [(t, v, c, m) for t in trees for v in VARIANTS for c, m in block]
 
-    def one(s, t, v, c, method):
-        rec = methods[method].per_seed[s][(t, v, c)]
+    def one(s, rec, t, v, c, method):
         sc, nl = rec.damping_scores, rec.damping_null
         if sc is None or nl is None:
             name = "" if method == "ours" else f" ({WHO.get(method, method)})"
@@ -90,13 +85,11 @@ def tab_damping(
             **interval_cells(rec),
         }
 
-    df, seeds = _method_frame("tab_damping", methods, keys, one)
-    col, fmt = partial(latex.cells, df), f".{int(digits)}f"
-    p, p_true = col("gamma_exponent", ".2f"), col("gamma_exponent_true", ".2f", cell=latex.mean)
-    err, corr = r"Med.\ rel.\ err.\ of $\hat\zeta$", r"corr($\log\hat\zeta$, $\log\zeta$)"
-    rows = [(tree_label(t, bones[t]), v, methods[m].row_label(c)) for t, v, c, m in keys]
-    cells = pd.DataFrame(
-        {
+    def columns(df):
+        col, fmt = partial(latex.cells, df), f".{int(digits)}f"
+        p, p_true = col("gamma_exponent", ".2f"), col("gamma_exponent_true", ".2f", cell=latex.mean)
+        err, corr = r"Med.\ rel.\ err.\ of $\hat\zeta$", r"corr($\log\hat\zeta$, $\log\zeta$)"
+        return {
             ("", "Trusted"): col("trusted", ".1f"),  # a mean count: one decimal
             (err, "Trained"): col("rel_err_pct", ".0f", r"\%"),
             (err, "Null"): col("null_rel_err_pct", ".0f", r"\%"),
@@ -108,12 +101,10 @@ def tab_damping(
             (r"$\hat\gamma\propto\hat\omega^p$", "$p$ (truth)"): [
                 a if b == "--" else f"{a} ({b})" for a, b in zip(p, p_true)
             ],
-        },
-        index=pd.MultiIndex.from_tuples(rows, names=["Tree", "Testbed", "Config"]),
-    )
-    cap = caption("tab_damping") + "".join(mr.note for mr in methods.values())
-    cap += latex.seed_note(len(seeds))
-    return Table("tab_damping", df, latex.render(cells, cap, "tab:damping"))
+        }
+
+    lead = caption("tab_damping")
+    return _method_table("tab_damping", methods, trees, bones, one, columns, lead, VARIANTS)
 
 
 # ---- the declarations ----------------------------------------------------------------------
