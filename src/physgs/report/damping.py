@@ -109,8 +109,8 @@ def tab_damping(
 
 # ---- the declarations ----------------------------------------------------------------------
 def _testbeds(tree: str) -> dict:
-    """{variant: testbed id} of a damping-benchmark tree."""
-    return {FAITHFUL: tree, DAMPING: damping_id(tree)}
+    """{(variant,): testbed id} of a damping-benchmark tree."""
+    return {(FAITHFUL,): tree, (DAMPING,): damping_id(tree)}
 
 
 def _damping_needs(plan, seeds):
@@ -120,21 +120,11 @@ def _damping_needs(plan, seeds):
 
 
 def _tab_damping(path, settings, inputs, out):
-    trees, seeds = settings["trees"], settings["seeds"]
+    def read(m, K, tb, c, s):
+        return load_recovery(path("recovery", tb, m, c, s))
 
-    def records(m, configs):  # {seed: {(tree, variant, config): record}}
-        return {
-            s: {
-                (t, v, c): load_recovery(path("recovery", tb, m, c, s))
-                for t in trees
-                for v, tb in _testbeds(t).items()
-                for c in configs
-            }
-            for s in seeds
-        }
-
-    methods = _table_methods(settings, records, damping=True)
-    return tab_damping(methods, trees, settings["bones"], digits=settings["digits"])
+    methods = _table_methods(settings, read, _testbeds, damping=True)
+    return tab_damping(methods, settings["trees"], settings["bones"], digits=settings["digits"])
 
 
 TAB_DAMPING = Output(

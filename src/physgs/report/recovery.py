@@ -224,13 +224,24 @@ def _methods_needs(plan, methods, configs, testbeds, s: int) -> list[tuple]:
     ]
 
 
-def _table_methods(settings: dict, records, damping: bool = False) -> dict[str, MethodRows]:
+def _table_methods(settings: dict, read, testbeds=None, damping=False) -> dict[str, MethodRows]:
     """Method id -> its ``MethodRows`` in ``RECOVERY_METHODS``' order (ours first), from the
-    ``_methods_settings`` and ``records(method, {config: K})`` -> its per-seed records."""
-    out, methods = {}, settings["methods"]
+    ``_methods_settings``: each record ``read(method, K, testbed, config, seed)`` at key (tree,
+    *variant, config), ``testbeds(tree)``: {(variant,): testbed id} (None: the tree alone)."""
+    out, methods, trees = {}, settings["methods"], settings["trees"]
+    beds = testbeds or (lambda t: {(): t})
     for m in (m for m in RECOVERY_METHODS if m in methods):
         labels, ks = ({c: v[f] for c, v in methods[m].items()} for f in ("label", "K"))
-        out[m] = method_rows(m, labels, records(m, ks), damping=damping)
+        at = [
+            ((t, *v, c), tb, c, k)
+            for t in trees
+            for v, tb in beds(t).items()
+            for c, k in ks.items()
+        ]
+        per_seed = {
+            s: {key: read(m, k, tb, c, s) for key, tb, c, k in at} for s in settings["seeds"]
+        }
+        out[m] = method_rows(m, labels, per_seed, damping=damping)
     return out
 
 
@@ -277,16 +288,11 @@ def _frequency_output(name: str, methods, in_report=lambda plan: True) -> Output
         return _methods_settings(cfg, methods(recovery_plan(cfg)), cfg["models"]["configs"])
 
     def table(path, settings, inputs, out):
-        trees, seeds = settings["trees"], settings["seeds"]
+        def read(m, K, t, c, s):  # its record and the null of its K
+            rec = load_recovery(path("recovery", t, m, c, s))
+            return rec, load_null(path("null", t, int(K), s))
 
-        def paired(m, configs):  # configs: {config: K}
-            def one(t, c, s):  # its record and the null of its K
-                rec = load_recovery(path("recovery", t, m, c, s))
-                return rec, load_null(path("null", t, int(configs[c]), s))
-
-            return {s: {(t, c): one(t, c, s) for t in trees for c in configs} for s in seeds}
-
-        rows = _table_methods(settings, paired)
+        rows, trees = _table_methods(settings, read), settings["trees"]
         return recovery_table(name, rows, trees, settings["bones"], digits=settings["digits"])
 
     return Output(
