@@ -224,18 +224,17 @@ def tab_parts_k(
     """
     seeds = seeds_of(per_seed, "tab_parts_k", trees)
     recs = []
-    for s in seeds:
-        for t in trees:
-            r = per_seed[s][t]
-            chain = {int(k): float(v) for k, v in r["chain"].items()}
-            m = matched_k(chain, float(r["ours"]), tie_db)
-            points = [("ours", int(base_k), float(r["ours"]))]
-            points += [("ours_chain", k, chain[k]) for k in sorted(chain)]
-            recs += [
-                {"seed": s, "tree": t, "bones": bones[t], "model": model, "K": k}
-                | {"heldout_psnr_db": v, "matched_k": float("nan") if m is None else float(m)}
-                for model, k, v in points
-            ]
+    for s, t in product(seeds, trees):
+        r = per_seed[s][t]
+        chain = {int(k): float(v) for k, v in r["chain"].items()}
+        m = matched_k(chain, float(r["ours"]), tie_db)
+        points = [("ours", int(base_k), float(r["ours"]))]
+        points += [("ours_chain", k, chain[k]) for k in sorted(chain)]
+        about, matched = {"seed": s, "tree": t, "bones": bones[t]}, float("nan") if m is None else m
+        recs += [
+            about | {"model": model, "K": k, "heldout_psnr_db": v, "matched_k": float(matched)}
+            for model, k, v in points
+        ]
     df = pd.DataFrame(recs)
     first = latex.rows(df)
     ks = sorted(int(k) for k in first.loc[first["model"] == "ours_chain", "K"].unique())

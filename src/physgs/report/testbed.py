@@ -30,6 +30,9 @@ INSTANCE_SPREAD = (
     "height_fill_pct",
     "coverage_pct",
 )
+#: an instance's statistics in tab_testbed (a tree's row: their mean), and their spreads' columns
+STATS = (*INSTANCE_SPREAD, "order_share", "order_share_random")
+SPREADS = tuple(f"{c}_sd" for c in INSTANCE_SPREAD)
 #: the percentage columns -> the fraction they show
 PERCENT = {
     "nearest_bone_gap_pct": "nearest_bone_gap",
@@ -41,8 +44,7 @@ PERCENT = {
 
 def _testbed_row(s: Mapping) -> dict:
     """One instance's statistics in tab_testbed's columns (percentages as percent)."""
-    cols = (*INSTANCE_SPREAD, "order_share", "order_share_random")
-    return {c: 100 * s[PERCENT[c]] if c in PERCENT else s[c] for c in cols}
+    return {c: 100 * s[PERCENT[c]] if c in PERCENT else s[c] for c in STATS}
 
 
 def tab_testbed(
@@ -71,23 +73,22 @@ def tab_testbed(
         The table: one row per tree.
     """
     check_keys(list(trees), stats, "tab_testbed")
-    rows = []
-    for t in trees:
+
+    def row(t):  # the mean over the tree's instances (or its one), the paper's values beside
         inst = pd.DataFrame([_testbed_row(x) for x in (instances or {}).get(t) or [stats[t]]])
         pt = (paper_trees or {}).get(t)
-        rows.append(
-            {
-                "tree": t,
-                "bones": int(stats[t]["bones"]),
-                "paper_bones": paper.BONES.get(pt),
-                **{c: float(inst[c].mean()) for c in inst.columns},
-                "paper_f_span": paper.FREQUENCY_SPAN,
-                "paper_nearest_bone_gap_pct": paper.NEAREST_BONE_GAP_PCT.get(pt, np.nan),
-                "instances": len(inst),
-                **{f"{c}_sd": float(inst[c].std(ddof=1)) for c in INSTANCE_SPREAD},  # one: NaN
-            }
-        )
-    df = pd.DataFrame(rows)
+        return {
+            "tree": t,
+            "bones": int(stats[t]["bones"]),
+            "paper_bones": paper.BONES.get(pt),
+            **{c: float(inst[c].mean()) for c in inst.columns},
+            "paper_f_span": paper.FREQUENCY_SPAN,
+            "paper_nearest_bone_gap_pct": paper.NEAREST_BONE_GAP_PCT.get(pt, np.nan),
+            "instances": len(inst),
+            **{f"{c}_sd": float(inst[c].std(ddof=1)) for c in INSTANCE_SPREAD},  # one: NaN
+        }
+
+    df = pd.DataFrame([row(t) for t in trees])
     fmt = f".{int(digits)}f"
     paper_gap = [
         "--" if not np.isfinite(x) else format(x, fmt) for x in df["paper_nearest_bone_gap_pct"]
@@ -154,17 +155,7 @@ TAB_TESTBED = Output(
     # values beside, and the spreads over the tree's instances (NaN with one)
     columns=Columns(
         keys=("tree",),
-        values=(
-            *INSTANCE_SPREAD[:5],
-            "paper_f_span",
-            "clamped",
-            "nearest_bone_gap_pct",
-            "paper_nearest_bone_gap_pct",
-            *INSTANCE_SPREAD[7:],
-            "order_share",
-            "order_share_random",
-            *(f"{c}_sd" for c in INSTANCE_SPREAD),
-        ),
+        values=(*STATS, "paper_f_span", "paper_nearest_bone_gap_pct", *SPREADS),
         about=("bones", "paper_bones", "instances"),
     ),
 )
