@@ -230,9 +230,9 @@ def tab_parts_k(
         m = matched_k(chain, float(r["ours"]), tie_db)
         points = [("ours", int(base_k), float(r["ours"]))]
         points += [("ours_chain", k, chain[k]) for k in sorted(chain)]
-        about, matched = {"seed": s, "tree": t, "bones": bones[t]}, float("nan") if m is None else m
+        about, found = {"seed": s, "tree": t, "bones": bones[t]}, float("nan") if m is None else m
         recs += [
-            about | {"model": model, "K": k, "heldout_psnr_db": v, "matched_k": float(matched)}
+            about | {"model": model, "K": k, "heldout_psnr_db": v, "matched_k": float(found)}
             for model, k, v in points
         ]
     df = pd.DataFrame(recs)

@@ -11,7 +11,7 @@ import yaml
 TEXT = yaml.safe_load(resources.files("physgs.report").joinpath("table_captions.yaml").read_text())
 
 
-def caption(*names: str, **fields) -> str:
+def caption(*names: str, **fields: object) -> str:
     """Caption entries joined by spaces, each ``<field>`` filled in.
 
     Args:
