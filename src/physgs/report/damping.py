@@ -5,6 +5,7 @@ fig_damping: each prior's recovered damping on the run's own trees (first seed).
 from __future__ import annotations
 
 from functools import partial
+from itertools import product
 from typing import Mapping, Sequence
 
 
@@ -149,12 +150,9 @@ def _fig_damping(path, settings, inputs, out):
     from physgs.report import figures  # matplotlib: not for the workflow's planning imports
 
     trees, configs, s0 = settings["trees"], settings["configs"], settings["seeds"][0]
+    pairs = list(product(trees, configs))
     damping = {
-        m: {
-            (t, c): load_recovery(path("recovery", t, m, c, s0)).damping
-            for t in trees
-            for c in configs
-        }
+        m: {(t, c): load_recovery(path("recovery", t, m, c, s0)).damping for t, c in pairs}
         for m in models_of("prior")
     }
     zeta, bound = float(settings["zeta"]), float(settings["zeta_bound"])
@@ -166,10 +164,7 @@ FIG_DAMPING = Output(
     "figure",
     lambda plan, seeds: [
         ("recovery", t, m, c, s)
-        for s in seeds
-        for t in plan.trees
-        for m in models_of("prior")
-        for c in plan.configs
+        for s, t, m, c in product(seeds, plan.trees, models_of("prior"), plan.configs)
     ],
     _fig_damping,
     settings=lambda cfg: {

@@ -65,7 +65,8 @@ def recovery_table(
     """
 
     def one(s, pair, t, c, method):
-        (rec, nl), m = pair, pair[0].match
+        rec, nl = pair
+        m = rec.match
         if nl.n_parts != m.n_parts:
             raise ValueError(
                 f"{name}: null for {t}/{c} (seed {s}) has K={nl.n_parts} but the "

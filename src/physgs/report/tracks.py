@@ -5,6 +5,7 @@ and a motionless prediction's at the same points; the tracks drawn over frame 0.
 from __future__ import annotations
 
 from functools import partial
+from itertools import product
 from typing import Mapping, Sequence
 
 import numpy as np
@@ -181,13 +182,10 @@ def fig_tracks(
 def _tab_tracks_needs(plan, seeds):
     """Per tree, configuration and seed: the evaluation record, ours' loss log (training
     seconds) and, for ``plan.tracks_fields``, the fields' scores."""
-    return [
-        (kind, t, *m, c, int(s))
-        for s in seeds
-        for t in plan.trees
-        for c in plan.tracks
-        for kind, m in (("tracks_eval", ()), ("loss", ("ours",)))
-    ] + [("tracks_fields", t, c, int(s)) for s in seeds for t, c in plan.tracks_fields]
+    each = (("tracks_eval", ()), ("loss", ("ours",)))  # the record, ours' loss log
+    mine = product([int(s) for s in seeds], plan.trees, plan.tracks)
+    out = [(k, t, *m, c, s) for s, t, c in mine for k, m in each]
+    return out + [("tracks_fields", t, c, int(s)) for s in seeds for t, c in plan.tracks_fields]
 
 
 def _tab_tracks_settings(cfg: dict) -> dict:
