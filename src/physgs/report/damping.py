@@ -8,42 +8,34 @@ from functools import partial
 from itertools import product
 from typing import Mapping, Sequence
 
-
 from physgs.models.registry import RECOVERY_METHODS, models_of
 from physgs.recovery.record import load_recovery
 from physgs.report import latex
+from physgs.report import recovery as R
 from physgs.report import seeds as seedstats
 from physgs.report.output import Columns, Output
-from physgs.report.recovery import (
-    INTERVAL_COLUMNS,
-    WHO,
-    MethodRows,
-    interval_cells,
-    _method_table,
-    _methods_needs,
-    _methods_settings,
-    _table_methods,
-)
 from physgs.report.table_captions import caption
 from physgs.report.tables import Table
 from physgs.testbed.variant import DAMPING, FAITHFUL, damping_id
 
 VARIANTS = (FAITHFUL, DAMPING)
-COLUMNS = (
-    "trusted",
-    "rel_err_pct",
-    "null_rel_err_pct",
-    "trained_minus_null_pp",
-    "log_corr",
-    "null_log_corr",
-    "gamma_exponent",
-    "null_gamma_exponent",
-    "gamma_exponent_true",
-)
+#: tab_damping's CSV values (before ``INTERVAL_COLUMNS``) -> each from a record's damping
+#: scores and their null
+VALUES = {
+    "trusted": lambda sc, nl: sc.n_trusted,
+    "rel_err_pct": lambda sc, nl: 100 * sc.median_rel_err,
+    "null_rel_err_pct": lambda sc, nl: 100 * nl.median_median_rel_err,
+    "trained_minus_null_pp": lambda sc, nl: 100 * (sc.median_rel_err - nl.median_median_rel_err),
+    "log_corr": lambda sc, nl: sc.log_corr,
+    "null_log_corr": lambda sc, nl: nl.median_log_corr,
+    "gamma_exponent": lambda sc, nl: sc.gamma_exponent,
+    "null_gamma_exponent": lambda sc, nl: nl.median_gamma_exponent,
+    "gamma_exponent_true": lambda sc, nl: sc.gamma_exponent_true,
+}
 
 
 def tab_damping(
-    methods: Mapping[str, MethodRows], trees: Sequence, bones: Mapping, digits: int = 2
+    methods: Mapping[str, R.MethodRows], trees: Sequence, bones: Mapping, digits: int = 2
 ) -> Table:
     """Damping recovery per seed, tree, variant, method and configuration, beside the null.
 
@@ -67,24 +59,13 @@ def tab_damping(
     def one(s, rec, t, v, c, method):
         sc, nl = rec.damping_scores, rec.damping_null
         if sc is None or nl is None:
-            name = "" if method == "ours" else f" ({WHO.get(method, method)})"
+            name = "" if method == "ours" else f" ({R.WHO.get(method, method)})"
             raise ValueError(
                 f"tab_damping: the recovery of {t}/{v}/{c}{name} (seed {s}) has no "
                 "damping scores; re-run its recovery rule with damping params"
             )
         about = {"tree": t, "bones": bones[t], "testbed": v, "config": c, "method": method}
-        return about | {
-            "trusted": sc.n_trusted,
-            "rel_err_pct": 100 * sc.median_rel_err,
-            "null_rel_err_pct": 100 * nl.median_median_rel_err,
-            "trained_minus_null_pp": 100 * (sc.median_rel_err - nl.median_median_rel_err),
-            "log_corr": sc.log_corr,
-            "null_log_corr": nl.median_log_corr,
-            "gamma_exponent": sc.gamma_exponent,
-            "null_gamma_exponent": nl.median_gamma_exponent,
-            "gamma_exponent_true": sc.gamma_exponent_true,
-            **interval_cells(rec),
-        }
+        return about | {k: f(sc, nl) for k, f in VALUES.items()} | R.interval_cells(rec)
 
     def columns(df):
         col, fmt = partial(latex.cells, df), f".{int(digits)}f"
@@ -105,7 +86,7 @@ def tab_damping(
         }
 
     lead = caption("tab_damping")
-    return _method_table("tab_damping", methods, trees, bones, one, columns, lead, VARIANTS)
+    return R._method_table("tab_damping", methods, trees, bones, one, columns, lead, VARIANTS)
 
 
 # ---- the declarations ----------------------------------------------------------------------
@@ -116,7 +97,7 @@ def _testbeds(tree: str) -> dict:
 
 def _damping_needs(plan, seeds):
     testbeds = [tb for t in plan.damping_trees for tb in _testbeds(t).values()]
-    need = partial(_methods_needs, plan, plan.recovery, plan.damping_configs, testbeds)
+    need = partial(R._methods_needs, plan, plan.recovery, plan.damping_configs, testbeds)
     return [x for s in seeds for x in need(int(s))]
 
 
@@ -124,7 +105,7 @@ def _tab_damping(path, settings, inputs, out):
     def read(m, K, tb, c, s):
         return load_recovery(path("recovery", tb, m, c, s))
 
-    methods = _table_methods(settings, read, _testbeds, damping=True)
+    methods = R._table_methods(settings, read, _testbeds, damping=True)
     return tab_damping(methods, settings["trees"], settings["bones"], digits=settings["digits"])
 
 
@@ -133,14 +114,14 @@ TAB_DAMPING = Output(
     "table",
     _damping_needs,
     _tab_damping,
-    settings=lambda cfg: _methods_settings(
+    settings=lambda cfg: R._methods_settings(
         cfg, RECOVERY_METHODS, cfg["damping_benchmark"]["configs"]
     ),
     trees="damping_benchmark",
     in_report=lambda plan: bool(plan.damping_trees),
     columns=Columns(
         keys=("seed", "tree", "testbed", "config", "method"),
-        values=(*COLUMNS, *INTERVAL_COLUMNS),
+        values=(*VALUES, *R.INTERVAL_COLUMNS),
         about=("bones",),
     ),
 )

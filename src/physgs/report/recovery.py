@@ -42,6 +42,26 @@ class MethodRows:
     note: str = ""
 
 
+#: tab_null's and tab_recovery's CSV values (before ``INTERVAL_COLUMNS``) -> each from a
+#: method's record and the null of its K
+NULL_VALUES = {
+    "trained_parts_trusted": lambda rec, nl: float(rec.match.n_trusted),
+    "trained_median_rel_err_pct": lambda rec, nl: 100 * rec.match.median_rel_err,
+    "trained_loglog_r2": lambda rec, nl: rec.match.loglog_r2,
+    "null_parts_trusted": lambda rec, nl: nl.median_n_trusted,
+    "null_median_rel_err_pct": lambda rec, nl: 100 * nl.median_median_rel_err,
+    "null_loglog_r2": lambda rec, nl: nl.median_loglog_r2,
+    "trained_minus_null_pp": (
+        lambda rec, nl: 100 * rec.match.median_rel_err - 100 * nl.median_median_rel_err
+    ),
+    "nearest_bone_gap_pct": lambda rec, nl: 100 * nl.nearest_bone_gap,
+    "trained_parts_trusted_visible": lambda rec, nl: float(rec.n_trusted_visible),
+    "trained_median_rel_err_visible_pct": lambda rec, nl: 100 * rec.median_rel_err_visible,
+    "null_parts_trusted_visible": lambda rec, nl: nl.median_n_trusted_visible,
+    "null_median_rel_err_visible_pct": lambda rec, nl: 100 * nl.median_median_rel_err_visible,
+}
+
+
 def recovery_table(
     name: str, methods: Mapping[str, MethodRows], trees: Sequence, bones: Mapping, digits: int = 2
 ) -> Table:
@@ -72,23 +92,8 @@ def recovery_table(
                 f"{name}: null for {t}/{c} (seed {s}) has K={nl.n_parts} but the "
                 f"model has K={m.n_parts}; re-run the null with the model's K"
             )
-        tr, nu = 100 * m.median_rel_err, 100 * nl.median_median_rel_err
         about = {"tree": t, "bones": bones[t], "config": c, "method": method, "K": m.n_parts}
-        return about | {
-            "trained_parts_trusted": float(m.n_trusted),
-            "trained_median_rel_err_pct": tr,
-            "trained_loglog_r2": m.loglog_r2,
-            "null_parts_trusted": nl.median_n_trusted,
-            "null_median_rel_err_pct": nu,
-            "null_loglog_r2": nl.median_loglog_r2,
-            "trained_minus_null_pp": tr - nu,
-            "nearest_bone_gap_pct": 100 * nl.nearest_bone_gap,
-            "trained_parts_trusted_visible": float(rec.n_trusted_visible),
-            "trained_median_rel_err_visible_pct": 100 * rec.median_rel_err_visible,
-            "null_parts_trusted_visible": nl.median_n_trusted_visible,
-            "null_median_rel_err_visible_pct": 100 * nl.median_median_rel_err_visible,
-            **interval_cells(rec),
-        }
+        return about | {k: f(rec, nl) for k, f in NULL_VALUES.items()} | interval_cells(rec)
 
     def columns(df):
         col, fmt, out = partial(latex.cells, df), f".{int(digits)}f", {}
@@ -254,21 +259,7 @@ def _paper(plan_or_methods) -> list[str]:
 #: tab_null's and tab_recovery's CSV: one row per seed, tree, configuration and method id
 NULL_COLUMNS = Columns(
     keys=("seed", "tree", "config", "method"),
-    values=(
-        "trained_parts_trusted",
-        "trained_median_rel_err_pct",
-        "trained_loglog_r2",
-        "null_parts_trusted",
-        "null_median_rel_err_pct",
-        "null_loglog_r2",
-        "trained_minus_null_pp",
-        "nearest_bone_gap_pct",
-        "trained_parts_trusted_visible",
-        "trained_median_rel_err_visible_pct",
-        "null_parts_trusted_visible",
-        "null_median_rel_err_visible_pct",
-        *INTERVAL_COLUMNS,
-    ),
+    values=(*NULL_VALUES, *INTERVAL_COLUMNS),
     about=("bones", "K"),
 )
 
