@@ -22,6 +22,17 @@ from physgs.report.tables import Table, seed_rows, seeds_of, tree_index
 #: the rows of each prior: configuration -> its label (fixed K, then K chosen from the data)
 ROWS = {"single": "fixed $K$", "auto": "chosen $K$"}
 
+#: tab_kselect's CSV values -> each from a row of its ``per_seed`` (its timings follow them)
+VALUES = {
+    "view_psnr_db": lambda r: r["view_psnr"],
+    "time_psnr_db": lambda r: r["time_psnr"],
+    "median_rel_err_pct": lambda r: 100 * r["median_rel_err"],
+    "parts_trusted": lambda r: int(r["trusted"]),
+    "parts_frozen": lambda r: int(r["frozen"]),
+    "k_heldout": lambda r: r["k_heldout"],
+    "k_bic": lambda r: r["k_bic"],
+}
+
 
 def tab_kselect(
     per_seed: Mapping[int, Mapping[tuple[str, str, str], dict]],
@@ -57,18 +68,9 @@ def tab_kselect(
         select_s = float(r["select_s"]) if c == "auto" else np.nan
         fixed_s = float(per_seed[s][(t, m, "single")]["train_s"])
         about = {"tree": t, "bones": bones[t], "model": m, "config": c, "K": int(r["K"])}
-        return about | {
-            "view_psnr_db": r["view_psnr"],
-            "time_psnr_db": r["time_psnr"],
-            "median_rel_err_pct": 100 * r["median_rel_err"],
-            "parts_trusted": int(r["trusted"]),
-            "parts_frozen": int(r["frozen"]),
-            "k_heldout": r["k_heldout"],
-            "k_bic": r["k_bic"],
-            "train_s": float(r["train_s"]),
-            "select_s": select_s,
-            "cost_x": (float(r["train_s"]) + select_s) / fixed_s if c == "auto" else np.nan,
-        }
+        cost = (float(r["train_s"]) + select_s) / fixed_s if c == "auto" else np.nan
+        timing = {"train_s": float(r["train_s"]), "select_s": select_s, "cost_x": cost}
+        return about | {k: f(r) for k, f in VALUES.items()} | timing
 
     df = seed_rows(seeds, keys, one)
     first = latex.rows(df)
@@ -149,15 +151,7 @@ TAB_KSELECT = Output(
     in_report=lambda plan: False,  # `all` builds it (Snakefile): K selection costs trainings
     columns=Columns(
         keys=("seed", "tree", "model", "config"),
-        values=(
-            "view_psnr_db",
-            "time_psnr_db",
-            "median_rel_err_pct",
-            "parts_trusted",
-            "parts_frozen",
-            "k_heldout",
-            "k_bic",
-        ),
+        values=tuple(VALUES),
         timing=("train_s", "select_s", "cost_x"),
         about=("bones", "K"),
     ),
