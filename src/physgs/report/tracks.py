@@ -34,6 +34,8 @@ TRACKER = {
 FIT = {"K": "K", "parts_estimated": "n_estimated", "n_fitted": "n_fitted", "fit_s": "seconds"}
 #: each motion prediction's column suffix and .tex heading
 WHO = {"": "Tracks", "_ours": "Ours", "_best_field": "Field", "_static": "Still"}
+#: the motion columns: per case (``tail``, each unseen wind), each prediction's and each field's
+MOTION = [f"{c}{who}_px" for c in ("tail", "wind_{wind}") for who in (*WHO, "_field_{model}")]
 
 
 def _stems(conditions: Sequence[float]) -> list[str]:
@@ -217,21 +219,11 @@ TAB_TRACKS = Output(
     _tab_tracks,
     settings=_tab_tracks_settings,
     in_report=lambda plan: bool(plan.tracks),
-    # the tracker, the fit and the displacement errors per case (``tail``, each unseen wind) of
-    # the control, ours, the best field, the static pose and each field scored
+    # the tracker, the fit and the displacement errors of the control, ours, the best field, the
+    # static pose and each field scored
     columns=Columns(
         keys=("seed", "tree", "config"),
-        values=(
-            *TRACKER,
-            "parts_estimated",
-            "n_fitted",
-            "fit_rms_px",
-            *(
-                f"{case}{who}_px"
-                for case in ("tail", "wind_{wind}")
-                for who in ("", "_ours", "_best_field", "_static", "_field_{model}")
-            ),
-        ),
+        values=(*TRACKER, "parts_estimated", "n_fitted", "fit_rms_px", *MOTION),
         timing=("fit_s", "ours_train_s"),
         about=("bones", "conditions", "K"),
     ),
