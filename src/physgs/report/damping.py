@@ -5,44 +5,37 @@ fig_damping: each prior's recovered damping on the run's own trees (first seed).
 from __future__ import annotations
 
 from functools import partial
+from itertools import product
 from typing import Mapping, Sequence
-
-import pandas as pd
 
 from physgs.models.registry import RECOVERY_METHODS, models_of
 from physgs.recovery.record import load_recovery
 from physgs.report import latex
+from physgs.report import recovery as R
 from physgs.report import seeds as seedstats
 from physgs.report.output import Columns, Output
-from physgs.report.recovery import (
-    INTERVAL_COLUMNS,
-    WHO,
-    MethodRows,
-    interval_cells,
-    _method_frame,
-    _methods_needs,
-    _methods_settings,
-    _table_methods,
-)
-from physgs.report.tables import Table, tree_label
+from physgs.report.table_captions import caption
+from physgs.report.tables import Table
 from physgs.testbed.variant import DAMPING, FAITHFUL, damping_id
 
 VARIANTS = (FAITHFUL, DAMPING)
-COLUMNS = (
-    "trusted",
-    "rel_err_pct",
-    "null_rel_err_pct",
-    "trained_minus_null_pp",
-    "log_corr",
-    "null_log_corr",
-    "gamma_exponent",
-    "null_gamma_exponent",
-    "gamma_exponent_true",
-)
+#: tab_damping's CSV values (before ``INTERVAL_COLUMNS``) -> each from a record's damping
+#: scores and their null
+VALUES = {
+    "trusted": lambda sc, nl: sc.n_trusted,
+    "rel_err_pct": lambda sc, nl: 100 * sc.median_rel_err,
+    "null_rel_err_pct": lambda sc, nl: 100 * nl.median_median_rel_err,
+    "trained_minus_null_pp": lambda sc, nl: 100 * (sc.median_rel_err - nl.median_median_rel_err),
+    "log_corr": lambda sc, nl: sc.log_corr,
+    "null_log_corr": lambda sc, nl: nl.median_log_corr,
+    "gamma_exponent": lambda sc, nl: sc.gamma_exponent,
+    "null_gamma_exponent": lambda sc, nl: nl.median_gamma_exponent,
+    "gamma_exponent_true": lambda sc, nl: sc.gamma_exponent_true,
+}
 
 
 def tab_damping(
-    methods: Mapping[str, MethodRows], trees: Sequence, bones: Mapping, digits: int = 2
+    methods: Mapping[str, R.MethodRows], trees: Sequence, bones: Mapping, digits: int = 2
 ) -> Table:
     """Damping recovery per seed, tree, variant, method and configuration, beside the null.
 
@@ -62,40 +55,23 @@ def tab_damping(
         ValueError: when a record has no damping scores.
         KeyError: when a seed lacks a record.
     """
-    methods = {m: mr for m, mr in methods.items() if mr.configs}
-    block = [(c, m) for m, mr in methods.items() for c in mr.configs]
-    keys = [(t, v, c, m) for t in trees for v in VARIANTS for c, m in block]
 
-    def one(s, t, v, c, method):
-        rec = methods[method].per_seed[s][(t, v, c)]
+    def one(s, rec, t, v, c, method):
         sc, nl = rec.damping_scores, rec.damping_null
         if sc is None or nl is None:
-            name = "" if method == "ours" else f" ({WHO.get(method, method)})"
+            name = "" if method == "ours" else f" ({R.WHO.get(method, method)})"
             raise ValueError(
                 f"tab_damping: the recovery of {t}/{v}/{c}{name} (seed {s}) has no "
                 "damping scores; re-run its recovery rule with damping params"
             )
         about = {"tree": t, "bones": bones[t], "testbed": v, "config": c, "method": method}
-        return about | {
-            "trusted": sc.n_trusted,
-            "rel_err_pct": 100 * sc.median_rel_err,
-            "null_rel_err_pct": 100 * nl.median_median_rel_err,
-            "trained_minus_null_pp": 100 * (sc.median_rel_err - nl.median_median_rel_err),
-            "log_corr": sc.log_corr,
-            "null_log_corr": nl.median_log_corr,
-            "gamma_exponent": sc.gamma_exponent,
-            "null_gamma_exponent": nl.median_gamma_exponent,
-            "gamma_exponent_true": sc.gamma_exponent_true,
-            **interval_cells(rec),
-        }
+        return about | {k: f(sc, nl) for k, f in VALUES.items()} | R.interval_cells(rec)
 
-    df, seeds = _method_frame("tab_damping", methods, keys, one)
-    col, fmt = partial(latex.cells, df), f".{int(digits)}f"
-    p, p_true = col("gamma_exponent", ".2f"), col("gamma_exponent_true", ".2f", cell=latex.mean)
-    err, corr = r"Med.\ rel.\ err.\ of $\hat\zeta$", r"corr($\log\hat\zeta$, $\log\zeta$)"
-    rows = [(tree_label(t, bones[t]), v, methods[m].row_label(c)) for t, v, c, m in keys]
-    cells = pd.DataFrame(
-        {
+    def columns(df):
+        col, fmt = partial(latex.cells, df), f".{int(digits)}f"
+        p, p_true = col("gamma_exponent", ".2f"), col("gamma_exponent_true", ".2f", cell=latex.mean)
+        err, corr = r"Med.\ rel.\ err.\ of $\hat\zeta$", r"corr($\log\hat\zeta$, $\log\zeta$)"
+        return {
             ("", "Trusted"): col("trusted", ".1f"),  # a mean count: one decimal
             (err, "Trained"): col("rel_err_pct", ".0f", r"\%"),
             (err, "Null"): col("null_rel_err_pct", ".0f", r"\%"),
@@ -107,54 +83,30 @@ def tab_damping(
             (r"$\hat\gamma\propto\hat\omega^p$", "$p$ (truth)"): [
                 a if b == "--" else f"{a} ({b})" for a, b in zip(p, p_true)
             ],
-        },
-        index=pd.MultiIndex.from_tuples(rows, names=["Tree", "Testbed", "Config"]),
-    )
-    cap = (
-        r"Damping recovery on the faithful testbed ($\zeta$ fixed on every bone, no deliberate "
-        r"transient) and on its damping variant ($\zeta$ per bone, log-uniform, and a gust "
-        r"dropping to calm inside the window). Over trusted parts: median relative error of "
-        r"$\hat\zeta$ against the matched bone's $\zeta$ (\%), beside the untrained null "
-        r"($\zeta$ drawn log-uniformly from the same range, scored on the same matching; "
-        r"medians over its draws) and the paired difference (percentage points; negative: "
-        r"the model beats chance); the correlation of $\log\hat\zeta$ with $\log\zeta$; the "
-        r"exponent $p$ of the fitted decay rate $\hat\gamma=\hat\zeta\hat\omega\propto"
-        r"\hat\omega^p$ ($p\approx0$: a frequency-independent rate fitted in place of a "
-        r"ratio), the truth's own $p$ on the matched bones in brackets."
-        + "".join(mr.note for mr in methods.values())
-        + latex.seed_note(len(seeds))
-    )
-    return Table("tab_damping", df, latex.render(cells, cap, "tab:damping"))
+        }
+
+    lead = caption("tab_damping")
+    return R._method_table("tab_damping", methods, trees, bones, one, columns, lead, VARIANTS)
 
 
 # ---- the declarations ----------------------------------------------------------------------
 def _testbeds(tree: str) -> dict:
-    """{variant: testbed id} of a damping-benchmark tree."""
-    return {FAITHFUL: tree, DAMPING: damping_id(tree)}
+    """{(variant,): testbed id} of a damping-benchmark tree."""
+    return {(FAITHFUL,): tree, (DAMPING,): damping_id(tree)}
 
 
 def _damping_needs(plan, seeds):
     testbeds = [tb for t in plan.damping_trees for tb in _testbeds(t).values()]
-    need = partial(_methods_needs, plan, plan.recovery, plan.damping_configs, testbeds)
+    need = partial(R._methods_needs, plan, plan.recovery, plan.damping_configs, testbeds)
     return [x for s in seeds for x in need(int(s))]
 
 
 def _tab_damping(path, settings, inputs, out):
-    trees, seeds = settings["trees"], settings["seeds"]
+    def read(m, K, tb, c, s):
+        return load_recovery(path("recovery", tb, m, c, s))
 
-    def records(m, configs):  # {seed: {(tree, variant, config): record}}
-        return {
-            s: {
-                (t, v, c): load_recovery(path("recovery", tb, m, c, s))
-                for t in trees
-                for v, tb in _testbeds(t).items()
-                for c in configs
-            }
-            for s in seeds
-        }
-
-    methods = _table_methods(settings, records, damping=True)
-    return tab_damping(methods, trees, settings["bones"], digits=settings["digits"])
+    methods = R._table_methods(settings, read, _testbeds, damping=True)
+    return tab_damping(methods, settings["trees"], settings["bones"], digits=settings["digits"])
 
 
 TAB_DAMPING = Output(
@@ -162,14 +114,14 @@ TAB_DAMPING = Output(
     "table",
     _damping_needs,
     _tab_damping,
-    settings=lambda cfg: _methods_settings(
+    settings=lambda cfg: R._methods_settings(
         cfg, RECOVERY_METHODS, cfg["damping_benchmark"]["configs"]
     ),
     trees="damping_benchmark",
     in_report=lambda plan: bool(plan.damping_trees),
     columns=Columns(
         keys=("seed", "tree", "testbed", "config", "method"),
-        values=(*COLUMNS, *INTERVAL_COLUMNS),
+        values=(*VALUES, *R.INTERVAL_COLUMNS),
         about=("bones",),
     ),
 )
@@ -179,12 +131,9 @@ def _fig_damping(path, settings, inputs, out):
     from physgs.report import figures  # matplotlib: not for the workflow's planning imports
 
     trees, configs, s0 = settings["trees"], settings["configs"], settings["seeds"][0]
+    pairs = list(product(trees, configs))
     damping = {
-        m: {
-            (t, c): load_recovery(path("recovery", t, m, c, s0)).damping
-            for t in trees
-            for c in configs
-        }
+        m: {(t, c): load_recovery(path("recovery", t, m, c, s0)).damping for t, c in pairs}
         for m in models_of("prior")
     }
     zeta, bound = float(settings["zeta"]), float(settings["zeta_bound"])
@@ -196,10 +145,7 @@ FIG_DAMPING = Output(
     "figure",
     lambda plan, seeds: [
         ("recovery", t, m, c, s)
-        for s in seeds
-        for t in plan.trees
-        for m in models_of("prior")
-        for c in plan.configs
+        for s, t, m, c in product(seeds, plan.trees, models_of("prior"), plan.configs)
     ],
     _fig_damping,
     settings=lambda cfg: {

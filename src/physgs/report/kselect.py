@@ -16,10 +16,22 @@ from physgs.models.registry import spec_of
 from physgs.recovery.record import load_recovery
 from physgs.report import latex
 from physgs.report.output import Columns, Output
+from physgs.report.table_captions import caption
 from physgs.report.tables import Table, seed_rows, seeds_of, tree_index
 
 #: the rows of each prior: configuration -> its label (fixed K, then K chosen from the data)
 ROWS = {"single": "fixed $K$", "auto": "chosen $K$"}
+
+#: tab_kselect's CSV values -> each from a row of its ``per_seed`` (its timings follow them)
+VALUES = {
+    "view_psnr_db": lambda r: r["view_psnr"],
+    "time_psnr_db": lambda r: r["time_psnr"],
+    "median_rel_err_pct": lambda r: 100 * r["median_rel_err"],
+    "parts_trusted": lambda r: int(r["trusted"]),
+    "parts_frozen": lambda r: int(r["frozen"]),
+    "k_heldout": lambda r: r["k_heldout"],
+    "k_bic": lambda r: r["k_bic"],
+}
 
 
 def tab_kselect(
@@ -56,18 +68,9 @@ def tab_kselect(
         select_s = float(r["select_s"]) if c == "auto" else np.nan
         fixed_s = float(per_seed[s][(t, m, "single")]["train_s"])
         about = {"tree": t, "bones": bones[t], "model": m, "config": c, "K": int(r["K"])}
-        return about | {
-            "view_psnr_db": r["view_psnr"],
-            "time_psnr_db": r["time_psnr"],
-            "median_rel_err_pct": 100 * r["median_rel_err"],
-            "parts_trusted": int(r["trusted"]),
-            "parts_frozen": int(r["frozen"]),
-            "k_heldout": r["k_heldout"],
-            "k_bic": r["k_bic"],
-            "train_s": float(r["train_s"]),
-            "select_s": select_s,
-            "cost_x": (float(r["train_s"]) + select_s) / fixed_s if c == "auto" else np.nan,
-        }
+        cost = (float(r["train_s"]) + select_s) / fixed_s if c == "auto" else np.nan
+        timing = {"train_s": float(r["train_s"]), "select_s": select_s, "cost_x": cost}
+        return about | {k: f(r) for k, f in VALUES.items()} | timing
 
     df = seed_rows(seeds, keys, one)
     first = latex.rows(df)
@@ -90,16 +93,8 @@ def tab_kselect(
         },
         index=tree_index(first, labels, "Model"),
     )
-    cap = (
-        rf"Each prior with fixed $K$ against $K$ chosen from the data (method: {method}, on "
-        r"held-out training-window frames; the CSV also lists the choice by held-out frames and "
-        r"by BIC). PSNR (dB) on the held-out views and on the time split (beyond the window); "
-        r"median relative frequency error over trusted parts; Frozen: parts whose swing stayed "
-        r"under a pixel. Train: seconds of the model's training; Select: seconds of the "
-        r"selection's short runs; Cost: (train + select) over the fixed-$K$ training."
-        + latex.seed_note(len(seeds), decides=False)
-        + r" $K$: as each seed chose it."
-    )
+    cap = caption("tab_kselect", method=method) + latex.seed_note(len(seeds), decides=False)
+    cap += r" $K$: as each seed chose it."
     return Table("tab_kselect", df, latex.render(cells, cap, "tab:kselect"))
 
 
@@ -156,15 +151,7 @@ TAB_KSELECT = Output(
     in_report=lambda plan: False,  # `all` builds it (Snakefile): K selection costs trainings
     columns=Columns(
         keys=("seed", "tree", "model", "config"),
-        values=(
-            "view_psnr_db",
-            "time_psnr_db",
-            "median_rel_err_pct",
-            "parts_trusted",
-            "parts_frozen",
-            "k_heldout",
-            "k_bic",
-        ),
+        values=tuple(VALUES),
         timing=("train_s", "select_s", "cost_x"),
         about=("bones", "K"),
     ),

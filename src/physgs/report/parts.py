@@ -23,6 +23,7 @@ from physgs.report import latex
 from physgs.report import seeds as seedstats
 from physgs.report.images import fit_row, fit_settings
 from physgs.report.output import Columns, Output
+from physgs.report.table_captions import caption
 from physgs.report.tables import Table, seed_rows, seeds_of, tree_label
 from physgs.testbed.variant import damping_id
 
@@ -151,16 +152,7 @@ def tab_parts(
         },
         index=pd.MultiIndex.from_tuples(rows, names=["Tree", "Config", "Parts"]),
     )
-    cap = (
-        r"The oscillator prior with the paper's spatial k-means parts beside parts cut along the "
-        r"tree (topology), independent or each riding on its parent (chained). \emph{Purity}: "
-        r"share of Gaussians whose vertex belongs to its part's majority bone (single "
-        r"configuration's parts). \emph{Of ceiling}: in-window fit as (model $-$ static) / (true "
-        r"motion $-$ static), and its paired difference from ours (percentage points). "
-        r"$\hat\omega$: median relative error over trusted parts on the faithful testbed, beside "
-        r"the untrained null of the same $K$; $\hat\zeta$: the same on the damping testbed "
-        r"(tab\_damping's measure)." + latex.seed_note(len(seeds))
-    )
+    cap = caption("tab_parts") + latex.seed_note(len(seeds))
     return Table("tab_parts", df, latex.render(cells, cap, "tab:parts"))
 
 
@@ -232,18 +224,17 @@ def tab_parts_k(
     """
     seeds = seeds_of(per_seed, "tab_parts_k", trees)
     recs = []
-    for s in seeds:
-        for t in trees:
-            r = per_seed[s][t]
-            chain = {int(k): float(v) for k, v in r["chain"].items()}
-            m = matched_k(chain, float(r["ours"]), tie_db)
-            points = [("ours", int(base_k), float(r["ours"]))]
-            points += [("ours_chain", k, chain[k]) for k in sorted(chain)]
-            recs += [
-                {"seed": s, "tree": t, "bones": bones[t], "model": model, "K": k}
-                | {"heldout_psnr_db": v, "matched_k": float("nan") if m is None else float(m)}
-                for model, k, v in points
-            ]
+    for s, t in product(seeds, trees):
+        r = per_seed[s][t]
+        chain = {int(k): float(v) for k, v in r["chain"].items()}
+        m = matched_k(chain, float(r["ours"]), tie_db)
+        points = [("ours", int(base_k), float(r["ours"]))]
+        points += [("ours_chain", k, chain[k]) for k in sorted(chain)]
+        about, found = {"seed": s, "tree": t, "bones": bones[t]}, float("nan") if m is None else m
+        recs += [
+            about | {"model": model, "K": k, "heldout_psnr_db": v, "matched_k": float(found)}
+            for model, k, v in points
+        ]
     df = pd.DataFrame(recs)
     first = latex.rows(df)
     ks = sorted(int(k) for k in first.loc[first["model"] == "ours_chain", "K"].unique())
@@ -260,14 +251,8 @@ def tab_parts_k(
         columns=pd.MultiIndex.from_tuples(heads),
     )
     cells[("", "matched $K$")] = matched
-    cap = (
-        r"How few parts the chained prior needs: held-out PSNR (dB) on the every-"
-        r"$k$-th training-window frames never trained on, at the training camera and wind, of ours "
-        rf"(k-means parts, $K{{=}}{base_k}$) and of the chained topology-aware prior at each $K$. "
-        rf"\emph{{Matched $K$}}: per seed, the smallest $K$ whose held-out PSNR lies within "
-        rf"{tie_db:g} dB of ours' (-- where none does)."
-        + latex.seed_note(len(seeds), decides=False)
-    )
+    cap = caption("tab_parts_k", base_k=base_k, tie_db=f"{tie_db:g}")
+    cap += latex.seed_note(len(seeds), decides=False)
     return Table("tab_parts_k", df, latex.render(cells, cap, "tab:parts_k"))
 
 

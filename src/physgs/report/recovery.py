@@ -5,7 +5,9 @@ method's, each against the null of its K), rows from ``registry.RECOVERY_METHODS
 from __future__ import annotations
 
 from dataclasses import dataclass
-from functools import partial
+from functools import partial, reduce
+from itertools import product
+from operator import getitem
 from typing import Mapping, Sequence
 
 import pandas as pd
@@ -15,7 +17,8 @@ from physgs.recovery.record import load_null, load_recovery
 from physgs.report import latex
 from physgs.report import seeds as seedstats
 from physgs.report.output import Columns, Output
-from physgs.report.tables import Table, check_keys, seed_rows, seeds_of, tree_index
+from physgs.report.table_captions import caption
+from physgs.report.tables import Table, check_keys, seed_rows, seeds_of, tree_label
 
 #: the method ids of the 2D-track control and the output-only analysis (``RECOVERY_METHODS``)
 TRACKS, OMA = "tracks", "oma"
@@ -38,25 +41,24 @@ class MethodRows:
     per_seed: Mapping[int, Mapping[tuple, object]]
     note: str = ""
 
-    def row_label(self, config: str) -> str:
-        """The LaTeX label of its row in a configuration.
 
-        Args:
-            config: a key of ``configs``.
-
-        Returns:
-            '<label>, <config label>' (ours': the configuration's label alone).
-        """
-        return f"{self.label}, {self.configs[config]}" if self.label else self.configs[config]
-
-
-#: each frequency-recovery table's caption, first sentence
-LEADS = {
-    "tab_null": "Frequency recovery against an untrained null.",
-    "tab_recovery": (
-        r"Frequency recovery of every method against the untrained null of its $K$; rows "
-        r"labelled by their configuration alone are ours (Table~\ref{tab:null})."
+#: tab_null's and tab_recovery's CSV values (before ``INTERVAL_COLUMNS``) -> each from a
+#: method's record and the null of its K
+NULL_VALUES = {
+    "trained_parts_trusted": lambda rec, nl: float(rec.match.n_trusted),
+    "trained_median_rel_err_pct": lambda rec, nl: 100 * rec.match.median_rel_err,
+    "trained_loglog_r2": lambda rec, nl: rec.match.loglog_r2,
+    "null_parts_trusted": lambda rec, nl: nl.median_n_trusted,
+    "null_median_rel_err_pct": lambda rec, nl: 100 * nl.median_median_rel_err,
+    "null_loglog_r2": lambda rec, nl: nl.median_loglog_r2,
+    "trained_minus_null_pp": (
+        lambda rec, nl: 100 * rec.match.median_rel_err - 100 * nl.median_median_rel_err
     ),
+    "nearest_bone_gap_pct": lambda rec, nl: 100 * nl.nearest_bone_gap,
+    "trained_parts_trusted_visible": lambda rec, nl: float(rec.n_trusted_visible),
+    "trained_median_rel_err_visible_pct": lambda rec, nl: 100 * rec.median_rel_err_visible,
+    "null_parts_trusted_visible": lambda rec, nl: nl.median_n_trusted_visible,
+    "null_median_rel_err_visible_pct": lambda rec, nl: 100 * nl.median_median_rel_err_visible,
 }
 
 
@@ -70,7 +72,7 @@ def recovery_table(
 
     Args:
         name: tab_null (the paper's methods) or tab_recovery (every method, ours first); its
-            label ``tab:<name without tab_>``, its caption's lead ``LEADS[name]``.
+            label ``tab:<name without tab_>``, its caption's lead ``table_captions.TEXT[name]``.
         methods: method id -> its ``MethodRows``, in row order (one without configurations has
             no rows): ``per_seed[seed][(tree, config)]`` = (``RecoveryRecord``, ``NullResult``
             of that seed and the method's K).
@@ -81,77 +83,60 @@ def recovery_table(
     Returns:
         The table: one CSV row per seed, tree, method and configuration.
     """
-    methods = {m: mr for m, mr in methods.items() if mr.configs}
-    keys = [(t, c, m) for t in trees for m, mr in methods.items() for c in mr.configs]
 
-    def one(s, t, c, method):
-        rec, nl = methods[method].per_seed[s][(t, c)]
+    def one(s, pair, t, c, method):
+        rec, nl = pair
         m = rec.match
         if nl.n_parts != m.n_parts:
             raise ValueError(
                 f"{name}: null for {t}/{c} (seed {s}) has K={nl.n_parts} but the "
                 f"model has K={m.n_parts}; re-run the null with the model's K"
             )
-        tr, nu = 100 * m.median_rel_err, 100 * nl.median_median_rel_err
         about = {"tree": t, "bones": bones[t], "config": c, "method": method, "K": m.n_parts}
-        return about | {
-            "trained_parts_trusted": float(m.n_trusted),
-            "trained_median_rel_err_pct": tr,
-            "trained_loglog_r2": m.loglog_r2,
-            "null_parts_trusted": nl.median_n_trusted,
-            "null_median_rel_err_pct": nu,
-            "null_loglog_r2": nl.median_loglog_r2,
-            "trained_minus_null_pp": tr - nu,
-            "nearest_bone_gap_pct": 100 * nl.nearest_bone_gap,
-            "trained_parts_trusted_visible": float(rec.n_trusted_visible),
-            "trained_median_rel_err_visible_pct": 100 * rec.median_rel_err_visible,
-            "null_parts_trusted_visible": nl.median_n_trusted_visible,
-            "null_median_rel_err_visible_pct": 100 * nl.median_median_rel_err_visible,
-            **interval_cells(rec),
-        }
+        return about | {k: f(rec, nl) for k, f in NULL_VALUES.items()} | interval_cells(rec)
 
-    df, seeds = _method_frame(name, methods, keys, one)
-    first = latex.rows(df)
-    fmt = f".{int(digits)}f"
-    col = partial(latex.cells, df)
-    columns = {}
-    for who, pre in (("Trained", "trained"), ("Untrained null", "null")):
-        trusted = col(f"{pre}_parts_trusted", ".3g", cell=latex.mean)
-        columns[(who, "Parts")] = [f"{n}/{k}" for n, k in zip(trusted, first["K"])]
-        columns[(who, r"Med.\ rel.\ err.")] = col(f"{pre}_median_rel_err_pct", fmt, r"\%")
-        columns[(who, r"log-log $R^2$")] = col(f"{pre}_loglog_r2", ".3f")
-    columns[("", r"Trained $-$ null")] = col(
-        "trained_minus_null_pp", fmt, cell=seedstats.difference
-    )
-    columns[("", "Gap")] = col("nearest_bone_gap_pct", fmt, r"\%", cell=latex.mean)
-    for who, pre in (("Trained", "trained"), ("Null", "null")):
-        columns[("Visible bones", who)] = col(f"{pre}_median_rel_err_visible_pct", fmt, r"\%")
-    labels = [methods[m].row_label(c) for m, c in zip(first["method"], first["config"])]
-    cells = pd.DataFrame(columns, index=tree_index(first, labels, "Config"))
-    cap = (
-        LEADS[name] + r" Parts: parts trusted ($|\mathrm{corr}|\geq0.7$) "
-        r"of $K$ (mean over seeds). Median relative error over trusted parts; $R^2$ of "
-        r"$\log\hat\omega_p$ against $\log\omega_p$. Null entries are medians over 8 draws "
-        r"of each seed, with the trained model's $K$; Trained $-$ null: percentage points, "
-        r"paired per seed (negative: the trained model beats chance); Gap: median nearest-bone "
-        r"gap. Visible bones: the median errors restricted to parts matched to bones whose own "
-        r"motion moves at least a pixel in the training camera (the CSV also gives the part "
-        r"counts)." + "".join(mr.note for mr in methods.values()) + latex.seed_note(len(seeds))
-    )
+    def columns(df):
+        col, fmt, out = partial(latex.cells, df), f".{int(digits)}f", {}
+        for who, pre in (("Trained", "trained"), ("Untrained null", "null")):
+            trusted = col(f"{pre}_parts_trusted", ".3g", cell=latex.mean)
+            out[(who, "Parts")] = [f"{n}/{k}" for n, k in zip(trusted, latex.rows(df)["K"])]
+            out[(who, r"Med.\ rel.\ err.")] = col(f"{pre}_median_rel_err_pct", fmt, r"\%")
+            out[(who, r"log-log $R^2$")] = col(f"{pre}_loglog_r2", ".3f")
+        out[("", r"Trained $-$ null")] = col(
+            "trained_minus_null_pp", fmt, cell=seedstats.difference
+        )
+        out[("", "Gap")] = col("nearest_bone_gap_pct", fmt, r"\%", cell=latex.mean)
+        for who, pre in (("Trained", "trained"), ("Null", "null")):
+            out[("Visible bones", who)] = col(f"{pre}_median_rel_err_visible_pct", fmt, r"\%")
+        return out
+
+    lead = caption(name, "frequency_recovery")
+    return _method_table(name, methods, trees, bones, one, columns, lead)
+
+
+def _method_table(name, methods, trees, bones, one, columns, lead, testbeds=()) -> Table:
+    """A recovery table of ``methods`` (those with configurations; each checked, KeyError, to
+    hold its keys at every seed of the first) per tree (and testbed variant): CSV rows
+    ``one(seed, per_seed[seed][(tree, *variant, config)], tree, *variant, config, method)``,
+    .tex ``columns(df)``, the caption ``lead``, the methods' notes and the seed note."""
+    methods = {m: mr for m, mr in methods.items() if mr.configs}
+    rows = [  # method, config, its row's label (ours': the configuration's label alone)
+        (m, c, f"{mr.label}, {mr.configs[c]}" if mr.label else mr.configs[c])
+        for m, mr in methods.items()
+        for c in mr.configs
+    ]
+    inner = [(v,) for v in testbeds] or [()]
+    keys = [(t, *v, c, m) for t in trees for v in inner for m, c, _ in rows]
+    seeds = seeds_of(next(iter(methods.values())).per_seed if methods else {}, name)
+    for s, (m, mr) in product(seeds, methods.items()):
+        mine = [k[:-1] for k in keys if k[-1] == m]
+        check_keys(mine, mr.per_seed.get(s, {}), f"{name} ({WHO.get(m, m)}, seed {s})")
+    df = seed_rows(seeds, keys, lambda s, *k: one(s, methods[k[-1]].per_seed[s][k[:-1]], *k))
+    labels = [(tree_label(t, bones[t]), *v, lab) for t in trees for v in inner for *_, lab in rows]
+    names = ["Tree", "Testbed", "Config"] if testbeds else ["Tree", "Config"]
+    cells = pd.DataFrame(columns(df), index=pd.MultiIndex.from_tuples(labels, names=names))
+    cap = lead + "".join(mr.note for mr in methods.values()) + latex.seed_note(len(seeds))
     return Table(name, df, latex.render(cells, cap, "tab:" + name.removeprefix("tab_")))
-
-
-def _method_frame(
-    what: str, methods: Mapping[str, MethodRows], keys: Sequence[tuple], one
-) -> tuple[pd.DataFrame, list[int]]:
-    """A recovery table's CSV frame and seeds, each method checked (KeyError) to hold its keys
-    (each ending in its id) at every seed of its first method."""
-    seeds = seeds_of(next(iter(methods.values())).per_seed if methods else {}, what)
-    for s in seeds:
-        for m, mr in methods.items():
-            mine = [k[:-1] for k in keys if k[-1] == m]
-            check_keys(mine, mr.per_seed.get(s, {}), f"{what} ({WHO.get(m, m)}, seed {s})")
-    return seed_rows(seeds, keys, one), seeds
 
 
 def method_rows(
@@ -174,23 +159,25 @@ def method_rows(
 
 
 #: tab_null / tab_damping's CSV columns of a method's own intervals (the output-only analysis';
-#: NaN for a method without): the median relative sd (sigma / value) over its trusted parts, the
-#: coverage of their 95% intervals, the parts covered, the parts its sigma rule keeps (alone, and
-#: with ours'), the mean relative interval scores of its intervals and of the null's draw range
-#: (``physgs.oma.intervals.relative_scores``; NaN in a record made before them)
-INTERVAL_COLUMNS = (
-    "omega_rel_sd",
-    "zeta_rel_sd",
-    "omega_interval_cover",
-    "zeta_interval_cover",
-    "interval_parts",
-    "sigma_parts_trusted",
-    "sigma_and_corr_parts_trusted",
-    "omega_interval_score",
-    "omega_null_interval_score",
-    "zeta_interval_score",
-    "zeta_null_interval_score",
-)
+#: NaN for a method without) -> where its record's ``intervals`` holds each: the median relative
+#: sd (sigma / value) over its trusted parts, the coverage of their 95% intervals, the parts
+#: covered, the parts its sigma rule keeps (alone, and with ours'), the mean relative interval
+#: scores of its intervals and of the null's draw range (``physgs.oma.intervals.relative_scores``;
+#: NaN in a record made before them)
+INTERVALS = {
+    "omega_rel_sd": ("median_rel_std", "omega"),
+    "zeta_rel_sd": ("median_rel_std", "zeta"),
+    "omega_interval_cover": ("coverage", "omega", "fraction"),
+    "zeta_interval_cover": ("coverage", "zeta", "fraction"),
+    "interval_parts": ("coverage", "omega", "n"),
+    "sigma_parts_trusted": ("n_sigma_trusted",),
+    "sigma_and_corr_parts_trusted": ("n_both_trusted",),
+    "omega_interval_score": ("interval_score", "omega", "score"),
+    "omega_null_interval_score": ("interval_score", "omega", "null_score"),
+    "zeta_interval_score": ("interval_score", "zeta", "score"),
+    "zeta_null_interval_score": ("interval_score", "zeta", "null_score"),
+}
+INTERVAL_COLUMNS = tuple(INTERVALS)
 
 
 def interval_cells(rec) -> dict:
@@ -205,22 +192,12 @@ def interval_cells(rec) -> dict:
     iv, nan = rec.intervals, float("nan")
     if not iv:
         return dict.fromkeys(INTERVAL_COLUMNS, nan)
-    cov, score = iv["coverage"], iv.get("interval_score", {})
-    sc = {q: score.get(q, {}) for q in ("omega", "zeta")}  # none in a record made before them
-    values = (
-        iv["median_rel_std"]["omega"],
-        iv["median_rel_std"]["zeta"],
-        cov["omega"]["fraction"],
-        cov["zeta"]["fraction"],
-        cov["omega"]["n"],
-        iv["n_sigma_trusted"],
-        iv["n_both_trusted"],
-        sc["omega"].get("score", nan),
-        sc["omega"].get("null_score", nan),
-        sc["zeta"].get("score", nan),
-        sc["zeta"].get("null_score", nan),
-    )
-    return dict(zip(INTERVAL_COLUMNS, map(float, values)))
+    scores = {  # NaN where the record has none (made before them)
+        q: {"score": nan, "null_score": nan} | iv.get("interval_score", {}).get(q, {})
+        for q in ("omega", "zeta")
+    }
+    iv = {**iv, "interval_score": scores}
+    return {c: float(reduce(getitem, at, iv)) for c, at in INTERVALS.items()}
 
 
 # ---- the declarations ----------------------------------------------------------------------
@@ -253,13 +230,24 @@ def _methods_needs(plan, methods, configs, testbeds, s: int) -> list[tuple]:
     ]
 
 
-def _table_methods(settings: dict, records, damping: bool = False) -> dict[str, MethodRows]:
+def _table_methods(settings: dict, read, testbeds=None, damping=False) -> dict[str, MethodRows]:
     """Method id -> its ``MethodRows`` in ``RECOVERY_METHODS``' order (ours first), from the
-    ``_methods_settings`` and ``records(method, {config: K})`` -> its per-seed records."""
-    out, methods = {}, settings["methods"]
+    ``_methods_settings``: each record ``read(method, K, testbed, config, seed)`` at key (tree,
+    *variant, config), ``testbeds(tree)``: {(variant,): testbed id} (None: the tree alone)."""
+    out, methods, trees = {}, settings["methods"], settings["trees"]
+    beds = testbeds or (lambda t: {(): t})
     for m in (m for m in RECOVERY_METHODS if m in methods):
         labels, ks = ({c: v[f] for c, v in methods[m].items()} for f in ("label", "K"))
-        out[m] = method_rows(m, labels, records(m, ks), damping=damping)
+        at = [
+            ((t, *v, c), tb, c, k)
+            for t in trees
+            for v, tb in beds(t).items()
+            for c, k in ks.items()
+        ]
+        per_seed = {
+            s: {key: read(m, k, tb, c, s) for key, tb, c, k in at} for s in settings["seeds"]
+        }
+        out[m] = method_rows(m, labels, per_seed, damping=damping)
     return out
 
 
@@ -271,21 +259,7 @@ def _paper(plan_or_methods) -> list[str]:
 #: tab_null's and tab_recovery's CSV: one row per seed, tree, configuration and method id
 NULL_COLUMNS = Columns(
     keys=("seed", "tree", "config", "method"),
-    values=(
-        "trained_parts_trusted",
-        "trained_median_rel_err_pct",
-        "trained_loglog_r2",
-        "null_parts_trusted",
-        "null_median_rel_err_pct",
-        "null_loglog_r2",
-        "trained_minus_null_pp",
-        "nearest_bone_gap_pct",
-        "trained_parts_trusted_visible",
-        "trained_median_rel_err_visible_pct",
-        "null_parts_trusted_visible",
-        "null_median_rel_err_visible_pct",
-        *INTERVAL_COLUMNS,
-    ),
+    values=(*NULL_VALUES, *INTERVAL_COLUMNS),
     about=("bones", "K"),
 )
 
@@ -306,16 +280,11 @@ def _frequency_output(name: str, methods, in_report=lambda plan: True) -> Output
         return _methods_settings(cfg, methods(recovery_plan(cfg)), cfg["models"]["configs"])
 
     def table(path, settings, inputs, out):
-        trees, seeds = settings["trees"], settings["seeds"]
+        def read(m, K, t, c, s):  # its record and the null of its K
+            rec = load_recovery(path("recovery", t, m, c, s))
+            return rec, load_null(path("null", t, int(K), s))
 
-        def paired(m, configs):  # configs: {config: K}
-            def one(t, c, s):  # its record and the null of its K
-                rec = load_recovery(path("recovery", t, m, c, s))
-                return rec, load_null(path("null", t, int(configs[c]), s))
-
-            return {s: {(t, c): one(t, c, s) for t in trees for c in configs} for s in seeds}
-
-        rows = _table_methods(settings, paired)
+        rows, trees = _table_methods(settings, read), settings["trees"]
         return recovery_table(name, rows, trees, settings["bones"], digits=settings["digits"])
 
     return Output(

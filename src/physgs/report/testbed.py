@@ -10,6 +10,7 @@ import pandas as pd
 from physgs.report import latex, paper
 from physgs.report.claim_cells import roles_of
 from physgs.report.output import Columns, Output
+from physgs.report.table_captions import caption
 from physgs.report.tables import Table, check_keys
 from physgs.testbed.stats import load_stats
 
@@ -29,6 +30,9 @@ INSTANCE_SPREAD = (
     "height_fill_pct",
     "coverage_pct",
 )
+#: an instance's statistics in tab_testbed (a tree's row: their mean), and their spreads' columns
+STATS = (*INSTANCE_SPREAD, "order_share", "order_share_random")
+SPREADS = tuple(f"{c}_sd" for c in INSTANCE_SPREAD)
 #: the percentage columns -> the fraction they show
 PERCENT = {
     "nearest_bone_gap_pct": "nearest_bone_gap",
@@ -40,8 +44,7 @@ PERCENT = {
 
 def _testbed_row(s: Mapping) -> dict:
     """One instance's statistics in tab_testbed's columns (percentages as percent)."""
-    cols = (*INSTANCE_SPREAD, "order_share", "order_share_random")
-    return {c: 100 * s[PERCENT[c]] if c in PERCENT else s[c] for c in cols}
+    return {c: 100 * s[PERCENT[c]] if c in PERCENT else s[c] for c in STATS}
 
 
 def tab_testbed(
@@ -70,23 +73,22 @@ def tab_testbed(
         The table: one row per tree.
     """
     check_keys(list(trees), stats, "tab_testbed")
-    rows = []
-    for t in trees:
+
+    def row(t):  # the mean over the tree's instances (or its one), the paper's values beside
         inst = pd.DataFrame([_testbed_row(x) for x in (instances or {}).get(t) or [stats[t]]])
         pt = (paper_trees or {}).get(t)
-        rows.append(
-            {
-                "tree": t,
-                "bones": int(stats[t]["bones"]),
-                "paper_bones": paper.BONES.get(pt),
-                **{c: float(inst[c].mean()) for c in inst.columns},
-                "paper_f_span": paper.FREQUENCY_SPAN,
-                "paper_nearest_bone_gap_pct": paper.NEAREST_BONE_GAP_PCT.get(pt, np.nan),
-                "instances": len(inst),
-                **{f"{c}_sd": float(inst[c].std(ddof=1)) for c in INSTANCE_SPREAD},  # one: NaN
-            }
-        )
-    df = pd.DataFrame(rows)
+        return {
+            "tree": t,
+            "bones": int(stats[t]["bones"]),
+            "paper_bones": paper.BONES.get(pt),
+            **{c: float(inst[c].mean()) for c in inst.columns},
+            "paper_f_span": paper.FREQUENCY_SPAN,
+            "paper_nearest_bone_gap_pct": paper.NEAREST_BONE_GAP_PCT.get(pt, np.nan),
+            "instances": len(inst),
+            **{f"{c}_sd": float(inst[c].std(ddof=1)) for c in INSTANCE_SPREAD},  # one: NaN
+        }
+
+    df = pd.DataFrame([row(t) for t in trees])
     fmt = f".{int(digits)}f"
     paper_gap = [
         "--" if not np.isfinite(x) else format(x, fmt) for x in df["paper_nearest_bone_gap_pct"]
@@ -115,22 +117,9 @@ def tab_testbed(
             "Height": [f"{x:.0f}\\%" for x in df["height_fill_pct"]],
         }
     ).set_axis(pd.Index(df["tree"].str.capitalize(), name="Tree"))
-    cap = (
-        r"The testbed. Distinct $f$: distinct natural frequencies; Span: max/min frequency "
-        + f"(paper: $\\sim${paper.FREQUENCY_SPAN}$\\times$)"
-        + r"; Gap: median nearest-bone gap, the "
-        r"paper's in brackets; Swing: median RMS of each bone's own angle over the window; "
-        r"Visible: median image displacement caused by a bone's own angle alone, acting on its "
-        r"subtree, in training-camera pixels, and the share of bones under 1\,px (no method "
-        r"can recover those); Height: training-image height spanned by the swept tree."
-        + (
-            f" Each value is the mean over a tree's {int(df['instances'].max())} instances "
-            r"(one per training seed), the gap $\pm$ its sd over them (the CSV: every "
-            r"statistic's)."
-            if (df["instances"] > 1).any()
-            else " One instance per tree (the paper's protocol)."
-        )
-    )
+    n = int(df["instances"].max())
+    each = "tab_testbed_instances" if (df["instances"] > 1).any() else "tab_testbed_one"
+    cap = caption("tab_testbed", each, span=paper.FREQUENCY_SPAN, n=n)
     return Table("tab_testbed", df, latex.render(cells, cap, "tab:testbed"))
 
 
@@ -166,17 +155,7 @@ TAB_TESTBED = Output(
     # values beside, and the spreads over the tree's instances (NaN with one)
     columns=Columns(
         keys=("tree",),
-        values=(
-            *INSTANCE_SPREAD[:5],
-            "paper_f_span",
-            "clamped",
-            "nearest_bone_gap_pct",
-            "paper_nearest_bone_gap_pct",
-            *INSTANCE_SPREAD[7:],
-            "order_share",
-            "order_share_random",
-            *(f"{c}_sd" for c in INSTANCE_SPREAD),
-        ),
+        values=(*STATS, "paper_f_span", "paper_nearest_bone_gap_pct", *SPREADS),
         about=("bones", "paper_bones", "instances"),
     ),
 )

@@ -5,6 +5,7 @@ and a motionless prediction's at the same points; the tracks drawn over frame 0.
 from __future__ import annotations
 
 from functools import partial
+from itertools import product
 from typing import Mapping, Sequence
 
 import numpy as np
@@ -14,6 +15,7 @@ from physgs.intermediate import read_json
 from physgs.report import latex
 from physgs.report.output import Columns, Output, key
 from physgs.report.recovery import _label_with_k
+from physgs.report.table_captions import caption
 from physgs.report.tables import Table, condition_label, seed_rows, seeds_of, tree_label
 from physgs.tracks.settings import parts as tracks_k
 from physgs.tracks.store import load_fit, load_tracks
@@ -32,6 +34,8 @@ TRACKER = {
 FIT = {"K": "K", "parts_estimated": "n_estimated", "n_fitted": "n_fitted", "fit_s": "seconds"}
 #: each motion prediction's column suffix and .tex heading
 WHO = {"": "Tracks", "_ours": "Ours", "_best_field": "Field", "_static": "Still"}
+#: the motion columns: per case (``tail``, each unseen wind), each prediction's and each field's
+MOTION = [f"{c}{who}_px" for c in ("tail", "wind_{wind}") for who in (*WHO, "_field_{model}")]
 
 
 def _stems(conditions: Sequence[float]) -> list[str]:
@@ -117,28 +121,9 @@ def tab_tracks(
             columns[(f"{head} (px)", who)] = col(f"{stem}{suffix}_px", fmt)
     rows = [(tree_label(t, bones[t]), configs[c]["label"]) for t, c in keys]
     cells = pd.DataFrame(columns, index=pd.MultiIndex.from_tuples(rows, names=["Tree", "Config"]))
-    joint = [c.replace("_", r"\_") for c in configs if configs[c]["conditions"] != "train"]
-    cap = (
-        r"The 2D-track control: ours' oscillators fitted to Lucas--Kanade point tracks of the "
-        r"training video. \emph{Tracker}, against the truth-projected mesh vertices over the "
-        r"training window: tracks started (share of the frame-0 tracks kept to the window's "
-        r"end), median / 90th-percentile position error and displacement error since each "
-        r"track's seed frame (px). \emph{Fit}: parts with an estimate of $K$ (a part needs "
-        r"enough tracks), wall seconds of the fit, beside ours' training seconds in the same "
-        r"configuration. Motion: median displacement error (px) of "
-        r"the predicted tracks beyond the training window (training wind) and under each other "
-        r"wind (window frames), beside ours' Gaussians at the same tracked points, the best "
-        r"learned field's (the lowest error of the fields trained in that configuration, per "
-        r"seed; -- where none is) and a motionless prediction (each track's mean tracked "
-        r"position)."
-        + (
-            f" The joint configurations ({', '.join(joint)}) are fitted to every wind: their "
-            "other-wind columns are not transfer."
-            if joint
-            else ""
-        )
-        + latex.seed_note(len(seeds), decides=False)
-    )
+    joint = ", ".join(c.replace("_", r"\_") for c in configs if configs[c]["conditions"] != "train")
+    cap = caption("tab_tracks", *(["tab_tracks_joint"] if joint else []), joint=joint)
+    cap += latex.seed_note(len(seeds), decides=False)
     return Table("tab_tracks", df, latex.render(cells, cap, "tab:tracks"))
 
 
@@ -199,13 +184,10 @@ def fig_tracks(
 def _tab_tracks_needs(plan, seeds):
     """Per tree, configuration and seed: the evaluation record, ours' loss log (training
     seconds) and, for ``plan.tracks_fields``, the fields' scores."""
-    return [
-        (kind, t, *m, c, int(s))
-        for s in seeds
-        for t in plan.trees
-        for c in plan.tracks
-        for kind, m in (("tracks_eval", ()), ("loss", ("ours",)))
-    ] + [("tracks_fields", t, c, int(s)) for s in seeds for t, c in plan.tracks_fields]
+    each = (("tracks_eval", ()), ("loss", ("ours",)))  # the record, ours' loss log
+    mine = product([int(s) for s in seeds], plan.trees, plan.tracks)
+    out = [(k, t, *m, c, s) for s, t, c in mine for k, m in each]
+    return out + [("tracks_fields", t, c, int(s)) for s in seeds for t, c in plan.tracks_fields]
 
 
 def _tab_tracks_settings(cfg: dict) -> dict:
@@ -237,21 +219,11 @@ TAB_TRACKS = Output(
     _tab_tracks,
     settings=_tab_tracks_settings,
     in_report=lambda plan: bool(plan.tracks),
-    # the tracker, the fit and the displacement errors per case (``tail``, each unseen wind) of
-    # the control, ours, the best field, the static pose and each field scored
+    # the tracker, the fit and the displacement errors of the control, ours, the best field, the
+    # static pose and each field scored
     columns=Columns(
         keys=("seed", "tree", "config"),
-        values=(
-            *TRACKER,
-            "parts_estimated",
-            "n_fitted",
-            "fit_rms_px",
-            *(
-                f"{case}{who}_px"
-                for case in ("tail", "wind_{wind}")
-                for who in ("", "_ours", "_best_field", "_static", "_field_{model}")
-            ),
-        ),
+        values=(*TRACKER, "parts_estimated", "n_fitted", "fit_rms_px", *MOTION),
         timing=("fit_s", "ours_train_s"),
         about=("bones", "conditions", "K"),
     ),
