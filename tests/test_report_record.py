@@ -211,6 +211,13 @@ def test_figures_are_shown_in_reading_order_each_with_a_caption_from_its_declara
     assert captions.find("testbed_dense_damping")[2] == "dense"
     with pytest.raises(KeyError, match="fig_new"):
         captions.caption("fig_new", [0])
+    # a caption of captions.yaml with a misspelled or a missing key is refused, naming it
+    entry = {"pattern": "fig_x", "title": "t", "shows": "s", "read": "r"}
+    assert captions.checked([entry])[0]["seeds"] == "first"
+    with pytest.raises(ValueError, match="'fig_x' has keys"):
+        captions.checked([{**entry, "raed": "r"}])
+    with pytest.raises(ValueError, match="'fig_x'"):
+        captions.checked([{k: v for k, v in entry.items() if k != "read"}])
 
 
 def test_the_committed_record_re_renders_from_its_own_files(tmp_path):
@@ -778,4 +785,9 @@ def test_a_sentence_of_the_prose_takes_its_clause_only_where_the_field_is_set():
     ledger = dict(same=1, both=2, changed=1, new=0, old=0, apart=0)
     assert say("rerun_ledger", **ledger).endswith("keep their verdict, 1 changed:")
     assert say("rerun_ledger", **{**ledger, "changed": 0}).endswith("keep their verdict.")
+    # claims in one run only: said before the colon that opens the table of moved verdicts
+    apart = say("rerun_ledger", **{**ledger, "apart": 3, "new": 2, "old": 1})
+    assert apart.endswith(
+        "keep their verdict (2 claims new in this run, 1 no longer asked), 1 changed:"
+    )
     assert all(isinstance(v, (str, list, dict)) for v in PROSE.values())

@@ -22,9 +22,32 @@ from physgs.report.outputs import OUTPUTS
 #: each ``pattern`` (its name, ``{tree}`` standing for a tree), ``title`` (a few words), ``shows``
 #: (what is drawn: every colour, band, line and unit), ``read`` (how to read it) and ``seeds`` (its
 #: seed scope when it is not a report output: ``physgs.report.output.SEEDS``).
-FIGURES: tuple[dict, ...] = tuple(
-    {"seeds": "first", **c}
-    for c in yaml.safe_load(resources.files("physgs.report").joinpath("captions.yaml").read_text())
+def checked(entries: list[dict]) -> tuple[dict, ...]:
+    """Captions as ``FIGURES`` holds them: the seed scope defaulted, a wrong key refused.
+
+    Args:
+        entries: the entries of ``captions.yaml``.
+
+    Returns:
+        The entries, each with ``seeds``.
+
+    Raises:
+        ValueError: naming an entry that lacks a key or has one no caption reads.
+    """
+    need, keys = (
+        {"pattern", "title", "shows", "read"},
+        {"pattern", "title", "shows", "read", "seeds"},
+    )
+    for c in entries:
+        if not need <= set(c) <= keys:
+            raise ValueError(
+                f"captions.yaml: {c.get('pattern')!r} has keys {sorted(c)}: {sorted(keys)}"
+            )
+    return tuple({"seeds": "first", **c} for c in entries)
+
+
+FIGURES: tuple[dict, ...] = checked(
+    yaml.safe_load(resources.files("physgs.report").joinpath("captions.yaml").read_text())
 )
 #: each figure's index and name as a regular expression (a tree: the group ``tree``), in the order
 #: ``find`` tries them: the plain names, then the per-tree ones, the longer first
