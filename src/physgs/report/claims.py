@@ -26,6 +26,7 @@ from physgs.models.registry import label, models_of
 from physgs.report.catalogue import CATALOGUE, KINDS, WITHIN, kind_of, origin_of, prior_tables
 from physgs.report.catalogue import undermines
 from physgs.report.claim_cells import RECOVERY, Run
+from physgs.report.prose import say
 from physgs.report.seeds import MAX_SEEDS, finite, interval, log_interval, seeds_to_decide
 
 #: The unit of a ratio: its interval is taken on the log scale (``estimate``).
@@ -419,27 +420,14 @@ def ledger_markdown(df: pd.DataFrame, stamp: Mapping[str, str] | None = None) ->
     lines = [
         "# Claims ledger",
         "",
-        "Each claim, measured by this pipeline: the paper's claims and this project's own, counted "
-        "apart; verdicts are computed by `physgs.report.claims` (holds / fails when the seed "
-        "interval lies on one side of the threshold, undecided when it straddles it or when one "
-        "seed gives no interval; a claim of flatness, equality or match, 'within ±t', holds inside "
-        "the band, fails wholly outside it and is undecided across either edge). Beside a figure "
-        "of the paper: whether it lies inside the measured interval (reproduced in size; the verdict "
-        "is a direction or a bar). A ratio's estimate is the geometric mean over seeds and its "
-        "interval the per-seed log-ratios' t-interval, exponentiated (it stays positive). For an "
-        "undecided claim, the seeds that would decide it if its effect and sd stayed as observed, "
-        "an estimate: the plug-in t half-width / a t-test at 80% power (`tt_solve_power`).",
+        say("claims_intro"),
         "",
         *(["Made by: " + ", ".join(f"{k}={v}" for k, v in stamp.items()), ""] if stamp else []),
-        f"The paper's {counted(df, 'paper')}. This project's own {counted(df, 'project')}. "
-        "A premise is what the comparison rests on (the testbed is the paper's, the models fit "
-        "their window); a finding is what it says.",
+        say("claims_counts", paper=counted(df, "paper"), project=counted(df, "project")),
         "",
         *[f"- {s[0].upper() + s[1:]}" for s in failed_premises(df)],
         "",
-        "| claim | origin | paper | measured | threshold | verdict | kind "
-        "| seeds to decide (est.) | from |",
-        "|---|---|---|---|---|---|---|---|---|",
+        *say("claims_head").splitlines(),
     ]
     for (_, r), k in zip(df.iterrows(), column(df, "kind")):
         meas = "--" if not np.isfinite(r.measured) else f"{number(r.measured, r.unit)} {r.unit}"
