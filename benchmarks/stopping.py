@@ -469,12 +469,24 @@ def fit_shortfalls(claims: pd.DataFrame, p: pd.DataFrame) -> pd.DataFrame:
                                       "last_psnr", "best", "heading"])  # fmt: skip
 
 
-def plateau(a: argparse.Namespace) -> None:
-    """Print (and with ``--markdown`` write) each curve's plateau; ``--figure`` draws them."""
-    df = pd.concat(
-        [pd.read_csv(p).assign(budget=lambda d: d["iteration"].max()) for p in a.curves],
+def read_curves(paths: list[str]) -> pd.DataFrame:
+    """Curve CSVs as one frame, each training's rows with its ``budget`` (its last iteration).
+
+    Args:
+        paths: curve CSVs (``curves``' output).
+
+    Returns:
+        Their rows (``FIELDS`` and ``budget``).
+    """
+    return pd.concat(
+        [pd.read_csv(p).assign(budget=lambda d: d["iteration"].max()) for p in paths],
         ignore_index=True,
     )
+
+
+def plateau(a: argparse.Namespace) -> None:
+    """Print (and with ``--markdown`` write) each curve's plateau; ``--figure`` draws them."""
+    df = read_curves(a.curves)
     refs = df[df["model"].isin(["static", "truth_motion"])]
     learned = df[~df["model"].isin(["static", "truth_motion"])]
     # the longest training of each (tree, model) is its curve; shorter ones are own-budget runs
@@ -537,10 +549,7 @@ def plateau(a: argparse.Namespace) -> None:
 
 def fits(a: argparse.Namespace) -> None:
     """Print (and with ``--markdown`` write) the fit bar's shortfalls beside their curves."""
-    df = pd.concat(
-        [pd.read_csv(p).assign(budget=lambda d: d["iteration"].max()) for p in a.curves],
-        ignore_index=True,
-    )
+    df = read_curves(a.curves)
     trained = {}
     if a.fit:  # the budget each model trained in the run: its own-schedule curve, where measured
         tf = pd.read_csv(a.fit)
