@@ -21,7 +21,7 @@ import numpy as np
 import pandas as pd
 
 from physgs.models.registry import BLIND_CONFIG, BLIND_PRIORS, MODELS, PRIOR_VARIANTS
-from physgs.models.registry import label, models_of, spec_of
+from physgs.models.registry import PAPER_MODEL, label, models_of, spec_of
 from physgs.report import paper, thresholds
 from physgs.report.claim_cells import CONFIG, FIELD_KINDS, RECOVERY, SEPARATED, TILED, Cell
 from physgs.report.claim_cells import Reader, Run, Scope, fields_of_kind, rows_of, value
@@ -31,7 +31,7 @@ from physgs.testbed.variant import DAMPING
 #: The origins of a claim: stated by the source paper, or this project's own.
 ORIGINS = ("paper", "project")
 #: The models the paper itself compared: a claim about any other model is this project's.
-PAPER_MODELS = (*models_of("control", "field"), "ours")
+PAPER_MODELS = (*models_of("control", "field"), PAPER_MODEL)
 #: The kinds of a claim: a premise of the comparison (``PREMISES``) or a finding.
 KINDS = ("premise", "finding")
 #: The side of an equivalence claim (flat, equal, matching): inside (-threshold, +threshold),
@@ -172,7 +172,7 @@ class ClaimSpec:
         def fill(template: str) -> str:
             return template.format(**WORDS, **cell)
 
-        prefix = cell.get("prefix", "" if cell["model"] == "ours" else f"{cell['model']}/")
+        prefix = cell.get("prefix", "" if cell["model"] == PAPER_MODEL else f"{cell['model']}/")
         suffix = f"/{cell['suffix']}" if cell.get("suffix") else ""
         cid = prefix + self.family + suffix
         paper = self.paper.text(cell) if isinstance(self.paper, Figure) else fill(self.paper)
@@ -353,7 +353,7 @@ _MOTION = (
         text="{tree}: ours is above the static pose beyond the window",
         source="tab_psnr, time column: ours - static",
         paper=Figure("ours - static beyond the window, tab:psnr",
-                     lambda c: _paper_over_static(c, ["ours"])),
+                     lambda c: _paper_over_static(c, [PAPER_MODEL])),
         headline="ours above the static pose beyond the training window",
     ),
     ClaimSpec(
@@ -651,7 +651,7 @@ def _blind_trees(run: Run) -> list[Cell]:
     have, out = set(null["method"]), []
     for blind in (m for m in BLIND_PRIORS if m in have):
         wind = spec_of(blind).blind_of
-        who, prefix = ("ours", "") if wind == "ours" else (f"the {label(wind)}", f"{wind}/")
+        who, prefix = ("ours", "") if wind == PAPER_MODEL else (f"the {label(wind)}", f"{wind}/")
         out += [
             {**c, "prefix": prefix, "blind": blind, "wind": wind, "who": who,
              "config": BLIND_CONFIG}
@@ -974,7 +974,7 @@ def headline(priors: Sequence[str] | None = None) -> list[tuple[str, str, str]]:
     Returns:
         One triple per headline family.
     """
-    others = [m for m in models_of("prior") if m != "ours"] if priors is None else priors
+    others = [m for m in models_of("prior") if m != PAPER_MODEL] if priors is None else priors
     out = []
     for s in (s for s in CATALOGUE if s.headline):
         if s.of == "ours":

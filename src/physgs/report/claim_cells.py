@@ -20,7 +20,7 @@ from typing import Any, Callable, Mapping, Sequence
 
 import pandas as pd
 
-from physgs.models.registry import models_of, spec_of
+from physgs.models.registry import PAPER_MODEL, models_of, spec_of
 
 #: The configuration the recovery claims read (the paper's joint K = 32).
 CONFIG = "joint32"
@@ -51,7 +51,7 @@ class Run:
 
     tables: Mapping[str, pd.DataFrame]
     trees: Sequence[str]
-    model: str = "ours"
+    model: str = PAPER_MODEL
     others: tuple[str, ...] = ()
     table: str = ""
     roles: Mapping[str, Mapping[str, str]] = field(default_factory=dict)
@@ -134,4 +134,4 @@ def rows_of(df: pd.DataFrame, who: str, col: str = "method") -> pd.Series:
     """
     if col in df.columns:
         return df[col].astype(str) == who
-    return pd.Series(who == "ours", index=df.index)
+    return pd.Series(who == PAPER_MODEL, index=df.index)

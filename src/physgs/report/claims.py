@@ -22,7 +22,7 @@ from typing import Mapping, Sequence
 import numpy as np
 import pandas as pd
 
-from physgs.models.registry import label, models_of
+from physgs.models.registry import PAPER_MODEL, label, models_of
 from physgs.report.catalogue import CATALOGUE, KINDS, WITHIN, kind_of, origin_of, prior_tables
 from physgs.report.catalogue import undermines
 from physgs.report.claim_cells import RECOVERY, Run
@@ -186,7 +186,7 @@ def measure(
         ``(claim, per-seed values)`` pairs, in the ledger's order (the catalogue's).
     """
     tabs = dict(tables)
-    summaries = {"ours": damping, **(prior_damping or {})}
+    summaries = {PAPER_MODEL: damping, **(prior_damping or {})}
     rec = [
         {"seed": i, "model": m, "tree": t, **summary}  # seed: the summary's place in its list
         for m, by_tree in summaries.items()
@@ -195,13 +195,13 @@ def measure(
     ]
     if rec:
         tabs[RECOVERY] = pd.DataFrame(rec)
-    others = tuple(m for m in models_of("prior") if m != "ours" and _holds(tables, m))
+    others = tuple(m for m in models_of("prior") if m != PAPER_MODEL and _holds(tables, m))
     out: list[tuple[Claim, list[float]]] = []
     for spec in CATALOGUE:
         if spec.optional and spec.table not in tabs:
             continue
         seeds = _per_seed(tabs[spec.table]) if spec.table in tabs else []
-        for model in ("ours",) if spec.of == "ours" else others:
+        for model in (PAPER_MODEL,) if spec.of == "ours" else others:
             run = Run(tabs, trees, model, others, spec.table, dict(roles or {}))
             for cell in spec.over(run):
                 cell = {"model": model, "name": label(model), "table": spec.table, **cell}

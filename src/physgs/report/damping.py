@@ -8,7 +8,7 @@ from functools import partial
 from itertools import product
 from typing import Mapping, Sequence
 
-from physgs.models.registry import RECOVERY_METHODS, models_of
+from physgs.models.registry import PAPER_MODEL, RECOVERY_METHODS, models_of
 from physgs.recovery.record import load_recovery
 from physgs.report import latex
 from physgs.report import recovery as R
@@ -59,7 +59,7 @@ def tab_damping(
     def one(s, rec, t, v, c, method):
         sc, nl = rec.damping_scores, rec.damping_null
         if sc is None or nl is None:
-            name = "" if method == "ours" else f" ({R.WHO.get(method, method)})"
+            name = "" if method == PAPER_MODEL else f" ({R.WHO.get(method, method)})"
             raise ValueError(
                 f"tab_damping: the recovery of {t}/{v}/{c}{name} (seed {s}) has no "
                 "damping scores; re-run its recovery rule with damping params"

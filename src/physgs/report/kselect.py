@@ -12,7 +12,7 @@ import pandas as pd
 
 from physgs.evaluate.splits import load_eval
 from physgs.experiments.kselect import BASE_MODEL, load_selection, selected_models
-from physgs.models.registry import spec_of
+from physgs.models.registry import PAPER_MODEL, spec_of
 from physgs.recovery.record import load_recovery
 from physgs.report import latex
 from physgs.report.output import Columns, Output
@@ -39,7 +39,7 @@ def tab_kselect(
     trees: Sequence[str],
     bones: Mapping[str, int],
     method: str,
-    models: Sequence[str] = ("ours",),
+    models: Sequence[str] = (PAPER_MODEL,),
     digits: int = 2,
 ) -> Table:
     """One LaTeX row per tree, prior and configuration (fixed, then chosen K).

@@ -17,7 +17,7 @@ from physgs.evaluate.metrics import ceiling_fraction
 from physgs.evaluate.parts import load_segmentations
 from physgs.experiments.kmatch import matched_k
 from physgs.intermediate import read_json
-from physgs.models.registry import BASE_CONFIG, REFERENCE_NAMES, config_label, label
+from physgs.models.registry import BASE_CONFIG, PAPER_MODEL, REFERENCE_NAMES, config_label, label
 from physgs.recovery.record import load_null, load_recovery
 from physgs.report import latex
 from physgs.report import seeds as seedstats
@@ -41,7 +41,7 @@ COLUMNS = (
     "train_s",
 )
 #: The model every variant is compared with (the paper's prior).
-BASELINE = "ours"
+BASELINE = PAPER_MODEL
 
 
 def row(
