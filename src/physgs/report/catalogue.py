@@ -477,7 +477,7 @@ def _fit_models(run: Run) -> list[Cell]:
     return [
         {"suffix": f"{t}/{m}", "tree": t, "fit_model": m, "fit_label": label(m)}
         for t in run.trees
-        for m in (*models_of("field"), "ours", *run.others)
+        for m in (*models_of("field"), PAPER_MODEL, *run.others)
     ]
 
 
@@ -859,9 +859,9 @@ def _tracks_separated(run: Run) -> list[Cell]:
 
 def _tracks_minus_ours(d: pd.DataFrame, c: Cell) -> float:
     """tab_recovery: 2D tracks - ours median omega error (points); NaN at another K than ours'"""
-    if value(d, _null_row(d, c), "K") != value(d, _null_row(d, c, "ours"), "K"):
+    if value(d, _null_row(d, c), "K") != value(d, _null_row(d, c, PAPER_MODEL), "K"):
         return float("nan")  # another K: not the same question
-    return _err(d, c) - _err(d, c, who="ours")
+    return _err(d, c) - _err(d, c, who=PAPER_MODEL)
 
 
 def _tracks_trees(run: Run) -> list[Cell]:
