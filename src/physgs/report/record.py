@@ -251,15 +251,18 @@ def _demote(markdown: str) -> str:
 
 
 def _rerun_page(
-    previous: Path,
-    stamp: Stamp,
-    claims_csv: str | Path,
-    tables: Sequence[str | Path],
-    first: Mapping[str, tuple] | None = None,
+    previous: Path, stamp: Stamp, claims_csv: str | Path, tables: Sequence[str | Path], roles=None
 ) -> str:
     """The record's "Against the previous record" page: this run's ledger verdict by verdict
-    (beside ``first``, its first seed alone, where the run has several instances of a tree) and
-    its seeded tables cell by cell against the record in ``previous`` (``rerun``)."""
+    (beside its first seed alone, ``claims.first_seed`` with ``roles``, where the run has several
+    instances of a tree) and its seeded tables cell by cell against the record in ``previous``."""
+    first = None
+    if any(len(s) > 1 for s in stamp.instances.values()):
+        from physgs.report.build import read_table  # build reads every output's module
+
+        tabs = {Path(t).stem: read_table(Path(t).stem, t) for t in tables}
+        tabs = {n: d for n, d in tabs.items() if n in catalogue.tables()}
+        first = ledger.first_seed(tabs, stamp.trees, roles)
     if not ((previous / "stamp.json").is_file() and (previous / "claims.csv").is_file()):
         return _blocks(PROSE["rerun_head"], PROSE["rerun_none"])
     old = json.loads((previous / "stamp.json").read_text())
@@ -451,32 +454,22 @@ def write_record(
     prior = json.loads(old_stamp.read_text()) if old_stamp.is_file() else {}
     now = json.loads(json.dumps(asdict(stamp)))  # its tuples as the JSON's lists
     keys = ("commit", "config_hash", "profile", "seeds", "trees")
-    if old_rerun.is_file() and all(prior.get(k) == now[k] for k in keys):
-        against = old_rerun.read_text()  # the same run recorded again keeps its comparison
-    else:
-        first = None
-        if any(len(s) > 1 for s in stamp.instances.values()):
-            from physgs.report.build import read_table  # build reads every output's module
-
-            names = set(catalogue.tables())
-            tabs = {Path(t).stem: read_table(Path(t).stem, t) for t in tables}
-            first = ledger.first_seed(
-                {n: d for n, d in tabs.items() if n in names}, stamp.trees, roles
-            )
-        against = _rerun_page(final, stamp, claims_csv, tables, first)
+    again = old_rerun.is_file() and all(prior.get(k) == now[k] for k in keys)
+    # the same run recorded again keeps its comparison
+    against = (
+        old_rerun.read_text() if again else _rerun_page(final, stamp, claims_csv, tables, roles)
+    )
     out = final.with_name(final.name + ".partial")  # the old record stands until this is whole
     _remove(out)  # an earlier write that stopped before its swap
     (out / "tables").mkdir(parents=True)
     (out / "figures").mkdir()
-    for name, kept_bytes in kept.items():
-        (out / name).write_bytes(kept_bytes)
-    (out / "stamp.json").write_text(json.dumps(asdict(stamp), indent=2) + "\n")
-    (out / "rerun.md").write_text(against)
-    for name, page in (("summary.md", summary_md), ("claims.md", claims_md)):
-        (out / name).write_text(_demote(Path(page).read_text()))
-    shutil.copyfile(claims_csv, out / "claims.csv")
-    for t in map(Path, tables):
-        shutil.copyfile(t, out / "tables" / t.name)
+    pages = {"summary.md": summary_md, "claims.md": claims_md}
+    kept |= {n: _demote(Path(p).read_text()).encode() for n, p in pages.items()}
+    kept |= {"stamp.json": (json.dumps(asdict(stamp), indent=2) + "\n").encode()}
+    for name, text in {**kept, "rerun.md": against.encode()}.items():
+        (out / name).write_bytes(text)
+    for src, to in [(claims_csv, "claims.csv"), *((t, f"tables/{Path(t).name}") for t in tables)]:
+        shutil.copyfile(src, out / to)
     for f in map(Path, figures):
         with Image.open(f) as im:
             if im.width > FIGURE_WIDTH_PX:
@@ -568,13 +561,9 @@ def derive_claims(record_dir: str | Path) -> list[Path]:
     stamp = {c: str(df[c].iloc[0]) for c in STAMP_COLUMNS if c in df and len(df)}
     pages = {out / "claims.md": _demote(ledger.ledger_markdown(df, stamp or None))}
     if (out / "summary.md").is_file():  # its other sections come from files the record lacks
-        lines = (out / "summary.md").read_text().split("\n")
-        if SUMMARY_CLAIMS in lines:
-            a = lines.index(SUMMARY_CLAIMS)
-            b = next((i for i in range(a + 1, len(lines)) if lines[i].startswith("### ")), None)
-            section = _demote("\n".join(claims_section(df))).split("\n")
-            lines[a:b] = section
-        pages[out / "summary.md"] = "\n".join(lines)
+        section = _demote("\n".join(claims_section(df)))  # up to the next section, or the end
+        at = re.compile(rf"^{re.escape(SUMMARY_CLAIMS)}$.*?(?=\n### |\Z)", re.M | re.S)
+        pages[out / "summary.md"] = at.sub(lambda _: section, (out / "summary.md").read_text(), 1)
     for p, printed in pages.items():
         if not p.is_file() or p.read_text() != printed:
             p.write_text(printed)
