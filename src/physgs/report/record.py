@@ -647,13 +647,11 @@ def ledger_page(claims_csv: str | Path, trees: Sequence[str]) -> str:
     )
     order = {o: i for i, o in enumerate(catalogue.ORIGINS)}  # the paper's first
     claims = claims.iloc[claims["_origin"].map(order).argsort(kind="stable")]
+    lead = re.compile(f"({'|'.join(map(re.escape, trees)) or '(?!)'})[:, ]")  # a leading tree
     rows = []
     for _, r in claims.iterrows():
-        text = str(r["claim"])  # a sentence's leading tree, and the rest
-        lead = [
-            t for t in trees if text.startswith(t) and text[len(t) : len(t) + 1] in (":", ",", " ")
-        ]
-        tree, short = (lead[0], text[len(lead[0]) :].lstrip(":, ")) if lead else ("--", text)
+        text, m = str(r["claim"]), lead.match(str(r["claim"]))
+        tree, short = (m[1], text[len(m[1]) :].lstrip(":, ")) if m else ("--", text)
         f = {c: str(r[c]) for c in ("claim", "id", "threshold", "unit", "source", "paper")}
         f |= {c: str(r["_" + c]) for c in ("origin", "kind", "verdict")}
         f |= {
