@@ -572,10 +572,11 @@ def derive_claims(record_dir: str | Path) -> list[Path]:
 
 
 def render_pages(record_dir: str | Path) -> list[Path]:
-    """Lay out the Results page's parts (``index.md`` and what it includes) from the record.
+    """Lay out the Results page's parts (``index.md`` and what it includes) from the record; of a
+    record folder that holds no run yet (no ``stamp.json``), ``index.md`` saying how to make one.
 
     Args:
-        record_dir: the record folder.
+        record_dir: the record folder (made if missing).
 
     Returns:
         The files written.
@@ -584,6 +585,10 @@ def render_pages(record_dir: str | Path) -> list[Path]:
         KeyError: naming a figure without a caption (``physgs.report.captions``).
     """
     out = Path(record_dir)
+    if not (out / "stamp.json").is_file():
+        out.mkdir(parents=True, exist_ok=True)
+        (out / "index.md").write_text(PROSE["unrecorded"])
+        return [out / "index.md"]
     stamp = Stamp(**json.loads((out / "stamp.json").read_text()))
     pages = {"stamp.md": stamp.markdown()}
     entries = []
@@ -667,21 +672,6 @@ def ledger_page(claims_csv: str | Path, trees: Sequence[str]) -> str:
         details = say("ledger_details", **f, seeds=n, s="s" if n != 1 else "")
         rows.append(say("ledger_row", **f, anchor=anchor, more=details) + "\n")
     return say("ledger_table", body="".join(rows))
-
-
-def write_unrecorded(out_dir: str | Path) -> Path:
-    """``index.md`` of a record folder that holds no run yet, saying how to make one.
-
-    Args:
-        out_dir: the record folder (made if missing).
-
-    Returns:
-        The path of the ``index.md`` written.
-    """
-    out = Path(out_dir)
-    out.mkdir(parents=True, exist_ok=True)
-    (out / "index.md").write_text(PROSE["unrecorded"])
-    return out / "index.md"
 
 
 def _lead(claims: pd.DataFrame, counts: str) -> list[str]:
