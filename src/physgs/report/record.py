@@ -454,11 +454,10 @@ def write_record(
     prior = json.loads(old_stamp.read_text()) if old_stamp.is_file() else {}
     now = json.loads(json.dumps(asdict(stamp)))  # its tuples as the JSON's lists
     keys = ("commit", "config_hash", "profile", "seeds", "trees")
-    again = old_rerun.is_file() and all(prior.get(k) == now[k] for k in keys)
-    # the same run recorded again keeps its comparison
-    against = (
-        old_rerun.read_text() if again else _rerun_page(final, stamp, claims_csv, tables, roles)
-    )
+    if old_rerun.is_file() and all(prior.get(k) == now[k] for k in keys):
+        against = old_rerun.read_text()  # the same run recorded again keeps its comparison
+    else:
+        against = _rerun_page(final, stamp, claims_csv, tables, roles)
     out = final.with_name(final.name + ".partial")  # the old record stands until this is whole
     _remove(out)  # an earlier write that stopped before its swap
     (out / "tables").mkdir(parents=True)
