@@ -253,7 +253,7 @@ def main() -> None:
         )
         print(f"{args.out}: {len(written)} files")
     if not (args.out / "stamp.json").is_file():
-        record.write_unrecorded(args.out)
+        record.render_pages(args.out)  # a folder without a run: how to make one
     found = record.found_lines(args.out)
     (args.out / "found.md").write_text("\n".join(found))
     costs = record.cost_lines(record.read_costs(args.out / "costs.csv"))

@@ -27,13 +27,7 @@ from physgs.report import captions, catalogue, claims as ledger, rerun
 from physgs.report.prose import PROSE, data, say
 
 #: The commands whose cost the README states, keyed as ``tools/timed.py --name`` records them.
-COMMANDS: tuple[tuple[str, str], ...] = (
-    ("quick_all", "snakemake --cores 2 all --config profile=quick"),
-    ("tab_null", "snakemake --cores 2 results/tables/tab_null.tex"),
-    ("all", "snakemake --cores 2 all"),
-    ("studies", "snakemake --cores 2 studies"),
-    ("tests", "python -m pytest -q"),
-)
+COMMANDS: tuple[tuple[str, str], ...] = tuple(PROSE["commands"].items())
 #: Widest figure in the record, px: the documentation's content column.
 FIGURE_WIDTH_PX = 1200
 #: Value columns of one summary table on the page: a wider one is cut, its keys repeated.
@@ -57,7 +51,6 @@ COMMIT = re.compile(r"^[0-9a-f]{7,40}$")
 BENCHMARKS = "benchmarks"
 #: The heading of the run summary's claims section as the record holds it (demoted).
 SUMMARY_CLAIMS = "### Claims ledger"
-NUMBER_WORDS = ("no", "one", "two", "three", "four", "five", "six", "seven", "eight", "nine", "ten")
 
 
 #: The Results page's part the record lays out (``index.md``): its figures, its ledger's counts,
@@ -242,9 +235,14 @@ def markdown_table(df: pd.DataFrame, right: Iterable[str] = ()) -> str:
     return "\n".join(lines) + "\n"
 
 
-def _table(rows: Iterable, columns: Sequence[str], right: Iterable[str] = ()) -> list[str]:
-    """``rows`` under ``columns`` as Markdown table lines, then a blank line."""
-    return markdown_table(pd.DataFrame(rows, columns=columns), right).split("\n")
+def _table(rows: Iterable, columns: Sequence[str], right: Iterable[str] = ()) -> str:
+    """``rows`` under ``columns`` as a Markdown table (no newline after its last row)."""
+    return markdown_table(pd.DataFrame(rows, columns=list(columns)), right)[:-1]
+
+
+def _blocks(*blocks: str) -> str:
+    """A page of ``blocks`` (paragraphs, tables), blank-line separated, ending in a newline."""
+    return "\n\n".join(blocks) + "\n"
 
 
 def _demote(markdown: str) -> str:
@@ -252,44 +250,48 @@ def _demote(markdown: str) -> str:
     return re.sub(r"^#+ ", r"#\g<0>", markdown, flags=re.MULTILINE)
 
 
-def _rerun_lines(
-    previous: Path,
-    stamp: Stamp,
-    claims_csv: str | Path,
-    tables: Sequence[str | Path],
-    first: Mapping[str, tuple] | None = None,
-) -> list[str]:
-    """The record's "Against the previous record" section: this run's ledger verdict by verdict
-    (beside ``first``, its first seed alone, where the run has several instances of a tree) and
-    its seeded tables cell by cell against the record in ``previous`` (``rerun``)."""
-    lines = ["## Against the previous record", ""]
+def _rerun_page(
+    previous: Path, stamp: Stamp, claims_csv: str | Path, tables: Sequence[str | Path], roles=None
+) -> str:
+    """The record's "Against the previous record" page: this run's ledger verdict by verdict
+    (beside its first seed alone, ``claims.first_seed`` with ``roles``, where the run has several
+    instances of a tree) and its seeded tables cell by cell against the record in ``previous``."""
+    first = None
+    if any(len(s) > 1 for s in stamp.instances.values()):
+        from physgs.report.build import read_table  # build reads every output's module
+
+        tabs = {Path(t).stem: read_table(Path(t).stem, t) for t in tables}
+        tabs = {n: d for n, d in tabs.items() if n in catalogue.tables()}
+        first = ledger.first_seed(tabs, stamp.trees, roles)
     if not ((previous / "stamp.json").is_file() and (previous / "claims.csv").is_file()):
-        return [*lines, PROSE["rerun_none"], ""]
+        return _blocks(PROSE["rerun_head"], PROSE["rerun_none"])
     old = json.loads((previous / "stamp.json").read_text())
     h = old.get("config_hash")
     settings = PROSE["rerun_same"] if h == stamp.config_hash else say("rerun_other", hash=h)
     c = rerun.compare_claims(_read(previous / "claims.csv"), _read(claims_csv), first)
-    n, k = len(c.changed), Counter(v.overlap for v in c.changed)
+    n, new, gone = len(c.changed), len(c.only_new), len(c.only_old)
     old_run = {"commit": stamp.commit, "old": old.get("commit"), "date": old.get("date")}
-    new, gone = len(c.only_new), len(c.only_old)
-    lines += [say("rerun_intro", **old_run, settings=settings), ""]
     both = {"same": c.same, "both": c.same + n, "changed": n, "new": new, "old": gone}
-    lines += [say("rerun_ledger", **both, apart=new + gone), ""]
+    page = [
+        PROSE["rerun_head"],
+        say("rerun_intro", **old_run, settings=settings),
+        say("rerun_ledger", **both, apart=new + gone),
+    ]
     if c.changed:
+        k = Counter(v.overlap for v in c.changed)
+        heads = PROSE["rerun_verdict_heads"][: 6 if first else 5]
         verdicts = [
             (f"`{v.id}`: {v.claim}", f"{v.old}, {v.old_value}", f"**{v.new}**, {v.new_value}")
-            + (v.threshold, v.overlap)
-            + ((v.alone,) if first else ())
+            + (v.threshold, v.overlap, v.alone)[: len(heads) - 3]
             for v in c.changed
         ]
-        heads = ("claim", "before", "after", "threshold", "intervals overlap")
-        lines += _table(verdicts, heads + (("first seed alone",) if first else ()))
-        lines += [say("rerun_overlap", n=n, yes=k["yes"], no=k["no"], none=k["--"]), ""]
+        overlap = say("rerun_overlap", n=n, yes=k["yes"], no=k["no"], none=k["--"])
+        page += [_table(verdicts, heads), overlap]
     if c.changed and first:
         k = Counter(v.alone.split(",")[0] for v in c.changed)
         seed = min(min(s) for s in stamp.instances.values())
         same, crossed = k[rerun.FIRST_SAME], k[rerun.FIRST_CROSSED]
-        lines += [say("rerun_first", seed=seed, same=same, crossed=crossed, none=k["--"]), ""]
+        page.append(say("rerun_first", seed=seed, same=same, crossed=crossed, none=k["--"]))
     rows, moved = [], []
     for t in sorted(Path(p) for p in tables):
         before = previous / "tables" / t.name
@@ -303,8 +305,8 @@ def _rerun_lines(
         r = rerun.compare_table_csv(before, t)
         rows.append((f"`{t.stem}`", r.rows, r.cells, r.identical, r.within, len(r.beyond)))
         moved += [(t.stem, ch) for ch in r.beyond]
-    counts = ("rows in both", "numeric cells", "identical", "within the seed spread", "beyond it")
-    lines += [PROSE["rerun_tables"], "", *_table(rows, ("table", *counts), right=counts)]
+    heads = PROSE["rerun_table_heads"]
+    page += [PROSE["rerun_tables"], _table(rows, heads, right=heads[1:])]
     if moved:
         moved.sort(key=lambda m: rerun.spreads_moved(m[1]), reverse=True)
         cells = [
@@ -312,13 +314,12 @@ def _rerun_lines(
             + (ch.old, ch.new, ch.spread)
             for name, ch in moved[:RERUN_CELLS_SHOWN]
         ]
-        shown = ("before", "after", "seed spread")
-        lines += [
+        heads = PROSE["rerun_move_heads"]
+        page += [
             say("rerun_moves", shown=len(cells), n=len(moved)),
-            "",
-            *_table(cells, ("table", "row", "column", *shown), right=shown),
+            _table(cells, heads, right=heads[3:]),
         ]
-    return lines
+    return _blocks(*page)
 
 
 @dataclass(frozen=True)
@@ -456,29 +457,18 @@ def write_record(
     if old_rerun.is_file() and all(prior.get(k) == now[k] for k in keys):
         against = old_rerun.read_text()  # the same run recorded again keeps its comparison
     else:
-        first = None
-        if any(len(s) > 1 for s in stamp.instances.values()):
-            from physgs.report.build import read_table  # build reads every output's module
-
-            names = set(catalogue.tables())
-            tabs = {Path(t).stem: read_table(Path(t).stem, t) for t in tables}
-            first = ledger.first_seed(
-                {n: d for n, d in tabs.items() if n in names}, stamp.trees, roles
-            )
-        against = "\n".join(_rerun_lines(final, stamp, claims_csv, tables, first))
+        against = _rerun_page(final, stamp, claims_csv, tables, roles)
     out = final.with_name(final.name + ".partial")  # the old record stands until this is whole
     _remove(out)  # an earlier write that stopped before its swap
     (out / "tables").mkdir(parents=True)
     (out / "figures").mkdir()
-    for name, kept_bytes in kept.items():
-        (out / name).write_bytes(kept_bytes)
-    (out / "stamp.json").write_text(json.dumps(asdict(stamp), indent=2) + "\n")
-    (out / "rerun.md").write_text(against)
-    for name, page in (("summary.md", summary_md), ("claims.md", claims_md)):
-        (out / name).write_text(_demote(Path(page).read_text()))
-    shutil.copyfile(claims_csv, out / "claims.csv")
-    for t in map(Path, tables):
-        shutil.copyfile(t, out / "tables" / t.name)
+    pages = {"summary.md": summary_md, "claims.md": claims_md}
+    kept |= {n: _demote(Path(p).read_text()).encode() for n, p in pages.items()}
+    kept |= {"stamp.json": (json.dumps(asdict(stamp), indent=2) + "\n").encode()}
+    for name, text in {**kept, "rerun.md": against.encode()}.items():
+        (out / name).write_bytes(text)
+    for src, to in [(claims_csv, "claims.csv"), *((t, f"tables/{Path(t).name}") for t in tables)]:
+        shutil.copyfile(src, out / to)
     for f in map(Path, figures):
         with Image.open(f) as im:
             if im.width > FIGURE_WIDTH_PX:
@@ -570,13 +560,9 @@ def derive_claims(record_dir: str | Path) -> list[Path]:
     stamp = {c: str(df[c].iloc[0]) for c in STAMP_COLUMNS if c in df and len(df)}
     pages = {out / "claims.md": _demote(ledger.ledger_markdown(df, stamp or None))}
     if (out / "summary.md").is_file():  # its other sections come from files the record lacks
-        lines = (out / "summary.md").read_text().split("\n")
-        if SUMMARY_CLAIMS in lines:
-            a = lines.index(SUMMARY_CLAIMS)
-            b = next((i for i in range(a + 1, len(lines)) if lines[i].startswith("### ")), None)
-            section = _demote("\n".join(claims_section(df))).split("\n")
-            lines[a:b] = section
-        pages[out / "summary.md"] = "\n".join(lines)
+        section = _demote("\n".join(claims_section(df)))  # up to the next section, or the end
+        at = re.compile(rf"^{re.escape(SUMMARY_CLAIMS)}$.*?(?=\n### |\Z)", re.M | re.S)
+        pages[out / "summary.md"] = at.sub(lambda _: section, (out / "summary.md").read_text(), 1)
     for p, printed in pages.items():
         if not p.is_file() or p.read_text() != printed:
             p.write_text(printed)
@@ -585,10 +571,11 @@ def derive_claims(record_dir: str | Path) -> list[Path]:
 
 
 def render_pages(record_dir: str | Path) -> list[Path]:
-    """Lay out the Results page's parts (``index.md`` and what it includes) from the record.
+    """Lay out the Results page's parts (``index.md`` and what it includes) from the record; of a
+    record folder that holds no run yet (no ``stamp.json``), ``index.md`` saying how to make one.
 
     Args:
-        record_dir: the record folder.
+        record_dir: the record folder (made if missing).
 
     Returns:
         The files written.
@@ -597,6 +584,10 @@ def render_pages(record_dir: str | Path) -> list[Path]:
         KeyError: naming a figure without a caption (``physgs.report.captions``).
     """
     out = Path(record_dir)
+    if not (out / "stamp.json").is_file():
+        out.mkdir(parents=True, exist_ok=True)
+        (out / "index.md").write_text(PROSE["unrecorded"])
+        return [out / "index.md"]
     stamp = Stamp(**json.loads((out / "stamp.json").read_text()))
     pages = {"stamp.md": stamp.markdown()}
     entries = []
@@ -617,15 +608,10 @@ def render_pages(record_dir: str | Path) -> list[Path]:
     pages["figures.md"] = "\n".join(
         f"![{n}](record/figures/{n}.png)\n\n{captions.caption(n, stamp.seeds)}\n" for n in names
     )
-    claims = _read(out / "claims.csv")
     pages["ledger.md"] = ledger_page(out / "claims.csv", stamp.trees)
-    story, premise = story_line(claims), _premise_line(claims)
-    led = [
-        say("index_ledger", **_counts(claims)),
-        *(["", premise[2:]] if premise else []),
-        *(["", story[2:]] if story else []),
-    ]
-    pages["index.md"] = INDEX_PAGE.format(s=stamp, seeds=_join(stamp.seeds), ledger="\n".join(led))
+    counts, *bullets = _lead(_read(out / "claims.csv"), "index_ledger")
+    led = "\n\n".join([counts, *(b[2:] for b in bullets)])  # its bullets as paragraphs
+    pages["index.md"] = INDEX_PAGE.format(s=stamp, seeds=_join(stamp.seeds), ledger=led)
     for name, text in pages.items():
         (out / name).write_text(text)
     return [out / name for name in pages]
@@ -665,13 +651,11 @@ def ledger_page(claims_csv: str | Path, trees: Sequence[str]) -> str:
     )
     order = {o: i for i, o in enumerate(catalogue.ORIGINS)}  # the paper's first
     claims = claims.iloc[claims["_origin"].map(order).argsort(kind="stable")]
+    lead = re.compile(f"({'|'.join(map(re.escape, trees)) or '(?!)'})[:, ]")  # a leading tree
     rows = []
     for _, r in claims.iterrows():
-        text = str(r["claim"])  # a sentence's leading tree, and the rest
-        lead = [
-            t for t in trees if text.startswith(t) and text[len(t) : len(t) + 1] in (":", ",", " ")
-        ]
-        tree, short = (lead[0], text[len(lead[0]) :].lstrip(":, ")) if lead else ("--", text)
+        text, m = str(r["claim"]), lead.match(str(r["claim"]))
+        tree, short = (m[1], text[len(m[1]) :].lstrip(":, ")) if m else ("--", text)
         f = {c: str(r[c]) for c in ("claim", "id", "threshold", "unit", "source", "paper")}
         f |= {c: str(r["_" + c]) for c in ("origin", "kind", "verdict")}
         f |= {
@@ -689,30 +673,14 @@ def ledger_page(claims_csv: str | Path, trees: Sequence[str]) -> str:
     return say("ledger_table", body="".join(rows))
 
 
-def write_unrecorded(out_dir: str | Path) -> Path:
-    """``index.md`` of a record folder that holds no run yet, saying how to make one.
-
-    Args:
-        out_dir: the record folder (made if missing).
-
-    Returns:
-        The path of the ``index.md`` written.
-    """
-    out = Path(out_dir)
-    out.mkdir(parents=True, exist_ok=True)
-    (out / "index.md").write_text(PROSE["unrecorded"])
-    return out / "index.md"
-
-
-def _counts(claims: pd.DataFrame) -> dict[str, str]:
-    """The ledger's counts (``claims.counted``) of the paper's claims and this project's."""
-    return {who: ledger.counted(claims, who) for who in ("paper", "project")}
-
-
-def _premise_line(claims: pd.DataFrame) -> str:
-    """A bullet naming the premises that fail and what each undermines; "" when all hold."""
+def _lead(claims: pd.DataFrame, counts: str) -> list[str]:
+    """The sentence ``counts`` of the ledger's counts (``claims.counted``) of the paper's claims
+    and this project's, then a bullet naming the premises that fail and what each undermines,
+    and the paper's story (``story_line``), each where there is one."""
+    n = {who: ledger.counted(claims, who) for who in ("paper", "project")}
     failed = "; ".join(f.rstrip(".") for f in ledger.failed_premises(claims))
-    return say("premises", failed=failed) if failed else ""
+    premise = say("premises", failed=failed) if failed else ""
+    return [line for line in (say(counts, **n), premise, story_line(claims)) if line]
 
 
 def _headline_families(claims: pd.DataFrame, origin: str | None = None):
@@ -763,9 +731,7 @@ def headline_lines(claims: pd.DataFrame) -> list[str]:
     Returns:
         The Markdown lines.
     """
-    story, premise = story_line(claims), _premise_line(claims)
-    lines = [say("count", **_counts(claims)), *([premise] if premise else [])]
-    lines += [story] if story else []
+    lines = _lead(claims, "count")
     for words, rows, where, kind in _headline_families(claims):
         cells = []
         for (_, r), w, k in zip(rows.iterrows(), where, kind):
@@ -804,7 +770,7 @@ def cost_lines(costs: pd.DataFrame) -> list[str]:
         # the command as it was measured (e.g. tab_null at three seeds), not the canonical one
         wall = format_duration(float(r["wall_s"])) + start
         rows.append((f"`{r['command']}`", wall, f"{r['date']}, commit `{r['commit']}`, {r['cpu']}"))
-    return _table(rows, ("command", "wall time on 2 cores", "measured on"))[:-1]
+    return _table(rows, PROSE["cost_heads"]).split("\n")
 
 
 def read_costs(path: str | Path) -> pd.DataFrame:
@@ -851,7 +817,8 @@ def instances_phrase(instances: Mapping[str, Sequence[int]]) -> str:
         return ""
     counts = {len(s) for s in many.values()}
     n = counts.pop() if len(counts) == 1 else None
-    number = (NUMBER_WORDS[n] if n < len(NUMBER_WORDS) else str(n)) if n else "several"
+    words = PROSE["number_words"]
+    number = (words[n] if n < len(words) else str(n)) if n else "several"
     seeds = {tuple(s) for s in many.values()}
     which = _join(seeds.pop()) if len(seeds) == 1 else ""
     return say(
@@ -869,16 +836,16 @@ def found_lines(record_dir: str | Path) -> list[str]:
         The Markdown lines, ending in a blank one.
     """
     record = Path(record_dir)
-    lines = [PROSE["found_head"], "", PROSE["found_none"]]
+    found = [PROSE["found_none"]]
     if (record / "claims.csv").is_file():
         s = json.loads((record / "stamp.json").read_text())
         made_with = _shell(s.get("overrides") or [])
         phrase = instances_phrase(s.get("instances") or {})
         fields = {"profile": s["profile"], "seeds": _join(s["seeds"]), "commit": s["commit"]}
         run = say("found_run", **fields, made_with=made_with, instances=phrase)
-        lines[2:] = [run, "", *headline_lines(_read(record / "claims.csv")), "", PROSE["words"]]
-    costs = cost_lines(read_costs(record / "costs.csv"))
-    return [*lines, "", PROSE["found_costs"], "", *costs, ""]
+        found = [run, "\n".join(headline_lines(_read(record / "claims.csv"))), PROSE["words"]]
+    costs = "\n".join(cost_lines(read_costs(record / "costs.csv")))
+    return _blocks(PROSE["found_head"], *found, PROSE["found_costs"], costs).split("\n")
 
 
 def replace_block(text: str, block: str) -> str:

@@ -155,15 +155,9 @@ def compare_seeded(
             raise ValueError(f"compare_seeded: the {name} table lacks key column(s) {missing}")
         if df.duplicated(keys).any():
             raise ValueError(f"compare_seeded: the {name} table repeats keys {keys}")
-    skip = {*keys, *timing, *PROVENANCE_COLUMNS}
-    numeric = [
-        c
-        for c in old.columns
-        if c not in skip
-        and c in new.columns
-        and pd.api.types.is_numeric_dtype(old[c])
-        and not pd.api.types.is_bool_dtype(old[c])  # a flag of the row, not a measurement
-    ]
+    skip = {*keys, *timing, *PROVENANCE_COLUMNS}  # nor a flag (bool) of the row: not a number
+    numbers = old.select_dtypes("number", exclude="timedelta")
+    numeric = [c for c in numbers if c not in skip and c in new.columns]
     group = [k for k in keys if k != seed]
     spread = old.groupby(group, dropna=False)[numeric].transform(lambda s: s.max() - s.min())
     old = old.join(spread.add_suffix("_spread"))

@@ -39,10 +39,8 @@ def _stale(stamp: Mapping[str, str], df: pd.DataFrame, name: str) -> list[str]:
     """A warning when a file was made under another config than the run's stamp."""
     found = config_hashes(df)
     if found and "config_hash" in stamp and found != [str(stamp["config_hash"])]:
-        return [
-            say("summary_stale", name=name, found=", ".join(found), hash=stamp["config_hash"]),
-            "",
-        ]
+        hash_ = stamp["config_hash"]
+        return [say("summary_stale", name=name, found=", ".join(found), hash=hash_), ""]
     return []
 
 
@@ -119,10 +117,8 @@ def prior_lines(claims: pd.DataFrame) -> list[str]:
         mine = ahead[ahead["id"].astype(str).str.startswith(f"{m}/{AHEAD}/")]
         held = mine[mine["verdict"].astype(str) == "holds"]
         where = ", ".join(i.split(f"/{AHEAD}/", 1)[1] for i in held["id"].astype(str))
-        lines += [
-            say("summary_prior", model=label(m), held=len(held), n=len(mine), where=where),
-            "",
-        ]
+        said = say("summary_prior", model=label(m), held=len(held), n=len(mine), where=where)
+        lines += [said, ""]
     return lines
 
 
