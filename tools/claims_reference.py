@@ -16,6 +16,7 @@ import sys
 from pathlib import Path
 
 from physgs.report import catalogue
+from physgs.report.record import replace_block
 
 
 def render(page: str) -> str:
@@ -30,10 +31,7 @@ def render(page: str) -> str:
     Raises:
         ValueError: when the page has no catalogue block.
     """
-    i, j = page.find(catalogue.BEGIN), page.find(catalogue.END)
-    if i < 0 or j < i:
-        raise ValueError(f"no {catalogue.BEGIN} ... {catalogue.END} block in the page")
-    return page[:i] + catalogue.markdown() + page[j + len(catalogue.END) :]
+    return replace_block(page, catalogue.markdown(), (catalogue.BEGIN, catalogue.END))
 
 
 def main() -> int:

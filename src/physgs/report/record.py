@@ -848,12 +848,13 @@ def found_lines(record_dir: str | Path) -> list[str]:
     return _blocks(PROSE["found_head"], *found, PROSE["found_costs"], costs).split("\n")
 
 
-def replace_block(text: str, block: str) -> str:
-    """``text`` with the part between ``BEGIN`` and ``END`` replaced by ``block``.
+def replace_block(text: str, block: str, markers: tuple[str, str] = (BEGIN, END)) -> str:
+    """``text`` with the part between two markers replaced by ``block``.
 
     Args:
         text: the page's text.
         block: the new block, markers included.
+        markers: the block's first and last marker (default: the README's findings).
 
     Returns:
         The new text.
@@ -861,10 +862,11 @@ def replace_block(text: str, block: str) -> str:
     Raises:
         ValueError: when the markers are missing or out of order.
     """
-    i, j = text.find(BEGIN), text.find(END)
+    begin, end = markers
+    i, j = text.find(begin), text.find(end)
     if i < 0 or j < i:
-        raise ValueError(f"no {BEGIN} ... {END} block to replace")
-    return text[:i] + block + text[j + len(END) :]
+        raise ValueError(f"no {begin} ... {end} block to replace")
+    return text[:i] + block + text[j + len(end) :]
 
 
 def record_costs(path: str | Path, row: Mapping[str, object]) -> None:
