@@ -149,11 +149,9 @@ def fig_tracks(
     """
     import matplotlib.pyplot as plt
 
-    from physgs.report.figures import FONT_PT, PAGE_WIDTH_IN, save_figure
+    from physgs.report.figures import PAGE_WIDTH_IN, _axes, _finish, _texts
 
-    fig, axes = plt.subplots(
-        1, len(trees), figsize=(PAGE_WIDTH_IN, PAGE_WIDTH_IN / len(trees) + 0.9), squeeze=False
-    )
+    fig, axes = _axes(1, len(trees), PAGE_WIDTH_IN / len(trees) + 0.9)
     cmap = plt.get_cmap("tab20")
     for ax, t in zip(axes[0], trees):
         tr, lab = tracks[t], labels.get(t)
@@ -167,17 +165,10 @@ def fig_tracks(
         s0 = tr.start == 0
         kept = float(tr.valid[s0, -1].mean()) if s0.any() else 0.0
         fitted = 0 if lab is None else int((np.asarray(lab) >= 0).sum())
-        ax.set_title(
-            f"{t}: {tr.n_tracks} tracks\n{100 * kept:.0f}% of frame 0's kept, {fitted} in parts",
-            fontsize=FONT_PT,
-        )
-        ax.set_xlabel("x (px)", fontsize=FONT_PT)  # the frame's own pixels are the scale
-        ax.tick_params(labelsize=FONT_PT)
-    axes[0, 0].set_ylabel("y (px)", fontsize=FONT_PT)
-    if title:
-        fig.suptitle(title, fontsize=FONT_PT)
-    fig.tight_layout()
-    save_figure(fig, outputs, dpi=150)
+        head = f"{t}: {tr.n_tracks} tracks\n{100 * kept:.0f}% of frame 0's kept, {fitted} in parts"
+        # the frame's own pixels are the scale
+        _texts(ax, head, "x (px)", "y (px)" if ax is axes[0, 0] else None)
+    _finish(fig, outputs, title, dpi=150)
 
 
 # ---- the declarations ----------------------------------------------------------------------

@@ -74,13 +74,11 @@ def draw_fit_vs_extrapolation(df: pd.DataFrame, outputs: Sequence[str]) -> None:
         df: [`fit_vs_extrapolation`][physgs.report.trade.fit_vs_extrapolation]'s rows.
         outputs: the paths to write.
     """
-    import matplotlib.pyplot as plt  # matplotlib: not for the workflow's planning imports
-
-    from physgs.report.figures import COLORS, save_figure
+    from physgs.report.figures import COLORS, _axes, _finish  # matplotlib: not for planning
 
     xy = ["of_ceiling", "beyond_gain"]
     trees = list(dict.fromkeys(df["tree"]))
-    fig, axes = plt.subplots(1, len(trees), figsize=(4.6 * len(trees), 3.9), squeeze=False)
+    fig, axes = _axes(1, len(trees), 3.9, width=4.6 * len(trees))
     for ax, tree in zip(axes[0], trees):
         t = df[(df["tree"] == tree) & ~df["model"].isin(REFERENCE_NAMES)]
         for m, g in t.groupby("model", sort=False):
@@ -93,18 +91,18 @@ def draw_fit_vs_extrapolation(df: pd.DataFrame, outputs: Sequence[str]) -> None:
             ax.plot(prof["of_ceiling"], prof["beyond_gain"], "*", color=color, ms=10)
         ax.axhline(0.0, color="0.55", ls="--", lw=1.0)
         ax.axvline(FIT_BAR, color="k", ls=":", lw=1.0)
-        ax.set_title(f"{tree} ({t['seed'].nunique()} seed(s))")
-        ax.set_xlabel("in-window fraction of the ceiling's gain")
-        ax.set_ylabel("gain over static beyond the window (dB)")
+        ax.set(
+            title=f"{tree} ({t['seed'].nunique()} seed(s))",
+            xlabel="in-window fraction of the ceiling's gain",
+            ylabel="gain over static beyond the window (dB)",
+        )
         ax.grid(alpha=0.3)
     axes[0][0].legend(fontsize=7)
-    fig.suptitle(
+    title = (
         "Does fitting the window more make a field extrapolate worse? (line: the budgets, star: "
-        "the profile's; dotted: the fit bar; dashed: static)",
-        fontsize=9,
+        "the profile's; dotted: the fit bar; dashed: static)"
     )
-    fig.tight_layout()
-    save_figure(fig, outputs)
+    _finish(fig, outputs, title, title_pt=9)
 
 
 def _fig_fit_vs_extrapolation(path, settings, inputs, out):
