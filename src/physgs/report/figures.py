@@ -227,8 +227,7 @@ def fig_teaser(
         _texts(ax, textwrap.fill(name, 16), "x (px)", "y (px)" if i == 0 else None)
         if i == len(panels) - 1:  # one key for the paths, right of the last panel
             ax.legend(fontsize=FONT_PT, loc="upper left", bbox_to_anchor=(1.02, 1.0), frameon=False)
-    unseen = unseen % len(conditions)
-    half = len(panels)
+    half, unseen = len(panels), unseen % len(conditions)
     unseen_wind = f"unseen wind {condition_label(conditions[unseen], tex=False)}"
     for j, (c, lab) in enumerate([(0, "training wind"), (unseen, unseen_wind)]):
         ax = fig.add_subplot(gs[1, j * half : (j + 1) * half])
@@ -421,10 +420,9 @@ def fig_speed_accuracy(
         ax.set(xscale="log", xlabel="wall time per point (s, log)", ylabel=ylabel)
         ax.grid(alpha=0.3)
     if null is not None and np.isfinite(null.get("median", np.nan)):
-        K, draws = null.get("K", "?"), null["draws"]
-        median = f"untrained null, K={K} (median)"
+        median = f"untrained null, K={null.get('K', '?')} (median)"
         axes[1].axhline(100 * null["median"], color="0.3", ls="--", lw=1.0, label=median)
-        band = f"null: central 95% of {draws} draws"
+        band = f"null: central 95% of {null['draws']} draws"
         low, high = 100 * null["low"], 100 * null["high"]
         axes[1].axhspan(low, high, color="0.6", alpha=0.25, lw=0, label=band)
         axes[1].legend(fontsize=7)

@@ -134,12 +134,9 @@ def _emph(model: str, reference: bool) -> str:
 
 def _best_cols(V: np.ndarray, rows: np.ndarray) -> np.ndarray:
     """[R] bool: among ``rows`` [R] bool, the row whose mean is highest when decided (V [S, R])."""
-    out = np.zeros(V.shape[1], bool)
     idx = np.flatnonzero(rows)
     b = seedstats.decided_best(V[:, idx], higher=True)
-    if b is not None:
-        out[idx[b]] = True
-    return out
+    return np.arange(V.shape[1]) == (-1 if b is None else idx[b])
 
 
 def tab_psnr(
@@ -312,13 +309,11 @@ def tab_transfer(
     first = latex.rows(df)
     V = np.stack([latex.by_seed(df, m) for m in models], axis=-1)  # [S, R, M]
     best = [seedstats.decided_best(V[:, i, :]) for i in range(len(first))]
-    splits = TEXT["tab_transfer_splits"]
     wind = [
         f"{tree_label(r.tree, r.bones)}, {condition_label(r.condition)}" for r in first.itertuples()
     ]
-    index = pd.MultiIndex.from_arrays(
-        [[splits[x] for x in first["split"]], wind], names=["Split", "Tree / unseen wind"]
-    )
+    split = first["split"].map(TEXT["tab_transfer_splits"])
+    index = pd.MultiIndex.from_arrays([split, wind], names=["Split", "Tree / unseen wind"])
 
     def head(m):  # (its field family's heading over the family's columns, or "", its short name)
         spec = spec_of(m)

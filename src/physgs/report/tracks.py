@@ -12,6 +12,7 @@ import numpy as np
 import pandas as pd
 
 from physgs.intermediate import read_json
+from physgs.models.registry import PAPER_MODEL
 from physgs.report import latex
 from physgs.report.output import Columns, Output, key
 from physgs.report.recovery import _label_with_k
@@ -98,29 +99,24 @@ def tab_tracks(
         return about | _row(per_seed[s][(t, c)], conditions)
 
     df = seed_rows(seeds, keys, one)
-    col, fmt = partial(latex.cells, df), f".{int(digits)}f"
-
-    def both(a: str, b: str) -> list[str]:  # 'median / 90th percentile'
-        return [f"{x} / {y}" for x, y in zip(col(a, fmt), col(b, fmt))]
-
-    n, kept, est, k = (
-        col(c, ".0f", cell=latex.mean, scale=f)
-        for c, f in (("n_tracks", 1), ("share_kept", 100), ("parts_estimated", 1), ("K", 1))
-    )
-    columns = {
-        ("Tracker", "Tracks (kept)"): [f"{a} ({b}\\%)" for a, b in zip(n, kept)],
-        ("Tracker", "Error (px)"): both("track_median_px", "track_p90_px"),
-        ("Tracker", r"Displ.\ (px)"): both("disp_median_px", "disp_p90_px"),
-        ("Fit", "Parts"): [f"{a}/{b}" for a, b in zip(est, k)],
+    col = lambda c, fmt=f".{int(digits)}f", **kw: pd.Series(latex.cells(df, c, fmt, **kw))
+    mean = partial(col, fmt=".0f", cell=latex.mean)  # counts and shares: no sd
+    kept = mean("n_tracks") + " (" + mean("share_kept", scale=100) + r"\%)"
+    columns = {  # a 'median / 90th percentile' pair in one cell
+        ("Tracker", "Tracks (kept)"): kept,
+        ("Tracker", "Error (px)"): col("track_median_px") + " / " + col("track_p90_px"),
+        ("Tracker", r"Displ.\ (px)"): col("disp_median_px") + " / " + col("disp_p90_px"),
+        ("Fit", "Parts"): mean("parts_estimated") + "/" + mean("K"),
         ("Fit", "s"): col("fit_s", ".0f"),
         ("Fit", "ours (s)"): col("ours_train_s", ".0f"),
     }
     winds = [f"wind {condition_label(float(c))}" for c in conditions[1:]]
     for head, stem in zip(["beyond the window", *winds], _stems(conditions)):
         for suffix, who in WHO.items():
-            columns[(f"{head} (px)", who)] = col(f"{stem}{suffix}_px", fmt)
+            columns[(f"{head} (px)", who)] = col(f"{stem}{suffix}_px")
     rows = [(tree_label(t, bones[t]), configs[c]["label"]) for t, c in keys]
-    cells = pd.DataFrame(columns, index=pd.MultiIndex.from_tuples(rows, names=["Tree", "Config"]))
+    index = pd.MultiIndex.from_tuples(rows, names=["Tree", "Config"])
+    cells = pd.DataFrame(columns).set_axis(index)
     joint = ", ".join(c.replace("_", r"\_") for c in configs if configs[c]["conditions"] != "train")
     cap = caption("tab_tracks", *(["tab_tracks_joint"] if joint else []), joint=joint)
     cap += latex.seed_note(len(seeds), decides=False)
@@ -175,7 +171,7 @@ def fig_tracks(
 def _tab_tracks_needs(plan, seeds):
     """Per tree, configuration and seed: the evaluation record, ours' loss log (training
     seconds) and, for ``plan.tracks_fields``, the fields' scores."""
-    each = (("tracks_eval", ()), ("loss", ("ours",)))  # the record, ours' loss log
+    each = (("tracks_eval", ()), ("loss", (PAPER_MODEL,)))  # the record, ours' loss log
     mine = product([int(s) for s in seeds], plan.trees, plan.tracks)
     out = [(k, t, *m, c, s) for s, t, c in mine for k, m in each]
     return out + [("tracks_fields", t, c, int(s)) for s in seeds for t, c in plan.tracks_fields]
@@ -194,7 +190,8 @@ def _tab_tracks(path, settings, inputs, out):
         if key(("tracks_fields", t, c, s)) in inputs:  # {case: {field: errors}}
             for case, f in read_json(path("tracks_fields", t, c, s), rule="tracks_fields").items():
                 sc[case]["fields"] = f
-        sc["ours_train_s"] = float(pd.read_csv(path("loss", t, "ours", c, s))["seconds"].iloc[-1])
+        loss = pd.read_csv(path("loss", t, PAPER_MODEL, c, s))
+        sc["ours_train_s"] = float(loss["seconds"].iloc[-1])
         return sc
 
     trees, configs, seeds = settings["trees"], settings["configs"], settings["seeds"]
