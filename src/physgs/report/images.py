@@ -189,10 +189,9 @@ def tab_psnr(
     first = latex.rows(df)
     ref, diff = first["reference"].to_numpy(bool), first["difference"].to_numpy(bool)
 
-    def name(m, r, d):  # a reference in italics; a difference "<a> $-$ <b>"
-        terms = [label(x) if x != BEST_FIELD else "best learned field" for x in m.split(PSNR_MINUS)]
-        return " $-$ ".join(terms) if d else _emph(m, r)
-
+    # a reference in italics; a difference "<a> $-$ <b>"
+    term = lambda x: label(x) if x != BEST_FIELD else "best learned field"
+    name = lambda m, r, d: " $-$ ".join(map(term, m.split(PSNR_MINUS))) if d else _emph(m, r)
     pm = partial(latex.cells, df, fmt=fmt)
     minus = partial(pm, cell=seedstats.difference)  # a difference's cell marks its interval
     names = [name(*x) for x in zip(first["model"], ref, diff)]
@@ -315,12 +314,11 @@ def tab_transfer(
     split = first["split"].map(TEXT["tab_transfer_splits"])
     index = pd.MultiIndex.from_arrays([split, wind], names=["Split", "Tree / unseen wind"])
 
-    def head(m):  # (its field family's heading over the family's columns, or "", its short name)
-        spec = spec_of(m)
-        return FAMILY_HEADS.get(spec.family, "") if spec.role == "field" else "", spec.short
-
+    # a field family's heading over the family's columns, and each model's short name
+    family = lambda spec: FAMILY_HEADS.get(spec.family, "") if spec.role == "field" else ""
+    heads = {m: (family(spec_of(m)), spec_of(m).short) for m in models}
     fmt = f".{int(digits)}f"
-    cells = pd.DataFrame({head(m): latex.cells(df, m, fmt) for m in models}, index=index)
+    cells = pd.DataFrame({heads[m]: latex.cells(df, m, fmt) for m in models}, index=index)
     bold = np.arange(len(models)) == np.array([-1 if b is None else b for b in best])[:, None]
     return _table("tab_transfer", df, cells, n_seeds=len(seeds), bold=bold)
 

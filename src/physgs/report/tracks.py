@@ -94,11 +94,8 @@ def tab_tracks(
     keys = [(t, c) for t in trees for c in configs]
     seeds = seeds_of(per_seed, "tab_tracks", keys)
 
-    def one(s, t, c):
-        about = {"tree": t, "bones": bones[t], "config": c, "conditions": configs[c]["conditions"]}
-        return about | _row(per_seed[s][(t, c)], conditions)
-
-    df = seed_rows(seeds, keys, one)
+    about = lambda t, c: dict(tree=t, bones=bones[t], config=c, conditions=configs[c]["conditions"])
+    df = seed_rows(seeds, keys, lambda s, t, c: about(t, c) | _row(per_seed[s][(t, c)], conditions))
     col = lambda c, fmt=f".{int(digits)}f", **kw: pd.Series(latex.cells(df, c, fmt, **kw))
     mean = partial(col, fmt=".0f", cell=latex.mean)  # counts and shares: no sd
     kept = mean("n_tracks") + " (" + mean("share_kept", scale=100) + r"\%)"
