@@ -180,7 +180,7 @@ def test_fig_fit_curve_labels_wall_time_in_plain_seconds(monkeypatch):
     from physgs.report import figures
 
     captured = []
-    monkeypatch.setattr(figures, "save_figure", lambda fig, outputs: captured.append(fig))
+    monkeypatch.setattr(figures, "save_figure", lambda fig, outputs, dpi=200: captured.append(fig))
     pts = [
         {
             "model": m,
@@ -334,7 +334,7 @@ def test_a_window_series_profile_star_has_its_lines_colour(monkeypatch):
     from physgs.report import figures
 
     captured = []
-    monkeypatch.setattr(figures, "save_figure", lambda fig, outputs: captured.append(fig))
+    monkeypatch.setattr(figures, "save_figure", lambda fig, outputs, dpi=200: captured.append(fig))
     pts = [
         {"model": m, "seed": 0, "iterations": it, "fit": 20.0 + it / 1000, "heldout": 19.0,
          "time": 18.0, "train_s": it / 10}

@@ -9,6 +9,7 @@ format (.pdf, .png), each written atomically. Matplotlib's Agg backend: no displ
 from __future__ import annotations
 
 import textwrap
+from itertools import product
 from pathlib import Path
 from typing import Mapping, Sequence
 
@@ -19,11 +20,13 @@ matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
 import pandas as pd  # noqa: E402
+from matplotlib.lines import Line2D  # noqa: E402
+from matplotlib.patches import Patch  # noqa: E402
 from matplotlib.ticker import LogLocator, NullFormatter, ScalarFormatter  # noqa: E402
 
 from physgs.atomic import atomic_path  # noqa: E402
 from physgs.models.registry import MODEL_NAMES as MODELS  # noqa: E402
-from physgs.models.registry import REFERENCE_NAMES, label, spec_of  # noqa: E402
+from physgs.models.registry import PAPER_MODEL, REFERENCE_NAMES, label, spec_of  # noqa: E402
 from physgs.report.tables import condition_label  # noqa: E402
 
 COLORS = {
@@ -71,7 +74,7 @@ def save_figure(fig, outputs: Sequence[str | Path], dpi: int = 200) -> None:
 def best_baseline(
     summaries: Mapping[str, Mapping[str, float]],
     key: str = "time",
-    exclude: Sequence[str] = ("static", "ours"),
+    exclude: Sequence[str] = ("static", PAPER_MODEL),
 ) -> str:
     """The id of the learned baseline with the highest ``summaries[model][key]`` (dB).
 
@@ -93,12 +96,24 @@ def best_baseline(
     return max(cands, key=cands.get)
 
 
-def _legend_below(fig, handles: list, *, ncol: int, top: float) -> None:
-    """The figure's key below its panels (its top at ``top`` < 0.2, in figure fractions), never
-    over the data: the panels keep the top 80%."""
-    fig.tight_layout(rect=(0, 0.2, 1, 1))
-    where = dict(loc="upper center", bbox_to_anchor=(0.5, top), ncol=ncol)
-    fig.legend(handles=handles, **where, fontsize=FONT_PT, frameon=False)
+def _axes(rows: int, cols: int, height: float, width: float = PAGE_WIDTH_IN, **kw):
+    """A figure of [rows, cols] axes, ``width`` x ``height`` inches (the page's width by default)."""
+    return plt.subplots(rows, cols, figsize=(width, height), squeeze=False, **kw)
+
+
+def _finish(
+    fig, outputs, title="", *, title_pt=FONT_PT, key=(), ncol=4, top=0.1, pad=1.08, dpi=200
+):
+    """Title ``fig``, lay it out and save it (``save_figure``); a ``key``: those handles in one
+    legend below the panels (its top at ``top`` < 0.2 in figure fractions), never over the data:
+    the panels keep the top 80%."""
+    if title:
+        fig.suptitle(title, fontsize=title_pt)
+    fig.tight_layout(pad=pad, rect=(0, 0.2, 1, 1) if key else None)
+    if key:
+        where = dict(loc="upper center", bbox_to_anchor=(0.5, top), ncol=ncol)
+        fig.legend(handles=list(key), **where, fontsize=FONT_PT, frameon=False)
+    save_figure(fig, outputs, dpi=dpi)
 
 
 def _plain_log(axis, locator=None) -> None:
@@ -141,36 +156,31 @@ def fig_temporal(
     Raises:
         KeyError: when a (tree, model) has no curve.
     """
-    from matplotlib.patches import Patch
-
-    fig, axes = plt.subplots(1, len(trees), figsize=(PAGE_WIDTH_IN, 3.4), squeeze=False)
-    n_seeds = 1
+    fig, axes = _axes(1, len(trees), 3.4)
     for ax, t in zip(axes[0], trees):
-        for m in models:
+        for m in (*models, *(r for r in REFERENCE_NAMES if (t, r) in curves)):
             if (t, m) not in curves:
                 raise KeyError(f"fig_temporal: no per-frame PSNR for ({t}, {m})")
             Y = np.atleast_2d(np.asarray(curves[(t, m)], dtype=np.float64))  # [S, F]
-            n_seeds, y = len(Y), Y.mean(0)
-            x = np.arange(1, len(y) + 1)
-            lw, ls = 1.4 if spec_of(m).role == "prior" else 0.8, "--" if m == "static" else "-"
-            ax.plot(x, y, color=COLORS.get(m), lw=lw, ls=ls, label=label(m))
-            if len(Y) > 1:  # the seeds' spread
-                ax.fill_between(x, Y.min(0), Y.max(0), color=COLORS.get(m), alpha=0.2, lw=0)
-        for m in REFERENCE_NAMES:
-            if (t, m) in curves:
-                Y = np.atleast_2d(np.asarray(curves[(t, m)], dtype=np.float64))
+            x = np.arange(1, Y.shape[1] + 1)
+            if m in REFERENCE_NAMES:  # the ceiling: no spread
                 ax.plot(x, Y.mean(0), color="k", lw=0.8, ls=":", label=label(m))
+                continue
+            n_seeds, color = len(Y), COLORS.get(m)
+            lw, ls = 1.4 if spec_of(m).role == "prior" else 0.8, "--" if m == "static" else "-"
+            ax.plot(x, Y.mean(0), color=color, lw=lw, ls=ls, label=label(m))
+            if len(Y) > 1:  # the seeds' spread
+                ax.fill_between(x, Y.min(0), Y.max(0), color=color, alpha=0.2, lw=0)
         ax.axvline(n_train + 0.5, color="k", lw=0.8, ls=":")
-        ax.axvspan(n_train + 0.5, len(y) + 0.5, color="0.9", zorder=0)
-        ax.set_xlim(1, len(y))
-        _texts(ax, t.capitalize(), "frame", title_pt=FONT_PT + 1)
-    axes[0, 0].set_ylabel("PSNR (dB)", fontsize=FONT_PT)
+        ax.axvspan(n_train + 0.5, len(x) + 0.5, color="0.9", zorder=0)
+        ax.set_xlim(1, len(x))
+        first = ax is axes[0, 0]
+        _texts(ax, t.capitalize(), "frame", "PSNR (dB)" if first else None, FONT_PT + 1)
     handles, _ = axes[0, 0].get_legend_handles_labels()
     handles.append(Patch(color="0.9", label=f"beyond the training window (after frame {n_train})"))
     if n_seeds > 1:
         handles.append(Patch(color="0.5", alpha=0.3, label=f"lowest to highest of {n_seeds} seeds"))
-    _legend_below(fig, handles, ncol=3, top=0.16)
-    save_figure(fig, outputs)
+    _finish(fig, outputs, key=handles, ncol=3, top=0.16)
 
 
 def fig_teaser(
@@ -205,7 +215,7 @@ def fig_teaser(
     fig = plt.figure(figsize=(PAGE_WIDTH_IN, PAGE_WIDTH_IN / len(panels) + 4.2))
     gs = fig.add_gridspec(2, 2 * len(panels), height_ratios=[1.0, 1.1])
     pad = 0.15 * max(np.ptp(gt[:, 0]), np.ptp(gt[:, 1]), 1.0)
-    lims = [gt[:, 0].min() - pad, gt[:, 0].max() + pad, gt[:, 1].max() + pad, gt[:, 1].min() - pad]
+    lo, hi = gt.min(0) - pad, gt.max(0) + pad
     for i, (name, p) in enumerate(panels):
         ax = fig.add_subplot(gs[0, 2 * i : 2 * i + 2])
         if i:
@@ -213,14 +223,11 @@ def fig_teaser(
         tail = p[n_train - 1 :]
         ax.plot(p[:n_train, 0], p[:n_train, 1], color=WINDOW, lw=0.9, label="training window")
         ax.plot(tail[:, 0], tail[:, 1], color=TAIL, lw=1.4, label="beyond the window")
-        ax.set_xlim(lims[0], lims[1])
-        ax.set_ylim(lims[2], lims[3])  # image y points down
-        ax.set_aspect("equal", adjustable="box")
+        ax.set(xlim=(lo[0], hi[0]), ylim=(hi[1], lo[1]), aspect="equal")  # image y points down
         _texts(ax, textwrap.fill(name, 16), "x (px)", "y (px)" if i == 0 else None)
         if i == len(panels) - 1:  # one key for the paths, right of the last panel
             ax.legend(fontsize=FONT_PT, loc="upper left", bbox_to_anchor=(1.02, 1.0), frameon=False)
-    unseen = unseen % len(conditions)
-    half = len(panels)
+    half, unseen = len(panels), unseen % len(conditions)
     unseen_wind = f"unseen wind {condition_label(conditions[unseen], tex=False)}"
     for j, (c, lab) in enumerate([(0, "training wind"), (unseen, unseen_wind)]):
         ax = fig.add_subplot(gs[1, j * half : (j + 1) * half])
@@ -232,10 +239,7 @@ def fig_teaser(
         _texts(ax, f"canopy-centroid error, {lab}", "frame", "error (px)")
         # below its panel, never over the curves
         ax.legend(fontsize=FONT_PT, loc="upper center", bbox_to_anchor=(0.5, -0.22), frameon=False)
-    if title:
-        fig.suptitle(title, fontsize=FONT_PT + 1)
-    fig.tight_layout()
-    save_figure(fig, outputs)
+    _finish(fig, outputs, title, title_pt=FONT_PT + 1)
 
 
 def fig_results(
@@ -243,7 +247,7 @@ def fig_results(
     columns: Sequence[str],
     images: Mapping[tuple[str, str], tuple[np.ndarray, float | None]],
     outputs: Sequence[str | Path],
-    ours: str = "ours",
+    ours: str = PAPER_MODEL,
 ) -> None:
     """fig_results: one row per (tree, split) label, one column per model (or 'gt').
 
@@ -259,35 +263,29 @@ def fig_results(
         KeyError: when a panel has no image.
     """
     side = PAGE_WIDTH_IN / (len(columns) + 0.3)  # one panel, inches; the row labels beside
-    fig, axes = plt.subplots(
-        len(rows), len(columns), figsize=(PAGE_WIDTH_IN, side * len(rows) + 0.5), squeeze=False
-    )
+    fig, axes = _axes(len(rows), len(columns), side * len(rows) + 0.5)
     box = dict(facecolor="white", alpha=0.8, lw=0, pad=1)
-    for i, r in enumerate(rows):
-        scores = {c: images[(r, c)][1] for c in columns if images[(r, c)][1] is not None}
-        ours_score = scores.get(ours)
-        for j, c in enumerate(columns):
-            if (r, c) not in images:
-                raise KeyError(f"fig_results: no image for row {r!r}, column {c!r}")
-            img, score = images[(r, c)]
-            ax = axes[i, j]
-            ax.imshow(np.asarray(img), interpolation="nearest")
-            ax.set_xticks([])
-            ax.set_yticks([])
-            if score is not None:
-                best = c == ours and ours_score is not None and ours_score >= max(scores.values())
-                beats = c != ours and ours_score is not None and score > ours_score
-                color = GOOD if best else BAD if beats else "k"
-                weight = "bold" if color != "k" else "normal"
-                kw = dict(fontsize=FONT_PT, color=color, fontweight=weight, bbox=box)
-                ax.text(0.03, 0.03, f"{score:.1f} dB", transform=ax.transAxes, **kw)
-            if i == 0:
-                name = "Ground truth" if c == "gt" else label(c)
-                ax.set_title(textwrap.fill(name, 12), fontsize=FONT_PT)
-            if j == 0:
-                ax.set_ylabel(textwrap.fill(r, 14), fontsize=FONT_PT)
-    fig.tight_layout(pad=0.3)
-    save_figure(fig, outputs)
+    for (i, r), (j, c) in product(enumerate(rows), enumerate(columns)):
+        scores = {x: images[(r, x)][1] for x in columns if images[(r, x)][1] is not None}
+        if (r, c) not in images:
+            raise KeyError(f"fig_results: no image for row {r!r}, column {c!r}")
+        img, score = images[(r, c)]
+        ax, mine = axes[i, j], scores.get(ours)
+        ax.imshow(np.asarray(img), interpolation="nearest")
+        ax.set(xticks=[], yticks=[])
+        if score is not None:
+            best = c == ours and mine is not None and mine >= max(scores.values())
+            beats = c != ours and mine is not None and score > mine
+            color = GOOD if best else BAD if beats else "k"
+            weight = "bold" if color != "k" else "normal"
+            kw = dict(fontsize=FONT_PT, color=color, fontweight=weight, bbox=box)
+            ax.text(0.03, 0.03, f"{score:.1f} dB", transform=ax.transAxes, **kw)
+        if i == 0:
+            name = "Ground truth" if c == "gt" else label(c)
+            ax.set_title(textwrap.fill(name, 12), fontsize=FONT_PT)
+        if j == 0:
+            ax.set_ylabel(textwrap.fill(r, 14), fontsize=FONT_PT)
+    _finish(fig, outputs, pad=0.3)
 
 
 def fig_damping(
@@ -312,48 +310,35 @@ def fig_damping(
     Raises:
         KeyError: naming a ``(tree, config)`` (and model) without a result.
     """
-    from matplotlib.lines import Line2D
-    from matplotlib.patches import Patch
-
-    fig, (a0, a1) = plt.subplots(1, 2, figsize=(PAGE_WIDTH_IN, 3.6))
+    fig, ((a0, a1),) = _axes(1, 2, 3.6)
     tree_colors = dict(zip(trees, ["tab:green", "tab:blue", "tab:red", "tab:purple"]))
     markers = dict(zip(configs, ["o", "s", "^", "D"]))
     models = list(damping)
-
-    def style(model, t):  # the first prior filled, the others hollow in the tree's colour
-        c = tree_colors[t]
-        return {"color": c} if model == models[0] else {"facecolors": "none", "edgecolors": c}
-
-    per_tree = len(configs) * len(models)
-    allw, centres = [], []
-    for i, t in enumerate(trees):
-        centres.append(i * (per_tree + 1) + (per_tree - 1) / 2)
-        for j, c in enumerate(configs):
-            for k, model in enumerate(models):
-                if (t, c) not in damping[model]:
-                    who = "" if model == "ours" else f" of {model}"
-                    raise KeyError(f"fig_damping: no damping result{who} for ({t}, {c})")
-                d = damping[model][(t, c)]
-                pos = i * (per_tree + 1) + j * len(models) + k  # a gap between trees
-                jitter = np.random.default_rng(pos).uniform(-0.2, 0.2, len(d.zeta))  # display
-                look = style(model, t)
-                a0.scatter(pos + jitter, d.zeta, s=7, marker=markers[c], alpha=0.5, **look)
-                a0.plot([pos - 0.35, pos + 0.35], [d.median_zeta] * 2, color="k", lw=1.5)
-                a1.scatter(d.omega, d.gamma, s=9, marker=markers[c], alpha=0.6, **look)
-                allw.append(d.omega)
+    per_tree, allw = len(configs) * len(models), []
+    for (i, t), (j, c), (k, model) in product(*map(enumerate, (trees, configs, models))):
+        if (t, c) not in damping[model]:
+            who = "" if model == PAPER_MODEL else f" of {model}"
+            raise KeyError(f"fig_damping: no damping result{who} for ({t}, {c})")
+        d = damping[model][(t, c)]
+        pos = i * (per_tree + 1) + j * len(models) + k  # a gap between trees
+        jitter = np.random.default_rng(pos).uniform(-0.2, 0.2, len(d.zeta))  # display
+        tc = tree_colors[t]  # the first prior filled, the others hollow in the tree's colour
+        look = {"color": tc} if k == 0 else {"facecolors": "none", "edgecolors": tc}
+        a0.scatter(pos + jitter, d.zeta, s=7, marker=markers[c], alpha=0.5, **look)
+        a0.plot([pos - 0.35, pos + 0.35], [d.median_zeta] * 2, color="k", lw=1.5)
+        a1.scatter(d.omega, d.gamma, s=9, marker=markers[c], alpha=0.6, **look)
+        allw.append(d.omega)
     a0.axhline(zeta_true, color="k", ls="--", lw=0.8)
     if zeta_bound is not None:
         a0.axhline(zeta_bound, color="0.4", ls=":", lw=1.0)
-    a0.set_xticks(centres)
+    a0.set_xticks([i * (per_tree + 1) + (per_tree - 1) / 2 for i in range(len(trees))])
     a0.set_xticklabels(trees, fontsize=FONT_PT)
-    _texts(
-        a0, "damping ratio per part (bar: median)", ylabel=r"$\hat\zeta_p$ (damping ratio, no unit)"
-    )
+    zeta = r"$\hat\zeta_p$ (damping ratio, no unit)"
+    _texts(a0, "damping ratio per part (bar: median)", ylabel=zeta)
     w = np.concatenate(allw)
     grid = np.geomspace(w.min() * 0.9, w.max() * 1.1, 50)
     a1.plot(grid, zeta_true * grid, "k--", lw=1)
-    a1.set_xscale("log")
-    a1.set_yscale("log")
+    a1.set(xscale="log", yscale="log")
     for axis in (a1.xaxis, a1.yaxis):
         _plain_log(axis, LogLocator(base=10, subs=(1.0, 2.0, 5.0)))
     gamma = r"$\hat\gamma_p = \hat\zeta_p\hat\omega_p$ (1/s)"
@@ -372,11 +357,9 @@ def fig_damping(
     truth = rf"truth $\zeta$ = {zeta_true} ($\gamma = \zeta\omega$)"
     handles.append(Line2D([], [], color="k", ls="--", label=truth))
     if zeta_bound is not None:
-        handles.append(
-            Line2D([], [], color="0.4", ls=":", label=rf"fitting bound $\zeta$ = {zeta_bound:g}")
-        )
-    _legend_below(fig, handles, ncol=4, top=0.15)
-    save_figure(fig, outputs)
+        bound = rf"fitting bound $\zeta$ = {zeta_bound:g}"
+        handles.append(Line2D([], [], color="0.4", ls=":", label=bound))
+    _finish(fig, outputs, key=handles, top=0.15)
 
 
 def _seed_mean(df: pd.DataFrame, by: list[str], cols: Sequence[str]) -> pd.DataFrame:
@@ -392,10 +375,8 @@ def _seed_mean(df: pd.DataFrame, by: list[str], cols: Sequence[str]) -> pd.DataF
 def _seed_errorbar(ax, g: pd.DataFrame, x: str, y: str, bars: bool, xbars: bool = True, **style):
     """``y`` against ``x`` of ``_seed_mean``'s rows, the seeds' sd as error bars (``bars``: more
     than one seed; ``xbars``: on ``x`` too)."""
-    yerr = g[f"{y}_sd"] if bars else None
-    ax.errorbar(
-        g[x], g[y], yerr=yerr, xerr=g[f"{x}_sd"] if bars and xbars else None, capsize=2, **style
-    )
+    xerr, yerr = (g[f"{x}_sd"] if bars and xbars else None), (g[f"{y}_sd"] if bars else None)
+    ax.errorbar(g[x], g[y], yerr=yerr, xerr=xerr, capsize=2, **style)
 
 
 def _save_sweep(fig, axes, head: str, n_seeds: int, outputs: Sequence[str | Path]) -> None:
@@ -403,9 +384,7 @@ def _save_sweep(fig, axes, head: str, n_seeds: int, outputs: Sequence[str | Path
     (closing ``head``'s parenthesis), and save it."""
     axes[0].legend(fontsize=7)
     seeds = f"; mean +- sd over {n_seeds} training seeds" if n_seeds > 1 else "; one seed"
-    fig.suptitle(f"{head}{seeds})")
-    fig.tight_layout()
-    save_figure(fig, outputs)
+    _finish(fig, outputs, f"{head}{seeds})", title_pt="large")
 
 
 def fig_speed_accuracy(
@@ -423,33 +402,30 @@ def fig_speed_accuracy(
     n_seeds = df["seed"].nunique()
     pct = df.assign(rel_pct=100 * df["rel_err"])
     m = _seed_mean(pct, ["knob", "value"], ("wall_s", "psnr_time", "rel_pct"))
-    fig, axes = plt.subplots(1, 2, figsize=(10, 4))
+    fig, (axes,) = _axes(1, 2, 4, width=10)
     colors = {k: f"C{i}" for i, k in enumerate(sorted(m["knob"].unique()))}
-    panels = ((axes[0], "psnr_time"), (axes[1], "rel_pct"))
+    ylabels = ("PSNR, time split (dB)", "median rel. error of omega, trusted parts (%)")
+    panels = tuple(zip(axes, ("psnr_time", "rel_pct"), ylabels))
     for knob, g in m.groupby("knob", sort=False):
         g = g.sort_values("value")
-        for ax, col in panels:
+        for ax, col, _ in panels:
             style = dict(fmt="-o", ms=3.5, lw=1.0, color=colors[knob], label=knob)
             _seed_errorbar(ax, g, "wall_s", col, n_seeds > 1, **style)
-            for _, r in g.iterrows():
-                kw = dict(fontsize=6, xytext=(3, 3), textcoords="offset points", color=colors[knob])
-                ax.annotate(str(int(r["value"])), (r["wall_s"], r[col]), **kw)
+            kw = dict(fontsize=6, xytext=(3, 3), textcoords="offset points", color=colors[knob])
+            for v, x, y in zip(g["value"], g["wall_s"], g[col]):
+                ax.annotate(str(int(v)), (x, y), **kw)
     base = m[m["is_base"]].iloc[0]
-    for ax, col in panels:
+    for ax, col, ylabel in panels:
         ax.plot([base["wall_s"]], [base[col]], "k*", ms=11, label="profile setting")
-        ax.set_xscale("log")
-        ax.set_xlabel("wall time per point (s, log)")
+        ax.set(xscale="log", xlabel="wall time per point (s, log)", ylabel=ylabel)
         ax.grid(alpha=0.3)
     if null is not None and np.isfinite(null.get("median", np.nan)):
-        K, draws = null.get("K", "?"), null["draws"]
-        median = f"untrained null, K={K} (median)"
+        median = f"untrained null, K={null.get('K', '?')} (median)"
         axes[1].axhline(100 * null["median"], color="0.3", ls="--", lw=1.0, label=median)
-        band = f"null: central 95% of {draws} draws"
+        band = f"null: central 95% of {null['draws']} draws"
         low, high = 100 * null["low"], 100 * null["high"]
         axes[1].axhspan(low, high, color="0.6", alpha=0.25, lw=0, label=band)
         axes[1].legend(fontsize=7)
-    axes[0].set_ylabel("PSNR, time split (dB)")
-    axes[1].set_ylabel("median rel. error of omega, trusted parts (%)")
     head = f"Speed-accuracy trade, ours on the {df['tree'].iloc[0]} tree (one knob at a time"
     _save_sweep(fig, axes, head, n_seeds, outputs)
 
@@ -470,20 +446,19 @@ def fig_fit_curve(df: pd.DataFrame, outputs: Sequence[str | Path]) -> None:
     )
     n_seeds = df["seed"].nunique()
     trees = list(dict.fromkeys(df["tree"]))
-    fig, grid = plt.subplots(len(trees), len(panels), figsize=(13, 3.8 * len(trees)), squeeze=False)
+    fig, grid = _axes(len(trees), len(panels), 3.8 * len(trees), width=13)
     refs = {"static": ("0.55", "--"), **{r: ("k", ":") for r in REFERENCE_NAMES}}
     for tree, axes in zip(trees, grid):
         t = _seed_mean(df[df["tree"] == tree], ["model", "iterations"], ("fit", "time", "train_s"))
         prof = t[t["is_profile"]].set_index("model")
         budgets = sorted(t["iterations"].unique())
+        row = f"{tree}: " if len(trees) > 1 else ""
         for ax, (x, y, xlabel, ylabel) in zip(axes, panels):
-            for m, g in t.groupby("model", sort=False):
-                if m in refs:
-                    continue
+            for m, g in t[~t["model"].isin(refs)].groupby("model", sort=False):
                 g = g.sort_values("iterations")
                 base, _, variant = m.partition("@")  # <field>@window: the diagnostic series
                 fmt, mfc, ms = ("D", "none", 6) if variant else ("-o", None, 3.5)
-                lw = 1.6 if m == "ours" else 1.0
+                lw = 1.6 if m == PAPER_MODEL else 1.0
                 lab = label(base) + (f" ({variant} time)" if variant else "")
                 look = dict(fmt=fmt, mfc=mfc, ms=ms, color=COLORS.get(base), lw=lw, label=lab)
                 # no x error bars on the budgets themselves (no spread)
@@ -494,13 +469,11 @@ def fig_fit_curve(df: pd.DataFrame, outputs: Sequence[str | Path]) -> None:
             for m, (c, ls) in refs.items():
                 if m in prof.index:
                     ax.axhline(prof.loc[m, y], color=c, ls=ls, lw=1.0, label=label(m))
-            ax.set_xscale("log")
+            ax.set(xscale="log", xlabel=xlabel, ylabel=row + ylabel)
             if x == "iterations":  # tick the budgets themselves, not powers of ten
                 ax.set_xticks(budgets)
             # seconds span under a decade: 1-2-5 ticks as plain numbers, minor labels overlap
             _plain_log(ax.xaxis, None if x == "iterations" else LogLocator(subs=(1.0, 2.0, 5.0)))
-            ax.set_xlabel(xlabel)
-            ax.set_ylabel(ylabel if len(trees) == 1 else f"{tree}: {ylabel}")
             ax.grid(alpha=0.3)
     where = f"the {trees[0]} tree" if len(trees) == 1 else "each tree (a row each)"
     _save_sweep(fig, grid[0], f"Fit curve on {where} (star: the profile's budget", n_seeds, outputs)

@@ -5,6 +5,7 @@ roles, trained in the base configuration."""
 
 from __future__ import annotations
 
+from functools import partial
 from importlib import resources
 from typing import Mapping, Sequence
 
@@ -16,7 +17,8 @@ from physgs.evaluate.metrics import ceiling_fraction
 from physgs.evaluate.splits import load_eval
 from physgs.evaluate.trajectories import load_trajectories
 from physgs.experiments.recipe import heldout_split
-from physgs.models.registry import BASE_CONFIG, BLIND_CONFIG, MODEL_NAMES, blind_priors
+from physgs.models.registry import BASE_CONFIG, BLIND_CONFIG, MODEL_NAMES, PAPER_MODEL
+from physgs.models.registry import blind_priors
 from physgs.models.registry import label, models_of, spec_of
 from physgs.report import latex, paper
 from physgs.report import seeds as seedstats
@@ -55,16 +57,16 @@ def _conditions(cfg: dict) -> dict:
     return {"conditions": [float(c) for c in cfg["testbed"]["conditions"]]}
 
 
+def _per_seed(settings, configs: Mapping[str, str], read) -> dict:
+    """{seed: {(tree, model): read(tree, model, config, seed)}}, ``configs``: model -> config."""
+    jobs = [(t, m, c) for t in settings["trees"] for m, c in configs.items()]
+    return {s: {(t, m): read(t, m, c, s) for t, m, c in jobs} for s in settings["seeds"]}
+
+
 def _summaries(path, settings, models) -> dict:
     """{seed: {(tree, model): summary}} of the models trained in the base configuration."""
-    return {
-        s: {
-            (t, m): load_eval(path("eval", t, m, BASE_CONFIG, s)).summary()
-            for t in settings["trees"]
-            for m in models
-        }
-        for s in settings["seeds"]
-    }
+    summary = lambda *job: load_eval(path("eval", *job)).summary()
+    return _per_seed(settings, dict.fromkeys(models, BASE_CONFIG), summary)
 
 
 def fit_row(eval_path, loss_path, n_train: int, holdout_every: int) -> dict:
@@ -114,13 +116,15 @@ def fit_settings(cfg: dict) -> dict:
 
 
 # ---- the tables' builders ------------------------------------------------------------------
-def _caption(*parts: str, n_seeds: int, decides: bool = True, **fills: str) -> str:
-    """The caption joined from ``TEXT``'s ``parts`` (an empty one left out), each ``<key>`` of
-    ``fills`` filled in, and the seeds' sentence."""
-    text = "".join(TEXT[p] for p in parts if p)
+def _table(name, df, cells, *parts, n_seeds: int, bold=None, decides=True, **fills) -> Table:
+    """The table ``name``: its CSV frame ``df`` and the .tex of ``cells`` under the caption joined
+    from ``TEXT``'s ``name`` and ``parts`` (an empty one left out), each ``<key>`` of ``fills``
+    filled in, and the seeds' sentence."""
+    text = "".join(TEXT[p] for p in (name, *parts) if p)
     for key, value in fills.items():
         text = text.replace(f"<{key}>", value)
-    return text + latex.seed_note(n_seeds, decides=decides)
+    cap = text + latex.seed_note(n_seeds, decides=decides)
+    return Table(name, df, latex.render(cells, cap, name.replace("tab_", "tab:"), bold))
 
 
 def _emph(model: str, reference: bool) -> str:
@@ -130,12 +134,9 @@ def _emph(model: str, reference: bool) -> str:
 
 def _best_cols(V: np.ndarray, rows: np.ndarray) -> np.ndarray:
     """[R] bool: among ``rows`` [R] bool, the row whose mean is highest when decided (V [S, R])."""
-    out = np.zeros(V.shape[1], bool)
     idx = np.flatnonzero(rows)
     b = seedstats.decided_best(V[:, idx], higher=True)
-    if b is not None:
-        out[idx[b]] = True
-    return out
+    return np.arange(V.shape[1]) == (-1 if b is None else idx[b])
 
 
 def tab_psnr(
@@ -177,40 +178,30 @@ def tab_psnr(
         of = learned if m == BEST_FIELD else [m]
         return {c: max(per_seed[s][(t, x)][sp] for x in of) for c, (t, sp) in cols.items()}
 
-    def row(s, m, other=None):
-        if other is None:
-            return {"model": m, **psnr(s, m), "reference": m in references, "difference": False}
-        a, b = psnr(s, m), psnr(s, other)
-        diff = {c: a[c] - b[c] for c in cols}
-        return {"model": f"{m}{PSNR_MINUS}{other}", **diff, "reference": False, "difference": True}
+    def row(s, m, other=None):  # a model's dB, or a prior's difference to ``other``'s
+        a, b = psnr(s, m), psnr(s, other) if other else None
+        name = f"{m}{PSNR_MINUS}{other}" if other else m
+        dB = {c: a[c] - b[c] for c in cols} if other else a
+        return {"model": name, **dB, "reference": m in references, "difference": bool(other)}
 
     keys = [(m,) for m in (*models, *references)] + [(p, o) for p in priors for o in others]
     df = seed_rows(seeds, keys, row)
     first = latex.rows(df)
     ref, diff = first["reference"].to_numpy(bool), first["difference"].to_numpy(bool)
 
-    def name(m, r, d):  # a reference in italics; a difference "<a> $-$ <b>"
-        terms = [label(x) if x != BEST_FIELD else "best learned field" for x in m.split(PSNR_MINUS)]
-        return " $-$ ".join(terms) if d else _emph(m, r)
-
+    # a reference in italics; a difference "<a> $-$ <b>"
+    term = lambda x: label(x) if x != BEST_FIELD else "best learned field"
+    name = lambda m, r, d: " $-$ ".join(map(term, m.split(PSNR_MINUS))) if d else _emph(m, r)
+    pm = partial(latex.cells, df, fmt=fmt)
+    minus = partial(pm, cell=seedstats.difference)  # a difference's cell marks its interval
     names = [name(*x) for x in zip(first["model"], ref, diff)]
-    cells = pd.DataFrame(
-        {
-            (tree_label(t, bones[t]), sp): np.where(
-                diff,
-                latex.cells(df, c, fmt, cell=seedstats.difference),
-                latex.cells(df, c, fmt),
-            )
-            for c, (t, sp) in cols.items()
-        },
-        index=names,
-    )
+    heads = {c: (tree_label(t, bones[t]), sp) for c, (t, sp) in cols.items()}
+    cells = pd.DataFrame({heads[c]: np.where(diff, minus(c), pm(c)) for c in cols}, index=names)
     bold = np.stack([_best_cols(latex.by_seed(df, c), ~ref & ~diff) for c in cols], axis=1)
     if not references:
         df = df.drop(columns="reference")
-    refs = "tab_psnr_references" if references else ""
-    cap = _caption("tab_psnr", refs, "tab_psnr_differences", n_seeds=len(seeds))
-    return Table("tab_psnr", df, latex.render(cells, cap, "tab:psnr", bold))
+    notes = ("tab_psnr_references" if references else "", "tab_psnr_differences")
+    return _table("tab_psnr", df, cells, *notes, n_seeds=len(seeds), bold=bold)
 
 
 def tab_fit(
@@ -262,27 +253,23 @@ def tab_fit(
     df = seed_rows(seeds, keys, one)
     first = latex.rows(df)
     fmt = f".{int(digits)}f"
-    view, time = (
-        [NOT_DEFINED if c == "--" else c for c in latex.cells(df, col, fmt)]
-        for col in ("view_psnr_db", "time_psnr_db")
-    )
     cells = pd.DataFrame(
         {
             "Fit": latex.cells(df, "fit_psnr_db", fmt),
             "Held-out frames": latex.cells(df, "heldout_psnr_db", fmt),
             "Of ceiling": latex.cells(df, "ceiling_frac", ".0f", r"\%", scale=100),
             "Held-out of ceiling": latex.cells(df, "heldout_ceiling_frac", ".0f", r"\%", scale=100),
-            "View": view,
-            "Time": time,
+            "View": latex.cells(df, "view_psnr_db", fmt),
+            "Time": latex.cells(df, "time_psnr_db", fmt),
             "Train (s)": latex.cells(df, "train_s", ".0f"),
             "Iter.": latex.cells(df, "iterations", ".0f"),
         },
         index=tree_index(first, [_emph(m, m == reference) for m in first["model"]], "Model"),
     )
-    nd = "tab_fit_not_defined" if NOT_DEFINED in (*view, *time) else ""
+    cells[["View", "Time"]] = cells[["View", "Time"]].replace("--", NOT_DEFINED)
+    nd = "tab_fit_not_defined" if cells[["View", "Time"]].eq(NOT_DEFINED).any(axis=None) else ""
     fills = {"every": f"{holdout_every}", "nd": NOT_DEFINED}
-    cap = _caption("tab_fit", nd, n_seeds=len(seeds), decides=False, **fills)
-    return Table("tab_fit", df, latex.render(cells, cap, "tab:fit"))
+    return _table("tab_fit", df, cells, nd, n_seeds=len(seeds), decides=False, **fills)
 
 
 def tab_transfer(
@@ -314,36 +301,26 @@ def tab_transfer(
 
     def row(s, sp, t, c):
         psnr = {m: per_seed[s][(t, m)][f"{stems[sp]}{c}"] for m in models}
-        return {
-            "split": sp,
-            "tree": t,
-            "bones": bones[t],
-            "condition": float(conditions[c]),
-            **psnr,
-        }
+        return dict(split=sp, tree=t, bones=bones[t], condition=float(conditions[c])) | psnr
 
     keys = [(sp, t, c) for sp in stems for t in trees for c in range(1, len(conditions))]
     df = seed_rows(seeds, keys, row)
     first = latex.rows(df)
     V = np.stack([latex.by_seed(df, m) for m in models], axis=-1)  # [S, R, M]
     best = [seedstats.decided_best(V[:, i, :]) for i in range(len(first))]
-    splits = TEXT["tab_transfer_splits"]
     wind = [
         f"{tree_label(r.tree, r.bones)}, {condition_label(r.condition)}" for r in first.itertuples()
     ]
-    index = pd.MultiIndex.from_arrays(
-        [[splits[x] for x in first["split"]], wind], names=["Split", "Tree / unseen wind"]
-    )
+    split = first["split"].map(TEXT["tab_transfer_splits"])
+    index = pd.MultiIndex.from_arrays([split, wind], names=["Split", "Tree / unseen wind"])
 
-    def head(m):  # (its field family's heading over the family's columns, or "", its short name)
-        spec = spec_of(m)
-        return FAMILY_HEADS.get(spec.family, "") if spec.role == "field" else "", spec.short
-
+    # a field family's heading over the family's columns, and each model's short name
+    family = lambda spec: FAMILY_HEADS.get(spec.family, "") if spec.role == "field" else ""
+    heads = {m: (family(spec_of(m)), spec_of(m).short) for m in models}
     fmt = f".{int(digits)}f"
-    cells = pd.DataFrame({head(m): latex.cells(df, m, fmt) for m in models}, index=index)
-    cap = _caption("tab_transfer", n_seeds=len(seeds))
+    cells = pd.DataFrame({heads[m]: latex.cells(df, m, fmt) for m in models}, index=index)
     bold = np.arange(len(models)) == np.array([-1 if b is None else b for b in best])[:, None]
-    return Table("tab_transfer", df, latex.render(cells, cap, "tab:transfer", bold))
+    return _table("tab_transfer", df, cells, n_seeds=len(seeds), bold=bold)
 
 
 def tab_margin(
@@ -351,7 +328,7 @@ def tab_margin(
     trees: Sequence[str],
     bones: Mapping[str, int],
     conditions: Sequence[float],
-    priors: Sequence[str] = ("ours",),
+    priors: Sequence[str] = (PAPER_MODEL,),
     baseline: str = "mlp_wind",
     digits: int = 2,
 ) -> Table:
@@ -384,23 +361,14 @@ def tab_margin(
     df = seed_rows(seeds, [(p, t) for p in priors for t in trees], row)
     first = latex.rows(df)
     fmt = f".{int(digits)}f"
-    index = pd.MultiIndex.from_arrays(
-        [
-            [rf"{label(p)} $-$ (Deformation MLP $+$\,wind)" for p in first["model"]],
-            [tree_label(t, b) for t, b in zip(first["tree"], first["bones"])],
-        ]
-    )
-    cells = pd.DataFrame(
-        {
-            condition_label(mult): latex.cells(df, col[mult], fmt, cell=seedstats.difference)
-            for mult in conditions
-        },
-        index=index,
-    )
-    others = ", ".join(label(p) for p in priors if p != "ours")
+    minus = [rf"{label(p)} $-$ (Deformation MLP $+$\,wind)" for p in first["model"]]
+    at = [tree_label(t, b) for t, b in zip(first["tree"], first["bones"])]
+    margin = lambda x: latex.cells(df, col[x], fmt, cell=seedstats.difference)
+    index = pd.MultiIndex.from_arrays([minus, at])
+    cells = pd.DataFrame({condition_label(x): margin(x) for x in conditions}, index=index)
+    others = ", ".join(label(p) for p in priors if p != PAPER_MODEL)
     more = "tab_margin_others" if others else ""
-    cap = _caption("tab_margin", more, n_seeds=len(seeds), others=others)
-    return Table("tab_margin", df, latex.render(cells, cap, "tab:margin"))
+    return _table("tab_margin", df, cells, more, n_seeds=len(seeds), others=others)
 
 
 # ---- the tables' declarations --------------------------------------------------------------
@@ -428,21 +396,12 @@ def _fit_settings(cfg):
 
 
 def _tab_fit(path, settings, inputs, out):
-    n, every, blind = (
-        int(settings["n_train"]),
-        int(settings["holdout_every"]),
-        settings.get("blind", []),
-    )
-    config = {m: BASE_CONFIG for m in models_of(*METHODS, *REFERENCES)}
-    config |= {m: BLIND_CONFIG for m in blind}
-    rows = {
-        s: {
-            (t, m): fit_row(path("eval", t, m, c, s), path("loss", t, m, c, s), n, every)
-            for t in settings["trees"]
-            for m, c in config.items()
-        }
-        for s in settings["seeds"]
-    }
+    n, every = int(settings["n_train"]), int(settings["holdout_every"])
+    blind = settings.get("blind", [])  # in BLIND_CONFIG, the others in BASE_CONFIG
+    config = dict.fromkeys(models_of(*METHODS, *REFERENCES), BASE_CONFIG)
+    config |= dict.fromkeys(blind, BLIND_CONFIG)
+    fit = lambda *job: fit_row(path("eval", *job), path("loss", *job), n, every)
+    rows = _per_seed(settings, config, fit)
     models, reference = (*models_of(*METHODS), *blind), models_of(*REFERENCES)[0]
     at = settings["trees"], settings["bones"], models, reference, settings["digits"]
     return tab_fit(rows, *at, holdout_every=every)
@@ -504,14 +463,9 @@ def teaser_tree(trees: Sequence[str], roles: dict | None = None) -> str:
 def _fig_temporal(path, settings, inputs, out):
     from physgs.report import figures  # matplotlib: not for the workflow's planning imports
 
-    seeds = settings["seeds"]
-    curves = {
-        (t, m): np.stack(
-            [load_eval(path("eval", t, m, BASE_CONFIG, s)).temporal_psnr for s in seeds]
-        )
-        for t in settings["trees"]
-        for m in models_of(*METHODS, *REFERENCES)
-    }
+    shown = dict.fromkeys(models_of(*METHODS, *REFERENCES), BASE_CONFIG)
+    runs = _per_seed(settings, shown, lambda *job: load_eval(path("eval", *job)).temporal_psnr)
+    curves = {k: np.stack([run[k] for run in runs.values()]) for k in next(iter(runs.values()))}
     figures.fig_temporal(curves, settings["trees"], int(settings["n_train"]), out)
 
 
@@ -539,7 +493,7 @@ def _fig_results(path, settings, inputs, out):
         for split in ("time", "view", "wind"):
             row = f"{t}: unseen {split}"
             rows.append(row)
-            images[(row, "gt")] = (panels["ours"][f"{split}_gt"], None)
+            images[(row, "gt")] = (panels[PAPER_MODEL][f"{split}_gt"], None)
             for m in models:
                 images[(row, m)] = (panels[m][f"{split}_pred"], float(panels[m][f"{split}_psnr"]))
     figures.fig_results(rows, ["gt", *models], images, out)

@@ -28,22 +28,17 @@ def fig_stabilisation(
         outputs: the paths to write (pdf, png).
         title: the figure's title.
     """
-    import matplotlib.pyplot as plt
     from matplotlib.lines import Line2D
 
-    from physgs.report.figures import FONT_PT, PAGE_WIDTH_IN, _legend_below, _texts, save_figure
+    from physgs.report.figures import _axes, _finish, _texts
 
-    fig, axes = plt.subplots(
-        2, len(trees), figsize=(PAGE_WIDTH_IN, 4.6), sharex="col", squeeze=False,
-        gridspec_kw={"height_ratios": [4, 1]},
-    )  # fmt: skip
+    fig, axes = _axes(2, len(trees), 4.6, sharex="col", gridspec_kw={"height_ratios": [4, 1]})
     for j, t in enumerate(trees):
-        ax, strip = axes[0, j], axes[1, j]
-        st, m = idents[t].modes.stab, idents[t].modes
+        (ax, strip), st, m = axes[:, j], idents[t].modes.stab, idents[t].modes
         orders = np.broadcast_to(st.orders[None, :], st.freq_hz.shape)
-        ok = np.isfinite(st.freq_hz)
-        ax.scatter(st.freq_hz[ok & ~st.stable], orders[ok & ~st.stable], s=3, c="0.75")
-        ax.scatter(st.freq_hz[ok & st.stable], orders[ok & st.stable], s=5, c="C0")
+        for poles, size, c in ((~st.stable, 3, "0.75"), (st.stable, 5, "C0")):
+            shown = np.isfinite(st.freq_hz) & poles
+            ax.scatter(st.freq_hz[shown], orders[shown], s=size, c=c)
         for f in m.freq_hz:
             ax.axvline(f, c="C3", lw=0.8)
         if m.n_modes:
@@ -53,23 +48,18 @@ def fig_stabilisation(
                 m.freq_hz, top, xerr=1.96 * np.nan_to_num(m.freq_std), fmt="v", c="C3", ms=4,
                 capsize=3, lw=1.0,
             )  # fmt: skip
-        _texts(ax, f"{t}: {m.n_modes} modes")
+        _texts(ax, f"{t}: {m.n_modes} modes", ylabel="model order" if j == 0 else None)
         fb = np.asarray(omega_bones[t], float) / (2 * np.pi)
         strip.vlines(fb, 0, 1, colors="k", lw=0.8)
-        strip.set_yticks([])
-        strip.set_xlim(0, max(MIN_FREQ_AXIS_HZ, 1.2 * float(fb.max(initial=0.0))))
+        strip.set(yticks=[], xlim=(0, max(MIN_FREQ_AXIS_HZ, 1.2 * float(fb.max(initial=0.0)))))
         _texts(strip, xlabel="frequency (Hz)", ylabel="bones" if j == 0 else None)
-    axes[0, 0].set_ylabel("model order", fontsize=FONT_PT)
-    if title:
-        fig.suptitle(title, fontsize=FONT_PT)
     handles = [
         Line2D([], [], ls="", marker="o", ms=3, c="0.75", label="pole"),
         Line2D([], [], ls="", marker="o", ms=3, c="C0", label="stable pole"),
         Line2D([], [], c="C3", lw=0.8, marker="v", ms=4, label="mode, 95% interval"),
         Line2D([], [], c="k", lw=0.8, label="a bone's true frequency"),
     ]
-    _legend_below(fig, handles, ncol=4, top=0.1)
-    save_figure(fig, outputs, dpi=150)
+    _finish(fig, outputs, title, key=handles, dpi=150)
 
 
 # ---- the declaration -----------------------------------------------------------------------

@@ -12,6 +12,7 @@ import numpy as np
 import pandas as pd
 
 from physgs.intermediate import read_json
+from physgs.models.registry import PAPER_MODEL
 from physgs.report import latex
 from physgs.report.output import Columns, Output, key
 from physgs.report.recovery import _label_with_k
@@ -93,34 +94,26 @@ def tab_tracks(
     keys = [(t, c) for t in trees for c in configs]
     seeds = seeds_of(per_seed, "tab_tracks", keys)
 
-    def one(s, t, c):
-        about = {"tree": t, "bones": bones[t], "config": c, "conditions": configs[c]["conditions"]}
-        return about | _row(per_seed[s][(t, c)], conditions)
-
-    df = seed_rows(seeds, keys, one)
-    col, fmt = partial(latex.cells, df), f".{int(digits)}f"
-
-    def both(a: str, b: str) -> list[str]:  # 'median / 90th percentile'
-        return [f"{x} / {y}" for x, y in zip(col(a, fmt), col(b, fmt))]
-
-    n, kept, est, k = (
-        col(c, ".0f", cell=latex.mean, scale=f)
-        for c, f in (("n_tracks", 1), ("share_kept", 100), ("parts_estimated", 1), ("K", 1))
-    )
-    columns = {
-        ("Tracker", "Tracks (kept)"): [f"{a} ({b}\\%)" for a, b in zip(n, kept)],
-        ("Tracker", "Error (px)"): both("track_median_px", "track_p90_px"),
-        ("Tracker", r"Displ.\ (px)"): both("disp_median_px", "disp_p90_px"),
-        ("Fit", "Parts"): [f"{a}/{b}" for a, b in zip(est, k)],
+    about = lambda t, c: dict(tree=t, bones=bones[t], config=c, conditions=configs[c]["conditions"])
+    df = seed_rows(seeds, keys, lambda s, t, c: about(t, c) | _row(per_seed[s][(t, c)], conditions))
+    col = lambda c, fmt=f".{int(digits)}f", **kw: pd.Series(latex.cells(df, c, fmt, **kw))
+    mean = partial(col, fmt=".0f", cell=latex.mean)  # counts and shares: no sd
+    kept = mean("n_tracks") + " (" + mean("share_kept", scale=100) + r"\%)"
+    columns = {  # a 'median / 90th percentile' pair in one cell
+        ("Tracker", "Tracks (kept)"): kept,
+        ("Tracker", "Error (px)"): col("track_median_px") + " / " + col("track_p90_px"),
+        ("Tracker", r"Displ.\ (px)"): col("disp_median_px") + " / " + col("disp_p90_px"),
+        ("Fit", "Parts"): mean("parts_estimated") + "/" + mean("K"),
         ("Fit", "s"): col("fit_s", ".0f"),
         ("Fit", "ours (s)"): col("ours_train_s", ".0f"),
     }
     winds = [f"wind {condition_label(float(c))}" for c in conditions[1:]]
     for head, stem in zip(["beyond the window", *winds], _stems(conditions)):
         for suffix, who in WHO.items():
-            columns[(f"{head} (px)", who)] = col(f"{stem}{suffix}_px", fmt)
+            columns[(f"{head} (px)", who)] = col(f"{stem}{suffix}_px")
     rows = [(tree_label(t, bones[t]), configs[c]["label"]) for t, c in keys]
-    cells = pd.DataFrame(columns, index=pd.MultiIndex.from_tuples(rows, names=["Tree", "Config"]))
+    index = pd.MultiIndex.from_tuples(rows, names=["Tree", "Config"])
+    cells = pd.DataFrame(columns).set_axis(index)
     joint = ", ".join(c.replace("_", r"\_") for c in configs if configs[c]["conditions"] != "train")
     cap = caption("tab_tracks", *(["tab_tracks_joint"] if joint else []), joint=joint)
     cap += latex.seed_note(len(seeds), decides=False)
@@ -149,11 +142,9 @@ def fig_tracks(
     """
     import matplotlib.pyplot as plt
 
-    from physgs.report.figures import FONT_PT, PAGE_WIDTH_IN, save_figure
+    from physgs.report.figures import PAGE_WIDTH_IN, _axes, _finish, _texts
 
-    fig, axes = plt.subplots(
-        1, len(trees), figsize=(PAGE_WIDTH_IN, PAGE_WIDTH_IN / len(trees) + 0.9), squeeze=False
-    )
+    fig, axes = _axes(1, len(trees), PAGE_WIDTH_IN / len(trees) + 0.9)
     cmap = plt.get_cmap("tab20")
     for ax, t in zip(axes[0], trees):
         tr, lab = tracks[t], labels.get(t)
@@ -167,24 +158,17 @@ def fig_tracks(
         s0 = tr.start == 0
         kept = float(tr.valid[s0, -1].mean()) if s0.any() else 0.0
         fitted = 0 if lab is None else int((np.asarray(lab) >= 0).sum())
-        ax.set_title(
-            f"{t}: {tr.n_tracks} tracks\n{100 * kept:.0f}% of frame 0's kept, {fitted} in parts",
-            fontsize=FONT_PT,
-        )
-        ax.set_xlabel("x (px)", fontsize=FONT_PT)  # the frame's own pixels are the scale
-        ax.tick_params(labelsize=FONT_PT)
-    axes[0, 0].set_ylabel("y (px)", fontsize=FONT_PT)
-    if title:
-        fig.suptitle(title, fontsize=FONT_PT)
-    fig.tight_layout()
-    save_figure(fig, outputs, dpi=150)
+        head = f"{t}: {tr.n_tracks} tracks\n{100 * kept:.0f}% of frame 0's kept, {fitted} in parts"
+        # the frame's own pixels are the scale
+        _texts(ax, head, "x (px)", "y (px)" if ax is axes[0, 0] else None)
+    _finish(fig, outputs, title, dpi=150)
 
 
 # ---- the declarations ----------------------------------------------------------------------
 def _tab_tracks_needs(plan, seeds):
     """Per tree, configuration and seed: the evaluation record, ours' loss log (training
     seconds) and, for ``plan.tracks_fields``, the fields' scores."""
-    each = (("tracks_eval", ()), ("loss", ("ours",)))  # the record, ours' loss log
+    each = (("tracks_eval", ()), ("loss", (PAPER_MODEL,)))  # the record, ours' loss log
     mine = product([int(s) for s in seeds], plan.trees, plan.tracks)
     out = [(k, t, *m, c, s) for s, t, c in mine for k, m in each]
     return out + [("tracks_fields", t, c, int(s)) for s in seeds for t, c in plan.tracks_fields]
@@ -203,7 +187,8 @@ def _tab_tracks(path, settings, inputs, out):
         if key(("tracks_fields", t, c, s)) in inputs:  # {case: {field: errors}}
             for case, f in read_json(path("tracks_fields", t, c, s), rule="tracks_fields").items():
                 sc[case]["fields"] = f
-        sc["ours_train_s"] = float(pd.read_csv(path("loss", t, "ours", c, s))["seconds"].iloc[-1])
+        loss = pd.read_csv(path("loss", t, PAPER_MODEL, c, s))
+        sc["ours_train_s"] = float(loss["seconds"].iloc[-1])
         return sc
 
     trees, configs, seeds = settings["trees"], settings["configs"], settings["seeds"]

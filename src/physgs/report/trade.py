@@ -20,31 +20,35 @@ from physgs.report.thresholds import FIT_BAR
 SPEED_ACCURACY, FIT_CURVE = "speed_accuracy", "fit_curve"
 
 
-def _studies(name: str, needs, build, **kw) -> Output:
-    """A figure of the studies' seeds that the `studies` target builds (Snakefile)."""
-    return Output(name, "figure", needs, build, seeds="studies", in_report=lambda plan: False, **kw)
+def _studies(name: str, study: str, draw, needs=lambda plan, seeds: [], **kw) -> Output:
+    """A figure of the studies' seeds that the `studies` target builds (Snakefile), drawn by
+    ``draw(df, out, path, settings)`` from its study's CSV ``df`` (need ``("table", study)``, then
+    ``needs``)."""
+
+    def build(path, settings, inputs, out):
+        draw(pd.read_csv(path("table", study)), out, path, settings)
+
+    every = lambda plan, seeds: [("table", study), *needs(plan, seeds)]
+    return Output(name, "figure", every, build, seeds="studies", in_report=lambda p: False, **kw)
 
 
-def _speed_accuracy_needs(plan, seeds):
-    """The sweep's CSV and, per study seed, the untrained null of the sweep tree at the base
-    configuration's K (the recovery panel's chance level)."""
-    K = int(plan.configs[BASE_CONFIG]["K"])
-    return [("table", SPEED_ACCURACY)] + [("null", plan.sweep_tree, K, int(s)) for s in seeds]
+def _nulls(plan, seeds):
+    """Per study seed, the untrained null of the sweep tree at the base configuration's K (the
+    recovery panel's chance level)."""
+    return [("null", plan.sweep_tree, int(plan.configs[BASE_CONFIG]["K"]), int(s)) for s in seeds]
 
 
-def _fig_speed_accuracy(path, settings, inputs, out):
-    df = pd.read_csv(path("table", SPEED_ACCURACY))
-    K = settings["K"]
-    null = null_level([load_null(path("null", settings["tree"], K, s)) for s in settings["seeds"]])
+def _speed_accuracy(df, out, path, settings):
     from physgs.report import figures  # matplotlib: not for the workflow's planning imports
 
-    figures.fig_speed_accuracy(df, out, null=null)
+    nulls = [load_null(path("null", settings["tree"], settings["K"], s)) for s in settings["seeds"]]
+    figures.fig_speed_accuracy(df, out, null=null_level(nulls))
 
 
-def _fig_fit_curve(path, settings, inputs, out):
+def _fit_curve(df, out, path, settings):
     from physgs.report import figures  # matplotlib: not for the workflow's planning imports
 
-    figures.fig_fit_curve(pd.read_csv(path("table", FIT_CURVE)), out)
+    figures.fig_fit_curve(df, out)
 
 
 def fit_vs_extrapolation(df: pd.DataFrame, static: str = "static") -> pd.DataFrame:
@@ -74,13 +78,11 @@ def draw_fit_vs_extrapolation(df: pd.DataFrame, outputs: Sequence[str]) -> None:
         df: [`fit_vs_extrapolation`][physgs.report.trade.fit_vs_extrapolation]'s rows.
         outputs: the paths to write.
     """
-    import matplotlib.pyplot as plt  # matplotlib: not for the workflow's planning imports
-
-    from physgs.report.figures import COLORS, save_figure
+    from physgs.report.figures import COLORS, _axes, _finish  # matplotlib: not for planning
 
     xy = ["of_ceiling", "beyond_gain"]
     trees = list(dict.fromkeys(df["tree"]))
-    fig, axes = plt.subplots(1, len(trees), figsize=(4.6 * len(trees), 3.9), squeeze=False)
+    fig, axes = _axes(1, len(trees), 3.9, width=4.6 * len(trees))
     for ax, tree in zip(axes[0], trees):
         t = df[(df["tree"] == tree) & ~df["model"].isin(REFERENCE_NAMES)]
         for m, g in t.groupby("model", sort=False):
@@ -93,39 +95,33 @@ def draw_fit_vs_extrapolation(df: pd.DataFrame, outputs: Sequence[str]) -> None:
             ax.plot(prof["of_ceiling"], prof["beyond_gain"], "*", color=color, ms=10)
         ax.axhline(0.0, color="0.55", ls="--", lw=1.0)
         ax.axvline(FIT_BAR, color="k", ls=":", lw=1.0)
-        ax.set_title(f"{tree} ({t['seed'].nunique()} seed(s))")
-        ax.set_xlabel("in-window fraction of the ceiling's gain")
-        ax.set_ylabel("gain over static beyond the window (dB)")
+        ax.set(
+            title=f"{tree} ({t['seed'].nunique()} seed(s))",
+            xlabel="in-window fraction of the ceiling's gain",
+            ylabel="gain over static beyond the window (dB)",
+        )
         ax.grid(alpha=0.3)
     axes[0][0].legend(fontsize=7)
-    fig.suptitle(
+    title = (
         "Does fitting the window more make a field extrapolate worse? (line: the budgets, star: "
-        "the profile's; dotted: the fit bar; dashed: static)",
-        fontsize=9,
+        "the profile's; dotted: the fit bar; dashed: static)"
     )
-    fig.tight_layout()
-    save_figure(fig, outputs)
+    _finish(fig, outputs, title, title_pt=9)
 
 
-def _fig_fit_vs_extrapolation(path, settings, inputs, out):
-    draw_fit_vs_extrapolation(fit_vs_extrapolation(pd.read_csv(path("table", FIT_CURVE))), out)
+def _fit_vs_extrapolation(df, out, path, settings):
+    draw_fit_vs_extrapolation(fit_vs_extrapolation(df), out)
+
+
+def _speed_accuracy_settings(cfg: dict) -> dict:
+    """The sweep's tree and the base configuration's K (its null's)."""
+    K = int(cfg["models"]["configs"][BASE_CONFIG]["K"])
+    return {"tree": cfg["speed_accuracy"]["tree"], "K": K}
 
 
 FIG_SPEED_ACCURACY = _studies(
-    "fig_speed_accuracy",
-    _speed_accuracy_needs,
-    _fig_speed_accuracy,
-    settings=lambda cfg: {
-        "tree": cfg["speed_accuracy"]["tree"],
-        "K": int(cfg["models"]["configs"][BASE_CONFIG]["K"]),
-    },
+    "fig_speed_accuracy", SPEED_ACCURACY, _speed_accuracy, _nulls, settings=_speed_accuracy_settings
 )
-# its CSV holds the studies' seeds' points
-FIG_FIT_CURVE = _studies(
-    "fig_fit_curve", lambda plan, seeds: [("table", FIT_CURVE)], _fig_fit_curve
-)
-FIG_FIT_VS_EXTRAPOLATION = _studies(
-    "fig_fit_vs_extrapolation",
-    lambda plan, seeds: [("table", FIT_CURVE)],
-    _fig_fit_vs_extrapolation,
-)
+# the fit curve's CSV holds the studies' seeds' points
+FIG_FIT_CURVE = _studies("fig_fit_curve", FIT_CURVE, _fit_curve)
+FIG_FIT_VS_EXTRAPOLATION = _studies("fig_fit_vs_extrapolation", FIT_CURVE, _fit_vs_extrapolation)
