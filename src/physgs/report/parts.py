@@ -169,13 +169,10 @@ def fig_parts(records: Mapping, trees: Sequence[str], outputs: Sequence[str], ti
     """
     import matplotlib.pyplot as plt
 
-    from physgs.report.figures import FONT_PT, PAGE_WIDTH_IN, save_figure
+    from physgs.report.figures import _axes, _finish, _texts
 
     cols = max(len(records[t]["models"]) for t in trees)
-    # drawn at the page's width, so FONT_PT text reads at FONT_PT px
-    fig, axes = plt.subplots(
-        len(trees), cols, figsize=(PAGE_WIDTH_IN, 3.0 * len(trees)), squeeze=False
-    )
+    fig, axes = _axes(len(trees), cols, 3.0 * len(trees))  # the page's width: FONT_PT reads true
     cmap = plt.get_cmap("tab20")
     for r, t in enumerate(trees):
         rec, xyz = records[t], records[t]["xyz"]
@@ -187,21 +184,12 @@ def fig_parts(records: Mapping, trees: Sequence[str], outputs: Sequence[str], ti
                 q = par[p]
                 ax.plot([piv[p, 0], piv[q, 0]], [piv[p, 2], piv[q, 2]], "k-", lw=0.7)
             ax.plot(piv[:, 0], piv[:, 2], "k.", ms=3)
-            ax.set_title(
-                f"{t}: {label(m)}\nK={lab.max() + 1}, purity {float(rec[f'{m}/overall']):.2f}",
-                fontsize=FONT_PT,
-            )
+            head = f"{t}: {label(m)}\nK={lab.max() + 1}, purity {float(rec[f'{m}/overall']):.2f}"
+            _texts(ax, head, "x (m)", "height z (m)" if j == 0 else None)
             ax.set_aspect("equal")
-            ax.tick_params(labelsize=FONT_PT)
-            ax.set_xlabel("x (m)", fontsize=FONT_PT)
-            if j == 0:
-                ax.set_ylabel("height z (m)", fontsize=FONT_PT)
         for j in range(len(rec["models"]), cols):
             axes[r, j].axis("off")
-    if title:
-        fig.suptitle(title, fontsize=FONT_PT)
-    fig.tight_layout()
-    save_figure(fig, outputs, dpi=150)
+    _finish(fig, outputs, title, dpi=150)
 
 
 def tab_parts_k(
