@@ -791,3 +791,19 @@ def test_a_sentence_of_the_prose_takes_its_clause_only_where_the_field_is_set():
         "keep their verdict (2 claims new in this run, 1 no longer asked), 1 changed:"
     )
     assert all(isinstance(v, (str, list, dict)) for v in PROSE.values())
+
+
+def test_a_folder_without_a_run_says_how_to_make_one_and_a_record_without_its_stamp_is_refused(
+    tmp_path,
+):
+    """An empty folder gets the unrecorded index; a record's files without stamp.json are an
+    error, never silently laid out as "no run yet"."""
+    import shutil
+
+    (written,) = record.render_pages(tmp_path / "empty")
+    assert written.read_text() == record.PROSE["unrecorded"]
+    copy = tmp_path / "record"
+    shutil.copytree(RECORD, copy)
+    (copy / "stamp.json").unlink()
+    with pytest.raises(FileNotFoundError, match="stamp.json"):
+        record.render_pages(copy)

@@ -582,9 +582,12 @@ def render_pages(record_dir: str | Path) -> list[Path]:
 
     Raises:
         KeyError: naming a figure without a caption (``physgs.report.captions``).
+        FileNotFoundError: for a folder that holds a run's claims or tables but no stamp.
     """
     out = Path(record_dir)
     if not (out / "stamp.json").is_file():
+        if (out / "claims.csv").exists() or (out / "tables").exists():  # a record lost its stamp
+            raise FileNotFoundError(f"{out / 'stamp.json'}: a record's files without its stamp")
         out.mkdir(parents=True, exist_ok=True)
         (out / "index.md").write_text(PROSE["unrecorded"])
         return [out / "index.md"]
