@@ -74,3 +74,11 @@ def test_best_baseline():
         "ours": {"time": 28.0},
     }
     assert FG.best_baseline(s) == "d3dgs"
+
+
+def test_fig_results_names_the_panel_without_an_image(tmp_path):
+    img = np.ones((8, 8, 3))
+    images = {("r", "gt"): (img, None), ("r", "ours"): (img, 25.0)}  # no ("r", "mlp")
+    with pytest.raises(KeyError, match="no image for row 'r', column 'mlp'"):
+        FG.fig_results(["r"], ["gt", "ours", "mlp"], images, [tmp_path / "q.png"])
+    assert not (tmp_path / "q.png").exists()

@@ -262,13 +262,14 @@ def fig_results(
     Raises:
         KeyError: when a panel has no image.
     """
+    for r, c in product(rows, columns):  # before drawing: each row's scores read every column
+        if (r, c) not in images:
+            raise KeyError(f"fig_results: no image for row {r!r}, column {c!r}")
     side = PAGE_WIDTH_IN / (len(columns) + 0.3)  # one panel, inches; the row labels beside
     fig, axes = _axes(len(rows), len(columns), side * len(rows) + 0.5)
     box = dict(facecolor="white", alpha=0.8, lw=0, pad=1)
     for (i, r), (j, c) in product(enumerate(rows), enumerate(columns)):
         scores = {x: images[(r, x)][1] for x in columns if images[(r, x)][1] is not None}
-        if (r, c) not in images:
-            raise KeyError(f"fig_results: no image for row {r!r}, column {c!r}")
         img, score = images[(r, c)]
         ax, mine = axes[i, j], scores.get(ours)
         ax.imshow(np.asarray(img), interpolation="nearest")
