@@ -282,7 +282,8 @@ def _rerun_page(
         heads = PROSE["rerun_verdict_heads"][: 6 if first else 5]
         verdicts = [
             (f"`{v.id}`: {v.claim}", f"{v.old}, {v.old_value}", f"**{v.new}**, {v.new_value}")
-            + (v.threshold, v.overlap, v.alone)[: len(heads) - 3]
+            + (v.threshold, v.overlap)
+            + ((v.alone,) if first else ())
             for v in c.changed
         ]
         overlap = say("rerun_overlap", n=n, yes=k["yes"], no=k["no"], none=k["--"])
