@@ -11,6 +11,16 @@ splits: this is what recipe settings are chosen on.
 
 ``--set KEY.PATH=VALUE`` overrides any config key. The recipe log in docs/models.md lists what
 each candidate bought.
+
+``--capacity`` asks what the oscillator prior's parts can hold of the tree's true motion
+(``physgs.models.capacity``; a diagnostic of a shortfall, no setting is chosen on it): after
+static, the ceiling and ours train, ours' parts are fitted to the ceiling's true trajectories
+over the window, as rigid turns with a free angle per frame and with one oscillator each (the
+best of a grid over ours' bounds, driven by the measured wind); each motion is held while the
+appearance trains as the ceiling's does (from the same start, the same iterations), and is
+scored like the models: the ceiling with ours' parts' motion in place of the true one.
+
+    python benchmarks/fit_recipe.py results/testbed/sparse --capacity
 """
 
 from __future__ import annotations
@@ -21,13 +31,19 @@ import time
 from pathlib import Path
 
 import numpy as np
+import torch
 
 import physgs.config
 from physgs.evaluate.run import training_camera_scores
 from physgs.experiments import fit, job_spec
 from physgs.experiments.recipe import heldout_split
+from physgs.models.gaussians import rotate_parts
+from physgs.models.capacity import PartsAtAngles, oscillator_angles, rigid_part_angles
+from physgs.models.omega_search import unit_responses
+from physgs.models.oscillator_params import condition_vbar
 from physgs.models.registry import is_reference
 from physgs.testbed.dataset import load_observed, load_truth
+from physgs.train.loop import train_model
 
 
 def main(argv: list[str] | None = None) -> None:
@@ -38,7 +54,10 @@ def main(argv: list[str] | None = None) -> None:
     ap.add_argument("--profile", default="default")
     ap.add_argument("--set", action="append", default=[], help="KEY.PATH=VALUE override")
     ap.add_argument("--every", type=int, default=3, help="score every k-th trained frame")
+    ap.add_argument("--capacity", action="store_true", help="ours' parts at the true motion")
     args = ap.parse_args(argv)
+    if args.capacity:
+        args.models = "static,truth_motion,ours"
     cfg = physgs.config.load("config/trees.yaml", args.profile)
     # the same schema and cross-key checks as the config: a bad --set stops here, key named
     cfg = physgs.config.apply_overrides(cfg, args.set)
@@ -49,7 +68,7 @@ def main(argv: list[str] | None = None) -> None:
     trained, held = heldout_split(n, every)
     print(f"# {args.dataset} overrides={args.set}")
     print(f"{'model':14s} {'fit dB':>8s} {'held dB':>8s} {'train s':>8s}")
-    res = {}
+    res, trained_models = {}, {}
     for m in args.models.split(","):
         job = job_spec(copy.deepcopy(cfg), m, "single")
         t0 = time.perf_counter()
@@ -58,7 +77,25 @@ def main(argv: list[str] | None = None) -> None:
         _, p_fit = training_camera_scores(r.model, obs, trained[:: args.every])
         _, p_held = training_camera_scores(r.model, obs, held)
         res[m] = (float(np.mean(p_fit)), float(np.mean(p_held)), wall)
+        trained_models[m] = (r.model, job)
         print(f"{m:14s} {res[m][0]:8.2f} {res[m][1]:8.2f} {wall:8.1f}", flush=True)
+    if args.capacity:
+        for m, model in capacity_models(
+            obs, *trained_models["truth_motion"], trained_models["ours"][0]
+        ):
+            t0 = time.perf_counter()
+            train_model(
+                model,
+                obs,
+                trained_models["ours"][1]["train"],
+                conditions=[0],
+                seed=0,
+                progress=False,
+            )
+            _, p_fit = training_camera_scores(model, obs, trained[:: args.every])
+            _, p_held = training_camera_scores(model, obs, held)
+            res[m] = (float(np.mean(p_fit)), float(np.mean(p_held)), time.perf_counter() - t0)
+            print(f"{m:14s} {res[m][0]:8.2f} {res[m][1]:8.2f} {res[m][2]:8.1f}", flush=True)
     if "static" in res and "truth_motion" in res:
         s, c = res["static"][0], res["truth_motion"][0]
         for m, (f, h, _) in res.items():
@@ -66,6 +103,70 @@ def main(argv: list[str] | None = None) -> None:
                 f"{m:14s} of ceiling: fit {100 * (f - s) / (c - s):5.0f}%  held "
                 f"{100 * (h - res['static'][1]) / (res['truth_motion'][1] - res['static'][1]):5.0f}%"
             )
+
+
+def capacity_models(obs, truth_model, truth_job, prior):
+    """The prior's parts at the true motion: free angles, then one oscillator each. Their
+    canonical sets start as the ceiling's did: only the motion differs.
+
+    Args:
+        obs: the dataset.
+        truth_model: the trained ceiling (its trajectories and appearance).
+        truth_job: its job (the canonical settings).
+        prior: the trained oscillator prior (its parts, bounds, RK4 steps).
+
+    Returns:
+        ``[(name, PartsAtAngles)]``, their canonical sets the ceiling's; the image error (px) of
+            each motion against the truth printed.
+    """
+    n, lead = int(obs.n_train), int(obs.lead_in_frames)
+    wind = torch.as_tensor(np.asarray(obs.wind[0]), dtype=torch.float64)
+    with torch.no_grad():
+        pts = np.stack(
+            [truth_model.gaussians_at(j, wind.float()).means.double().numpy() for j in range(n)]
+        )
+    labels, K = prior.part_labels.cpu().numpy(), int(prior.K)
+    axis = truth_model.swing_axis.double().numpy()
+    free = rigid_part_angles(pts, labels, K, axis)
+    b = prior.bounds  # a grid inset from the bounds (omega, zeta are sigmoids of raw values)
+    om = np.exp(np.linspace(np.log(b.omega_lo), np.log(b.omega_hi), 62)[1:-1])
+    ze = np.linspace(b.zeta_lo, b.zeta_hi, 14)[1:-1]
+    om, ze = np.repeat(om, len(ze)), np.tile(ze, len(om))
+    r = unit_responses(
+        om, ze, wind, condition_vbar(prior.vbar_ratio, wind), prior.dt, prior.substeps
+    )
+    r = r[:, lead : lead + n] - r[:, lead : lead + 1]
+    *_, osc = oscillator_angles(free.theta, r, om, ze)
+    cam, (uv, _) = obs.train_camera, obs.train_camera.project(pts.reshape(-1, 3))
+    uv = uv.reshape(n, -1, 2)
+    out = []
+    for name, theta in (("parts_free", free.theta), ("parts_osc", osc)):
+        m = PartsAtAngles(
+            prior.ctx, truth_job["settings"]["canonical"], labels, axis, free.pivot, theta
+        )
+        x0 = torch.as_tensor(pts[0])  # the motion alone, from the true frame 0
+        q0 = torch.tensor([[1.0, 0.0, 0.0, 0.0]], dtype=torch.float64).expand(len(x0), 4)
+        with torch.no_grad():
+            at = np.stack(
+                [
+                    rotate_parts(
+                        x0,
+                        q0,
+                        m.part_labels,
+                        m.axis.double(),
+                        m.theta[:, j].double(),
+                        m.pivot.double(),
+                    )[0].numpy()
+                    for j in range(n)
+                ]
+            )
+        err = np.linalg.norm(cam.project(at.reshape(-1, 3))[0].reshape(n, -1, 2) - uv, axis=-1)
+        moved = np.linalg.norm(uv - uv[:1], axis=-1)
+        print(
+            f"# {name}: image error {err.mean():.2f} px against a true motion of {moved.mean():.2f} px"
+        )
+        out.append((name, m))
+    return out
 
 
 if __name__ == "__main__":

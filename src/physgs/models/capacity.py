@@ -1,0 +1,220 @@
+"""What the oscillator prior's parts can represent of a tree's true motion, apart from training.
+
+A shortfall of the prior's fit has two possible causes: the descent did not find the motion, or
+the prior cannot hold it. To tell them apart, its parts are fitted to the true Gaussian
+trajectories directly (the testbed's truth, a diagnostic: no setting is chosen on it), in two
+steps of decreasing freedom:
+
+1. **Rigid parts, free angles** ([`rigid_part_angles`][physgs.models.capacity.rigid_part_angles]):
+   each part turns about the true swing axis through one fixed pivot by any angle at each frame.
+   For a fixed pivot the least-squares angle of a frame is closed-form (a 2-D Procrustes turn in
+   the plane normal to the axis); the pivot is searched by Nelder-Mead.
+2. **One oscillator per part** ([`oscillator_angles`][physgs.models.capacity.oscillator_angles]):
+   each part's free angle replaced by the single damped oscillator's response to the measured
+   wind that fits it best ([`project_to_oscillators`][physgs.models.omega_search.project_to_oscillators]),
+   the prior's own constraint. A part's true angle is its bone's and its ancestors', a sum of
+   several modes, which one oscillator follows only in part.
+
+``benchmarks/fit_recipe.py --capacity`` renders both through the prior with its appearance
+trained and its motion held, beside the prior trained as the pipeline trains it.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+import torch
+from scipy.optimize import minimize
+
+from physgs.models.base import BaseModel, ModelContext
+from physgs.models.gaussians import GaussianState, rotate_parts
+
+
+@dataclass(frozen=True)
+class PartAngles:
+    """Parts fitted as rigid turns about one axis (``rigid_part_angles``).
+
+    Attributes:
+        pivot: [K, 3] each part's pivot (world units; on the axis through it, the part's mean
+            coordinate along the axis). NaN for a part without points.
+        theta: [K, T] each part's angle at each frame, rad, relative to frame 0 (theta[:, 0] = 0).
+        fitted: [T, N, 3] the points moved by their part's turn.
+    """
+
+    pivot: np.ndarray
+    theta: np.ndarray
+    fitted: np.ndarray
+
+
+def plane_basis(axis: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """A right-handed orthonormal frame ``(e1, e2, a)`` with ``a`` along ``axis``.
+
+    Args:
+        axis: [3] the swing axis (any length > 0).
+
+    Returns:
+        ``(e1, e2, a)``, [3] each: a turn by +theta about ``a`` takes e1 towards e2.
+    """
+    a = np.asarray(axis, dtype=np.float64)
+    a = a / np.linalg.norm(a)
+    e1 = np.cross(a, [1.0, 0.0, 0.0] if abs(a[0]) < 0.9 else [0.0, 1.0, 0.0])
+    e1 /= np.linalg.norm(e1)
+    return e1, np.cross(a, e1), a
+
+
+def _turn(y: np.ndarray, y0: np.ndarray, q: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Each frame's least-squares angle about in-plane pivot ``q`` and the points it moves.
+
+    Args:
+        y: [T, n, 2] the points' in-plane positions over the frames.
+        y0: [n, 2] their positions at frame 0.
+        q: [2] the pivot.
+
+    Returns:
+        ``(theta [T] rad, moved [T, n, 2])``.
+    """
+    u, v = y0 - q, y - q
+    cos = (v * u).sum((1, 2))
+    sin = (u[None, :, 0] * v[..., 1] - u[None, :, 1] * v[..., 0]).sum(1)
+    th = np.arctan2(sin, cos)
+    c, s = np.cos(th)[:, None], np.sin(th)[:, None]
+    moved = np.stack([c * u[:, 0] - s * u[:, 1], s * u[:, 0] + c * u[:, 1]], -1) + q
+    return th, moved
+
+
+def rigid_part_angles(points: np.ndarray, labels: np.ndarray, K: int, axis) -> PartAngles:
+    """Each part's best fixed pivot and per-frame angle about ``axis`` for true trajectories.
+
+    Args:
+        points: [T, N, 3] the points' true positions over T frames (frame 0 the reference).
+        labels: [N] each point's part, in [0, K).
+        K: the number of parts.
+        axis: [3] the swing axis every part turns about.
+
+    Returns:
+        The [`PartAngles`][physgs.models.capacity.PartAngles]. A point's motion along the axis
+            is not a turn's: it is kept as it is at frame 0.
+
+    Raises:
+        ValueError: when the shapes disagree or a label is outside [0, K).
+    """
+    x = np.asarray(points, dtype=np.float64)
+    lab = np.asarray(labels)
+    if x.ndim != 3 or x.shape[2] != 3 or lab.shape != (x.shape[1],):
+        raise ValueError(f"points [T, N, 3] and labels [N]; got {x.shape} and {lab.shape}")
+    if lab.size and (lab.min() < 0 or lab.max() >= K):
+        raise ValueError(f"labels must lie in [0, {K})")
+    e1, e2, a = plane_basis(axis)
+    y = np.stack([x @ e1, x @ e2], -1)  # [T, N, 2]
+    along = x[0] @ a  # [N]
+    pivot = np.full((K, 3), np.nan)
+    theta = np.zeros((K, x.shape[0]))
+    moved = np.empty_like(y)
+    for p in range(K):
+        i = lab == p
+        if not i.any():
+            continue
+        yp, y0 = y[:, i], y[0, i]
+
+        def cost(q, yp=yp, y0=y0):
+            return float(((_turn(yp, y0, q)[1] - yp) ** 2).sum())
+
+        # the part's centre and its two ends across the plane: a pivot off the part is common
+        starts = (y0.mean(0), y0[np.argmin(y0[:, 1])], y0[np.argmax(y0[:, 1])])
+        fits = [
+            minimize(cost, s, method="Nelder-Mead", options={"xatol": 1e-9, "fatol": 1e-14})
+            for s in starts
+        ]
+        q = min(fits, key=lambda r: r.fun).x
+        theta[p], moved[:, i] = _turn(yp, y0, q)
+        pivot[p] = q[0] * e1 + q[1] * e2 + along[i].mean() * a
+    fitted = moved[..., :1] * e1 + moved[..., 1:] * e2 + along[None, :, None] * a
+    return PartAngles(pivot, theta, fitted)
+
+
+def oscillator_angles(
+    theta: np.ndarray, responses: np.ndarray, omega: np.ndarray, zeta: np.ndarray
+) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+    """Each part's free angle replaced by the one oscillator of a grid that fits it best.
+
+    Args:
+        theta: [K, T] free angles relative to frame 0, rad (``PartAngles.theta``).
+        responses: [G, T] the grid's unit-gain responses to the wind at the same frames, each
+            relative to its value at frame 0 (the angles' reference).
+        omega: [G] the grid's natural frequencies, rad/s.
+        zeta: [G] its damping ratios.
+
+    Returns:
+        ``(omega [K], zeta [K], gain [K], theta [K, T])``: each part's oscillator and the angle
+            it gives (gain x its response).
+    """
+    from physgs.models.omega_search import project_to_oscillators
+
+    om, ze, gain, _ = project_to_oscillators(theta, responses, omega, zeta)
+    rr = np.einsum("gs,gs->g", responses, responses)
+    best = np.argmax((theta @ responses.T) ** 2 / rr, axis=1)  # the grid point each part took
+    return om, ze, gain, gain[:, None] * responses[best]
+
+
+class PartsAtAngles(BaseModel):
+    """Rigid parts turned by given angles: the canonical set (frame 0) turned part by part about
+    one axis by ``theta[:, j]`` at recorded frame j. Only its appearance trains; it predicts the
+    frames its angles cover, under the wind they were fitted to.
+    """
+
+    name = "parts_at_angles"
+
+    def __init__(self, ctx: ModelContext, canonical_cfg: dict, labels, axis, pivot, theta):
+        """Hold the parts' motion as buffers.
+
+        Args:
+            ctx: the observed-dataset facts (its canonical positions: frame 0's).
+            canonical_cfg: config ``models.canonical``.
+            labels: [N] each Gaussian's part, in [0, K).
+            axis: [3] the axis every part turns about.
+            pivot: [K, 3] each part's pivot, world units (NaN for a part without Gaussians).
+            theta: [K, F] each part's angle at recorded frames 0 .. F-1, rad, relative to frame 0.
+        """
+        super().__init__(ctx, canonical_cfg)
+        theta = torch.as_tensor(np.asarray(theta), dtype=torch.float32)
+        K = theta.shape[0]
+        a = torch.as_tensor(plane_basis(axis)[2], dtype=torch.float32)
+        self.register_buffer("part_labels", torch.as_tensor(np.asarray(labels)).long())
+        self.register_buffer("axis", a.expand(K, 3).clone())
+        self.register_buffer("pivot", torch.nan_to_num(torch.as_tensor(pivot).float()))
+        self.register_buffer("theta", theta)
+
+    def defined(self, frame_idx: int, condition: int) -> bool:
+        """Whether ``frame_idx`` is among the frames the angles cover (condition 0's only).
+
+        Args:
+            frame_idx: recorded frame, 0-based.
+            condition: wind condition index.
+
+        Returns:
+            True for condition 0 and frame_idx < F.
+        """
+        return condition == 0 and frame_idx < self.theta.shape[1]
+
+    def deform(self, frame_idx: int, wind: torch.Tensor) -> GaussianState:
+        """The canonical set turned part by part by its angles at ``frame_idx``.
+
+        Args:
+            frame_idx: recorded frame, 0-based (< F).
+            wind: [L+F] the observed wind, m/s (not read: the angles were fitted under it).
+
+        Returns:
+            The turned Gaussians.
+        """
+        c = self.canonical
+        means, quats = rotate_parts(
+            c.means, c.quats, self.part_labels, self.axis, self.theta[:, frame_idx], self.pivot
+        )
+        return GaussianState(
+            means,
+            quats,
+            torch.exp(c.log_scales),
+            torch.sigmoid(c.opacity_logits),
+            torch.sigmoid(c.color_logits),
+        )
