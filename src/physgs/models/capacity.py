@@ -83,7 +83,9 @@ def _turn(y: np.ndarray, y0: np.ndarray, q: np.ndarray) -> tuple[np.ndarray, np.
     return th, moved
 
 
-def rigid_part_angles(points: np.ndarray, labels: np.ndarray, K: int, axis) -> PartAngles:
+def rigid_part_angles(
+    points: np.ndarray, labels: np.ndarray, K: int, axis: np.ndarray
+) -> PartAngles:
     """Each part's best fixed pivot and per-frame angle about ``axis`` for true trajectories.
 
     Args:
@@ -165,7 +167,15 @@ class PartsAtAngles(BaseModel):
 
     name = "parts_at_angles"
 
-    def __init__(self, ctx: ModelContext, canonical_cfg: dict, labels, axis, pivot, theta):
+    def __init__(
+        self,
+        ctx: ModelContext,
+        canonical_cfg: dict,
+        labels: np.ndarray,
+        axis: np.ndarray,
+        pivot: np.ndarray,
+        theta: np.ndarray,
+    ):
         """Hold the parts' motion as buffers.
 
         Args:
