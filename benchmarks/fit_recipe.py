@@ -12,13 +12,15 @@ splits: this is what recipe settings are chosen on.
 ``--set KEY.PATH=VALUE`` overrides any config key. The recipe log in docs/models.md lists what
 each candidate bought.
 
-``--capacity`` asks what the oscillator prior's parts can hold of the tree's true motion
+``--capacity`` asks what the oscillator priors' parts can hold of the tree's true motion
 (``physgs.models.capacity``; a diagnostic of a shortfall, no setting is chosen on it): after
-static, the ceiling and ours train, ours' parts are fitted to the ceiling's true trajectories
-over the window, as rigid turns with a free angle per frame and with one oscillator each (the
-best of a grid over ours' bounds, driven by the measured wind); each motion is held while the
-appearance trains as the ceiling's does (from the same start, the same iterations), and is
-scored like the models: the ceiling with ours' parts' motion in place of the true one.
+static, the ceiling, ours and the chained prior train, each prior's parts are fitted to the
+ceiling's true trajectories over the window (the chained prior's as a chain, each part on its
+parent's turn), as rigid turns with a free angle per frame (rows ``<prior>_free``) and with one
+oscillator each (``<prior>_osc``: the best of a grid over the prior's bounds, driven by the
+measured wind); each motion is held while the appearance trains as the ceiling's does (from the
+same start, the same iterations), and is scored like the models: the ceiling with the parts'
+motion in place of the true one.
 
     python benchmarks/fit_recipe.py results/testbed/sparse --capacity
 """
@@ -37,8 +39,13 @@ import physgs.config
 from physgs.evaluate.run import training_camera_scores
 from physgs.experiments import fit, job_spec
 from physgs.experiments.recipe import heldout_split
-from physgs.models.gaussians import rotate_parts
-from physgs.models.capacity import PartsAtAngles, oscillator_angles, rigid_part_angles
+from physgs.models.capacity import (
+    PartsAtAngles,
+    chain_turns,
+    oscillator_angles,
+    rigid_part_angles,
+    turned,
+)
 from physgs.models.omega_search import unit_responses
 from physgs.models.oscillator_params import condition_vbar
 from physgs.models.registry import is_reference
@@ -54,10 +61,10 @@ def main(argv: list[str] | None = None) -> None:
     ap.add_argument("--profile", default="default")
     ap.add_argument("--set", action="append", default=[], help="KEY.PATH=VALUE override")
     ap.add_argument("--every", type=int, default=3, help="score every k-th trained frame")
-    ap.add_argument("--capacity", action="store_true", help="ours' parts at the true motion")
+    ap.add_argument("--capacity", action="store_true", help="the priors' parts at the true motion")
     args = ap.parse_args(argv)
     if args.capacity:
-        args.models = "static,truth_motion,ours"
+        args.models = "static,truth_motion,ours,ours_chain"
     cfg = physgs.config.load("config/trees.yaml", args.profile)
     # the same schema and cross-key checks as the config: a bad --set stops here, key named
     cfg = physgs.config.apply_overrides(cfg, args.set)
@@ -79,19 +86,14 @@ def main(argv: list[str] | None = None) -> None:
         res[m] = (float(np.mean(p_fit)), float(np.mean(p_held)), wall)
         trained_models[m] = (r.model, job)
         print(f"{m:14s} {res[m][0]:8.2f} {res[m][1]:8.2f} {wall:8.1f}", flush=True)
-    if args.capacity:
+    priors = ("ours", "ours_chain") if args.capacity else ()
+    for prior in priors:  # each prior's parts at the true motion, trained as the ceiling is
         for m, model in capacity_models(
-            obs, *trained_models["truth_motion"], trained_models["ours"][0]
+            obs, *trained_models["truth_motion"], prior, trained_models[prior][0]
         ):
             t0 = time.perf_counter()
-            train_model(
-                model,
-                obs,
-                trained_models["ours"][1]["train"],
-                conditions=[0],
-                seed=0,
-                progress=False,
-            )
+            train = trained_models[prior][1]["train"]
+            train_model(model, obs, train, conditions=[0], seed=0, progress=False)
             _, p_fit = training_camera_scores(model, obs, trained[:: args.every])
             _, p_held = training_camera_scores(model, obs, held)
             res[m] = (float(np.mean(p_fit)), float(np.mean(p_held)), time.perf_counter() - t0)
@@ -105,19 +107,21 @@ def main(argv: list[str] | None = None) -> None:
             )
 
 
-def capacity_models(obs, truth_model, truth_job, prior):
-    """The prior's parts at the true motion: free angles, then one oscillator each. Their
-    canonical sets start as the ceiling's did: only the motion differs.
+def capacity_models(obs, truth_model, truth_job, prior_id, prior):
+    """The prior's parts at the true motion: free angles, then one oscillator each (a chained
+    prior's parts fitted as a chain). Their canonical sets start as the ceiling's did: only the
+    motion differs.
 
     Args:
         obs: the dataset.
-        truth_model: the trained ceiling (its trajectories and appearance).
+        truth_model: the trained ceiling (its trajectories).
         truth_job: its job (the canonical settings).
+        prior_id: the prior's registry id (names the rows).
         prior: the trained oscillator prior (its parts, bounds, RK4 steps).
 
     Returns:
-        ``[(name, PartsAtAngles)]``, their canonical sets the ceiling's; the image error (px) of
-            each motion against the truth printed.
+        ``[(name, PartsAtAngles)]``; the image error (px) of each motion against the truth
+            printed.
     """
     n, lead = int(obs.n_train), int(obs.lead_in_frames)
     wind = torch.as_tensor(np.asarray(obs.wind[0]), dtype=torch.float64)
@@ -126,8 +130,9 @@ def capacity_models(obs, truth_model, truth_job, prior):
             [truth_model.gaussians_at(j, wind.float()).means.double().numpy() for j in range(n)]
         )
     labels, K = prior.part_labels.cpu().numpy(), int(prior.K)
+    parent = prior.part_parent.cpu().numpy() if getattr(prior, "chain", False) else None
     axis = truth_model.swing_axis.double().numpy()
-    free = rigid_part_angles(pts, labels, K, axis)
+    free = rigid_part_angles(pts, labels, K, axis, parent)
     b = prior.bounds  # a grid inset from the bounds (omega, zeta are sigmoids of raw values)
     om = np.exp(np.linspace(np.log(b.omega_lo), np.log(b.omega_hi), 62)[1:-1])
     ze = np.linspace(b.zeta_lo, b.zeta_hi, 14)[1:-1]
@@ -137,33 +142,21 @@ def capacity_models(obs, truth_model, truth_job, prior):
     )
     r = r[:, lead : lead + n] - r[:, lead : lead + 1]
     *_, osc = oscillator_angles(free.theta, r, om, ze)
-    cam, (uv, _) = obs.train_camera, obs.train_camera.project(pts.reshape(-1, 3))
-    uv = uv.reshape(n, -1, 2)
+    uv = obs.train_camera.project(pts.reshape(-1, 3))[0].reshape(n, -1, 2)
+    moved = np.linalg.norm(uv - uv[:1], axis=-1).mean()
     out = []
-    for name, theta in (("parts_free", free.theta), ("parts_osc", osc)):
-        m = PartsAtAngles(
-            prior.ctx, truth_job["settings"]["canonical"], labels, axis, free.pivot, theta
+    for how, theta in (("free", free.theta), ("osc", osc)):
+        shift = None
+        if parent is not None:  # a chain: each part's total turn and the shift it carries
+            theta, shift = chain_turns(theta, free.pivot, parent, axis)
+        at = turned(pts[0], labels, axis, free.pivot, theta, shift)
+        err = np.linalg.norm(
+            obs.train_camera.project(at.reshape(-1, 3))[0].reshape(n, -1, 2) - uv, axis=-1
         )
-        x0 = torch.as_tensor(pts[0])  # the motion alone, from the true frame 0
-        q0 = torch.tensor([[1.0, 0.0, 0.0, 0.0]], dtype=torch.float64).expand(len(x0), 4)
-        with torch.no_grad():
-            at = np.stack(
-                [
-                    rotate_parts(
-                        x0,
-                        q0,
-                        m.part_labels,
-                        m.axis.double(),
-                        m.theta[:, j].double(),
-                        m.pivot.double(),
-                    )[0].numpy()
-                    for j in range(n)
-                ]
-            )
-        err = np.linalg.norm(cam.project(at.reshape(-1, 3))[0].reshape(n, -1, 2) - uv, axis=-1)
-        moved = np.linalg.norm(uv - uv[:1], axis=-1)
-        print(
-            f"# {name}: image error {err.mean():.2f} px against a true motion of {moved.mean():.2f} px"
+        name = f"{prior_id}_{how}"
+        print(f"# {name}: image error {err.mean():.2f} px against a true motion of {moved:.2f} px")
+        m = PartsAtAngles(
+            prior.ctx, truth_job["settings"]["canonical"], labels, axis, free.pivot, theta, shift
         )
         out.append((name, m))
     return out

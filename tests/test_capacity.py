@@ -8,9 +8,11 @@ from scipy.spatial.transform import Rotation
 
 from physgs.models.capacity import (
     PartsAtAngles,
+    chain_turns,
     oscillator_angles,
     plane_basis,
     rigid_part_angles,
+    turned,
 )
 from physgs.models.base import ModelContext
 
@@ -38,6 +40,7 @@ def test_fixed_pivot_turns_are_recovered_exactly():
     fit = rigid_part_angles(pts, labels, 2, AXIS)
     np.testing.assert_allclose(fit.theta, angles - angles[:, :1], atol=1e-6)
     np.testing.assert_allclose(fit.fitted, pts, atol=1e-6)
+    np.testing.assert_allclose(turned(pts[0], labels, AXIS, fit.pivot, fit.theta), pts, atol=1e-6)
     e1, e2, _ = plane_basis(AXIS)  # a pivot is defined up to its place along the axis
     for p in range(2):
         np.testing.assert_allclose(
@@ -103,3 +106,52 @@ def test_parts_at_angles_turns_its_canonical_set():
 def test_shapes_are_checked():
     with pytest.raises(ValueError, match="labels must lie"):
         rigid_part_angles(np.zeros((2, 3, 3)), np.array([0, 1, 2]), 2, AXIS)
+
+
+def test_a_chain_is_fitted_top_down_and_recomposed():
+    """A child turning about its head on top of its parent's turn: the chain's fit recovers both
+    own angles and every position; chain_turns recomposes the same shifts from the angles, and
+    PartsAtAngles moves its canonical set there."""
+    rng = np.random.default_rng(4)
+    T = 40
+    t = np.arange(T) / 24.0
+    phi_a, phi_b = 0.2 * np.sin(2 * np.pi * 0.5 * t), 0.3 * np.sin(2 * np.pi * 1.7 * t)
+    parent_pivot, head = np.array([0.1, 0.0, 0.0]), np.array([0.2, -0.3, 2.0])
+    xa = rng.normal(size=(30, 3)) * 0.2 + [0.0, 0.0, 1.0]
+    xb = head + rng.normal(size=(30, 3)) * 0.2
+    pts = np.stack(
+        [
+            np.concatenate(
+                [
+                    _turn(xa, phi_a[j], parent_pivot),
+                    _turn(_turn(xb, phi_b[j], head), phi_a[j], parent_pivot),
+                ]
+            )
+            for j in range(T)
+        ]
+    )
+    labels, parent = np.repeat([0, 1], 30), np.array([-1, 0])
+    fit = rigid_part_angles(pts, labels, 2, AXIS, parent=parent)
+    np.testing.assert_allclose(fit.theta, np.stack([phi_a, phi_b]), atol=1e-6)
+    np.testing.assert_allclose(fit.fitted, pts, atol=1e-6)
+    total, shift = chain_turns(fit.theta, fit.pivot, parent, AXIS)
+    np.testing.assert_allclose(total, np.stack([phi_a, phi_a + phi_b]), atol=1e-6)
+    np.testing.assert_allclose(shift, fit.shift, atol=1e-9)
+    np.testing.assert_allclose(
+        turned(pts[0], labels, AXIS, fit.pivot, total, shift), pts, atol=1e-6
+    )
+    ctx = ModelContext(
+        canonical_xyz=pts[0],
+        fps=24,
+        n_train=T,
+        lead_in_frames=0,
+        wind_mean=5.0,
+        wind_std=1.0,
+        wind_force_std=10.0,
+        view_dir=np.array([0.0, 1.0, 0.0]),
+    )
+    m = PartsAtAngles(ctx, {}, labels, AXIS, fit.pivot, total, shift)
+    with torch.no_grad():
+        m.canonical.means.copy_(torch.as_tensor(pts[0]))
+        got = m.gaussians_at(25, torch.zeros(T)).means.double().numpy()
+    np.testing.assert_allclose(got, pts[25], atol=1e-5)

@@ -383,9 +383,9 @@ def test_summary_is_printed_from_the_run(run):
 
 
 def test_fit_recipe_capacity_scores_the_parts_at_the_true_motion(run, monkeypatch, capsys):
-    """`benchmarks/fit_recipe.py --capacity` on the quick DAG's tree: both motions of ours' parts
-    are trained and scored, and the free angles leave no more image error than one oscillator
-    each (the oscillator's angles are among the free ones)."""
+    """`benchmarks/fit_recipe.py --capacity` on the quick DAG's tree: both motions of both priors'
+    parts are trained and scored, and the free angles leave no more image error than one
+    oscillator each (the oscillator's angles are among the free ones)."""
     import sys
 
     monkeypatch.chdir(ROOT)
@@ -395,9 +395,13 @@ def test_fit_recipe_capacity_scores_the_parts_at_the_true_motion(run, monkeypatc
 
     fit_recipe.main([str(run / "results/testbed/sparse"), "--capacity", "--profile", "quick"])
     out = capsys.readouterr().out
-    err = dict(re.findall(r"# (parts_\w+): image error ([\d.]+) px", out))
-    assert set(err) == {"parts_free", "parts_osc"}, out
-    assert float(err["parts_free"]) <= float(err["parts_osc"]) + 0.01, out
-    rows = re.findall(r"^(parts_\w+)\s+([\d.]+)\s+([\d.]+)", out, flags=re.M)
-    assert [r[0] for r in rows] == ["parts_free", "parts_osc"], out
+    err = {
+        k: float(v) for k, v in re.findall(r"# (\w+_(?:free|osc)): image error ([\d.]+) px", out)
+    }
+    names = [f"{p}_{how}" for p in ("ours", "ours_chain") for how in ("free", "osc")]
+    assert sorted(err) == sorted(names), out
+    for p in ("ours", "ours_chain"):
+        assert err[f"{p}_free"] <= err[f"{p}_osc"] + 0.01, out
+    rows = re.findall(r"^(\w+_(?:free|osc))\s+([\d.]+)\s+([\d.]+)", out, flags=re.M)
+    assert [r[0] for r in rows] == names, out
     assert all(np.isfinite(float(v)) for r in rows for v in r[1:]), out

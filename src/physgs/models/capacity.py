@@ -28,7 +28,8 @@ import torch
 from scipy.optimize import minimize
 
 from physgs.models.base import BaseModel, ModelContext
-from physgs.models.gaussians import GaussianState, rotate_parts
+from physgs.models.gaussians import GaussianState, axis_angle_quat, rodrigues_minus_identity
+from physgs.models.part_transform import transform_parts
 
 
 @dataclass(frozen=True)
@@ -38,13 +39,17 @@ class PartAngles:
     Attributes:
         pivot: [K, 3] each part's pivot (world units; on the axis through it, the part's mean
             coordinate along the axis). NaN for a part without points.
-        theta: [K, T] each part's angle at each frame, rad, relative to frame 0 (theta[:, 0] = 0).
+        theta: [K, T] each part's own angle at each frame, rad, relative to frame 0
+            (theta[:, 0] = 0); in a chain, relative to its parent's turn.
         fitted: [T, N, 3] the points moved by their part's turn.
+        shift: [K, T, 3] in a chain, each part's translation after its total turn (its
+            ancestors'); None for independent parts.
     """
 
     pivot: np.ndarray
     theta: np.ndarray
     fitted: np.ndarray
+    shift: np.ndarray | None = None
 
 
 def plane_basis(axis: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
@@ -84,7 +89,11 @@ def _turn(y: np.ndarray, y0: np.ndarray, q: np.ndarray) -> tuple[np.ndarray, np.
 
 
 def rigid_part_angles(
-    points: np.ndarray, labels: np.ndarray, K: int, axis: np.ndarray
+    points: np.ndarray,
+    labels: np.ndarray,
+    K: int,
+    axis: np.ndarray,
+    parent: np.ndarray | None = None,
 ) -> PartAngles:
     """Each part's best fixed pivot and per-frame angle about ``axis`` for true trajectories.
 
@@ -93,6 +102,9 @@ def rigid_part_angles(
         labels: [N] each point's part, in [0, K).
         K: the number of parts.
         axis: [3] the swing axis every part turns about.
+        parent: [K] each part's parent (-1: a root; parents numbered before their children) for
+            a chain, whose part turns on its parent's turn: fitted top-down, each part's points
+            taken back by its ancestors' fitted turns first. None: independent parts.
 
     Returns:
         The [`PartAngles`][physgs.models.capacity.PartAngles]. A point's motion along the axis
@@ -110,14 +122,23 @@ def rigid_part_angles(
     e1, e2, a = plane_basis(axis)
     y = np.stack([x @ e1, x @ e2], -1)  # [T, N, 2]
     along = x[0] @ a  # [N]
+    T = x.shape[0]
     pivot = np.full((K, 3), np.nan)
-    theta = np.zeros((K, x.shape[0]))
+    theta, total = np.zeros((K, T)), np.zeros((K, T))
+    shift = np.zeros((K, T, 2))  # in-plane: x -> R(total) (x - q) + q + shift
+    q2 = np.zeros((K, 2))
     moved = np.empty_like(y)
     for p in range(K):
         i = lab == p
+        a_ = -1 if parent is None else int(parent[p])
         if not i.any():
+            if a_ >= 0:  # an empty part passes its parent's turn on
+                q2[p], total[p] = q2[a_], total[a_]
+                shift[p] = shift[a_]
             continue
         yp, y0 = y[:, i], y[0, i]
+        if a_ >= 0:  # the part's points in its parent's frame: the parent's turn undone
+            yp = _rotate(yp - q2[a_] - shift[a_][:, None], -total[a_]) + q2[a_]
 
         def cost(q, yp=yp, y0=y0):
             return float(((_turn(yp, y0, q)[1] - yp) ** 2).sum())
@@ -128,11 +149,86 @@ def rigid_part_angles(
             minimize(cost, s, method="Nelder-Mead", options={"xatol": 1e-9, "fatol": 1e-14})
             for s in starts
         ]
-        q = min(fits, key=lambda r: r.fun).x
-        theta[p], moved[:, i] = _turn(yp, y0, q)
-        pivot[p] = q[0] * e1 + q[1] * e2 + along[i].mean() * a
+        q2[p] = min(fits, key=lambda r: r.fun).x
+        theta[p], _ = _turn(yp, y0, q2[p])
+        if a_ >= 0:  # T_p = T_a o turn_p: the turns add, the pivot's offset turns with the parent
+            total[p] = total[a_] + theta[p]
+            shift[p] = _rotate((q2[p] - q2[a_])[None], total[a_])[:, 0] + q2[a_] + shift[a_] - q2[p]
+        else:
+            total[p] = theta[p]
+        moved[:, i] = _rotate(y0 - q2[p], total[p]) + q2[p] + shift[p][:, None]
+        pivot[p] = q2[p, 0] * e1 + q2[p, 1] * e2 + along[i].mean() * a
     fitted = moved[..., :1] * e1 + moved[..., 1:] * e2 + along[None, :, None] * a
-    return PartAngles(pivot, theta, fitted)
+    shift3 = None if parent is None else shift[..., :1] * e1 + shift[..., 1:] * e2
+    return PartAngles(pivot, theta, fitted, shift3)
+
+
+def _rotate(v: np.ndarray, angle: np.ndarray) -> np.ndarray:
+    """In-plane vectors ``v`` [T, n, 2] turned by ``angle`` [T] rad (e1 towards e2)."""
+    c, s = np.cos(angle)[:, None], np.sin(angle)[:, None]
+    return np.stack([c * v[..., 0] - s * v[..., 1], s * v[..., 0] + c * v[..., 1]], -1)
+
+
+def chain_turns(
+    theta: np.ndarray, pivot: np.ndarray, parent: np.ndarray, axis: np.ndarray
+) -> tuple[np.ndarray, np.ndarray]:
+    """Each chained part's total turn from its own angles: x -> R(total) (x - pivot) + pivot +
+    shift, R about ``axis``, each part's turn composed after its ancestors'.
+
+    Args:
+        theta: [K, T] each part's own angle, rad, relative to its parent's turn.
+        pivot: [K, 3] each part's pivot, world units (NaN: an empty part, its parent's taken).
+        parent: [K] each part's parent (-1: a root; parents numbered before their children).
+        axis: [3] the axis every part turns about.
+
+    Returns:
+        ``(total [K, T] rad, shift [K, T, 3] world units)``.
+    """
+    e1, e2, _ = plane_basis(axis)
+    K, T = theta.shape
+    q = np.stack([pivot @ e1, pivot @ e2], -1)  # [K, 2]
+    total, shift = np.array(theta, dtype=np.float64), np.zeros((K, T, 2))
+    for p in range(K):
+        a = int(parent[p])
+        if a < 0:
+            continue
+        if np.isnan(q[p]).any():
+            q[p] = q[a]
+        total[p] = total[a] + theta[p]
+        shift[p] = _rotate((q[p] - q[a])[None], total[a])[:, 0] + q[a] + shift[a] - q[p]
+    return total, shift[..., :1] * e1 + shift[..., 1:] * e2
+
+
+def turned(
+    x0: np.ndarray,
+    labels: np.ndarray,
+    axis: np.ndarray,
+    pivot: np.ndarray,
+    theta: np.ndarray,
+    shift: np.ndarray | None = None,
+) -> np.ndarray:
+    """Points moved by their parts' turns: R(theta) (x - pivot) + pivot + shift, about ``axis``.
+
+    Args:
+        x0: [N, 3] the points at frame 0, world units.
+        labels: [N] each point's part.
+        axis: [3] the axis every part turns about.
+        pivot: [K, 3] each part's pivot (NaN rows: parts without points).
+        theta: [K, T] each part's (total) angle, rad.
+        shift: [K, T, 3] each part's translation after its turn; None: none.
+
+    Returns:
+        [T, N, 3] the points at each frame.
+    """
+    e1, e2, a = plane_basis(axis)
+    lab = np.asarray(labels)
+    q = np.nan_to_num(np.stack([pivot @ e1, pivot @ e2], -1))[lab]  # [N, 2]
+    y0 = np.stack([x0 @ e1, x0 @ e2], -1) - q  # [N, 2]
+    th = np.asarray(theta)[lab].T  # [T, N]
+    c, s = np.cos(th), np.sin(th)
+    y = np.stack([c * y0[:, 0] - s * y0[:, 1], s * y0[:, 0] + c * y0[:, 1]], -1) + q
+    out = y[..., :1] * e1 + y[..., 1:] * e2 + (x0 @ a)[None, :, None] * a
+    return out if shift is None else out + np.transpose(np.asarray(shift), (1, 0, 2))[:, lab]
 
 
 def oscillator_angles(
@@ -161,7 +257,7 @@ def oscillator_angles(
 
 class PartsAtAngles(BaseModel):
     """Rigid parts turned by given angles: the canonical set (frame 0) turned part by part about
-    one axis by ``theta[:, j]`` at recorded frame j. Only its appearance trains; it predicts the
+    one axis by ``theta[:, j]`` at recorded frame j (then shifted by ``shift[:, j]``). Only its appearance trains; it predicts the
     frames its angles cover, under the wind they were fitted to.
     """
 
@@ -175,6 +271,7 @@ class PartsAtAngles(BaseModel):
         axis: np.ndarray,
         pivot: np.ndarray,
         theta: np.ndarray,
+        shift: np.ndarray | None = None,
     ):
         """Hold the parts' motion as buffers.
 
@@ -185,6 +282,8 @@ class PartsAtAngles(BaseModel):
             axis: [3] the axis every part turns about.
             pivot: [K, 3] each part's pivot, world units (NaN for a part without Gaussians).
             theta: [K, F] each part's angle at recorded frames 0 .. F-1, rad, relative to frame 0.
+            shift: [K, F, 3] each part's translation after its turn (a chain's, from
+                ``chain_turns``, with ``theta`` its total angles); None: none.
         """
         super().__init__(ctx, canonical_cfg)
         theta = torch.as_tensor(np.asarray(theta), dtype=torch.float32)
@@ -194,6 +293,8 @@ class PartsAtAngles(BaseModel):
         self.register_buffer("axis", a.expand(K, 3).clone())
         self.register_buffer("pivot", torch.nan_to_num(torch.as_tensor(pivot).float()))
         self.register_buffer("theta", theta)
+        shift = np.zeros((*theta.shape, 3)) if shift is None else np.asarray(shift)
+        self.register_buffer("shift", torch.as_tensor(shift, dtype=torch.float32))
 
     def defined(self, frame_idx: int, condition: int) -> bool:
         """Whether ``frame_idx`` is among the frames the angles cover (condition 0's only).
@@ -217,9 +318,15 @@ class PartsAtAngles(BaseModel):
         Returns:
             The turned Gaussians.
         """
-        c = self.canonical
-        means, quats = rotate_parts(
-            c.means, c.quats, self.part_labels, self.axis, self.theta[:, frame_idx], self.pivot
+        c, th = self.canonical, self.theta[:, frame_idx]
+        means, quats = transform_parts(
+            c.means,
+            c.quats,
+            self.part_labels,
+            rodrigues_minus_identity(self.axis, th),
+            self.pivot,
+            self.shift[:, frame_idx],
+            axis_angle_quat(self.axis, th),
         )
         return GaussianState(
             means,
