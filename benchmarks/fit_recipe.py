@@ -13,14 +13,14 @@ splits: this is what recipe settings are chosen on.
 each candidate bought.
 
 ``--capacity`` asks what the oscillator priors' parts can hold of the tree's true motion
-(``physgs.models.capacity``; a diagnostic of a shortfall, no setting is chosen on it): after
-static, the ceiling, ours and the chained prior train, each prior's parts are fitted to the
-ceiling's true trajectories over the window (the chained prior's as a chain, each part on its
-parent's turn), as rigid turns with a free angle per frame (rows ``<prior>_free``) and with one
-oscillator each (``<prior>_osc``: the best of a grid over the prior's bounds, driven by the
-measured wind); each motion is held while the appearance trains as the ceiling's does (from the
-same start, the same iterations), and is scored like the models: the ceiling with the parts'
-motion in place of the true one.
+(``physgs.models.capacity``; a diagnostic of a shortfall, no setting is chosen on it): after static,
+the ceiling, ours and the chained prior train, each prior's parts are fitted to the ceiling's true
+trajectories over the window (the chained prior's as a chain, each part on its parent's turn), as
+rigid turns with a free angle per frame (rows ``<prior>_free``) and with one oscillator each
+(``<prior>_osc``: the best of a grid over the prior's bounds, driven by the measured wind, refined
+by Nelder-Mead); each motion is held while the appearance trains as the ceiling's does (from the
+same start, the same iterations), and is scored like the models: the ceiling with the parts' motion
+in place of the true one.
 
     python benchmarks/fit_recipe.py results/testbed/sparse --capacity
 """
@@ -43,6 +43,7 @@ from physgs.models.capacity import (
     PartsAtAngles,
     chain_turns,
     oscillator_angles,
+    refine_oscillators,
     rigid_part_angles,
     turned,
 )
@@ -141,7 +142,15 @@ def capacity_models(obs, truth_model, truth_job, prior_id, prior):
         om, ze, wind, condition_vbar(prior.vbar_ratio, wind), prior.dt, prior.substeps
     )
     r = r[:, lead : lead + n] - r[:, lead : lead + 1]
-    *_, osc = oscillator_angles(free.theta, r, om, ze)
+    om, ze, *_ = oscillator_angles(free.theta, r, om, ze)
+    vbar = condition_vbar(prior.vbar_ratio, wind)
+
+    def response(w, z):  # one oscillator's unit response over the window, from frame 0
+        x = unit_responses([w], [z], wind, vbar, prior.dt, prior.substeps)[0]
+        return x[lead : lead + n] - x[lead]
+
+    bounds = ((b.omega_lo, b.omega_hi), (b.zeta_lo, b.zeta_hi))
+    *_, osc = refine_oscillators(free.theta, om, ze, response, bounds)
     uv = obs.train_camera.project(pts.reshape(-1, 3))[0].reshape(n, -1, 2)
     moved = np.linalg.norm(uv - uv[:1], axis=-1).mean()
     out = []

@@ -11,6 +11,7 @@ from physgs.models.capacity import (
     chain_turns,
     oscillator_angles,
     plane_basis,
+    refine_oscillators,
     rigid_part_angles,
     turned,
 )
@@ -155,3 +156,20 @@ def test_a_chain_is_fitted_top_down_and_recomposed():
         m.canonical.means.copy_(torch.as_tensor(pts[0]))
         got = m.gaussians_at(25, torch.zeros(T)).means.double().numpy()
     np.testing.assert_allclose(got, pts[25], atol=1e-5)
+
+
+def test_an_oscillator_between_grid_points_is_refined_to_its_own_values():
+    """An analytic damped sine (the free response's shape) off the grid: the refinement finds its
+    frequency, damping and gain from the nearest grid point."""
+    t = np.arange(120) / 24.0
+
+    def response(w, z):
+        return np.exp(-z * w * t) * np.sin(w * np.sqrt(1 - z * z) * t)
+
+    theta = np.stack([1.7 * response(3.3, 0.12), np.zeros_like(t)])
+    om, ze, gain, fitted = refine_oscillators(
+        theta, np.array([3.0, 3.0]), np.array([0.1, 0.1]), response, ((0.5, 20.0), (0.01, 0.5))
+    )
+    np.testing.assert_allclose([om[0], ze[0], gain[0]], [3.3, 0.12, 1.7], rtol=1e-4)
+    np.testing.assert_allclose(fitted[0], theta[0], atol=1e-6)
+    assert gain[1] == 0 and not fitted[1].any()  # a part that never turns keeps no oscillator

@@ -21,6 +21,7 @@ trained and its motion held, beside the prior trained as the pipeline trains it.
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from dataclasses import dataclass
 
 import numpy as np
@@ -335,3 +336,61 @@ class PartsAtAngles(BaseModel):
             torch.sigmoid(c.opacity_logits),
             torch.sigmoid(c.color_logits),
         )
+
+
+def refine_oscillators(
+    theta: np.ndarray,
+    omega: np.ndarray,
+    zeta: np.ndarray,
+    response: Callable[[float, float], np.ndarray],
+    bounds: tuple[tuple[float, float], tuple[float, float]],
+) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+    """Each part's oscillator refined from its grid point: (log omega, zeta) by Nelder-Mead on
+    the residual of its free angle, the gain by least squares (a grid's step dephases a
+    response over a long window).
+
+    Args:
+        theta: [K, T] free angles, rad.
+        omega: [K] the grid's choice, rad/s.
+        zeta: [K] the grid's choice.
+        response: ``(omega, zeta) -> [T]`` the unit-gain response at the angles' frames, relative
+            to frame 0.
+        bounds: ``((omega_lo, omega_hi), (zeta_lo, zeta_hi))``, the prior's.
+
+    Returns:
+        ``(omega [K], zeta [K], gain [K], theta [K, T])``.
+    """
+    (wlo, whi), (zlo, zhi) = bounds
+    K = theta.shape[0]
+    om, ze, gain, out = (
+        np.array(omega, float),
+        np.array(zeta, float),
+        np.zeros(K),
+        np.zeros_like(theta),
+    )
+
+    def fit(v, th):
+        w, z = float(np.exp(v[0])), float(v[1])
+        if not (wlo < w < whi and zlo < z < zhi):
+            return np.inf, 0.0, None
+        r = response(w, z)
+        g = float(th @ r / (r @ r)) if r @ r > 0 else 0.0
+        return float(((th - g * r) ** 2).sum()), g, r
+
+    for p in range(K):
+        if not np.any(theta[p]):
+            continue
+        best = minimize(
+            lambda v, th=theta[p]: fit(v, th)[0],
+            [np.log(om[p]), ze[p]],
+            method="Nelder-Mead",
+            options={"xatol": 1e-6, "fatol": 1e-14, "maxiter": 400},
+        )
+        v = (
+            best.x
+            if fit(best.x, theta[p])[0] <= fit([np.log(om[p]), ze[p]], theta[p])[0]
+            else [np.log(om[p]), ze[p]]
+        )
+        _, gain[p], r = fit(v, theta[p])
+        om[p], ze[p], out[p] = np.exp(v[0]), v[1], gain[p] * r
+    return om, ze, gain, out
