@@ -33,6 +33,7 @@ import time
 from pathlib import Path
 
 import numpy as np
+import pandas as pd
 import torch
 
 import physgs.config
@@ -63,6 +64,7 @@ def main(argv: list[str] | None = None) -> None:
     ap.add_argument("--set", action="append", default=[], help="KEY.PATH=VALUE override")
     ap.add_argument("--every", type=int, default=3, help="score every k-th trained frame")
     ap.add_argument("--capacity", action="store_true", help="the priors' parts at the true motion")
+    ap.add_argument("--markdown", type=Path, help="write the rows as a Markdown table here")
     args = ap.parse_args(argv)
     if args.capacity:
         args.models = "static,truth_motion,ours,ours_chain"
@@ -76,7 +78,7 @@ def main(argv: list[str] | None = None) -> None:
     trained, held = heldout_split(n, every)
     print(f"# {args.dataset} overrides={args.set}")
     print(f"{'model':14s} {'fit dB':>8s} {'held dB':>8s} {'train s':>8s}")
-    res, trained_models = {}, {}
+    res, trained_models, motion_px = {}, {}, {}
     for m in args.models.split(","):
         job = job_spec(copy.deepcopy(cfg), m, "single")
         t0 = time.perf_counter()
@@ -89,9 +91,10 @@ def main(argv: list[str] | None = None) -> None:
         print(f"{m:14s} {res[m][0]:8.2f} {res[m][1]:8.2f} {wall:8.1f}", flush=True)
     priors = ("ours", "ours_chain") if args.capacity else ()
     for prior in priors:  # each prior's parts at the true motion, trained as the ceiling is
-        for m, model in capacity_models(
+        for m, model, err_px in capacity_models(
             obs, *trained_models["truth_motion"], prior, trained_models[prior][0]
         ):
+            motion_px[m] = err_px
             t0 = time.perf_counter()
             train = trained_models[prior][1]["train"]
             train_model(model, obs, train, conditions=[0], seed=0, progress=False)
@@ -99,13 +102,21 @@ def main(argv: list[str] | None = None) -> None:
             _, p_held = training_camera_scores(model, obs, held)
             res[m] = (float(np.mean(p_fit)), float(np.mean(p_held)), time.perf_counter() - t0)
             print(f"{m:14s} {res[m][0]:8.2f} {res[m][1]:8.2f} {res[m][2]:8.1f}", flush=True)
-    if "static" in res and "truth_motion" in res:
-        s, c = res["static"][0], res["truth_motion"][0]
-        for m, (f, h, _) in res.items():
-            print(
-                f"{m:14s} of ceiling: fit {100 * (f - s) / (c - s):5.0f}%  held "
-                f"{100 * (h - res['static'][1]) / (res['truth_motion'][1] - res['static'][1]):5.0f}%"
-            )
+    rows = pd.DataFrame(res, index=["fit_db", "held_db", "train_s"]).T
+    if {"static", "truth_motion"} <= set(res):  # each split's share of the ceiling's gain
+        for col, share in (("fit_db", "fit_of_ceiling"), ("held_db", "held_of_ceiling")):
+            s, c = rows.at["static", col], rows.at["truth_motion", col]
+            rows[share] = (rows[col] - s) / (c - s)
+            for m, v in rows[share].items():
+                print(f"{m:16s} {col[:-3]} of ceiling {100 * v:5.0f}%")
+    rows["motion_error_px"] = pd.Series(motion_px, dtype=float)
+    if args.markdown:
+        args.markdown.write_text(
+            f"`{args.dataset}`, {args.profile} profile, overrides {args.set or 'none'}: "
+            f"{int(cfg['train']['iterations'])} iterations\n\n"
+            + rows.rename_axis("model").reset_index().to_markdown(index=False, floatfmt=".2f")
+            + "\n"
+        )
 
 
 def capacity_models(obs, truth_model, truth_job, prior_id, prior):
@@ -121,8 +132,8 @@ def capacity_models(obs, truth_model, truth_job, prior_id, prior):
         prior: the trained oscillator prior (its parts, bounds, RK4 steps).
 
     Returns:
-        ``[(name, PartsAtAngles)]``; the image error (px) of each motion against the truth
-            printed.
+        ``[(name, PartsAtAngles, image error px)]``: the mean image error of each motion against
+            the truth (also printed).
     """
     n, lead = int(obs.n_train), int(obs.lead_in_frames)
     wind = torch.as_tensor(np.asarray(obs.wind[0]), dtype=torch.float64)
@@ -167,7 +178,7 @@ def capacity_models(obs, truth_model, truth_job, prior_id, prior):
         m = PartsAtAngles(
             prior.ctx, truth_job["settings"]["canonical"], labels, axis, free.pivot, theta, shift
         )
-        out.append((name, m))
+        out.append((name, m, float(err.mean())))
     return out
 
 

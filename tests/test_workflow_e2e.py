@@ -382,7 +382,9 @@ def test_summary_is_printed_from_the_run(run):
         assert f"| {stage} | " in text
 
 
-def test_fit_recipe_capacity_scores_the_parts_at_the_true_motion(run, monkeypatch, capsys):
+def test_fit_recipe_capacity_scores_the_parts_at_the_true_motion(
+    run, monkeypatch, capsys, tmp_path
+):
     """`benchmarks/fit_recipe.py --capacity` on the quick DAG's tree: both motions of both priors'
     parts are trained and scored, and the free angles leave no more image error than one
     oscillator each (the oscillator's angles are among the free ones)."""
@@ -393,7 +395,17 @@ def test_fit_recipe_capacity_scores_the_parts_at_the_true_motion(run, monkeypatc
     sys.modules.pop("fit_recipe", None)
     import fit_recipe
 
-    fit_recipe.main([str(run / "results/testbed/sparse"), "--capacity", "--profile", "quick"])
+    md = tmp_path / "capacity.md"
+    fit_recipe.main(
+        [
+            str(run / "results/testbed/sparse"),
+            "--capacity",
+            "--profile",
+            "quick",
+            "--markdown",
+            str(md),
+        ]
+    )
     out = capsys.readouterr().out
     err = {
         k: float(v) for k, v in re.findall(r"# (\w+_(?:free|osc)): image error ([\d.]+) px", out)
@@ -405,3 +417,6 @@ def test_fit_recipe_capacity_scores_the_parts_at_the_true_motion(run, monkeypatc
     rows = re.findall(r"^(\w+_(?:free|osc))\s+([\d.]+)\s+([\d.]+)", out, flags=re.M)
     assert [r[0] for r in rows] == names, out
     assert all(np.isfinite(float(v)) for r in rows for v in r[1:]), out
+    table = md.read_text()
+    for name in ["static", "truth_motion", "ours", "ours_chain", *names]:
+        assert re.search(rf"^\| {name} +\|", table, flags=re.M), table
