@@ -57,7 +57,8 @@ from physgs.train.loop import train_model
 
 def main(argv: list[str] | None = None) -> None:
     """Run with ``argv`` (default: the command line)."""
-    ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawTextHelpFormatter)
+    # the first paragraph: the rest (the module docstring) is the reference
+    ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     ap.add_argument("dataset", type=Path, help="folder with observed.npz (and truth.npz)")
     ap.add_argument("--models", default="static,mlp,mlp_wind,d3dgs,d3dgs_wind,ours,truth_motion")
     ap.add_argument("--profile", default="default")
