@@ -21,6 +21,7 @@ trained and its motion held, beside the prior trained as the pipeline trains it.
 
 from __future__ import annotations
 
+import dataclasses
 from collections.abc import Callable
 from dataclasses import dataclass
 
@@ -329,13 +330,7 @@ class PartsAtAngles(BaseModel):
             self.shift[:, frame_idx],
             axis_angle_quat(self.axis, th),
         )
-        return GaussianState(
-            means,
-            quats,
-            torch.exp(c.log_scales),
-            torch.sigmoid(c.opacity_logits),
-            torch.sigmoid(c.color_logits),
-        )
+        return dataclasses.replace(c.state(), means=means, quats=quats)
 
 
 def refine_oscillators(
