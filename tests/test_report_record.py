@@ -807,3 +807,22 @@ def test_a_folder_without_a_run_says_how_to_make_one_and_a_record_without_its_st
     (copy / "stamp.json").unlink()
     with pytest.raises(FileNotFoundError, match="stamp.json"):
         record.render_pages(copy)
+
+
+def test_the_ledger_page_prints_the_digits_the_csv_stores(tmp_path, monkeypatch):
+    """A value at a rounding edge (1.2149999 in memory, 1.215 in the CSV's 6 digits) prints on
+    the page make_claims writes as on a page rendered again from the CSV (derive_claims)."""
+    from physgs.provenance import Stamp
+    from physgs.report import build
+
+    df = pd.read_csv(RECORD / "claims.csv", dtype={"config_hash": str})
+    df = df.drop(columns=list(record.STAMP_COLUMNS)).head(3)
+    df.loc[0, ["measured", "ci_low", "ci_high"]] = [2.0, 1.2149999999999999, 3.0]
+    df.loc[0, ["unit", "scale"]] = ["fraction", "linear"]
+    monkeypatch.setattr(build, "claims_frame", lambda *a: df.copy())
+    out = tmp_path / "record"
+    out.mkdir()
+    stamp = Stamp("default", "f9b6aa0f2d2f", "0.1.0")
+    build.make_claims({}, ["sparse"], out / "claims.md", out / "claims.csv", stamp=stamp)
+    assert "1.215" in (out / "claims.csv").read_text()
+    assert "[+1.22, +3]" in (out / "claims.md").read_text()  # as re-rendered from the CSV

@@ -133,9 +133,12 @@ def make_claims(
     """
     df = claims_frame(inputs, trees, roles)
     sd = stamp.to_dict() if stamp is not None else None
-    write_text(md_path, claims.ledger_markdown(df, sd))
     with atomic_path(csv_path) as tmp:
         (df.assign(**sd) if sd else df).to_csv(tmp, index=False, float_format="%.6g")
+    # the page prints the ledger as stored (6 digits): 1.2149999 printed from memory reads 1.21,
+    # from the CSV's 1.215 it reads 1.22, and a page rendered again from the record must agree
+    stored = pd.read_csv(csv_path, dtype={"config_hash": str})
+    write_text(md_path, claims.ledger_markdown(stored, sd))
     return df
 
 
