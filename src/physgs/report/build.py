@@ -135,9 +135,7 @@ def make_claims(
     sd = stamp.to_dict() if stamp is not None else None
     with atomic_path(csv_path) as tmp:
         (df.assign(**sd) if sd else df).to_csv(tmp, index=False, float_format="%.6g")
-    # the page prints the ledger as stored (6 digits): 1.2149999 printed from memory reads 1.21,
-    # from the CSV's 1.215 it reads 1.22, and a page rendered again from the record must agree
-    stored = pd.read_csv(csv_path, dtype={"config_hash": str})
+    stored = pd.read_csv(csv_path, dtype={"config_hash": str})  # the page prints the CSV's digits
     write_text(md_path, claims.ledger_markdown(stored, sd))
     return df
 
