@@ -5,11 +5,13 @@ import re
 import subprocess
 import sys
 
+import numpy as np
 import optuna
 import pytest
 
 from physgs.config_checks import recipes_are_known, search_is_runnable, warmup_below_iterations
 from physgs.experiments.recipe import fit, job_spec, tree_recipe
+from physgs.experiments import search
 from physgs.experiments.search import (
     SearchSettings,
     recipe_yaml,
@@ -125,6 +127,71 @@ def test_search_scores_every_trial_on_its_held_out_window_frames_and_keeps_the_b
     assert (ends[pruned["number"]] == 12).all()
     text = recipe_yaml("sparse", "mlp_wind", trials, best)
     assert text.startswith("# sparse mlp_wind: trial ") and "mlp_wind:" in text
+
+
+@pytest.mark.parametrize("cut", [KeyboardInterrupt, SystemExit], ids=["ctrl-c", "killed"])
+def test_a_search_cut_short_resumes_from_its_journal(swaying, tmp_path, monkeypatch, cut):
+    """A search stopped in its third training keeps its two finished trials (not trained again,
+    their values those of a search run in one go) and trains the third's recipe again. Ctrl-C
+    leaves that trial FAIL in the journal; a kill (SystemExit passes through Optuna's handler, as
+    a kill does) leaves it RUNNING: both resume the same way."""
+    cfg = quick_train_cfg(12, 2)
+    base = job_spec(cfg, "ours", "single", tree="sparse")
+    settings = SearchSettings(trials=3, every=6, startup=3, seed=5)
+    whole, whole_steps, _ = run_search(swaying, base, settings, log=lambda _: None)
+    journal = tmp_path / "ours.journal"
+    calls = []
+
+    def fit_cut_at_third(*args, **kwargs):
+        calls.append(1)
+        if len(calls) == 3:
+            raise cut()
+        return fit(*args, **kwargs)
+
+    monkeypatch.setattr(search, "fit", fit_cut_at_third)
+    with pytest.raises(cut):
+        run_search(swaying, base, settings, log=lambda _: None, journal=journal)
+    assert journal.exists()
+    monkeypatch.setattr(search, "fit", lambda *a, **k: (calls.append(1), fit(*a, **k))[1])
+    lines = []
+    trials, steps, _ = run_search(swaying, base, settings, log=lines.append, journal=journal)
+    assert len(calls) == 4  # the resumed search trained one recipe: the cut one's
+    assert list(trials["state"]) == ["COMPLETE", "COMPLETE", "FAIL", "COMPLETE"]
+    params = [c for c in trials if c.startswith("params_")]
+    assert trials.loc[3, params].tolist() == trials.loc[2, params].tolist()
+    assert trials.loc[:1, "holdout_loss"].tolist() == pytest.approx(
+        whole.loc[:1, "holdout_loss"].tolist(), rel=1e-6
+    )
+    assert trials.loc[:1, params].equals(whole.loc[:1, params])
+    assert np.isnan(trials.loc[2, "seconds"]) and not trials["seconds"].drop(2).isna().any()
+    assert set(steps["trial"]) == {0, 1, 3}
+    assert steps[steps["trial"] < 2].reset_index(drop=True).equals(
+        whole_steps[whole_steps["trial"] < 2].reset_index(drop=True)
+    )
+    assert any("trial 2 was cut short" in line for line in lines)
+    assert any("2 of 3 trials finished" in line for line in lines)
+    assert not journal.exists()  # a finished search leaves no journal to resume
+
+
+def test_a_search_cut_short_in_its_first_trial_starts_afresh(swaying, tmp_path, monkeypatch):
+    """The first trial is the config's own recipe: a search cut in it keeps nothing, so trial 0
+    of the resumed search is still the config's own."""
+    cfg = quick_train_cfg(12, 2)
+    base = job_spec(cfg, "ours", "single", tree="sparse")
+    settings = SearchSettings(trials=2, every=6, startup=2, seed=5)
+    journal = tmp_path / "ours.journal"
+
+    def killed(*args, **kwargs):
+        raise SystemExit()
+
+    monkeypatch.setattr(search, "fit", killed)
+    with pytest.raises(SystemExit):
+        run_search(swaying, base, settings, log=lambda _: None, journal=journal)
+    monkeypatch.setattr(search, "fit", fit)
+    trials, _, _ = run_search(swaying, base, settings, log=lambda _: None, journal=journal)
+    assert list(trials["number"]) == [0, 1] and (trials["state"] == "COMPLETE").all()
+    own = space_of("ours").params(trial_job(base, {}))
+    assert {k: trials.loc[0, f"params_{k}"] for k in own} == pytest.approx(own)
 
 
 def test_a_trial_that_fails_stops_the_search_naming_it(swaying):

@@ -14,6 +14,7 @@ with job(sm) as log:
         SearchSettings.from_config(sm.params.search),
         tree=sm.wildcards.tree,
         log=lambda line: print(line, file=log, flush=True),
+        journal=sm.params.journal,
     )
     trials.to_csv(sm.output.trials, index=False)
     steps.to_csv(sm.output.steps, index=False)

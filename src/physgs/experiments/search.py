@@ -16,8 +16,11 @@ in the config (``{"train": {...}, "settings": {...}}``), so the best one is past
 
 from __future__ import annotations
 
+import hashlib
+import json
 import time
-from dataclasses import dataclass
+from dataclasses import asdict, dataclass
+from pathlib import Path
 from typing import Callable
 
 import pandas as pd
@@ -220,8 +223,18 @@ def run_search(
     *,
     tree: str = "",
     log: Callable[[str], None] = print,
+    journal: str | Path | None = None,
 ) -> tuple[pd.DataFrame, pd.DataFrame, dict]:
     """Search a model's recipe on a tree's held-out window frames.
+
+    With ``journal``, the study lives in that Optuna journal file as it runs, so a search cut
+    short (a session's or a cluster job's end) resumes where it stopped: its finished trials are
+    kept, not trained again; the trial it was training is kept as ``FAIL`` (no value) and its
+    recipe trained again as a new trial; the sampler is seeded with ``seed`` plus the trials
+    already held, so a resumed search proposes its later trials as a search run in one go would
+    not. A search cut short before its first trial (the config's own recipe) ended starts afresh.
+    The file is removed once the search has finished. Its study is named by the job and budget, so
+    a job whose settings changed since starts its own study.
 
     Args:
         observed (Observed): the tree's observed dataset (the training camera's video).
@@ -230,6 +243,7 @@ def run_search(
         settings: the budget.
         tree: the tree's name (the rows' and the log lines' label).
         log: where one line per trial goes (progress).
+        journal: the journal file that makes the search resumable; None: in memory only.
 
     Returns:
         ``(trials, steps, best)``: one row per trial (number, state, the objective, held-out
@@ -243,69 +257,132 @@ def run_search(
 
     model = base["model"]
     space = space_of(model)
-    steps: list[dict] = []
-    recipes: dict[int, dict] = {}
+    own = space.params(trial_job(base, {}))
 
     def objective(trial) -> float:
-        recipe = space.suggest(trial, model)
-        recipes[trial.number] = recipe
-        job = trial_job(base, recipe)
+        job = trial_job(base, space.suggest(trial, model))
         scorer = window_scorer(observed, job)
         warmup = int(job.train["warmup"])
+        steps: list[list] = []  # [iteration, loss, psnr], kept in the study as they come
+
+        def score(it, mdl) -> float:
+            loss, psnr = scorer.evaluate(mdl)
+            steps.append([it, loss, psnr])
+            trial.set_user_attr("steps", steps)
+            return loss
 
         def report(it, mdl, opt):
             if it <= warmup or it % settings.every:
                 return None
-            loss, psnr = scorer.evaluate(mdl)
-            steps.append(
-                dict(trial=trial.number, iteration=it, holdout_loss=loss, holdout_psnr=psnr)
-            )
+            loss = score(it, mdl)
             trial.report(loss, it)
             if trial.should_prune():
                 raise optuna.TrialPruned(f"held-out window loss {loss:.4f} at iteration {it}")
             return None
 
         res = fit(observed, job, progress=False, hooks=(report,))
-        loss, psnr = scorer.evaluate(res.model)
-        steps.append(
-            dict(trial=trial.number, iteration=len(res.log), holdout_loss=loss, holdout_psnr=psnr)
-        )
-        trial.set_user_attr("holdout_psnr", psnr)
+        loss = score(len(res.log), res.model)
+        trial.set_user_attr("holdout_psnr", steps[-1][2])
         return loss
+
+    finished = (optuna.trial.TrialState.COMPLETE, optuna.trial.TrialState.PRUNED)
 
     def progress(study, trial) -> None:
         value = "pruned" if trial.value is None else f"{trial.value:.4f}"
-        log(f"{tree} {model}: trial {trial.number + 1}/{settings.trials} {value} {trial.params}")
+        n = sum(t.state in finished for t in study.trials)
+        log(f"{tree} {model}: trial {n}/{settings.trials} {value} {trial.params}")
 
     optuna.logging.set_verbosity(optuna.logging.WARNING)
+    study = _study(base, settings, journal, log=log, label=f"{tree} {model}")
+    if not study.trials:
+        # the first trial is the recipe the config holds: the search is measured against it
+        study.enqueue_trial(own)
+    t0 = time.perf_counter()
+    left = settings.trials - sum(t.state in finished for t in study.trials)
+    study.optimize(objective, n_trials=max(left, 0), callbacks=[progress])
+    done = [t for t in study.trials if t.state == optuna.trial.TrialState.COMPLETE]
+    if not done:
+        raise ValueError(f"{tree} {model}: no trial of {settings.trials} completed")
+    trials = study.trials_dataframe(attrs=("number", "state", "value", "params", "duration"))
+    trials = trials.rename(columns={"value": "holdout_loss"})
+    trials["holdout_psnr"] = [t.user_attrs.get("holdout_psnr") for t in study.trials]
+    trials.insert(0, "model", model)
+    trials.insert(0, "tree", tree)
+    # an interrupted trial's duration would span the pause: not its cost
+    seconds = trials.pop("duration").dt.total_seconds()
+    trials["seconds"] = seconds.where(trials["state"] != "FAIL")
+    steps = pd.DataFrame(
+        [[t.number, *row] for t in study.trials for row in t.user_attrs.get("steps", [])],
+        columns=list(STEP_FIELDS),
+    )
+    log(
+        f"{tree} {model}: {len(done)} of {settings.trials} trials complete, {time.perf_counter() - t0:.0f} s"
+    )
+    best = space.suggest(optuna.trial.FixedTrial(study.best_trial.params), model)
+    if journal is not None:
+        Path(journal).unlink(missing_ok=True)
+    return trials, steps, best
+
+
+def _study(base: dict, settings: SearchSettings, journal, *, log, label: str):
+    """The search's Optuna study: new, or resumed from ``journal`` (``run_search``).
+
+    Args:
+        base: the model's job on the tree (names the study, with ``settings``).
+        settings: the budget.
+        journal: the journal file, or None (in memory).
+        log: where the line saying what was resumed goes.
+        label: the search's name in that line.
+
+    Returns:
+        The study, its interrupted trial (``RUNNING`` if killed, ``FAIL`` if stopped by Ctrl-C)
+        marked ``FAIL`` and its recipe queued again.
+    """
+    import optuna
+
+    running, failed = optuna.trial.TrialState.RUNNING, optuna.trial.TrialState.FAIL
+    storage, name, held = None, None, 0
+    if journal is not None:
+        from optuna.storages.journal import JournalFileBackend
+
+        storage = optuna.storages.JournalStorage(JournalFileBackend(str(journal)))
+        key = json.dumps([base, asdict(settings)], sort_keys=True, default=str)
+        name = f"{label}/{hashlib.sha256(key.encode()).hexdigest()[:12]}"
+        try:
+            kept = optuna.load_study(study_name=name, storage=storage).trials
+        except KeyError:  # no such study yet
+            kept = []
+        if kept and kept[0].state in (running, failed):
+            # cut short before the config's own recipe (its first trial) ended: nothing to keep
+            optuna.delete_study(study_name=name, storage=storage)
+            kept = []
+        held = len(kept)
     study = optuna.create_study(
+        study_name=name,
+        storage=storage,
+        load_if_exists=True,
         direction="minimize",
-        sampler=optuna.samplers.TPESampler(seed=settings.seed, n_startup_trials=settings.startup),
+        sampler=optuna.samplers.TPESampler(
+            seed=settings.seed + held, n_startup_trials=settings.startup
+        ),
         pruner=optuna.pruners.MedianPruner(
             n_startup_trials=settings.startup,
             n_warmup_steps=int(settings.prune_after * int(base["train"]["iterations"])),
         ),
     )
-    # the first trial is the recipe the config holds: the search is measured against it
-    study.enqueue_trial(space.params(trial_job(base, {})))
-    t0 = time.perf_counter()
-    study.optimize(objective, n_trials=settings.trials, callbacks=[progress])
-    done = [t for t in study.trials if t.state == optuna.trial.TrialState.COMPLETE]
-    if not done:
-        raise ValueError(f"{tree} {model}: no trial of {settings.trials} completed")
-    trials = study.trials_dataframe(
-        attrs=("number", "state", "value", "params", "duration", "user_attrs")
-    )
-    trials = trials.rename(
-        columns={"value": "holdout_loss", "user_attrs_holdout_psnr": "holdout_psnr"}
-    )
-    trials.insert(0, "model", model)
-    trials.insert(0, "tree", tree)
-    trials["seconds"] = trials.pop("duration").dt.total_seconds()
-    log(
-        f"{tree} {model}: {len(done)} of {settings.trials} trials complete, {time.perf_counter() - t0:.0f} s"
-    )
-    return trials, pd.DataFrame(steps, columns=list(STEP_FIELDS)), recipes[study.best_trial.number]
+    # a trial killed stays RUNNING, one stopped by Ctrl-C is FAIL: either way it trains again
+    retried = {t.user_attrs.get("retry_of") for t in study.trials}
+    for t in study.trials:
+        if t.state in (running, failed) and t.number not in retried:
+            if t.state == running:
+                study.tell(t.number, state=failed)
+            study.enqueue_trial(t.params, user_attrs={"retry_of": t.number})
+            log(f"{label}: trial {t.number} was cut short: kept as FAIL, its recipe queued again")
+    if held:
+        done = sum(t.state in (optuna.trial.TrialState.COMPLETE, optuna.trial.TrialState.PRUNED)
+                   for t in study.trials)
+        log(f"{label}: resumed from {journal}: {done} of {settings.trials} trials finished")
+    return study
 
 
 def recipe_yaml(tree: str, model: str, trials: pd.DataFrame, recipe: dict) -> str:
