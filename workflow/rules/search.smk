@@ -25,8 +25,6 @@ rule search_recipe:
         * (10 + search_job(wc)["train"]["iterations"] // 60),
     params:
         job=search_job,
-        # not an output: Snakemake removes a cut job's outputs, and this file resumes it
-        journal=SEARCH.replace("{what}", "journal"),
         search=lambda wc: {
             k: CFG["search"][k] for k in ("trials", "every", "startup", "seed", "prune_after")
         },

@@ -14,7 +14,8 @@ with job(sm) as log:
         SearchSettings.from_config(sm.params.search),
         tree=sm.wildcards.tree,
         log=lambda line: print(line, file=log, flush=True),
-        journal=sm.params.journal,
+        # beside the outputs, not one: Snakemake removes a cut job's outputs, this file resumes it
+        journal=sm.output.trials.replace(".trials.csv", ".journal"),
     )
     trials.to_csv(sm.output.trials, index=False)
     steps.to_csv(sm.output.steps, index=False)
