@@ -22,15 +22,17 @@ def test_budgets_add_the_profiles_own_and_train_only_the_others(cfg):
     assert fc.extra_budgets(cfg) == [500, 3000]
 
 
-def test_a_point_is_the_tables_job_with_the_budget_alone_changed(cfg):
-    own = int(cfg["train"]["iterations"])
+@pytest.mark.parametrize("tree", ["sparse", "medium", "dense"])
+def test_a_point_is_the_tables_job_with_the_budget_alone_changed(cfg, tree):
+    """A point on a tree is that tree's job (its recipe included) at another budget."""
     for m in cfg["speed_accuracy"]["fit_curve"]["models"]:
-        assert fc.point_job(cfg, m, own) == job_spec(cfg, m, "single")
-        j = fc.point_job(cfg, m, 3000)
-        ref = job_spec(cfg, m, "single")
-        assert j["train"]["iterations"] == 3000
-        frac = cfg["train"]["warmup"] / own  # the static warm-up keeps its fraction
-        assert j["train"]["warmup"] == round(frac * 3000)
+        ref = job_spec(cfg, m, "single", tree=tree)
+        own = int(ref["train"]["iterations"])
+        assert fc.point_job(cfg, m, own, tree=tree) == ref
+        j = fc.point_job(cfg, m, 1500, tree=tree)
+        assert j["train"]["iterations"] == 1500
+        frac = ref["train"]["warmup"] / own  # the static warm-up keeps its fraction
+        assert j["train"]["warmup"] == round(frac * 1500)
         strip = lambda d: {
             **d,
             "train": {k: v for k, v in d["train"].items() if k not in ("iterations", "warmup")},

@@ -165,8 +165,10 @@ def test_a_search_cut_short_resumes_from_its_journal(swaying, tmp_path, monkeypa
     assert trials.loc[:1, params].equals(whole.loc[:1, params])
     assert np.isnan(trials.loc[2, "seconds"]) and not trials["seconds"].drop(2).isna().any()
     assert set(steps["trial"]) == {0, 1, 3}
-    assert steps[steps["trial"] < 2].reset_index(drop=True).equals(
-        whole_steps[whole_steps["trial"] < 2].reset_index(drop=True)
+    assert (
+        steps[steps["trial"] < 2]
+        .reset_index(drop=True)
+        .equals(whole_steps[whole_steps["trial"] < 2].reset_index(drop=True))
     )
     assert any("trial 2 was cut short" in line for line in lines)
     assert any("2 of 3 trials finished" in line for line in lines)

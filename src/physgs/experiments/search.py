@@ -379,8 +379,10 @@ def _study(base: dict, settings: SearchSettings, journal, *, log, label: str):
             study.enqueue_trial(t.params, user_attrs={"retry_of": t.number})
             log(f"{label}: trial {t.number} was cut short: kept as FAIL, its recipe queued again")
     if held:
-        done = sum(t.state in (optuna.trial.TrialState.COMPLETE, optuna.trial.TrialState.PRUNED)
-                   for t in study.trials)
+        done = sum(
+            t.state in (optuna.trial.TrialState.COMPLETE, optuna.trial.TrialState.PRUNED)
+            for t in study.trials
+        )
         log(f"{label}: resumed from {journal}: {done} of {settings.trials} trials finished")
     return study
 
