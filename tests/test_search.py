@@ -4,9 +4,11 @@ import copy
 import re
 import subprocess
 import sys
+from pathlib import Path
 
 import numpy as np
 import optuna
+import pandas as pd
 import pytest
 
 from physgs.config_checks import recipes_are_known, search_is_runnable, warmup_below_iterations
@@ -17,6 +19,7 @@ from physgs.experiments.search import (
     recipe_yaml,
     run_search,
     space_of,
+    summary,
     trial_job,
     window_scorer,
 )
@@ -219,3 +222,41 @@ def test_the_search_is_a_target_of_its_own_over_every_tree(tmp_path):
     planned = set(re.findall(r"output: results/search/(\w+)/(\w+)\.trials\.csv", r.stdout))
     models = quick_config()["search"]["models"]
     assert planned == {(t, m) for t in ("sparse", "dense") for m in models}
+
+
+def test_the_summary_keeps_a_searched_recipe_only_above_the_adoption_gain():
+    """Per search: the own recipe is trial 0, the best the complete trial of the lowest loss
+    (a pruned trial never, however low its last score), the gain their PSNR difference."""
+    rows = [  # tree, model, number, state, loss, psnr
+        ("sparse", "mlp", 0, "COMPLETE", 0.030, 24.00),
+        ("sparse", "mlp", 1, "COMPLETE", 0.020, 24.30),
+        ("sparse", "mlp", 2, "PRUNED", 0.010, None),
+        ("dense", "ours", 0, "COMPLETE", 0.010, 30.00),
+        ("dense", "ours", 1, "COMPLETE", 0.009, 30.05),
+        ("dense", "ours", 2, "FAIL", None, None),
+    ]
+    trials = pd.DataFrame(
+        rows, columns=["tree", "model", "number", "state", "holdout_loss", "holdout_psnr"]
+    )
+    found = summary(trials, adopt_above_db=0.1).set_index(["tree", "model"])
+    assert list(found.index) == [("sparse", "mlp"), ("dense", "ours")]
+    mlp, ours = found.loc[("sparse", "mlp")], found.loc[("dense", "ours")]
+    assert (mlp["trials"], mlp["complete"], mlp["best_trial"]) == (3, 2, 1)
+    assert mlp["gain_db"] == pytest.approx(0.30) and mlp["recipe"] == "searched"
+    assert (ours["trials"], ours["complete"], ours["best_trial"]) == (3, 2, 1)
+    assert ours["gain_db"] == pytest.approx(0.05) and ours["recipe"] == "config's"
+    assert summary(trials, adopt_above_db=0.5).set_index("model").loc["mlp", "recipe"] == "config's"
+
+
+def test_the_docs_search_summary_is_the_committed_searches():
+    """docs/studies/search_summary.md is what tools/search_summary.py makes of the committed
+    trials files."""
+    files = sorted(str(p) for p in Path("docs/studies/search").glob("*.trials.csv"))
+    r = subprocess.run(
+        [sys.executable, "tools/search_summary.py", *files, "--check"]
+        + ["--markdown", "docs/studies/search_summary.md"],
+        capture_output=True,
+        text=True,
+        timeout=120,
+    )
+    assert r.returncode == 0, r.stderr

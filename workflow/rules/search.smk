@@ -49,6 +49,7 @@ rule search:
     output:
         trials="results/search/trials.csv",
         recipes="results/search/recipes.yaml",
+        summary="results/search/summary.md",
     log:
         "logs/search/collect.log",
     conda:
@@ -57,5 +58,7 @@ rule search:
     resources:
         mem_mb=1000,
         runtime=5,
+    params:
+        adopt_above_db=CFG["search"]["adopt_above_db"],
     script:
         "../scripts/search_collect.py"

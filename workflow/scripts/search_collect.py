@@ -1,10 +1,11 @@
-"""Snakemake script of rule `search`: every search's trials in one CSV, the chosen recipes in one
-YAML block for config/trees.yaml."""
+"""Snakemake script of rule `search`: every search's trials in one CSV, the best recipes in one
+YAML block for config/trees.yaml, and what each search found (which recipe stays)."""
 
 from pathlib import Path
 
 import pandas as pd
 
+from physgs.experiments.search import summary
 from physgs.jobs import job
 
 sm = snakemake  # noqa: F821 (injected by Snakemake)
@@ -16,4 +17,6 @@ with job(sm) as log:
         for p in sm.input.recipes
     )
     Path(sm.output.recipes).write_text(text)
+    found = summary(trials, sm.params.adopt_above_db)
+    Path(sm.output.summary).write_text(found.to_markdown(index=False, floatfmt=".2f") + "\n")
     print(f"{len(trials)} trials, {len(sm.input.recipes)} recipes", file=log)

@@ -387,6 +387,51 @@ def _study(base: dict, settings: SearchSettings, journal, *, log, label: str):
     return study
 
 
+#: the columns of a search summary (``summary``), one row per tree and model
+SUMMARY_FIELDS = (
+    "tree",
+    "model",
+    "trials",
+    "complete",
+    "own_psnr",
+    "best_psnr",
+    "best_trial",
+    "gain_db",
+    "recipe",
+)
+
+
+def summary(trials: pd.DataFrame, adopt_above_db: float) -> pd.DataFrame:
+    """What each search found: its config's own recipe against its best, and which one stays.
+
+    Args:
+        trials: ``run_search``'s trials of one or more searches (``tree``, ``model`` columns;
+            trial 0 of each is the config's own recipe).
+        adopt_above_db: the gain on the held-out window frames (dB) a best trial must exceed to
+            replace the config's recipe (``search.adopt_above_db``).
+
+    Returns:
+        One row per (tree, model) in ``trials``' order (``SUMMARY_FIELDS``): trials run and
+        complete, the own and the best complete trial's held-out PSNR (dB), the best trial's
+        number, the gain (dB), and ``recipe``: ``"searched"`` where the gain exceeds
+        ``adopt_above_db``, else ``"config's"``.
+    """
+    rows = []
+    for (tree, model), t in trials.groupby(["tree", "model"], sort=False):
+        done = t[t["state"] == "COMPLETE"]
+        best = done.loc[done["holdout_loss"].idxmin()]
+        own = float(t.loc[t["number"] == 0, "holdout_psnr"].iloc[0])
+        gain = float(best["holdout_psnr"]) - own
+        rows.append(
+            dict(
+                tree=tree, model=model, trials=len(t), complete=len(done), own_psnr=own,
+                best_psnr=float(best["holdout_psnr"]), best_trial=int(best["number"]),
+                gain_db=gain, recipe="searched" if gain > adopt_above_db else "config's",
+            )
+        )  # fmt: skip
+    return pd.DataFrame(rows, columns=list(SUMMARY_FIELDS))
+
+
 def recipe_yaml(tree: str, model: str, trials: pd.DataFrame, recipe: dict) -> str:
     """The best recipe as a ``recipes`` block for config/trees.yaml, its evidence in a comment.
 
