@@ -218,9 +218,9 @@ def test_window_series_is_the_field_with_only_its_time_encoding_changed(cfg):
     cfg["models"]["mlp"]["time_top_hz"] = {"mlp": 1.5, "mlp_wind": "window"}
     cfg["speed_accuracy"]["fit_curve"]["models"] = ["mlp", "mlp_wind", "ours"]
     assert fc.window_models(cfg) == ["mlp"]
-    own = int(cfg["train"]["iterations"])
-    j = fc.point_job(cfg, "mlp", own, window_time=True)
-    ref = job_spec(cfg, "mlp", "single")
+    ref = job_spec(cfg, "mlp", "single", tree="sparse")  # its recipe there included
+    own = int(ref["train"]["iterations"])
+    j = fc.point_job(cfg, "mlp", own, window_time=True, tree="sparse")
     assert ref["settings"]["mlp"]["time_top_hz"]["mlp"] == 1.5
     assert j["settings"]["mlp"]["time_top_hz"]["mlp"] == "window"
     j["settings"]["mlp"]["time_top_hz"]["mlp"] = 1.5
