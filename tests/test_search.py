@@ -10,6 +10,7 @@ import numpy as np
 import optuna
 import pandas as pd
 import pytest
+import yaml
 
 from physgs.config_checks import recipes_are_known, search_is_runnable, warmup_below_iterations
 from physgs.experiments.recipe import fit, job_spec, tree_recipe
@@ -18,6 +19,7 @@ from physgs.experiments.search import (
     SearchSettings,
     recipe_yaml,
     run_search,
+    recipes_block,
     space_of,
     summary,
     trial_job,
@@ -260,3 +262,41 @@ def test_the_docs_search_summary_is_the_committed_searches():
         timeout=120,
     )
     assert r.returncode == 0, r.stderr
+
+
+def test_the_recipes_block_holds_only_the_recipes_that_replace_the_configs():
+    """The block pasted into config/trees.yaml is the searched recipes the summary keeps,
+    under ``recipes:``, with their comments; a recipe within the rule is left out."""
+    texts = [
+        recipe_yaml(
+            "sparse",
+            "mlp",
+            trials_of("sparse", "mlp", 24.0, 24.5),
+            {"train": {"lr": {"deform": 0.002}}},
+        ),
+        recipe_yaml(
+            "dense",
+            "ours",
+            trials_of("dense", "ours", 30.0, 30.05),
+            {"train": {"lr": {"pivot": 0.001}}},
+        ),
+    ]
+    trials = pd.concat(
+        [trials_of("sparse", "mlp", 24.0, 24.5), trials_of("dense", "ours", 30.0, 30.05)]
+    )
+    block = recipes_block(texts, summary(trials, adopt_above_db=0.1))
+    assert yaml.safe_load(block) == {
+        "recipes": {"sparse": {"mlp": {"train": {"lr": {"deform": 0.002}}}}}
+    }
+    assert "  # sparse mlp: trial 1 of 2" in block
+    assert yaml.safe_load(recipes_block(texts, summary(trials, adopt_above_db=1.0))) == {
+        "recipes": None
+    }
+
+
+def trials_of(tree, model, own, best):
+    """Two complete trials of a search: the config's own recipe and a better one (PSNR, dB)."""
+    return pd.DataFrame(
+        [(tree, model, 0, "COMPLETE", 0.02, own), (tree, model, 1, "COMPLETE", 0.01, best)],
+        columns=["tree", "model", "number", "state", "holdout_loss", "holdout_psnr"],
+    )

@@ -56,7 +56,7 @@ import pandas as pd
 
 import physgs.config
 from physgs.experiments.cost import dry_run, plan_jobs, plan_outputs, summarise
-from physgs.provenance import EVERY_JOB_ENV, config_hash, git_commit, machine_cpu
+from physgs.provenance import EVERY_JOB_ENV, config_hash, git_commit, machine_cpu, read_stamped
 from physgs.report import record
 from physgs.report.claim_cells import roles_of
 from snakemake.cli import parse_config
@@ -201,7 +201,7 @@ def main() -> None:
         print(f"{args.out}: {len(record.render_pages(args.out))} pages laid out again")
     elif not args.readme_only:
         r = args.results
-        fit = pd.read_csv(r / "tables" / "tab_fit.csv", dtype={"config_hash": str})
+        fit = read_stamped(r / "tables" / "tab_fit.csv")
         config = _run_items(str(fit["profile"].iloc[0]), args.config)
         here = str(fit["config_hash"].iloc[0])
         outputs, benchmarks = _plan(config, args.configfile, here)

@@ -21,8 +21,6 @@ import physgs.config
 from physgs.experiments.search import summary
 from physgs.models.registry import label
 
-#: the order the page lists the searches in
-TREES = ("sparse", "medium", "dense")
 #: the page's column headers
 HEADERS = {
     "own_psnr": "own (dB)",
@@ -43,9 +41,8 @@ def main(argv: list[str] | None = None) -> int:
     cfg = physgs.config.load(args.config)
     trials = pd.concat([pd.read_csv(p) for p in sorted(args.trials)], ignore_index=True)
     found = summary(trials, float(cfg["search"]["adopt_above_db"]))
-    found = found.sort_values(
-        "tree", key=lambda t: t.map({k: i for i, k in enumerate(TREES)}), kind="stable"
-    )
+    order = {t: i for i, t in enumerate(cfg["trees"])}  # the config's order of the trees
+    found = found.sort_values("tree", key=lambda t: t.map(order), kind="stable")
     found["model"] = found["model"].map(label)
     found = found.rename(columns=HEADERS)
     text = found.to_markdown(index=False, floatfmt=".2f") + "\n"

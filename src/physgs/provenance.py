@@ -96,6 +96,21 @@ def stamp(cfg: dict) -> Stamp:
     return Stamp(str(cfg.get("profile", "unknown")), config_hash(cfg), package_version())
 
 
+def read_stamped(path) -> "pandas.DataFrame":  # noqa: F821 (pandas: imported when called)
+    """A CSV whose rows carry a [`Stamp`][physgs.provenance.Stamp] (a run's table, its claims),
+    the config hash read as text: a hash of digits stays one.
+
+    Args:
+        path (str | Path): the CSV.
+
+    Returns:
+        Its rows.
+    """
+    import pandas as pd  # not at the top: the Snakefile imports this module to plan
+
+    return pd.read_csv(path, dtype={"config_hash": str})
+
+
 def machine_cpu(cpuinfo: str | Path = "/proc/cpuinfo") -> str:
     """The CPU's model and whether it computes bf16 natively (AVX-512 BF16, AMX): what a
     timing depends on (the fields run in bf16).

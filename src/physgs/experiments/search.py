@@ -418,9 +418,7 @@ def summary(trials: pd.DataFrame, adopt_above_db: float) -> pd.DataFrame:
     """
     rows = []
     for (tree, model), t in trials.groupby(["tree", "model"], sort=False):
-        done = t[t["state"] == "COMPLETE"]
-        best = done.loc[done["holdout_loss"].idxmin()]
-        own = float(t.loc[t["number"] == 0, "holdout_psnr"].iloc[0])
+        own, best, done = _own_and_best(t)
         gain = float(best["holdout_psnr"]) - own
         rows.append(
             dict(
@@ -430,6 +428,14 @@ def summary(trials: pd.DataFrame, adopt_above_db: float) -> pd.DataFrame:
             )
         )  # fmt: skip
     return pd.DataFrame(rows, columns=list(SUMMARY_FIELDS))
+
+
+def _own_and_best(trials: pd.DataFrame) -> tuple[float, pd.Series, pd.DataFrame]:
+    """One search's own recipe's held-out PSNR (dB, trial 0), its best complete trial (the
+    objective's lowest, as Optuna's ``best_trial``) and its complete trials."""
+    done = trials[trials["state"] == "COMPLETE"]
+    own = float(trials.loc[trials["number"] == 0, "holdout_psnr"].iloc[0])
+    return own, done.loc[done["holdout_loss"].idxmin()], done
 
 
 def recipe_yaml(tree: str, model: str, trials: pd.DataFrame, recipe: dict) -> str:
@@ -447,12 +453,34 @@ def recipe_yaml(tree: str, model: str, trials: pd.DataFrame, recipe: dict) -> st
     """
     import yaml
 
-    done = trials[trials["state"] == "COMPLETE"]
-    best = done.loc[done["holdout_loss"].idxmin()]
-    own = trials.loc[trials["number"] == 0, "holdout_psnr"].iloc[0]
+    own, best, done = _own_and_best(trials)
     head = (
         f"# {tree} {model}: trial {int(best['number'])} of {len(trials)} ({len(done)} complete), "
         f"held-out window frames {best['holdout_psnr']:.2f} dB against the config's "
         f"{own:.2f} dB (trial 0)\n"
     )
     return head + yaml.safe_dump({tree: {model: recipe}}, sort_keys=True)
+
+
+def recipes_block(texts: list[str], found: pd.DataFrame) -> str:
+    """The searched recipes that replace the config's, as one ``recipes:`` block.
+
+    Args:
+        texts: ``recipe_yaml`` texts (``{tree: {model: recipe}}`` under their comment).
+        found: ``summary`` of the same searches: a recipe is kept where its ``recipe`` is
+            ``"searched"``.
+
+    Returns:
+        YAML text for config/trees.yaml: ``recipes:`` and the kept texts indented under it,
+        their comments included.
+    """
+    import yaml
+
+    kept = {(r.tree, r.model) for r in found.itertuples() if r.recipe == "searched"}
+    lines = [
+        f"  {line}\n"
+        for text in texts
+        if {(t, m) for t, by in yaml.safe_load(text).items() for m in by} <= kept
+        for line in text.splitlines()
+    ]
+    return "recipes:\n" + "".join(lines)

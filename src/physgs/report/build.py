@@ -16,6 +16,7 @@ import pandas as pd
 from physgs.atomic import atomic_path, write_text
 from physgs.config import study_seeds
 from physgs.models.registry import BASE_CONFIG, models_of
+from physgs.provenance import read_stamped
 from physgs.recovery.record import load_recovery
 from physgs.report import catalogue, claims, tables
 from physgs.report.claim_cells import CONFIG as CLAIMS_CONFIG
@@ -82,7 +83,7 @@ def read_table(name: str, path) -> pd.DataFrame:
         The table.
     """
     o = _output(name, "table")
-    df = pd.read_csv(path, dtype={"config_hash": str})  # a hash of digits stays text
+    df = read_stamped(path)
     o.columns.check(name, list(df.columns))
     return df
 
@@ -135,7 +136,7 @@ def make_claims(
     sd = stamp.to_dict() if stamp is not None else None
     with atomic_path(csv_path) as tmp:
         (df.assign(**sd) if sd else df).to_csv(tmp, index=False, float_format="%.6g")
-    stored = pd.read_csv(csv_path, dtype={"config_hash": str})  # the page prints the CSV's digits
+    stored = read_stamped(csv_path)  # the page prints the CSV's digits
     write_text(md_path, claims.ledger_markdown(stored, sd))
     return df
 

@@ -23,6 +23,7 @@ import pandas as pd
 from PIL import Image
 
 from physgs.experiments import cost
+from physgs.provenance import read_stamped
 from physgs.report import captions, catalogue, claims as ledger, rerun
 from physgs.report.prose import PROSE, data, say
 
@@ -170,7 +171,7 @@ def other_configs(files: Iterable[str | Path], config_hash: str) -> list[str]:
     Returns:
         One phrase per file that disagrees: its path and the hashes it holds.
     """
-    found = [(f, config_hashes(_read(f))) for f in files]
+    found = [(f, config_hashes(read_stamped(f))) for f in files]
     return [
         f"{f}: config_hash {', '.join(h) or 'none'}, not {config_hash}"
         for f, h in found
@@ -188,11 +189,6 @@ def config_hashes(df: pd.DataFrame) -> list[str] | None:
         The hashes, sorted; None for a table without the column (not judged).
     """
     return sorted({str(h) for h in df["config_hash"].dropna()}) if "config_hash" in df else None
-
-
-def _read(path: str | Path) -> pd.DataFrame:
-    """A run's CSV, the config hash read as text (a hash of digits stays one)."""
-    return pd.read_csv(path, dtype={"config_hash": str})
 
 
 def format_duration(seconds: float) -> str:
@@ -268,7 +264,7 @@ def _rerun_page(
     old = json.loads((previous / "stamp.json").read_text())
     h = old.get("config_hash")
     settings = PROSE["rerun_same"] if h == stamp.config_hash else say("rerun_other", hash=h)
-    c = rerun.compare_claims(_read(previous / "claims.csv"), _read(claims_csv), first)
+    c = rerun.compare_claims(read_stamped(previous / "claims.csv"), read_stamped(claims_csv), first)
     n, new, gone = len(c.changed), len(c.only_new), len(c.only_old)
     old_run = {"commit": stamp.commit, "old": old.get("commit"), "date": old.get("date")}
     both = {"same": c.same, "both": c.same + n, "changed": n, "new": new, "old": gone}
@@ -298,7 +294,7 @@ def _rerun_page(
         before = previous / "tables" / t.name
         if not before.is_file():
             continue
-        a, b = _read(before), _read(t)
+        a, b = read_stamped(before), read_stamped(t)
         if "seed" not in a.columns or "seed" not in b.columns:
             same = "identical" if a.equals(b) else "changed"
             rows.append((f"`{t.stem}` (not seeded)", len(b), "", same, "", ""))
@@ -557,7 +553,7 @@ def derive_claims(record_dir: str | Path) -> list[Path]:
         text.insert(at, "kind", ledger.column(text, "kind"))
         text.to_csv(path, index=False)
         written.append(path)
-    df = _read(path)
+    df = read_stamped(path)
     stamp = {c: str(df[c].iloc[0]) for c in STAMP_COLUMNS if c in df and len(df)}
     pages = {out / "claims.md": _demote(ledger.ledger_markdown(df, stamp or None))}
     if (out / "summary.md").is_file():  # its other sections come from files the record lacks
@@ -613,7 +609,7 @@ def render_pages(record_dir: str | Path) -> list[Path]:
         f"![{n}](record/figures/{n}.png)\n\n{captions.caption(n, stamp.seeds)}\n" for n in names
     )
     pages["ledger.md"] = ledger_page(out / "claims.csv", stamp.trees)
-    counts, *bullets = _lead(_read(out / "claims.csv"), "index_ledger")
+    counts, *bullets = _lead(read_stamped(out / "claims.csv"), "index_ledger")
     led = "\n\n".join([counts, *(b[2:] for b in bullets)])  # its bullets as paragraphs
     pages["index.md"] = INDEX_PAGE.format(s=stamp, seeds=_join(stamp.seeds), ledger=led)
     for name, text in pages.items():
@@ -641,7 +637,7 @@ def ledger_page(claims_csv: str | Path, trees: Sequence[str]) -> str:
     Returns:
         The page part: raw HTML, ending in a newline.
     """
-    claims = _read(claims_csv)
+    claims = read_stamped(claims_csv)
     # a ledger of fewer columns (an older or a partial one) shows what it has
     shown = {"paper": "--", "source": "--", "threshold": "", "unit": "", "seeds": 0}
     shown |= {c: np.nan for c in ("measured", "ci_low", "ci_high")}
@@ -847,7 +843,8 @@ def found_lines(record_dir: str | Path) -> list[str]:
         phrase = instances_phrase(s.get("instances") or {})
         fields = {"profile": s["profile"], "seeds": _join(s["seeds"]), "commit": s["commit"]}
         run = say("found_run", **fields, made_with=made_with, instances=phrase)
-        found = [run, "\n".join(headline_lines(_read(record / "claims.csv"))), PROSE["words"]]
+        heads = headline_lines(read_stamped(record / "claims.csv"))
+        found = [run, "\n".join(heads), PROSE["words"]]
     costs = "\n".join(cost_lines(read_costs(record / "costs.csv")))
     return _blocks(PROSE["found_head"], *found, PROSE["found_costs"], costs).split("\n")
 

@@ -12,6 +12,7 @@ from typing import Mapping
 import numpy as np
 import pandas as pd
 
+from physgs.provenance import read_stamped
 from physgs.report.claims import Claim, on_claim
 from physgs.report.outputs import OUTPUTS, PROVENANCE_COLUMNS
 
@@ -117,8 +118,7 @@ def compare_table_csv(old_csv, new_csv, keys: list[str] | None = None) -> RerunC
     Returns:
         The [`RerunComparison`][physgs.report.rerun.RerunComparison].
     """
-    text = {"config_hash": str}  # a hash of digits stays text
-    a, b = pd.read_csv(old_csv, dtype=text), pd.read_csv(new_csv, dtype=text)
+    a, b = read_stamped(old_csv), read_stamped(new_csv)
     name = Path(old_csv).stem
     keys = table_keys(name, a) if keys is None else keys
     return compare_seeded(a, b, keys, timing=timing_columns(name))

@@ -15,6 +15,7 @@ import pandas as pd
 
 from physgs.experiments.cost import read_costs, summarise, wall_spans
 from physgs.models.registry import label
+from physgs.provenance import read_stamped
 from physgs.report.thresholds import FIT_BAR
 from physgs.report.catalogue import AHEAD
 from physgs.report.claims import column, counted, decide_cell, failed_premises, number
@@ -178,8 +179,7 @@ def run_summary(stamp: Mapping[str, str], claims_csv, tab_fit_csv, benchmark_dir
     for p in (claims_csv, tab_fit_csv):
         if not Path(p).is_file():
             raise FileNotFoundError(f"{p}: missing (run `snakemake --cores 2 all` first)")
-    claims = pd.read_csv(claims_csv, dtype={"config_hash": str})
-    tab_fit = pd.read_csv(tab_fit_csv, dtype={"config_hash": str})
+    claims, tab_fit = read_stamped(claims_csv), read_stamped(tab_fit_csv)
     seeds = sorted(int(x) for x in tab_fit["seed"].unique())
     made_by = ", ".join(f"{k}={v}" for k, v in stamp.items())
     trees = ", ".join(dict.fromkeys(tab_fit["tree"]))
