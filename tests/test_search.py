@@ -245,7 +245,8 @@ def test_the_summary_keeps_a_searched_recipe_only_above_the_adoption_gain():
     mlp, ours = found.loc[("sparse", "mlp")], found.loc[("dense", "ours")]
     assert (mlp["trials"], mlp["complete"], mlp["best_trial"]) == (3, 2, 1)
     assert mlp["gain_db"] == pytest.approx(0.30) and mlp["recipe"] == "searched"
-    assert (ours["trials"], ours["complete"], ours["best_trial"]) == (3, 2, 1)
+    assert (ours["trials"], ours["complete"], ours["cut"], ours["best_trial"]) == (2, 2, 1, 1)
+    assert mlp["cut"] == 0
     assert ours["gain_db"] == pytest.approx(0.05) and ours["recipe"] == "config's"
     assert summary(trials, adopt_above_db=0.5).set_index("model").loc["mlp", "recipe"] == "config's"
 

@@ -3,10 +3,10 @@
     python tools/search_summary.py docs/studies/search/*.trials.csv \
         --markdown docs/studies/search_summary.md [--check]
 
-Each row (`physgs.experiments.search.summary`): trials run and complete, the config's own recipe's
-held-out window PSNR (trial 0) and the best complete trial's, the gain, and which recipe the
-config keeps by `search.adopt_above_db` (read from config/trees.yaml). `--check` writes nothing
-and exits 1 when the page is out of date.
+Each row (`physgs.experiments.search.summary`): trials scored and complete, those cut short
+(trained again on resuming), the config's own recipe's held-out window PSNR (trial 0) and the
+best complete trial's, the gain, and which recipe the config keeps by `search.adopt_above_db`
+(read from config/trees.yaml). `--check` writes nothing and exits 1 when the page is out of date.
 """
 
 from __future__ import annotations
@@ -23,6 +23,8 @@ from physgs.models.registry import label
 
 #: the page's column headers
 HEADERS = {
+    "trials": "trials scored",
+    "cut": "cut, trained again",
     "own_psnr": "own (dB)",
     "best_psnr": "best (dB)",
     "best_trial": "best trial",

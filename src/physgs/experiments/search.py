@@ -393,6 +393,7 @@ SUMMARY_FIELDS = (
     "model",
     "trials",
     "complete",
+    "cut",
     "own_psnr",
     "best_psnr",
     "best_trial",
@@ -411,8 +412,9 @@ def summary(trials: pd.DataFrame, adopt_above_db: float) -> pd.DataFrame:
             replace the config's recipe (``search.adopt_above_db``).
 
     Returns:
-        One row per (tree, model) in ``trials``' order (``SUMMARY_FIELDS``): trials run and
-        complete, the own and the best complete trial's held-out PSNR (dB), the best trial's
+        One row per (tree, model) in ``trials``' order (``SUMMARY_FIELDS``): the trials scored
+        (the budget's: complete or pruned) and complete, those cut short (``FAIL``: a search
+        resumed trains their recipes again, as later trials), the own and the best complete trial's held-out PSNR (dB), the best trial's
         number, the gain (dB), and ``recipe``: ``"searched"`` where the gain exceeds
         ``adopt_above_db``, else ``"config's"``.
     """
@@ -422,7 +424,8 @@ def summary(trials: pd.DataFrame, adopt_above_db: float) -> pd.DataFrame:
         gain = float(best["holdout_psnr"]) - own
         rows.append(
             dict(
-                tree=tree, model=model, trials=len(t), complete=len(done), own_psnr=own,
+                tree=tree, model=model, trials=int((t["state"] != "FAIL").sum()),
+                complete=len(done), cut=int((t["state"] == "FAIL").sum()), own_psnr=own,
                 best_psnr=float(best["holdout_psnr"]), best_trial=int(best["number"]),
                 gain_db=gain, recipe="searched" if gain > adopt_above_db else "config's",
             )
