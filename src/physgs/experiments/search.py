@@ -414,9 +414,9 @@ def summary(trials: pd.DataFrame, adopt_above_db: float) -> pd.DataFrame:
     Returns:
         One row per (tree, model) in ``trials``' order (``SUMMARY_FIELDS``): the trials scored
         (the budget's: complete or pruned) and complete, those cut short (``FAIL``: a search
-        resumed trains their recipes again, as later trials), the own and the best complete trial's held-out PSNR (dB), the best trial's
-        number, the gain (dB), and ``recipe``: ``"searched"`` where the gain exceeds
-        ``adopt_above_db``, else ``"config's"``.
+        resumed trains their recipes again, as later trials), the own and the best complete
+        trial's held-out PSNR (dB), the best trial's number, the gain (dB), and ``recipe``:
+        ``"searched"`` where the gain exceeds ``adopt_above_db``, else ``"config's"``.
     """
     rows = []
     for (tree, model), t in trials.groupby(["tree", "model"], sort=False):
