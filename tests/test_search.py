@@ -247,6 +247,10 @@ def test_the_summary_keeps_a_searched_recipe_only_above_the_adoption_gain():
     assert mlp["gain_db"] == pytest.approx(0.30) and mlp["recipe"] == "searched"
     assert (ours["trials"], ours["complete"], ours["cut"], ours["best_trial"]) == (2, 2, 1, 1)
     assert mlp["cut"] == 0
+    cut = trials[trials["model"] == "ours"]  # the recipe's comment counts the budget's trials too
+    assert recipe_yaml("dense", "ours", cut, {}).startswith(
+        "# dense ours: trial 1 of 2 (2 complete)"
+    )
     assert ours["gain_db"] == pytest.approx(0.05) and ours["recipe"] == "config's"
     assert summary(trials, adopt_above_db=0.5).set_index("model").loc["mlp", "recipe"] == "config's"
 

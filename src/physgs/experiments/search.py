@@ -30,7 +30,6 @@ from physgs.mappings import deep_merge
 from physgs.models.registry import spec_of
 from physgs.models.timescale import WINDOW_TIME
 
-
 #: the columns of a search's steps file: every held-out score a trial reported
 STEP_FIELDS = ("trial", "iteration", "holdout_loss", "holdout_psnr")
 
@@ -424,13 +423,18 @@ def summary(trials: pd.DataFrame, adopt_above_db: float) -> pd.DataFrame:
         gain = float(best["holdout_psnr"]) - own
         rows.append(
             dict(
-                tree=tree, model=model, trials=int((t["state"] != "FAIL").sum()),
-                complete=len(done), cut=int((t["state"] == "FAIL").sum()), own_psnr=own,
+                tree=tree, model=model, trials=_scored(t), complete=len(done),
+                cut=len(t) - _scored(t), own_psnr=own,
                 best_psnr=float(best["holdout_psnr"]), best_trial=int(best["number"]),
                 gain_db=gain, recipe="searched" if gain > adopt_above_db else "config's",
             )
         )  # fmt: skip
     return pd.DataFrame(rows, columns=list(SUMMARY_FIELDS))
+
+
+def _scored(trials: pd.DataFrame) -> int:
+    """The trials the budget counts: every one but those cut short (``FAIL``)."""
+    return int((trials["state"] != "FAIL").sum())
 
 
 def _own_and_best(trials: pd.DataFrame) -> tuple[float, pd.Series, pd.DataFrame]:
@@ -458,7 +462,8 @@ def recipe_yaml(tree: str, model: str, trials: pd.DataFrame, recipe: dict) -> st
 
     own, best, done = _own_and_best(trials)
     head = (
-        f"# {tree} {model}: trial {int(best['number'])} of {len(trials)} ({len(done)} complete), "
+        f"# {tree} {model}: trial {int(best['number'])} of {_scored(trials)} "
+        f"({len(done)} complete), "
         f"held-out window frames {best['holdout_psnr']:.2f} dB against the config's "
         f"{own:.2f} dB (trial 0)\n"
     )
