@@ -105,7 +105,9 @@ def test_search_scores_every_trial_on_its_held_out_window_frames_and_keeps_the_b
     settings = SearchSettings(trials=3, every=6, startup=1, seed=3, prune_after=0.5)
     lines = []
     trials, steps, best = run_search(swaying, base, settings, tree="sparse", log=lines.append)
-    assert len(trials) == 3 and len(lines) == 4
+    # a line per trial and the closing line, and one per held-out score a trial reported
+    scored = [line for line in lines if ", iteration " in line]
+    assert len(trials) == 3 and len(lines) - len(scored) == 4
     assert list(trials["number"]) == [0, 1, 2]
     # trial 0 is the config's recipe: its objective is that job's held-out window loss (an
     # independent training and scoring of the job)
@@ -130,6 +132,11 @@ def test_search_scores_every_trial_on_its_held_out_window_frames_and_keeps_the_b
     assert set(steps["iteration"]) <= {6, 12, 18}
     pruned = trials[trials["state"] == "PRUNED"]
     assert (ends[pruned["number"]] == 12).all()
+    # the progress lines are the scores the pruner read: each is a step, a pruned trial's all
+    logged = {tuple(map(int, re.search(r"trial (\d+), iteration (\d+):", line).groups()))
+              for line in scored}  # fmt: skip
+    assert logged and logged <= set(zip(steps["trial"], steps["iteration"]))
+    assert set(zip(pruned["number"], ends[pruned["number"]])) <= logged
     text = recipe_yaml("sparse", "mlp_wind", trials, best)
     assert text.startswith("# sparse mlp_wind: trial ") and "mlp_wind:" in text
 

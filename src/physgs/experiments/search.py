@@ -241,7 +241,7 @@ def run_search(
             registry id with a space (``SPACES``): every trial is this job with its recipe over it.
         settings: the budget.
         tree: the tree's name (the rows' and the log lines' label).
-        log: where one line per trial goes (progress).
+        log: where the progress goes: a line per held-out score and per trial.
         journal: the journal file that makes the search resumable; None: in memory only.
 
     Returns:
@@ -274,6 +274,8 @@ def run_search(
             if it <= warmup or it % settings.every:
                 return None
             loss = score(it, mdl)
+            # a trial runs minutes to an hour: each held-out score is the search's progress
+            log(f"{tree} {model}: trial {trial.number}, iteration {it}: {steps[-1][2]:.2f} dB")
             trial.report(loss, it)
             if trial.should_prune():
                 raise optuna.TrialPruned(f"held-out window loss {loss:.4f} at iteration {it}")
