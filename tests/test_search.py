@@ -22,6 +22,7 @@ from physgs.experiments.search import (
     recipes_block,
     space_of,
     summary,
+    trade,
     trial_job,
     window_scorer,
 )
@@ -176,6 +177,7 @@ def test_a_search_cut_short_resumes_from_its_journal(swaying, tmp_path, monkeypa
     )
     assert trials.loc[:1, params].equals(whole.loc[:1, params])
     assert np.isnan(trials.loc[2, "seconds"]) and not trials["seconds"].drop(2).isna().any()
+    assert np.isnan(trials.loc[2, "cpu_seconds"]) and (trials["cpu_seconds"].drop(2) > 0).all()
     assert set(steps["trial"]) == {0, 1, 3}
     assert (
         steps[steps["trial"] < 2]
@@ -263,12 +265,13 @@ def test_the_summary_keeps_a_searched_recipe_only_above_the_adoption_gain():
 
 
 def test_the_docs_search_summary_is_the_committed_searches():
-    """docs/studies/search_summary.md is what tools/search_summary.py makes of the committed
-    trials files."""
+    """docs/studies/search_summary.md and search_trade.md are what tools/search_summary.py
+    makes of the committed trials files."""
     files = sorted(str(p) for p in Path("docs/studies/search").glob("*.trials.csv"))
     r = subprocess.run(
         [sys.executable, "tools/search_summary.py", *files, "--check"]
-        + ["--markdown", "docs/studies/search_summary.md"],
+        + ["--markdown", "docs/studies/search_summary.md"]
+        + ["--trade", "docs/studies/search_trade.md"],
         capture_output=True,
         text=True,
         timeout=120,
@@ -304,6 +307,46 @@ def test_the_recipes_block_holds_only_the_recipes_that_replace_the_configs():
     assert yaml.safe_load(recipes_block(texts, summary(trials, adopt_above_db=1.0))) == {
         "recipes": None
     }
+
+
+def test_the_trade_keeps_the_trials_no_cheaper_one_scores_above():
+    """Each search's front, against a brute force over its complete trials: a trial is on it
+    when every trial cheaper (or as cheap and no better) scores below it; CPU seconds where the
+    search has them for every trial, wall seconds otherwise."""
+    rng = np.random.default_rng(7)
+    rows = []
+    for model, n in (("mlp", 9), ("ours", 7)):
+        for i in range(n):
+            state = "PRUNED" if i % 4 == 3 else "COMPLETE"
+            rows.append(("dense", model, i, state, rng.uniform(20, 30), rng.uniform(50, 500)))
+    trials = pd.DataFrame(
+        rows, columns=["tree", "model", "number", "state", "holdout_psnr", "seconds"]
+    )
+    trials["holdout_loss"] = -trials["holdout_psnr"]
+    cpu = trials["seconds"] * rng.uniform(0.5, 1.0, len(trials))
+    trials["cpu_seconds"] = cpu.where(trials["model"] == "mlp")  # ours: wall time only
+    found = trade(trials)
+    for model, clock, name in (("mlp", "cpu_seconds", "cpu"), ("ours", "seconds", "wall")):
+        t = trials[(trials["model"] == model) & (trials["state"] == "COMPLETE")]
+        front = [
+            r.number
+            for r in t.itertuples()
+            if not any(
+                (getattr(o, clock) < getattr(r, clock) and o.holdout_psnr >= r.holdout_psnr)
+                or (getattr(o, clock) == getattr(r, clock) and o.holdout_psnr > r.holdout_psnr)
+                for o in t.itertuples()
+                if o.number != r.number
+            )
+        ]
+        mine = found[found["model"] == model]
+        assert sorted(mine["number"]) == sorted(front)
+        assert (mine["clock"] == name).all()
+        own = t[t["number"] == 0].iloc[0]
+        for r in mine.itertuples():
+            row = t[t["number"] == r.number].iloc[0]
+            assert r.seconds == row[clock] and r.cost_x == pytest.approx(row[clock] / own[clock])
+            assert r.delta_db == pytest.approx(row["holdout_psnr"] - own["holdout_psnr"])
+        assert list(mine["seconds"]) == sorted(mine["seconds"])
 
 
 def trials_of(tree, model, own, best):

@@ -1,12 +1,15 @@
 """What the committed recipe searches found: one row per tree and model, from their trials files.
 
     python tools/search_summary.py docs/studies/search/*.trials.csv \
-        --markdown docs/studies/search_summary.md [--check]
+        --markdown docs/studies/search_summary.md [--trade docs/studies/search_trade.md] \
+        [--figure docs/img/search_trade.png] [--check]
 
 Each row (`physgs.experiments.search.summary`): trials scored and complete, those cut short
 (trained again on resuming), the config's own recipe's held-out window PSNR (trial 0) and the
 best complete trial's, the gain, and which recipe the config keeps by `search.adopt_above_db`
-(read from config/trees.yaml). `--check` writes nothing and exits 1 when the page is out of date.
+(read from config/trees.yaml). `--trade`: each search's cost-accuracy front
+(`physgs.experiments.search.trade`), and `--figure` draws every complete trial's seconds against
+its held-out window PSNR. `--check` writes nothing and exits 1 when a page is out of date.
 """
 
 from __future__ import annotations
@@ -18,8 +21,8 @@ from pathlib import Path
 import pandas as pd
 
 import physgs.config
-from physgs.experiments.search import summary
-from physgs.models.registry import label
+from physgs.experiments.search import summary, trade
+from physgs.models.registry import MODEL_NAMES, label
 
 #: the page's column headers
 HEADERS = {
@@ -30,32 +33,90 @@ HEADERS = {
     "best_trial": "best trial",
     "gain_db": "gain (dB)",
     "recipe": "recipe kept",
+    "number": "trial",
+    "holdout_psnr": "held-out window (dB)",
+    "cost_x": "seconds / own",
+    "delta_db": "against own (dB)",
+    "own": "config's recipe",
 }
+
+
+def _markdown(df: pd.DataFrame, order: dict) -> str:
+    """``df`` with the config's order of the trees, the models' labels and the pages' headers."""
+    df = df.sort_values("tree", key=lambda t: t.map(order), kind="stable")
+    df = df.assign(model=df["model"].map(label)).rename(columns=HEADERS)
+    return df.to_markdown(index=False, floatfmt=".2f") + "\n"
+
+
+def _figure(trials: pd.DataFrame, front: pd.DataFrame, trees: list[str], path: Path) -> None:
+    """A panel per model: every complete trial's seconds against its held-out window PSNR, a
+    colour per tree, its front as a line and the config's recipe as a star."""
+    import matplotlib
+
+    import matplotlib.ticker
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    done = trials[trials["state"] == "COMPLETE"]
+    models = [m for m in MODEL_NAMES if m in set(done["model"])]
+    fig, axes = plt.subplots(2, -(-len(models) // 2), figsize=(12, 6.5), squeeze=False)
+    for ax, model in zip(axes.flat, models):
+        for i, tree in enumerate(trees):
+            t, f = (d[(d["model"] == model) & (d["tree"] == tree)] for d in (done, front))
+            c = f"C{i}"
+            ax.scatter(t["seconds"], t["holdout_psnr"], s=14, color=c, alpha=0.4)
+            ax.plot(f["seconds"], f["holdout_psnr"], "-o", ms=3, color=c, label=tree)
+            own = t[t["number"] == 0]
+            ax.scatter(own["seconds"], own["holdout_psnr"], marker="*", s=140, color=c, ec="k")
+        ax.set(title=label(model), xscale="log", xlabel="training seconds")
+        # 1-2-5 ticks, plain numbers: a panel's trials often span less than a decade
+        ax.xaxis.set_major_locator(matplotlib.ticker.LogLocator(subs=(1, 2, 5)))
+        ax.xaxis.set_major_formatter(matplotlib.ticker.ScalarFormatter())
+        ax.xaxis.set_minor_formatter(matplotlib.ticker.NullFormatter())
+        ax.set_ylabel("held-out window PSNR (dB)")
+        ax.legend(fontsize=8)
+    for ax in list(axes.flat)[len(models) :]:
+        ax.set_visible(False)
+    fig.suptitle("Recipe searches: what each recipe costs (star: the config's recipe)")
+    fig.tight_layout()
+    fig.savefig(path, dpi=110)
+    plt.close(fig)
 
 
 def main(argv: list[str] | None = None) -> int:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("trials", nargs="+", help="searches' trials CSVs")
     ap.add_argument("--markdown", required=True, help="the page to write")
+    ap.add_argument("--trade", help="the page of the searches' cost-accuracy fronts")
+    ap.add_argument("--figure", help="the PNG of every complete trial's cost and score")
     ap.add_argument("--config", default="config/trees.yaml")
-    ap.add_argument("--check", action="store_true", help="exit 1 if the page is out of date")
+    ap.add_argument("--check", action="store_true", help="exit 1 if a page is out of date")
     args = ap.parse_args(argv)
     cfg = physgs.config.load(args.config)
     trials = pd.concat([pd.read_csv(p) for p in sorted(args.trials)], ignore_index=True)
-    found = summary(trials, float(cfg["search"]["adopt_above_db"]))
     order = {t: i for i, t in enumerate(cfg["trees"])}  # the config's order of the trees
-    found = found.sort_values("tree", key=lambda t: t.map(order), kind="stable")
-    found["model"] = found["model"].map(label)
-    found = found.rename(columns=HEADERS)
-    text = found.to_markdown(index=False, floatfmt=".2f") + "\n"
-    out = Path(args.markdown)
+    pages = {
+        args.markdown: _markdown(summary(trials, float(cfg["search"]["adopt_above_db"])), order)
+    }
+    if args.trade:
+        front = trade(trials)
+        pages[args.trade] = _markdown(
+            front.assign(own=front["own"].map({True: "yes", False: ""})), order
+        )
     if args.check:
-        stale = not out.exists() or out.read_text() != text
-        if stale:
-            print(f"{out} is out of date: rerun without --check", file=sys.stderr)
-        return int(stale)
-    out.write_text(text)
-    print(f"{out}: {len(found)} searches")
+        stale = [
+            p for p, text in pages.items() if not Path(p).exists() or Path(p).read_text() != text
+        ]
+        for p in stale:
+            print(f"{p} is out of date: rerun without --check", file=sys.stderr)
+        return int(bool(stale))
+    for p, text in pages.items():
+        Path(p).write_text(text)
+        print(f"{p}: {text.count(chr(10)) - 2} rows")
+    if args.figure:
+        _figure(trials, trade(trials), list(cfg["trees"]), Path(args.figure))
+        print(args.figure)
     return 0
 
 

@@ -23,6 +23,7 @@ from dataclasses import asdict, dataclass
 from pathlib import Path
 from typing import Callable
 
+import numpy as np
 import pandas as pd
 
 from physgs.experiments.recipe import Job, fit, window_scorer
@@ -246,8 +247,8 @@ def run_search(
 
     Returns:
         ``(trials, steps, best)``: one row per trial (number, state, the objective, held-out
-        PSNR, the parameters, seconds; trial 0 is the config's own recipe), every reported score
-        (``STEP_FIELDS``), and the best complete trial's recipe.
+        PSNR, the parameters, wall and CPU seconds; trial 0 is the config's own recipe), every
+        reported score (``STEP_FIELDS``), and the best complete trial's recipe.
 
     Raises:
         ValueError: no space for the model, or no trial completed.
@@ -281,8 +282,14 @@ def run_search(
                 raise optuna.TrialPruned(f"held-out window loss {loss:.4f} at iteration {it}")
             return None
 
-        res = fit(observed, job, progress=False, hooks=(report,))
-        loss = score(len(res.log), res.model)
+        cpu0 = time.process_time()
+        try:
+            res = fit(observed, job, progress=False, hooks=(report,))
+            loss = score(len(res.log), res.model)
+        finally:
+            # the process's CPU time: a trial's cost even where a busy neighbour stretched its
+            # wall time (the trial's duration)
+            trial.set_user_attr("cpu_seconds", time.process_time() - cpu0)
         trial.set_user_attr("holdout_psnr", steps[-1][2])
         return loss
 
@@ -312,6 +319,8 @@ def run_search(
     # an interrupted trial's duration would span the pause: not its cost
     seconds = trials.pop("duration").dt.total_seconds()
     trials["seconds"] = seconds.where(trials["state"] != "FAIL")
+    cpu = pd.Series([t.user_attrs.get("cpu_seconds") for t in study.trials], dtype=float)
+    trials["cpu_seconds"] = cpu.where(trials["state"] != "FAIL")
     steps = pd.DataFrame(
         [[t.number, *row] for t in study.trials for row in t.user_attrs.get("steps", [])],
         columns=list(STEP_FIELDS),
@@ -432,6 +441,46 @@ def summary(trials: pd.DataFrame, adopt_above_db: float) -> pd.DataFrame:
             )
         )  # fmt: skip
     return pd.DataFrame(rows, columns=list(SUMMARY_FIELDS))
+
+
+#: the columns of ``trade``: a search's complete trials that no cheaper trial scores above
+TRADE_FIELDS = (
+    "tree", "model", "number", "clock", "seconds", "holdout_psnr", "cost_x", "delta_db", "own",
+)  # fmt: skip
+
+
+def trade(trials: pd.DataFrame) -> pd.DataFrame:
+    """Each search's cost-accuracy front: the complete trials no cheaper one scores above.
+
+    A search ranks recipes by their held-out window loss alone; this is what each costs: a
+    trial's CPU seconds (``cpu_seconds``) where its search recorded them for every trial, else
+    its wall time (``seconds``), which a busy neighbour stretches. Either compares within a
+    search (one machine), not across machines.
+
+    Args:
+        trials: ``run_search``'s trials of one or more searches (trial 0: the config's recipe).
+
+    Returns:
+        One row per trial on a front (``TRADE_FIELDS``), cheapest first within each search:
+        the ``clock`` (``"cpu"`` or ``"wall"``) and its seconds on it, the held-out window PSNR
+        (dB), ``cost_x`` (its seconds over the config's recipe's), ``delta_db`` (its PSNR minus
+        the config's recipe's) and ``own`` (it is the config's recipe). Pruned trials are not on
+        a front: their seconds and scores are partial.
+    """
+    rows = []
+    for (tree, model), t in trials.groupby(["tree", "model"], sort=False):
+        own, _, done = _own_and_best(t)
+        cpu = "cpu_seconds" in t and t.loc[t["state"] != "FAIL", "cpu_seconds"].notna().all()
+        done = done.assign(cost=done["cpu_seconds" if cpu else "seconds"])
+        own_s = float(done.loc[done["number"] == 0, "cost"].iloc[0])
+        best = -np.inf
+        for r in done.sort_values(["cost", "holdout_psnr"], ascending=[True, False]).itertuples():
+            if r.holdout_psnr > best:
+                best = r.holdout_psnr
+                rows.append((tree, model, int(r.number), "cpu" if cpu else "wall", float(r.cost),
+                             float(r.holdout_psnr), r.cost / own_s, r.holdout_psnr - own,
+                             r.number == 0))  # fmt: skip
+    return pd.DataFrame(rows, columns=list(TRADE_FIELDS))
 
 
 def _scored(trials: pd.DataFrame) -> int:
