@@ -279,6 +279,27 @@ def test_the_docs_search_summary_is_the_committed_searches():
     assert r.returncode == 0, r.stderr
 
 
+def test_the_search_figure_draws_the_committed_searches_at_the_page_width(tmp_path):
+    """tools/search_summary.py --figure writes a PNG as wide as the docs' page at its dpi."""
+    from PIL import Image
+
+    from physgs.report.figures import PAGE_WIDTH_IN
+
+    files = sorted(str(p) for p in Path("docs/studies/search").glob("*.trials.csv"))
+    png = tmp_path / "trade.png"
+    r = subprocess.run(
+        [sys.executable, "tools/search_summary.py", *files, "--figure", str(png)]
+        + ["--markdown", str(tmp_path / "summary.md"), "--trade", str(tmp_path / "trade.md")],
+        capture_output=True,
+        text=True,
+        timeout=120,
+    )
+    assert r.returncode == 0, r.stderr
+    width, _ = Image.open(png).size
+    assert abs(width - PAGE_WIDTH_IN * 150) < 0.1 * PAGE_WIDTH_IN * 150  # tight bbox trims a little
+    assert (tmp_path / "trade.md").read_text() == Path("docs/studies/search_trade.md").read_text()
+
+
 def test_the_recipes_block_holds_only_the_recipes_that_replace_the_configs():
     """The block pasted into config/trees.yaml is the searched recipes the summary keeps,
     under ``recipes:``, with their comments; a recipe within the rule is left out."""

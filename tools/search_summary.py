@@ -50,38 +50,42 @@ def _markdown(df: pd.DataFrame, order: dict) -> str:
 
 def _figure(trials: pd.DataFrame, front: pd.DataFrame, trees: list[str], path: Path) -> None:
     """A panel per model: every complete trial's seconds against its held-out window PSNR, a
-    colour per tree, its front as a line and the config's recipe as a star."""
-    import matplotlib
-
-    import matplotlib.ticker
-
-    matplotlib.use("Agg")
+    colour per tree, its front as a line and the config's recipe as a star; at the docs' page
+    width and font size (``physgs.report.figures``)."""
     import matplotlib.pyplot as plt
+    from matplotlib.ticker import LogLocator, NullFormatter, ScalarFormatter
+
+    from physgs.report.figures import FONT_PT, PAGE_WIDTH_IN, save_figure
 
     done = trials[trials["state"] == "COMPLETE"]
     models = [m for m in MODEL_NAMES if m in set(done["model"])]
-    fig, axes = plt.subplots(2, -(-len(models) // 2), figsize=(12, 6.5), squeeze=False)
+    cols = -(-len(models) // 2)
+    fig, axes = plt.subplots(2, cols, figsize=(PAGE_WIDTH_IN, 6.0), squeeze=False)
     for ax, model in zip(axes.flat, models):
         for i, tree in enumerate(trees):
             t, f = (d[(d["model"] == model) & (d["tree"] == tree)] for d in (done, front))
+            x = "cpu_seconds" if (f["clock"] == "cpu").all() and len(f) else "seconds"
             c = f"C{i}"
-            ax.scatter(t["seconds"], t["holdout_psnr"], s=14, color=c, alpha=0.4)
-            ax.plot(f["seconds"], f["holdout_psnr"], "-o", ms=3, color=c, label=tree)
+            ax.scatter(t[x], t["holdout_psnr"], s=10, color=c, alpha=0.4)
+            ax.plot(f["seconds"], f["holdout_psnr"], "-o", ms=2.5, lw=1, color=c, label=tree)
             own = t[t["number"] == 0]
-            ax.scatter(own["seconds"], own["holdout_psnr"], marker="*", s=140, color=c, ec="k")
-        ax.set(title=label(model), xscale="log", xlabel="training seconds")
+            ax.scatter(own[x], own["holdout_psnr"], marker="*", s=90, color=c, ec="k", lw=0.5)
+        ax.set_xscale("log")
         # 1-2-5 ticks, plain numbers: a panel's trials often span less than a decade
-        ax.xaxis.set_major_locator(matplotlib.ticker.LogLocator(subs=(1, 2, 5)))
-        ax.xaxis.set_major_formatter(matplotlib.ticker.ScalarFormatter())
-        ax.xaxis.set_minor_formatter(matplotlib.ticker.NullFormatter())
-        ax.set_ylabel("held-out window PSNR (dB)")
-        ax.legend(fontsize=8)
+        ax.xaxis.set_major_locator(LogLocator(subs=(1, 2, 5)))
+        ax.xaxis.set_major_formatter(ScalarFormatter())
+        ax.xaxis.set_minor_formatter(NullFormatter())
+        ax.set_title(label(model), fontsize=FONT_PT)
+        ax.tick_params(labelsize=FONT_PT - 1)
+    for ax in axes[-1]:
+        ax.set_xlabel("training seconds", fontsize=FONT_PT)
+    for ax in axes[:, 0]:
+        ax.set_ylabel("held-out window (dB)", fontsize=FONT_PT)
     for ax in list(axes.flat)[len(models) :]:
         ax.set_visible(False)
-    fig.suptitle("Recipe searches: what each recipe costs (star: the config's recipe)")
+    axes.flat[0].legend(fontsize=FONT_PT - 1, frameon=False)
     fig.tight_layout()
-    fig.savefig(path, dpi=110)
-    plt.close(fig)
+    save_figure(fig, [path], dpi=150)
 
 
 def main(argv: list[str] | None = None) -> int:
