@@ -109,6 +109,10 @@ def test_search_scores_every_trial_on_its_held_out_window_frames_and_keeps_the_b
     # a line per trial and the closing line, and one per held-out score a trial reported
     scored = [line for line in lines if ", iteration " in line]
     assert len(trials) == 3 and len(lines) - len(scored) == 4
+    # each trial's line says what is left; after the last trial, nothing
+    ends = [line for line in lines if "/3 " in line]
+    assert len(ends) == 3 and all(re.search(r"\(about \d+ min left\)$", e) for e in ends)
+    assert ends[-1].endswith("(about 0 min left)")
     assert list(trials["number"]) == [0, 1, 2]
     # trial 0 is the config's recipe: its objective is that job's held-out window loss (an
     # independent training and scoring of the job)

@@ -298,7 +298,10 @@ def run_search(
     def progress(study, trial) -> None:
         value = "pruned" if trial.value is None else f"{trial.value:.4f}"
         n = sum(t.state in finished for t in study.trials)
-        log(f"{tree} {model}: trial {n}/{settings.trials} {value} {trial.params}")
+        # what is left at this run's pace so far (pruned trials end early: a rough guide)
+        pace = (time.perf_counter() - t0) / max(n - n0, 1)
+        eta = f"about {pace * (settings.trials - n) / 60:.0f} min left"
+        log(f"{tree} {model}: trial {n}/{settings.trials} {value} {trial.params} ({eta})")
 
     optuna.logging.set_verbosity(optuna.logging.WARNING)
     study = _study(base, settings, journal, log=log, label=f"{tree} {model}")
@@ -306,7 +309,8 @@ def run_search(
         # the first trial is the recipe the config holds: the search is measured against it
         study.enqueue_trial(own)
     t0 = time.perf_counter()
-    left = settings.trials - sum(t.state in finished for t in study.trials)
+    n0 = sum(t.state in finished for t in study.trials)  # held from an earlier run: not timed
+    left = settings.trials - n0
     study.optimize(objective, n_trials=max(left, 0), callbacks=[progress])
     done = [t for t in study.trials if t.state == optuna.trial.TrialState.COMPLETE]
     if not done:
