@@ -301,7 +301,6 @@ def test_the_search_figure_draws_the_committed_searches_at_the_page_width(tmp_pa
     assert r.returncode == 0, r.stderr
     width, _ = Image.open(png).size
     assert abs(width - PAGE_WIDTH_IN * 150) < 0.1 * PAGE_WIDTH_IN * 150  # tight bbox trims a little
-    assert (tmp_path / "trade.md").read_text() == Path("docs/studies/search_trade.md").read_text()
 
 
 def test_the_recipes_block_holds_only_the_recipes_that_replace_the_configs():

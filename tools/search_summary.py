@@ -53,9 +53,9 @@ def _figure(trials: pd.DataFrame, front: pd.DataFrame, trees: list[str], path: P
     colour per tree, its front as a line and the config's recipe as a star; at the docs' page
     width and font size (``physgs.report.figures``)."""
     import matplotlib.pyplot as plt
-    from matplotlib.ticker import LogLocator, NullFormatter, ScalarFormatter
+    from matplotlib.ticker import LogLocator
 
-    from physgs.report.figures import FONT_PT, PAGE_WIDTH_IN, save_figure
+    from physgs.report.figures import FONT_PT, PAGE_WIDTH_IN, _plain_log, save_figure
 
     done = trials[trials["state"] == "COMPLETE"]
     models = [m for m in MODEL_NAMES if m in set(done["model"])]
@@ -72,9 +72,7 @@ def _figure(trials: pd.DataFrame, front: pd.DataFrame, trees: list[str], path: P
             ax.scatter(own[x], own["holdout_psnr"], marker="*", s=90, color=c, ec="k", lw=0.5)
         ax.set_xscale("log")
         # 1-2-5 ticks, plain numbers: a panel's trials often span less than a decade
-        ax.xaxis.set_major_locator(LogLocator(subs=(1, 2, 5)))
-        ax.xaxis.set_major_formatter(ScalarFormatter())
-        ax.xaxis.set_minor_formatter(NullFormatter())
+        _plain_log(ax.xaxis, LogLocator(subs=(1, 2, 5)))
         ax.set_title(label(model), fontsize=FONT_PT)
         ax.tick_params(labelsize=FONT_PT - 1)
     for ax in axes[-1]:
@@ -103,8 +101,8 @@ def main(argv: list[str] | None = None) -> int:
     pages = {
         args.markdown: _markdown(summary(trials, float(cfg["search"]["adopt_above_db"])), order)
     }
+    front = trade(trials) if args.trade or args.figure else None
     if args.trade:
-        front = trade(trials)
         pages[args.trade] = _markdown(
             front.assign(own=front["own"].map({True: "yes", False: ""})), order
         )
@@ -119,7 +117,7 @@ def main(argv: list[str] | None = None) -> int:
         Path(p).write_text(text)
         print(f"{p}: {text.count(chr(10)) - 2} rows")
     if args.figure:
-        _figure(trials, trade(trials), list(cfg["trees"]), Path(args.figure))
+        _figure(trials, front, list(cfg["trees"]), Path(args.figure))
         print(args.figure)
     return 0
 
