@@ -1,12 +1,17 @@
 """physgs.experiments.cost: job-seconds from Snakemake benchmark files, by stage and seed."""
 
+import subprocess
+import time
+
 import pytest
 
 from physgs.experiments.cost import (
+    earlier_segments,
     extra_seed_wall_s,
     plan_cost,
     plan_jobs,
     read_costs,
+    segment_seconds,
     summarise,
 )
 
@@ -261,3 +266,51 @@ def test_a_training_estimate_prices_each_job_at_its_own_budget():
     del rates[("medium", "static", "single")]
     est = training_estimate(plan_jobs(dry), rates, ["single"], 3000, 0, budget=budget)
     assert est["jobs"] == 0 and sum(est["unrated"].values()) == 2
+
+
+# Snakemake 9's log in the form the record's run at 23fa2c6 wrote (two jobs finished, one cut)
+_LOG9 = """Building DAG of jobs...
+[Mon Nov  9 08:57:10 2026]
+localrule testbed_dataset_seeded:
+    jobid: 45
+[Mon Nov  9 08:57:51 2026]
+Finished jobid: 45 (Rule: testbed_dataset_seeded)
+[Mon Nov  9 08:57:51 2026]
+localrule testbed_dataset_seeded:
+    jobid: 773
+[Mon Nov  9 09:58:07 2026]
+Finished jobid: 773 (Rule: testbed_dataset_seeded)
+[Mon Nov  9 09:58:07 2026]
+localrule train:
+    jobid: 12
+"""
+
+
+def test_a_segment_ends_at_its_last_finished_job(tmp_path):
+    log9 = tmp_path / "2026-11-09T085706.329317.snakemake.log"
+    log9.write_text(_LOG9)
+    # 08:57:06 to 09:58:07 on the same day, by hand: 1 h 1 min 1 s; the cut train job adds nothing
+    assert segment_seconds(log9) == 3661.0
+    log8 = tmp_path / "2026-11-10T100000.000001.snakemake.log"
+    log8.write_text("[Tue Nov 10 10:00:30 2026]\nFinished job 3.\n[Tue Nov 10 10:05:00 2026]\n")
+    assert segment_seconds(log8) == 30.0
+    unlock = tmp_path / "2026-11-10T110000.5.snakemake.log"
+    unlock.write_text("Unlocked working directory.\n")
+    assert segment_seconds(unlock) is None
+    assert earlier_segments(tmp_path) == [(log9.name, 3661.0), (log8.name, 30.0)]
+    with pytest.raises(ValueError, match="not a Snakemake log"):
+        segment_seconds(tmp_path / "run.log")
+
+
+def test_a_real_snakemake_log_gives_its_segment(tmp_path):
+    # the installed Snakemake's own log format, not a copy of it
+    (tmp_path / "Snakefile").write_text(
+        'rule a:\n    output: "a.txt"\n    shell: "touch {output}"\n'
+    )
+    t0 = time.time()
+    subprocess.run(
+        ["snakemake", "--cores", "1", "a.txt"], cwd=tmp_path, check=True, capture_output=True
+    )
+    wall = time.time() - t0
+    found = earlier_segments(tmp_path / ".snakemake" / "log")
+    assert len(found) == 1 and 0 <= found[0][1] <= wall + 1  # whole seconds in the log

@@ -564,6 +564,32 @@ def test_a_resumed_run_records_the_sum_of_its_segments(tmp_path):
     assert "(from nothing), in 3 segments" in line
 
 
+def test_a_resumed_run_reads_its_earlier_segments_from_snakemakes_logs(tmp_path):
+    logs = tmp_path / "log"
+    logs.mkdir()
+    (logs / "2026-11-09T080000.1.snakemake.log").write_text(
+        "[Mon Nov  9 09:00:00 2026]\nFinished jobid: 1 (Rule: a)\n"
+    )
+    (logs / "2026-11-09T100000.2.snakemake.log").write_text("Unlocked working directory.\n")
+    (logs / "2026-11-10T080000.3.snakemake.log").write_text(
+        "[Tue Nov 10 08:30:00 2026]\nFinished job 2.\n"
+    )
+    costs = tmp_path / "costs.csv"
+    cmd = [sys.executable, "tools/timed.py", "--name", "all", "--costs", str(costs)]
+    ok = subprocess.run(
+        [*cmd, "--earlier-logs", str(logs), "--", "true"], cwd=ROOT, capture_output=True, text=True
+    )
+    assert ok.returncode == 0, ok.stderr
+    row = record.read_costs(costs).iloc[0]
+    assert 5400 <= row["wall_s"] < 5430 and row["segments"] == 3  # 1 h + 30 min + this one
+    assert "earlier segment 2026-11-10T080000.3.snakemake.log: 30 min 0 s" in ok.stderr
+    both = subprocess.run(
+        [*cmd, "--earlier-logs", str(logs), "--earlier", "5", "--", "true"], cwd=ROOT,
+        capture_output=True, text=True,
+    )  # fmt: skip
+    assert both.returncode == 2 and "one way" in both.stderr
+
+
 def test_a_cost_is_shown_with_the_command_it_was_measured_with(tmp_path):
     # tab_null timed at three seeds while the default profile runs five: the row must say so
     costs = tmp_path / "costs.csv"

@@ -11,7 +11,9 @@ lines are printed from that file (`python tools/record.py --readme-only`). Names
 A run interrupted and resumed with the same command (a long pipeline spanning two sessions) is
 one cost: give each earlier segment's wall seconds with `--earlier` (for a Snakemake run, from
 its start to its last finished job in `.snakemake/log/`), and the row records their sum with
-this segment's and the number of segments.
+this segment's and the number of segments. `--earlier-logs .snakemake/log` reads them from
+the run's Snakemake logs instead (each log with a finished job, to that job's end:
+`physgs.experiments.cost.earlier_segments`), read before this segment starts its own.
 """
 
 from __future__ import annotations
@@ -24,6 +26,7 @@ import sys
 import time
 from pathlib import Path
 
+from physgs.experiments import cost
 from physgs.report import record
 from physgs.provenance import git_commit, git_dirty, machine_cpu
 
@@ -40,6 +43,12 @@ def main() -> int:
         metavar="S",
         help="wall seconds of earlier segments of the same run (resumed with the same command)",
     )
+    ap.add_argument(
+        "--earlier-logs",
+        type=Path,
+        metavar="DIR",
+        help="read the earlier segments from the run's Snakemake logs (.snakemake/log)",
+    )
     ap.add_argument("--costs", default="docs/record/costs.csv", type=Path)
     ap.add_argument("command", nargs=argparse.REMAINDER)
     args = ap.parse_args()
@@ -50,6 +59,13 @@ def main() -> int:
         print(
             f"warning: uncommitted changes; the cost is recorded at {git_commit()}", file=sys.stderr
         )
+    if args.earlier_logs is not None:
+        if args.earlier:
+            ap.error("--earlier and --earlier-logs: give the segments one way")
+        found = cost.earlier_segments(args.earlier_logs)
+        for name, s in found:
+            print(f"earlier segment {name}: {record.format_duration(s)}", file=sys.stderr)
+        args.earlier = [s for _, s in found]
     t0 = time.monotonic()
     rc = subprocess.call(cmd)
     wall = time.monotonic() - t0 + sum(args.earlier)

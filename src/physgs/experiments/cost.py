@@ -15,6 +15,7 @@ measured wall time of the run says how much they and the scheduling add.
 from __future__ import annotations
 
 import csv
+import datetime as dt
 import math
 import os
 import re
@@ -331,6 +332,63 @@ def resources_by_stage(jobs: list[JobCost]) -> dict[str, dict]:
             "rss_max_mb": stats([j.max_rss_mb for j in js])[1],
         }
     return out
+
+
+#: A Snakemake log's name (``.snakemake/log/2026-11-29T085706.329317.snakemake.log``): its start.
+_LOG_NAME = re.compile(r"^(\d{4}-\d\d-\d\dT\d{6})(?:\.\d+)?\.snakemake\.log$")
+#: The time stamp Snakemake writes before each job's start and end (``[Sun Nov 29 08:57:51 2026]``).
+_LOG_STAMP = re.compile(r"^\[(\w{3} \w{3} +\d+ \d\d:\d\d:\d\d \d{4})\]$")
+#: A finished job, as Snakemake 8 (``Finished job 45.``) and 9 (``Finished jobid: 45 (...)``) say it.
+_LOG_FINISHED = re.compile(r"^Finished job(?:id:)? \d+")
+
+
+def segment_seconds(log: str | Path) -> float | None:
+    """A Snakemake run's wall time up to its last finished job, from its log.
+
+    A run cut by a session's end loses the jobs it had in flight: what it achieved ends with its
+    last finished job, and a resumed run (``--rerun-incomplete``) starts those jobs again. So a
+    segment counts from the log's start (its file name) to the stamp before that job's
+    ``Finished`` line.
+
+    Args:
+        log: a log under ``.snakemake/log/`` (its name as Snakemake gives it).
+
+    Returns:
+        Seconds; None for a log with no finished job (a dry run, ``--unlock``, a run cut before
+        its first job ended).
+
+    Raises:
+        ValueError: for a file not named as Snakemake names its logs.
+    """
+    m = _LOG_NAME.match(Path(log).name)
+    if m is None:
+        raise ValueError(f"{log}: not a Snakemake log (<date>T<hhmmss>.<us>.snakemake.log)")
+    start = dt.datetime.strptime(m.group(1), "%Y-%m-%dT%H%M%S")
+    stamp, last = None, None
+    for line in Path(log).read_text(errors="replace").splitlines():
+        if s := _LOG_STAMP.match(line.strip()):
+            stamp = s.group(1)
+        elif _LOG_FINISHED.match(line.strip()) and stamp is not None:
+            last = stamp
+    if last is None:
+        return None
+    end = dt.datetime.strptime(" ".join(last.split()), "%a %b %d %H:%M:%S %Y")
+    return (end - start).total_seconds()
+
+
+def earlier_segments(log_dir: str | Path) -> list[tuple[str, float]]:
+    """The segments of a run resumed with the same command, from its ``.snakemake/log/``.
+
+    Args:
+        log_dir: the run's ``.snakemake/log`` folder (a worktree made for the run holds only its
+            segments' logs and those of runs that finished no job).
+
+    Returns:
+        ``(log name, seconds)`` per log with a finished job, oldest first.
+    """
+    logs = sorted(p for p in Path(log_dir).glob("*.snakemake.log"))
+    found = [(p.name, segment_seconds(p)) for p in logs]
+    return [(n, s) for n, s in found if s is not None]
 
 
 _BENCHMARK_LINE = re.compile(r"^\s*benchmark:\s*(\S+)\s*$")
