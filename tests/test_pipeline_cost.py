@@ -300,6 +300,8 @@ def test_a_segment_ends_at_its_last_finished_job(tmp_path):
     assert earlier_segments(tmp_path) == [(log9.name, 3661.0), (log8.name, 30.0)]
     with pytest.raises(ValueError, match="not a Snakemake log"):
         segment_seconds(tmp_path / "run.log")
+    with pytest.raises(FileNotFoundError, match="no such folder"):
+        earlier_segments(tmp_path / ".snakemake" / "lgo")
 
 
 def test_a_real_snakemake_log_gives_its_segment(tmp_path):

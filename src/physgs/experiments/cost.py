@@ -385,7 +385,12 @@ def earlier_segments(log_dir: str | Path) -> list[tuple[str, float]]:
 
     Returns:
         ``(log name, seconds)`` per log with a finished job, oldest first.
+
+    Raises:
+        FileNotFoundError: where ``log_dir`` is not a folder (a mistyped path would count none).
     """
+    if not Path(log_dir).is_dir():
+        raise FileNotFoundError(f"{log_dir}: no such folder of Snakemake logs")
     logs = sorted(p for p in Path(log_dir).glob("*.snakemake.log"))
     found = [(p.name, segment_seconds(p)) for p in logs]
     return [(n, s) for n, s in found if s is not None]
