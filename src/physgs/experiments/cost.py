@@ -365,10 +365,10 @@ def segment_seconds(log: str | Path) -> float | None:
         raise ValueError(f"{log}: not a Snakemake log (<date>T<hhmmss>.<us>.snakemake.log)")
     start = dt.datetime.strptime(m.group(1), "%Y-%m-%dT%H%M%S")
     stamp, last = None, None
-    for line in Path(log).read_text(errors="replace").splitlines():
-        if s := _LOG_STAMP.match(line.strip()):
+    for line in map(str.strip, Path(log).read_text(errors="replace").splitlines()):
+        if s := _LOG_STAMP.match(line):
             stamp = s.group(1)
-        elif _LOG_FINISHED.match(line.strip()) and stamp is not None:
+        elif _LOG_FINISHED.match(line) and stamp is not None:
             last = stamp
     if last is None:
         return None
