@@ -53,9 +53,7 @@ def _figure(trials: pd.DataFrame, front: pd.DataFrame, trees: list[str], path: P
     colour per tree, its front as a line and the config's recipe as a star; at the docs' page
     width and font size (``physgs.report.figures``)."""
     import matplotlib.pyplot as plt
-    from matplotlib.ticker import LogLocator
-
-    from physgs.report.figures import FONT_PT, PAGE_WIDTH_IN, _plain_log, save_figure
+    from physgs.report.figures import FONT_PT, PAGE_WIDTH_IN, plain_log, save_figure
 
     done = trials[trials["state"] == "COMPLETE"]
     models = [m for m in MODEL_NAMES if m in set(done["model"])]
@@ -72,7 +70,7 @@ def _figure(trials: pd.DataFrame, front: pd.DataFrame, trees: list[str], path: P
             ax.scatter(own[x], own["holdout_psnr"], marker="*", s=90, color=c, ec="k", lw=0.5)
         ax.set_xscale("log")
         # 1-2-5 ticks, plain numbers: a panel's trials often span less than a decade
-        _plain_log(ax.xaxis, LogLocator(subs=(1, 2, 5)))
+        plain_log(ax.xaxis)
         ax.set_title(label(model), fontsize=FONT_PT)
         ax.tick_params(labelsize=FONT_PT - 1)
     for ax in axes[-1]:

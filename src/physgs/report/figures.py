@@ -116,11 +116,11 @@ def _finish(
     save_figure(fig, outputs, dpi=dpi)
 
 
-def _plain_log(axis, locator=None) -> None:
+def plain_log(axis, ticks: bool = True) -> None:
     """Plain-number labels on a log axis (10^x labels collide on a short one), none on minor
-    ticks; ``locator`` sets the major ticks first."""
-    if locator is not None:
-        axis.set_major_locator(locator)
+    ticks; ``ticks`` puts the major ticks at 1, 2 and 5 per decade (a span under one gets some)."""
+    if ticks:
+        axis.set_major_locator(LogLocator(subs=(1.0, 2.0, 5.0)))
     axis.set_major_formatter(ScalarFormatter())
     axis.set_minor_formatter(NullFormatter())
 
@@ -341,7 +341,7 @@ def fig_damping(
     a1.plot(grid, zeta_true * grid, "k--", lw=1)
     a1.set(xscale="log", yscale="log")
     for axis in (a1.xaxis, a1.yaxis):
-        _plain_log(axis, LogLocator(base=10, subs=(1.0, 2.0, 5.0)))
+        plain_log(axis)
     gamma = r"$\hat\gamma_p = \hat\zeta_p\hat\omega_p$ (1/s)"
     _texts(a1, "decay rate against natural frequency", r"$\hat\omega_p$ (rad/s)", gamma)
     # one key for both panels, below them: colour = tree, marker = configuration, fill = prior
@@ -474,7 +474,7 @@ def fig_fit_curve(df: pd.DataFrame, outputs: Sequence[str | Path]) -> None:
             if x == "iterations":  # tick the budgets themselves, not powers of ten
                 ax.set_xticks(budgets)
             # seconds span under a decade: 1-2-5 ticks as plain numbers, minor labels overlap
-            _plain_log(ax.xaxis, None if x == "iterations" else LogLocator(subs=(1.0, 2.0, 5.0)))
+            plain_log(ax.xaxis, ticks=x != "iterations")
             ax.grid(alpha=0.3)
     where = f"the {trees[0]} tree" if len(trees) == 1 else "each tree (a row each)"
     _save_sweep(fig, grid[0], f"Fit curve on {where} (star: the profile's budget", n_seeds, outputs)
