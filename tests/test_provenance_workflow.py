@@ -61,17 +61,18 @@ def _readme(wd: Path) -> Path:
     return path
 
 
-def _record(wd: Path, *overrides: str) -> subprocess.CompletedProcess:
-    """tools/record.py on ``wd``'s run, into ``wd/record`` (a README of its own)."""
+def _record(wd: Path, *overrides: str, at: Path | None = None) -> subprocess.CompletedProcess:
+    """tools/record.py on ``wd``'s run, into ``record`` (a README of its own), run in ``wd`` or,
+    given ``at``, in that other folder naming the run's folder by its path."""
     return _run(
-        wd,
+        at or wd,
         sys.executable,
         str(ROOT / "tools" / "record.py"),
-        "results",
+        str(wd / "results") if at else "results",
         "--out",
         "record",
         "--readme",
-        str(_readme(wd)),
+        str(_readme(at or wd)),
         "--wall-s",
         "60",
         "--commit",
@@ -97,6 +98,13 @@ def test_a_run_made_with_overrides_is_recorded_with_them(run):
     assert (
         "made with `--config profile=quick 'trees=[\"sparse\"]'`" in (run / "README.md").read_text()
     )
+    # recorded from another folder naming the run's: the run's checkout's config and plan
+    away = run.parent / "away"
+    away.mkdir()
+    far = _record(run, *QUICK, at=away)
+    assert far.returncode == 0, (far.stdout + far.stderr)[-3000:]
+    assert json.loads((away / "record" / "stamp.json").read_text()) == stamp
+    assert (away / "README.md").read_text() == (run / "README.md").read_text()
     # without them the run is another config's: refused, saying to give them
     bare = _record(run)
     assert bare.returncode != 0 and "giving the run's own overrides" in bare.stderr

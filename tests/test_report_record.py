@@ -852,3 +852,20 @@ def test_the_ledger_page_prints_the_digits_the_csv_stores(tmp_path, monkeypatch)
     build.make_claims({}, ["sparse"], out / "claims.md", out / "claims.csv", stamp=stamp)
     assert "1.215" in (out / "claims.csv").read_text()
     assert "[+1.22, +3]" in (out / "claims.md").read_text()  # as re-rendered from the CSV
+
+
+def test_recording_a_run_without_its_tables_says_to_finish_it(tmp_path):
+    (tmp_path / "results").mkdir()
+    cmd = [sys.executable, str(ROOT / "tools" / "record.py")]
+    unfinished = subprocess.run(
+        [*cmd, str(tmp_path / "results"), "--out", str(tmp_path / "rec")],
+        cwd=ROOT, capture_output=True, text=True,
+    )  # fmt: skip
+    assert unfinished.returncode == 1 and "Traceback" not in unfinished.stderr
+    assert "no tables/tab_fit.csv" in unfinished.stderr
+    assert "finish it: snakemake --cores 2 all" in unfinished.stderr
+    elsewhere = subprocess.run(
+        [*cmd, str(tmp_path), "--out", str(tmp_path / "rec")], cwd=ROOT, capture_output=True, text=True
+    )
+    assert elsewhere.returncode == 1 and "not a run's folder" in elsewhere.stderr
+    assert not (tmp_path / "rec").exists()

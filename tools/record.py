@@ -24,8 +24,11 @@ for the stamp's job count and job-minutes by stage (the jobs of the run whose wa
 states). A table, figure or benchmark file of the plan that the folder lacks stops it, named;
 what the folder holds beyond the plan (a `snakemake studies` run's tables and figures, whose
 jobs keep their benchmark files under `results/studies/benchmarks/`, or an earlier run's files)
-is left out and listed. Run it in the
-checkout the run was made with, giving the `--configfile` and `--config` words the run was given
+is left out and listed. It works in the checkout that holds `results` (the run's folder, named
+`results`): that checkout's config, plan and commit are the run's, so a run made in another
+worktree is recorded from here with `python tools/record.py ../wt/results` (`--out`, `--readme`
+and this checkout's library stay this checkout's; `--configfile` paths are the run's checkout's).
+Give the `--configfile` and `--config` words the run was given
 (`profile=P` is added, P the profile of the run's `tab_fit.csv`, unless they set it): they are
 written into the stamp and the README's block. A config whose hash is not the run's (its tables'
 `config_hash`) is refused, since its plan is another run's. It takes one run of one config: every
@@ -48,6 +51,7 @@ from __future__ import annotations
 
 import argparse
 import datetime
+import os
 import shlex
 import subprocess
 from pathlib import Path
@@ -144,6 +148,24 @@ def _words(config: list[str], configfiles: list[str]) -> str:
     return "".join(" " + shlex.quote(w) for w in words)
 
 
+def _run_folder(args) -> Path:
+    """Move into the checkout that holds the run's folder (its config, plan and commit are the
+    run's), ``--out`` and ``--readme`` kept where they were named; refuse a folder that is not a
+    run's or a run whose tables are not made yet."""
+    r = args.results
+    if r.name != RUN_ROOT.name or not r.is_dir():
+        raise SystemExit(f"{r}: not a run's folder (the `{RUN_ROOT}` folder of its checkout)")
+    args.out, args.readme = args.out.resolve(), args.readme.resolve()
+    os.chdir(r.resolve().parent)
+    fit = RUN_ROOT / "tables" / "tab_fit.csv"
+    if not fit.is_file():
+        raise SystemExit(
+            f"{r}: no {fit.relative_to(RUN_ROOT)}: the run has not made its tables yet "
+            f"(finish it: snakemake --cores 2 {TARGET})"
+        )
+    return RUN_ROOT
+
+
 def _wall_s(args, commit: str) -> float:
     """The run's wall time: ``--wall-s``, or the ``all`` row of the record's costs measured at
     the run's commit."""
@@ -200,7 +222,7 @@ def main() -> None:
             print(f"{p}: derived again from the record's claims.csv")
         print(f"{args.out}: {len(record.render_pages(args.out))} pages laid out again")
     elif not args.readme_only:
-        r = args.results
+        r = _run_folder(args)
         fit = read_stamped(r / "tables" / "tab_fit.csv")
         config = _run_items(str(fit["profile"].iloc[0]), args.config)
         here = str(fit["config_hash"].iloc[0])
