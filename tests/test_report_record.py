@@ -865,7 +865,10 @@ def test_recording_a_run_without_its_tables_says_to_finish_it(tmp_path):
     assert "no tables/tab_fit.csv" in unfinished.stderr
     assert "finish it: snakemake --cores 2 all" in unfinished.stderr
     elsewhere = subprocess.run(
-        [*cmd, str(tmp_path), "--out", str(tmp_path / "rec")], cwd=ROOT, capture_output=True, text=True
+        [*cmd, str(tmp_path), "--out", str(tmp_path / "rec")],
+        cwd=ROOT,
+        capture_output=True,
+        text=True,
     )
     assert elsewhere.returncode == 1 and "not a run's folder" in elsewhere.stderr
     assert not (tmp_path / "rec").exists()
