@@ -16,7 +16,7 @@ block between `<!-- record:begin -->` and `<!-- record:end -->`
 `summary.md`, `claims.{csv,md}`, `tables/*.csv`, `figures/*.png`, `benchmarks/`).
 
 It takes exactly what `all`'s plan makes, not what the folder holds: Snakemake's dry run of
-`all` in this checkout (`snakemake -n --forceall all --config profile=P`, P the profile of the
+`all` in the run's checkout (`snakemake -n --forceall all --config profile=P`, P the profile of the
 run's `tab_fit.csv`) names every output and benchmark file of `all`'s jobs
 (`physgs.experiments.cost.plan_outputs`, `plan_jobs`), and `physgs.report.record.run_files`
 keeps those: the tables and figures among the outputs, and the jobs of those benchmark files
@@ -94,14 +94,14 @@ def _config_hash(config: list[str], configfiles: list[str]) -> str:
 
 def _plan(config: list[str], configfiles: list[str], run_hash: str) -> tuple[list[str], list[str]]:
     """`all`'s outputs and benchmark files under the run's overrides, relative to the run's
-    folder, from Snakemake's dry run in this checkout; refused unless this checkout's config
-    with those overrides is the run's."""
+    folder, from Snakemake's dry run in the run's checkout (the current folder); refused unless
+    its config with those overrides is the run's."""
     here = _config_hash(config, configfiles)
     if here != run_hash:
         raise SystemExit(
-            f"this checkout's config with `{_words(config, configfiles).strip()}` hashes to "
-            f"{here}, the run's tables to {run_hash}: its plan is another run's; record from "
-            "the checkout the run was made with, giving the run's own overrides (`--config "
+            f"{Path.cwd()}: its config with `{_words(config, configfiles).strip()}` hashes to "
+            f"{here}, the run's tables to {run_hash}: its plan is another run's; name the run's "
+            "folder in the checkout it was made in, giving the run's own overrides (`--config "
             "KEY=VALUE ...`, `--configfile FILE ...`)"
         )
     dry = dry_run([TARGET], config, configfiles=configfiles)
