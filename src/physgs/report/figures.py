@@ -117,8 +117,13 @@ def _finish(
 
 
 def plain_log(axis, ticks: bool = True) -> None:
-    """Plain-number labels on a log axis (10^x labels collide on a short one), none on minor
-    ticks; ``ticks`` puts the major ticks at 1, 2 and 5 per decade (a span under one gets some)."""
+    """Plain-number labels on a log axis (10^x labels collide on a short one), none on minor ticks.
+
+    Args:
+        axis (matplotlib.axis.Axis): a log-scaled axis (``ax.xaxis``, ``ax.yaxis``).
+        ticks: major ticks at 1, 2 and 5 per decade (a span under one gets some); False keeps
+            the major ticks the caller set.
+    """
     if ticks:
         axis.set_major_locator(LogLocator(subs=(1.0, 2.0, 5.0)))
     axis.set_major_formatter(ScalarFormatter())
