@@ -8,6 +8,7 @@ import pytest
 from physgs.experiments.cost import (
     earlier_segments,
     extra_seed_wall_s,
+    left_cost,
     plan_cost,
     plan_jobs,
     read_costs,
@@ -168,6 +169,28 @@ def test_a_plan_costs_the_measured_seconds_of_its_jobs(bench):
     assert cost["by_rule"] == {"testbed_dataset": (1, 50.0), "train": (1, 100.0)}
     assert cost["unmeasured"] == {"train": 1}  # the dense training did not run
     assert cost["light"] == {"recovery": 1, "table": 1}
+
+
+def test_a_cut_run_prices_each_job_left_by_its_nearest_finished_jobs(bench):
+    b = f"{bench}/"
+    planned = [
+        ("train", b + "train/sparse/seed2/ours_single.tsv"),  # itself at seeds 0, 1: 100, 120
+        ("train", b + "train/sparse_damping/seed1/mlp_single.tsv"),  # its tree's trainings: 80
+        ("evaluate", b + "evaluate/dense/seed0/ours_single.tsv"),  # its stage's one job: 20
+        ("testbed_dataset_seeded", b + "testbed/sparse_seed2.tsv"),  # sparse, sparse_seed1: 50, 60
+        ("oma_identify", b + "oma/sparse/seed0/modes.tsv"),  # no oma job finished
+        ("table", None),
+    ]
+    cost = left_cost(planned, read_costs(bench), bench)
+    assert cost["by_rule"] == {
+        "train": (2, pytest.approx(110.0 + 80.0)),
+        "evaluate": (1, pytest.approx(20.0)),
+        "testbed_dataset_seeded": (1, pytest.approx(55.0)),
+    }
+    assert cost["job_s"] == pytest.approx(110.0 + 80.0 + 20.0 + 55.0)
+    assert cost["by_match"] == {"kind": 2, "tree": 1, "stage": 1}
+    assert cost["unpriced"] == {"oma_identify": 1} and cost["light"] == {"table": 1}
+    assert cost["done_s"] == pytest.approx(509.0)  # every finished job, as summarise counts
 
 
 def _timed(root, rel, s, end):

@@ -1,7 +1,7 @@
 """What a finished pipeline run cost: job-seconds per stage and seed, and what one more seed adds.
 
     python tools/pipeline_cost.py [--benchmarks results/benchmarks] [--wall-s SECONDS]
-        [--target TARGET ...]
+        [--target TARGET ...] [--left [--config WORDS ...]]
 
 Reads every Snakemake benchmark file of the run (physgs.experiments.cost) and prints job wall
 seconds by stage, per training seed and shared (testbeds), the damping benchmark's share, and,
@@ -11,6 +11,12 @@ targets from nothing would cost, from the same run's measured jobs (``snakemake 
 lists the plan; each planned job's benchmark file gives its seconds), scaled to wall time by the
 finished run's own ratio of wall time to job time (``--wall-s``): an estimate for a reader who
 wants one table (``--target results/tables/tab_null.tex``), not a measurement.
+
+With ``--left``, what a cut or running run of ``--target`` (default ``all``) has left: the jobs
+``snakemake -n`` would run now (with the run's ``--config`` words), each priced at the median of the run's own finished jobs of its
+kind (``physgs.experiments.cost.left_cost``), and the wall time that is at this run's pace so far
+(its segments' wall time, from ``.snakemake/log``, per finished job-second): an estimate, printed
+as one. Run it in the run's folder; it reads and plans, and never locks the run.
 
 The timeline (``--cores``, default 2; ``--bin-min``, default 10) says when the cores were busy:
 the jobs running at once in each stretch of the run (from the benchmark files' times), the
@@ -24,7 +30,9 @@ import argparse
 
 from physgs.experiments.cost import (
     dry_run,
+    earlier_segments,
     extra_seed_wall_s,
+    left_cost,
     occupancy,
     plan_cost,
     plan_jobs,
@@ -43,10 +51,15 @@ def main() -> None:
     ap.add_argument("--benchmarks", default="results/benchmarks")
     ap.add_argument("--wall-s", type=float, default=None, help="the run's measured wall seconds")
     ap.add_argument("--target", nargs="+", default=None, help="Snakemake targets to cost")
+    ap.add_argument("--left", action="store_true", help="what a cut or running run has left")
+    ap.add_argument("--config", nargs="+", default=[], help="the run's --config words")
     ap.add_argument("--cores", type=int, default=2, help="the cores the run had")
     ap.add_argument("--bin-min", type=float, default=10.0, help="timeline bin, minutes")
     args = ap.parse_args()
     jobs = read_costs(args.benchmarks)
+    if args.left:
+        left(args.target or ["all"], args.config, jobs, args.benchmarks, args.cores)
+        return
     if args.target:
         target_cost(args.target, jobs, args.benchmarks, args.wall_s, summarise(jobs)["total_s"])
         return
@@ -104,6 +117,30 @@ def timeline(jobs, cores: int, bin_s: float) -> None:
     print(
         f"idle while jobs ran: {occ.idle_core_s / 60:.1f} core-min; no benchmarked job running: "
         f"{occ.paused_s / 60:.1f} min (a pause between segments, or light jobs only)"
+    )
+
+
+def left(targets, config, jobs, benchmarks, cores: int) -> None:
+    """Print what a cut or running run of ``targets`` has left, priced by its finished jobs."""
+    cost = left_cost(plan_jobs(dry_run(targets, config, forceall=False)), jobs, benchmarks)
+    print(f"{' '.join(targets)}: the jobs left, each at the median of the run's finished jobs")
+    for rule, (n, s) in sorted(cost["by_rule"].items(), key=lambda kv: -kv[1][1]):
+        print(f"{rule:<24}{n:>5} jobs{_min(s)} job-min")
+    print(f"{'left':<24}{sum(cost['by_match'].values()):>5} jobs{_min(cost['job_s'])} job-min")
+    print(f"{'finished':<24}{len(jobs):>5} jobs{_min(cost['done_s'])} job-min")
+    print(f"priced by the same job at other seeds / its stage on its tree / its stage: "
+          f"{' / '.join(str(n) for n in cost['by_match'].values())} jobs; jobs running now count whole")  # fmt: skip
+    if cost["unpriced"]:
+        print(f"left unpriced (no finished job of their stage): {cost['unpriced']}")
+    light = ", ".join(f"{r} {n}" for r, n in sorted(cost["light"].items()))
+    print(f"jobs without a benchmark (not counted): {light or 'none'}")
+    segments = [s for _, s in earlier_segments(".snakemake/log")] if cost["done_s"] else []
+    pace = sum(segments) / cost["done_s"] if segments else float("nan")
+    print(
+        f"wall time left: at least {_min(cost['job_s'] / cores).strip()} min on {cores} cores; "
+        f"about {_min(cost['job_s'] * pace).strip()} min at this run's pace so far "
+        f"({pace:.2f} s of wall per job-second over {len(segments)} segments, "
+        f"{_min(sum(segments)).strip()} min): an estimate"
     )
 
 

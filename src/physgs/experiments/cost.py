@@ -19,6 +19,7 @@ import datetime as dt
 import math
 import os
 import re
+import statistics
 import subprocess
 import sys
 from collections.abc import Callable, Collection, Mapping, Sequence
@@ -555,6 +556,63 @@ def plan_cost(
         n, s = out["by_rule"].get(rule, (0, 0.0))
         out["by_rule"][rule] = (n + 1, s + wall[rel])
         out["job_s"] += wall[rel]
+    return out
+
+
+#: How near a finished job prices a job left (``left_cost``): its own kind (the benchmark path
+#: without its seed), else its stage and tree (the path's first two parts), else its stage.
+LEFT_MATCHES = ("kind", "tree", "stage")
+
+
+def _kinds(rel: str) -> tuple[tuple[str, ...], ...]:
+    """A benchmark path's keys, nearest first (``LEFT_MATCHES``): ``train/medium/seed0/mlp_single``
+    -> (train, medium, mlp_single), (train, medium), (train,)."""
+    parts = tuple(p for p in (_SEED.sub("", x) for x in Path(rel).with_suffix("").parts) if p)
+    return parts, parts[:2], parts[:1]
+
+
+def left_cost(
+    planned: list[tuple[str, str | None]], jobs: list[JobCost], benchmark_dir: str | Path
+) -> dict:
+    """What a cut or running run has left, priced by its own finished jobs: an estimate.
+
+    Each planned job with a benchmark costs the median wall seconds of the run's finished jobs
+    nearest it (``LEFT_MATCHES``: the same job at other seeds, else its stage on its tree, else
+    its stage); a job with no finished job of its stage is counted apart, never guessed. A job
+    running now counts whole (its outputs are missing, so the plan holds it).
+
+    Args:
+        planned: the jobs the run would run now (``plan_jobs`` of ``snakemake -n TARGET``,
+            without ``--forceall``).
+        jobs: the run's finished benchmarked jobs (``read_costs(benchmark_dir)``).
+        benchmark_dir: the folder ``jobs`` were read from (the planned paths start with it).
+
+    Returns:
+        {"job_s": job-seconds of the priced jobs, "done_s": job-seconds finished, "by_rule":
+        {rule: (jobs, job_s)}, "by_match": {match: jobs} (``LEFT_MATCHES``), "unpriced":
+        {rule: jobs}, "light": {rule: jobs} (rules without a benchmark)}.
+    """
+    root = Path(benchmark_dir)
+    seen: dict[tuple[str, ...], list[float]] = {}
+    for j in jobs:
+        for key in dict.fromkeys(_kinds(j.path)):
+            seen.setdefault(key, []).append(j.wall_s)
+    out: dict = {"job_s": 0.0, "done_s": sum(j.wall_s for j in jobs), "by_rule": {},
+                 "by_match": dict.fromkeys(LEFT_MATCHES, 0), "unpriced": {}, "light": {}}  # fmt: skip
+    for rule, bench in planned:
+        if bench is None:
+            out["light"][rule] = out["light"].get(rule, 0) + 1
+            continue
+        keys = _kinds(str(Path(bench).relative_to(root)))
+        match = next((m for m, k in zip(LEFT_MATCHES, keys) if k in seen), None)
+        if match is None:
+            out["unpriced"][rule] = out["unpriced"].get(rule, 0) + 1
+            continue
+        s = statistics.median(seen[keys[LEFT_MATCHES.index(match)]])
+        n, total = out["by_rule"].get(rule, (0, 0.0))
+        out["by_rule"][rule] = (n + 1, total + s)
+        out["by_match"][match] += 1
+        out["job_s"] += s
     return out
 
 
