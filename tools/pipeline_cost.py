@@ -13,10 +13,11 @@ finished run's own ratio of wall time to job time (``--wall-s``): an estimate fo
 wants one table (``--target results/tables/tab_null.tex``), not a measurement.
 
 With ``--left``, what a cut or running run of ``--target`` (default ``all``) has left: the jobs
-``snakemake -n`` would run now (with the run's ``--config`` words), each priced at the median of the run's own finished jobs of its
-kind (``physgs.experiments.cost.left_cost``), and the wall time that is at this run's pace so far
-(its segments' wall time, from ``.snakemake/log``, per finished job-second): an estimate, printed
-as one. Run it in the run's folder; it reads and plans, and never locks the run.
+``snakemake -n`` would run now (given the run's ``--config`` words), each priced at the median of
+the run's own finished jobs of its kind (``physgs.experiments.cost.left_cost``), and the wall
+time that is at this run's pace so far (its segments' wall time, from ``.snakemake/log``, per
+finished job-second): an estimate, printed as one. Run it in the run's folder; it reads and
+plans, and never locks the run.
 
 The timeline (``--cores``, default 2; ``--bin-min``, default 10) says when the cores were busy:
 the jobs running at once in each stretch of the run (from the benchmark files' times), the
@@ -27,6 +28,7 @@ jobs ran (``physgs.experiments.cost.occupancy``).
 from __future__ import annotations
 
 import argparse
+from pathlib import Path
 
 from physgs.experiments.cost import (
     dry_run,
@@ -134,11 +136,15 @@ def left(targets, config, jobs, benchmarks, cores: int) -> None:
         print(f"left unpriced (no finished job of their stage): {cost['unpriced']}")
     light = ", ".join(f"{r} {n}" for r, n in sorted(cost["light"].items()))
     print(f"jobs without a benchmark (not counted): {light or 'none'}")
-    segments = [s for _, s in earlier_segments(".snakemake/log")] if cost["done_s"] else []
-    pace = sum(segments) / cost["done_s"] if segments else float("nan")
+    logs = Path(".snakemake/log")  # a results folder copied without them: no pace to read
+    segments = [s for _, s in earlier_segments(logs)] if logs.is_dir() else []
+    floor = f"wall time left: at least {_min(cost['job_s'] / cores).strip()} min on {cores} cores"
+    if not segments or not cost["done_s"]:
+        print(f"{floor}; no segment in .snakemake/log to read this run's pace from")
+        return
+    pace = sum(segments) / cost["done_s"]
     print(
-        f"wall time left: at least {_min(cost['job_s'] / cores).strip()} min on {cores} cores; "
-        f"about {_min(cost['job_s'] * pace).strip()} min at this run's pace so far "
+        f"{floor}; about {_min(cost['job_s'] * pace).strip()} min at this run's pace so far "
         f"({pace:.2f} s of wall per job-second over {len(segments)} segments, "
         f"{_min(sum(segments)).strip()} min): an estimate"
     )
