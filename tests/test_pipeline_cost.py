@@ -6,6 +6,7 @@ import time
 import pytest
 
 from physgs.experiments.cost import (
+    by_job,
     earlier_segments,
     extra_seed_wall_s,
     left_cost,
@@ -59,6 +60,15 @@ def test_sums_by_seed_shared_and_damping(bench):
     assert s["damping_per_seed"] == pytest.approx({0: 80, 1: 4})
     assert s["by_stage"]["train"] == pytest.approx({0: 180, 1: 120})
     assert s["total_s"] == pytest.approx(95 + 200 + 214)
+
+
+def test_each_job_costs_its_seconds_over_every_tree_and_seed(bench):
+    got = by_job(read_costs(bench))
+    assert got[("train", "ours_single")] == (3, pytest.approx(100 + 120 + 80))  # 2 seeds, damping
+    assert got[("testbed", "sparse")] == (2, pytest.approx(50 + 60))  # the seeded one with it
+    assert got[("testbed", "stats_sparse_damping")] == (1, pytest.approx(4.0))
+    assert list(got)[0] == ("train", "ours_single")  # costliest first
+    assert sum(n for n, _ in got.values()) == 10
 
 
 def test_one_more_seed_scales_by_the_runs_own_packing(bench):

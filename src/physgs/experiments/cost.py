@@ -301,6 +301,24 @@ def occupancy(jobs: list[JobCost], cores: int, bin_s: float = 600.0) -> Occupanc
     return Occupancy(bin_s, busy, running, idle, paused)
 
 
+def by_job(jobs: list[JobCost]) -> dict[tuple[str, str], tuple[int, float]]:
+    """Job-seconds per job of a stage over every tree and seed: what each model's trainings and
+    evaluations cost a run (``train``, ``d3dgs_single``), for a user weighing a cheaper recipe.
+
+    Args:
+        jobs: the benchmarked jobs.
+
+    Returns:
+        ``(stage, job name without its seed) -> (jobs, wall seconds summed)``, largest first.
+    """
+    out: dict[tuple[str, str], tuple[int, float]] = {}
+    for j in jobs:
+        key = (j.stage, _SEED.sub("", Path(j.path).stem))
+        n, s = out.get(key, (0, 0.0))
+        out[key] = (n + 1, s + j.wall_s)
+    return dict(sorted(out.items(), key=lambda kv: -kv[1][1]))
+
+
 def resources_by_stage(jobs: list[JobCost]) -> dict[str, dict]:
     """What each stage's jobs used, to size a cluster's requests from measurement: per stage
     {jobs, wall_mean_s, wall_max_s, cpu_mean_s, cpu_max_s, rss_max_mb} (NaN-free maxima and
