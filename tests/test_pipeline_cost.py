@@ -69,6 +69,8 @@ def test_each_job_costs_its_seconds_over_every_tree_and_seed(bench):
     assert got[("testbed", "stats_sparse_damping")] == (1, pytest.approx(4.0))
     assert list(got)[0] == ("train", "ours_single")  # costliest first
     assert sum(n for n, _ in got.values()) == 10
+    _write(bench, "kselect/sparse/seed0.tsv", 7.0)  # a file named by its seed alone
+    assert by_job(read_costs(bench))[("kselect", "-")] == (1, pytest.approx(7.0))
 
 
 def test_one_more_seed_scales_by_the_runs_own_packing(bench):

@@ -309,11 +309,12 @@ def by_job(jobs: list[JobCost]) -> dict[tuple[str, str], tuple[int, float]]:
         jobs: the benchmarked jobs.
 
     Returns:
-        ``(stage, job name without its seed) -> (jobs, wall seconds summed)``, largest first.
+        ``(stage, job name without its seed) -> (jobs, wall seconds summed)``, largest first;
+        the name ``-`` for a stage whose file is named by its seed alone (``kselect``).
     """
     out: dict[tuple[str, str], tuple[int, float]] = {}
     for j in jobs:
-        key = (j.stage, _SEED.sub("", Path(j.path).stem))
+        key = (j.stage, _SEED.sub("", Path(j.path).stem) or "-")  # kselect/<tree>/seed<N>: "-"
         n, s = out.get(key, (0, 0.0))
         out[key] = (n + 1, s + j.wall_s)
     return dict(sorted(out.items(), key=lambda kv: -kv[1][1]))
