@@ -616,18 +616,18 @@ def left_cost(
     for j in jobs:
         for key in dict.fromkeys(_kinds(j.path)):
             seen.setdefault(key, []).append(j.wall_s)
+    median = {k: statistics.median(v) for k, v in seen.items()}  # once per kind, not per job
     out: dict = {"job_s": 0.0, "done_s": sum(j.wall_s for j in jobs), "by_rule": {},
                  "by_match": dict.fromkeys(LEFT_MATCHES, 0), "unpriced": {}, "light": {}}  # fmt: skip
     for rule, bench in planned:
         if bench is None:
             out["light"][rule] = out["light"].get(rule, 0) + 1
             continue
-        keys = _kinds(str(Path(bench).relative_to(root)))
-        match = next((m for m, k in zip(LEFT_MATCHES, keys) if k in seen), None)
+        keys = zip(LEFT_MATCHES, _kinds(str(Path(bench).relative_to(root))))
+        match, s = next(((m, median[k]) for m, k in keys if k in median), (None, 0.0))
         if match is None:
             out["unpriced"][rule] = out["unpriced"].get(rule, 0) + 1
             continue
-        s = statistics.median(seen[keys[LEFT_MATCHES.index(match)]])
         n, total = out["by_rule"].get(rule, (0, 0.0))
         out["by_rule"][rule] = (n + 1, total + s)
         out["by_match"][match] += 1
