@@ -799,6 +799,18 @@ def test_a_record_on_instances_says_where_the_first_seed_alone_lies(tmp_path):
     _record(r, out, tables=sorted((r / "tables").glob("*.csv")), figures=[], stamp=one)
     text = (out / "rerun.md").read_text()
     assert "1 changed" in text and "first seed alone" not in text  # one instance: not asked
+    # two runs over instances: the first seed is no longer the record's own tree, so not asked
+    claims.loc[0, ["measured", "ci_low", "ci_high", "verdict"]] = [-1.0, -4.0, 2.0, "undecided"]
+    claims.to_csv(r / "claims.csv", index=False)
+    _record(r, out, tables=sorted((r / "tables").glob("*.csv")), figures=[], stamp=stamp,
+            roles={"sparse": {}})  # fmt: skip
+    claims.loc[0, ["measured", "ci_low", "ci_high", "verdict"]] = [1.99, 1.2, 2.77, "holds"]
+    claims.to_csv(r / "claims.csv", index=False)
+    _record(r, out, tables=sorted((r / "tables").glob("*.csv")), figures=[],
+            stamp=record.Stamp(**{**asdict(stamp), "commit": "1b2c3d4"}), roles={"sparse": {}})  # fmt: skip
+    text = (out / "rerun.md").read_text()
+    assert "1 changed" in text and "first seed alone" not in text
+    assert "several instances of a tree (the stamp's), the record one" not in text
 
 
 def test_a_sentence_of_the_prose_takes_its_clause_only_where_the_field_is_set():

@@ -251,17 +251,22 @@ def _rerun_page(
 ) -> str:
     """The record's "Against the previous record" page: this run's ledger verdict by verdict
     (beside its first seed alone, ``claims.first_seed`` with ``roles``, where the run has several
-    instances of a tree) and its seeded tables cell by cell against the record in ``previous``."""
+    instances of a tree and the previous record one) and its seeded tables cell by cell against
+    the record in ``previous``."""
+    if not ((previous / "stamp.json").is_file() and (previous / "claims.csv").is_file()):
+        return _blocks(PROSE["rerun_head"], PROSE["rerun_none"])
+    old = json.loads((previous / "stamp.json").read_text())
     first = None
-    if any(len(s) > 1 for s in stamp.instances.values()):
+    # the first seed alone is the old record's own tree only where that record had one per preset
+    # (a stamp from before instances has none): two runs over instances compare mean with mean
+    if any(len(s) > 1 for s in stamp.instances.values()) and not any(
+        len(s) > 1 for s in old.get("instances", {}).values()
+    ):
         from physgs.report.build import read_table  # build reads every output's module
 
         tabs = {Path(t).stem: read_table(Path(t).stem, t) for t in tables}
         tabs = {n: d for n, d in tabs.items() if n in catalogue.tables()}
         first = ledger.first_seed(tabs, stamp.trees, roles)
-    if not ((previous / "stamp.json").is_file() and (previous / "claims.csv").is_file()):
-        return _blocks(PROSE["rerun_head"], PROSE["rerun_none"])
-    old = json.loads((previous / "stamp.json").read_text())
     h = old.get("config_hash")
     settings = PROSE["rerun_same"] if h == stamp.config_hash else say("rerun_other", hash=h)
     c = rerun.compare_claims(read_stamped(previous / "claims.csv"), read_stamped(claims_csv), first)
