@@ -74,7 +74,9 @@ def _alive(pid: int) -> bool:
 def test_sigint_to_snakemake_ends_the_running_job_in_seconds_and_keeps_finished_ones(tmp_path):
     (tmp_path / "Snakefile").write_text(SNAKEFILE)
     (tmp_path / "long.py").write_text(LONG)
-    env = {**os.environ, "PYTHONPATH": str(ROOT / "src")}
+    # a run that outlives the SIGINT is sent SIGABRT: faulthandler then writes every thread's
+    # stack to run.out, so a failure says where Snakemake's main thread was waiting
+    env = {**os.environ, "PYTHONPATH": str(ROOT / "src"), "PYTHONFAULTHANDLER": "1"}
     cmd = [sys.executable, "-m", "snakemake", "--cores", "1", "--rerun-incomplete"]
     with open(tmp_path / "run.out", "w") as out:
         # its own session: the SIGINT goes to Snakemake's process only, not to a process group
@@ -106,8 +108,12 @@ def test_sigint_to_snakemake_ends_the_running_job_in_seconds_and_keeps_finished_
             took = time.monotonic() - t_int
         finally:
             if run.poll() is None:
-                run.kill()
-                run.wait()
+                run.send_signal(signal.SIGABRT)
+                try:
+                    run.wait(timeout=5)
+                except subprocess.TimeoutExpired:
+                    run.kill()
+                    run.wait()
     log = (tmp_path / "run.out").read_text()
     assert code is not None and took < 10, f"Snakemake ran {took:.1f} s after SIGINT:\n{log}"
     assert code != 0, log
@@ -122,3 +128,91 @@ def test_sigint_to_snakemake_ends_the_running_job_in_seconds_and_keeps_finished_
     assert plan.returncode == 0, plan.stdout + plan.stderr
     jobs = [line.split()[-1] for line in plan.stdout.splitlines() if line.startswith("rule ")]
     assert sorted(jobs) == ["all:", "long:"], plan.stdout  # not `done`: it had finished
+
+
+# a coroutine of the kind that lost the SIGINT: it lets no cancellation out and returns normally
+SWALLOWED = """
+import asyncio, os, signal, sys
+
+from physgs.scheduling import sigint_always_raises
+
+if sys.argv[1] == "ours":
+    sigint_always_raises()
+
+
+async def step():
+    try:
+        os.kill(os.getpid(), signal.SIGINT)
+        await asyncio.sleep(1)
+    except asyncio.CancelledError:  # e.g. a cancelled subtask's, taken for its own
+        pass
+    return "finished"
+
+
+with asyncio.Runner() as runner:  # as Snakemake's Workflow.async_run keeps one per thread
+    try:
+        print(runner.run(step()))
+    except KeyboardInterrupt:
+        print("interrupted")
+"""
+
+
+def test_a_sigint_inside_asyncio_reaches_the_main_thread_as_keyboard_interrupt(tmp_path):
+    """With Python's default handler, asyncio's runner turns a SIGINT into a cancellation that a
+    coroutine can swallow (the run goes on as if none came); with ``sigint_always_raises`` it is a
+    ``KeyboardInterrupt`` in the main thread, as Snakemake's loop expects."""
+    (tmp_path / "swallowed.py").write_text(SWALLOWED)
+    env = {**os.environ, "PYTHONPATH": str(ROOT / "src")}
+
+    def run(handler: str) -> str:
+        out = subprocess.run(
+            [sys.executable, "swallowed.py", handler],
+            cwd=tmp_path, env=env, capture_output=True, text=True, timeout=60,
+        )  # fmt: skip
+        assert out.returncode == 0, out.stderr
+        return out.stdout.strip()
+
+    assert run("python") == "finished"  # the SIGINT lost: what the loop saw before
+    assert run("ours") == "interrupted"
+
+
+# the scheduling loop's wait, with SIGINT blocked in the main thread so that the kernel must run it
+# on another thread (as it may for a run's SIGINT while a job's thread waits on its process)
+ELSEWHERE = """
+import os, signal, sys, threading, time
+
+from physgs.scheduling import _watch_sigint
+
+open_jobs = threading.Semaphore(0)  # Snakemake's JobScheduler._open_jobs
+if sys.argv[1] == "wake":
+    assert _watch_sigint(open_jobs.release)
+job_thread = threading.Thread(target=time.sleep, args=(30,), daemon=True)
+job_thread.start()  # SIGINT not blocked here
+signal.pthread_sigmask(signal.SIG_BLOCK, {signal.SIGINT})
+t0 = time.monotonic()
+threading.Timer(0.2, os.kill, (os.getpid(), signal.SIGINT)).start()
+try:
+    open_jobs.acquire(timeout=3)
+    print("none")
+except KeyboardInterrupt:
+    print(f"{time.monotonic() - t0:.2f}")
+"""
+
+
+def test_a_sigint_run_on_another_thread_wakes_the_waiting_loop(tmp_path):
+    """A SIGINT the kernel runs on a thread other than the waiting main thread reaches the main
+    thread's handler only when the wait ends: at its timeout without the watcher (the loop's wait
+    has none: it waited for the running job), at once with it."""
+    (tmp_path / "elsewhere.py").write_text(ELSEWHERE)
+    env = {**os.environ, "PYTHONPATH": str(ROOT / "src")}
+
+    def seconds(mode: str) -> float:
+        out = subprocess.run(
+            [sys.executable, "elsewhere.py", mode],
+            cwd=tmp_path, env=env, capture_output=True, text=True, timeout=60,
+        )  # fmt: skip
+        assert out.returncode == 0, out.stderr
+        return float(out.stdout)
+
+    assert seconds("plain") > 2.7  # the handler ran only when the 3 s wait timed out
+    assert seconds("wake") < 2.0

@@ -19,7 +19,10 @@ is already pending; an earlier request replaces the pending one. The timer is a 
 so a finished run exits at once instead of waiting out the last timespan.
 
 A SIGINT to Snakemake's own process used to leave its running jobs to their end, marked
-incomplete; [`stop_jobs_on_cancel`][physgs.scheduling.stop_jobs_on_cancel] stops them first.
+incomplete; [`stop_jobs_on_cancel`][physgs.scheduling.stop_jobs_on_cancel] stops them first, and
+[`wake_on_sigint`][physgs.scheduling.wake_on_sigint] and
+[`sigint_always_raises`][physgs.scheduling.sigint_always_raises] make sure the SIGINT reaches the
+loop (a waiting main thread is woken; asyncio does not swallow it).
 
 The Snakefile installs both when the workflow loads (Snakemake imports the Snakefile in the
 process that runs the loop). A Snakemake whose method is missing, or no longer arms a timer that
@@ -30,6 +33,7 @@ than running either loop silently.
 from __future__ import annotations
 
 import inspect
+import os
 import signal
 import sys
 import threading
@@ -41,6 +45,7 @@ from snakemake.scheduling.job_scheduler import JobScheduler
 #: marks a class whose method is already replaced (a Snakefile can be loaded more than once)
 _MARK = "_physgs_single_timer"
 _STOP_MARK = "_physgs_stops_jobs"
+_WAKE_MARK = "_physgs_wakes_on_sigint"
 #: seconds a job has to end after SIGTERM before it is killed (its handler raises at once; what
 #: can delay it is a long call into compiled code, which no signal interrupts)
 STOP_GRACE_S = 4.0
@@ -180,9 +185,87 @@ def stop_jobs_on_cancel(executor_cls: type) -> None:
     setattr(executor_cls, _STOP_MARK, True)
 
 
+def _raise_keyboard_interrupt(signum: int, frame) -> None:
+    raise KeyboardInterrupt
+
+
+def sigint_always_raises() -> None:
+    """Make SIGINT raise ``KeyboardInterrupt`` in the main thread even inside an asyncio run.
+
+    Snakemake runs coroutines in its main thread through one ``asyncio.Runner`` per thread
+    (``Workflow.async_run``). While SIGINT's handler is Python's default, each ``Runner.run``
+    swaps in its own, which cancels the running task instead of raising: a coroutine that ends
+    without letting the cancellation out then returns normally, and the SIGINT is gone. The
+    scheduling loop went back to waiting for its jobs, and a stop by ``kill -INT`` was ignored
+    until the running jobs had finished.
+    A handler of our own that raises as the default does is one the runner leaves in place
+    (it swaps only the default), so the interrupt reaches the loop's ``except
+    KeyboardInterrupt`` and its ``cancel``. Only the main thread may set a handler; elsewhere,
+    and where a handler other than the default is set, nothing changes.
+    """
+    if threading.current_thread() is not threading.main_thread():
+        return
+    if signal.getsignal(signal.SIGINT) is signal.default_int_handler:
+        signal.signal(signal.SIGINT, _raise_keyboard_interrupt)
+
+
+def _watch_sigint(wake) -> bool:
+    """Call ``wake()`` from a daemon thread each time the process receives SIGINT, whichever of
+    its threads the kernel ran the signal on (``signal.set_wakeup_fd``). False where it cannot:
+    not the main thread, or another wakeup fd is already set (left in place)."""
+    if threading.current_thread() is not threading.main_thread():
+        return False
+    r, w = os.pipe()
+    os.set_blocking(w, False)  # set_wakeup_fd requires it: the C handler must never block
+    old = signal.set_wakeup_fd(w, warn_on_full_buffer=False)
+    if old != -1:
+        signal.set_wakeup_fd(old)
+        os.close(r), os.close(w)
+        return False
+
+    def watch() -> None:
+        while data := os.read(r, 64):  # one byte per signal: its number
+            if signal.SIGINT in data:
+                wake()
+
+    threading.Thread(target=watch, name="physgs-sigint-wake", daemon=True).start()
+    return True
+
+
+def wake_on_sigint(scheduler_cls: type) -> None:
+    """Wake Snakemake's scheduling loop when SIGINT arrives, so that its main thread raises it.
+
+    While jobs run and none is ready, the loop waits on ``_open_jobs`` with no timer pending
+    (upstream's pass that finds nothing to run arms none either), until a job ends. Python runs
+    signal handlers only in the main thread, and a wait there is cut short only when the kernel
+    delivers the signal to that thread; delivered to a job's thread (which the kernel may pick),
+    the handler waited for the running job: a ``kill -INT`` of a run left its training to its end
+    (the suite's interrupt test, run beside other tests, about one time in two). A thread that
+    reads the signal's wakeup byte releases ``_open_jobs`` once, and the woken main thread runs
+    the handler (``KeyboardInterrupt``, the loop's ``cancel``); an extra release costs one pass.
+
+    Args:
+        scheduler_cls: Snakemake's ``JobScheduler`` (a class whose ``schedule`` waits on
+            ``self._open_jobs``, a semaphore).
+    """
+    if getattr(scheduler_cls, _WAKE_MARK, False):
+        return
+    schedule = scheduler_cls.schedule
+
+    def schedule_awake(self):
+        _watch_sigint(self._open_jobs.release)
+        return schedule(self)
+
+    scheduler_cls.schedule = schedule_awake
+    setattr(scheduler_cls, _WAKE_MARK, True)
+
+
 def install() -> None:
     """Install [`single_reevaluation_timer`][physgs.scheduling.single_reevaluation_timer] on
-    Snakemake's ``JobScheduler`` and [`stop_jobs_on_cancel`][physgs.scheduling.stop_jobs_on_cancel]
-    on its local executor."""
+    Snakemake's ``JobScheduler``, [`stop_jobs_on_cancel`][physgs.scheduling.stop_jobs_on_cancel]
+    on its local executor, [`wake_on_sigint`][physgs.scheduling.wake_on_sigint] on the scheduler
+    and [`sigint_always_raises`][physgs.scheduling.sigint_always_raises]."""
     single_reevaluation_timer(JobScheduler)
     stop_jobs_on_cancel(LocalExecutor)
+    wake_on_sigint(JobScheduler)
+    sigint_always_raises()
