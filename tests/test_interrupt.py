@@ -130,6 +130,18 @@ def test_sigint_to_snakemake_ends_the_running_job_in_seconds_and_keeps_finished_
     assert sorted(jobs) == ["all:", "long:"], plan.stdout  # not `done`: it had finished
 
 
+def _printed(tmp_path, source: str, arg: str) -> str:
+    """What a Python script prints, run in a process of its own with ``arg``."""
+    (tmp_path / "script.py").write_text(source)
+    env = {**os.environ, "PYTHONPATH": str(ROOT / "src")}
+    out = subprocess.run(
+        [sys.executable, "script.py", arg],
+        cwd=tmp_path, env=env, capture_output=True, text=True, timeout=60,
+    )  # fmt: skip
+    assert out.returncode == 0, out.stderr
+    return out.stdout.strip()
+
+
 # a coroutine of the kind that lost the SIGINT: it lets no cancellation out and returns normally
 SWALLOWED = """
 import asyncio, os, signal, sys
@@ -161,19 +173,8 @@ def test_a_sigint_inside_asyncio_reaches_the_main_thread_as_keyboard_interrupt(t
     """With Python's default handler, asyncio's runner turns a SIGINT into a cancellation that a
     coroutine can swallow (the run goes on as if none came); with ``sigint_always_raises`` it is a
     ``KeyboardInterrupt`` in the main thread, as Snakemake's loop expects."""
-    (tmp_path / "swallowed.py").write_text(SWALLOWED)
-    env = {**os.environ, "PYTHONPATH": str(ROOT / "src")}
-
-    def run(handler: str) -> str:
-        out = subprocess.run(
-            [sys.executable, "swallowed.py", handler],
-            cwd=tmp_path, env=env, capture_output=True, text=True, timeout=60,
-        )  # fmt: skip
-        assert out.returncode == 0, out.stderr
-        return out.stdout.strip()
-
-    assert run("python") == "finished"  # the SIGINT lost: what the loop saw before
-    assert run("ours") == "interrupted"
+    assert _printed(tmp_path, SWALLOWED, "python") == "finished"  # lost, as the loop saw it
+    assert _printed(tmp_path, SWALLOWED, "ours") == "interrupted"
 
 
 # the scheduling loop's wait, with SIGINT blocked in the main thread so that the kernel must run it
@@ -203,16 +204,6 @@ def test_a_sigint_run_on_another_thread_wakes_the_waiting_loop(tmp_path):
     """A SIGINT the kernel runs on a thread other than the waiting main thread reaches the main
     thread's handler only when the wait ends: at its timeout without the watcher (the loop's wait
     has none: it waited for the running job), at once with it."""
-    (tmp_path / "elsewhere.py").write_text(ELSEWHERE)
-    env = {**os.environ, "PYTHONPATH": str(ROOT / "src")}
-
-    def seconds(mode: str) -> float:
-        out = subprocess.run(
-            [sys.executable, "elsewhere.py", mode],
-            cwd=tmp_path, env=env, capture_output=True, text=True, timeout=60,
-        )  # fmt: skip
-        assert out.returncode == 0, out.stderr
-        return float(out.stdout)
-
-    assert seconds("plain") > 2.7  # the handler ran only when the 3 s wait timed out
-    assert seconds("wake") < 2.0
+    # without the watcher the handler ran only when the 3 s wait timed out
+    assert float(_printed(tmp_path, ELSEWHERE, "plain")) > 2.7
+    assert float(_printed(tmp_path, ELSEWHERE, "wake")) < 2.0
