@@ -4,7 +4,8 @@ import numpy as np
 import pandas as pd
 import pytest
 
-from physgs.report.trade import draw_fit_vs_extrapolation, fit_vs_extrapolation
+from physgs.experiments.fit_curve import fit_vs_extrapolation, trade_summary
+from physgs.report.trade import draw_fit_vs_extrapolation
 
 
 def _curve() -> pd.DataFrame:
@@ -90,3 +91,37 @@ def test_the_figure_draws_one_panel_per_tree(tmp_path):
 
     img = mpimg.imread(png)
     assert img.shape[1] > 1.8 * img.shape[0]  # two panels side by side
+
+
+def test_the_trade_summary_gives_each_curves_means_and_their_change():
+    """Per tree and model: the budgets (the profile's starred), the means over seeds at each, and
+    largest-budget minus smallest; the ceiling left out. By hand from the fixture: the fit
+    fraction 0.3 / 0.5 / 0.8, the gain +1.0 / +0.5 / -0.25 dB on both trees."""
+    s = trade_summary(fit_vs_extrapolation(_curve())).set_index(["tree", "model"])
+    assert list(s.index) == [("medium", "d3dgs_wind"), ("dense", "d3dgs_wind")]
+    row = s.loc[("dense", "d3dgs_wind")]
+    assert row["budgets"] == "1500 / 3000* / 6000" and row["seeds"] == 2
+    assert row["of_ceiling"] == "0.30 / 0.50 / 0.80"
+    assert row["beyond_gain_db"] == "+1.00 / +0.50 / -0.25"
+    assert row["d_of_ceiling"] == pytest.approx(0.5)
+    assert row["d_beyond_db"] == pytest.approx(-1.25)
+
+
+def test_the_tool_writes_the_summary_as_markdown(tmp_path):
+    import subprocess
+    import sys
+    from pathlib import Path
+
+    root = Path(__file__).resolve().parents[1]
+    _curve().to_csv(tmp_path / "fit_curve.csv", index=False)
+    page = tmp_path / "fit_trade.md"
+    out = subprocess.run(
+        [sys.executable, root / "tools" / "fit_trade.py", tmp_path / "fit_curve.csv",
+         "--markdown", page],
+        capture_output=True, text=True, timeout=60,
+    )  # fmt: skip
+    assert out.returncode == 0, out.stderr
+    lines = page.read_text().splitlines()
+    assert lines[0].split("|")[1].strip() == "tree" and len(lines) == 4  # head, rule, 2 rows
+    assert "| dense  | d3dgs_wind | 1500 / 3000* / 6000 |" in page.read_text()
+    assert lines[-1].rstrip("| ").endswith("-1.25")

@@ -303,3 +303,61 @@ def curve_table(
     )
     df["of_ceiling"] = ceiling_fraction(df)
     return df
+
+
+def fit_vs_extrapolation(df: pd.DataFrame, static: str = "static") -> pd.DataFrame:
+    """Each fit-curve point's in-window fraction of the ceiling and its gain over the static pose
+    beyond the window.
+
+    Args:
+        df: the fit curve's CSV ([`fit_curve.collect`][physgs.experiments.fit_curve.collect]
+            with ``of_ceiling``): one row per tree, seed, model and budget.
+        static: the static pose's id.
+
+    Returns:
+        The rows of every model but the static pose that have both numbers (the references
+        too: the figure leaves them out), with ``beyond_gain``: time-split PSNR minus the same
+        tree's and seed's static pose at the profile's budget (dB).
+    """
+    prof = df[df["is_profile"] & (df["model"] == static)].set_index(["tree", "seed"])["time"]
+    out = df[df["model"] != static].join(prof.rename("static_time"), on=["tree", "seed"])
+    out["beyond_gain"] = out.pop("time") - out.pop("static_time")
+    return out.dropna(subset=["of_ceiling", "beyond_gain"])
+
+
+def trade_summary(df: pd.DataFrame, references: Sequence[str] = ("truth_motion",)) -> pd.DataFrame:
+    """Along each model's fit curve, its in-window fit and its gain beyond the window at each
+    budget (means over seeds), and how both moved from its smallest budget to its largest: what
+    fig_fit_vs_extrapolation draws, as numbers.
+
+    Args:
+        df: [`fit_vs_extrapolation`][physgs.experiments.fit_curve.fit_vs_extrapolation]'s rows.
+        references: models left out (the ceiling is no opponent).
+
+    Returns:
+        One row per tree and model (the curve's order): ``budgets`` (iterations, the profile's
+        starred), ``seeds``, ``of_ceiling`` and ``beyond_gain_db`` (per budget, ``a / b / c``),
+        ``d_of_ceiling`` and ``d_beyond_db`` (largest budget minus smallest).
+    """
+    rows = []
+    for (tree, model), g in df[~df["model"].isin(references)].groupby(
+        ["tree", "model"], sort=False
+    ):
+        m = g.groupby("iterations").agg(
+            of_ceiling=("of_ceiling", "mean"),
+            beyond=("beyond_gain", "mean"),
+            profile=("is_profile", "any"),
+        )
+        rows.append(
+            {
+                "tree": tree,
+                "model": model,
+                "budgets": " / ".join(f"{i}{'*' * p}" for i, p in zip(m.index, m["profile"])),
+                "seeds": g["seed"].nunique(),
+                "of_ceiling": " / ".join(f"{v:.2f}" for v in m["of_ceiling"]),
+                "beyond_gain_db": " / ".join(f"{v:+.2f}" for v in m["beyond"]),
+                "d_of_ceiling": m["of_ceiling"].iloc[-1] - m["of_ceiling"].iloc[0],
+                "d_beyond_db": m["beyond"].iloc[-1] - m["beyond"].iloc[0],
+            }
+        )
+    return pd.DataFrame(rows)

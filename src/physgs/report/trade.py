@@ -10,6 +10,7 @@ from typing import Sequence
 
 import pandas as pd
 
+from physgs.experiments.fit_curve import fit_vs_extrapolation
 from physgs.experiments.sweep import null_level
 from physgs.models.registry import BASE_CONFIG, REFERENCE_NAMES, label
 from physgs.recovery.record import load_null
@@ -51,31 +52,11 @@ def _fit_curve(df, out, path, settings):
     figures.fig_fit_curve(df, out)
 
 
-def fit_vs_extrapolation(df: pd.DataFrame, static: str = "static") -> pd.DataFrame:
-    """Each fit-curve point's in-window fraction of the ceiling and its gain over the static pose
-    beyond the window.
-
-    Args:
-        df: the fit curve's CSV ([`fit_curve.collect`][physgs.experiments.fit_curve.collect]
-            with ``of_ceiling``): one row per tree, seed, model and budget.
-        static: the static pose's id.
-
-    Returns:
-        The rows of every model but the static pose that have both numbers (the references
-        too: the figure leaves them out), with ``beyond_gain``: time-split PSNR minus the same
-        tree's and seed's static pose at the profile's budget (dB).
-    """
-    prof = df[df["is_profile"] & (df["model"] == static)].set_index(["tree", "seed"])["time"]
-    out = df[df["model"] != static].join(prof.rename("static_time"), on=["tree", "seed"])
-    out["beyond_gain"] = out.pop("time") - out.pop("static_time")
-    return out.dropna(subset=["of_ceiling", "beyond_gain"])
-
-
 def draw_fit_vs_extrapolation(df: pd.DataFrame, outputs: Sequence[str]) -> None:
     """fig_fit_vs_extrapolation: one panel per tree, one line per model through its budgets.
 
     Args:
-        df: [`fit_vs_extrapolation`][physgs.report.trade.fit_vs_extrapolation]'s rows.
+        df: [`fit_vs_extrapolation`][physgs.experiments.fit_curve.fit_vs_extrapolation]'s rows.
         outputs: the paths to write.
     """
     from physgs.report.figures import COLORS, _axes, _finish  # matplotlib: not for planning
