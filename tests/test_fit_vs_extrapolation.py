@@ -114,10 +114,11 @@ def test_the_tool_writes_the_summary_as_markdown(tmp_path):
 
     root = Path(__file__).resolve().parents[1]
     _curve().to_csv(tmp_path / "fit_curve.csv", index=False)
-    page = tmp_path / "fit_trade.md"
+    page, png, small = tmp_path / "fit_trade.md", tmp_path / "fig.png", tmp_path / "small.png"
+    draw_fit_vs_extrapolation(fit_vs_extrapolation(_curve()), [png])
     out = subprocess.run(
         [sys.executable, root / "tools" / "fit_trade.py", tmp_path / "fit_curve.csv",
-         "--markdown", page],
+         "--markdown", page, "--figure", png, small],
         capture_output=True, text=True, timeout=60,
     )  # fmt: skip
     assert out.returncode == 0, out.stderr
@@ -125,3 +126,9 @@ def test_the_tool_writes_the_summary_as_markdown(tmp_path):
     assert lines[0].split("|")[1].strip() == "tree" and len(lines) == 4  # head, rule, 2 rows
     assert "| dense  | d3dgs_wind | 1500 / 3000* / 6000 |" in page.read_text()
     assert lines[-1].rstrip("| ").endswith("-1.25")
+    from PIL import Image
+
+    from physgs.report.record import FIGURE_WIDTH_PX
+
+    with Image.open(png) as big, Image.open(small) as im:
+        assert big.width > FIGURE_WIDTH_PX and im.width == FIGURE_WIDTH_PX
