@@ -114,15 +114,21 @@ def test_the_tool_writes_the_summary_as_markdown(tmp_path):
 
     root = Path(__file__).resolve().parents[1]
     _curve().to_csv(tmp_path / "fit_curve.csv", index=False)
+    tool = [sys.executable, root / "tools" / "fit_trade.py", tmp_path / "fit_curve.csv"]
+    bare = subprocess.run(tool, capture_output=True, text=True, timeout=60)
+    assert bare.returncode != 0 and "no provenance record" in bare.stderr  # made by what?
+    from physgs.provenance import write_provenance
+
+    write_provenance([tmp_path / "fit_curve.csv"], "fit_curve", {"seeds": [0, 1]}, commit="abc1234")
     page, png, small = tmp_path / "fit_trade.md", tmp_path / "fig.png", tmp_path / "small.png"
     draw_fit_vs_extrapolation(fit_vs_extrapolation(_curve()), [png])
     out = subprocess.run(
-        [sys.executable, root / "tools" / "fit_trade.py", tmp_path / "fit_curve.csv",
-         "--markdown", page, "--figure", png, small],
+        [*tool, "--markdown", page, "--figure", png, small],
         capture_output=True, text=True, timeout=60,
     )  # fmt: skip
     assert out.returncode == 0, out.stderr
-    lines = page.read_text().splitlines()
+    origin, lines = page.read_text().splitlines()[0], page.read_text().splitlines()[2:]
+    assert "commit abc1234" in origin and "seeds [0, 1]" in origin
     assert lines[0].split("|")[1].strip() == "tree" and len(lines) == 4  # head, rule, 2 rows
     assert "| dense  | d3dgs_wind | 1500 / 3000* / 6000 |" in page.read_text()
     assert lines[-1].rstrip("| ").endswith("-1.25")

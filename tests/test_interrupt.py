@@ -173,7 +173,7 @@ def test_a_sigint_inside_asyncio_reaches_the_main_thread_as_keyboard_interrupt(t
     """With Python's default handler, asyncio's runner turns a SIGINT into a cancellation that a
     coroutine can swallow (the run goes on as if none came); with ``sigint_always_raises`` it is a
     ``KeyboardInterrupt`` in the main thread, as Snakemake's loop expects."""
-    assert _printed(tmp_path, SWALLOWED, "python") == "finished"  # lost, as the loop saw it
+    assert _printed(tmp_path, SWALLOWED, "python") == "finished"  # the cancellation swallowed
     assert _printed(tmp_path, SWALLOWED, "ours") == "interrupted"
 
 

@@ -12,7 +12,8 @@ from pathlib import Path
 import pandas as pd
 
 from physgs.experiments.fit_curve import fit_vs_extrapolation, trade_summary
-from physgs.report.record import FIGURE_WIDTH_PX
+from physgs.provenance import read_provenance
+from physgs.report.record import web_sized
 
 ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
 ap.add_argument("csv", type=Path, help="the fit curve's CSV")
@@ -21,16 +22,18 @@ ap.add_argument("--figure", nargs=2, type=Path, metavar=("PNG", "TO"), help="cop
 a = ap.parse_args()
 if not a.csv.is_file():
     raise SystemExit(f"{a.csv}: missing; run `snakemake --cores 2 studies` first")
-table = trade_summary(fit_vs_extrapolation(pd.read_csv(a.csv))).to_markdown(
+made = read_provenance(a.csv)  # the Snakemake job's sidecar: what made the CSV
+if made is None:
+    raise SystemExit(f"{a.csv}: no provenance record beside it; remake it with the workflow")
+origin = (
+    f"Made from `{a.csv.name}` (commit {made['commit']}, settings {made['settings_hash']}, "
+    f"seeds {made['settings']['params']['seeds']}) by `python tools/fit_trade.py`.\n\n"
+)
+table = origin + trade_summary(fit_vs_extrapolation(pd.read_csv(a.csv))).to_markdown(
     index=False, floatfmt="+.2f"
 )
 print(table)
 if a.markdown:
     a.markdown.write_text(table + "\n")
 if a.figure:
-    from PIL import Image
-
-    with Image.open(a.figure[0]) as im:  # sized as the record sizes its figures
-        h = round(im.height * FIGURE_WIDTH_PX / im.width)
-        small = im.resize((FIGURE_WIDTH_PX, h), Image.LANCZOS) if im.width > FIGURE_WIDTH_PX else im
-        small.save(a.figure[1], optimize=True)
+    web_sized(*a.figure)

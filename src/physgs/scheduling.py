@@ -195,9 +195,9 @@ def sigint_always_raises() -> None:
     Snakemake runs coroutines in its main thread through one ``asyncio.Runner`` per thread
     (``Workflow.async_run``). While SIGINT's handler is Python's default, each ``Runner.run``
     swaps in its own, which cancels the running task instead of raising: a coroutine that ends
-    without letting the cancellation out then returns normally, and the SIGINT is gone. The
-    scheduling loop went back to waiting for its jobs, and a stop by ``kill -INT`` was ignored
-    until the running jobs had finished.
+    without letting the cancellation out then returns normally, and the SIGINT is gone: the
+    scheduling loop would go back to waiting for its jobs (shown on a bare runner in
+    ``tests/test_interrupt.py``; not caught in Snakemake itself).
     A handler of our own that raises as the default does is one the runner leaves in place
     (it swaps only the default), so the interrupt reaches the loop's ``except
     KeyboardInterrupt`` and its ``cancel``. Only the main thread may set a handler; elsewhere,
@@ -240,7 +240,7 @@ def wake_on_sigint(scheduler_cls: type) -> None:
     signal handlers only in the main thread, and a wait there is cut short only when the kernel
     delivers the signal to that thread; delivered to a job's thread (which the kernel may pick),
     the handler waited for the running job: a ``kill -INT`` of a run left its training to its end
-    (the suite's interrupt test, run beside other tests, about one time in two). A thread that
+    (the suite's interrupt test hung so beside other tests, its stack dump in that wait). A thread that
     reads the signal's wakeup byte releases ``_open_jobs`` once, and the woken main thread runs
     the handler (``KeyboardInterrupt``, the loop's ``cancel``); an extra release costs one pass.
 

@@ -246,6 +246,15 @@ def _demote(markdown: str) -> str:
     return re.sub(r"^#+ ", r"#\g<0>", markdown, flags=re.MULTILINE)
 
 
+def web_sized(png: str | Path, to: str | Path) -> None:
+    """Copy a figure at most ``FIGURE_WIDTH_PX`` wide (its aspect kept), as the record keeps it."""
+    with Image.open(png) as im:
+        if im.width > FIGURE_WIDTH_PX:
+            h = round(im.height * FIGURE_WIDTH_PX / im.width)
+            im = im.resize((FIGURE_WIDTH_PX, h), Image.LANCZOS)
+        im.save(to, optimize=True)
+
+
 def _rerun_page(
     previous: Path, stamp: Stamp, claims_csv: str | Path, tables: Sequence[str | Path], roles=None
 ) -> str:
@@ -472,11 +481,7 @@ def write_record(
     for src, to in [(claims_csv, "claims.csv"), *((t, f"tables/{Path(t).name}") for t in tables)]:
         shutil.copyfile(src, out / to)
     for f in map(Path, figures):
-        with Image.open(f) as im:
-            if im.width > FIGURE_WIDTH_PX:
-                h = round(im.height * FIGURE_WIDTH_PX / im.width)
-                im = im.resize((FIGURE_WIDTH_PX, h), Image.LANCZOS)
-            im.save(out / "figures" / f.name, optimize=True)
+        web_sized(f, out / "figures" / f.name)
     render_pages(out)
     written = sorted(final / p.relative_to(out) for p in out.rglob("*") if p.is_file())
     if final.exists():
