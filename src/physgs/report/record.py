@@ -247,7 +247,12 @@ def _demote(markdown: str) -> str:
 
 
 def web_sized(png: str | Path, to: str | Path) -> None:
-    """Copy a figure at most ``FIGURE_WIDTH_PX`` wide (its aspect kept), as the record keeps it."""
+    """Copy a figure at most ``FIGURE_WIDTH_PX`` wide (its aspect kept), as the record keeps it.
+
+    Args:
+        png: the figure (an image file; PNG in the record).
+        to: where the copy goes.
+    """
     with Image.open(png) as im:
         if im.width > FIGURE_WIDTH_PX:
             h = round(im.height * FIGURE_WIDTH_PX / im.width)
