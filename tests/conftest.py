@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import math
 import os
+from pathlib import Path
 from types import SimpleNamespace
 
 import numpy as np
@@ -69,17 +70,35 @@ def swaying_dataset(seed: int = 0) -> SimpleNamespace:
     )
 
 
+#: A SLURM configuration with no controller, answered at once. tools/slurm_up.sh leaves SLURM's
+#: packages installed, and with its daemons down every `snakemake` call (the SLURM executor plugin
+#: runs `scontrol show config` whenever it is imported: Snakemake's start, and collecting
+#: test_cluster_profile.py) waited 1 s for the controller, about 50 s of the suite's wall time on
+#: two workers. Only test_slurm.py talks to a SLURM: its fixture puts ``MACHINE_SLURM_CONF`` back.
+NO_CONTROLLER = Path(__file__).with_name("no_slurm_controller.conf")
+# xdist's workers inherit the controller's environment: the machine's value is kept beside it
+os.environ.setdefault("PHYSGS_MACHINE_SLURM_CONF", os.environ.get("SLURM_CONF", ""))
+MACHINE_SLURM_CONF = os.environ["PHYSGS_MACHINE_SLURM_CONF"] or None
+os.environ["SLURM_CONF"] = str(NO_CONTROLLER)  # before any test module imports the plugin
+
+
 @pytest.hookimpl(tryfirst=True)  # before pytest-xdist reads the groups
 def pytest_collection_modifyitems(items):
     """Order and group the tests for the suite's two workers (``--dist loadgroup``, order kept).
 
     One test that reads the quick DAG goes first, so one worker builds the DAG on both cores
-    while the other runs the tests that need no DAG; the rest of the DAG's readers go last and
-    are shared by both workers. A module with a module-scoped fixture stays on one worker, so
-    its fixture is built once."""
+    while the other runs the tests that need no DAG and start processes (the long ones); the
+    rest of the DAG's readers follow, shared by both workers, and the tests of modules that
+    start no process go last: many short tests, so both workers end within seconds of each
+    other. A module with a module-scoped fixture stays on one worker, so its fixture is built
+    once."""
     dag = [it for it in items if "quick_dag" in it.fixturenames]
     rest = [it for it in items if "quick_dag" not in it.fixturenames]
-    items[:] = dag[:1] + rest + dag[1:]
+    spawns = {it.path: "subprocess" in it.path.read_text() for it in rest}
+    items[:] = (
+        dag[:1] + [it for it in rest if spawns[it.path]] + dag[1:]
+        + [it for it in rest if not spawns[it.path]]
+    )  # fmt: skip
     for it in items:
         defs = it._fixtureinfo.name2fixturedefs.values()
         if any(d[-1].scope == "module" for d in defs):

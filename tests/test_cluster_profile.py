@@ -7,9 +7,11 @@ from __future__ import annotations
 import base64
 import os
 import re
+import shutil
 import stat
 import subprocess
 import sys
+import time
 
 import pytest
 import yaml
@@ -161,3 +163,18 @@ def test_no_group_job_serialises_the_tail_of_the_run(tmp_path):
     assert len(post) >= 2 and max(map(len, post)) <= 20, [len(p) for p in post]
     assert not grouped & {"table", "figure", "claims", "summary", "testbed_stats"}, grouped
     assert any(group == "fit" and "evaluate" in rules for group, rules in jobs)
+
+
+def test_the_suites_snakemake_calls_wait_on_no_slurm_controller():
+    """The suite without its `slurm` tests points SLURM at a configuration with no controller
+    (conftest.py), so a `snakemake` call does not wait for a controller that is down, as it did
+    for 1 s each where SLURM's packages were installed."""
+    import conftest
+    from conftest import NO_CONTROLLER
+
+    assert sys.modules["conftest"] is conftest and conftest.MACHINE_SLURM_CONF != str(NO_CONTROLLER)
+    assert os.environ.get("SLURM_CONF") == str(NO_CONTROLLER) and NO_CONTROLLER.is_file()
+    if shutil.which("scontrol"):  # the packages are installed: the probe the plugin runs
+        t0 = time.perf_counter()
+        subprocess.run(["scontrol", "show", "config"], capture_output=True, timeout=30)
+        assert time.perf_counter() - t0 < 0.5

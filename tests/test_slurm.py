@@ -23,6 +23,7 @@ import pandas as pd
 import pytest
 import torch
 
+from conftest import MACHINE_SLURM_CONF
 from workflow_helpers import ROOT, snakemake, workflow_copy
 
 # one worker, in file order: the last test checks what the first one left
@@ -57,8 +58,13 @@ BEFORE = {d: _running(d) for d in DAEMONS}
 
 
 @pytest.fixture
-def slurm_cluster():
-    """A one-node SLURM for the test; stopped after it unless one was running before."""
+def slurm_cluster(monkeypatch):
+    """A one-node SLURM for the test; stopped after it unless one was running before. The
+    machine's SLURM configuration, not the suite's ``conftest.NO_CONTROLLER``."""
+    if MACHINE_SLURM_CONF is None:
+        monkeypatch.delenv("SLURM_CONF")
+    else:
+        monkeypatch.setenv("SLURM_CONF", MACHINE_SLURM_CONF)
     _boot()
     yield
     if not any(BEFORE.values()):
