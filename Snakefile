@@ -32,8 +32,8 @@ CFG = physgs.config.load_workflow_config(
 )
 TREES = CFG["trees"]
 # a bfloat16 field on a CPU that would emulate bf16 (~48x slower) stops here, before any job
-# (torch loads only when a field asks for bf16, so a float32 plan stays light)
-physgs.experiments.recipe.check_precision_supported(CFG["models"])
+# (torch loads only when a field asks for bf16 and the CPU's flags do not report it)
+physgs.experiments.recipe.check_precision_supported(CFG["models"], planning=True)
 
 
 report: "workflow/report/workflow.rst"

@@ -130,6 +130,40 @@ def test_the_plan_stops_before_any_job_on_a_cpu_without_bf16_and_the_overlay_is_
     check_precision_supported(quick["models"])  # the tests' profile runs on any CPU
 
 
+def test_the_plans_check_trusts_the_cpus_bf16_flags_and_asks_onednn_without_them(monkeypatch):
+    """At plan time (every Snakemake call) a CPU whose flags report native bf16 passes without
+    oneDNN's probe (torch's start-up); without those flags the probe decides, and a training
+    job always asks it."""
+    import physgs.experiments.recipe as recipe
+    import physgs.models.fields as fields
+
+    default = pconfig.load_workflow_config(
+        yaml.safe_load((ROOT / "config" / "trees.yaml").read_text()), "default"
+    )["models"]
+    monkeypatch.setattr(fields, "native_bf16", lambda: False)
+    monkeypatch.setattr(recipe, "bf16_flags", lambda: ["avx512_bf16"])
+    recipe.check_precision_supported(default, planning=True)  # the flags: no probe, no raise
+    with pytest.raises(RuntimeError, match="config/float32.yaml"):
+        recipe.check_precision_supported(default)  # a job asks oneDNN, whatever the flags
+    monkeypatch.setattr(recipe, "bf16_flags", lambda: [])
+    with pytest.raises(RuntimeError, match="config/float32.yaml"):
+        recipe.check_precision_supported(default, planning=True)
+
+
+def test_the_cpu_flags_are_read_as_the_kernel_writes_them_and_agree_with_onednn(tmp_path):
+    from physgs.models.fields import native_bf16
+    from physgs.provenance import bf16_flags, machine_cpu
+
+    info = tmp_path / "cpuinfo"
+    info.write_text("model name\t: Some CPU\nflags\t\t: fpu avx512f avx512_bf16 avx512_vnni\n")
+    assert bf16_flags(info) == ["avx512_bf16"] and machine_cpu(info) == "Some CPU (avx512_bf16)"
+    info.write_text("flags\t\t: fpu avx512f avx512_bf16x amx_tile amx_bf16\n")
+    assert bf16_flags(info) == ["amx_bf16"]  # whole words only
+    assert bf16_flags(tmp_path / "absent") == []
+    if bf16_flags():  # this machine reports them: oneDNN's probe says the same
+        assert native_bf16()
+
+
 def test_bf16_field_gives_bitwise_equal_gradients_when_run_twice():
     _, b16 = _pair()
     x = torch.rand(300, 40) * 2 - 1

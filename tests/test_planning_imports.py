@@ -25,14 +25,21 @@ def test_the_workflows_imports_load_no_heavy_library():
     # the Snakefile's own first step: validate and check the shipped config (its checks reuse
     # the testbed's formulas, whose modules must not load torch either)
     load = (
-        "physgs.config.load_workflow_config(yaml.safe_load(open('config/trees.yaml')), "
+        "cfg = physgs.config.load_workflow_config(yaml.safe_load(open('config/trees.yaml')), "
         "'default', source='config/trees.yaml')"
+    )
+    # then its bf16 check, on a CPU whose flags report native bf16 (the default's fields are
+    # bf16): the flags decide, and torch stays unloaded
+    check = (
+        "physgs.experiments.recipe.bf16_flags = lambda: ['avx512_bf16']\n"
+        "physgs.experiments.recipe.check_precision_supported(cfg['models'], planning=True)"
     )
     code = "\n".join(
         [
             *imports,
             "import yaml",
             load,
+            check,
             "import sys",
             f"print(sorted(m for m in {HEAVY!r} if m in sys.modules))",
         ]

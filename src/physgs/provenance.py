@@ -111,6 +111,27 @@ def read_stamped(path) -> "pandas.DataFrame":  # noqa: F821 (pandas: imported wh
     return pd.read_csv(path, dtype={"config_hash": str})
 
 
+#: The CPU flags of native bf16 dot products (AVX-512 BF16, AMX), as Linux names them.
+BF16_FLAGS = ("avx512_bf16", "amx_bf16")
+
+
+def _cpuinfo(cpuinfo: str | Path) -> str:
+    return Path(cpuinfo).read_text() if Path(cpuinfo).is_file() else ""
+
+
+def bf16_flags(cpuinfo: str | Path = "/proc/cpuinfo") -> list[str]:
+    """The flags among ``BF16_FLAGS`` that the kernel reports for this CPU.
+
+    Args:
+        cpuinfo: the kernel's CPU description (Linux).
+
+    Returns:
+        Those flags; empty where it reports none or there is no such file (not Linux).
+    """
+    words = _cpuinfo(cpuinfo).split()
+    return [f for f in BF16_FLAGS if f in words]
+
+
 def machine_cpu(cpuinfo: str | Path = "/proc/cpuinfo") -> str:
     """The CPU's model and whether it computes bf16 natively (AVX-512 BF16, AMX): what a
     timing depends on (the fields run in bf16).
@@ -121,11 +142,11 @@ def machine_cpu(cpuinfo: str | Path = "/proc/cpuinfo") -> str:
     Returns:
         ``'<model> (<flags>)'``, the flags among ``avx512_bf16`` and ``amx_bf16`` or ``no bf16``.
     """
-    info = Path(cpuinfo).read_text() if Path(cpuinfo).is_file() else ""
+    info = _cpuinfo(cpuinfo)
     model = next(
         (ln.split(":", 1)[1].strip() for ln in info.splitlines() if "model name" in ln), ""
     )
-    flags = [f for f in ("avx512_bf16", "amx_bf16") if f in info.split()]
+    flags = bf16_flags(cpuinfo)
     return f"{model or platform.processor() or 'unknown CPU'} ({', '.join(flags) or 'no bf16'})"
 
 

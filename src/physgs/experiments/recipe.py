@@ -12,6 +12,7 @@ from typing import TYPE_CHECKING
 import numpy as np
 
 from physgs.mappings import deep_merge
+from physgs.provenance import bf16_flags
 from physgs.models.checkpoint import save_checkpoint
 from physgs.testbed.variant import parse_id
 from physgs.models.families import searches_omega
@@ -406,7 +407,9 @@ def training_hooks(observed, job: Job, conditions: list[int]) -> list:
     return [h for h in hooks if h is not None]
 
 
-def check_precision_supported(settings: dict, families: tuple[str, ...] = FIELD_FAMILIES) -> None:
+def check_precision_supported(
+    settings: dict, families: tuple[str, ...] = FIELD_FAMILIES, *, planning: bool = False
+) -> None:
     """Raise RuntimeError if any of ``families`` asks for ``precision: bfloat16`` in the models
     settings ``settings`` and this CPU has no native bf16 (autocast would emulate it, ~48x
     slower than float32: a default run would take days), naming the key and the way out. torch
@@ -415,6 +418,10 @@ def check_precision_supported(settings: dict, families: tuple[str, ...] = FIELD_
     Args:
         settings: the ``models`` settings.
         families: the field families checked.
+        planning: the plan's check (the Snakefile, at every Snakemake call): a CPU whose flags
+            report native bf16 (``physgs.provenance.bf16_flags``) passes without loading torch
+            (~1.5 CPU-s a call); otherwise, and always in a training job, oneDNN's own probe
+            decides.
 
     Raises:
         RuntimeError: naming the key and the way out when bf16 is asked for without native
@@ -423,7 +430,7 @@ def check_precision_supported(settings: dict, families: tuple[str, ...] = FIELD_
     asked = [
         f for f in families if (settings.get(f) or {}).get("precision", "float32") == "bfloat16"
     ]
-    if not asked:
+    if not asked or (planning and bf16_flags()):
         return
     from physgs.models.fields import native_bf16  # here: torch, only when bf16 is asked for
 
