@@ -9,14 +9,15 @@ from types import SimpleNamespace
 
 import numpy as np
 import pytest
-import torch
 from filelock import FileLock
 
-from physgs.camera import look_at
-from physgs.render import rasterization
 from workflow_helpers import snakemake, workflow_copy
 
+# torch only in the workers: xdist's controller loads this file before it starts them, and runs
+# no test (torch's start-up there delayed both workers by ~1.5 s)
 if os.environ.get("PYTEST_XDIST_WORKER"):
+    import torch
+
     torch.set_num_threads(1)  # two workers on two cores: one thread each, no oversubscription
 
 FPS, N_TRAIN, N_TAIL, LEAD_IN, RES = 24, 20, 4, 150, 24
@@ -25,6 +26,11 @@ FPS, N_TRAIN, N_TAIL, LEAD_IN, RES = 24, 20, 4, 150, 24
 def swaying_dataset(seed: int = 0) -> SimpleNamespace:
     """Observed-like dataset: 120 Gaussians (trunk + crown), the crown swaying as
     cond * 0.12 * height^2 * sin(2 pi 0.8 t) in x, rendered by the fast rasterizer at 24 px."""
+    import torch
+
+    from physgs.camera import look_at
+    from physgs.render import rasterization
+
     rng = np.random.default_rng(seed)
     trunk = np.stack([np.zeros(30), np.zeros(30), np.linspace(0, 1, 30)], 1)
     crown = rng.normal(size=(90, 3)) * [0.35, 0.35, 0.3] + [0, 0, 1.4]
