@@ -119,6 +119,11 @@ def _cpuinfo(cpuinfo: str | Path) -> str:
     return Path(cpuinfo).read_text() if Path(cpuinfo).is_file() else ""
 
 
+def _flags_in(info: str) -> list[str]:
+    words = info.split()
+    return [f for f in BF16_FLAGS if f in words]
+
+
 def bf16_flags(cpuinfo: str | Path = "/proc/cpuinfo") -> list[str]:
     """The flags among ``BF16_FLAGS`` that the kernel reports for this CPU.
 
@@ -128,8 +133,7 @@ def bf16_flags(cpuinfo: str | Path = "/proc/cpuinfo") -> list[str]:
     Returns:
         Those flags; empty where it reports none or there is no such file (not Linux).
     """
-    words = _cpuinfo(cpuinfo).split()
-    return [f for f in BF16_FLAGS if f in words]
+    return _flags_in(_cpuinfo(cpuinfo))
 
 
 def machine_cpu(cpuinfo: str | Path = "/proc/cpuinfo") -> str:
@@ -146,7 +150,7 @@ def machine_cpu(cpuinfo: str | Path = "/proc/cpuinfo") -> str:
     model = next(
         (ln.split(":", 1)[1].strip() for ln in info.splitlines() if "model name" in ln), ""
     )
-    flags = bf16_flags(cpuinfo)
+    flags = _flags_in(info)  # the text read once
     return f"{model or platform.processor() or 'unknown CPU'} ({', '.join(flags) or 'no bf16'})"
 
 
