@@ -168,10 +168,7 @@ class ClaimSpec:
                 sentences and the paper's figure filled in, the threshold's value, the origin
                 (``origin_of``) and the companion's id on the same cell (``requires``).
         """
-
-        def fill(template: str) -> str:
-            return template.format(**WORDS, **cell)
-
+        fill = lambda template: template.format(**WORDS, **cell)
         prefix = cell.get("prefix", "" if cell["model"] == PAPER_MODEL else f"{cell['model']}/")
         suffix = f"/{cell['suffix']}" if cell.get("suffix") else ""
         cid = prefix + self.family + suffix
@@ -204,63 +201,63 @@ TRACKS_PROPOSAL = "not run (the paper's closing proposal)"
 _AHEAD_DB = dict(threshold="EVEN", unit="dB", one_sided=DIRECTION)
 #: A study or control of this project's that only some runs make.
 _STUDY = dict(origin="project", optional=True)
+#: A claim about ours asked again of every other prior.
+_PRIOR = dict(of="priors", origin="project")
 
 
 # ---- scopes and readers several families share ---------------------------------------------------
-def _trees(run: Run) -> list[Cell]:
-    """each tree"""
-    return [{"suffix": t, "tree": t, "paper": run.role(t, "paper")} for t in run.trees]
-
-
-def _with_role(run: Run, role: str) -> list[Cell]:
-    return [c for c in _trees(run) if run.role(c["tree"], "frequencies") == role]
+def _trees(run: Run, role: str = "", **fields) -> list[Cell]:
+    """each tree"""  # the claims page's words; ``role``: only trees of it, ``fields``: added
+    return [
+        {"suffix": t, "tree": t, "paper": run.role(t, "paper"), **fields}
+        for t in run.trees
+        if not role or run.role(t, "frequencies") == role
+    ]
 
 
 def _recovered_trees(run: Run) -> list[Cell]:
     """each tree with the asked prior's recovery records (joint K = 32)"""
     rec = run.own
     have = set() if rec is None else set(rec.loc[rec["model"] == run.model, "tree"])
-    return [{**c, "config": CONFIG} for c in _trees(run) if c["tree"] in have]
+    return [c for c in _trees(run, config=CONFIG) if c["tree"] in have]
 
 
-def _psnr(d: pd.DataFrame, c: Cell, models: Sequence[str], split: str = "time") -> float:
-    """tab_psnr: the best of ``models``' ``<tree>_<split>`` cells."""
-    return max(value(d, d["model"].astype(str) == m, f"{c['tree']}_{split}") for m in models)
-
-
-def _over_static(d: pd.DataFrame, c: Cell, models: Sequence[str]) -> float:
-    return _psnr(d, c, models) - _psnr(d, c, ["static"])
-
-
-def _ahead_of_fields(d: pd.DataFrame, c: Cell) -> float:
-    sp = c.get("split", "view")
-    return _psnr(d, c, [c["model"]], sp) - _psnr(d, c, models_of("field"), sp)
+def _winds(run: Run) -> list[Cell]:
+    """each split (training timestamps, beyond the window) x tree x unseen wind of tab_transfer"""
+    tr = run.own
+    if tr is None:
+        return []
+    return [
+        {"suffix": f"{t}/wind_{sp}/{c:.2f}", "tree": t, "condition": c, "cond": f"{c:.2f}",
+         "split": sp, "where": "beyond the window" if sp == "beyond" else "at training timestamps"}
+        for (sp, t, c), _ in tr.groupby(["split", "tree", "condition"], sort=False)
+    ]  # fmt: skip
 
 
 def _winds_beyond(run: Run) -> list[Cell]:
     """each tree x unseen wind of tab_transfer, beyond the window"""
-    tr = run.own
-    if tr is None:
-        return []
-    beyond = tr[tr["split"] == "beyond"]  # a key of tab_transfer (images.TRANSFER_COLUMNS)
+    # "beyond": a key of tab_transfer (images.TRANSFER_COLUMNS)
     return [
-        {"suffix": f"{t}/{c:.2f}", "tree": t, "condition": c, "cond": f"{c:.2f}", "split": "beyond"}
-        for (t, c), _ in beyond.groupby(["tree", "condition"], sort=False)
+        {**c, "suffix": f"{c['tree']}/{c['cond']}"} for c in _winds(run) if c["split"] == "beyond"
     ]
 
 
-def _transfer(d: pd.DataFrame, c: Cell, models: Sequence[str]) -> float:
-    """tab_transfer: the best of ``models`` in the cell's split, tree and wind."""
+def _best(d: pd.DataFrame, c: Cell, models: Sequence[str], split: str = "time") -> float:
+    """The best of ``models``: tab_transfer's in the cell's split, tree and wind (a cell with a
+    ``condition``), else tab_psnr's ``<tree>_<split>`` cells."""
+    if "condition" not in c:
+        return max(value(d, d["model"].astype(str) == m, f"{c['tree']}_{split}") for m in models)
     row = (d["split"] == c["split"]) & (d["tree"] == c["tree"])
     return max(value(d, row & np.isclose(d["condition"], c["condition"]), m) for m in models)
 
 
-def _transfer_over_static(d: pd.DataFrame, c: Cell, models: Sequence[str]) -> float:
-    return _transfer(d, c, models) - _transfer(d, c, ["static"])
+def _over_static(d: pd.DataFrame, c: Cell, models: Sequence[str]) -> float:
+    return _best(d, c, models) - _best(d, c, ["static"])
 
 
-def _wind_ahead(d: pd.DataFrame, c: Cell) -> float:
-    return _transfer(d, c, [c["model"]]) - _transfer(d, c, models_of("field"))
+def _ahead_of_fields(d: pd.DataFrame, c: Cell) -> float:
+    sp = c.get("split", "view")
+    return _best(d, c, [c["model"]], sp) - _best(d, c, models_of("field"), sp)
 
 
 def _margin_trees(run: Run) -> list[Cell]:
@@ -268,7 +265,7 @@ def _margin_trees(run: Run) -> list[Cell]:
     mg = run.own
     cols = [c for c in mg.columns if c.startswith("margin_")] if mg is not None else []
     first, last = (cols[0], cols[-1]) if cols else ("first", "last")
-    return [{**c, "first": first, "last": last} for c in _trees(run)]
+    return _trees(run, first=first, last=last)
 
 
 def _margin_growth(d: pd.DataFrame, c: Cell) -> float:
@@ -277,9 +274,8 @@ def _margin_growth(d: pd.DataFrame, c: Cell) -> float:
 
 
 def _null_trees_separated(run: Run) -> list[Cell]:
-    """each tree of separated frequencies, in the ledger's recovery configuration (joint K =
-    32)"""
-    return [{**c, "config": CONFIG, "method": run.model} for c in _with_role(run, SEPARATED)]
+    """each tree of separated frequencies, in the ledger's recovery configuration (joint K = 32)"""
+    return _trees(run, SEPARATED, config=CONFIG, method=run.model)
 
 
 def _at(d: pd.DataFrame, c: Cell) -> pd.Series:
@@ -306,15 +302,15 @@ def _trained_minus_null(d: pd.DataFrame, c: Cell) -> float:
     return _err(d, c) - _err(d, c, "null")
 
 
-def _recovery(d: pd.DataFrame, c: Cell, col: str) -> float:
-    """The prior's recovery summary ``col`` in the cell's tree."""
-    return value(d, (d["model"] == c["model"]) & (d["tree"] == c["tree"]), col)
+def _of(d: pd.DataFrame, c: Cell, col: str, model: str = "") -> float:
+    """``col`` of ``model`` (default: the cell's; the recovery summaries') in the cell's tree."""
+    return value(d, (d["model"] == (model or c["model"])) & (d["tree"] == c["tree"]), col)
 
 
 def _damping_off(d: pd.DataFrame, c: Cell) -> float:
     """|median zeta_hat - zeta| / zeta"""
-    z = _recovery(d, c, "zeta_true")
-    return abs(_recovery(d, c, "median_zeta") - z) / z
+    z = _of(d, c, "zeta_true")
+    return abs(_of(d, c, "median_zeta") - z) / z
 
 
 # ---- the paper's figures (``ClaimSpec.paper``) ---------------------------------------------------
@@ -376,8 +372,8 @@ _MOTION = (
         )),
     ),
     ClaimSpec(
-        family="transfer_ours_ahead", over=_winds_beyond, table="tab_transfer", read=_wind_ahead,
-        **_AHEAD_DB, side=">",
+        family="transfer_ours_ahead", over=_winds_beyond, table="tab_transfer",
+        read=_ahead_of_fields, **_AHEAD_DB, side=">",
         text="{tree}, {cond} v0, beyond the window: ours ahead of the best baseline",
         source="tab_transfer (beyond): ours - max learned",
         paper="ahead in every cell, by 0.38-4.68 dB",
@@ -385,7 +381,7 @@ _MOTION = (
     ),
     ClaimSpec(
         family="transfer_baselines_below_static", over=_winds_beyond, table="tab_transfer",
-        read=lambda d, c: _transfer_over_static(d, c, models_of("field")), **_AHEAD_DB, side="<",
+        read=lambda d, c: _over_static(d, c, models_of("field")), **_AHEAD_DB, side="<",
         text="{tree}, {cond} v0, beyond the window: every learned baseline below static",
         source="tab_transfer (beyond): max learned - static",
         paper="below static in all 24 cells, by 0.10-2.79 dB",
@@ -432,7 +428,7 @@ _KINDS = (
     ),
     ClaimSpec(
         family="transfer_kind_below_static", over=_kind_winds_beyond, table="tab_transfer",
-        read=lambda d, c: _transfer_over_static(d, c, fields_of_kind(c["kind"])),
+        read=lambda d, c: _over_static(d, c, fields_of_kind(c["kind"])),
         threshold="EVEN", side="<", unit="dB", origin="project", one_sided=KIND_DIRECTION,
         text="{tree}, {cond} v0, beyond the window: every {kind_words} learned field "
         "({kind_fields}) below static",
@@ -453,7 +449,7 @@ _KINDS = (
 # ---- the paper's: recovery against the untrained null (tab:null, section 4) ----------------------
 def _null_trees_tiled(run: Run) -> list[Cell]:
     """each tree of tiled frequencies, in the ledger's recovery configuration (joint K = 32)"""
-    return [{**c, "config": CONFIG, "method": run.model} for c in _with_role(run, TILED)]
+    return _trees(run, TILED, config=CONFIG, method=run.model)
 
 
 def _gap_trees(run: Run) -> list[Cell]:
@@ -532,7 +528,7 @@ _RECOVERY = (
     ),
     ClaimSpec(
         family="decay_rate_flat", over=_recovered_trees, table=RECOVERY,
-        read=lambda d, c: _recovery(d, c, "loglog_exponent"),
+        read=lambda d, c: _of(d, c, "loglog_exponent"),
         threshold="RATE_EXPONENT", side=WITHIN, unit="exponent",
         text="{tree}: the fitted decay rate gamma = zeta*omega is nearly frequency-independent "
         "(gamma ~ omega^p, |p| < {RATE_EXPONENT})",
@@ -541,9 +537,7 @@ _RECOVERY = (
     # the premise of every comparison (a model the paper did not train: the project's row)
     ClaimSpec(
         family="fits_window", over=_fit_models, table="tab_fit",
-        read=lambda d, c: value(
-            d, (d["tree"] == c["tree"]) & (d["model"] == c["fit_model"]), "ceiling_frac"
-        ),
+        read=lambda d, c: _of(d, c, "ceiling_frac", c["fit_model"]),
         threshold="FIT_BAR", side=">", unit="fraction",
         text="{tree}: {fit_label} fits its training window (reaches {FIT_BAR:.0%} of the "
         "true-motion ceiling's in-window gain over static)",
@@ -565,72 +559,59 @@ def _splits(run: Run) -> list[Cell]:
     ]
 
 
-def _winds(run: Run) -> list[Cell]:
-    """each split (training timestamps, beyond the window) x tree x unseen wind of tab_transfer"""
-    tr = run.own
-    if tr is None:
-        return []
-    return [
-        {"suffix": f"{t}/wind_{sp}/{c:.2f}", "tree": t, "condition": c, "cond": f"{c:.2f}",
-         "split": sp, "where": "beyond the window" if sp == "beyond" else "at training timestamps"}
-        for (sp, t, c), _ in tr.groupby(["split", "tree", "condition"], sort=False)
-    ]  # fmt: skip
-
-
 def _recovery_trees(run: Run) -> list[Cell]:
     """each tree, in the ledger's recovery configuration (joint K = 32)"""
-    return [{**c, "config": CONFIG, "method": run.model} for c in _trees(run)]
+    return _trees(run, config=CONFIG, method=run.model)
 
 
 _PRIORS = (
     ClaimSpec(
-        family="above_static_beyond", of="priors", over=_trees, table="tab_psnr", **_AHEAD_DB,
-        side=">", read=lambda d, c: _over_static(d, c, [c["model"]]), origin="project",
+        family="above_static_beyond", **_PRIOR, over=_trees, table="tab_psnr", **_AHEAD_DB,
+        side=">", read=lambda d, c: _over_static(d, c, [c["model"]]),
         text="{tree}: the {name} is above the static pose beyond the window",
         source="tab_psnr, time column: prior - static",
         headline="the {name} above the static pose beyond the window",
     ),
     ClaimSpec(
-        family=AHEAD, of="priors", over=_splits, table="tab_psnr", read=_ahead_of_fields,
-        **_AHEAD_DB, side=">", origin="project",
+        family=AHEAD, **_PRIOR, over=_splits, table="tab_psnr", read=_ahead_of_fields,
+        **_AHEAD_DB, side=">",
         text="{tree}: the {name} is ahead of the best learned field on {where}",
         source="tab_psnr, {split} column: prior - max over learned fields",
     ),
     ClaimSpec(
-        family=AHEAD, of="priors", over=_winds, table="tab_transfer", read=_wind_ahead,
-        **_AHEAD_DB, side=">", origin="project",
+        family=AHEAD, **_PRIOR, over=_winds, table="tab_transfer", read=_ahead_of_fields,
+        **_AHEAD_DB, side=">",
         text="{tree}, {cond} v0, {where}: the {name} is ahead of the best learned field",
         source="tab_transfer ({split}): prior - max learned",
     ),
     ClaimSpec(
-        family="margin_grows", of="priors", over=_margin_trees, table="tab_margin",
-        read=_margin_growth, threshold="EVEN", side=">", unit="dB", origin="project",
+        family="margin_grows", **_PRIOR, over=_margin_trees, table="tab_margin",
+        read=_margin_growth, threshold="EVEN", side=">", unit="dB", one_sided=GROWS,
         text="{tree}: the {name}'s margin against MLP + wind grows as the wind departs",
-        source="tab_margin ({model}): {last} - {first}", one_sided=GROWS,
+        source="tab_margin ({model}): {last} - {first}",
     ),
     ClaimSpec(
-        family="beats_null", of="priors", over=_recovery_trees, table="tab_recovery",
+        family="beats_null", **_PRIOR, over=_recovery_trees, table="tab_recovery",
         read=_trained_minus_null, threshold="-NULL_MATCH_PP", side="<", unit="points",
         text="{tree}: the {name} beats the untrained null on frequency recovery (by "
         "{NULL_MATCH_PP} points or more)",
-        source="{table}, {config}: trained - null median rel. error (points)", origin="project",
+        source="{table}, {config}: trained - null median rel. error (points)",
         one_sided="superiority by a margin: ahead of the null by the margin or more",
     ),
     ClaimSpec(
-        family="damping_recovered", of="priors", over=_recovered_trees, table=RECOVERY,
+        family="damping_recovered", **_PRIOR, over=_recovered_trees, table=RECOVERY,
         read=_damping_off, threshold="DAMPING_OFF", side="<", unit="fraction",
         text="{tree}: the {name} recovers damping (median zeta_hat within {DAMPING_OFF:.0%} of "
         "the truth)",
-        source="recovery ({config}): |median zeta_hat - zeta| / zeta",
-        origin="project", one_sided=ABSOLUTE,
+        source="recovery ({config}): |median zeta_hat - zeta| / zeta", one_sided=ABSOLUTE,
     ),
     ClaimSpec(
-        family="decay_rate_flat", of="priors", over=_recovered_trees, table=RECOVERY,
-        read=lambda d, c: _recovery(d, c, "loglog_exponent"),
+        family="decay_rate_flat", **_PRIOR, over=_recovered_trees, table=RECOVERY,
+        read=lambda d, c: _of(d, c, "loglog_exponent"),
         threshold="RATE_EXPONENT", side=WITHIN, unit="exponent",
         text="{tree}: the {name}'s fitted decay rate gamma = zeta*omega is nearly "
         "frequency-independent (gamma ~ omega^p, |p| < {RATE_EXPONENT})",
-        source="recovery ({config}): exponent p", origin="project",
+        source="recovery ({config}): exponent p",
     ),
 )  # fmt: skip
 
@@ -652,20 +633,14 @@ def _blind_trees(run: Run) -> list[Cell]:
     for blind in (m for m in BLIND_PRIORS if m in have):
         wind = spec_of(blind).blind_of
         who, prefix = ("ours", "") if wind == PAPER_MODEL else (f"the {label(wind)}", f"{wind}/")
-        out += [
-            {**c, "prefix": prefix, "blind": blind, "wind": wind, "who": who,
-             "config": BLIND_CONFIG}
-            for c in _trees(run)
-            if (null["tree"] == c["tree"]).any()
-        ]  # fmt: skip
+        cells = _trees(run, prefix=prefix, blind=blind, wind=wind, who=who, config=BLIND_CONFIG)
+        out += [c for c in cells if (null["tree"] == c["tree"]).any()]
     return out
 
 
 def _oma_separated(run: Run) -> list[Cell]:
     """each tree of separated frequencies, when tab_recovery holds the output-only analysis"""
-    if not _has(run.own, OMA):
-        return []
-    return [{**c, "config": BLIND_CONFIG, "method": OMA} for c in _with_role(run, SEPARATED)]
+    return _trees(run, SEPARATED, config=BLIND_CONFIG, method=OMA) if _has(run.own, OMA) else []
 
 
 def _oma_damping_trees(run: Run) -> list[Cell]:
@@ -673,20 +648,18 @@ def _oma_damping_trees(run: Run) -> list[Cell]:
     dmp = run.own
     if not _has(dmp, OMA):
         return []
-    return [{**c, "config": BLIND_CONFIG} for c in _trees(run) if (dmp["tree"] == c["tree"]).any()]
+    return [c for c in _trees(run, config=BLIND_CONFIG) if (dmp["tree"] == c["tree"]).any()]
 
 
 def _oma_interval_trees(run: Run) -> list[Cell]:
     """each tree of tab_damping, when it holds the output-only analysis' interval coverage"""
     dmp = run.own
-    if dmp is None or "omega_interval_cover" not in dmp.columns:
-        return []
-    return _oma_damping_trees(run)
+    ok = dmp is not None and "omega_interval_cover" in dmp.columns
+    return _oma_damping_trees(run) if ok else []
 
 
 def _oma(d: pd.DataFrame, c: Cell, col: str) -> float:
-    """tab_damping (damping testbed): the output-only analysis' ``col`` in the cell's tree and
-    configuration."""
+    """tab_damping, damping testbed: the output-only analysis' ``col`` in the cell's tree, config."""
     return value(d, _at(d, c) & (d["testbed"] == DAMPING) & (d["method"] == OMA), col)
 
 
@@ -795,21 +768,16 @@ def _parts_damping_trees(run: Run) -> list[Cell]:
     df, models, c0 = _parts(run)
     if "ours_topo" not in models:
         return []
-    return [
-        {**c, "config": c0}
-        for c in _trees(run)
-        if np.isfinite(df.loc[df["tree"] == c["tree"], "zeta_rel_err_pct"]).any()
-    ]
+    zeta = df.loc[np.isfinite(df["zeta_rel_err_pct"]), "tree"]
+    return [c for c in _trees(run, config=c0) if (zeta == c["tree"]).any()]
 
 
 def _parts_coupling(run: Run) -> list[Cell]:
     """each tree of separated frequencies in tab_parts (its first configuration), when it holds
     both topology priors (no id suffix for a single such tree: the family's id as before)"""
     _, models, c0 = _parts(run)
-    if not {"ours_topo", "ours_chain"} <= models:
-        return []
-    cells = _with_role(run, SEPARATED)
-    return [{**c, "suffix": "" if len(cells) == 1 else c["tree"], "config": c0} for c in cells]
+    cells = _trees(run, SEPARATED, config=c0) if {"ours_topo", "ours_chain"} <= models else []
+    return [{**c, "suffix": "" if len(cells) == 1 else c["tree"]} for c in cells]
 
 
 def _parts_gain(d: pd.DataFrame, c: Cell, better: str, base: str, col: str) -> float:
@@ -852,9 +820,7 @@ def _tracks_separated(run: Run) -> list[Cell]:
     (else its first configuration)"""
     null = run.own
     c = _config_of(null.loc[null["method"] == "tracks", "config"], CONFIG) if _has(null) else None
-    if c is None:
-        return []
-    return [{**x, "config": c, "method": "tracks"} for x in _with_role(run, SEPARATED)]
+    return [] if c is None else _trees(run, SEPARATED, config=c, method="tracks")
 
 
 def _tracks_minus_ours(d: pd.DataFrame, c: Cell) -> float:
@@ -868,9 +834,9 @@ def _tracks_trees(run: Run) -> list[Cell]:
     """each tree in tab_tracks, its base configuration (else its first)"""
     tr = run.own
     c = None if tr is None else _config_of(tr["config"], "single")
-    if c is None:
-        return []
-    return [{**x, "config": c} for x in _trees(run) if (tr["tree"] == x["tree"]).any()]
+    return (
+        [] if c is None else [x for x in _trees(run, config=c) if (tr["tree"] == x["tree"]).any()]
+    )
 
 
 _TRACKS = (
@@ -942,17 +908,6 @@ def required_tables() -> tuple[str, ...]:
         Table names.
     """
     return tables(optional=False)
-
-
-def prior_tables() -> tuple[str, ...]:
-    """The tables whose rows or columns say that a run holds a prior other than ours.
-
-    Returns:
-        The tables of the ``of="priors"`` families.
-    """
-    return tuple(
-        dict.fromkeys(s.table for s in CATALOGUE if s.of == "priors" and s.table != RECOVERY)
-    )
 
 
 def reads_recovery() -> bool:
@@ -1042,15 +997,10 @@ def undermines(claim_id: str) -> str:
 
 def _template(text: str, table: str = "") -> str:
     """A sentence template as the claims page shows it: thresholds filled in, fields ``<f>``."""
-    out = []
-    for lit, f, spec, _ in string.Formatter().parse(text):
-        if f is None:
-            out.append(lit)
-        elif f in WORDS:
-            out.append(lit + format(WORDS[f], spec or ""))
-        else:
-            out.append(lit + {"name": "<prior>", "table": table}.get(f, f"<{f}>"))
-    return "".join(out)
+    other = {"name": "<prior>", "table": table}
+    fill = lambda f, spec: format(WORDS[f], spec) if f in WORDS else other.get(f, f"<{f}>")
+    parts = string.Formatter().parse(text)
+    return "".join(lit + ("" if f is None else fill(f, spec)) for lit, f, spec, _ in parts)
 
 
 BEGIN, END = "<!-- catalogue:begin -->", "<!-- catalogue:end -->"

@@ -17,14 +17,14 @@ Which claims there are, what each reads and its threshold: the catalogue
 from __future__ import annotations
 
 from dataclasses import dataclass
+from functools import partial
 from typing import Mapping, Sequence
 
 import numpy as np
 import pandas as pd
 
 from physgs.models.registry import PAPER_MODEL, label, models_of
-from physgs.report.catalogue import CATALOGUE, KINDS, WITHIN, kind_of, origin_of, prior_tables
-from physgs.report.catalogue import undermines
+from physgs.report.catalogue import CATALOGUE, KINDS, WITHIN, kind_of, origin_of, undermines
 from physgs.report.claim_cells import RECOVERY, Run
 from physgs.report.prose import say
 from physgs.report.seeds import MAX_SEEDS, finite, interval, log_interval, seeds_to_decide
@@ -91,7 +91,7 @@ def verdict(claim: Claim, values: Sequence[float]) -> str:
         The verdict, as [`decide`][physgs.report.claims.decide]'s.
     """
     m, _, lo, hi = estimate(claim, values)
-    return decide(claim, m, lo, hi, int(np.isfinite(np.asarray(values, dtype=np.float64)).sum()))
+    return decide(claim, m, lo, hi, len(finite(values)))
 
 
 def on_claim(claim: Claim, x: float) -> bool:
@@ -125,11 +125,7 @@ def decide(claim: Claim, m: float, lo: float, hi: float, n: int) -> str:
         The verdict; ``'undecided: not measured'`` without a finite estimate, and the one-seed
             verdict says on which side the point estimate lies.
     """
-    t = claim.threshold
-
-    def on(x: float) -> bool:
-        return on_claim(claim, x)
-
+    on = partial(on_claim, claim)
     if not np.isfinite(m):
         return "undecided: not measured"
     if not claim.needs_variance:
@@ -139,7 +135,7 @@ def decide(claim: Claim, m: float, lo: float, hi: float, n: int) -> str:
     if on(lo) and on(hi):
         return "holds"
     if claim.side == WITHIN:  # outside the band: wholly beyond one edge
-        return "fails" if hi <= -t or lo >= t else "undecided"
+        return "fails" if hi <= -claim.threshold or lo >= claim.threshold else "undecided"
     return "fails" if not on(lo) and not on(hi) else "undecided"
 
 
@@ -148,14 +144,13 @@ def _per_seed(df: pd.DataFrame) -> list[pd.DataFrame]:
 
 
 def _holds(tables: Mapping[str, pd.DataFrame], model: str) -> bool:
-    """Whether a table of the other priors (``catalogue.prior_tables``) has a row or column of
-    ``model``."""
-    for df in (tables[k] for k in prior_tables() if k in tables):
-        if model in df.columns or any(
-            c in df.columns and (df[c].astype(str) == model).any() for c in ("model", "method")
-        ):
-            return True
-    return False
+    """Whether a table of a family asked of the priors has a row or column of ``model``."""
+    names = {s.table for s in CATALOGUE if s.of == "priors" and s.table in tables} - {RECOVERY}
+    return any(
+        model in df.columns
+        or any(c in df.columns and (df[c].astype(str) == model).any() for c in ("model", "method"))
+        for df in map(tables.get, names)
+    )
 
 
 def measure(
@@ -283,11 +278,9 @@ def paper_in_interval(claim: Claim, low: float, high: float) -> str:
 def _gated(claim: Claim, own: str, verdicts: Mapping[str, str]) -> str:
     """``own``, unless it holds and its companion (``Claim.requires``) does not: then "fails:
     ..." or "undecided: ...", naming the companion's verdict."""
-    if not claim.requires or own != "holds":
-        return own
     comp = verdicts.get(claim.requires, "undecided: not measured")
     kind = comp.split(":")[0]
-    if kind == "holds":
+    if not claim.requires or own != "holds" or kind == "holds":
         return own
     return f"{'fails' if kind == 'fails' else 'undecided'}: covers, but {claim.requires} {comp}"
 
@@ -432,8 +425,7 @@ def ledger_markdown(df: pd.DataFrame, stamp: Mapping[str, str] | None = None) ->
     for (_, r), k in zip(df.iterrows(), column(df, "kind")):
         meas = "--" if not np.isfinite(r.measured) else f"{number(r.measured, r.unit)} {r.unit}"
         if np.isfinite(r.ci_low):
-            lo, hi = number(r.ci_low, r.unit), number(r.ci_high, r.unit)
-            meas += f" [{lo}, {hi}], {r.seeds} seeds"
+            meas += f" [{number(r.ci_low, r.unit)}, {number(r.ci_high, r.unit)}], {r.seeds} seeds"
         elif np.isfinite(r.measured):
             meas += f", {r.seeds} seed"
         size = r.get("paper_in_interval", "")
@@ -458,8 +450,5 @@ def decide_cell(row) -> str:
     """
     if str(row["verdict"]) != "undecided" or "seeds_to_decide_t_est" not in row.index:
         return ""
-
-    def n(x) -> str:
-        return f"{int(x)}" if np.isfinite(x) else f"> {MAX_SEEDS}"
-
+    n = lambda x: f"{int(x)}" if np.isfinite(x) else f"> {MAX_SEEDS}"
     return f"t {n(row['seeds_to_decide_t_est'])} / power {n(row['seeds_to_decide_power80_est'])}"

@@ -16,9 +16,8 @@ from physgs.report import seeds as seedstats
 from physgs.report.output import Columns, Output
 from physgs.report.table_captions import caption
 from physgs.report.tables import Table
-from physgs.testbed.variant import DAMPING, FAITHFUL, damping_id
+from physgs.testbed.variant import DAMPING, FAITHFUL, VARIANTS, damping_id
 
-VARIANTS = (FAITHFUL, DAMPING)
 #: tab_damping's CSV values (before ``INTERVAL_COLUMNS``) -> each from a record's damping
 #: scores and their null
 VALUES = {

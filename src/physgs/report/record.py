@@ -66,11 +66,6 @@ def _join(xs: Iterable) -> str:
     return ", ".join(map(str, xs))
 
 
-def _shell(words: Iterable[str]) -> str:
-    """Command-line words, each quoted as a shell needs."""
-    return " ".join(shlex.quote(w) for w in words)
-
-
 @dataclass(frozen=True)
 class Stamp:
     """Where a record comes from.
@@ -129,7 +124,7 @@ class Stamp:
                 f"{', '.join(trees)}: testbed seed{'s' if len(s) > 1 else ''} {_join(s)}"
                 for s, trees in by.items()
             ),
-            "overrides": _shell(self.overrides),
+            "overrides": shlex.join(self.overrides),
             "note": self.note,
             "seeds": _join(self.seeds),
             "trees": ", ".join(self.trees),
@@ -854,7 +849,7 @@ def found_lines(record_dir: str | Path) -> list[str]:
     found = [PROSE["found_none"]]
     if (record / "claims.csv").is_file():
         s = json.loads((record / "stamp.json").read_text())
-        made_with = _shell(s.get("overrides") or [])
+        made_with = shlex.join(s.get("overrides") or [])
         phrase = instances_phrase(s.get("instances") or {})
         fields = {"profile": s["profile"], "seeds": _join(s["seeds"]), "commit": s["commit"]}
         run = say("found_run", **fields, made_with=made_with, instances=phrase)
