@@ -100,7 +100,7 @@ def pytest_collection_modifyitems(items):
     once."""
     dag = [it for it in items if "quick_dag" in it.fixturenames]
     rest = [it for it in items if "quick_dag" not in it.fixturenames]
-    spawns = {it.path: "subprocess" in it.path.read_text() for it in rest}
+    spawns = {p: "subprocess" in p.read_text() for p in {it.path for it in rest}}  # each file once
     items[:] = (
         dag[:1] + [it for it in rest if spawns[it.path]] + dag[1:]
         + [it for it in rest if not spawns[it.path]]

@@ -240,9 +240,10 @@ def wake_on_sigint(scheduler_cls: type) -> None:
     signal handlers only in the main thread, and a wait there is cut short only when the kernel
     delivers the signal to that thread; delivered to a job's thread (which the kernel may pick),
     the handler waited for the running job: a ``kill -INT`` of a run left its training to its end
-    (the suite's interrupt test hung so beside other tests, its stack dump in that wait). A thread that
-    reads the signal's wakeup byte releases ``_open_jobs`` once, and the woken main thread runs
-    the handler (``KeyboardInterrupt``, the loop's ``cancel``); an extra release costs one pass.
+    (the suite's interrupt test, run beside other tests, hung there: its stack dump shows that
+    wait). A thread that reads the signal's wakeup byte releases ``_open_jobs`` once, and the
+    woken main thread runs the handler (``KeyboardInterrupt``, the loop's ``cancel``); an extra
+    release costs one pass.
 
     Args:
         scheduler_cls: Snakemake's ``JobScheduler`` (a class whose ``schedule`` waits on

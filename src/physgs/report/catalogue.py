@@ -659,7 +659,8 @@ def _oma_interval_trees(run: Run) -> list[Cell]:
 
 
 def _oma(d: pd.DataFrame, c: Cell, col: str) -> float:
-    """tab_damping, damping testbed: the output-only analysis' ``col`` in the cell's tree, config."""
+    """tab_damping (damping testbed): the output-only analysis' ``col`` in the cell's tree and
+    configuration."""
     return value(d, _at(d, c) & (d["testbed"] == DAMPING) & (d["method"] == OMA), col)
 
 
@@ -834,9 +835,9 @@ def _tracks_trees(run: Run) -> list[Cell]:
     """each tree in tab_tracks, its base configuration (else its first)"""
     tr = run.own
     c = None if tr is None else _config_of(tr["config"], "single")
-    return (
-        [] if c is None else [x for x in _trees(run, config=c) if (tr["tree"] == x["tree"]).any()]
-    )
+    if c is None:
+        return []
+    return [x for x in _trees(run, config=c) if (tr["tree"] == x["tree"]).any()]
 
 
 _TRACKS = (
